@@ -1,0 +1,159 @@
+//! The B × B block grid of the histogram pass: which pixels form which block, and
+//! where each block's entries start in the sorted list.
+
+use crate::types::BLOCK_SIZES;
+use thiserror::Error;
+
+/// An image cut into B × B blocks; edge blocks are partial when B does not divide the size.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BlockGrid {
+    /// Image width in pixels (> 0).
+    pub width: u32,
+    /// Image height in pixels (> 0).
+    pub height: u32,
+    /// B, one of [`BLOCK_SIZES`].
+    pub block_size: u32,
+}
+
+/// An image size or block size the histogram pass cannot take.
+#[derive(Clone, Debug, Error, PartialEq, Eq)]
+pub enum GridError {
+    /// Width or height is zero.
+    #[error("image size {width}x{height}: width and height must be at least 1")]
+    EmptyImage {
+        /// Requested width.
+        width: u32,
+        /// Requested height.
+        height: u32,
+    },
+    /// The block size is not one of 4, 8, 16, 32.
+    #[error("block size {0}: must be a power of two from 4 to 32 (4, 8, 16 or 32)")]
+    BlockSize(u32),
+    /// More pixels than a u32 index can address.
+    #[error("image size {width}x{height}: more than 2^32 - 1 pixels")]
+    TooLarge {
+        /// Requested width.
+        width: u32,
+        /// Requested height.
+        height: u32,
+    },
+}
+
+/// One block's pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BlockRect {
+    /// Left pixel column.
+    pub x: u32,
+    /// Top pixel row.
+    pub y: u32,
+    /// Width (B, or less at the right edge).
+    pub width: u32,
+    /// Height (B, or less at the bottom edge).
+    pub height: u32,
+    /// Index of the block's first entry in the sorted list.
+    pub base: u32,
+}
+
+impl BlockRect {
+    /// Pixels in the block.
+    pub fn len(&self) -> u32 {
+        self.width * self.height
+    }
+
+    /// Whether the block has no pixels (never, for a valid grid).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Row-major image index of the block's `local`-th pixel (row-major inside the block).
+    pub fn pixel(&self, image_width: u32, local: u32) -> u32 {
+        (self.y + local / self.width) * image_width + self.x + local % self.width
+    }
+}
+
+impl BlockGrid {
+    /// Checks the sizes.
+    pub fn new(width: u32, height: u32, block_size: u32) -> Result<Self, GridError> {
+        if width == 0 || height == 0 {
+            return Err(GridError::EmptyImage { width, height });
+        }
+        if !BLOCK_SIZES.contains(&block_size) {
+            return Err(GridError::BlockSize(block_size));
+        }
+        if u64::from(width) * u64::from(height) > u64::from(u32::MAX) {
+            return Err(GridError::TooLarge { width, height });
+        }
+        Ok(Self { width, height, block_size })
+    }
+
+    /// Pixels in the image.
+    pub fn pixel_count(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+
+    /// Blocks per row.
+    pub fn blocks_x(&self) -> u32 {
+        self.width.div_ceil(self.block_size)
+    }
+
+    /// Blocks per column.
+    pub fn blocks_y(&self) -> u32 {
+        self.height.div_ceil(self.block_size)
+    }
+
+    /// Blocks in the image.
+    pub fn block_count(&self) -> u32 {
+        self.blocks_x() * self.blocks_y()
+    }
+
+    /// The block with row-major index `block`.
+    pub fn block(&self, block: u32) -> BlockRect {
+        let b = self.block_size;
+        let x = block % self.blocks_x() * b;
+        let y = block / self.blocks_x() * b;
+        let width = b.min(self.width - x);
+        let height = b.min(self.height - y);
+        BlockRect { x, y, width, height, base: y * self.width + x * height }
+    }
+
+    /// The block containing pixel (x, y).
+    pub fn block_of(&self, x: u32, y: u32) -> u32 {
+        y / self.block_size * self.blocks_x() + x / self.block_size
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn blocks_tile_the_sorted_list_without_gaps() {
+        for (w, h, b) in [(1, 1, 4), (17, 33, 8), (33, 17, 16), (64, 64, 32), (5, 70, 4)] {
+            let grid = BlockGrid::new(w, h, b).unwrap();
+            let mut covered = vec![false; grid.pixel_count()];
+            let mut entries = vec![false; grid.pixel_count()];
+            for block in 0..grid.block_count() {
+                let rect = grid.block(block);
+                for local in 0..rect.len() {
+                    let pixel = rect.pixel(w, local) as usize;
+                    assert!(!covered[pixel]);
+                    covered[pixel] = true;
+                    assert_eq!(grid.block_of(pixel as u32 % w, pixel as u32 / w), block);
+                    let entry = (rect.base + local) as usize;
+                    assert!(!entries[entry]);
+                    entries[entry] = true;
+                }
+            }
+            assert!(covered.iter().all(|&c| c) && entries.iter().all(|&e| e));
+        }
+    }
+
+    #[test]
+    fn bad_sizes_are_named() {
+        assert_eq!(BlockGrid::new(0, 5, 16), Err(GridError::EmptyImage { width: 0, height: 5 }));
+        assert_eq!(BlockGrid::new(5, 5, 12), Err(GridError::BlockSize(12)));
+        assert_eq!(BlockGrid::new(5, 5, 64), Err(GridError::BlockSize(64)));
+        assert!(BlockGrid::new(1 << 20, 1 << 20, 16).is_err());
+        assert!(BlockGrid::new(5, 5, 12).unwrap_err().to_string().contains("block size 12"));
+    }
+}

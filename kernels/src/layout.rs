@@ -1,0 +1,154 @@
+//! Checks that a `#[repr(C)]` host struct and its WGSL twin agree byte for byte.
+//!
+//! vec3 padding, a field added on one side only, a reordered field: each makes the GPU
+//! read garbage without any error. [`check_struct`] compares the host struct's size and
+//! every field's name, offset and size with naga's layout of the WGSL struct.
+
+use crate::types::{BlockStats, Candidate, ClusterSpan, HistogramParams};
+use naga::proc::Layouter;
+
+/// One field of a host struct.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HostField {
+    /// Field name (the WGSL member must have the same name).
+    pub name: &'static str,
+    /// Byte offset.
+    pub offset: usize,
+    /// Byte size.
+    pub size: usize,
+}
+
+/// A host struct with a WGSL twin of the same name.
+pub trait ShaderStruct: bytemuck::Pod {
+    /// Name of the WGSL struct.
+    const WGSL_NAME: &'static str;
+    /// The struct's fields in declaration order.
+    fn fields() -> Vec<HostField>;
+}
+
+/// Implements [`ShaderStruct`] for `$ty` with the listed fields.
+macro_rules! shader_struct {
+    ($ty:ty, $wgsl:literal, [$($field:ident),* $(,)?]) => {
+        impl ShaderStruct for $ty {
+            const WGSL_NAME: &'static str = $wgsl;
+            fn fields() -> Vec<HostField> {
+                fn size_of_field<T, F>(_: impl Fn(&T) -> &F) -> usize {
+                    core::mem::size_of::<F>()
+                }
+                vec![$(HostField {
+                    name: stringify!($field),
+                    offset: core::mem::offset_of!($ty, $field),
+                    size: size_of_field(|s: &$ty| &s.$field),
+                }),*]
+            }
+        }
+    };
+}
+
+shader_struct!(Candidate, "Candidate", [key, object_id]);
+shader_struct!(ClusterSpan, "ClusterSpan", [offset, length, valid]);
+shader_struct!(BlockStats, "BlockStats", [clusters, invalid, empty]);
+shader_struct!(
+    HistogramParams,
+    "HistogramParams",
+    [width, height, block_size, log2_block_size, blocks_x, blocks_y, workgroups_x, _pad]
+);
+
+/// Compares `T` with the struct `T::WGSL_NAME` of `module`; the error lists every
+/// difference.
+pub fn check_struct<T: ShaderStruct>(module: &naga::Module) -> Result<(), String> {
+    let (_, ty) = module
+        .types
+        .iter()
+        .find(|(_, ty)| ty.name.as_deref() == Some(T::WGSL_NAME))
+        .ok_or_else(|| format!("no WGSL struct `{}` in the module", T::WGSL_NAME))?;
+    let naga::TypeInner::Struct { members, span } = &ty.inner else {
+        return Err(format!("WGSL `{}` is not a struct", T::WGSL_NAME));
+    };
+    let mut layouter = Layouter::default();
+    layouter
+        .update(module.to_ctx())
+        .map_err(|e| format!("naga layouter: {e}"))?;
+    let mut problems = Vec::new();
+    let host_size = core::mem::size_of::<T>();
+    if *span as usize != host_size {
+        problems.push(format!("size: WGSL {span} bytes, host {host_size} bytes"));
+    }
+    let host = T::fields();
+    if host.len() != members.len() {
+        problems.push(format!(
+            "field count: WGSL {}, host {}",
+            members.len(),
+            host.len()
+        ));
+    }
+    for (index, (wgsl, host)) in members.iter().zip(&host).enumerate() {
+        let wgsl_name = wgsl.name.as_deref().unwrap_or("<unnamed>");
+        let wgsl_size = layouter[wgsl.ty].size as usize;
+        if wgsl_name != host.name {
+            problems.push(format!(
+                "field {index}: WGSL `{wgsl_name}`, host `{}`",
+                host.name
+            ));
+        }
+        if wgsl.offset as usize != host.offset {
+            problems.push(format!(
+                "field `{}`: WGSL offset {}, host offset {}",
+                host.name, wgsl.offset, host.offset
+            ));
+        }
+        if wgsl_size != host.size {
+            problems.push(format!(
+                "field `{}`: WGSL size {wgsl_size}, host size {}",
+                host.name, host.size
+            ));
+        }
+    }
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "host struct and WGSL `{}` differ:\n  {}",
+            T::WGSL_NAME,
+            problems.join("\n  ")
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A host struct holding a 16-byte vector (like glam's `Vec3A`) before an id.
+    #[repr(C)]
+    #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+    struct Padded {
+        position: [f32; 4],
+        id: u32,
+        pad: [u32; 3],
+    }
+    shader_struct!(Padded, "Padded", [position, id, pad]);
+
+    fn module(source: &str) -> naga::Module {
+        naga::front::wgsl::parse_str(source).unwrap()
+    }
+
+    #[test]
+    fn vec3_padding_is_caught() {
+        // WGSL puts a u32 right after a vec3<f32>, at offset 12: the host has it at 16.
+        let bad = module("struct Padded { position: vec3<f32>, id: u32, pad: vec3<u32> }");
+        let error = check_struct::<Padded>(&bad).unwrap_err();
+        assert!(error.contains("field `id`: WGSL offset 12, host offset 16"), "{error}");
+        assert!(error.contains("field `position`: WGSL size 12, host size 16"), "{error}");
+        let good = module("struct Padded { position: vec4<f32>, id: u32, pad: array<u32, 3> }");
+        check_struct::<Padded>(&good).unwrap();
+    }
+
+    #[test]
+    fn renamed_and_missing_fields_are_caught() {
+        let renamed = module("struct Padded { pos: vec4<f32>, id: u32, pad: array<u32, 3> }");
+        assert!(check_struct::<Padded>(&renamed).unwrap_err().contains("`pos`"));
+        let missing = module("struct Other { id: u32 }");
+        assert!(check_struct::<Padded>(&missing).unwrap_err().contains("no WGSL struct"));
+    }
+}

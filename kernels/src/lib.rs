@@ -1,0 +1,25 @@
+//! strata's compute kernels, written once in WGSL.
+//!
+//! * [`registry`]: every kernel the project ships, parsed and validated by naga, with
+//!   its entry point, workgroup size and bindings read from naga's IR.
+//! * [`types`]: the `#[repr(C)]` host twins of the structs the kernels share with the
+//!   host, checked against naga's layout by [`layout`].
+//! * [`translate`]: naga's SPIR-V, HLSL, MSL and GLSL back ends with the options every
+//!   backend of the project uses.
+//! * [`reference`]: plain-Rust statements of what each kernel computes, the oracle of
+//!   the tests.
+
+pub mod binding;
+pub mod block_grid;
+pub mod error;
+pub mod layout;
+pub mod reference;
+pub mod registry;
+pub mod source;
+pub mod translate;
+pub mod types;
+
+pub use binding::{BindingAccess, BindingInfo, BindingKind, ElementLayout};
+pub use block_grid::{BlockGrid, BlockRect, GridError};
+pub use error::KernelError;
+pub use registry::{Kernel, KernelId, Registry};

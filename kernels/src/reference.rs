@@ -1,0 +1,3 @@
+//! Plain-Rust statements of what the kernels compute: the oracles of the tests.
+
+pub mod block_histogram;

@@ -1,0 +1,335 @@
+//! The kernel registry: every kernel strata ships, with what the backends need to run
+//! it, derived from naga's IR of the WGSL source.
+
+use crate::binding::{BindingAccess, BindingInfo, BindingKind, element_layout};
+use crate::error::KernelError;
+use crate::fragment;
+use crate::source::{ComposedSource, Fragment};
+use naga::valid::{Capabilities, ModuleInfo, ShaderStages, SubgroupOperationSet, ValidationFlags};
+
+/// Names a registry kernel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum KernelId {
+    /// Per-block histogram: candidates clustered by object id and sorted by key
+    /// (paper §4.1, §4.3), without subgroup operations.
+    BlockHistogram,
+    /// The same pass exchanging elements between subgroup lanes (needs subgroups).
+    BlockHistogramSubgroup,
+}
+
+impl KernelId {
+    /// Every registry kernel.
+    pub const ALL: [KernelId; 2] = [KernelId::BlockHistogram, KernelId::BlockHistogramSubgroup];
+
+    /// What the registry knows of this kernel before parsing it.
+    pub fn spec(self) -> KernelSpec {
+        const HISTOGRAM: [Fragment; 2] = [
+            fragment!("common/candidate.wgsl"),
+            fragment!("histogram/block_sort.wgsl"),
+        ];
+        match self {
+            KernelId::BlockHistogram => KernelSpec {
+                name: "block_histogram",
+                fragments: vec![HISTOGRAM[0], HISTOGRAM[1], fragment!("histogram/entry_portable.wgsl")],
+                entry_point: "block_histogram",
+                features: KernelFeatures::empty(),
+                float_ulp_bound: None,
+            },
+            KernelId::BlockHistogramSubgroup => KernelSpec {
+                name: "block_histogram_subgroup",
+                fragments: vec![HISTOGRAM[0], HISTOGRAM[1], fragment!("histogram/entry_subgroup.wgsl")],
+                entry_point: "block_histogram_subgroup",
+                features: KernelFeatures::SUBGROUP,
+                float_ulp_bound: None,
+            },
+        }
+    }
+}
+
+/// Optional device features a kernel needs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct KernelFeatures {
+    /// Subgroup operations in compute shaders.
+    pub subgroup: bool,
+}
+
+impl KernelFeatures {
+    /// Nothing beyond core WebGPU.
+    pub const fn empty() -> Self {
+        Self { subgroup: false }
+    }
+    /// Subgroup operations.
+    pub const SUBGROUP: Self = Self { subgroup: true };
+
+    fn capabilities(self) -> Capabilities {
+        if self.subgroup {
+            Capabilities::SUBGROUP | Capabilities::SUBGROUP_BARRIER
+        } else {
+            Capabilities::empty()
+        }
+    }
+}
+
+/// A kernel as declared in the registry.
+#[derive(Clone, Debug)]
+pub struct KernelSpec {
+    /// Registry name (also the name of translated files).
+    pub name: &'static str,
+    /// WGSL fragments, concatenated in order.
+    pub fragments: Vec<Fragment>,
+    /// The compute entry point.
+    pub entry_point: &'static str,
+    /// Device features the kernel needs.
+    pub features: KernelFeatures,
+    /// Largest difference in ULPs allowed between backends for float outputs; `None`
+    /// when every output is an integer or an ordering, compared bit for bit.
+    pub float_ulp_bound: Option<u32>,
+}
+
+/// A parsed, validated registry kernel.
+#[derive(Debug)]
+pub struct Kernel {
+    /// Which kernel.
+    pub id: KernelId,
+    /// Its declaration.
+    pub spec: KernelSpec,
+    /// The composed WGSL.
+    pub source: ComposedSource,
+    /// naga's IR.
+    pub module: naga::Module,
+    /// naga's validation results.
+    pub info: ModuleInfo,
+    /// `@workgroup_size`.
+    pub workgroup_size: [u32; 3],
+    /// Bindings the entry point uses, sorted by (group, binding).
+    pub bindings: Vec<BindingInfo>,
+}
+
+impl Kernel {
+    /// Registry name.
+    pub fn name(&self) -> &'static str {
+        self.spec.name
+    }
+
+    /// Entry point name in the WGSL source.
+    pub fn entry_point(&self) -> &'static str {
+        self.spec.entry_point
+    }
+
+    /// Invocations per workgroup.
+    pub fn invocations(&self) -> u32 {
+        self.workgroup_size.iter().product()
+    }
+
+    /// Index of the entry point in `module.entry_points`.
+    pub fn entry_index(&self) -> usize {
+        self.module
+            .entry_points
+            .iter()
+            .position(|ep| ep.name == self.spec.entry_point)
+            .expect("checked when the kernel was loaded")
+    }
+
+    /// The binding `@group(group) @binding(binding)`, if the entry point uses it.
+    pub fn binding(&self, group: u32, binding: u32) -> Option<&BindingInfo> {
+        self.bindings
+            .iter()
+            .find(|b| b.group == group && b.binding == binding)
+    }
+
+    /// The binding whose WGSL variable is `name`.
+    pub fn binding_named(&self, name: &str) -> Option<&BindingInfo> {
+        self.bindings.iter().find(|b| b.name == name)
+    }
+
+    /// Bytes of workgroup memory the entry point declares.
+    pub fn workgroup_memory_bytes(&self) -> u64 {
+        let mut layouter = naga::proc::Layouter::default();
+        if layouter.update(self.module.to_ctx()).is_err() {
+            return 0;
+        }
+        let ep_info = self.info.get_entry_point(self.entry_index());
+        self.module
+            .global_variables
+            .iter()
+            .filter(|(handle, var)| {
+                var.space == naga::AddressSpace::WorkGroup && !ep_info[*handle].is_empty()
+            })
+            .map(|(_, var)| u64::from(layouter[var.ty].size))
+            .sum()
+    }
+
+    /// Parses, validates and describes `id`.
+    pub fn load(id: KernelId) -> Result<Kernel, KernelError> {
+        let spec = id.spec();
+        let source = ComposedSource::compose(&spec.fragments);
+        let module = naga::front::wgsl::parse_str(&source.text).map_err(|error| {
+            let location = error
+                .labels()
+                .next()
+                .map(|(span, _)| source.describe_offset(span.to_range().map_or(0, |r| r.start)))
+                .unwrap_or_default();
+            KernelError::Parse {
+                kernel: spec.name.into(),
+                message: format!("at {location}\n{}", error.emit_to_string(&source.text)),
+            }
+        })?;
+        let info = naga::valid::Validator::new(ValidationFlags::all(), spec.features.capabilities())
+            .subgroup_stages(ShaderStages::COMPUTE)
+            .subgroup_operations(SubgroupOperationSet::all())
+            .validate(&module)
+            .map_err(|error| KernelError::Validation {
+                kernel: spec.name.into(),
+                message: error.emit_to_string(&source.text),
+            })?;
+        let entry_index = module
+            .entry_points
+            .iter()
+            .position(|ep| ep.name == spec.entry_point && ep.stage == naga::ShaderStage::Compute)
+            .ok_or_else(|| KernelError::MissingEntryPoint {
+                kernel: spec.name.into(),
+                entry: spec.entry_point.into(),
+            })?;
+        let workgroup_size = module.entry_points[entry_index].workgroup_size;
+        let bindings = describe_bindings(spec.name, &module, &info, entry_index)?;
+        Ok(Kernel { id, spec, source, module, info, workgroup_size, bindings })
+    }
+}
+
+fn describe_bindings(
+    kernel: &str,
+    module: &naga::Module,
+    info: &ModuleInfo,
+    entry_index: usize,
+) -> Result<Vec<BindingInfo>, KernelError> {
+    let mut layouter = naga::proc::Layouter::default();
+    layouter
+        .update(module.to_ctx())
+        .map_err(|e| KernelError::Validation { kernel: kernel.into(), message: e.to_string() })?;
+    let ep_info = info.get_entry_point(entry_index);
+    let mut bindings = Vec::new();
+    for (handle, var) in module.global_variables.iter() {
+        let Some(resource) = &var.binding else { continue };
+        if ep_info[handle].is_empty() {
+            continue;
+        }
+        let name = var.name.clone().unwrap_or_default();
+        let unsupported = |reason: &str| KernelError::UnsupportedBinding {
+            kernel: kernel.into(),
+            group: resource.group,
+            binding: resource.binding,
+            name: name.clone(),
+            reason: reason.into(),
+        };
+        let kind = match var.space {
+            naga::AddressSpace::Uniform => BindingKind::Uniform,
+            naga::AddressSpace::Storage { access } => {
+                if access.contains(naga::StorageAccess::STORE) {
+                    BindingKind::Storage(BindingAccess::ReadWrite)
+                } else {
+                    BindingKind::Storage(BindingAccess::ReadOnly)
+                }
+            }
+            _ => return Err(unsupported("only uniform and storage buffers are supported")),
+        };
+        if resource.group != 0 {
+            return Err(unsupported("registry kernels use @group(0) only (GLSL has no descriptor sets)"));
+        }
+        bindings.push(BindingInfo {
+            group: resource.group,
+            binding: resource.binding,
+            name,
+            kind,
+            element: element_layout(module, &layouter, var.ty),
+        });
+    }
+    bindings.sort_by_key(|b| (b.group, b.binding));
+    Ok(bindings)
+}
+
+/// Every registry kernel, loaded.
+#[derive(Debug)]
+pub struct Registry {
+    kernels: Vec<Kernel>,
+}
+
+impl Registry {
+    /// Loads every kernel of [`KernelId::ALL`].
+    pub fn load() -> Result<Registry, KernelError> {
+        let kernels = KernelId::ALL.iter().map(|&id| Kernel::load(id)).collect::<Result<_, _>>()?;
+        Ok(Registry { kernels })
+    }
+
+    /// The kernel `id`.
+    pub fn get(&self, id: KernelId) -> &Kernel {
+        self.kernels
+            .iter()
+            .find(|k| k.id == id)
+            .expect("the registry loads every KernelId")
+    }
+
+    /// All kernels, in [`KernelId::ALL`] order.
+    pub fn kernels(&self) -> &[Kernel] {
+        &self.kernels
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::layout::check_struct;
+    use crate::types::{BlockStats, Candidate, ClusterSpan, HistogramParams};
+
+    #[test]
+    fn every_kernel_loads_with_bindings_from_the_ir() {
+        let registry = Registry::load().unwrap_or_else(|e| panic!("{e}"));
+        let kernel = registry.get(KernelId::BlockHistogram);
+        assert_eq!(kernel.workgroup_size, [128, 1, 1]);
+        let names: Vec<_> = kernel.bindings.iter().map(|b| (b.binding, b.name.as_str())).collect();
+        assert_eq!(
+            names,
+            [(0, "params"), (1, "candidates"), (2, "sorted_pixels"), (3, "spans"), (4, "block_stats")]
+        );
+        assert_eq!(kernel.bindings[0].kind, BindingKind::Uniform);
+        assert_eq!(kernel.bindings[1].kind, BindingKind::Storage(BindingAccess::ReadOnly));
+        assert_eq!(kernel.bindings[3].kind, BindingKind::Storage(BindingAccess::ReadWrite));
+        assert_eq!(kernel.bindings[1].element.type_name, "Candidate");
+        assert_eq!(kernel.bindings[1].element.stride, 8);
+        assert_eq!(kernel.bindings[1].element.count, None);
+        assert_eq!(kernel.bindings[3].element.stride, 12);
+        assert_eq!(kernel.bindings[0].element.count, Some(1));
+        assert_eq!(kernel.bindings[0].min_size(), 32);
+        // 3 x 1024 u32 of keys plus 192 counters: within WebGPU's 16 KiB minimum.
+        assert!(kernel.workgroup_memory_bytes() <= 16 * 1024, "{}", kernel.workgroup_memory_bytes());
+        for kernel in registry.kernels() {
+            assert!(kernel.bindings.iter().all(|b| b.group == 0), "{}", kernel.name());
+        }
+    }
+
+    #[test]
+    fn host_structs_match_their_wgsl_twins() {
+        let registry = Registry::load().unwrap_or_else(|e| panic!("{e}"));
+        for kernel in registry.kernels() {
+            let module = &kernel.module;
+            for result in [
+                check_struct::<Candidate>(module),
+                check_struct::<ClusterSpan>(module),
+                check_struct::<BlockStats>(module),
+                check_struct::<HistogramParams>(module),
+            ] {
+                result.unwrap_or_else(|e| panic!("{}: {e}", kernel.name()));
+            }
+        }
+    }
+
+    #[test]
+    fn the_portable_kernel_is_validated_without_subgroups() {
+        let mut spec = KernelId::BlockHistogram.spec();
+        spec.fragments[2] = fragment!("histogram/entry_subgroup.wgsl");
+        let source = ComposedSource::compose(&spec.fragments);
+        let module = naga::front::wgsl::parse_str(&source.text).unwrap();
+        let result = naga::valid::Validator::new(ValidationFlags::all(), spec.features.capabilities())
+            .validate(&module);
+        assert!(result.is_err(), "subgroup operations must need the SUBGROUP capability");
+    }
+}

@@ -1,0 +1,94 @@
+//! A kernel's WGSL source: fragments concatenated in order (WGSL has no includes), with
+//! the map from lines of the whole back to fragment files for diagnostics.
+
+/// One WGSL file under `kernels/wgsl/`, embedded at compile time.
+#[derive(Clone, Copy, Debug)]
+pub struct Fragment {
+    /// Path relative to `kernels/wgsl/`.
+    pub path: &'static str,
+    /// The file's text.
+    pub text: &'static str,
+}
+
+/// Embeds `kernels/wgsl/$path` as a [`Fragment`].
+#[macro_export]
+macro_rules! fragment {
+    ($path:literal) => {
+        $crate::source::Fragment {
+            path: $path,
+            text: include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/wgsl/", $path)),
+        }
+    };
+}
+
+/// The concatenated source of a kernel.
+#[derive(Clone, Debug)]
+pub struct ComposedSource {
+    /// The WGSL naga parses.
+    pub text: String,
+    /// (first line in `text`, 0-based; fragment path) in ascending order.
+    starts: Vec<(usize, &'static str)>,
+}
+
+impl ComposedSource {
+    /// Concatenates `fragments`, each starting on a fresh line.
+    pub fn compose(fragments: &[Fragment]) -> Self {
+        let mut text = String::new();
+        let mut starts = Vec::with_capacity(fragments.len());
+        for fragment in fragments {
+            starts.push((text.lines().count(), fragment.path));
+            text.push_str(fragment.text);
+            if !text.ends_with('\n') {
+                text.push('\n');
+            }
+        }
+        Self { text, starts }
+    }
+
+    /// The fragment and 1-based line within it of 1-based `line` of the composed text.
+    pub fn locate(&self, line: usize) -> (&'static str, usize) {
+        let zero_based = line.saturating_sub(1);
+        let (start, path) = self
+            .starts
+            .iter()
+            .rev()
+            .find(|(start, _)| *start <= zero_based)
+            .copied()
+            .unwrap_or((0, "<unknown>"));
+        (path, zero_based - start + 1)
+    }
+
+    /// "fragment:line" for a byte offset into the composed text.
+    pub fn describe_offset(&self, offset: usize) -> String {
+        let line = self.text[..offset.min(self.text.len())].lines().count().max(1);
+        let line = if self.text[..offset.min(self.text.len())].ends_with('\n') {
+            line + 1
+        } else {
+            line
+        };
+        let (path, local) = self.locate(line);
+        format!("kernels/wgsl/{path}:{local}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_map_back_to_fragments() {
+        let source = ComposedSource::compose(&[
+            Fragment { path: "a.wgsl", text: "one\ntwo\n" },
+            Fragment { path: "b.wgsl", text: "three\nfour" },
+            Fragment { path: "c.wgsl", text: "five\n" },
+        ]);
+        assert_eq!(source.locate(1), ("a.wgsl", 1));
+        assert_eq!(source.locate(2), ("a.wgsl", 2));
+        assert_eq!(source.locate(3), ("b.wgsl", 1));
+        assert_eq!(source.locate(4), ("b.wgsl", 2));
+        assert_eq!(source.locate(5), ("c.wgsl", 1));
+        let four = source.text.find("four").unwrap();
+        assert_eq!(source.describe_offset(four), "kernels/wgsl/b.wgsl:2");
+        assert_eq!(source.describe_offset(0), "kernels/wgsl/a.wgsl:1");
+    }
+}

@@ -1,0 +1,169 @@
+//! naga's back ends with the options strata uses everywhere.
+//!
+//! * SPIR-V 1.3 without naga's DEBUG flag (its OpSource language marker makes Debian's
+//!   validation layer report "Invalid source language operand: 10").
+//! * HLSL shader model 6.0 (wave intrinsics for the subgroup kernels); registers follow
+//!   WGSL: `@group(g) @binding(b)` → `register(?b, space g)`.
+//! * MSL 2.3 with an explicit per-entry-point buffer map (`[[buffer(b)]]`).
+//! * GLSL 4.50 core with `layout(binding = b)` from a binding map (GLSL has no sets).
+//!
+//! Workgroup zero-initialisation is left to naga (every kernel is correct with it), except
+//! where [`TranslateOptions::zero_initialize_workgroup_memory`] turns it off for tools
+//! that reject naga's initialisers (glslang's HLSL front end).
+
+use crate::error::KernelError;
+use crate::registry::Kernel;
+
+/// Options shared by the back ends.
+#[derive(Clone, Copy, Debug)]
+pub struct TranslateOptions {
+    /// Emit naga's zero-initialisation of workgroup variables.
+    pub zero_initialize_workgroup_memory: bool,
+}
+
+impl Default for TranslateOptions {
+    fn default() -> Self {
+        Self { zero_initialize_workgroup_memory: true }
+    }
+}
+
+/// A translated kernel in one target language.
+#[derive(Clone, Debug)]
+pub struct Translation {
+    /// Source text (for SPIR-V, the disassembly is not produced; see [`Translation::words`]).
+    pub text: String,
+    /// SPIR-V words (empty for text targets).
+    pub words: Vec<u32>,
+    /// The entry point's name in the output (back ends rename some, e.g. `sort_256` → `sort_256_`).
+    pub entry_point: String,
+}
+
+fn error(kernel: &Kernel, target: &'static str, message: impl ToString) -> KernelError {
+    KernelError::Translation { kernel: kernel.name().into(), target, message: message.to_string() }
+}
+
+/// SPIR-V for Vulkan 1.1+, the entry point alone.
+pub fn spirv(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, KernelError> {
+    use naga::back::spv;
+    let mut flags = spv::WriterFlags::empty();
+    flags.set(spv::WriterFlags::LABEL_VARYINGS, true);
+    let spv_options = spv::Options {
+        lang_version: (1, 3),
+        flags,
+        zero_initialize_workgroup_memory: if options.zero_initialize_workgroup_memory {
+            spv::ZeroInitializeWorkgroupMemoryMode::Polyfill
+        } else {
+            spv::ZeroInitializeWorkgroupMemoryMode::None
+        },
+        ..spv::Options::default()
+    };
+    let pipeline = spv::PipelineOptions {
+        shader_stage: naga::ShaderStage::Compute,
+        entry_point: kernel.entry_point().into(),
+    };
+    let words = spv::write_vec(&kernel.module, &kernel.info, &spv_options, Some(&pipeline))
+        .map_err(|e| error(kernel, "SPIR-V", e))?;
+    Ok(Translation { text: String::new(), words, entry_point: kernel.entry_point().into() })
+}
+
+/// HLSL (shader model 6.0) for DXC, or glslang's HLSL front end.
+pub fn hlsl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, KernelError> {
+    use naga::back::hlsl;
+    let hlsl_options = hlsl::Options {
+        shader_model: hlsl::ShaderModel::V6_0,
+        zero_initialize_workgroup_memory: options.zero_initialize_workgroup_memory,
+        ..hlsl::Options::default()
+    };
+    let pipeline = hlsl::PipelineOptions {
+        entry_point: Some((naga::ShaderStage::Compute, kernel.entry_point().into())),
+    };
+    let mut text = String::new();
+    let reflection = hlsl::Writer::new(&mut text, &hlsl_options, &pipeline)
+        .write(&kernel.module, &kernel.info, None)
+        .map_err(|e| error(kernel, "HLSL", e))?;
+    let entry_point = translated_name(kernel, "HLSL", reflection.entry_point_names)?;
+    Ok(Translation { text, words: Vec::new(), entry_point })
+}
+
+/// Metal Shading Language 2.3.
+pub fn msl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, KernelError> {
+    use naga::back::msl;
+    let mut resources = msl::BindingMap::default();
+    for binding in &kernel.bindings {
+        resources.insert(
+            naga::ResourceBinding { group: binding.group, binding: binding.binding },
+            msl::BindTarget {
+                buffer: Some(binding.binding as u8),
+                mutable: binding.is_writable(),
+                ..Default::default()
+            },
+        );
+    }
+    let mut per_entry_point_map = msl::EntryPointResourceMap::default();
+    per_entry_point_map.insert(
+        kernel.entry_point().into(),
+        msl::EntryPointResources { resources, immediates_buffer: None, sizes_buffer: Some(30) },
+    );
+    let msl_options = msl::Options {
+        lang_version: (2, 3),
+        per_entry_point_map,
+        fake_missing_bindings: false,
+        zero_initialize_workgroup_memory: options.zero_initialize_workgroup_memory,
+        ..msl::Options::default()
+    };
+    let pipeline = msl::PipelineOptions {
+        entry_point: Some((naga::ShaderStage::Compute, kernel.entry_point().into())),
+        ..Default::default()
+    };
+    let (text, info) = msl::write_string(&kernel.module, &kernel.info, &msl_options, &pipeline)
+        .map_err(|e| error(kernel, "MSL", e))?;
+    let entry_point = translated_name(kernel, "MSL", info.entry_point_names)?;
+    Ok(Translation { text, words: Vec::new(), entry_point })
+}
+
+/// GLSL 4.50 core; bindings from WGSL's `@binding` (group 0 only).
+pub fn glsl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, KernelError> {
+    use naga::back::glsl;
+    let mut binding_map = glsl::BindingMap::default();
+    for binding in &kernel.bindings {
+        binding_map.insert(
+            naga::ResourceBinding { group: binding.group, binding: binding.binding },
+            binding.binding as u8,
+        );
+    }
+    let glsl_options = glsl::Options {
+        version: glsl::Version::Desktop(450),
+        writer_flags: glsl::WriterFlags::empty(),
+        binding_map,
+        zero_initialize_workgroup_memory: options.zero_initialize_workgroup_memory,
+    };
+    let pipeline = glsl::PipelineOptions {
+        shader_stage: naga::ShaderStage::Compute,
+        entry_point: kernel.entry_point().into(),
+        multiview: None,
+    };
+    let mut text = String::new();
+    glsl::Writer::new(
+        &mut text,
+        &kernel.module,
+        &kernel.info,
+        &glsl_options,
+        &pipeline,
+        naga::proc::BoundsCheckPolicies::default(),
+    )
+    .and_then(|mut writer| writer.write())
+    .map_err(|e| error(kernel, "GLSL", e))?;
+    Ok(Translation { text, words: Vec::new(), entry_point: "main".into() })
+}
+
+fn translated_name<E: std::fmt::Display>(
+    kernel: &Kernel,
+    target: &'static str,
+    names: Vec<Result<String, E>>,
+) -> Result<String, KernelError> {
+    match names.into_iter().nth(kernel.entry_index()) {
+        Some(Ok(name)) => Ok(name),
+        Some(Err(e)) => Err(error(kernel, target, e)),
+        None => Err(error(kernel, target, "the back end reported no entry point name")),
+    }
+}

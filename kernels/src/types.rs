@@ -1,0 +1,88 @@
+//! Host twins of the structs the kernels share with the host: `#[repr(C)]`, Pod, and
+//! checked field by field against naga's layout of the WGSL struct (see
+//! [`crate::layout`] and the `layout` tests).
+
+use bytemuck::{Pod, Zeroable};
+
+/// `OBJECT_ID_NONE`: the pixel has no candidate (no hit and no environment, or no valid path).
+pub const OBJECT_ID_NONE: u32 = 0xffff_ffff;
+/// `OBJECT_ID_ENVIRONMENT`: the camera ray escaped; the environment is one cluster of its own.
+pub const OBJECT_ID_ENVIRONMENT: u32 = 0xffff_fffe;
+/// `INVALID_KEY`: canonical sort key of an invalid candidate, above every valid key.
+pub const INVALID_KEY: u32 = 0xffff_ffff;
+/// Block sizes the histogram pass accepts.
+pub const BLOCK_SIZES: [u32; 4] = [4, 8, 16, 32];
+
+/// One candidate per pixel (WGSL `Candidate`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Candidate {
+    /// Luminance of the candidate's own one-sample estimate f/p at its own pixel
+    /// (paper §4.1). NaN, ±Inf and negative values make the candidate invalid.
+    pub key: f32,
+    /// Object id of the first hit, [`OBJECT_ID_ENVIRONMENT`] or [`OBJECT_ID_NONE`].
+    pub object_id: u32,
+}
+
+/// Where a pixel's own cluster lies in its block's sorted list (WGSL `ClusterSpan`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Pod, Zeroable)]
+pub struct ClusterSpan {
+    /// Index into `sorted_pixels` of the run's first candidate.
+    pub offset: u32,
+    /// Candidates in the run, valid and invalid.
+    pub length: u32,
+    /// The run's first `valid` candidates are valid; the rest have weight 0.
+    pub valid: u32,
+}
+
+/// Per-block counters of the histogram pass (WGSL `BlockStats`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Pod, Zeroable)]
+pub struct BlockStats {
+    /// Distinct object ids in the block, the no-candidate cluster included.
+    pub clusters: u32,
+    /// Candidates with an object id but a NaN, infinite or negative key.
+    pub invalid: u32,
+    /// Pixels without a candidate.
+    pub empty: u32,
+}
+
+/// Sizes of one histogram dispatch (WGSL `HistogramParams`, a uniform).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct HistogramParams {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// B: blocks are B × B pixels.
+    pub block_size: u32,
+    /// log2(B).
+    pub log2_block_size: u32,
+    /// Blocks per row, ceil(width / B).
+    pub blocks_x: u32,
+    /// Blocks per column, ceil(height / B).
+    pub blocks_y: u32,
+    /// Workgroups per row of the 2-D dispatch grid.
+    pub workgroups_x: u32,
+    /// Padding to 32 bytes.
+    pub _pad: u32,
+}
+
+/// Canonical sort key of a candidate, decided on its bit pattern so that every backend
+/// agrees: -0 → 0, denormals kept, NaN / ±Inf / negative → [`INVALID_KEY`], and every
+/// key of a pixel without a candidate is [`INVALID_KEY`]. Mirrors WGSL `canonical_key`.
+pub fn canonical_key(candidate: Candidate) -> u32 {
+    let bits = candidate.key.to_bits();
+    let magnitude = bits & 0x7fff_ffff;
+    if candidate.object_id == OBJECT_ID_NONE {
+        INVALID_KEY
+    } else if magnitude == 0 {
+        0
+    } else if bits >> 31 != 0 || magnitude >= 0x7f80_0000 {
+        INVALID_KEY
+    } else {
+        bits
+    }
+}

@@ -1,1 +1,10 @@
-//! placeholder
+//! strata's host: the passes that drive the kernels on any [`Backend`], synthetic
+//! inputs, and the `strata` command line (in `main.rs`).
+//!
+//! [`Backend`]: strata_backends::Backend
+
+pub mod backend_choice;
+pub mod histogram_pass;
+pub mod synthetic;
+
+pub use histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};

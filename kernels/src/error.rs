@@ -3,7 +3,7 @@
 use thiserror::Error;
 
 /// A kernel that fails to parse, validate or translate.
-#[derive(Debug, Error)]
+#[derive(Clone, Debug, Error)]
 pub enum KernelError {
     /// naga's WGSL front end rejected the source.
     #[error("kernel `{kernel}`: WGSL parse error\n{message}")]

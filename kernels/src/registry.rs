@@ -254,6 +254,12 @@ pub struct Registry {
 }
 
 impl Registry {
+    /// The registry of this process, loaded on first use.
+    pub fn shared() -> Result<&'static Registry, KernelError> {
+        static SHARED: std::sync::OnceLock<Result<Registry, KernelError>> = std::sync::OnceLock::new();
+        SHARED.get_or_init(Registry::load).as_ref().map_err(Clone::clone)
+    }
+
     /// Loads every kernel of [`KernelId::ALL`].
     pub fn load() -> Result<Registry, KernelError> {
         let kernels = KernelId::ALL.iter().map(|&id| Kernel::load(id)).collect::<Result<_, _>>()?;

@@ -1,0 +1,95 @@
+//! The [`Backend`] trait: buffers in, registry kernel dispatched, buffers out.
+
+use crate::device_info::DeviceInfo;
+use crate::error::BackendError;
+use std::time::Duration;
+use strata_kernels::Kernel;
+
+/// A buffer owned by a backend.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct BufferId(pub u64);
+
+/// Buffer bound at `@group(0) @binding(binding)` of a dispatch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Bind {
+    /// WGSL binding number.
+    pub binding: u32,
+    /// The buffer, bound whole.
+    pub buffer: BufferId,
+}
+
+impl Bind {
+    /// Binds `buffer` at `binding`.
+    pub fn new(binding: u32, buffer: BufferId) -> Self {
+        Self { binding, buffer }
+    }
+}
+
+/// Something that runs registry kernels.
+///
+/// Dispatches are ordered: a dispatch sees the writes of every earlier dispatch and
+/// upload; [`Backend::read_buffer`] waits for all of them.
+pub trait Backend {
+    /// The device and what it can do.
+    fn info(&self) -> &DeviceInfo;
+
+    /// A zero-filled buffer of `size` bytes (> 0) usable as uniform or storage buffer.
+    fn create_buffer(&mut self, label: &str, size: u64) -> Result<BufferId, BackendError>;
+
+    /// Writes `data` at byte `offset`; offset and length must be multiples of 4.
+    fn write_buffer(&mut self, buffer: BufferId, offset: u64, data: &[u8])
+    -> Result<(), BackendError>;
+
+    /// The buffer's whole contents, after every submitted dispatch has finished.
+    fn read_buffer(&mut self, buffer: BufferId) -> Result<Vec<u8>, BackendError>;
+
+    /// Frees the buffer.
+    fn destroy_buffer(&mut self, buffer: BufferId) -> Result<(), BackendError>;
+
+    /// Whether the device can run `kernel` at all (features, workgroup size and memory);
+    /// the error says what is missing.
+    fn check_kernel(&self, kernel: &Kernel) -> Result<(), BackendError>;
+
+    /// Runs `kernel` on `workgroups` workgroups with `binds` (every binding the kernel
+    /// uses, each exactly once).
+    fn dispatch(
+        &mut self,
+        kernel: &Kernel,
+        binds: &[Bind],
+        workgroups: [u32; 3],
+    ) -> Result<(), BackendError>;
+
+    /// Like [`Backend::dispatch`], waits for it, and returns the device time of the pass
+    /// from timestamp queries.
+    fn dispatch_timed(
+        &mut self,
+        kernel: &Kernel,
+        binds: &[Bind],
+        workgroups: [u32; 3],
+    ) -> Result<Duration, BackendError>;
+}
+
+/// Writes a Pod slice into a new buffer.
+pub fn upload<T: bytemuck::Pod>(
+    backend: &mut dyn Backend,
+    label: &str,
+    data: &[T],
+) -> Result<BufferId, BackendError> {
+    let bytes: &[u8] = bytemuck::cast_slice(data);
+    let buffer = backend.create_buffer(label, bytes.len() as u64)?;
+    backend.write_buffer(buffer, 0, bytes)?;
+    Ok(buffer)
+}
+
+/// Reads a buffer back as a Vec of Pod values.
+pub fn download<T: bytemuck::Pod>(
+    backend: &mut dyn Backend,
+    buffer: BufferId,
+) -> Result<Vec<T>, BackendError> {
+    let bytes = backend.read_buffer(buffer)?;
+    let size = std::mem::size_of::<T>();
+    Ok(bytes[..bytes.len() / size * size]
+        .chunks_exact(size)
+        .map(bytemuck::pod_read_unaligned)
+        .collect())
+}

@@ -1,0 +1,117 @@
+//! Checks every backend makes before a dispatch, so that a mistake becomes a clear
+//! [`BackendError`] instead of a validation panic or a silent wrong result.
+
+use crate::backend::{Bind, BufferId};
+use crate::device_info::DeviceInfo;
+use crate::error::BackendError;
+use strata_kernels::{BindingKind, Kernel};
+
+/// Whether `device` can run `kernel`: features, workgroup size, workgroup memory and
+/// storage buffer count.
+pub fn check_kernel_fits(kernel: &Kernel, device: &DeviceInfo) -> Result<(), BackendError> {
+    let limits = &device.limits;
+    if kernel.spec.features.subgroup && device.subgroup_sizes.is_none() {
+        return Err(BackendError::MissingFeature {
+            kernel: kernel.name().into(),
+            feature: "subgroup operations".into(),
+            device: device.summary(),
+        });
+    }
+    let what = || format!("kernel `{}`", kernel.name());
+    let exceeded = |limit, requested: u64, available: u64| {
+        if requested > available {
+            Err(BackendError::LimitExceeded { what: what(), limit, requested, available })
+        } else {
+            Ok(())
+        }
+    };
+    exceeded(
+        "invocations per workgroup",
+        u64::from(kernel.invocations()),
+        u64::from(limits.max_invocations_per_workgroup),
+    )?;
+    for (axis, (&size, &max)) in kernel.workgroup_size.iter().zip(&limits.max_workgroup_size).enumerate() {
+        exceeded(["workgroup size x", "workgroup size y", "workgroup size z"][axis], u64::from(size), u64::from(max))?;
+    }
+    exceeded("workgroup memory bytes", kernel.workgroup_memory_bytes(), limits.max_workgroup_storage)?;
+    let storage = kernel.bindings.iter().filter(|b| matches!(b.kind, BindingKind::Storage(_))).count();
+    exceeded(
+        "storage buffers per stage",
+        storage as u64,
+        u64::from(limits.max_storage_buffers_per_stage),
+    )
+}
+
+/// Whether `binds` bind every binding of `kernel` once, with buffers large enough and
+/// within the device's binding limits. `size_of` gives a buffer's size in bytes.
+pub fn check_binds(
+    kernel: &Kernel,
+    binds: &[Bind],
+    device: &DeviceInfo,
+    size_of: impl Fn(BufferId) -> Result<u64, BackendError>,
+) -> Result<(), BackendError> {
+    let error = |binding: u32, reason: String| BackendError::Binding {
+        kernel: kernel.name().into(),
+        binding,
+        reason,
+    };
+    for (index, bind) in binds.iter().enumerate() {
+        if binds[..index].iter().any(|b| b.binding == bind.binding) {
+            return Err(error(bind.binding, "bound twice".into()));
+        }
+        if kernel.binding(0, bind.binding).is_none() {
+            return Err(error(bind.binding, "the kernel has no such binding".into()));
+        }
+    }
+    for info in &kernel.bindings {
+        let bind = binds
+            .iter()
+            .find(|b| b.binding == info.binding)
+            .ok_or_else(|| error(info.binding, format!("`{}` is not bound", info.name)))?;
+        let size = size_of(bind.buffer)?;
+        if size < info.min_size() {
+            return Err(error(
+                info.binding,
+                format!(
+                    "`{}` needs at least {} bytes ({} of {}), the buffer has {size}",
+                    info.name,
+                    info.min_size(),
+                    info.element.count.unwrap_or(1),
+                    info.element.type_name
+                ),
+            ));
+        }
+        let (limit, available) = match info.kind {
+            BindingKind::Uniform => ("uniform binding bytes", device.limits.max_uniform_binding),
+            BindingKind::Storage(_) => ("storage binding bytes", device.limits.max_storage_binding),
+        };
+        if size > available {
+            return Err(BackendError::LimitExceeded {
+                what: format!("kernel `{}` binding `{}`", kernel.name(), info.name),
+                limit,
+                requested: size,
+                available,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Whether the device accepts `workgroups` in one dispatch.
+pub fn check_workgroups(
+    kernel: &Kernel,
+    workgroups: [u32; 3],
+    device: &DeviceInfo,
+) -> Result<(), BackendError> {
+    for &count in &workgroups {
+        if u64::from(count) > u64::from(device.limits.max_workgroups_per_dimension) {
+            return Err(BackendError::LimitExceeded {
+                what: format!("dispatch of `{}`", kernel.name()),
+                limit: "workgroups per dimension",
+                requested: u64::from(count),
+                available: u64::from(device.limits.max_workgroups_per_dimension),
+            });
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,279 @@
+//! The [`Backend`] on wgpu: Vulkan (lavapipe on machines without a GPU) or GL.
+
+mod buffers;
+mod errors;
+mod pipelines;
+
+use crate::backend::{Backend, Bind, BufferId};
+use crate::bindings_check::{check_binds, check_kernel_fits, check_workgroups};
+use crate::device_info::{DeviceInfo, DeviceLimits};
+use crate::error::BackendError;
+use buffers::BufferTable;
+use errors::ErrorSink;
+use pipelines::PipelineCache;
+use std::time::Duration;
+use strata_kernels::Kernel;
+
+/// Which wgpu backend to open.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WgpuApi {
+    /// Vulkan (lavapipe counts).
+    Vulkan,
+    /// OpenGL / GLES through EGL.
+    Gl,
+}
+
+/// How to open a [`WgpuBackend`].
+#[derive(Clone, Copy, Debug)]
+pub struct WgpuOptions {
+    /// The graphics API.
+    pub api: WgpuApi,
+    /// Turn on the API's validation (Vulkan validation layer where installed).
+    pub validation: bool,
+    /// Request subgroup operations when the adapter has them.
+    pub subgroups: bool,
+}
+
+impl Default for WgpuOptions {
+    fn default() -> Self {
+        Self { api: WgpuApi::Vulkan, validation: false, subgroups: true }
+    }
+}
+
+/// A wgpu device running registry kernels.
+pub struct WgpuBackend {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    info: DeviceInfo,
+    buffers: BufferTable,
+    pipelines: PipelineCache,
+    errors: ErrorSink,
+    timestamps: Option<(wgpu::QuerySet, wgpu::Buffer, wgpu::Buffer)>,
+}
+
+impl WgpuBackend {
+    /// Opens the first adapter of `options.api`.
+    pub fn new(options: WgpuOptions) -> Result<Self, BackendError> {
+        let backend_name = match options.api {
+            WgpuApi::Vulkan => "wgpu-vulkan",
+            WgpuApi::Gl => "wgpu-gl",
+        };
+        let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
+        descriptor.backends = match options.api {
+            WgpuApi::Vulkan => wgpu::Backends::VULKAN,
+            WgpuApi::Gl => wgpu::Backends::GL,
+        };
+        // VALIDATION only: DEBUG makes naga's SPIR-V carry an OpSource marker that
+        // Debian's validation layer misreports.
+        descriptor.flags = if options.validation {
+            wgpu::InstanceFlags::VALIDATION
+        } else {
+            wgpu::InstanceFlags::empty()
+        };
+        let instance = wgpu::Instance::new(descriptor);
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: None,
+            apply_limit_buckets: false,
+        }))
+        .map_err(|e| BackendError::NoAdapter { backend: backend_name.into(), reason: e.to_string() })?;
+
+        let adapter_features = adapter.features();
+        let mut features = wgpu::Features::empty();
+        let subgroups = options.subgroups && adapter_features.contains(wgpu::Features::SUBGROUP);
+        if subgroups {
+            features |= wgpu::Features::SUBGROUP;
+        }
+        let timestamps = adapter_features.contains(wgpu::Features::TIMESTAMP_QUERY);
+        if timestamps {
+            features |= wgpu::Features::TIMESTAMP_QUERY;
+        }
+        let limits = adapter.limits();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("strata"),
+            required_features: features,
+            required_limits: limits.clone(),
+            ..Default::default()
+        }))
+        .map_err(|e| BackendError::DeviceCreation { backend: backend_name.into(), reason: e.to_string() })?;
+
+        let errors = ErrorSink::install(&device, backend_name);
+        let adapter_info = adapter.get_info();
+        let info = DeviceInfo {
+            backend: backend_name.into(),
+            adapter: adapter_info.name.clone(),
+            device_type: format!("{:?}", adapter_info.device_type),
+            driver: format!("{} {}", adapter_info.driver, adapter_info.driver_info).trim().into(),
+            subgroup_sizes: subgroups.then(|| {
+                (adapter_info.subgroup_min_size, adapter_info.subgroup_max_size)
+            }),
+            timestamps,
+            limits: DeviceLimits {
+                max_workgroup_storage: u64::from(limits.max_compute_workgroup_storage_size),
+                max_invocations_per_workgroup: limits.max_compute_invocations_per_workgroup,
+                max_workgroup_size: [
+                    limits.max_compute_workgroup_size_x,
+                    limits.max_compute_workgroup_size_y,
+                    limits.max_compute_workgroup_size_z,
+                ],
+                max_workgroups_per_dimension: limits.max_compute_workgroups_per_dimension,
+                max_storage_binding: limits.max_storage_buffer_binding_size,
+                max_uniform_binding: limits.max_uniform_buffer_binding_size,
+                max_buffer_size: limits.max_buffer_size,
+                max_storage_buffers_per_stage: limits.max_storage_buffers_per_shader_stage,
+            },
+        };
+        let timestamps = timestamps.then(|| {
+            let set = device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("strata timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
+            });
+            let resolve = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("strata timestamp resolve"),
+                size: 16,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let readback = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("strata timestamp readback"),
+                size: 16,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            (set, resolve, readback)
+        });
+        Ok(Self {
+            device,
+            queue,
+            info,
+            buffers: BufferTable::default(),
+            pipelines: PipelineCache::default(),
+            errors,
+            timestamps,
+        })
+    }
+
+    fn encode(
+        &mut self,
+        kernel: &Kernel,
+        binds: &[Bind],
+        workgroups: [u32; 3],
+        timed: bool,
+    ) -> Result<(), BackendError> {
+        self.check_kernel(kernel)?;
+        check_workgroups(kernel, workgroups, &self.info)?;
+        check_binds(kernel, binds, &self.info, |id| self.buffers.get(id).map(|b| b.size))?;
+        let pipeline = self.pipelines.get_or_create(&self.device, &self.errors, kernel)?;
+        let scope = self.errors.scope(&self.device);
+        let entries = binds
+            .iter()
+            .map(|bind| {
+                Ok(wgpu::BindGroupEntry {
+                    binding: bind.binding,
+                    resource: self.buffers.get(bind.buffer)?.buffer.as_entire_binding(),
+                })
+            })
+            .collect::<Result<Vec<_>, BackendError>>()?;
+        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(kernel.name()),
+            layout: &pipeline.layout,
+            entries: &entries,
+        });
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(kernel.name()) });
+        {
+            let timestamp_writes = match (&self.timestamps, timed) {
+                (Some((set, _, _)), true) => Some(wgpu::ComputePassTimestampWrites {
+                    query_set: set,
+                    beginning_of_pass_write_index: Some(0),
+                    end_of_pass_write_index: Some(1),
+                }),
+                _ => None,
+            };
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(kernel.name()),
+                timestamp_writes,
+            });
+            pass.set_pipeline(&pipeline.pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.dispatch_workgroups(workgroups[0], workgroups[1], workgroups[2]);
+        }
+        if let (Some((set, resolve, readback)), true) = (&self.timestamps, timed) {
+            encoder.resolve_query_set(set, 0..2, resolve, 0);
+            encoder.copy_buffer_to_buffer(resolve, 0, readback, 0, 16);
+        }
+        self.queue.submit([encoder.finish()]);
+        scope.finish(&format!("dispatch of `{}`", kernel.name()))
+    }
+
+    fn wait(&self) -> Result<(), BackendError> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| self.errors.lost_or(e.to_string()))?;
+        self.errors.check_lost()
+    }
+}
+
+impl Backend for WgpuBackend {
+    fn info(&self) -> &DeviceInfo {
+        &self.info
+    }
+
+    fn create_buffer(&mut self, label: &str, size: u64) -> Result<BufferId, BackendError> {
+        self.buffers.create(&self.device, &self.errors, &self.info, label, size)
+    }
+
+    fn write_buffer(&mut self, buffer: BufferId, offset: u64, data: &[u8]) -> Result<(), BackendError> {
+        let entry = self.buffers.get(buffer)?;
+        if offset % 4 != 0 || data.len() % 4 != 0 || offset + data.len() as u64 > entry.size {
+            return Err(BackendError::Buffer {
+                label: entry.label.clone(),
+                reason: format!(
+                    "write of {} bytes at offset {offset} into {} bytes (offset and length must be multiples of 4)",
+                    data.len(),
+                    entry.size
+                ),
+            });
+        }
+        self.queue.write_buffer(&entry.buffer, offset, data);
+        Ok(())
+    }
+
+    fn read_buffer(&mut self, buffer: BufferId) -> Result<Vec<u8>, BackendError> {
+        let entry = self.buffers.get(buffer)?;
+        buffers::read_back(&self.device, &self.queue, &self.errors, entry)
+    }
+
+    fn destroy_buffer(&mut self, buffer: BufferId) -> Result<(), BackendError> {
+        self.buffers.destroy(buffer)
+    }
+
+    fn check_kernel(&self, kernel: &Kernel) -> Result<(), BackendError> {
+        check_kernel_fits(kernel, &self.info)
+    }
+
+    fn dispatch(&mut self, kernel: &Kernel, binds: &[Bind], workgroups: [u32; 3]) -> Result<(), BackendError> {
+        self.encode(kernel, binds, workgroups, false)
+    }
+
+    fn dispatch_timed(
+        &mut self,
+        kernel: &Kernel,
+        binds: &[Bind],
+        workgroups: [u32; 3],
+    ) -> Result<Duration, BackendError> {
+        if self.timestamps.is_none() {
+            return Err(BackendError::NoTimestamps(self.info.backend.clone()));
+        }
+        self.encode(kernel, binds, workgroups, true)?;
+        self.wait()?;
+        let (_, _, readback) = self.timestamps.as_ref().expect("checked above");
+        let bytes = buffers::map_read(&self.device, &self.errors, readback, 16)?;
+        let ticks: [u64; 2] = bytemuck::pod_read_unaligned(&bytes);
+        let nanos = ticks[1].saturating_sub(ticks[0]) as f64 * f64::from(self.queue.get_timestamp_period());
+        Ok(Duration::from_nanos(nanos as u64))
+    }
+}

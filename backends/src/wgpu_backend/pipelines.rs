@@ -1,0 +1,78 @@
+//! One compute pipeline per registry kernel, with an explicit bind group layout built
+//! from the registry's bindings (so a registry mistake fails here, not silently).
+
+use super::errors::ErrorSink;
+use crate::error::BackendError;
+use std::borrow::Cow;
+use std::collections::HashMap;
+use std::num::NonZeroU64;
+use std::sync::Arc;
+use strata_kernels::{BindingAccess, BindingKind, Kernel, KernelId};
+
+pub(super) struct Pipeline {
+    pub(super) pipeline: wgpu::ComputePipeline,
+    pub(super) layout: wgpu::BindGroupLayout,
+}
+
+#[derive(Default)]
+pub(super) struct PipelineCache {
+    pipelines: HashMap<KernelId, Arc<Pipeline>>,
+}
+
+impl PipelineCache {
+    pub(super) fn get_or_create(
+        &mut self,
+        device: &wgpu::Device,
+        errors: &ErrorSink,
+        kernel: &Kernel,
+    ) -> Result<Arc<Pipeline>, BackendError> {
+        if let Some(pipeline) = self.pipelines.get(&kernel.id) {
+            return Ok(Arc::clone(pipeline));
+        }
+        let scope = errors.scope(device);
+        let entries: Vec<_> = kernel
+            .bindings
+            .iter()
+            .map(|binding| wgpu::BindGroupLayoutEntry {
+                binding: binding.binding,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: match binding.kind {
+                        BindingKind::Uniform => wgpu::BufferBindingType::Uniform,
+                        BindingKind::Storage(access) => wgpu::BufferBindingType::Storage {
+                            read_only: access == BindingAccess::ReadOnly,
+                        },
+                    },
+                    has_dynamic_offset: false,
+                    min_binding_size: NonZeroU64::new(binding.min_size()),
+                },
+                count: None,
+            })
+            .collect();
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(kernel.name()),
+            entries: &entries,
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(kernel.name()),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(kernel.name()),
+            source: wgpu::ShaderSource::Naga(Cow::Owned(kernel.module.clone())),
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(kernel.name()),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some(kernel.entry_point()),
+            compilation_options: wgpu::PipelineCompilationOptions::default(),
+            cache: None,
+        });
+        scope.finish(&format!("pipeline creation for `{}`", kernel.name()))?;
+        let pipeline = Arc::new(Pipeline { pipeline, layout });
+        self.pipelines.insert(kernel.id, Arc::clone(&pipeline));
+        Ok(pipeline)
+    }
+}

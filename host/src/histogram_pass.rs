@@ -1,0 +1,185 @@
+//! The block-histogram pass on any backend: buffers, parameters, dispatch, read-back.
+
+use strata_backends::backend::{download, upload};
+use strata_backends::{Backend, BackendError, Bind, BufferId};
+use strata_kernels::reference::block_histogram::HistogramOutput;
+use strata_kernels::types::{BlockStats, Candidate, ClusterSpan, HistogramParams};
+use strata_kernels::{BlockGrid, GridError, Kernel, KernelError, KernelId, Registry};
+use thiserror::Error;
+
+/// Slots one workgroup sorts (`SLOTS` in `block_sort.wgsl`).
+pub const SLOTS_PER_WORKGROUP: u32 = 1024;
+
+/// Which entry point of the histogram kernel to run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HistogramVariant {
+    /// Workgroup memory only; runs everywhere.
+    Portable,
+    /// Subgroup shuffles for the middle strides; needs subgroup support.
+    Subgroup,
+    /// Subgroup if the device has subgroups, else portable.
+    Auto,
+}
+
+/// A failure of a host pass.
+#[derive(Debug, Error)]
+pub enum PassError {
+    /// Bad image or block size.
+    #[error(transparent)]
+    Grid(#[from] GridError),
+    /// The backend failed.
+    #[error(transparent)]
+    Backend(#[from] BackendError),
+    /// The kernel failed to load.
+    #[error(transparent)]
+    Kernel(#[from] KernelError),
+    /// Candidate count differs from the pixel count.
+    #[error("{width}x{height} image needs {expected} candidates, got {got}")]
+    CandidateCount {
+        /// Image width.
+        width: u32,
+        /// Image height.
+        height: u32,
+        /// Pixels.
+        expected: usize,
+        /// Candidates given.
+        got: usize,
+    },
+}
+
+/// The histogram pass for one image size and block size, with its buffers.
+pub struct BlockHistogramPass {
+    kernel: &'static Kernel,
+    grid: BlockGrid,
+    workgroups: [u32; 3],
+    /// Uniform `HistogramParams`.
+    pub params: BufferId,
+    /// Input: one `Candidate` per pixel.
+    pub candidates: BufferId,
+    /// Output: per block, its pixel indices in sorted order.
+    pub sorted_pixels: BufferId,
+    /// Output: per pixel, its cluster's `ClusterSpan`.
+    pub spans: BufferId,
+    /// Output: per block, its `BlockStats`.
+    pub block_stats: BufferId,
+}
+
+impl BlockHistogramPass {
+    /// Creates the buffers and checks that `backend` can run the chosen variant.
+    pub fn new(
+        backend: &mut dyn Backend,
+        variant: HistogramVariant,
+        grid: BlockGrid,
+    ) -> Result<Self, PassError> {
+        let registry = Registry::shared()?;
+        let id = match variant {
+            HistogramVariant::Portable => KernelId::BlockHistogram,
+            HistogramVariant::Subgroup => KernelId::BlockHistogramSubgroup,
+            HistogramVariant::Auto if backend.info().subgroup_sizes.is_some() => {
+                KernelId::BlockHistogramSubgroup
+            }
+            HistogramVariant::Auto => KernelId::BlockHistogram,
+        };
+        let kernel = registry.get(id);
+        backend.check_kernel(kernel)?;
+        let block_area = grid.block_size * grid.block_size;
+        let total = grid.block_count().div_ceil(SLOTS_PER_WORKGROUP / block_area);
+        let max = backend.info().limits.max_workgroups_per_dimension.max(1);
+        let x = total.min(max);
+        let workgroups = [x, total.div_ceil(x), 1];
+        let params = HistogramParams {
+            width: grid.width,
+            height: grid.height,
+            block_size: grid.block_size,
+            log2_block_size: grid.block_size.trailing_zeros(),
+            blocks_x: grid.blocks_x(),
+            blocks_y: grid.blocks_y(),
+            workgroups_x: x,
+            _pad: 0,
+        };
+        let pixels = grid.pixel_count() as u64;
+        let params = upload(backend, "histogram params", &[params])?;
+        let candidates = backend.create_buffer("candidates", pixels * size_of::<Candidate>() as u64)?;
+        let sorted_pixels = backend.create_buffer("sorted pixels", pixels * 4)?;
+        let spans = backend.create_buffer("cluster spans", pixels * size_of::<ClusterSpan>() as u64)?;
+        let block_stats = backend.create_buffer(
+            "block stats",
+            u64::from(grid.block_count()) * size_of::<BlockStats>() as u64,
+        )?;
+        Ok(Self { kernel, grid, workgroups, params, candidates, sorted_pixels, spans, block_stats })
+    }
+
+    /// The kernel this pass runs.
+    pub fn kernel(&self) -> &'static Kernel {
+        self.kernel
+    }
+
+    /// The image's block grid.
+    pub fn grid(&self) -> BlockGrid {
+        self.grid
+    }
+
+    /// Workgroups of one dispatch.
+    pub fn workgroups(&self) -> [u32; 3] {
+        self.workgroups
+    }
+
+    /// Uploads one candidate per pixel.
+    pub fn upload_candidates(&self, backend: &mut dyn Backend, candidates: &[Candidate]) -> Result<(), PassError> {
+        if candidates.len() != self.grid.pixel_count() {
+            return Err(PassError::CandidateCount {
+                width: self.grid.width,
+                height: self.grid.height,
+                expected: self.grid.pixel_count(),
+                got: candidates.len(),
+            });
+        }
+        backend.write_buffer(self.candidates, 0, bytemuck::cast_slice(candidates))?;
+        Ok(())
+    }
+
+    fn binds(&self) -> [Bind; 5] {
+        [
+            Bind::new(0, self.params),
+            Bind::new(1, self.candidates),
+            Bind::new(2, self.sorted_pixels),
+            Bind::new(3, self.spans),
+            Bind::new(4, self.block_stats),
+        ]
+    }
+
+    /// Runs the pass on the uploaded candidates.
+    pub fn dispatch(&self, backend: &mut dyn Backend) -> Result<(), PassError> {
+        backend.dispatch(self.kernel, &self.binds(), self.workgroups)?;
+        Ok(())
+    }
+
+    /// Runs the pass and returns its device time (timestamp queries).
+    pub fn dispatch_timed(&self, backend: &mut dyn Backend) -> Result<std::time::Duration, PassError> {
+        Ok(backend.dispatch_timed(self.kernel, &self.binds(), self.workgroups)?)
+    }
+
+    /// Reads the outputs back.
+    pub fn read_output(&self, backend: &mut dyn Backend) -> Result<HistogramOutput, PassError> {
+        Ok(HistogramOutput {
+            sorted_pixels: download(backend, self.sorted_pixels)?,
+            spans: download(backend, self.spans)?,
+            stats: download(backend, self.block_stats)?,
+        })
+    }
+
+    /// Uploads, runs and reads back in one call.
+    pub fn run(&self, backend: &mut dyn Backend, candidates: &[Candidate]) -> Result<HistogramOutput, PassError> {
+        self.upload_candidates(backend, candidates)?;
+        self.dispatch(backend)?;
+        self.read_output(backend)
+    }
+
+    /// Frees the pass's buffers.
+    pub fn destroy(self, backend: &mut dyn Backend) -> Result<(), PassError> {
+        for buffer in [self.params, self.candidates, self.sorted_pixels, self.spans, self.block_stats] {
+            backend.destroy_buffer(buffer)?;
+        }
+        Ok(())
+    }
+}

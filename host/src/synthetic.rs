@@ -1,0 +1,80 @@
+//! Generated candidate images for tests, benchmarks and the `strata histogram` command:
+//! object regions with many equal keys, plus every kind of awkward value.
+
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+use strata_kernels::types::{Candidate, OBJECT_ID_ENVIRONMENT, OBJECT_ID_NONE};
+
+/// What a generated image contains.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CandidateMix {
+    /// Distinct object ids (besides environment and none).
+    pub objects: u32,
+    /// Distinct key values per object: small numbers give many equal keys.
+    pub key_levels: u32,
+    /// Share of pixels with awkward values: NaN, ±Inf, negative, -0, denormal keys,
+    /// environment misses and pixels without a candidate.
+    pub awkward: f64,
+}
+
+impl Default for CandidateMix {
+    fn default() -> Self {
+        Self { objects: 6, key_levels: 16, awkward: 0.05 }
+    }
+}
+
+/// A `width × height` candidate image from `seed`. Objects occupy noisy rectangular
+/// regions so that blocks hold one to a few clusters, as a rendered image does.
+pub fn candidate_image(width: u32, height: u32, seed: u64, mix: CandidateMix) -> Vec<Candidate> {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let objects = mix.objects.max(1);
+    let cell = rng.random_range(3..=24u32);
+    let offsets: Vec<u32> = (0..8).map(|_| rng.random_range(0..objects)).collect();
+    let mut image = Vec::with_capacity(width as usize * height as usize);
+    for y in 0..height {
+        for x in 0..width {
+            let region = (x / cell + 3 * (y / cell)) as usize % offsets.len();
+            let mut object_id = (offsets[region] * 7919 + 13) % 1_000_003;
+            if rng.random_bool(0.1) {
+                object_id = rng.random_range(0..objects) * 7919 % 1_000_003;
+            }
+            let level = rng.random_range(0..mix.key_levels.max(1));
+            let mut key = level as f32 * 0.25;
+            if rng.random_bool(mix.awkward.clamp(0.0, 1.0)) {
+                match rng.random_range(0..9) {
+                    0 => key = f32::NAN,
+                    1 => key = f32::INFINITY,
+                    2 => key = f32::NEG_INFINITY,
+                    3 => key = -rng.random_range(0.0..4.0f32) - f32::MIN_POSITIVE,
+                    4 => key = -0.0,
+                    5 => key = f32::from_bits(rng.random_range(1..0x0080_0000)),
+                    6 => object_id = OBJECT_ID_ENVIRONMENT,
+                    7 => object_id = OBJECT_ID_NONE,
+                    _ => key = f32::from_bits(0x7fc0_0000 | rng.random_range(1..0x0040_0000)),
+                }
+            }
+            image.push(Candidate { key, object_id });
+        }
+    }
+    image
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn images_contain_every_awkward_kind_and_equal_keys() {
+        let image = candidate_image(128, 128, 7, CandidateMix { awkward: 0.2, ..Default::default() });
+        assert!(image.iter().any(|c| c.key.is_nan()));
+        assert!(image.iter().any(|c| c.key == f32::INFINITY));
+        assert!(image.iter().any(|c| c.key == f32::NEG_INFINITY));
+        assert!(image.iter().any(|c| c.key.is_subnormal()));
+        assert!(image.iter().any(|c| c.key == 0.0 && c.key.is_sign_negative()));
+        assert!(image.iter().any(|c| c.object_id == OBJECT_ID_NONE));
+        assert!(image.iter().any(|c| c.object_id == OBJECT_ID_ENVIRONMENT));
+        let equal = image.iter().filter(|c| c.key == 1.0).count();
+        assert!(equal > 100, "{equal}");
+        assert_eq!(image, candidate_image(128, 128, 7, CandidateMix { awkward: 0.2, ..Default::default() }));
+    }
+}

@@ -1,0 +1,77 @@
+//! The block-histogram kernel against its Rust reference, on fresh random inputs with
+//! many equal keys, mixed object ids and every awkward value, at every block size and at
+//! image sizes with partial edge blocks; output buffers poisoned before every run.
+
+use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
+use strata::synthetic::{CandidateMix, candidate_image};
+use strata_backends::Backend;
+use strata_kernels::reference::block_histogram::{HistogramOutput, block_histogram};
+use strata_kernels::types::{BLOCK_SIZES, Candidate, ClusterSpan};
+use strata_kernels::BlockGrid;
+use strata_tests::{poison, vulkan_backend};
+
+fn run_poisoned(
+    backend: &mut dyn Backend,
+    variant: HistogramVariant,
+    grid: BlockGrid,
+    candidates: &[Candidate],
+) -> HistogramOutput {
+    let pass = BlockHistogramPass::new(backend, variant, grid).unwrap_or_else(|e| panic!("{e}"));
+    let pixels = grid.pixel_count() as u64;
+    poison(backend, pass.sorted_pixels, pixels * 4);
+    poison(backend, pass.spans, pixels * size_of::<ClusterSpan>() as u64);
+    poison(backend, pass.block_stats, u64::from(grid.block_count()) * 12);
+    let output = pass.run(backend, candidates).unwrap_or_else(|e| panic!("{e}"));
+    pass.destroy(backend).unwrap();
+    output
+}
+
+fn assert_same(grid: BlockGrid, variant: HistogramVariant, got: &HistogramOutput, want: &HistogramOutput) {
+    let context = format!("{}x{} B={} {variant:?}", grid.width, grid.height, grid.block_size);
+    if let Some(i) = (0..want.sorted_pixels.len()).find(|&i| got.sorted_pixels[i] != want.sorted_pixels[i]) {
+        panic!("{context}: sorted_pixels[{i}] = {:#x}, want {:#x}", got.sorted_pixels[i], want.sorted_pixels[i]);
+    }
+    if let Some(i) = (0..want.spans.len()).find(|&i| got.spans[i] != want.spans[i]) {
+        panic!("{context}: spans[{i}] = {:?}, want {:?}", got.spans[i], want.spans[i]);
+    }
+    if let Some(i) = (0..want.stats.len()).find(|&i| got.stats[i] != want.stats[i]) {
+        panic!("{context}: block_stats[{i}] = {:?}, want {:?}", got.stats[i], want.stats[i]);
+    }
+    assert_eq!(got, want, "{context}");
+}
+
+fn check_sizes(variant: HistogramVariant, sizes: &[(u32, u32)], seed: u64) {
+    let Some(mut backend) = vulkan_backend("block_histogram") else { return };
+    if variant == HistogramVariant::Subgroup && backend.info().subgroup_sizes.is_none() {
+        panic!("the Vulkan device has no subgroups: {}", backend.info().summary());
+    }
+    for (index, &(width, height)) in sizes.iter().enumerate() {
+        for (b, &block_size) in BLOCK_SIZES.iter().enumerate() {
+            let grid = BlockGrid::new(width, height, block_size).unwrap();
+            let seed = seed ^ (index as u64) << 8 ^ b as u64;
+            let mix = CandidateMix { objects: 1 + (seed % 7) as u32, key_levels: 1 + (seed % 23) as u32, awkward: 0.08 };
+            let candidates = candidate_image(width, height, seed, mix);
+            let want = block_histogram(grid, &candidates);
+            let got = run_poisoned(&mut backend, variant, grid, &candidates);
+            assert_same(grid, variant, &got, &want);
+        }
+    }
+}
+
+const SMALL: &[(u32, u32)] = &[(1, 1), (17, 33), (33, 17), (64, 64), (3, 100), (129, 65)];
+
+#[test]
+fn portable_matches_reference_on_small_images() {
+    check_sizes(HistogramVariant::Portable, SMALL, 0x5eed_0001);
+}
+
+#[test]
+fn subgroup_matches_reference_on_small_images() {
+    check_sizes(HistogramVariant::Subgroup, SMALL, 0x5eed_0002);
+}
+
+#[test]
+fn both_variants_match_reference_at_1080p() {
+    check_sizes(HistogramVariant::Portable, &[(1920, 1080)], 0x5eed_0003);
+    check_sizes(HistogramVariant::Subgroup, &[(1920, 1080)], 0x5eed_0004);
+}

@@ -75,6 +75,8 @@ mod tests {
         assert!(image.iter().any(|c| c.object_id == OBJECT_ID_ENVIRONMENT));
         let equal = image.iter().filter(|c| c.key == 1.0).count();
         assert!(equal > 100, "{equal}");
-        assert_eq!(image, candidate_image(128, 128, 7, CandidateMix { awkward: 0.2, ..Default::default() }));
+        let again = candidate_image(128, 128, 7, CandidateMix { awkward: 0.2, ..Default::default() });
+        let bits = |image: &[Candidate]| image.iter().map(|c| (c.key.to_bits(), c.object_id)).collect::<Vec<_>>();
+        assert_eq!(bits(&image), bits(&again), "the same seed gives the same image");
     }
 }

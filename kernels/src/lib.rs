@@ -18,6 +18,7 @@ pub mod registry;
 pub mod source;
 pub mod translate;
 pub mod types;
+pub mod validate;
 
 pub use binding::{BindingAccess, BindingInfo, BindingKind, ElementLayout};
 pub use block_grid::{BlockGrid, BlockRect, GridError};

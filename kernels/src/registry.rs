@@ -290,7 +290,7 @@ mod tests {
     fn every_kernel_loads_with_bindings_from_the_ir() {
         let registry = Registry::load().unwrap_or_else(|e| panic!("{e}"));
         let kernel = registry.get(KernelId::BlockHistogram);
-        assert_eq!(kernel.workgroup_size, [128, 1, 1]);
+        assert_eq!(kernel.workgroup_size, [64, 1, 1]);
         let names: Vec<_> = kernel.bindings.iter().map(|b| (b.binding, b.name.as_str())).collect();
         assert_eq!(
             names,

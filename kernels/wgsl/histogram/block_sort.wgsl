@@ -16,21 +16,24 @@
 //   3 storage, rw        array<ClusterSpan> per pixel: its own cluster's run
 //   4 storage, rw        array<BlockStats> per block
 //
-// Dispatch: one workgroup sorts SLOTS = 1024 slots, i.e. 1024 / (B*B) whole blocks;
-// workgroups = ceil(blocks / (1024 / (B*B))) laid out in rows of params.workgroups_x.
+// Dispatch: 64 invocations per workgroup sort SLOTS = 1024 slots, i.e. 1024 / (B*B) whole
+// blocks; workgroups = ceil(blocks / (1024 / (B*B))) in rows of params.workgroups_x.
 //
-// Sorting: bitonic, ELEMS elements per invocation held in registers. Compare steps whose
-// stride lies inside an invocation's elements run in registers; subgroup lanes (in the
-// subgroup entry point) handle the next strides by shuffles; larger strides are
-// brought into registers by re-reading the block from workgroup memory in a
-// transposed order, ELEM_BITS steps per round trip. A 16 x 16 block takes 8 round
-// trips without subgroups, 2 with 8-wide subgroups, against 36 barriers for the naive
-// one-step-per-barrier network.
+// Sorting: bitonic, ELEMS = 16 elements per invocation held in vector registers.
+// Compare steps whose stride lies inside an invocation's elements run in registers;
+// subgroup lanes (in the subgroup entry point) handle the next strides by shuffles;
+// larger strides are brought into registers by re-reading the block from workgroup
+// memory in a transposed order, ELEM_BITS = 4 steps per round trip. A 16 x 16 block takes
+// 8 round trips (16 barriers) without subgroups and 2 with 8-wide subgroups, against 36
+// barriers for the naive one-step-per-barrier network. Workgroup memory: 12.75 KiB.
+//
+// Invalid inputs: see canonical_key (common/candidate.wgsl). Every output element is
+// written for every pixel; sentinel slots past a partial block's pixels write nothing.
 
-const ELEMS: u32 = 8u;
-const ELEM_BITS: u32 = 3u;
+const ELEMS: u32 = 16u;
+const ELEM_BITS: u32 = 4u;
 const SLOTS: u32 = 1024u;
-const INVOCATIONS: u32 = 128u;
+const INVOCATIONS: u32 = 64u;
 const MAX_SEGMENTS: u32 = 64u;
 
 @group(0) @binding(0) var<uniform> params: HistogramParams;
@@ -39,20 +42,37 @@ const MAX_SEGMENTS: u32 = 64u;
 @group(0) @binding(3) var<storage, read_write> spans: array<ClusterSpan>;
 @group(0) @binding(4) var<storage, read_write> block_stats: array<BlockStats>;
 
-var<workgroup> shared_cluster: array<u32, SLOTS>;
-var<workgroup> shared_key: array<u32, SLOTS>;
+// The block's elements between relayouts: (cluster, key) and local pixel index.
+var<workgroup> shared_cluster_key: array<vec2<u32>, SLOTS>;
 var<workgroup> shared_local: array<u32, SLOTS>;
 // Per segment (block of this workgroup): clusters, invalid, empty.
 var<workgroup> shared_stats: array<atomic<u32>, 192>;
 
-// This invocation's elements: (cluster, key, local pixel index within its block).
-var<private> reg_cluster: array<u32, ELEMS>;
-var<private> reg_key: array<u32, ELEMS>;
-var<private> reg_local: array<u32, ELEMS>;
+// Four elements, one per vector lane.
+struct Quad {
+    cluster: vec4<u32>,
+    key: vec4<u32>,
+    local: vec4<u32>,
+}
 
-// Strict total order on (cluster, key, local); locals are unique within a block.
-fn precedes(c0: u32, k0: u32, l0: u32, c1: u32, k1: u32, l1: u32) -> bool {
-    return select(select(l0 < l1, k0 < k1, k0 != k1), c0 < c1, c0 != c1);
+// An invocation's ELEMS = 16 elements: element 4q + i is lane i of quad q. Quads of
+// vectors rather than arrays, so that every driver keeps them in registers (nothing is
+// indexed dynamically) and every translation initialises them without array
+// constructors (which glslang's HLSL front end rejects).
+struct Elements {
+    q0: Quad,
+    q1: Quad,
+    q2: Quad,
+    q3: Quad,
+}
+
+// Strict total order on (cluster, key, local), lane by lane; locals are unique within a block.
+fn precedes(a: Quad, b: Quad) -> vec4<bool> {
+    return select(select(a.local < b.local, a.key < b.key, a.key != b.key), a.cluster < b.cluster, a.cluster != b.cluster);
+}
+
+fn pick(a: Quad, b: Quad, take_b: vec4<bool>) -> Quad {
+    return Quad(select(a.cluster, b.cluster, take_b), select(a.key, b.key, take_b), select(a.local, b.local, take_b));
 }
 
 // Slot of element `e` of invocation `t` when the ELEM_BITS slot bits from `lo` up are
@@ -62,91 +82,149 @@ fn slot_of(t: u32, e: u32, lo: u32) -> u32 {
     return ((t & ~low_mask) << ELEM_BITS) | (t & low_mask) | (e << lo);
 }
 
-// Sort direction of the pair containing `slot` in merge stage 2^log_k. The last stage
-// sorts every block ascending; earlier stages alternate to build bitonic sequences.
-fn ascending(slot: u32, log_k: u32, log_n: u32) -> bool {
-    return log_k == log_n || ((slot >> log_k) & 1u) == 0u;
+// Sort direction of the pairs whose lower elements are `lower` (element indices) in
+// merge stage 2^log_k. The last stage sorts every block ascending; earlier stages
+// alternate to build bitonic sequences.
+fn ascending(t: u32, lower: vec4<u32>, lo: u32, log_k: u32, log_n: u32) -> vec4<bool> {
+    let slots = vec4<u32>(slot_of(t, 0u, lo)) | (lower << vec4<u32>(lo));
+    return vec4<bool>(log_k == log_n) | (((slots >> vec4<u32>(log_k)) & vec4<u32>(1u)) == vec4<u32>(0u));
 }
 
-// Compare-exchange of register elements a < b whose slots differ in one bit.
-fn exchange_registers(a: u32, b: u32, up: bool) {
-    let b_first = precedes(reg_cluster[b], reg_key[b], reg_local[b], reg_cluster[a], reg_key[a], reg_local[a]);
-    if b_first == up {
-        let c = reg_cluster[a];
-        let k = reg_key[a];
-        let l = reg_local[a];
-        reg_cluster[a] = reg_cluster[b];
-        reg_key[a] = reg_key[b];
-        reg_local[a] = reg_local[b];
-        reg_cluster[b] = c;
-        reg_key[b] = k;
-        reg_local[b] = l;
-    }
+// Compare-exchange of four pairs: returns (first, second) ordered as `up` asks.
+struct QuadPair {
+    first: Quad,
+    second: Quad,
 }
 
-// One compare step on register bit `bit` (0, 1 or 2) in the layout with window `lo`.
-// Written out with constant indices so that drivers keep the elements in registers.
-fn step_registers(t: u32, bit: u32, lo: u32, log_k: u32, log_n: u32) {
-    if bit == 2u {
-        exchange_registers(0u, 4u, ascending(slot_of(t, 0u, lo), log_k, log_n));
-        exchange_registers(1u, 5u, ascending(slot_of(t, 1u, lo), log_k, log_n));
-        exchange_registers(2u, 6u, ascending(slot_of(t, 2u, lo), log_k, log_n));
-        exchange_registers(3u, 7u, ascending(slot_of(t, 3u, lo), log_k, log_n));
-    } else if bit == 1u {
-        exchange_registers(0u, 2u, ascending(slot_of(t, 0u, lo), log_k, log_n));
-        exchange_registers(1u, 3u, ascending(slot_of(t, 1u, lo), log_k, log_n));
-        exchange_registers(4u, 6u, ascending(slot_of(t, 4u, lo), log_k, log_n));
-        exchange_registers(5u, 7u, ascending(slot_of(t, 5u, lo), log_k, log_n));
-    } else {
-        exchange_registers(0u, 1u, ascending(slot_of(t, 0u, lo), log_k, log_n));
-        exchange_registers(2u, 3u, ascending(slot_of(t, 2u, lo), log_k, log_n));
-        exchange_registers(4u, 5u, ascending(slot_of(t, 4u, lo), log_k, log_n));
-        exchange_registers(6u, 7u, ascending(slot_of(t, 6u, lo), log_k, log_n));
+fn exchange(a: Quad, b: Quad, up: vec4<bool>) -> QuadPair {
+    let swap = precedes(b, a) == up;
+    return QuadPair(pick(a, b, swap), pick(b, a, swap));
+}
+
+// Compare step on element bit 3 or 2: pairs of whole quads (q, q + 2) or (q, q + 1).
+fn step_quads(a: Quad, b: Quad, first: u32, t: u32, lo: u32, log_k: u32, log_n: u32) -> QuadPair {
+    return exchange(a, b, ascending(t, vec4<u32>(first) + vec4<u32>(0u, 1u, 2u, 3u), lo, log_k, log_n));
+}
+
+// Compare step on element bit 1 inside quads a (elements first..first+3) and b (next 4):
+// pairs (0,2) (1,3) of each.
+fn step_bit1(a: Quad, b: Quad, first: u32, t: u32, lo: u32, log_k: u32, log_n: u32) -> QuadPair {
+    let x = Quad(vec4(a.cluster.xy, b.cluster.xy), vec4(a.key.xy, b.key.xy), vec4(a.local.xy, b.local.xy));
+    let y = Quad(vec4(a.cluster.zw, b.cluster.zw), vec4(a.key.zw, b.key.zw), vec4(a.local.zw, b.local.zw));
+    let r = exchange(x, y, ascending(t, vec4<u32>(first) + vec4<u32>(0u, 1u, 4u, 5u), lo, log_k, log_n));
+    return QuadPair(
+        Quad(vec4(r.first.cluster.xy, r.second.cluster.xy), vec4(r.first.key.xy, r.second.key.xy), vec4(r.first.local.xy, r.second.local.xy)),
+        Quad(vec4(r.first.cluster.zw, r.second.cluster.zw), vec4(r.first.key.zw, r.second.key.zw), vec4(r.first.local.zw, r.second.local.zw)),
+    );
+}
+
+// Compare step on element bit 0: pairs (0,1) (2,3) of quads a and b.
+fn step_bit0(a: Quad, b: Quad, first: u32, t: u32, lo: u32, log_k: u32, log_n: u32) -> QuadPair {
+    let x = Quad(vec4(a.cluster.xz, b.cluster.xz), vec4(a.key.xz, b.key.xz), vec4(a.local.xz, b.local.xz));
+    let y = Quad(vec4(a.cluster.yw, b.cluster.yw), vec4(a.key.yw, b.key.yw), vec4(a.local.yw, b.local.yw));
+    let r = exchange(x, y, ascending(t, vec4<u32>(first) + vec4<u32>(0u, 2u, 4u, 6u), lo, log_k, log_n));
+    return QuadPair(
+        Quad(
+            vec4(r.first.cluster.x, r.second.cluster.x, r.first.cluster.y, r.second.cluster.y),
+            vec4(r.first.key.x, r.second.key.x, r.first.key.y, r.second.key.y),
+            vec4(r.first.local.x, r.second.local.x, r.first.local.y, r.second.local.y),
+        ),
+        Quad(
+            vec4(r.first.cluster.z, r.second.cluster.z, r.first.cluster.w, r.second.cluster.w),
+            vec4(r.first.key.z, r.second.key.z, r.first.key.w, r.second.key.w),
+            vec4(r.first.local.z, r.second.local.z, r.first.local.w, r.second.local.w),
+        ),
+    );
+}
+
+// The register steps from element bit `top` (<= 3) down to 0, in the layout with window `lo`.
+fn steps_registers(el: Elements, t: u32, top: u32, lo: u32, log_k: u32, log_n: u32) -> Elements {
+    var e = el;
+    if top >= 3u {
+        let r02 = step_quads(e.q0, e.q2, 0u, t, lo, log_k, log_n);
+        let r13 = step_quads(e.q1, e.q3, 4u, t, lo, log_k, log_n);
+        e = Elements(r02.first, r13.first, r02.second, r13.second);
     }
+    if top >= 2u {
+        let r01 = step_quads(e.q0, e.q1, 0u, t, lo, log_k, log_n);
+        let r23 = step_quads(e.q2, e.q3, 8u, t, lo, log_k, log_n);
+        e = Elements(r01.first, r01.second, r23.first, r23.second);
+    }
+    if top >= 1u {
+        let r01 = step_bit1(e.q0, e.q1, 0u, t, lo, log_k, log_n);
+        let r23 = step_bit1(e.q2, e.q3, 8u, t, lo, log_k, log_n);
+        e = Elements(r01.first, r01.second, r23.first, r23.second);
+    }
+    let r01 = step_bit0(e.q0, e.q1, 0u, t, lo, log_k, log_n);
+    let r23 = step_bit0(e.q2, e.q3, 8u, t, lo, log_k, log_n);
+    return Elements(r01.first, r01.second, r23.first, r23.second);
+}
+
+// Keeps, per element, this lane's or the partner lane's element (lanes differing in
+// the shuffle mask), as the compare step on that slot bit asks; natural layout.
+fn keep_lane(mine: Quad, mask: u32, lower: bool, first: u32, t: u32, log_k: u32, log_n: u32) -> Quad {
+    let other = Quad(lane_exchange(mine.cluster, mask), lane_exchange(mine.key, mask), lane_exchange(mine.local, mask));
+    let up = ascending(t, vec4<u32>(first) + vec4<u32>(0u, 1u, 2u, 3u), 0u, log_k, log_n);
+    return pick(mine, other, precedes(other, mine) == (vec4<bool>(lower) == up));
 }
 
 // One compare step across subgroup lanes: slot bit ELEM_BITS + lane_bit, natural layout.
-fn step_lanes(t: u32, lane_bit: u32, log_k: u32, log_n: u32) {
+fn step_lanes(el: Elements, t: u32, lane_bit: u32, log_k: u32, log_n: u32) -> Elements {
     let mask = 1u << lane_bit;
     let lower = (t & mask) == 0u;
-    for (var e = 0u; e < ELEMS; e++) {
-        let c = lane_exchange(reg_cluster[e], mask);
-        let k = lane_exchange(reg_key[e], mask);
-        let l = lane_exchange(reg_local[e], mask);
-        let up = ascending(slot_of(t, e, 0u), log_k, log_n);
-        let other_first = precedes(c, k, l, reg_cluster[e], reg_key[e], reg_local[e]);
-        if other_first == (lower == up) {
-            reg_cluster[e] = c;
-            reg_key[e] = k;
-            reg_local[e] = l;
-        }
-    }
+    return Elements(
+        keep_lane(el.q0, mask, lower, 0u, t, log_k, log_n),
+        keep_lane(el.q1, mask, lower, 4u, t, log_k, log_n),
+        keep_lane(el.q2, mask, lower, 8u, t, log_k, log_n),
+        keep_lane(el.q3, mask, lower, 12u, t, log_k, log_n),
+    );
 }
 
-fn store_registers(t: u32, lo: u32) {
-    for (var e = 0u; e < ELEMS; e++) {
-        let slot = slot_of(t, e, lo);
-        shared_cluster[slot] = reg_cluster[e];
-        shared_key[slot] = reg_key[e];
-        shared_local[slot] = reg_local[e];
-    }
+fn place(slot: u32, cluster: u32, key: u32, local: u32) {
+    shared_cluster_key[slot] = vec2<u32>(cluster, key);
+    shared_local[slot] = local;
 }
 
-fn load_registers(t: u32, lo: u32) {
-    for (var e = 0u; e < ELEMS; e++) {
-        let slot = slot_of(t, e, lo);
-        reg_cluster[e] = shared_cluster[slot];
-        reg_key[e] = shared_key[slot];
-        reg_local[e] = shared_local[slot];
-    }
+// Stores quad q (elements first..first+3) at its slots in layout `lo`.
+fn store_quad(q: Quad, first: u32, t: u32, lo: u32) {
+    let base = slot_of(t, 0u, lo);
+    place(base | (first << lo), q.cluster.x, q.key.x, q.local.x);
+    place(base | ((first + 1u) << lo), q.cluster.y, q.key.y, q.local.y);
+    place(base | ((first + 2u) << lo), q.cluster.z, q.key.z, q.local.z);
+    place(base | ((first + 3u) << lo), q.cluster.w, q.key.w, q.local.w);
+}
+
+fn store_registers(el: Elements, t: u32, lo: u32) {
+    store_quad(el.q0, 0u, t, lo);
+    store_quad(el.q1, 4u, t, lo);
+    store_quad(el.q2, 8u, t, lo);
+    store_quad(el.q3, 12u, t, lo);
+}
+
+// Quad of elements first..first+3 from their slots in layout `lo`.
+fn load_quad(first: u32, t: u32, lo: u32) -> Quad {
+    let slots = vec4<u32>(slot_of(t, 0u, lo)) | ((vec4<u32>(first) + vec4<u32>(0u, 1u, 2u, 3u)) << vec4<u32>(lo));
+    let a = shared_cluster_key[slots.x];
+    let b = shared_cluster_key[slots.y];
+    let c = shared_cluster_key[slots.z];
+    let d = shared_cluster_key[slots.w];
+    return Quad(
+        vec4<u32>(a.x, b.x, c.x, d.x),
+        vec4<u32>(a.y, b.y, c.y, d.y),
+        vec4<u32>(shared_local[slots.x], shared_local[slots.y], shared_local[slots.z], shared_local[slots.w]),
+    );
+}
+
+fn load_registers(t: u32, lo: u32) -> Elements {
+    return Elements(load_quad(0u, t, lo), load_quad(4u, t, lo), load_quad(8u, t, lo), load_quad(12u, t, lo));
 }
 
 // Moves the elements from layout `old_lo` to layout `new_lo` through workgroup memory.
-fn relayout(t: u32, old_lo: u32, new_lo: u32) {
+fn relayout(el: Elements, t: u32, old_lo: u32, new_lo: u32) -> Elements {
     workgroupBarrier();
-    store_registers(t, old_lo);
+    store_registers(el, t, old_lo);
     workgroupBarrier();
-    load_registers(t, new_lo);
+    return load_registers(t, new_lo);
 }
 
 // First index in [begin, end) whose cluster is not below `cluster`
@@ -156,7 +234,7 @@ fn search_cluster(begin: u32, end: u32, cluster: u32, inclusive: bool) -> u32 {
     var hi = end;
     while lo < hi {
         let mid = (lo + hi) / 2u;
-        let c = shared_cluster[mid];
+        let c = shared_cluster_key[mid].x;
         if c < cluster || (inclusive && c == cluster) {
             lo = mid + 1u;
         } else {
@@ -172,7 +250,7 @@ fn search_invalid(begin: u32, end: u32) -> u32 {
     var hi = end;
     while lo < hi {
         let mid = (lo + hi) / 2u;
-        if shared_key[mid] != INVALID_KEY {
+        if shared_cluster_key[mid].y != INVALID_KEY {
             lo = mid + 1u;
         } else {
             hi = mid;
@@ -207,38 +285,97 @@ fn pixel_of(rect: BlockRect, local: u32) -> u32 {
     return (rect.y + local / rect.width) * params.width + rect.x + local % rect.width;
 }
 
+// Dispatch-wide sizes derived from params, the same in every invocation.
+struct Sizes {
+    log_n: u32,
+    n: u32,
+    segments: u32,
+    block_count: u32,
+    first_block: u32,
+}
+
+// (cluster, canonical key, local) of the slot: the pixel's candidate, or a sentinel that
+// sorts after every real element when the slot lies past its block's pixels.
+fn load_element(slot: u32, sizes: Sizes) -> vec3<u32> {
+    let block = sizes.first_block + (slot >> sizes.log_n);
+    let local = slot & (sizes.n - 1u);
+    if block < sizes.block_count {
+        let rect = block_rect(block);
+        if local < rect.width * rect.height {
+            let candidate = candidates[pixel_of(rect, local)];
+            return vec3<u32>(candidate.object_id, canonical_key(candidate), local);
+        }
+    }
+    return vec3<u32>(OBJECT_ID_NONE, INVALID_KEY, local);
+}
+
+// Quad of the elements at slots first..first+3.
+fn load_candidates(first: u32, sizes: Sizes) -> Quad {
+    let a = load_element(first, sizes);
+    let b = load_element(first + 1u, sizes);
+    let c = load_element(first + 2u, sizes);
+    let d = load_element(first + 3u, sizes);
+    return Quad(vec4<u32>(a.x, b.x, c.x, d.x), vec4<u32>(a.y, b.y, c.y, d.y), vec4<u32>(a.z, b.z, c.z, d.z));
+}
+
+fn finish_quad(q: Quad, first: u32, sizes: Sizes) {
+    finish_element(first, q.cluster.x, q.key.x, q.local.x, sizes);
+    finish_element(first + 1u, q.cluster.y, q.key.y, q.local.y, sizes);
+    finish_element(first + 2u, q.cluster.z, q.key.z, q.local.z, sizes);
+    finish_element(first + 3u, q.cluster.w, q.key.w, q.local.w, sizes);
+}
+
+// Writes the outputs of the sorted element at `slot` (natural layout, after the sort,
+// with the sorted block in workgroup memory).
+fn finish_element(slot: u32, cluster: u32, key: u32, local: u32, sizes: Sizes) {
+    let segment = slot >> sizes.log_n;
+    let block = sizes.first_block + segment;
+    let position = slot & (sizes.n - 1u);
+    if block >= sizes.block_count {
+        return;
+    }
+    let rect = block_rect(block);
+    let count = rect.width * rect.height;
+    if position >= count {
+        return;
+    }
+    let begin = slot - position;
+    let run_begin = search_cluster(begin, slot, cluster, false);
+    let run_end = search_cluster(slot + 1u, begin + count, cluster, true);
+    let valid_end = search_invalid(run_begin, run_end);
+    let pixel = pixel_of(rect, local);
+    sorted_pixels[rect.base + position] = pixel;
+    spans[pixel] = ClusterSpan(rect.base + run_begin - begin, run_end - run_begin, valid_end - run_begin);
+    if run_begin == slot {
+        atomicAdd(&shared_stats[3u * segment], 1u);
+    }
+    if cluster == OBJECT_ID_NONE {
+        atomicAdd(&shared_stats[3u * segment + 2u], 1u);
+    } else if key == INVALID_KEY {
+        atomicAdd(&shared_stats[3u * segment + 1u], 1u);
+    }
+}
+
 // The whole pass for one workgroup; `lane_bits` = log2 of the subgroup size usable for
 // shuffles (0: none). Must be called in uniform control flow.
 fn run_block_histogram(t: u32, workgroup_id: vec3<u32>, lane_bits: u32) {
     let log_n = 2u * params.log2_block_size;
-    let n = 1u << log_n;
     let segments = SLOTS >> log_n;
-    let block_count = params.blocks_x * params.blocks_y;
-    let first_block = (workgroup_id.y * params.workgroups_x + workgroup_id.x) * segments;
+    let sizes = Sizes(
+        log_n,
+        1u << log_n,
+        segments,
+        params.blocks_x * params.blocks_y,
+        (workgroup_id.y * params.workgroups_x + workgroup_id.x) * segments,
+    );
 
     for (var i = t; i < 3u * MAX_SEGMENTS; i += INVOCATIONS) {
         atomicStore(&shared_stats[i], 0u);
     }
 
-    // Load: natural layout; slots past a block's pixels hold sentinels that sort last.
-    for (var e = 0u; e < ELEMS; e++) {
-        let slot = slot_of(t, e, 0u);
-        let block = first_block + (slot >> log_n);
-        let local = slot & (n - 1u);
-        var cluster = OBJECT_ID_NONE;
-        var key = INVALID_KEY;
-        if block < block_count {
-            let rect = block_rect(block);
-            if local < rect.width * rect.height {
-                let candidate = candidates[pixel_of(rect, local)];
-                cluster = candidate.object_id;
-                key = canonical_key(candidate);
-            }
-        }
-        reg_cluster[e] = cluster;
-        reg_key[e] = key;
-        reg_local[e] = local;
-    }
+    // Load in the natural layout.
+    let base = slot_of(t, 0u, 0u);
+    var el = Elements(load_candidates(base, sizes), load_candidates(base + 4u, sizes), load_candidates(base + 8u, sizes), load_candidates(base + 12u, sizes));
 
     // Bitonic sort of every n-slot segment.
     var current_lo = 0u;
@@ -247,65 +384,37 @@ fn run_block_histogram(t: u32, workgroup_id: vec3<u32>, lane_bits: u32) {
         loop {
             if top < ELEM_BITS + lane_bits {
                 if current_lo != 0u {
-                    relayout(t, current_lo, 0u);
+                    el = relayout(el, t, current_lo, 0u);
                     current_lo = 0u;
                 }
                 for (var s = top + 1u; s > ELEM_BITS; s--) {
-                    step_lanes(t, s - 1u - ELEM_BITS, log_k, log_n);
+                    el = step_lanes(el, t, s - 1u - ELEM_BITS, log_k, log_n);
                 }
-                for (var s = min(top, ELEM_BITS - 1u) + 1u; s > 0u; s--) {
-                    step_registers(t, s - 1u, 0u, log_k, log_n);
-                }
+                el = steps_registers(el, t, min(top, ELEM_BITS - 1u), 0u, log_k, log_n);
                 break;
             }
             let lo = top + 1u - ELEM_BITS;
-            relayout(t, current_lo, lo);
+            el = relayout(el, t, current_lo, lo);
             current_lo = lo;
-            for (var s = ELEM_BITS; s > 0u; s--) {
-                step_registers(t, s - 1u, lo, log_k, log_n);
-            }
+            el = steps_registers(el, t, ELEM_BITS - 1u, lo, log_k, log_n);
             top -= ELEM_BITS;
         }
     }
 
     workgroupBarrier();
-    store_registers(t, 0u);
+    store_registers(el, t, 0u);
     workgroupBarrier();
 
     // Runs, spans and counters.
-    for (var e = 0u; e < ELEMS; e++) {
-        let slot = slot_of(t, e, 0u);
-        let segment = slot >> log_n;
-        let block = first_block + segment;
-        let position = slot & (n - 1u);
-        if block < block_count {
-            let rect = block_rect(block);
-            let count = rect.width * rect.height;
-            if position < count {
-                let begin = slot - position;
-                let cluster = reg_cluster[e];
-                let run_begin = search_cluster(begin, slot, cluster, false);
-                let run_end = search_cluster(slot + 1u, begin + count, cluster, true);
-                let valid_end = search_invalid(run_begin, run_end);
-                let pixel = pixel_of(rect, reg_local[e]);
-                sorted_pixels[rect.base + position] = pixel;
-                spans[pixel] = ClusterSpan(rect.base + run_begin - begin, run_end - run_begin, valid_end - run_begin);
-                if run_begin == slot {
-                    atomicAdd(&shared_stats[3u * segment], 1u);
-                }
-                if cluster == OBJECT_ID_NONE {
-                    atomicAdd(&shared_stats[3u * segment + 2u], 1u);
-                } else if reg_key[e] == INVALID_KEY {
-                    atomicAdd(&shared_stats[3u * segment + 1u], 1u);
-                }
-            }
-        }
-    }
+    finish_quad(el.q0, base, sizes);
+    finish_quad(el.q1, base + 4u, sizes);
+    finish_quad(el.q2, base + 8u, sizes);
+    finish_quad(el.q3, base + 12u, sizes);
 
     workgroupBarrier();
     for (var segment = t; segment < segments; segment += INVOCATIONS) {
-        let block = first_block + segment;
-        if block < block_count {
+        let block = sizes.first_block + segment;
+        if block < sizes.block_count {
             block_stats[block] = BlockStats(
                 atomicLoad(&shared_stats[3u * segment]),
                 atomicLoad(&shared_stats[3u * segment + 1u]),

@@ -2,11 +2,11 @@
 // GL backend and the CPU interpreter included). See block_sort.wgsl.
 
 // Never called: with zero lane bits every exchange stays in registers or workgroup memory.
-fn lane_exchange(value: u32, mask: u32) -> u32 {
+fn lane_exchange(value: vec4<u32>, mask: u32) -> vec4<u32> {
     return value;
 }
 
-@compute @workgroup_size(128)
+@compute @workgroup_size(64)
 fn block_histogram(
     @builtin(local_invocation_index) local_index: u32,
     @builtin(workgroup_id) workgroup_id: vec3<u32>,

@@ -8,11 +8,11 @@
 var<workgroup> lane_mismatch: atomic<u32>;
 var<workgroup> lane_bits_chosen: u32;
 
-fn lane_exchange(value: u32, mask: u32) -> u32 {
+fn lane_exchange(value: vec4<u32>, mask: u32) -> vec4<u32> {
     return subgroupShuffleXor(value, mask);
 }
 
-@compute @workgroup_size(128)
+@compute @workgroup_size(64)
 fn block_histogram_subgroup(
     @builtin(local_invocation_index) local_index: u32,
     @builtin(workgroup_id) workgroup_id: vec3<u32>,

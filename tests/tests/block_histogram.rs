@@ -75,3 +75,19 @@ fn both_variants_match_reference_at_1080p() {
     check_sizes(HistogramVariant::Portable, &[(1920, 1080)], 0x5eed_0003);
     check_sizes(HistogramVariant::Subgroup, &[(1920, 1080)], 0x5eed_0004);
 }
+
+/// The portable kernel on wgpu's GL backend (naga's GLSL on llvmpipe's OpenGL), which
+/// has no subgroups: the path every adapter can run.
+#[test]
+fn portable_matches_reference_on_gl() {
+    use strata_backends::wgpu_backend::{WgpuApi, WgpuOptions};
+    let options = WgpuOptions { api: WgpuApi::Gl, validation: false, subgroups: true };
+    let Some(mut backend) = strata_tests::open_or_skip("portable_matches_reference_on_gl", options) else { return };
+    assert!(backend.info().subgroup_sizes.is_none(), "wgpu's GL backend has no subgroups");
+    for (width, height, block_size, seed) in [(17, 33, 4, 1), (40, 33, 32, 3), (33, 17, 8, 4), (20, 20, 16, 2)] {
+        let grid = BlockGrid::new(width, height, block_size).unwrap();
+        let candidates = candidate_image(width, height, seed, CandidateMix { awkward: 0.1, ..Default::default() });
+        let got = run_poisoned(&mut backend, HistogramVariant::Auto, grid, &candidates);
+        assert_same(grid, HistogramVariant::Auto, &got, &block_histogram(grid, &candidates));
+    }
+}

@@ -37,8 +37,12 @@ pub trait Backend {
     fn create_buffer(&mut self, label: &str, size: u64) -> Result<BufferId, BackendError>;
 
     /// Writes `data` at byte `offset`; offset and length must be multiples of 4.
-    fn write_buffer(&mut self, buffer: BufferId, offset: u64, data: &[u8])
-    -> Result<(), BackendError>;
+    fn write_buffer(
+        &mut self,
+        buffer: BufferId,
+        offset: u64,
+        data: &[u8],
+    ) -> Result<(), BackendError>;
 
     /// The buffer's whole contents, after every submitted dispatch has finished.
     fn read_buffer(&mut self, buffer: BufferId) -> Result<Vec<u8>, BackendError>;

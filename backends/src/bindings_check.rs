@@ -20,7 +20,12 @@ pub fn check_kernel_fits(kernel: &Kernel, device: &DeviceInfo) -> Result<(), Bac
     let what = || format!("kernel `{}`", kernel.name());
     let exceeded = |limit, requested: u64, available: u64| {
         if requested > available {
-            Err(BackendError::LimitExceeded { what: what(), limit, requested, available })
+            Err(BackendError::LimitExceeded {
+                what: what(),
+                limit,
+                requested,
+                available,
+            })
         } else {
             Ok(())
         }
@@ -30,11 +35,28 @@ pub fn check_kernel_fits(kernel: &Kernel, device: &DeviceInfo) -> Result<(), Bac
         u64::from(kernel.invocations()),
         u64::from(limits.max_invocations_per_workgroup),
     )?;
-    for (axis, (&size, &max)) in kernel.workgroup_size.iter().zip(&limits.max_workgroup_size).enumerate() {
-        exceeded(["workgroup size x", "workgroup size y", "workgroup size z"][axis], u64::from(size), u64::from(max))?;
+    for (axis, (&size, &max)) in kernel
+        .workgroup_size
+        .iter()
+        .zip(&limits.max_workgroup_size)
+        .enumerate()
+    {
+        exceeded(
+            ["workgroup size x", "workgroup size y", "workgroup size z"][axis],
+            u64::from(size),
+            u64::from(max),
+        )?;
     }
-    exceeded("workgroup memory bytes", kernel.workgroup_memory_bytes(), limits.max_workgroup_storage)?;
-    let storage = kernel.bindings.iter().filter(|b| matches!(b.kind, BindingKind::Storage(_))).count();
+    exceeded(
+        "workgroup memory bytes",
+        kernel.workgroup_memory_bytes(),
+        limits.max_workgroup_storage,
+    )?;
+    let storage = kernel
+        .bindings
+        .iter()
+        .filter(|b| matches!(b.kind, BindingKind::Storage(_)))
+        .count();
     exceeded(
         "storage buffers per stage",
         storage as u64,

@@ -24,7 +24,10 @@ pub fn open_backend(choice: BackendChoice) -> Result<Box<dyn Backend>, BackendEr
         BackendChoice::Auto | BackendChoice::Wgpu => WgpuApi::Vulkan,
         BackendChoice::WgpuGl => WgpuApi::Gl,
     };
-    match WgpuBackend::new(WgpuOptions { api, ..Default::default() }) {
+    match WgpuBackend::new(WgpuOptions {
+        api,
+        ..Default::default()
+    }) {
         Ok(backend) => Ok(Box::new(backend)),
         Err(BackendError::NoAdapter { backend, reason }) => Err(BackendError::NoAdapter {
             backend,

@@ -51,7 +51,16 @@ shader_struct!(BlockStats, "BlockStats", [clusters, invalid, empty]);
 shader_struct!(
     HistogramParams,
     "HistogramParams",
-    [width, height, block_size, log2_block_size, blocks_x, blocks_y, workgroups_x, _pad]
+    [
+        width,
+        height,
+        block_size,
+        log2_block_size,
+        blocks_x,
+        blocks_y,
+        workgroups_x,
+        _pad
+    ]
 );
 
 /// Compares `T` with the struct `T::WGSL_NAME` of `module`; the error lists every
@@ -138,8 +147,14 @@ mod tests {
         // WGSL puts a u32 right after a vec3<f32>, at offset 12: the host has it at 16.
         let bad = module("struct Padded { position: vec3<f32>, id: u32, pad: vec3<u32> }");
         let error = check_struct::<Padded>(&bad).unwrap_err();
-        assert!(error.contains("field `id`: WGSL offset 12, host offset 16"), "{error}");
-        assert!(error.contains("field `position`: WGSL size 12, host size 16"), "{error}");
+        assert!(
+            error.contains("field `id`: WGSL offset 12, host offset 16"),
+            "{error}"
+        );
+        assert!(
+            error.contains("field `position`: WGSL size 12, host size 16"),
+            "{error}"
+        );
         let good = module("struct Padded { position: vec4<f32>, id: u32, pad: array<u32, 3> }");
         check_struct::<Padded>(&good).unwrap();
     }
@@ -147,8 +162,16 @@ mod tests {
     #[test]
     fn renamed_and_missing_fields_are_caught() {
         let renamed = module("struct Padded { pos: vec4<f32>, id: u32, pad: array<u32, 3> }");
-        assert!(check_struct::<Padded>(&renamed).unwrap_err().contains("`pos`"));
+        assert!(
+            check_struct::<Padded>(&renamed)
+                .unwrap_err()
+                .contains("`pos`")
+        );
         let missing = module("struct Other { id: u32 }");
-        assert!(check_struct::<Padded>(&missing).unwrap_err().contains("no WGSL struct"));
+        assert!(
+            check_struct::<Padded>(&missing)
+                .unwrap_err()
+                .contains("no WGSL struct")
+        );
     }
 }

@@ -30,14 +30,22 @@ impl KernelId {
         match self {
             KernelId::BlockHistogram => KernelSpec {
                 name: "block_histogram",
-                fragments: vec![HISTOGRAM[0], HISTOGRAM[1], fragment!("histogram/entry_portable.wgsl")],
+                fragments: vec![
+                    HISTOGRAM[0],
+                    HISTOGRAM[1],
+                    fragment!("histogram/entry_portable.wgsl"),
+                ],
                 entry_point: "block_histogram",
                 features: KernelFeatures::empty(),
                 float_ulp_bound: None,
             },
             KernelId::BlockHistogramSubgroup => KernelSpec {
                 name: "block_histogram_subgroup",
-                fragments: vec![HISTOGRAM[0], HISTOGRAM[1], fragment!("histogram/entry_subgroup.wgsl")],
+                fragments: vec![
+                    HISTOGRAM[0],
+                    HISTOGRAM[1],
+                    fragment!("histogram/entry_subgroup.wgsl"),
+                ],
                 entry_point: "block_histogram_subgroup",
                 features: KernelFeatures::SUBGROUP,
                 float_ulp_bound: None,
@@ -174,14 +182,15 @@ impl Kernel {
                 message: format!("at {location}\n{}", error.emit_to_string(&source.text)),
             }
         })?;
-        let info = naga::valid::Validator::new(ValidationFlags::all(), spec.features.capabilities())
-            .subgroup_stages(ShaderStages::COMPUTE)
-            .subgroup_operations(SubgroupOperationSet::all())
-            .validate(&module)
-            .map_err(|error| KernelError::Validation {
-                kernel: spec.name.into(),
-                message: error.emit_to_string(&source.text),
-            })?;
+        let info =
+            naga::valid::Validator::new(ValidationFlags::all(), spec.features.capabilities())
+                .subgroup_stages(ShaderStages::COMPUTE)
+                .subgroup_operations(SubgroupOperationSet::all())
+                .validate(&module)
+                .map_err(|error| KernelError::Validation {
+                    kernel: spec.name.into(),
+                    message: error.emit_to_string(&source.text),
+                })?;
         let entry_index = module
             .entry_points
             .iter()
@@ -192,7 +201,15 @@ impl Kernel {
             })?;
         let workgroup_size = module.entry_points[entry_index].workgroup_size;
         let bindings = describe_bindings(spec.name, &module, &info, entry_index)?;
-        Ok(Kernel { id, spec, source, module, info, workgroup_size, bindings })
+        Ok(Kernel {
+            id,
+            spec,
+            source,
+            module,
+            info,
+            workgroup_size,
+            bindings,
+        })
     }
 }
 
@@ -205,11 +222,16 @@ fn describe_bindings(
     let mut layouter = naga::proc::Layouter::default();
     layouter
         .update(module.to_ctx())
-        .map_err(|e| KernelError::Validation { kernel: kernel.into(), message: e.to_string() })?;
+        .map_err(|e| KernelError::Validation {
+            kernel: kernel.into(),
+            message: e.to_string(),
+        })?;
     let ep_info = info.get_entry_point(entry_index);
     let mut bindings = Vec::new();
     for (handle, var) in module.global_variables.iter() {
-        let Some(resource) = &var.binding else { continue };
+        let Some(resource) = &var.binding else {
+            continue;
+        };
         if ep_info[handle].is_empty() {
             continue;
         }
@@ -230,10 +252,16 @@ fn describe_bindings(
                     BindingKind::Storage(BindingAccess::ReadOnly)
                 }
             }
-            _ => return Err(unsupported("only uniform and storage buffers are supported")),
+            _ => {
+                return Err(unsupported(
+                    "only uniform and storage buffers are supported",
+                ));
+            }
         };
         if resource.group != 0 {
-            return Err(unsupported("registry kernels use @group(0) only (GLSL has no descriptor sets)"));
+            return Err(unsupported(
+                "registry kernels use @group(0) only (GLSL has no descriptor sets)",
+            ));
         }
         bindings.push(BindingInfo {
             group: resource.group,
@@ -256,13 +284,20 @@ pub struct Registry {
 impl Registry {
     /// The registry of this process, loaded on first use.
     pub fn shared() -> Result<&'static Registry, KernelError> {
-        static SHARED: std::sync::OnceLock<Result<Registry, KernelError>> = std::sync::OnceLock::new();
-        SHARED.get_or_init(Registry::load).as_ref().map_err(Clone::clone)
+        static SHARED: std::sync::OnceLock<Result<Registry, KernelError>> =
+            std::sync::OnceLock::new();
+        SHARED
+            .get_or_init(Registry::load)
+            .as_ref()
+            .map_err(Clone::clone)
     }
 
     /// Loads every kernel of [`KernelId::ALL`].
     pub fn load() -> Result<Registry, KernelError> {
-        let kernels = KernelId::ALL.iter().map(|&id| Kernel::load(id)).collect::<Result<_, _>>()?;
+        let kernels = KernelId::ALL
+            .iter()
+            .map(|&id| Kernel::load(id))
+            .collect::<Result<_, _>>()?;
         Ok(Registry { kernels })
     }
 
@@ -291,14 +326,30 @@ mod tests {
         let registry = Registry::load().unwrap_or_else(|e| panic!("{e}"));
         let kernel = registry.get(KernelId::BlockHistogram);
         assert_eq!(kernel.workgroup_size, [64, 1, 1]);
-        let names: Vec<_> = kernel.bindings.iter().map(|b| (b.binding, b.name.as_str())).collect();
+        let names: Vec<_> = kernel
+            .bindings
+            .iter()
+            .map(|b| (b.binding, b.name.as_str()))
+            .collect();
         assert_eq!(
             names,
-            [(0, "params"), (1, "candidates"), (2, "sorted_pixels"), (3, "spans"), (4, "block_stats")]
+            [
+                (0, "params"),
+                (1, "candidates"),
+                (2, "sorted_pixels"),
+                (3, "spans"),
+                (4, "block_stats")
+            ]
         );
         assert_eq!(kernel.bindings[0].kind, BindingKind::Uniform);
-        assert_eq!(kernel.bindings[1].kind, BindingKind::Storage(BindingAccess::ReadOnly));
-        assert_eq!(kernel.bindings[3].kind, BindingKind::Storage(BindingAccess::ReadWrite));
+        assert_eq!(
+            kernel.bindings[1].kind,
+            BindingKind::Storage(BindingAccess::ReadOnly)
+        );
+        assert_eq!(
+            kernel.bindings[3].kind,
+            BindingKind::Storage(BindingAccess::ReadWrite)
+        );
         assert_eq!(kernel.bindings[1].element.type_name, "Candidate");
         assert_eq!(kernel.bindings[1].element.stride, 8);
         assert_eq!(kernel.bindings[1].element.count, None);
@@ -306,9 +357,17 @@ mod tests {
         assert_eq!(kernel.bindings[0].element.count, Some(1));
         assert_eq!(kernel.bindings[0].min_size(), 32);
         // 3 x 1024 u32 of keys plus 192 counters: within WebGPU's 16 KiB minimum.
-        assert!(kernel.workgroup_memory_bytes() <= 16 * 1024, "{}", kernel.workgroup_memory_bytes());
+        assert!(
+            kernel.workgroup_memory_bytes() <= 16 * 1024,
+            "{}",
+            kernel.workgroup_memory_bytes()
+        );
         for kernel in registry.kernels() {
-            assert!(kernel.bindings.iter().all(|b| b.group == 0), "{}", kernel.name());
+            assert!(
+                kernel.bindings.iter().all(|b| b.group == 0),
+                "{}",
+                kernel.name()
+            );
         }
     }
 
@@ -334,8 +393,12 @@ mod tests {
         spec.fragments[2] = fragment!("histogram/entry_subgroup.wgsl");
         let source = ComposedSource::compose(&spec.fragments);
         let module = naga::front::wgsl::parse_str(&source.text).unwrap();
-        let result = naga::valid::Validator::new(ValidationFlags::all(), spec.features.capabilities())
-            .validate(&module);
-        assert!(result.is_err(), "subgroup operations must need the SUBGROUP capability");
+        let result =
+            naga::valid::Validator::new(ValidationFlags::all(), spec.features.capabilities())
+                .validate(&module);
+        assert!(
+            result.is_err(),
+            "subgroup operations must need the SUBGROUP capability"
+        );
     }
 }

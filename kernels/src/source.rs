@@ -60,7 +60,10 @@ impl ComposedSource {
 
     /// "fragment:line" for a byte offset into the composed text.
     pub fn describe_offset(&self, offset: usize) -> String {
-        let line = self.text[..offset.min(self.text.len())].lines().count().max(1);
+        let line = self.text[..offset.min(self.text.len())]
+            .lines()
+            .count()
+            .max(1);
         let line = if self.text[..offset.min(self.text.len())].ends_with('\n') {
             line + 1
         } else {
@@ -78,9 +81,18 @@ mod tests {
     #[test]
     fn lines_map_back_to_fragments() {
         let source = ComposedSource::compose(&[
-            Fragment { path: "a.wgsl", text: "one\ntwo\n" },
-            Fragment { path: "b.wgsl", text: "three\nfour" },
-            Fragment { path: "c.wgsl", text: "five\n" },
+            Fragment {
+                path: "a.wgsl",
+                text: "one\ntwo\n",
+            },
+            Fragment {
+                path: "b.wgsl",
+                text: "three\nfour",
+            },
+            Fragment {
+                path: "c.wgsl",
+                text: "five\n",
+            },
         ]);
         assert_eq!(source.locate(1), ("a.wgsl", 1));
         assert_eq!(source.locate(2), ("a.wgsl", 2));

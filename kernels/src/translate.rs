@@ -23,7 +23,9 @@ pub struct TranslateOptions {
 
 impl Default for TranslateOptions {
     fn default() -> Self {
-        Self { zero_initialize_workgroup_memory: true }
+        Self {
+            zero_initialize_workgroup_memory: true,
+        }
     }
 }
 
@@ -39,7 +41,11 @@ pub struct Translation {
 }
 
 fn error(kernel: &Kernel, target: &'static str, message: impl ToString) -> KernelError {
-    KernelError::Translation { kernel: kernel.name().into(), target, message: message.to_string() }
+    KernelError::Translation {
+        kernel: kernel.name().into(),
+        target,
+        message: message.to_string(),
+    }
 }
 
 /// SPIR-V for Vulkan 1.1+, the entry point alone.
@@ -63,7 +69,11 @@ pub fn spirv(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, 
     };
     let words = spv::write_vec(&kernel.module, &kernel.info, &spv_options, Some(&pipeline))
         .map_err(|e| error(kernel, "SPIR-V", e))?;
-    Ok(Translation { text: String::new(), words, entry_point: kernel.entry_point().into() })
+    Ok(Translation {
+        text: String::new(),
+        words,
+        entry_point: kernel.entry_point().into(),
+    })
 }
 
 /// HLSL (shader model 6.0) for DXC, or glslang's HLSL front end.
@@ -82,7 +92,11 @@ pub fn hlsl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, K
         .write(&kernel.module, &kernel.info, None)
         .map_err(|e| error(kernel, "HLSL", e))?;
     let entry_point = translated_name(kernel, "HLSL", reflection.entry_point_names)?;
-    Ok(Translation { text, words: Vec::new(), entry_point })
+    Ok(Translation {
+        text,
+        words: Vec::new(),
+        entry_point,
+    })
 }
 
 /// Metal Shading Language 2.3.
@@ -91,7 +105,10 @@ pub fn msl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, Ke
     let mut resources = msl::BindingMap::default();
     for binding in &kernel.bindings {
         resources.insert(
-            naga::ResourceBinding { group: binding.group, binding: binding.binding },
+            naga::ResourceBinding {
+                group: binding.group,
+                binding: binding.binding,
+            },
             msl::BindTarget {
                 buffer: Some(binding.binding as u8),
                 mutable: binding.is_writable(),
@@ -102,7 +119,11 @@ pub fn msl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, Ke
     let mut per_entry_point_map = msl::EntryPointResourceMap::default();
     per_entry_point_map.insert(
         kernel.entry_point().into(),
-        msl::EntryPointResources { resources, immediates_buffer: None, sizes_buffer: Some(30) },
+        msl::EntryPointResources {
+            resources,
+            immediates_buffer: None,
+            sizes_buffer: Some(30),
+        },
     );
     let msl_options = msl::Options {
         lang_version: (2, 3),
@@ -118,7 +139,11 @@ pub fn msl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, Ke
     let (text, info) = msl::write_string(&kernel.module, &kernel.info, &msl_options, &pipeline)
         .map_err(|e| error(kernel, "MSL", e))?;
     let entry_point = translated_name(kernel, "MSL", info.entry_point_names)?;
-    Ok(Translation { text, words: Vec::new(), entry_point })
+    Ok(Translation {
+        text,
+        words: Vec::new(),
+        entry_point,
+    })
 }
 
 /// GLSL 4.50 core; bindings from WGSL's `@binding` (group 0 only).
@@ -127,7 +152,10 @@ pub fn glsl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, K
     let mut binding_map = glsl::BindingMap::default();
     for binding in &kernel.bindings {
         binding_map.insert(
-            naga::ResourceBinding { group: binding.group, binding: binding.binding },
+            naga::ResourceBinding {
+                group: binding.group,
+                binding: binding.binding,
+            },
             binding.binding as u8,
         );
     }
@@ -153,7 +181,11 @@ pub fn glsl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, K
     )
     .and_then(|mut writer| writer.write())
     .map_err(|e| error(kernel, "GLSL", e))?;
-    Ok(Translation { text, words: Vec::new(), entry_point: "main".into() })
+    Ok(Translation {
+        text,
+        words: Vec::new(),
+        entry_point: "main".into(),
+    })
 }
 
 fn translated_name<E: std::fmt::Display>(
@@ -164,6 +196,10 @@ fn translated_name<E: std::fmt::Display>(
     match names.into_iter().nth(kernel.entry_index()) {
         Some(Ok(name)) => Ok(name),
         Some(Err(e)) => Err(error(kernel, target, e)),
-        None => Err(error(kernel, target, "the back end reported no entry point name")),
+        None => Err(error(
+            kernel,
+            target,
+            "the back end reported no entry point name",
+        )),
     }
 }

@@ -62,7 +62,12 @@ impl Target {
     pub fn translate(self, kernel: &Kernel) -> Result<Translation, crate::KernelError> {
         match self {
             Target::Spirv => translate::spirv(kernel, TranslateOptions::default()),
-            Target::Hlsl => translate::hlsl(kernel, TranslateOptions { zero_initialize_workgroup_memory: false }),
+            Target::Hlsl => translate::hlsl(
+                kernel,
+                TranslateOptions {
+                    zero_initialize_workgroup_memory: false,
+                },
+            ),
             Target::Msl => translate::msl(kernel, TranslateOptions::default()),
             Target::Glsl => translate::glsl(kernel, TranslateOptions::default()),
         }
@@ -100,11 +105,17 @@ pub fn translate_and_validate(kernel: &Kernel, target: Target, dir: &Path) -> (P
         std::fs::write(&path, &translation.text)
     };
     if let Err(e) = written {
-        return (path.clone(), Verdict::Invalid(format!("cannot write {}: {e}", path.display())));
+        return (
+            path.clone(),
+            Verdict::Invalid(format!("cannot write {}: {e}", path.display())),
+        );
     }
     let verdict = match target {
         Target::Spirv => spirv_val(&path),
-        Target::Glsl => run_tool("glslangValidator", &[arg("-S"), arg("comp"), path.clone().into()]),
+        Target::Glsl => run_tool(
+            "glslangValidator",
+            &[arg("-S"), arg("comp"), path.clone().into()],
+        ),
         Target::Hlsl => {
             let spv = path.with_extension("hlsl.spv");
             match run_tool(
@@ -124,13 +135,17 @@ pub fn translate_and_validate(kernel: &Kernel, target: Target, dir: &Path) -> (P
                 ],
             ) {
                 Verdict::Valid(tool) => match spirv_val(&spv) {
-                    Verdict::Valid(val) => Verdict::Valid(format!("{tool} (HLSL front end) + {val}")),
+                    Verdict::Valid(val) => {
+                        Verdict::Valid(format!("{tool} (HLSL front end) + {val}"))
+                    }
                     other => other,
                 },
                 other => other,
             }
         }
-        Target::Msl => Verdict::Missing("no Metal compiler exists on Linux (translation succeeded)".into()),
+        Target::Msl => {
+            Verdict::Missing("no Metal compiler exists on Linux (translation succeeded)".into())
+        }
     };
     (path, verdict)
 }
@@ -140,12 +155,17 @@ fn arg(s: &str) -> std::ffi::OsString {
 }
 
 fn spirv_val(path: &Path) -> Verdict {
-    run_tool("spirv-val", &[arg("--target-env"), arg("vulkan1.1"), path.into()])
+    run_tool(
+        "spirv-val",
+        &[arg("--target-env"), arg("vulkan1.1"), path.into()],
+    )
 }
 
 fn run_tool(tool: &str, args: &[std::ffi::OsString]) -> Verdict {
     match Command::new(tool).args(args).output() {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Verdict::Missing(format!("`{tool}` is not installed")),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            Verdict::Missing(format!("`{tool}` is not installed"))
+        }
         Err(e) => Verdict::Invalid(format!("`{tool}` could not run: {e}")),
         Ok(out) if out.status.success() => Verdict::Valid(tool.into()),
         Ok(out) => Verdict::Invalid(format!(

@@ -29,7 +29,10 @@ impl BufferTable {
         size: u64,
     ) -> Result<BufferId, BackendError> {
         if size == 0 {
-            return Err(BackendError::Buffer { label: label.into(), reason: "size 0: buffers must hold at least one byte".into() });
+            return Err(BackendError::Buffer {
+                label: label.into(),
+                reason: "size 0: buffers must hold at least one byte".into(),
+            });
         }
         let padded = size.div_ceil(4) * 4;
         if padded > info.limits.max_buffer_size {
@@ -52,16 +55,28 @@ impl BufferTable {
         });
         scope.finish(&format!("creation of buffer `{label}` ({size} bytes)"))?;
         self.next += 1;
-        self.entries.insert(self.next, BufferEntry { buffer, size, label: label.into() });
+        self.entries.insert(
+            self.next,
+            BufferEntry {
+                buffer,
+                size,
+                label: label.into(),
+            },
+        );
         Ok(BufferId(self.next))
     }
 
     pub(super) fn get(&self, id: BufferId) -> Result<&BufferEntry, BackendError> {
-        self.entries.get(&id.0).ok_or(BackendError::UnknownBuffer(id.0))
+        self.entries
+            .get(&id.0)
+            .ok_or(BackendError::UnknownBuffer(id.0))
     }
 
     pub(super) fn destroy(&mut self, id: BufferId) -> Result<(), BackendError> {
-        let entry = self.entries.remove(&id.0).ok_or(BackendError::UnknownBuffer(id.0))?;
+        let entry = self
+            .entries
+            .remove(&id.0)
+            .ok_or(BackendError::UnknownBuffer(id.0))?;
         entry.buffer.destroy();
         Ok(())
     }
@@ -82,7 +97,9 @@ pub(super) fn read_back(
         usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("read-back") });
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+        label: Some("read-back"),
+    });
     encoder.copy_buffer_to_buffer(&entry.buffer, 0, &staging, 0, padded);
     queue.submit([encoder.finish()]);
     scope.finish(&format!("read-back of `{}`", entry.label))?;

@@ -45,13 +45,19 @@ impl ErrorSink {
             device.push_error_scope(wgpu::ErrorFilter::OutOfMemory),
             device.push_error_scope(wgpu::ErrorFilter::Validation),
         ];
-        Scope { sink: self.clone(), guards }
+        Scope {
+            sink: self.clone(),
+            guards,
+        }
     }
 
     /// The device-lost error, if the device was lost.
     pub(super) fn check_lost(&self) -> Result<(), BackendError> {
         match self.lost.lock().ok().and_then(|slot| slot.clone()) {
-            Some(reason) => Err(BackendError::DeviceLost { backend: self.backend.clone(), reason }),
+            Some(reason) => Err(BackendError::DeviceLost {
+                backend: self.backend.clone(),
+                reason,
+            }),
             None => Ok(()),
         }
     }
@@ -101,7 +107,13 @@ impl Scope {
         if let Some(error) = first {
             return Err(self.sink.convert(error, operation));
         }
-        if let Some(error) = self.sink.uncaptured.lock().ok().and_then(|mut list| list.pop()) {
+        if let Some(error) = self
+            .sink
+            .uncaptured
+            .lock()
+            .ok()
+            .and_then(|mut list| list.pop())
+        {
             return Err(self.sink.convert(error, operation));
         }
         self.sink.check_lost()

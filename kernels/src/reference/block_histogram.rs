@@ -28,7 +28,11 @@ pub fn sort_block(candidates: &[Candidate], entries: &mut [u32]) {
 
 /// The histogram pass on the CPU.
 pub fn block_histogram(grid: BlockGrid, candidates: &[Candidate]) -> HistogramOutput {
-    assert_eq!(candidates.len(), grid.pixel_count(), "one candidate per pixel");
+    assert_eq!(
+        candidates.len(),
+        grid.pixel_count(),
+        "one candidate per pixel"
+    );
     let mut sorted_pixels = vec![0u32; grid.pixel_count()];
     let mut spans = vec![ClusterSpan::default(); grid.pixel_count()];
     let mut stats = Vec::with_capacity(grid.block_count() as usize);
@@ -70,5 +74,9 @@ pub fn block_histogram(grid: BlockGrid, candidates: &[Candidate]) -> HistogramOu
         }
         stats.push(block_stats);
     }
-    HistogramOutput { sorted_pixels, spans, stats }
+    HistogramOutput {
+        sorted_pixels,
+        spans,
+        stats,
+    }
 }

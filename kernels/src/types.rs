@@ -9,7 +9,7 @@ pub const OBJECT_ID_NONE: u32 = 0xffff_ffff;
 /// `OBJECT_ID_ENVIRONMENT`: the camera ray escaped; the environment is one cluster of its own.
 pub const OBJECT_ID_ENVIRONMENT: u32 = 0xffff_fffe;
 /// `INVALID_KEY`: canonical sort key of an invalid candidate, above every valid key.
-pub const INVALID_KEY: u32 = 0xffff_ffff;
+pub const INVALID_KEY: u32 = 0xffff_fffe;
 /// Block sizes the histogram pass accepts.
 pub const BLOCK_SIZES: [u32; 4] = [4, 8, 16, 32];
 

@@ -16,8 +16,9 @@ struct Candidate {
 const OBJECT_ID_NONE: u32 = 0xffffffffu;
 // The camera ray escaped: the environment is one cluster of its own.
 const OBJECT_ID_ENVIRONMENT: u32 = 0xfffffffeu;
-// Canonical sort key of an invalid candidate: above every finite non-negative key.
-const INVALID_KEY: u32 = 0xffffffffu;
+// Canonical sort key of an invalid candidate: above every finite non-negative key
+// (0xffffffff is left to padding).
+const INVALID_KEY: u32 = 0xfffffffeu;
 
 // Where a pixel's cluster lies in the block's sorted candidate list.
 struct ClusterSpan {

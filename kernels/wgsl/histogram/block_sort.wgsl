@@ -35,6 +35,8 @@ const ELEM_BITS: u32 = 4u;
 const SLOTS: u32 = 1024u;
 const INVOCATIONS: u32 = 64u;
 const MAX_SEGMENTS: u32 = 64u;
+// Key of the padding slots past a partial block's pixels: after every real element.
+const SENTINEL_KEY: u32 = 0xffffffffu;
 
 @group(0) @binding(0) var<uniform> params: HistogramParams;
 @group(0) @binding(1) var<storage, read> candidates: array<Candidate>;
@@ -244,13 +246,14 @@ fn search_cluster(begin: u32, end: u32, cluster: u32, inclusive: bool) -> u32 {
     return lo;
 }
 
-// First index in [begin, end) holding an invalid key (keys ascend within a run).
+// First index in [begin, end) holding an invalid key (keys ascend within a run; invalid
+// and sentinel keys are the two largest).
 fn search_invalid(begin: u32, end: u32) -> u32 {
     var lo = begin;
     var hi = end;
     while lo < hi {
         let mid = (lo + hi) / 2u;
-        if shared_cluster_key[mid].y != INVALID_KEY {
+        if shared_cluster_key[mid].y < INVALID_KEY {
             lo = mid + 1u;
         } else {
             hi = mid;
@@ -259,8 +262,12 @@ fn search_invalid(begin: u32, end: u32) -> u32 {
     return lo;
 }
 
-// Geometry of one block of the image.
+// One block of the image. Elements carry their pixel's position in the full B x B block,
+// local = row * B + column, so that finding a pixel needs shifts, not divisions; slots
+// outside a partial block hold sentinels.
 struct BlockRect {
+    // Whether the block exists (the last workgroup may have spare segments).
+    exists: bool,
     // Top-left pixel.
     x: u32,
     y: u32,
@@ -272,87 +279,229 @@ struct BlockRect {
 
 fn block_rect(block: u32) -> BlockRect {
     let b = params.block_size;
+    let exists = block < params.blocks_x * params.blocks_y;
     let bx = block % params.blocks_x;
     let by = block / params.blocks_x;
     let x = bx * b;
     let y = by * b;
-    let w = min(b, params.width - x);
-    let h = min(b, params.height - y);
-    return BlockRect(x, y, w, h, y * params.width + x * h);
+    let w = select(0u, min(b, params.width - x), exists);
+    let h = select(0u, min(b, params.height - y), exists);
+    return BlockRect(exists, x, y, w, h, y * params.width + x * h);
+}
+
+fn column_of(local: u32) -> u32 {
+    return local & (params.block_size - 1u);
+}
+
+fn row_of(local: u32) -> u32 {
+    return local >> params.log2_block_size;
 }
 
 fn pixel_of(rect: BlockRect, local: u32) -> u32 {
-    return (rect.y + local / rect.width) * params.width + rect.x + local % rect.width;
+    return (rect.y + row_of(local)) * params.width + rect.x + column_of(local);
 }
 
-// Dispatch-wide sizes derived from params, the same in every invocation.
-struct Sizes {
-    log_n: u32,
-    n: u32,
-    segments: u32,
-    block_count: u32,
-    first_block: u32,
-}
-
-// (cluster, canonical key, local) of the slot: the pixel's candidate, or a sentinel that
-// sorts after every real element when the slot lies past its block's pixels.
-fn load_element(slot: u32, sizes: Sizes) -> vec3<u32> {
-    let block = sizes.first_block + (slot >> sizes.log_n);
-    let local = slot & (sizes.n - 1u);
-    if block < sizes.block_count {
-        let rect = block_rect(block);
-        if local < rect.width * rect.height {
-            let candidate = candidates[pixel_of(rect, local)];
-            return vec3<u32>(candidate.object_id, canonical_key(candidate), local);
-        }
+// (cluster, canonical key, local) of a slot: the pixel's candidate, or a sentinel that
+// sorts after every real element when the position lies outside the block.
+fn load_element(rect: BlockRect, local: u32) -> vec3<u32> {
+    if column_of(local) < rect.width && row_of(local) < rect.height {
+        let candidate = candidates[pixel_of(rect, local)];
+        return vec3<u32>(candidate.object_id, canonical_key(candidate), local);
     }
-    return vec3<u32>(OBJECT_ID_NONE, INVALID_KEY, local);
+    return vec3<u32>(OBJECT_ID_NONE, SENTINEL_KEY, local);
 }
 
-// Quad of the elements at slots first..first+3.
-fn load_candidates(first: u32, sizes: Sizes) -> Quad {
-    let a = load_element(first, sizes);
-    let b = load_element(first + 1u, sizes);
-    let c = load_element(first + 2u, sizes);
-    let d = load_element(first + 3u, sizes);
+// Quad of the elements at block positions first..first+3.
+fn load_candidates(rect: BlockRect, first: u32) -> Quad {
+    let a = load_element(rect, first);
+    let b = load_element(rect, first + 1u);
+    let c = load_element(rect, first + 2u);
+    let d = load_element(rect, first + 3u);
     return Quad(vec4<u32>(a.x, b.x, c.x, d.x), vec4<u32>(a.y, b.y, c.y, d.y), vec4<u32>(a.z, b.z, c.z, d.z));
 }
 
-fn finish_quad(q: Quad, first: u32, sizes: Sizes) {
-    finish_element(first, q.cluster.x, q.key.x, q.local.x, sizes);
-    finish_element(first + 1u, q.cluster.y, q.key.y, q.local.y, sizes);
-    finish_element(first + 2u, q.cluster.z, q.key.z, q.local.z, sizes);
-    finish_element(first + 3u, q.cluster.w, q.key.w, q.local.w, sizes);
+// Sixteen u32 values, element 4q + i in lane i of q<q>: one invocation's elements.
+struct U16 {
+    q0: vec4<u32>,
+    q1: vec4<u32>,
+    q2: vec4<u32>,
+    q3: vec4<u32>,
 }
 
-// Writes the outputs of the sorted element at `slot` (natural layout, after the sort,
-// with the sorted block in workgroup memory).
-fn finish_element(slot: u32, cluster: u32, key: u32, local: u32, sizes: Sizes) {
-    let segment = slot >> sizes.log_n;
-    let block = sizes.first_block + segment;
-    let position = slot & (sizes.n - 1u);
-    if block >= sizes.block_count {
-        return;
+// Element i takes element i - 1; element 0 takes `first`.
+fn from_left(v: U16, first: u32) -> U16 {
+    return U16(vec4(first, v.q0.xyz), vec4(v.q0.w, v.q1.xyz), vec4(v.q1.w, v.q2.xyz), vec4(v.q2.w, v.q3.xyz));
+}
+
+// Element i takes element i + 1; element 15 takes `last`.
+fn from_right(v: U16, last: u32) -> U16 {
+    return U16(vec4(v.q0.yzw, v.q1.x), vec4(v.q1.yzw, v.q2.x), vec4(v.q2.yzw, v.q3.x), vec4(v.q3.yzw, last));
+}
+
+fn prefix_max4(v: vec4<u32>, carry: u32) -> vec4<u32> {
+    let a = max(v, vec4(0u, v.xyz));
+    let b = max(a, vec4(0u, 0u, a.xy));
+    return max(b, vec4(carry));
+}
+
+// Inclusive prefix maximum over the 16 elements.
+fn prefix_max(v: U16) -> U16 {
+    let q0 = prefix_max4(v.q0, 0u);
+    let q1 = prefix_max4(v.q1, q0.w);
+    let q2 = prefix_max4(v.q2, q1.w);
+    return U16(q0, q1, q2, prefix_max4(v.q3, q2.w));
+}
+
+fn suffix_min4(v: vec4<u32>, carry: u32) -> vec4<u32> {
+    let a = min(v, vec4(v.yzw, 0xffffffffu));
+    let b = min(a, vec4(a.zw, 0xffffffffu, 0xffffffffu));
+    return min(b, vec4(carry));
+}
+
+// Inclusive suffix minimum over the 16 elements.
+fn suffix_min(v: U16) -> U16 {
+    let q3 = suffix_min4(v.q3, 0xffffffffu);
+    let q2 = suffix_min4(v.q2, q3.x);
+    let q1 = suffix_min4(v.q1, q2.x);
+    return U16(suffix_min4(v.q0, q1.x), q1, q2, q3);
+}
+
+// select(f, t, c) element-wise.
+fn pick16(f: U16, t: U16, c: U16) -> U16 {
+    let z = vec4(0u);
+    return U16(select(f.q0, t.q0, c.q0 != z), select(f.q1, t.q1, c.q1 != z), select(f.q2, t.q2, c.q2 != z), select(f.q3, t.q3, c.q3 != z));
+}
+
+fn splat16(x: u32) -> U16 {
+    return U16(vec4(x), vec4(x), vec4(x), vec4(x));
+}
+
+fn flag4(c: vec4<bool>) -> vec4<u32> {
+    return select(vec4(0u), vec4(1u), c);
+}
+
+fn count16(v: U16) -> u32 {
+    let s = v.q0 + v.q1 + v.q2 + v.q3;
+    return s.x + s.y + s.z + s.w;
+}
+
+fn write_element(rect: BlockRect, begin: u32, position: u32, local: u32, run_begin: u32, run_end: u32, valid_end: u32) {
+    if position < rect.width * rect.height {
+        let pixel = pixel_of(rect, local);
+        sorted_pixels[rect.base + position] = pixel;
+        spans[pixel] = ClusterSpan(rect.base + run_begin - begin, run_end - run_begin, valid_end - run_begin);
     }
-    let rect = block_rect(block);
+}
+
+fn write_quad(rect: BlockRect, begin: u32, position: u32, local: vec4<u32>, run_begin: vec4<u32>, run_end: vec4<u32>, valid_end: vec4<u32>) {
+    write_element(rect, begin, position, local.x, run_begin.x, run_end.x, valid_end.x);
+    write_element(rect, begin, position + 1u, local.y, run_begin.y, run_end.y, valid_end.y);
+    write_element(rect, begin, position + 2u, local.z, run_begin.z, run_end.z, valid_end.z);
+    write_element(rect, begin, position + 3u, local.w, run_begin.w, run_end.w, valid_end.w);
+}
+
+// Writes the outputs of this invocation's 16 sorted elements: sorted positions
+// first..first+15 of the block whose first slot is `begin`, with the sorted block in
+// workgroup memory. Runs are found from the neighbours in registers; only a run that
+// crosses the invocation's edge costs a binary search (at most four per invocation).
+fn finish_elements(rect: BlockRect, begin: u32, segment: u32, first: u32, el: Elements) {
     let count = rect.width * rect.height;
-    if position >= count {
+    if first >= count {
         return;
     }
-    let begin = slot - position;
-    let run_begin = search_cluster(begin, slot, cluster, false);
-    let run_end = search_cluster(slot + 1u, begin + count, cluster, true);
-    let valid_end = search_invalid(run_begin, run_end);
-    let pixel = pixel_of(rect, local);
-    sorted_pixels[rect.base + position] = pixel;
-    spans[pixel] = ClusterSpan(rect.base + run_begin - begin, run_end - run_begin, valid_end - run_begin);
-    if run_begin == slot {
-        atomicAdd(&shared_stats[3u * segment], 1u);
+    let base = begin + first;
+    let i4 = vec4(0u, 1u, 2u, 3u);
+    let slots = U16(vec4(base) + i4, vec4(base + 4u) + i4, vec4(base + 8u) + i4, vec4(base + 12u) + i4);
+    let cluster = U16(el.q0.cluster, el.q1.cluster, el.q2.cluster, el.q3.cluster);
+    let key = U16(el.q0.key, el.q1.key, el.q2.key, el.q3.key);
+    let z = vec4(0u);
+    let invalid = U16(flag4(key.q0 >= vec4(INVALID_KEY)), flag4(key.q1 >= vec4(INVALID_KEY)), flag4(key.q2 >= vec4(INVALID_KEY)), flag4(key.q3 >= vec4(INVALID_KEY)));
+    let real = U16(flag4(slots.q0 < vec4(begin + count)), flag4(slots.q1 < vec4(begin + count)), flag4(slots.q2 < vec4(begin + count)), flag4(slots.q3 < vec4(begin + count)));
+
+    // Neighbours just outside: the previous and next sorted elements of the block.
+    var previous = vec2(~cluster.q0.x, 0u);
+    if first > 0u {
+        previous = shared_cluster_key[base - 1u];
     }
-    if cluster == OBJECT_ID_NONE {
-        atomicAdd(&shared_stats[3u * segment + 2u], 1u);
-    } else if key == INVALID_KEY {
-        atomicAdd(&shared_stats[3u * segment + 1u], 1u);
+    var next_cluster = ~cluster.q3.w;
+    if first + 16u < count {
+        next_cluster = shared_cluster_key[base + 16u].x;
+    }
+
+    // Run starts and ends.
+    let left = from_left(cluster, previous.x);
+    let starts = U16(flag4(cluster.q0 != left.q0), flag4(cluster.q1 != left.q1), flag4(cluster.q2 != left.q2), flag4(cluster.q3 != left.q3));
+    let right = from_right(cluster, next_cluster);
+    let ends = U16(flag4(cluster.q0 != right.q0), flag4(cluster.q1 != right.q1), flag4(cluster.q2 != right.q2), flag4(cluster.q3 != right.q3));
+    var begin_seed = base;
+    if starts.q0.x == 0u {
+        begin_seed = search_cluster(begin, base, cluster.q0.x, false);
+    }
+    var end_seed = base + 16u;
+    if ends.q3.w == 0u {
+        end_seed = search_cluster(base + 16u, begin + count, cluster.q3.w, true);
+    }
+    var begin_marks = pick16(splat16(0u), slots, starts);
+    begin_marks.q0.x = begin_seed;
+    let run_begin = prefix_max(begin_marks);
+    let plus_one = U16(slots.q0 + 1u, slots.q1 + 1u, slots.q2 + 1u, slots.q3 + 1u);
+    var end_marks = pick16(splat16(0xffffffffu), plus_one, ends);
+    end_marks.q3.w = end_seed;
+    let unclamped_end = suffix_min(end_marks);
+    let limit = vec4(begin + count);
+    let run_end = U16(min(unclamped_end.q0, limit), min(unclamped_end.q1, limit), min(unclamped_end.q2, limit), min(unclamped_end.q3, limit));
+
+    // Valid/invalid boundaries: the first invalid element of each run.
+    let invalid_left = from_left(invalid, select(0u, 1u, previous.y >= INVALID_KEY));
+    let first_invalid = U16(
+        flag4(invalid.q0 != z & (starts.q0 != z | invalid_left.q0 == z)),
+        flag4(invalid.q1 != z & (starts.q1 != z | invalid_left.q1 == z)),
+        flag4(invalid.q2 != z & (starts.q2 != z | invalid_left.q2 == z)),
+        flag4(invalid.q3 != z & (starts.q3 != z | invalid_left.q3 == z)),
+    );
+    // Invalid elements: their run's boundary is the last one at or before them.
+    var boundary_before = pick16(splat16(0u), slots, first_invalid);
+    if invalid.q0.x != 0u && first_invalid.q0.x == 0u {
+        boundary_before.q0.x = search_invalid(run_begin.q0.x, base);
+    }
+    let valid_end_invalid = prefix_max(boundary_before);
+    // Valid elements: the first boundary after them, or their run's end.
+    var boundary_after = pick16(splat16(0xffffffffu), slots, first_invalid);
+    if invalid.q3.w == 0u && run_end.q3.w > base + 16u {
+        boundary_after.q3.w = search_invalid(base + 16u, run_end.q3.w);
+    }
+    let after = suffix_min(boundary_after);
+    let valid_end_valid = U16(min(after.q0, run_end.q0), min(after.q1, run_end.q1), min(after.q2, run_end.q2), min(after.q3, run_end.q3));
+    let valid_end = pick16(valid_end_valid, valid_end_invalid, invalid);
+
+    write_quad(rect, begin, first, el.q0.local, run_begin.q0, run_end.q0, valid_end.q0);
+    write_quad(rect, begin, first + 4u, el.q1.local, run_begin.q1, run_end.q1, valid_end.q1);
+    write_quad(rect, begin, first + 8u, el.q2.local, run_begin.q2, run_end.q2, valid_end.q2);
+    write_quad(rect, begin, first + 12u, el.q3.local, run_begin.q3, run_end.q3, valid_end.q3);
+
+    // Counters: one atomic each per invocation.
+    let none = vec4(OBJECT_ID_NONE);
+    let clusters = count16(U16(starts.q0 & real.q0, starts.q1 & real.q1, starts.q2 & real.q2, starts.q3 & real.q3));
+    let empty = count16(U16(
+        flag4(cluster.q0 == none) & real.q0,
+        flag4(cluster.q1 == none) & real.q1,
+        flag4(cluster.q2 == none) & real.q2,
+        flag4(cluster.q3 == none) & real.q3,
+    ));
+    let invalid_keys = count16(U16(
+        flag4(cluster.q0 != none & key.q0 == vec4(INVALID_KEY)) & real.q0,
+        flag4(cluster.q1 != none & key.q1 == vec4(INVALID_KEY)) & real.q1,
+        flag4(cluster.q2 != none & key.q2 == vec4(INVALID_KEY)) & real.q2,
+        flag4(cluster.q3 != none & key.q3 == vec4(INVALID_KEY)) & real.q3,
+    ));
+    if clusters != 0u {
+        atomicAdd(&shared_stats[3u * segment], clusters);
+    }
+    if invalid_keys != 0u {
+        atomicAdd(&shared_stats[3u * segment + 1u], invalid_keys);
+    }
+    if empty != 0u {
+        atomicAdd(&shared_stats[3u * segment + 2u], empty);
     }
 }
 
@@ -361,21 +510,24 @@ fn finish_element(slot: u32, cluster: u32, key: u32, local: u32, sizes: Sizes) {
 fn run_block_histogram(t: u32, workgroup_id: vec3<u32>, lane_bits: u32) {
     let log_n = 2u * params.log2_block_size;
     let segments = SLOTS >> log_n;
-    let sizes = Sizes(
-        log_n,
-        1u << log_n,
-        segments,
-        params.blocks_x * params.blocks_y,
-        (workgroup_id.y * params.workgroups_x + workgroup_id.x) * segments,
-    );
+    let first_block = (workgroup_id.y * params.workgroups_x + workgroup_id.x) * segments;
 
     for (var i = t; i < 3u * MAX_SEGMENTS; i += INVOCATIONS) {
         atomicStore(&shared_stats[i], 0u);
     }
 
-    // Load in the natural layout.
+    // Load in the natural layout. An invocation's ELEMS consecutive slots lie in one
+    // block (blocks have at least 16 slots), so the block geometry is computed once.
     let base = slot_of(t, 0u, 0u);
-    var el = Elements(load_candidates(base, sizes), load_candidates(base + 4u, sizes), load_candidates(base + 8u, sizes), load_candidates(base + 12u, sizes));
+    let segment = base >> log_n;
+    let first = base & ((1u << log_n) - 1u);
+    let rect = block_rect(first_block + segment);
+    var el = Elements(
+        load_candidates(rect, first),
+        load_candidates(rect, first + 4u),
+        load_candidates(rect, first + 8u),
+        load_candidates(rect, first + 12u),
+    );
 
     // Bitonic sort of every n-slot segment.
     var current_lo = 0u;
@@ -405,16 +557,16 @@ fn run_block_histogram(t: u32, workgroup_id: vec3<u32>, lane_bits: u32) {
     store_registers(el, t, 0u);
     workgroupBarrier();
 
-    // Runs, spans and counters.
-    finish_quad(el.q0, base, sizes);
-    finish_quad(el.q1, base + 4u, sizes);
-    finish_quad(el.q2, base + 8u, sizes);
-    finish_quad(el.q3, base + 12u, sizes);
+    // Runs, spans and counters. After the sort, an invocation's slots still lie in one
+    // block, now holding sorted positions first..first+15.
+    if rect.exists {
+        finish_elements(rect, base - first, segment, first, el);
+    }
 
     workgroupBarrier();
     for (var segment = t; segment < segments; segment += INVOCATIONS) {
-        let block = sizes.first_block + segment;
-        if block < sizes.block_count {
+        let block = first_block + segment;
+        if block < params.blocks_x * params.blocks_y {
             block_stats[block] = BlockStats(
                 atomicLoad(&shared_stats[3u * segment]),
                 atomicLoad(&shared_stats[3u * segment + 1u]),

@@ -4,6 +4,7 @@
 //! [`Backend`]: strata_backends::Backend
 
 pub mod backend_choice;
+pub mod check;
 pub mod histogram_pass;
 pub mod synthetic;
 

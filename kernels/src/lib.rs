@@ -12,6 +12,7 @@
 pub mod binding;
 pub mod block_grid;
 pub mod error;
+pub mod glslang;
 pub mod layout;
 pub mod reference;
 pub mod registry;

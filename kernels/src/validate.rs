@@ -10,10 +10,11 @@
 //!
 //! A validator that is not installed is reported as [`Verdict::Missing`], never as a pass.
 
+use crate::glslang::{self, GlslangInput, ToolError, run_tool};
 use crate::registry::Kernel;
 use crate::translate::{self, TranslateOptions, Translation};
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 /// Target languages of the translation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -92,6 +93,16 @@ impl Verdict {
     }
 }
 
+impl From<Result<String, ToolError>> for Verdict {
+    fn from(result: Result<String, ToolError>) -> Self {
+        match result {
+            Ok(tools) => Verdict::Valid(tools),
+            Err(ToolError::Missing(tool)) => Verdict::Missing(format!("`{tool}` is not installed")),
+            Err(ToolError::Failed(message)) => Verdict::Invalid(message),
+        }
+    }
+}
+
 /// Translates `kernel` to `target`, writes it to `dir/NAME.EXT` and validates it.
 pub fn translate_and_validate(kernel: &Kernel, target: Target, dir: &Path) -> (PathBuf, Verdict) {
     let path = dir.join(format!("{}.{}", kernel.name(), target.extension()));
@@ -111,38 +122,17 @@ pub fn translate_and_validate(kernel: &Kernel, target: Target, dir: &Path) -> (P
         );
     }
     let verdict = match target {
-        Target::Spirv => spirv_val(&path),
+        Target::Spirv => spirv_val(&path).map(|()| "spirv-val".to_string()).into(),
         Target::Glsl => run_tool(
             "glslangValidator",
-            &[arg("-S"), arg("comp"), path.clone().into()],
-        ),
-        Target::Hlsl => {
-            let spv = path.with_extension("hlsl.spv");
-            match run_tool(
-                "glslangValidator",
-                &[
-                    arg("-D"),
-                    arg("-e"),
-                    arg(&translation.entry_point),
-                    arg("-S"),
-                    arg("comp"),
-                    arg("-V"),
-                    arg("--target-env"),
-                    arg("vulkan1.1"),
-                    path.clone().into(),
-                    arg("-o"),
-                    spv.clone().into(),
-                ],
-            ) {
-                Verdict::Valid(tool) => match spirv_val(&spv) {
-                    Verdict::Valid(val) => {
-                        Verdict::Valid(format!("{tool} (HLSL front end) + {val}"))
-                    }
-                    other => other,
-                },
-                other => other,
-            }
-        }
+            &[OsStr::new("-S"), OsStr::new("comp"), path.as_os_str()],
+        )
+        .map(|()| "glslangValidator".to_string())
+        .into(),
+        Target::Hlsl => glslang::compile(kernel, GlslangInput::Hlsl, dir)
+            .and_then(|_| spirv_val(&dir.join(format!("{}.hlsl.spv", kernel.name()))))
+            .map(|()| "glslangValidator (HLSL front end) + spirv-val".to_string())
+            .into(),
         Target::Msl => {
             Verdict::Missing("no Metal compiler exists on Linux (translation succeeded)".into())
         }
@@ -150,28 +140,13 @@ pub fn translate_and_validate(kernel: &Kernel, target: Target, dir: &Path) -> (P
     (path, verdict)
 }
 
-fn arg(s: &str) -> std::ffi::OsString {
-    s.into()
-}
-
-fn spirv_val(path: &Path) -> Verdict {
+fn spirv_val(path: &Path) -> Result<(), ToolError> {
     run_tool(
         "spirv-val",
-        &[arg("--target-env"), arg("vulkan1.1"), path.into()],
+        &[
+            OsStr::new("--target-env"),
+            OsStr::new("vulkan1.1"),
+            path.as_os_str(),
+        ],
     )
-}
-
-fn run_tool(tool: &str, args: &[std::ffi::OsString]) -> Verdict {
-    match Command::new(tool).args(args).output() {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            Verdict::Missing(format!("`{tool}` is not installed"))
-        }
-        Err(e) => Verdict::Invalid(format!("`{tool}` could not run: {e}")),
-        Ok(out) if out.status.success() => Verdict::Valid(tool.into()),
-        Ok(out) => Verdict::Invalid(format!(
-            "`{tool}` rejected it:\n{}{}",
-            String::from_utf8_lossy(&out.stdout),
-            String::from_utf8_lossy(&out.stderr)
-        )),
-    }
 }

@@ -5,6 +5,10 @@
 //!   the external validator for its language (see `strata_kernels::validate`). Exits
 //!   non-zero if any output is invalid; with `--strict`, also if a validator that can
 //!   exist on this machine is missing (CI uses this).
+//! * `cargo xtask check [--full]`: runs every registry kernel on every available backend
+//!   (wgpu Vulkan and GL, ash on naga's SPIR-V and on glslang's compilation of naga's
+//!   GLSL and HLSL) with generated inputs and compares the outputs with the kernels'
+//!   references; prints a kernels × backends table and exits non-zero on any mismatch.
 
 use anyhow::{Result, bail};
 use clap::{Parser, Subcommand};
@@ -30,12 +34,29 @@ enum Command {
         #[arg(long, default_value = "target/shaders")]
         out: PathBuf,
     },
+    /// Check that every kernel gives identical outputs on every backend.
+    Check {
+        /// At least 20 seeds at several sizes per kernel (default: 3 seeds, small sizes).
+        #[arg(long)]
+        full: bool,
+    },
 }
 
 fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Shaders { strict, out } => shaders(strict, out),
+        Command::Check { full } => check(full),
     }
+}
+
+fn check(full: bool) -> Result<()> {
+    let report = strata::check::run_check(strata::check::CheckConfig { full });
+    print!("{}", report.render());
+    let failures = report.failures();
+    if !failures.is_empty() {
+        bail!("{} kernel/backend pair(s) failed", failures.len());
+    }
+    Ok(())
 }
 
 fn shaders(strict: bool, out: PathBuf) -> Result<()> {

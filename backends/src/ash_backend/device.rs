@@ -1,0 +1,722 @@
+//! Vulkan instance, device, queue, memory and command submission for the ash backend.
+
+use super::AshOptions;
+use super::pipelines::AshPipeline;
+use crate::device_info::{DeviceInfo, DeviceLimits};
+use crate::error::BackendError;
+use ash::vk;
+use std::ffi::{CStr, c_void};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+use strata_kernels::{BindingKind, Kernel};
+
+const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+
+fn vk_error(operation: &str, result: vk::Result) -> BackendError {
+    match result {
+        vk::Result::ERROR_DEVICE_LOST => BackendError::DeviceLost {
+            backend: "ash".into(),
+            reason: operation.into(),
+        },
+        vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY => {
+            BackendError::OutOfMemory {
+                backend: "ash".into(),
+                operation: operation.into(),
+            }
+        }
+        other => BackendError::Validation {
+            backend: "ash".into(),
+            operation: operation.into(),
+            message: format!("{other:?}"),
+        },
+    }
+}
+
+type Messages = Arc<Mutex<Vec<String>>>;
+
+unsafe extern "system" fn on_validation_message(
+    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
+    _types: vk::DebugUtilsMessageTypeFlagsEXT,
+    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
+    user: *mut c_void,
+) -> vk::Bool32 {
+    // SAFETY: `user` is the `Messages` box owned by VulkanDevice, alive until the
+    // messenger is destroyed; `data` is valid for the duration of the call.
+    unsafe {
+        let messages = &*(user as *const Messages);
+        let text = if data.is_null() || (*data).p_message.is_null() {
+            "<no message>".to_string()
+        } else {
+            CStr::from_ptr((*data).p_message)
+                .to_string_lossy()
+                .into_owned()
+        };
+        if let Ok(mut list) = messages.lock() {
+            list.push(format!("{severity:?}: {text}"));
+        }
+    }
+    vk::FALSE
+}
+
+/// Everything Vulkan that outlives a dispatch.
+pub(super) struct VulkanDevice {
+    _entry: ash::Entry,
+    instance: ash::Instance,
+    debug: Option<(
+        ash::ext::debug_utils::Instance,
+        vk::DebugUtilsMessengerEXT,
+        Box<Messages>,
+    )>,
+    physical: vk::PhysicalDevice,
+    pub(super) device: ash::Device,
+    queue: vk::Queue,
+    memory_type: u32,
+    command_pool: vk::CommandPool,
+    command_buffer: vk::CommandBuffer,
+    fence: vk::Fence,
+    query_pool: Option<vk::QueryPool>,
+    timestamp_period: f64,
+    subgroup_size: Option<u32>,
+}
+
+impl VulkanDevice {
+    pub(super) fn open(options: AshOptions) -> Result<Self, BackendError> {
+        // SAFETY: loading the system Vulkan loader; failure is reported, not assumed.
+        let entry = unsafe { ash::Entry::load() }.map_err(|e| BackendError::NoAdapter {
+            backend: options.source.name().into(),
+            reason: format!("no Vulkan loader: {e}"),
+        })?;
+        let mut layers = Vec::new();
+        let mut extensions = Vec::new();
+        if options.validation {
+            // SAFETY: plain enumeration.
+            let available = unsafe { entry.enumerate_instance_layer_properties() }
+                .map_err(|e| vk_error("enumerating layers", e))?;
+            let found = available.iter().any(|layer| {
+                layer
+                    .layer_name_as_c_str()
+                    .is_ok_and(|name| name == VALIDATION_LAYER)
+            });
+            if !found {
+                return Err(BackendError::DeviceCreation {
+                    backend: options.source.name().into(),
+                    reason:
+                        "validation requested but VK_LAYER_KHRONOS_validation is not installed \
+                             (Debian: apt-get install vulkan-validationlayers)"
+                            .into(),
+                });
+            }
+            layers.push(VALIDATION_LAYER.as_ptr());
+            extensions.push(ash::ext::debug_utils::NAME.as_ptr());
+        }
+        let app = vk::ApplicationInfo::default()
+            .application_name(c"strata")
+            .api_version(vk::API_VERSION_1_1);
+        let create = vk::InstanceCreateInfo::default()
+            .application_info(&app)
+            .enabled_layer_names(&layers)
+            .enabled_extension_names(&extensions);
+        // SAFETY: valid create info with static strings.
+        let instance = unsafe { entry.create_instance(&create, None) }.map_err(|e| {
+            BackendError::NoAdapter {
+                backend: options.source.name().into(),
+                reason: format!("vkCreateInstance failed: {e:?}"),
+            }
+        })?;
+        let mut this_debug = None;
+        if options.validation {
+            let messages: Box<Messages> = Box::default();
+            let utils = ash::ext::debug_utils::Instance::new(&entry, &instance);
+            let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+                .message_severity(
+                    vk::DebugUtilsMessageSeverityFlagsEXT::WARNING
+                        | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR,
+                )
+                .message_type(
+                    vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                        | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                        | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+                )
+                .pfn_user_callback(Some(on_validation_message))
+                .user_data(&*messages as *const Messages as *mut c_void);
+            // SAFETY: the callback's user data outlives the messenger (both in `debug`).
+            match unsafe { utils.create_debug_utils_messenger(&info, None) } {
+                Ok(messenger) => this_debug = Some((utils, messenger, messages)),
+                Err(e) => {
+                    // SAFETY: nothing else was created from the instance.
+                    unsafe { instance.destroy_instance(None) };
+                    return Err(vk_error("creating the debug messenger", e));
+                }
+            }
+        }
+        let mut partial = PartialInstance {
+            instance: Some(instance),
+            debug: this_debug,
+        };
+        let instance_ref = partial.instance.as_ref().expect("set above");
+        let (physical, family) = pick_device(instance_ref, options)?;
+        // SAFETY: valid physical device.
+        let properties = unsafe { instance_ref.get_physical_device_properties(physical) };
+        let families =
+            unsafe { instance_ref.get_physical_device_queue_family_properties(physical) };
+        let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
+        let mut properties2 = vk::PhysicalDeviceProperties2::default().push_next(&mut subgroup);
+        // SAFETY: Vulkan 1.1 core query on a 1.1 device.
+        unsafe { instance_ref.get_physical_device_properties2(physical, &mut properties2) };
+        let subgroup_size = (options.subgroups
+            && subgroup
+                .supported_stages
+                .contains(vk::ShaderStageFlags::COMPUTE)
+            && subgroup.supported_operations.contains(
+                vk::SubgroupFeatureFlags::BASIC
+                    | vk::SubgroupFeatureFlags::SHUFFLE
+                    | vk::SubgroupFeatureFlags::SHUFFLE_RELATIVE,
+            ))
+        .then_some(subgroup.subgroup_size);
+        let priorities = [1.0f32];
+        let queue_info = [vk::DeviceQueueCreateInfo::default()
+            .queue_family_index(family)
+            .queue_priorities(&priorities)];
+        let device_info = vk::DeviceCreateInfo::default().queue_create_infos(&queue_info);
+        // SAFETY: valid physical device and create info.
+        let device =
+            unsafe { instance_ref.create_device(physical, &device_info, None) }.map_err(|e| {
+                BackendError::DeviceCreation {
+                    backend: options.source.name().into(),
+                    reason: format!("{e:?}"),
+                }
+            })?;
+        // SAFETY: the queue family was requested above.
+        let queue = unsafe { device.get_device_queue(family, 0) };
+        let memory = unsafe { instance_ref.get_physical_device_memory_properties(physical) };
+        let wanted = vk::MemoryPropertyFlags::HOST_VISIBLE | vk::MemoryPropertyFlags::HOST_COHERENT;
+        let memory_type = (0..memory.memory_type_count)
+            .find(|&i| {
+                memory.memory_types[i as usize]
+                    .property_flags
+                    .contains(wanted)
+            })
+            .ok_or_else(|| BackendError::DeviceCreation {
+                backend: options.source.name().into(),
+                reason: "no host-visible, coherent memory type".into(),
+            });
+        let memory_type = match memory_type {
+            Ok(index) => index,
+            Err(error) => {
+                // SAFETY: nothing was created from the device yet.
+                unsafe { device.destroy_device(None) };
+                return Err(error);
+            }
+        };
+        let timestamps = properties.limits.timestamp_compute_and_graphics == vk::TRUE
+            && properties.limits.timestamp_period > 0.0
+            && families[family as usize].timestamp_valid_bits > 0;
+        let mut objects = DeviceObjects::default();
+        if let Err(error) = objects.create(&device, family, timestamps) {
+            objects.destroy(&device);
+            // SAFETY: every child object was destroyed just above.
+            unsafe { device.destroy_device(None) };
+            return Err(error);
+        }
+        let DeviceObjects {
+            command_pool,
+            command_buffer,
+            fence,
+            query_pool,
+        } = objects;
+        let (command_pool, command_buffer, fence) = (
+            command_pool.expect("created"),
+            command_buffer.expect("created"),
+            fence.expect("created"),
+        );
+        let (instance, debug) = partial.take();
+        Ok(Self {
+            _entry: entry,
+            instance,
+            debug,
+            physical,
+            device,
+            queue,
+            memory_type,
+            command_pool,
+            command_buffer,
+            fence,
+            query_pool,
+            timestamp_period: f64::from(properties.limits.timestamp_period),
+            subgroup_size,
+        })
+    }
+
+    pub(super) fn device_info(&self, options: AshOptions) -> DeviceInfo {
+        let mut maintenance3 = vk::PhysicalDeviceMaintenance3Properties::default();
+        let mut driver = vk::PhysicalDeviceDriverProperties::default();
+        let mut properties2 = vk::PhysicalDeviceProperties2::default()
+            .push_next(&mut maintenance3)
+            .push_next(&mut driver);
+        // SAFETY: Vulkan 1.1 core query (driver properties: 1.2, zeroed if unsupported).
+        unsafe {
+            self.instance
+                .get_physical_device_properties2(self.physical, &mut properties2)
+        };
+        let properties = properties2.properties;
+        let limits = properties.limits;
+        let name = properties
+            .device_name_as_c_str()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let driver_name = driver
+            .driver_name_as_c_str()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let driver_info = driver
+            .driver_info_as_c_str()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        DeviceInfo {
+            backend: options.source.name().into(),
+            adapter: name,
+            device_type: format!("{:?}", properties.device_type),
+            driver: format!("{driver_name} {driver_info}").trim().into(),
+            subgroup_sizes: self.subgroup_size.map(|s| (s, s)),
+            timestamps: self.query_pool.is_some(),
+            limits: DeviceLimits {
+                max_workgroup_storage: u64::from(limits.max_compute_shared_memory_size),
+                max_invocations_per_workgroup: limits.max_compute_work_group_invocations,
+                max_workgroup_size: limits.max_compute_work_group_size,
+                max_workgroups_per_dimension: limits
+                    .max_compute_work_group_count
+                    .iter()
+                    .copied()
+                    .min()
+                    .unwrap_or(0),
+                max_storage_binding: u64::from(limits.max_storage_buffer_range),
+                max_uniform_binding: u64::from(limits.max_uniform_buffer_range),
+                max_buffer_size: maintenance3.max_memory_allocation_size,
+                max_storage_buffers_per_stage: limits.max_per_stage_descriptor_storage_buffers,
+            },
+        }
+    }
+
+    pub(super) fn validation_messages(&self) -> Vec<String> {
+        self.debug
+            .as_ref()
+            .and_then(|(_, _, messages)| messages.lock().ok().map(|list| list.clone()))
+            .unwrap_or_default()
+    }
+
+    pub(super) fn create_buffer(
+        &self,
+        label: &str,
+        size: u64,
+    ) -> Result<(vk::Buffer, vk::DeviceMemory, *mut u8), BackendError> {
+        let operation = format!("creating buffer `{label}` ({size} bytes)");
+        // SAFETY: valid device; every object is destroyed on the error paths.
+        unsafe {
+            let buffer = self
+                .device
+                .create_buffer(
+                    &vk::BufferCreateInfo::default()
+                        .size(size)
+                        .usage(
+                            vk::BufferUsageFlags::STORAGE_BUFFER
+                                | vk::BufferUsageFlags::UNIFORM_BUFFER
+                                | vk::BufferUsageFlags::TRANSFER_SRC
+                                | vk::BufferUsageFlags::TRANSFER_DST,
+                        )
+                        .sharing_mode(vk::SharingMode::EXCLUSIVE),
+                    None,
+                )
+                .map_err(|e| vk_error(&operation, e))?;
+            let requirements = self.device.get_buffer_memory_requirements(buffer);
+            if requirements.memory_type_bits & (1 << self.memory_type) == 0 {
+                self.device.destroy_buffer(buffer, None);
+                return Err(BackendError::Buffer {
+                    label: label.into(),
+                    reason: "the device cannot place storage buffers in host-visible memory".into(),
+                });
+            }
+            let memory = match self.device.allocate_memory(
+                &vk::MemoryAllocateInfo::default()
+                    .allocation_size(requirements.size)
+                    .memory_type_index(self.memory_type),
+                None,
+            ) {
+                Ok(memory) => memory,
+                Err(e) => {
+                    self.device.destroy_buffer(buffer, None);
+                    return Err(vk_error(&operation, e));
+                }
+            };
+            let bound = self.device.bind_buffer_memory(buffer, memory, 0);
+            let mapped = bound.and_then(|()| {
+                self.device
+                    .map_memory(memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty())
+            });
+            match mapped {
+                Ok(pointer) => {
+                    std::ptr::write_bytes(pointer as *mut u8, 0, size as usize);
+                    Ok((buffer, memory, pointer as *mut u8))
+                }
+                Err(e) => {
+                    self.device.destroy_buffer(buffer, None);
+                    self.device.free_memory(memory, None);
+                    Err(vk_error(&operation, e))
+                }
+            }
+        }
+    }
+
+    pub(super) fn destroy_buffer(&self, buffer: vk::Buffer, memory: vk::DeviceMemory) {
+        // SAFETY: no dispatch is in flight between calls; the buffer is not used again.
+        unsafe {
+            self.device.destroy_buffer(buffer, None);
+            self.device.free_memory(memory, None);
+        }
+    }
+
+    /// Records, submits and waits for one dispatch; returns its device time if `timed`.
+    pub(super) fn dispatch(
+        &self,
+        pipeline: &AshPipeline,
+        kernel: &Kernel,
+        buffers: &[(u32, vk::Buffer)],
+        workgroups: [u32; 3],
+        timed: bool,
+    ) -> Result<Option<Duration>, BackendError> {
+        let operation = format!("dispatch of `{}`", kernel.name());
+        let error = |e| vk_error(&operation, e);
+        let uniform = kernel
+            .bindings
+            .iter()
+            .filter(|b| b.kind == BindingKind::Uniform)
+            .count() as u32;
+        let storage = kernel.bindings.len() as u32 - uniform;
+        let mut sizes = Vec::new();
+        if uniform > 0 {
+            sizes.push(vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::UNIFORM_BUFFER,
+                descriptor_count: uniform,
+            });
+        }
+        if storage > 0 {
+            sizes.push(vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::STORAGE_BUFFER,
+                descriptor_count: storage,
+            });
+        }
+        // SAFETY: all handles are valid; the pool is destroyed after the fence wait.
+        unsafe {
+            let pool = self
+                .device
+                .create_descriptor_pool(
+                    &vk::DescriptorPoolCreateInfo::default()
+                        .max_sets(1)
+                        .pool_sizes(&sizes),
+                    None,
+                )
+                .map_err(error)?;
+            let result = (|| {
+                let layouts = [pipeline.set_layout];
+                let set = self
+                    .device
+                    .allocate_descriptor_sets(
+                        &vk::DescriptorSetAllocateInfo::default()
+                            .descriptor_pool(pool)
+                            .set_layouts(&layouts),
+                    )
+                    .map_err(error)?[0];
+                let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
+                    .iter()
+                    .map(|&(_, buffer)| {
+                        [vk::DescriptorBufferInfo {
+                            buffer,
+                            offset: 0,
+                            range: vk::WHOLE_SIZE,
+                        }]
+                    })
+                    .collect();
+                let writes: Vec<_> = buffers
+                    .iter()
+                    .zip(&infos)
+                    .map(|(&(binding, _), info)| {
+                        let kind = kernel.binding(0, binding).map(|b| b.kind);
+                        vk::WriteDescriptorSet::default()
+                            .dst_set(set)
+                            .dst_binding(binding)
+                            .descriptor_type(if kind == Some(BindingKind::Uniform) {
+                                vk::DescriptorType::UNIFORM_BUFFER
+                            } else {
+                                vk::DescriptorType::STORAGE_BUFFER
+                            })
+                            .buffer_info(info)
+                    })
+                    .collect();
+                self.device.update_descriptor_sets(&writes, &[]);
+                let cb = self.command_buffer;
+                self.device
+                    .reset_command_buffer(cb, vk::CommandBufferResetFlags::empty())
+                    .map_err(error)?;
+                self.device
+                    .begin_command_buffer(
+                        cb,
+                        &vk::CommandBufferBeginInfo::default()
+                            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+                    )
+                    .map_err(error)?;
+                let queries = self.query_pool.filter(|_| timed);
+                if let Some(queries) = queries {
+                    self.device.cmd_reset_query_pool(cb, queries, 0, 2);
+                    self.device.cmd_write_timestamp(
+                        cb,
+                        vk::PipelineStageFlags::TOP_OF_PIPE,
+                        queries,
+                        0,
+                    );
+                }
+                self.device.cmd_bind_pipeline(
+                    cb,
+                    vk::PipelineBindPoint::COMPUTE,
+                    pipeline.pipeline,
+                );
+                self.device.cmd_bind_descriptor_sets(
+                    cb,
+                    vk::PipelineBindPoint::COMPUTE,
+                    pipeline.layout,
+                    0,
+                    &[set],
+                    &[],
+                );
+                self.device
+                    .cmd_dispatch(cb, workgroups[0], workgroups[1], workgroups[2]);
+                if let Some(queries) = queries {
+                    self.device.cmd_write_timestamp(
+                        cb,
+                        vk::PipelineStageFlags::BOTTOM_OF_PIPE,
+                        queries,
+                        1,
+                    );
+                }
+                let barrier = vk::MemoryBarrier::default()
+                    .src_access_mask(vk::AccessFlags::SHADER_WRITE)
+                    .dst_access_mask(vk::AccessFlags::HOST_READ);
+                self.device.cmd_pipeline_barrier(
+                    cb,
+                    vk::PipelineStageFlags::COMPUTE_SHADER,
+                    vk::PipelineStageFlags::HOST,
+                    vk::DependencyFlags::empty(),
+                    &[barrier],
+                    &[],
+                    &[],
+                );
+                self.device.end_command_buffer(cb).map_err(error)?;
+                let command_buffers = [cb];
+                let submit = [vk::SubmitInfo::default().command_buffers(&command_buffers)];
+                self.device
+                    .queue_submit(self.queue, &submit, self.fence)
+                    .map_err(error)?;
+                self.device
+                    .wait_for_fences(&[self.fence], true, u64::MAX)
+                    .map_err(error)?;
+                self.device.reset_fences(&[self.fence]).map_err(error)?;
+                match queries {
+                    Some(queries) => {
+                        let mut ticks = [0u64; 2];
+                        self.device
+                            .get_query_pool_results(
+                                queries,
+                                0,
+                                &mut ticks,
+                                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+                            )
+                            .map_err(error)?;
+                        let nanos =
+                            ticks[1].saturating_sub(ticks[0]) as f64 * self.timestamp_period;
+                        Ok(Some(Duration::from_nanos(nanos as u64)))
+                    }
+                    None => Ok(None),
+                }
+            })();
+            self.device.destroy_descriptor_pool(pool, None);
+            result
+        }
+    }
+
+    pub(super) fn wait_idle(&self) {
+        // SAFETY: valid device.
+        let _ = unsafe { self.device.device_wait_idle() };
+    }
+}
+
+impl Drop for VulkanDevice {
+    fn drop(&mut self) {
+        // SAFETY: the owner (AshBackend) destroyed buffers and pipelines first and
+        // waited for the device to be idle.
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            if let Some(pool) = self.query_pool {
+                self.device.destroy_query_pool(pool, None);
+            }
+            self.device.destroy_fence(self.fence, None);
+            self.device.destroy_command_pool(self.command_pool, None);
+            self.device.destroy_device(None);
+            if let Some((utils, messenger, _messages)) = self.debug.take() {
+                utils.destroy_debug_utils_messenger(messenger, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}
+
+/// The device's long-lived objects while they are being created.
+#[derive(Default)]
+struct DeviceObjects {
+    command_pool: Option<vk::CommandPool>,
+    command_buffer: Option<vk::CommandBuffer>,
+    fence: Option<vk::Fence>,
+    query_pool: Option<vk::QueryPool>,
+}
+
+impl DeviceObjects {
+    fn create(
+        &mut self,
+        device: &ash::Device,
+        family: u32,
+        timestamps: bool,
+    ) -> Result<(), BackendError> {
+        // SAFETY: valid device; on error the caller destroys what was created.
+        unsafe {
+            let pool = device
+                .create_command_pool(
+                    &vk::CommandPoolCreateInfo::default()
+                        .queue_family_index(family)
+                        .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER),
+                    None,
+                )
+                .map_err(|e| vk_error("creating the command pool", e))?;
+            self.command_pool = Some(pool);
+            let buffers = device
+                .allocate_command_buffers(
+                    &vk::CommandBufferAllocateInfo::default()
+                        .command_pool(pool)
+                        .level(vk::CommandBufferLevel::PRIMARY)
+                        .command_buffer_count(1),
+                )
+                .map_err(|e| vk_error("allocating a command buffer", e))?;
+            self.command_buffer = Some(buffers[0]);
+            self.fence = Some(
+                device
+                    .create_fence(&vk::FenceCreateInfo::default(), None)
+                    .map_err(|e| vk_error("creating a fence", e))?,
+            );
+            if timestamps {
+                self.query_pool = Some(
+                    device
+                        .create_query_pool(
+                            &vk::QueryPoolCreateInfo::default()
+                                .query_type(vk::QueryType::TIMESTAMP)
+                                .query_count(2),
+                            None,
+                        )
+                        .map_err(|e| vk_error("creating the timestamp query pool", e))?,
+                );
+            }
+        }
+        Ok(())
+    }
+
+    fn destroy(&mut self, device: &ash::Device) {
+        // SAFETY: nothing was submitted; each object is destroyed once.
+        unsafe {
+            if let Some(pool) = self.query_pool.take() {
+                device.destroy_query_pool(pool, None);
+            }
+            if let Some(fence) = self.fence.take() {
+                device.destroy_fence(fence, None);
+            }
+            if let Some(pool) = self.command_pool.take() {
+                device.destroy_command_pool(pool, None);
+            }
+        }
+    }
+}
+
+/// Instance and messenger until the device exists: destroyed if opening fails.
+struct PartialInstance {
+    instance: Option<ash::Instance>,
+    debug: Option<(
+        ash::ext::debug_utils::Instance,
+        vk::DebugUtilsMessengerEXT,
+        Box<Messages>,
+    )>,
+}
+
+impl PartialInstance {
+    #[allow(clippy::type_complexity)]
+    fn take(
+        &mut self,
+    ) -> (
+        ash::Instance,
+        Option<(
+            ash::ext::debug_utils::Instance,
+            vk::DebugUtilsMessengerEXT,
+            Box<Messages>,
+        )>,
+    ) {
+        (self.instance.take().expect("taken once"), self.debug.take())
+    }
+}
+
+impl Drop for PartialInstance {
+    fn drop(&mut self) {
+        // SAFETY: only reached when opening failed before the device took ownership.
+        unsafe {
+            if let Some((utils, messenger, _)) = self.debug.take() {
+                utils.destroy_debug_utils_messenger(messenger, None);
+            }
+            if let Some(instance) = self.instance.take() {
+                instance.destroy_instance(None);
+            }
+        }
+    }
+}
+
+/// The best physical device with a compute queue and Vulkan 1.1: discrete first, CPU last.
+fn pick_device(
+    instance: &ash::Instance,
+    options: AshOptions,
+) -> Result<(vk::PhysicalDevice, u32), BackendError> {
+    // SAFETY: plain enumeration.
+    let devices = unsafe { instance.enumerate_physical_devices() }
+        .map_err(|e| vk_error("enumerating devices", e))?;
+    let rank = |kind: vk::PhysicalDeviceType| match kind {
+        vk::PhysicalDeviceType::DISCRETE_GPU => 0,
+        vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
+        vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+        vk::PhysicalDeviceType::CPU => 3,
+        _ => 4,
+    };
+    let mut best = None;
+    for device in devices {
+        // SAFETY: valid handle from enumeration.
+        let properties = unsafe { instance.get_physical_device_properties(device) };
+        if properties.api_version < vk::API_VERSION_1_1 {
+            continue;
+        }
+        let families = unsafe { instance.get_physical_device_queue_family_properties(device) };
+        let Some(family) = families
+            .iter()
+            .position(|f| f.queue_flags.contains(vk::QueueFlags::COMPUTE))
+        else {
+            continue;
+        };
+        let key = rank(properties.device_type);
+        if best.is_none_or(|(k, _, _)| key < k) {
+            best = Some((key, device, family as u32));
+        }
+    }
+    best.map(|(_, device, family)| (device, family))
+        .ok_or_else(|| BackendError::NoAdapter {
+            backend: options.source.name().into(),
+            reason: "no Vulkan 1.1 device with a compute queue".into(),
+        })
+}

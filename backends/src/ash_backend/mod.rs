@@ -1,0 +1,267 @@
+//! The [`Backend`] on raw Vulkan through ash, running naga's SPIR-V (or SPIR-V that
+//! glslang compiled from naga's GLSL or HLSL, to execute those translations too).
+//!
+//! Deliberately simple: every buffer lives in host-visible, coherent memory (persistently
+//! mapped), and every dispatch is recorded, submitted and waited for on its own. That is
+//! the right trade for a reference and cross-check backend; an engine's own Vulkan code
+//! does its own memory management.
+
+mod device;
+mod pipelines;
+
+use crate::backend::{Backend, Bind, BufferId};
+use crate::bindings_check::{check_binds, check_kernel_fits, check_workgroups};
+use crate::device_info::DeviceInfo;
+use crate::error::BackendError;
+use ash::vk;
+use device::VulkanDevice;
+use pipelines::PipelineCache;
+use std::collections::HashMap;
+use std::time::Duration;
+use strata_kernels::Kernel;
+
+/// Where the SPIR-V the ash backend runs comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SpirvSource {
+    /// naga's SPIR-V back end.
+    Naga,
+    /// glslang's compilation of naga's GLSL output.
+    GlslangFromGlsl,
+    /// glslang's compilation of naga's HLSL output.
+    GlslangFromHlsl,
+}
+
+impl SpirvSource {
+    /// Backend name suffix.
+    pub fn name(self) -> &'static str {
+        match self {
+            SpirvSource::Naga => "ash",
+            SpirvSource::GlslangFromGlsl => "ash-glsl",
+            SpirvSource::GlslangFromHlsl => "ash-hlsl",
+        }
+    }
+}
+
+/// How to open an [`AshBackend`].
+#[derive(Clone, Copy, Debug)]
+pub struct AshOptions {
+    /// Enable `VK_LAYER_KHRONOS_validation`; its warnings and errors are collected
+    /// (see [`AshBackend::validation_messages`]). Fails if the layer is not installed.
+    pub validation: bool,
+    /// Where the SPIR-V comes from.
+    pub source: SpirvSource,
+    /// Let kernels use subgroup operations when the device supports them.
+    pub subgroups: bool,
+}
+
+impl Default for AshOptions {
+    fn default() -> Self {
+        Self {
+            validation: false,
+            source: SpirvSource::Naga,
+            subgroups: true,
+        }
+    }
+}
+
+struct AshBuffer {
+    buffer: vk::Buffer,
+    memory: vk::DeviceMemory,
+    mapped: *mut u8,
+    size: u64,
+    label: String,
+}
+
+/// A Vulkan device driven through ash.
+pub struct AshBackend {
+    // Field order is drop order: buffers and pipelines go before the device.
+    buffers: HashMap<u64, AshBuffer>,
+    next_buffer: u64,
+    pipelines: PipelineCache,
+    vulkan: VulkanDevice,
+    info: DeviceInfo,
+}
+
+impl AshBackend {
+    /// Opens the best Vulkan device: a discrete GPU first, a CPU device (lavapipe) last.
+    pub fn new(options: AshOptions) -> Result<Self, BackendError> {
+        if options.source != SpirvSource::Naga {
+            let probe = std::process::Command::new("glslangValidator")
+                .arg("--version")
+                .output();
+            if !probe.is_ok_and(|out| out.status.success()) {
+                return Err(BackendError::NoAdapter {
+                    backend: options.source.name().into(),
+                    reason:
+                        "glslangValidator is not installed (Debian: apt-get install glslang-tools)"
+                            .into(),
+                });
+            }
+        }
+        let vulkan = VulkanDevice::open(options)?;
+        let info = vulkan.device_info(options);
+        let pipelines = PipelineCache::new(options.source);
+        Ok(Self {
+            buffers: HashMap::new(),
+            next_buffer: 0,
+            pipelines,
+            vulkan,
+            info,
+        })
+    }
+
+    /// Warnings and errors the validation layer reported so far (empty without validation).
+    pub fn validation_messages(&self) -> Vec<String> {
+        self.vulkan.validation_messages()
+    }
+
+    fn buffer(&self, id: BufferId) -> Result<&AshBuffer, BackendError> {
+        self.buffers
+            .get(&id.0)
+            .ok_or(BackendError::UnknownBuffer(id.0))
+    }
+
+    fn run(
+        &mut self,
+        kernel: &Kernel,
+        binds: &[Bind],
+        workgroups: [u32; 3],
+        timed: bool,
+    ) -> Result<Option<Duration>, BackendError> {
+        self.check_kernel(kernel)?;
+        check_workgroups(kernel, workgroups, &self.info)?;
+        check_binds(kernel, binds, &self.info, |id| {
+            self.buffer(id).map(|b| b.size)
+        })?;
+        let pipeline = self.pipelines.get_or_create(&self.vulkan, kernel)?;
+        let buffers = binds
+            .iter()
+            .map(|bind| Ok((bind.binding, self.buffer(bind.buffer)?.buffer)))
+            .collect::<Result<Vec<_>, BackendError>>()?;
+        self.vulkan
+            .dispatch(&pipeline, kernel, &buffers, workgroups, timed)
+    }
+}
+
+impl Backend for AshBackend {
+    fn info(&self) -> &DeviceInfo {
+        &self.info
+    }
+
+    fn create_buffer(&mut self, label: &str, size: u64) -> Result<BufferId, BackendError> {
+        if size == 0 {
+            return Err(BackendError::Buffer {
+                label: label.into(),
+                reason: "size 0: buffers must hold at least one byte".into(),
+            });
+        }
+        if size > self.info.limits.max_buffer_size {
+            return Err(BackendError::LimitExceeded {
+                what: format!("buffer `{label}`"),
+                limit: "buffer bytes",
+                requested: size,
+                available: self.info.limits.max_buffer_size,
+            });
+        }
+        let (buffer, memory, mapped) = self.vulkan.create_buffer(label, size.div_ceil(4) * 4)?;
+        self.next_buffer += 1;
+        self.buffers.insert(
+            self.next_buffer,
+            AshBuffer {
+                buffer,
+                memory,
+                mapped,
+                size,
+                label: label.into(),
+            },
+        );
+        Ok(BufferId(self.next_buffer))
+    }
+
+    fn write_buffer(
+        &mut self,
+        buffer: BufferId,
+        offset: u64,
+        data: &[u8],
+    ) -> Result<(), BackendError> {
+        let entry = self.buffer(buffer)?;
+        if !offset.is_multiple_of(4)
+            || !data.len().is_multiple_of(4)
+            || offset + data.len() as u64 > entry.size
+        {
+            return Err(BackendError::Buffer {
+                label: entry.label.clone(),
+                reason: format!(
+                    "write of {} bytes at offset {offset} into {} bytes (offset and length must be multiples of 4)",
+                    data.len(),
+                    entry.size
+                ),
+            });
+        }
+        // SAFETY: the mapping covers the whole buffer, the range was checked above, and
+        // no dispatch is in flight (dispatches complete before `dispatch` returns).
+        unsafe {
+            std::ptr::copy_nonoverlapping(
+                data.as_ptr(),
+                entry.mapped.add(offset as usize),
+                data.len(),
+            );
+        }
+        Ok(())
+    }
+
+    fn read_buffer(&mut self, buffer: BufferId) -> Result<Vec<u8>, BackendError> {
+        let entry = self.buffer(buffer)?;
+        let mut bytes = vec![0u8; entry.size as usize];
+        // SAFETY: as in write_buffer.
+        unsafe {
+            std::ptr::copy_nonoverlapping(entry.mapped, bytes.as_mut_ptr(), bytes.len());
+        }
+        Ok(bytes)
+    }
+
+    fn destroy_buffer(&mut self, buffer: BufferId) -> Result<(), BackendError> {
+        let entry = self
+            .buffers
+            .remove(&buffer.0)
+            .ok_or(BackendError::UnknownBuffer(buffer.0))?;
+        self.vulkan.destroy_buffer(entry.buffer, entry.memory);
+        Ok(())
+    }
+
+    fn check_kernel(&self, kernel: &Kernel) -> Result<(), BackendError> {
+        check_kernel_fits(kernel, &self.info)
+    }
+
+    fn dispatch(
+        &mut self,
+        kernel: &Kernel,
+        binds: &[Bind],
+        workgroups: [u32; 3],
+    ) -> Result<(), BackendError> {
+        self.run(kernel, binds, workgroups, false).map(|_| ())
+    }
+
+    fn dispatch_timed(
+        &mut self,
+        kernel: &Kernel,
+        binds: &[Bind],
+        workgroups: [u32; 3],
+    ) -> Result<Duration, BackendError> {
+        if !self.info.timestamps {
+            return Err(BackendError::NoTimestamps(self.info.backend.clone()));
+        }
+        self.run(kernel, binds, workgroups, true)?
+            .ok_or_else(|| BackendError::NoTimestamps(self.info.backend.clone()))
+    }
+}
+
+impl Drop for AshBackend {
+    fn drop(&mut self) {
+        self.vulkan.wait_idle();
+        for (_, entry) in self.buffers.drain() {
+            self.vulkan.destroy_buffer(entry.buffer, entry.memory);
+        }
+        self.pipelines.destroy(&self.vulkan);
+    }
+}

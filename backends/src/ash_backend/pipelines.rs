@@ -1,0 +1,159 @@
+//! One compute pipeline per registry kernel for the ash backend: SPIR-V from naga (or
+//! from glslang on naga's GLSL / HLSL), descriptor set 0 laid out from the registry.
+
+use super::SpirvSource;
+use super::device::VulkanDevice;
+use crate::error::BackendError;
+use ash::vk;
+use std::collections::HashMap;
+use std::ffi::CString;
+use std::sync::Arc;
+use strata_kernels::glslang::{self, GlslangInput};
+use strata_kernels::translate::{self, TranslateOptions};
+use strata_kernels::{BindingKind, Kernel, KernelId};
+
+pub(super) struct AshPipeline {
+    module: vk::ShaderModule,
+    pub(super) set_layout: vk::DescriptorSetLayout,
+    pub(super) layout: vk::PipelineLayout,
+    pub(super) pipeline: vk::Pipeline,
+}
+
+pub(super) struct PipelineCache {
+    source: SpirvSource,
+    pipelines: HashMap<KernelId, Arc<AshPipeline>>,
+}
+
+impl PipelineCache {
+    pub(super) fn new(source: SpirvSource) -> Self {
+        Self {
+            source,
+            pipelines: HashMap::new(),
+        }
+    }
+
+    /// SPIR-V words and entry point name of `kernel` from this cache's source.
+    fn spirv(&self, kernel: &Kernel) -> Result<(Vec<u32>, String), BackendError> {
+        let glslang_input = match self.source {
+            SpirvSource::Naga => {
+                // No naga DEBUG flag: Debian's validation layer misreads its OpSource marker.
+                let translation = translate::spirv(kernel, TranslateOptions::default())?;
+                return Ok((translation.words, translation.entry_point));
+            }
+            SpirvSource::GlslangFromGlsl => GlslangInput::Glsl,
+            SpirvSource::GlslangFromHlsl => GlslangInput::Hlsl,
+        };
+        let dir = std::env::temp_dir().join(format!("strata-glslang-{}", std::process::id()));
+        let result = glslang::compile(kernel, glslang_input, &dir);
+        let _ = std::fs::remove_dir_all(&dir);
+        result.map_err(|error| BackendError::Validation {
+            backend: self.source.name().into(),
+            operation: format!("glslang compilation of `{}`", kernel.name()),
+            message: error.to_string(),
+        })
+    }
+
+    pub(super) fn get_or_create(
+        &mut self,
+        vulkan: &VulkanDevice,
+        kernel: &Kernel,
+    ) -> Result<Arc<AshPipeline>, BackendError> {
+        if let Some(pipeline) = self.pipelines.get(&kernel.id) {
+            return Ok(Arc::clone(pipeline));
+        }
+        let (words, entry_point) = self.spirv(kernel)?;
+        let entry_point = CString::new(entry_point).map_err(|e| BackendError::Validation {
+            backend: self.source.name().into(),
+            operation: format!("pipeline of `{}`", kernel.name()),
+            message: e.to_string(),
+        })?;
+        let operation = format!("pipeline creation for `{}`", kernel.name());
+        let error = |result: vk::Result| BackendError::Validation {
+            backend: self.source.name().into(),
+            operation: operation.clone(),
+            message: format!("{result:?}"),
+        };
+        let device = &vulkan.device;
+        let bindings: Vec<_> = kernel
+            .bindings
+            .iter()
+            .map(|binding| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(binding.binding)
+                    .descriptor_type(match binding.kind {
+                        BindingKind::Uniform => vk::DescriptorType::UNIFORM_BUFFER,
+                        BindingKind::Storage(_) => vk::DescriptorType::STORAGE_BUFFER,
+                    })
+                    .descriptor_count(1)
+                    .stage_flags(vk::ShaderStageFlags::COMPUTE)
+            })
+            .collect();
+        // SAFETY: valid device and create infos; every object is destroyed on the error
+        // paths or in `destroy`.
+        unsafe {
+            let module = device
+                .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), None)
+                .map_err(error)?;
+            let set_layout = match device.create_descriptor_set_layout(
+                &vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings),
+                None,
+            ) {
+                Ok(layout) => layout,
+                Err(e) => {
+                    device.destroy_shader_module(module, None);
+                    return Err(error(e));
+                }
+            };
+            let set_layouts = [set_layout];
+            let layout = match device.create_pipeline_layout(
+                &vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts),
+                None,
+            ) {
+                Ok(layout) => layout,
+                Err(e) => {
+                    device.destroy_descriptor_set_layout(set_layout, None);
+                    device.destroy_shader_module(module, None);
+                    return Err(error(e));
+                }
+            };
+            let stage = vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::COMPUTE)
+                .module(module)
+                .name(&entry_point);
+            let create = [vk::ComputePipelineCreateInfo::default()
+                .stage(stage)
+                .layout(layout)];
+            let pipeline =
+                match device.create_compute_pipelines(vk::PipelineCache::null(), &create, None) {
+                    Ok(pipelines) => pipelines[0],
+                    Err((_, e)) => {
+                        device.destroy_pipeline_layout(layout, None);
+                        device.destroy_descriptor_set_layout(set_layout, None);
+                        device.destroy_shader_module(module, None);
+                        return Err(error(e));
+                    }
+                };
+            let pipeline = Arc::new(AshPipeline {
+                module,
+                set_layout,
+                layout,
+                pipeline,
+            });
+            self.pipelines.insert(kernel.id, Arc::clone(&pipeline));
+            Ok(pipeline)
+        }
+    }
+
+    pub(super) fn destroy(&mut self, vulkan: &VulkanDevice) {
+        let device = &vulkan.device;
+        for (_, pipeline) in self.pipelines.drain() {
+            // SAFETY: the device is idle; each object is destroyed once.
+            unsafe {
+                device.destroy_pipeline(pipeline.pipeline, None);
+                device.destroy_pipeline_layout(pipeline.layout, None);
+                device.destroy_descriptor_set_layout(pipeline.set_layout, None);
+                device.destroy_shader_module(pipeline.module, None);
+            }
+        }
+    }
+}

@@ -1,0 +1,122 @@
+//! The cross-backend identity check (`cargo xtask check`, and a test under `cargo test`):
+//! every registry kernel on every available backend with generated inputs, compared
+//! with the kernel's Rust reference. Integer and ordering outputs must be bit-exact;
+//! float outputs must stay within the ULP bound the registry declares for the kernel.
+
+mod backends;
+mod compare;
+mod histogram;
+mod report;
+
+pub use backends::{BackendSlot, backend_slots};
+pub use compare::{Compare, Mismatch, Output, compare_outputs};
+pub use report::{CellResult, CheckReport};
+
+use crate::histogram_pass::PassError;
+use strata_backends::Backend;
+use strata_kernels::KernelId;
+
+/// How much to check.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CheckConfig {
+    /// `--full`: at least 20 seeds at several sizes per kernel; otherwise 3 seeds at small
+    /// sizes (what `cargo test` runs).
+    pub full: bool,
+}
+
+/// One generated input of a kernel check.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Case {
+    /// Human-readable description, used in mismatch reports.
+    pub label: String,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Block size, for block kernels.
+    pub block_size: u32,
+    /// Seed of the generated input.
+    pub seed: u64,
+    /// Which input family (kernel-specific: e.g. mostly valid, mostly invalid, all empty).
+    pub family: u32,
+}
+
+/// How one registry kernel is exercised and judged.
+pub trait KernelCheck {
+    /// The kernel.
+    fn kernel(&self) -> KernelId;
+    /// Inputs drawn from the kernel's domain, awkward values included.
+    fn cases(&self, config: CheckConfig) -> Vec<Case>;
+    /// Runs the kernel on `backend`.
+    fn run(&self, backend: &mut dyn Backend, case: &Case) -> Result<Vec<Output>, PassError>;
+    /// What the outputs must be.
+    fn reference(&self, case: &Case) -> Vec<Output>;
+}
+
+/// Every kernel check: one line per registry kernel.
+pub fn kernel_checks() -> Vec<Box<dyn KernelCheck>> {
+    vec![
+        Box::new(histogram::HistogramCheck(KernelId::BlockHistogram)),
+        Box::new(histogram::HistogramCheck(KernelId::BlockHistogramSubgroup)),
+    ]
+}
+
+/// Runs every kernel check on every backend slot.
+pub fn run_check(config: CheckConfig) -> CheckReport {
+    let checks = kernel_checks();
+    let mut report = CheckReport::new(
+        checks.iter().map(|c| c.kernel()).collect(),
+        backend_slots().iter().map(|s| s.name.to_string()).collect(),
+    );
+    for slot in backend_slots() {
+        let mut backend = match (slot.open)() {
+            Ok(backend) => backend,
+            Err(error) => {
+                for check in &checks {
+                    report.set(
+                        check.kernel(),
+                        slot.name,
+                        CellResult::Unavailable(error.to_string()),
+                    );
+                }
+                continue;
+            }
+        };
+        report.set_device(slot.name, backend.info().summary());
+        for check in &checks {
+            let result = run_one(check.as_ref(), backend.as_mut(), config);
+            report.set(check.kernel(), slot.name, result);
+        }
+    }
+    report
+}
+
+fn run_one(check: &dyn KernelCheck, backend: &mut dyn Backend, config: CheckConfig) -> CellResult {
+    let kernel = match strata_kernels::Registry::shared() {
+        Ok(registry) => registry.get(check.kernel()),
+        Err(error) => return CellResult::Failed(error.to_string()),
+    };
+    if let Err(error) = backend.check_kernel(kernel) {
+        return CellResult::Unavailable(error.to_string());
+    }
+    let mut max_ulp = 0;
+    let cases = check.cases(config);
+    for case in &cases {
+        let outputs = match check.run(backend, case) {
+            Ok(outputs) => outputs,
+            Err(error) => return CellResult::Failed(format!("{}: {error}", case.label)),
+        };
+        match compare_outputs(&outputs, &check.reference(case)) {
+            Ok(ulp) => max_ulp = max_ulp.max(ulp),
+            Err(mismatch) => return CellResult::Failed(format!("{}: {mismatch}", case.label)),
+        }
+    }
+    if max_ulp == 0 {
+        CellResult::Identical { cases: cases.len() }
+    } else {
+        CellResult::WithinUlp {
+            cases: cases.len(),
+            max_ulp,
+        }
+    }
+}

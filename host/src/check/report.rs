@@ -1,0 +1,134 @@
+//! The check's result table: kernels × backends.
+
+use std::collections::BTreeMap;
+use strata_kernels::KernelId;
+
+/// What one kernel did on one backend.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum CellResult {
+    /// Every output bit-identical to the reference on every case.
+    Identical {
+        /// Cases run.
+        cases: usize,
+    },
+    /// Float outputs differed, within the kernel's bound.
+    WithinUlp {
+        /// Cases run.
+        cases: usize,
+        /// Largest difference seen.
+        max_ulp: u32,
+    },
+    /// A mismatch or an error, with the first differing element.
+    Failed(String),
+    /// The backend or the kernel's needs are not available here, and why.
+    Unavailable(String),
+}
+
+/// Results of a whole check.
+#[derive(Clone, Debug)]
+pub struct CheckReport {
+    kernels: Vec<KernelId>,
+    backends: Vec<String>,
+    devices: BTreeMap<String, String>,
+    cells: BTreeMap<(KernelId, String), CellResult>,
+}
+
+impl CheckReport {
+    pub(super) fn new(kernels: Vec<KernelId>, backends: Vec<String>) -> Self {
+        Self {
+            kernels,
+            backends,
+            devices: BTreeMap::new(),
+            cells: BTreeMap::new(),
+        }
+    }
+
+    pub(super) fn set(&mut self, kernel: KernelId, backend: &str, result: CellResult) {
+        self.cells.insert((kernel, backend.to_string()), result);
+    }
+
+    pub(super) fn set_device(&mut self, backend: &str, device: String) {
+        self.devices.insert(backend.to_string(), device);
+    }
+
+    /// The result of `kernel` on `backend`.
+    pub fn cell(&self, kernel: KernelId, backend: &str) -> Option<&CellResult> {
+        self.cells.get(&(kernel, backend.to_string()))
+    }
+
+    /// Every failed cell, as "kernel on backend: reason".
+    pub fn failures(&self) -> Vec<String> {
+        self.cells
+            .iter()
+            .filter_map(|((kernel, backend), result)| match result {
+                CellResult::Failed(why) => Some(format!("{kernel:?} on {backend}: {why}")),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// The table, for people.
+    pub fn render(&self) -> String {
+        let mut text = String::new();
+        for backend in &self.backends {
+            if let Some(device) = self.devices.get(backend) {
+                text.push_str(&format!("{device}\n"));
+            }
+        }
+        text.push('\n');
+        let name = |k: &KernelId| {
+            strata_kernels::Registry::shared()
+                .map(|r| r.get(*k).name())
+                .unwrap_or("?")
+        };
+        let width = self
+            .kernels
+            .iter()
+            .map(|k| name(k).len())
+            .max()
+            .unwrap_or(6)
+            .max(6);
+        text.push_str(&format!("{:<width$}", "kernel"));
+        for backend in &self.backends {
+            text.push_str(&format!(" | {backend:<22}"));
+        }
+        text.push('\n');
+        let mut notes = Vec::new();
+        for kernel in &self.kernels {
+            text.push_str(&format!("{:<width$}", name(kernel)));
+            for backend in &self.backends {
+                let cell = match self.cell(*kernel, backend) {
+                    Some(CellResult::Identical { cases }) => format!("identical ({cases} cases)"),
+                    Some(CellResult::WithinUlp { cases, max_ulp }) => {
+                        format!("max {max_ulp} ULP ({cases})")
+                    }
+                    Some(CellResult::Failed(why)) => {
+                        notes.push(format!(
+                            "[{}] {} on {backend}: FAILED: {why}",
+                            notes.len() + 1,
+                            name(kernel)
+                        ));
+                        format!("FAILED [{}]", notes.len())
+                    }
+                    Some(CellResult::Unavailable(why)) => {
+                        notes.push(format!(
+                            "[{}] {} on {backend}: unavailable: {why}",
+                            notes.len() + 1,
+                            name(kernel)
+                        ));
+                        format!("unavailable [{}]", notes.len())
+                    }
+                    None => "not run".into(),
+                };
+                text.push_str(&format!(" | {cell:<22}"));
+            }
+            text.push('\n');
+        }
+        if !notes.is_empty() {
+            text.push('\n');
+            text.push_str(&notes.join("\n"));
+            text.push('\n');
+        }
+        text
+    }
+}

@@ -1,0 +1,111 @@
+//! SPIR-V compiled by glslang from naga's GLSL and HLSL output: runs the translated
+//! sources themselves (through the ash backend), a far stronger check than parsing them.
+
+use crate::registry::Kernel;
+use crate::translate::{self, TranslateOptions};
+use std::path::Path;
+use std::process::Command;
+
+/// Which naga output glslang compiles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum GlslangInput {
+    /// naga's GLSL 4.50 (`glslangValidator -V`).
+    Glsl,
+    /// naga's HLSL SM 6.0 with workgroup zero-initialisation off (`glslangValidator -D -V`).
+    Hlsl,
+}
+
+/// Why glslang produced no SPIR-V.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ToolError {
+    /// The tool is not installed.
+    Missing(String),
+    /// The tool ran and failed, or could not run.
+    Failed(String),
+}
+
+impl std::fmt::Display for ToolError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ToolError::Missing(tool) => write!(f, "`{tool}` is not installed"),
+            ToolError::Failed(message) => f.write_str(message),
+        }
+    }
+}
+
+/// Runs `tool` with `args`; stdout and stderr go into the error.
+pub fn run_tool(tool: &str, args: &[&std::ffi::OsStr]) -> Result<(), ToolError> {
+    match Command::new(tool).args(args).output() {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(ToolError::Missing(tool.into())),
+        Err(e) => Err(ToolError::Failed(format!("`{tool}` could not run: {e}"))),
+        Ok(out) if out.status.success() => Ok(()),
+        Ok(out) => Err(ToolError::Failed(format!(
+            "`{tool}` rejected it:\n{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        ))),
+    }
+}
+
+/// Writes naga's `input` translation of `kernel` to `dir`, compiles it with glslang for
+/// Vulkan 1.1 and returns the SPIR-V words and the entry point name.
+pub fn compile(
+    kernel: &Kernel,
+    input: GlslangInput,
+    dir: &Path,
+) -> Result<(Vec<u32>, String), ToolError> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| ToolError::Failed(format!("{}: {e}", dir.display())))?;
+    let (translation, extension) = match input {
+        GlslangInput::Glsl => (translate::glsl(kernel, TranslateOptions::default()), "comp"),
+        GlslangInput::Hlsl => (
+            translate::hlsl(
+                kernel,
+                TranslateOptions {
+                    zero_initialize_workgroup_memory: false,
+                },
+            ),
+            "hlsl",
+        ),
+    };
+    let translation = translation.map_err(|e| ToolError::Failed(e.to_string()))?;
+    let source = dir.join(format!("{}.{extension}", kernel.name()));
+    let output = dir.join(format!("{}.{extension}.spv", kernel.name()));
+    std::fs::write(&source, &translation.text)
+        .map_err(|e| ToolError::Failed(format!("{}: {e}", source.display())))?;
+    use std::ffi::OsStr;
+    let mut args: Vec<&OsStr> = Vec::new();
+    if input == GlslangInput::Hlsl {
+        args.extend([
+            OsStr::new("-D"),
+            OsStr::new("-e"),
+            OsStr::new(&translation.entry_point),
+        ]);
+    }
+    args.extend([
+        OsStr::new("-V"),
+        OsStr::new("--target-env"),
+        OsStr::new("vulkan1.1"),
+    ]);
+    args.extend([
+        OsStr::new("-S"),
+        OsStr::new("comp"),
+        source.as_os_str(),
+        OsStr::new("-o"),
+        output.as_os_str(),
+    ]);
+    run_tool("glslangValidator", &args)?;
+    let bytes = std::fs::read(&output)
+        .map_err(|e| ToolError::Failed(format!("{}: {e}", output.display())))?;
+    if bytes.len() % 4 != 0 {
+        return Err(ToolError::Failed(format!(
+            "{}: not a SPIR-V file",
+            output.display()
+        )));
+    }
+    let words = bytes
+        .chunks_exact(4)
+        .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
+        .collect();
+    Ok((words, translation.entry_point))
+}

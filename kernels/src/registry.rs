@@ -15,11 +15,17 @@ pub enum KernelId {
     BlockHistogram,
     /// The same pass exchanging elements between subgroup lanes (needs subgroups).
     BlockHistogramSubgroup,
+    /// Does nothing: measures dispatch overhead.
+    Empty,
 }
 
 impl KernelId {
     /// Every registry kernel.
-    pub const ALL: [KernelId; 2] = [KernelId::BlockHistogram, KernelId::BlockHistogramSubgroup];
+    pub const ALL: [KernelId; 3] = [
+        KernelId::BlockHistogram,
+        KernelId::BlockHistogramSubgroup,
+        KernelId::Empty,
+    ];
 
     /// What the registry knows of this kernel before parsing it.
     pub fn spec(self) -> KernelSpec {
@@ -48,6 +54,13 @@ impl KernelId {
                 ],
                 entry_point: "block_histogram_subgroup",
                 features: KernelFeatures::SUBGROUP,
+                float_ulp_bound: None,
+            },
+            KernelId::Empty => KernelSpec {
+                name: "empty",
+                fragments: vec![fragment!("util/empty.wgsl")],
+                entry_point: "empty",
+                features: KernelFeatures::empty(),
                 float_ulp_bound: None,
             },
         }
@@ -376,6 +389,9 @@ mod tests {
         let registry = Registry::load().unwrap_or_else(|e| panic!("{e}"));
         for kernel in registry.kernels() {
             let module = &kernel.module;
+            if kernel.id == KernelId::Empty {
+                continue;
+            }
             for result in [
                 check_struct::<Candidate>(module),
                 check_struct::<ClusterSpan>(module),

@@ -5,6 +5,7 @@
 
 mod backends;
 mod compare;
+mod empty;
 mod histogram;
 mod report;
 
@@ -58,6 +59,7 @@ pub fn kernel_checks() -> Vec<Box<dyn KernelCheck>> {
     vec![
         Box::new(histogram::HistogramCheck(KernelId::BlockHistogram)),
         Box::new(histogram::HistogramCheck(KernelId::BlockHistogramSubgroup)),
+        Box::new(empty::EmptyCheck),
     ]
 }
 

@@ -1,5 +1,6 @@
 //! Picking a backend for the command line: the GPU if there is one.
 
+use strata_backends::ash_backend::{AshBackend, AshOptions};
 use strata_backends::wgpu_backend::{WgpuApi, WgpuBackend, WgpuOptions};
 use strata_backends::{Backend, BackendError};
 
@@ -12,6 +13,8 @@ pub enum BackendChoice {
     Wgpu,
     /// wgpu on OpenGL (no subgroups).
     WgpuGl,
+    /// Raw Vulkan through ash, on naga's SPIR-V.
+    Ash,
 }
 
 /// Opens the requested backend.
@@ -23,6 +26,7 @@ pub fn open_backend(choice: BackendChoice) -> Result<Box<dyn Backend>, BackendEr
     let api = match choice {
         BackendChoice::Auto | BackendChoice::Wgpu => WgpuApi::Vulkan,
         BackendChoice::WgpuGl => WgpuApi::Gl,
+        BackendChoice::Ash => return Ok(Box::new(AshBackend::new(AshOptions::default())?)),
     };
     match WgpuBackend::new(WgpuOptions {
         api,

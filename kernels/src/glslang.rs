@@ -2,7 +2,7 @@
 //! sources themselves (through the ash backend), a far stronger check than parsing them.
 
 use crate::registry::Kernel;
-use crate::translate::{self, TranslateOptions};
+use crate::translate::{self, TranslateOptions, WorkgroupZeroInit};
 use std::path::Path;
 use std::process::Command;
 
@@ -62,7 +62,7 @@ pub fn compile(
             translate::hlsl(
                 kernel,
                 TranslateOptions {
-                    zero_initialize_workgroup_memory: false,
+                    workgroup_zero_init: WorkgroupZeroInit::Off,
                 },
             ),
             "hlsl",

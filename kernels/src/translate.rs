@@ -7,25 +7,44 @@
 //! * MSL 2.3 with an explicit per-entry-point buffer map (`[[buffer(b)]]`).
 //! * GLSL 4.50 core with `layout(binding = b)` from a binding map (GLSL has no sets).
 //!
-//! Workgroup zero-initialisation is left to naga (every kernel is correct with it), except
-//! where [`TranslateOptions::zero_initialize_workgroup_memory`] turns it off for tools
-//! that reject naga's initialisers (glslang's HLSL front end).
+//! WGSL zero-initialises workgroup memory. [`WorkgroupZeroInit`] says who does it: naga's
+//! polyfill (a store loop and a barrier in the shader: correct everywhere, slow on
+//! lavapipe), the driver (`shaderZeroInitializeWorkgroupMemory`, Vulkan 1.3), or nobody,
+//! for tools that reject naga's initialisers (glslang's HLSL front end); strata's kernels
+//! initialise every workgroup variable they read, so they are correct without it.
 
 use crate::error::KernelError;
 use crate::registry::Kernel;
 
+/// Who zero-initialises workgroup memory.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WorkgroupZeroInit {
+    /// naga writes the zeros in the shader.
+    Polyfill,
+    /// The driver does (SPIR-V only; Vulkan's `shaderZeroInitializeWorkgroupMemory`).
+    Native,
+    /// Nobody: only for kernels that initialise what they read.
+    Off,
+}
+
 /// Options shared by the back ends.
 #[derive(Clone, Copy, Debug)]
 pub struct TranslateOptions {
-    /// Emit naga's zero-initialisation of workgroup variables.
-    pub zero_initialize_workgroup_memory: bool,
+    /// Zero-initialisation of workgroup variables.
+    pub workgroup_zero_init: WorkgroupZeroInit,
 }
 
 impl Default for TranslateOptions {
     fn default() -> Self {
         Self {
-            zero_initialize_workgroup_memory: true,
+            workgroup_zero_init: WorkgroupZeroInit::Polyfill,
         }
+    }
+}
+
+impl TranslateOptions {
+    fn zero_init_in_source(self) -> bool {
+        self.workgroup_zero_init != WorkgroupZeroInit::Off
     }
 }
 
@@ -56,10 +75,10 @@ pub fn spirv(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, 
     let spv_options = spv::Options {
         lang_version: (1, 3),
         flags,
-        zero_initialize_workgroup_memory: if options.zero_initialize_workgroup_memory {
-            spv::ZeroInitializeWorkgroupMemoryMode::Polyfill
-        } else {
-            spv::ZeroInitializeWorkgroupMemoryMode::None
+        zero_initialize_workgroup_memory: match options.workgroup_zero_init {
+            WorkgroupZeroInit::Polyfill => spv::ZeroInitializeWorkgroupMemoryMode::Polyfill,
+            WorkgroupZeroInit::Native => spv::ZeroInitializeWorkgroupMemoryMode::Native,
+            WorkgroupZeroInit::Off => spv::ZeroInitializeWorkgroupMemoryMode::None,
         },
         ..spv::Options::default()
     };
@@ -81,7 +100,7 @@ pub fn hlsl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, K
     use naga::back::hlsl;
     let hlsl_options = hlsl::Options {
         shader_model: hlsl::ShaderModel::V6_0,
-        zero_initialize_workgroup_memory: options.zero_initialize_workgroup_memory,
+        zero_initialize_workgroup_memory: options.zero_init_in_source(),
         ..hlsl::Options::default()
     };
     let pipeline = hlsl::PipelineOptions {
@@ -129,7 +148,7 @@ pub fn msl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, Ke
         lang_version: (2, 3),
         per_entry_point_map,
         fake_missing_bindings: false,
-        zero_initialize_workgroup_memory: options.zero_initialize_workgroup_memory,
+        zero_initialize_workgroup_memory: options.zero_init_in_source(),
         ..msl::Options::default()
     };
     let pipeline = msl::PipelineOptions {
@@ -163,7 +182,7 @@ pub fn glsl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, K
         version: glsl::Version::Desktop(450),
         writer_flags: glsl::WriterFlags::empty(),
         binding_map,
-        zero_initialize_workgroup_memory: options.zero_initialize_workgroup_memory,
+        zero_initialize_workgroup_memory: options.zero_init_in_source(),
     };
     let pipeline = glsl::PipelineOptions {
         shader_stage: naga::ShaderStage::Compute,

@@ -12,7 +12,7 @@
 
 use crate::glslang::{self, GlslangInput, ToolError, run_tool};
 use crate::registry::Kernel;
-use crate::translate::{self, TranslateOptions, Translation};
+use crate::translate::{self, TranslateOptions, Translation, WorkgroupZeroInit};
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 
@@ -66,7 +66,7 @@ impl Target {
             Target::Hlsl => translate::hlsl(
                 kernel,
                 TranslateOptions {
-                    zero_initialize_workgroup_memory: false,
+                    workgroup_zero_init: WorkgroupZeroInit::Off,
                 },
             ),
             Target::Msl => translate::msl(kernel, TranslateOptions::default()),

@@ -67,10 +67,13 @@ fn translations_keep_the_entry_point_and_bindings() {
             "{}",
             kernel.name()
         );
-        assert!(
-            msl.text.contains("[[buffer(4)]]"),
-            "{}: MSL lacks the explicit buffer map",
-            kernel.name()
-        );
+        for binding in &kernel.bindings {
+            assert!(
+                msl.text.contains(&format!("[[buffer({})]]", binding.binding)),
+                "{}: MSL lacks [[buffer({})]] from the explicit buffer map",
+                kernel.name(),
+                binding.binding
+            );
+        }
     }
 }

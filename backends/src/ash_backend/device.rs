@@ -77,6 +77,8 @@ pub(super) struct VulkanDevice {
     query_pool: Option<vk::QueryPool>,
     timestamp_period: f64,
     subgroup_size: Option<u32>,
+    /// The driver zero-initialises workgroup memory (`shaderZeroInitializeWorkgroupMemory`).
+    pub(super) native_zero_init: bool,
 }
 
 impl VulkanDevice {
@@ -111,7 +113,7 @@ impl VulkanDevice {
         }
         let app = vk::ApplicationInfo::default()
             .application_name(c"strata")
-            .api_version(vk::API_VERSION_1_1);
+            .api_version(vk::API_VERSION_1_3);
         let create = vk::InstanceCreateInfo::default()
             .application_info(&app)
             .enabled_layer_names(&layers)
@@ -173,11 +175,25 @@ impl VulkanDevice {
                     | vk::SubgroupFeatureFlags::SHUFFLE_RELATIVE,
             ))
         .then_some(subgroup.subgroup_size);
+        // The driver zero-initialises workgroup memory where it can (Vulkan 1.3), instead
+        // of naga's in-shader polyfill, which costs a store loop and a barrier per workgroup.
+        let mut vulkan13 = vk::PhysicalDeviceVulkan13Features::default();
+        if properties.api_version >= vk::API_VERSION_1_3 {
+            let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut vulkan13);
+            // SAFETY: Vulkan 1.1 core query; the 1.3 struct only on a 1.3 device.
+            unsafe { instance_ref.get_physical_device_features2(physical, &mut features2) };
+        }
+        let native_zero_init = vulkan13.shader_zero_initialize_workgroup_memory == vk::TRUE;
+        let mut enable13 = vk::PhysicalDeviceVulkan13Features::default()
+            .shader_zero_initialize_workgroup_memory(native_zero_init);
         let priorities = [1.0f32];
         let queue_info = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(family)
             .queue_priorities(&priorities)];
-        let device_info = vk::DeviceCreateInfo::default().queue_create_infos(&queue_info);
+        let mut device_info = vk::DeviceCreateInfo::default().queue_create_infos(&queue_info);
+        if native_zero_init {
+            device_info = device_info.push_next(&mut enable13);
+        }
         // SAFETY: valid physical device and create info.
         let device =
             unsafe { instance_ref.create_device(physical, &device_info, None) }.map_err(|e| {
@@ -244,6 +260,7 @@ impl VulkanDevice {
             query_pool,
             timestamp_period: f64::from(properties.limits.timestamp_period),
             subgroup_size,
+            native_zero_init,
         })
     }
 

@@ -9,7 +9,7 @@ use std::collections::HashMap;
 use std::ffi::CString;
 use std::sync::Arc;
 use strata_kernels::glslang::{self, GlslangInput};
-use strata_kernels::translate::{self, TranslateOptions};
+use strata_kernels::translate::{self, TranslateOptions, WorkgroupZeroInit};
 use strata_kernels::{BindingKind, Kernel, KernelId};
 
 pub(super) struct AshPipeline {
@@ -33,11 +33,25 @@ impl PipelineCache {
     }
 
     /// SPIR-V words and entry point name of `kernel` from this cache's source.
-    fn spirv(&self, kernel: &Kernel) -> Result<(Vec<u32>, String), BackendError> {
+    fn spirv(
+        &self,
+        kernel: &Kernel,
+        native_zero_init: bool,
+    ) -> Result<(Vec<u32>, String), BackendError> {
         let glslang_input = match self.source {
             SpirvSource::Naga => {
+                let workgroup_zero_init = if native_zero_init {
+                    WorkgroupZeroInit::Native
+                } else {
+                    WorkgroupZeroInit::Polyfill
+                };
                 // No naga DEBUG flag: Debian's validation layer misreads its OpSource marker.
-                let translation = translate::spirv(kernel, TranslateOptions::default())?;
+                let translation = translate::spirv(
+                    kernel,
+                    TranslateOptions {
+                        workgroup_zero_init,
+                    },
+                )?;
                 return Ok((translation.words, translation.entry_point));
             }
             SpirvSource::GlslangFromGlsl => GlslangInput::Glsl,
@@ -61,7 +75,7 @@ impl PipelineCache {
         if let Some(pipeline) = self.pipelines.get(&kernel.id) {
             return Ok(Arc::clone(pipeline));
         }
-        let (words, entry_point) = self.spirv(kernel)?;
+        let (words, entry_point) = self.spirv(kernel, vulkan.native_zero_init)?;
         let entry_point = CString::new(entry_point).map_err(|e| BackendError::Validation {
             backend: self.source.name().into(),
             operation: format!("pipeline of `{}`", kernel.name()),

@@ -69,7 +69,8 @@ fn translations_keep_the_entry_point_and_bindings() {
         );
         for binding in &kernel.bindings {
             assert!(
-                msl.text.contains(&format!("[[buffer({})]]", binding.binding)),
+                msl.text
+                    .contains(&format!("[[buffer({})]]", binding.binding)),
                 "{}: MSL lacks [[buffer({})]] from the explicit buffer map",
                 kernel.name(),
                 binding.binding

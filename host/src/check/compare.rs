@@ -1,16 +1,54 @@
 //! Comparing a kernel's outputs with the expected ones.
 
 /// How an output is compared.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Compare {
     /// Integers and orderings: bit for bit.
     Exact,
-    /// f32 values: within this many units in the last place (NaN must meet NaN).
-    FloatUlp(u32),
+    /// f32 values within `ulp` units in the last place (NaN must meet NaN). Kernels whose
+    /// control flow depends on float results (BVH traversal, path tracing) may let a
+    /// share `max_outside` of the values exceed the bound; 0 allows none.
+    Float {
+        /// ULP bound per value.
+        ulp: u32,
+        /// Largest share of values (0..1) allowed beyond `ulp`.
+        max_outside: f64,
+    },
+}
+
+/// How closely outputs agreed.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Agreement {
+    /// Largest ULP difference among float values within their bound.
+    pub max_ulp: u32,
+    /// Float values beyond their bound (allowed by `max_outside`).
+    pub outside: usize,
+    /// Float values compared.
+    pub floats: usize,
+}
+
+impl Agreement {
+    /// Combines two agreements.
+    pub fn merge(self, other: Agreement) -> Agreement {
+        Agreement {
+            max_ulp: self.max_ulp.max(other.max_ulp),
+            outside: self.outside + other.outside,
+            floats: self.floats + other.floats,
+        }
+    }
+
+    /// Share of float values beyond their bound.
+    pub fn outside_share(&self) -> f64 {
+        if self.floats == 0 {
+            0.0
+        } else {
+            self.outside as f64 / self.floats as f64
+        }
+    }
 }
 
 /// One named output buffer as 32-bit words.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Output {
     /// Buffer name (the WGSL variable).
     pub name: &'static str,
@@ -68,9 +106,9 @@ pub fn ulp_distance(a: u32, b: u32) -> u32 {
         .min(u64::from(u32::MAX)) as u32
 }
 
-/// Compares `got` with `want` output by output; returns the largest ULP difference seen.
-pub fn compare_outputs(got: &[Output], want: &[Output]) -> Result<u32, Mismatch> {
-    let mut max_ulp = 0;
+/// Compares `got` with `want` output by output.
+pub fn compare_outputs(got: &[Output], want: &[Output]) -> Result<Agreement, Mismatch> {
+    let mut agreement = Agreement::default();
     for want in want {
         let Some(got) = got.iter().find(|o| o.name == want.name) else {
             return Err(Mismatch {
@@ -88,26 +126,44 @@ pub fn compare_outputs(got: &[Output], want: &[Output]) -> Result<u32, Mismatch>
                 want: want.words.len() as u64,
             });
         }
-        for (index, (&g, &w)) in got.words.iter().zip(&want.words).enumerate() {
-            let ok = match want.compare {
-                Compare::Exact => g == w,
-                Compare::FloatUlp(bound) => {
-                    let ulp = ulp_distance(g, w);
-                    max_ulp = max_ulp.max(ulp);
-                    ulp <= bound
+        let mut pairs = got.words.iter().zip(&want.words).enumerate();
+        match want.compare {
+            Compare::Exact => {
+                if let Some((index, (&g, &w))) = pairs.find(|(_, (g, w))| g != w) {
+                    return Err(Mismatch {
+                        output: want.name,
+                        index: Some(index),
+                        got: u64::from(g),
+                        want: u64::from(w),
+                    });
                 }
-            };
-            if !ok {
-                return Err(Mismatch {
-                    output: want.name,
-                    index: Some(index),
-                    got: u64::from(g),
-                    want: u64::from(w),
-                });
+            }
+            Compare::Float { ulp, max_outside } => {
+                let mut outside = Vec::new();
+                for (index, (&g, &w)) in pairs {
+                    let distance = ulp_distance(g, w);
+                    if distance <= ulp {
+                        agreement.max_ulp = agreement.max_ulp.max(distance);
+                    } else {
+                        outside.push((index, g, w));
+                    }
+                }
+                let allowed = (max_outside * want.words.len() as f64).floor() as usize;
+                if outside.len() > allowed {
+                    let (index, g, w) = outside[0];
+                    return Err(Mismatch {
+                        output: want.name,
+                        index: Some(index),
+                        got: u64::from(g),
+                        want: u64::from(w),
+                    });
+                }
+                agreement.outside += outside.len();
+                agreement.floats += want.words.len();
             }
         }
     }
-    Ok(max_ulp)
+    Ok(agreement)
 }
 
 #[cfg(test)]
@@ -144,19 +200,50 @@ mod tests {
         let floats = [Output {
             name: "f",
             words: vec![1.0f32.to_bits()],
-            compare: Compare::FloatUlp(2),
+            compare: Compare::Float {
+                ulp: 2,
+                max_outside: 0.0,
+            },
         }];
         let close = [Output {
             name: "f",
             words: vec![1.0f32.to_bits() + 2],
-            compare: Compare::FloatUlp(2),
+            compare: Compare::Exact,
         }];
-        assert_eq!(compare_outputs(&close, &floats), Ok(2));
+        assert_eq!(compare_outputs(&close, &floats).map(|a| a.max_ulp), Ok(2));
         let far = [Output {
             name: "f",
             words: vec![1.0f32.to_bits() + 3],
-            compare: Compare::FloatUlp(2),
+            compare: Compare::Exact,
         }];
         assert!(compare_outputs(&far, &floats).is_err());
+    }
+
+    #[test]
+    fn a_declared_share_of_outliers_is_allowed_and_counted() {
+        let values: Vec<u32> = (0..1000).map(|i| (1.0 + i as f32).to_bits()).collect();
+        let mut noisy = values.clone();
+        noisy[10] += 1000;
+        noisy[20] += 1000;
+        let want = |max_outside| {
+            [Output {
+                name: "image",
+                words: values.clone(),
+                compare: Compare::Float {
+                    ulp: 4,
+                    max_outside,
+                },
+            }]
+        };
+        let got = [Output {
+            name: "image",
+            words: noisy,
+            compare: Compare::Exact,
+        }];
+        let agreement = compare_outputs(&got, &want(0.002)).unwrap();
+        assert_eq!((agreement.outside, agreement.floats), (2, 1000));
+        assert!((agreement.outside_share() - 0.002).abs() < 1e-12);
+        let mismatch = compare_outputs(&got, &want(0.001)).unwrap_err();
+        assert_eq!(mismatch.index, Some(10));
     }
 }

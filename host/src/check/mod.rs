@@ -10,7 +10,7 @@ mod histogram;
 mod report;
 
 pub use backends::{BackendSlot, backend_slots};
-pub use compare::{Compare, Mismatch, Output, compare_outputs};
+pub use compare::{Agreement, Compare, Mismatch, Output, compare_outputs};
 pub use report::{CellResult, CheckReport};
 
 use crate::histogram_pass::PassError;
@@ -101,7 +101,7 @@ fn run_one(check: &dyn KernelCheck, backend: &mut dyn Backend, config: CheckConf
     if let Err(error) = backend.check_kernel(kernel) {
         return CellResult::Unavailable(error.to_string());
     }
-    let mut max_ulp = 0;
+    let mut agreement = Agreement::default();
     let cases = check.cases(config);
     for case in &cases {
         let outputs = match check.run(backend, case) {
@@ -109,16 +109,17 @@ fn run_one(check: &dyn KernelCheck, backend: &mut dyn Backend, config: CheckConf
             Err(error) => return CellResult::Failed(format!("{}: {error}", case.label)),
         };
         match compare_outputs(&outputs, &check.reference(case)) {
-            Ok(ulp) => max_ulp = max_ulp.max(ulp),
+            Ok(case_agreement) => agreement = agreement.merge(case_agreement),
             Err(mismatch) => return CellResult::Failed(format!("{}: {mismatch}", case.label)),
         }
     }
-    if max_ulp == 0 {
+    if agreement.max_ulp == 0 && agreement.outside == 0 {
         CellResult::Identical { cases: cases.len() }
     } else {
         CellResult::WithinUlp {
             cases: cases.len(),
-            max_ulp,
+            max_ulp: agreement.max_ulp,
+            outside_share: agreement.outside_share(),
         }
     }
 }

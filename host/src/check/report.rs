@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use strata_kernels::KernelId;
 
 /// What one kernel did on one backend.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum CellResult {
     /// Every output bit-identical to the reference on every case.
     Identical {
@@ -15,8 +15,10 @@ pub enum CellResult {
     WithinUlp {
         /// Cases run.
         cases: usize,
-        /// Largest difference seen.
+        /// Largest difference seen within the bound.
         max_ulp: u32,
+        /// Share of float values beyond the bound (allowed for float-dependent control flow).
+        outside_share: f64,
     },
     /// A mismatch or an error, with the first differing element.
     Failed(String),
@@ -99,7 +101,17 @@ impl CheckReport {
             for backend in &self.backends {
                 let cell = match self.cell(*kernel, backend) {
                     Some(CellResult::Identical { cases }) => format!("identical ({cases} cases)"),
-                    Some(CellResult::WithinUlp { cases, max_ulp }) => {
+                    Some(CellResult::WithinUlp {
+                        cases,
+                        max_ulp,
+                        outside_share,
+                    }) if *outside_share > 0.0 => {
+                        format!(
+                            "max {max_ulp} ULP, {:.3}% out ({cases})",
+                            outside_share * 100.0
+                        )
+                    }
+                    Some(CellResult::WithinUlp { cases, max_ulp, .. }) => {
                         format!("max {max_ulp} ULP ({cases})")
                     }
                     Some(CellResult::Failed(why)) => {

@@ -37,12 +37,7 @@ pub trait Backend {
     fn create_buffer(&mut self, label: &str, size: u64) -> Result<BufferId, BackendError>;
 
     /// Writes `data` at byte `offset`; offset and length must be multiples of 4.
-    fn write_buffer(
-        &mut self,
-        buffer: BufferId,
-        offset: u64,
-        data: &[u8],
-    ) -> Result<(), BackendError>;
+    fn write_buffer(&mut self, buffer: BufferId, offset: u64, data: &[u8]) -> Result<(), BackendError>;
 
     /// The buffer's whole contents, after every submitted dispatch has finished.
     fn read_buffer(&mut self, buffer: BufferId) -> Result<Vec<u8>, BackendError>;
@@ -56,12 +51,7 @@ pub trait Backend {
 
     /// Runs `kernel` on `workgroups` workgroups with `binds` (every binding the kernel
     /// uses, each exactly once).
-    fn dispatch(
-        &mut self,
-        kernel: &Kernel,
-        binds: &[Bind],
-        workgroups: [u32; 3],
-    ) -> Result<(), BackendError>;
+    fn dispatch(&mut self, kernel: &Kernel, binds: &[Bind], workgroups: [u32; 3]) -> Result<(), BackendError>;
 
     /// Like [`Backend::dispatch`], waits for it, and returns the device time of the pass
     /// from timestamp queries.
@@ -74,11 +64,7 @@ pub trait Backend {
 }
 
 /// Writes a Pod slice into a new buffer.
-pub fn upload<T: bytemuck::Pod>(
-    backend: &mut dyn Backend,
-    label: &str,
-    data: &[T],
-) -> Result<BufferId, BackendError> {
+pub fn upload<T: bytemuck::Pod>(backend: &mut dyn Backend, label: &str, data: &[T]) -> Result<BufferId, BackendError> {
     let bytes: &[u8] = bytemuck::cast_slice(data);
     let buffer = backend.create_buffer(label, bytes.len() as u64)?;
     backend.write_buffer(buffer, 0, bytes)?;
@@ -86,14 +72,8 @@ pub fn upload<T: bytemuck::Pod>(
 }
 
 /// Reads a buffer back as a Vec of Pod values.
-pub fn download<T: bytemuck::Pod>(
-    backend: &mut dyn Backend,
-    buffer: BufferId,
-) -> Result<Vec<T>, BackendError> {
+pub fn download<T: bytemuck::Pod>(backend: &mut dyn Backend, buffer: BufferId) -> Result<Vec<T>, BackendError> {
     let bytes = backend.read_buffer(buffer)?;
     let size = std::mem::size_of::<T>();
-    Ok(bytes[..bytes.len() / size * size]
-        .chunks_exact(size)
-        .map(bytemuck::pod_read_unaligned)
-        .collect())
+    Ok(bytes[..bytes.len() / size * size].chunks_exact(size).map(bytemuck::pod_read_unaligned).collect())
 }

@@ -20,12 +20,7 @@ pub fn check_kernel_fits(kernel: &Kernel, device: &DeviceInfo) -> Result<(), Bac
     let what = || format!("kernel `{}`", kernel.name());
     let exceeded = |limit, requested: u64, available: u64| {
         if requested > available {
-            Err(BackendError::LimitExceeded {
-                what: what(),
-                limit,
-                requested,
-                available,
-            })
+            Err(BackendError::LimitExceeded { what: what(), limit, requested, available })
         } else {
             Ok(())
         }
@@ -35,33 +30,12 @@ pub fn check_kernel_fits(kernel: &Kernel, device: &DeviceInfo) -> Result<(), Bac
         u64::from(kernel.invocations()),
         u64::from(limits.max_invocations_per_workgroup),
     )?;
-    for (axis, (&size, &max)) in kernel
-        .workgroup_size
-        .iter()
-        .zip(&limits.max_workgroup_size)
-        .enumerate()
-    {
-        exceeded(
-            ["workgroup size x", "workgroup size y", "workgroup size z"][axis],
-            u64::from(size),
-            u64::from(max),
-        )?;
+    for (axis, (&size, &max)) in kernel.workgroup_size.iter().zip(&limits.max_workgroup_size).enumerate() {
+        exceeded(["workgroup size x", "workgroup size y", "workgroup size z"][axis], u64::from(size), u64::from(max))?;
     }
-    exceeded(
-        "workgroup memory bytes",
-        kernel.workgroup_memory_bytes(),
-        limits.max_workgroup_storage,
-    )?;
-    let storage = kernel
-        .bindings
-        .iter()
-        .filter(|b| matches!(b.kind, BindingKind::Storage(_)))
-        .count();
-    exceeded(
-        "storage buffers per stage",
-        storage as u64,
-        u64::from(limits.max_storage_buffers_per_stage),
-    )
+    exceeded("workgroup memory bytes", kernel.workgroup_memory_bytes(), limits.max_workgroup_storage)?;
+    let storage = kernel.bindings.iter().filter(|b| matches!(b.kind, BindingKind::Storage(_))).count();
+    exceeded("storage buffers per stage", storage as u64, u64::from(limits.max_storage_buffers_per_stage))
 }
 
 /// Whether `binds` bind every binding of `kernel` once, with buffers large enough and
@@ -72,11 +46,7 @@ pub fn check_binds(
     device: &DeviceInfo,
     size_of: impl Fn(BufferId) -> Result<u64, BackendError>,
 ) -> Result<(), BackendError> {
-    let error = |binding: u32, reason: String| BackendError::Binding {
-        kernel: kernel.name().into(),
-        binding,
-        reason,
-    };
+    let error = |binding: u32, reason: String| BackendError::Binding { kernel: kernel.name().into(), binding, reason };
     for (index, bind) in binds.iter().enumerate() {
         if binds[..index].iter().any(|b| b.binding == bind.binding) {
             return Err(error(bind.binding, "bound twice".into()));
@@ -120,11 +90,7 @@ pub fn check_binds(
 }
 
 /// Whether the device accepts `workgroups` in one dispatch.
-pub fn check_workgroups(
-    kernel: &Kernel,
-    workgroups: [u32; 3],
-    device: &DeviceInfo,
-) -> Result<(), BackendError> {
+pub fn check_workgroups(kernel: &Kernel, workgroups: [u32; 3], device: &DeviceInfo) -> Result<(), BackendError> {
     for &count in &workgroups {
         if u64::from(count) > u64::from(device.limits.max_workgroups_per_dimension) {
             return Err(BackendError::LimitExceeded {

@@ -22,10 +22,7 @@ pub struct DeviceInfo {
 impl DeviceInfo {
     /// One line for people: backend, adapter, type.
     pub fn summary(&self) -> String {
-        format!(
-            "{} on {} ({}, {})",
-            self.backend, self.adapter, self.device_type, self.driver
-        )
+        format!("{} on {} ({}, {})", self.backend, self.adapter, self.device_type, self.driver)
     }
 }
 

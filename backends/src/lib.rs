@@ -12,6 +12,7 @@
 pub mod ash_backend;
 pub mod backend;
 pub mod bindings_check;
+pub mod cpu_backend;
 pub mod device_info;
 pub mod error;
 pub mod require_gpu;

@@ -23,14 +23,8 @@ type Opened = Result<Box<dyn Backend>, BackendError>;
 
 fn backends() -> Vec<(&'static str, Opened)> {
     vec![
-        (
-            "wgpu",
-            WgpuBackend::new(WgpuOptions::default()).map(|b| Box::new(b) as Box<dyn Backend>),
-        ),
-        (
-            "ash",
-            AshBackend::new(AshOptions::default()).map(|b| Box::new(b) as Box<dyn Backend>),
-        ),
+        ("wgpu", WgpuBackend::new(WgpuOptions::default()).map(|b| Box::new(b) as Box<dyn Backend>)),
+        ("ash", AshBackend::new(AshOptions::default()).map(|b| Box::new(b) as Box<dyn Backend>)),
     ]
 }
 
@@ -47,9 +41,7 @@ fn compare_backends(c: &mut Criterion) {
     let grid = BlockGrid::new(width, height, 16).expect("valid grid");
     let empty = Registry::shared().expect("registry").get(KernelId::Empty);
     let mut group = c.benchmark_group("backends");
-    group
-        .sample_size(10)
-        .measurement_time(Duration::from_secs(8));
+    group.sample_size(10).measurement_time(Duration::from_secs(8));
     for (name, backend) in backends() {
         let mut backend = match backend {
             Ok(backend) => backend,
@@ -59,20 +51,16 @@ fn compare_backends(c: &mut Criterion) {
             }
         };
         eprintln!("{name}: {}", backend.info().summary());
-        for (label, variant) in [
-            ("histogram_portable", HistogramVariant::Portable),
-            ("histogram_subgroup", HistogramVariant::Subgroup),
-        ] {
+        for (label, variant) in
+            [("histogram_portable", HistogramVariant::Portable), ("histogram_subgroup", HistogramVariant::Subgroup)]
+        {
             let Ok(pass) = BlockHistogramPass::new(backend.as_mut(), variant, grid) else {
                 eprintln!("{name}/{label} skipped: unsupported");
                 continue;
             };
-            pass.upload_candidates(backend.as_mut(), &candidates)
-                .expect("upload");
+            pass.upload_candidates(backend.as_mut(), &candidates).expect("upload");
             group.bench_function(format!("{label}/{name}"), |b| {
-                device_time(b, backend.as_mut(), |backend| {
-                    pass.dispatch_timed(backend).expect("dispatch")
-                })
+                device_time(b, backend.as_mut(), |backend| pass.dispatch_timed(backend).expect("dispatch"))
             });
             pass.destroy(backend.as_mut()).expect("destroy");
         }
@@ -80,17 +68,11 @@ fn compare_backends(c: &mut Criterion) {
         let binds = [Bind::new(0, sink)];
         group.bench_function(format!("empty_device/{name}"), |b| {
             device_time(b, backend.as_mut(), |backend| {
-                backend
-                    .dispatch_timed(empty, &binds, [1, 1, 1])
-                    .expect("dispatch")
+                backend.dispatch_timed(empty, &binds, [1, 1, 1]).expect("dispatch")
             })
         });
         group.bench_function(format!("empty_wall/{name}"), |b| {
-            b.iter(|| {
-                backend
-                    .dispatch_timed(empty, &binds, [1, 1, 1])
-                    .expect("dispatch")
-            })
+            b.iter(|| backend.dispatch_timed(empty, &binds, [1, 1, 1]).expect("dispatch"))
         });
         backend.destroy_buffer(sink).expect("destroy");
     }

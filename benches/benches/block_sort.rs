@@ -23,9 +23,7 @@ fn block_sort(c: &mut Criterion) {
     let (width, height, candidates) = benchmark_candidates();
     let grid = BlockGrid::new(width, height, 16).expect("valid grid");
     let mut group = c.benchmark_group("block_sort_1M_B16");
-    group
-        .sample_size(10)
-        .measurement_time(Duration::from_secs(10));
+    group.sample_size(10).measurement_time(Duration::from_secs(10));
 
     let mut entries = vec![0u32; grid.pixel_count()];
     group.bench_function("native_sort_unstable_by", |b| {
@@ -41,9 +39,7 @@ fn block_sort(c: &mut Criterion) {
             black_box(&entries);
         })
     });
-    group.bench_function("native_reference", |b| {
-        b.iter(|| black_box(block_histogram(grid, &candidates)))
-    });
+    group.bench_function("native_reference", |b| b.iter(|| black_box(block_histogram(grid, &candidates))));
 
     let mut backend = match WgpuBackend::new(WgpuOptions::default()) {
         Ok(backend) => backend,
@@ -53,10 +49,9 @@ fn block_sort(c: &mut Criterion) {
         }
     };
     eprintln!("device: {}", backend.info().summary());
-    for (name, variant) in [
-        ("wgpu_portable", HistogramVariant::Portable),
-        ("wgpu_subgroup", HistogramVariant::Subgroup),
-    ] {
+    for (name, variant) in
+        [("wgpu_portable", HistogramVariant::Portable), ("wgpu_subgroup", HistogramVariant::Subgroup)]
+    {
         let pass = match BlockHistogramPass::new(&mut backend, variant, grid) {
             Ok(pass) => pass,
             Err(error) => {
@@ -64,13 +59,10 @@ fn block_sort(c: &mut Criterion) {
                 continue;
             }
         };
-        pass.upload_candidates(&mut backend, &candidates)
-            .expect("upload");
+        pass.upload_candidates(&mut backend, &candidates).expect("upload");
         group.bench_function(name, |b| {
             b.iter_custom(|iterations| {
-                (0..iterations)
-                    .map(|_| pass.dispatch_timed(&mut backend).expect("dispatch"))
-                    .sum()
+                (0..iterations).map(|_| pass.dispatch_timed(&mut backend).expect("dispatch")).sum()
             })
         });
         pass.destroy(&mut backend).expect("destroy");

@@ -7,9 +7,5 @@ use strata_kernels::types::Candidate;
 /// The benchmark image: 1024 × 1024 = 1M candidates, default mix, fixed seed.
 pub fn benchmark_candidates() -> (u32, u32, Vec<Candidate>) {
     let (width, height) = (1024, 1024);
-    (
-        width,
-        height,
-        candidate_image(width, height, 2025, CandidateMix::default()),
-    )
+    (width, height, candidate_image(width, height, 2025, CandidateMix::default()))
 }

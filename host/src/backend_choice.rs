@@ -28,10 +28,7 @@ pub fn open_backend(choice: BackendChoice) -> Result<Box<dyn Backend>, BackendEr
         BackendChoice::WgpuGl => WgpuApi::Gl,
         BackendChoice::Ash => return Ok(Box::new(AshBackend::new(AshOptions::default())?)),
     };
-    match WgpuBackend::new(WgpuOptions {
-        api,
-        ..Default::default()
-    }) {
+    match WgpuBackend::new(WgpuOptions { api, ..Default::default() }) {
         Ok(backend) => Ok(Box::new(backend)),
         Err(BackendError::NoAdapter { backend, reason }) => Err(BackendError::NoAdapter {
             backend,

@@ -66,26 +66,18 @@ pub struct BlockHistogramPass {
 
 impl BlockHistogramPass {
     /// Creates the buffers and checks that `backend` can run the chosen variant.
-    pub fn new(
-        backend: &mut dyn Backend,
-        variant: HistogramVariant,
-        grid: BlockGrid,
-    ) -> Result<Self, PassError> {
+    pub fn new(backend: &mut dyn Backend, variant: HistogramVariant, grid: BlockGrid) -> Result<Self, PassError> {
         let registry = Registry::shared()?;
         let id = match variant {
             HistogramVariant::Portable => KernelId::BlockHistogram,
             HistogramVariant::Subgroup => KernelId::BlockHistogramSubgroup,
-            HistogramVariant::Auto if backend.info().subgroup_sizes.is_some() => {
-                KernelId::BlockHistogramSubgroup
-            }
+            HistogramVariant::Auto if backend.info().subgroup_sizes.is_some() => KernelId::BlockHistogramSubgroup,
             HistogramVariant::Auto => KernelId::BlockHistogram,
         };
         let kernel = registry.get(id);
         backend.check_kernel(kernel)?;
         let block_area = grid.block_size * grid.block_size;
-        let total = grid
-            .block_count()
-            .div_ceil(SLOTS_PER_WORKGROUP / block_area);
+        let total = grid.block_count().div_ceil(SLOTS_PER_WORKGROUP / block_area);
         let max = backend.info().limits.max_workgroups_per_dimension.max(1);
         let x = total.min(max);
         let workgroups = [x, total.div_ceil(x), 1];
@@ -101,25 +93,12 @@ impl BlockHistogramPass {
         };
         let pixels = grid.pixel_count() as u64;
         let params = upload(backend, "histogram params", &[params])?;
-        let candidates =
-            backend.create_buffer("candidates", pixels * size_of::<Candidate>() as u64)?;
+        let candidates = backend.create_buffer("candidates", pixels * size_of::<Candidate>() as u64)?;
         let sorted_pixels = backend.create_buffer("sorted pixels", pixels * 4)?;
-        let spans =
-            backend.create_buffer("cluster spans", pixels * size_of::<ClusterSpan>() as u64)?;
-        let block_stats = backend.create_buffer(
-            "block stats",
-            u64::from(grid.block_count()) * size_of::<BlockStats>() as u64,
-        )?;
-        Ok(Self {
-            kernel,
-            grid,
-            workgroups,
-            params,
-            candidates,
-            sorted_pixels,
-            spans,
-            block_stats,
-        })
+        let spans = backend.create_buffer("cluster spans", pixels * size_of::<ClusterSpan>() as u64)?;
+        let block_stats =
+            backend.create_buffer("block stats", u64::from(grid.block_count()) * size_of::<BlockStats>() as u64)?;
+        Ok(Self { kernel, grid, workgroups, params, candidates, sorted_pixels, spans, block_stats })
     }
 
     /// The kernel this pass runs.
@@ -138,11 +117,7 @@ impl BlockHistogramPass {
     }
 
     /// Uploads one candidate per pixel.
-    pub fn upload_candidates(
-        &self,
-        backend: &mut dyn Backend,
-        candidates: &[Candidate],
-    ) -> Result<(), PassError> {
+    pub fn upload_candidates(&self, backend: &mut dyn Backend, candidates: &[Candidate]) -> Result<(), PassError> {
         if candidates.len() != self.grid.pixel_count() {
             return Err(PassError::CandidateCount {
                 width: self.grid.width,
@@ -172,10 +147,7 @@ impl BlockHistogramPass {
     }
 
     /// Runs the pass and returns its device time (timestamp queries).
-    pub fn dispatch_timed(
-        &self,
-        backend: &mut dyn Backend,
-    ) -> Result<std::time::Duration, PassError> {
+    pub fn dispatch_timed(&self, backend: &mut dyn Backend) -> Result<std::time::Duration, PassError> {
         Ok(backend.dispatch_timed(self.kernel, &self.binds(), self.workgroups)?)
     }
 
@@ -189,11 +161,7 @@ impl BlockHistogramPass {
     }
 
     /// Uploads, runs and reads back in one call.
-    pub fn run(
-        &self,
-        backend: &mut dyn Backend,
-        candidates: &[Candidate],
-    ) -> Result<HistogramOutput, PassError> {
+    pub fn run(&self, backend: &mut dyn Backend, candidates: &[Candidate]) -> Result<HistogramOutput, PassError> {
         self.upload_candidates(backend, candidates)?;
         self.dispatch(backend)?;
         self.read_output(backend)
@@ -201,13 +169,7 @@ impl BlockHistogramPass {
 
     /// Frees the pass's buffers.
     pub fn destroy(self, backend: &mut dyn Backend) -> Result<(), PassError> {
-        for buffer in [
-            self.params,
-            self.candidates,
-            self.sorted_pixels,
-            self.spans,
-            self.block_stats,
-        ] {
+        for buffer in [self.params, self.candidates, self.sorted_pixels, self.spans, self.block_stats] {
             backend.destroy_buffer(buffer)?;
         }
         Ok(())

@@ -71,10 +71,7 @@ fn main() -> Result<()> {
 fn histogram(args: HistogramArgs) -> Result<()> {
     let grid = BlockGrid::new(args.width, args.height, args.block_size)?;
     if !(0.0..=1.0).contains(&args.awkward) {
-        bail!(
-            "--awkward {}: must be a share between 0 and 1",
-            args.awkward
-        );
+        bail!("--awkward {}: must be a share between 0 and 1", args.awkward);
     }
     let mut backend = open_backend(args.backend)?;
     println!("backend: {}", backend.info().summary());
@@ -83,11 +80,7 @@ fn histogram(args: HistogramArgs) -> Result<()> {
         VariantArg::Portable => HistogramVariant::Portable,
         VariantArg::Subgroup => HistogramVariant::Subgroup,
     };
-    let mix = CandidateMix {
-        objects: args.objects,
-        awkward: args.awkward,
-        ..Default::default()
-    };
+    let mix = CandidateMix { objects: args.objects, awkward: args.awkward, ..Default::default() };
     let candidates = candidate_image(grid.width, grid.height, args.seed, mix);
     let pass = BlockHistogramPass::new(backend.as_mut(), variant, grid)?;
     println!(
@@ -117,10 +110,7 @@ fn histogram(args: HistogramArgs) -> Result<()> {
         "clusters: {clusters} ({:.2} per block); invalid keys: {invalid}; pixels without candidate: {empty}",
         clusters as f64 / f64::from(grid.block_count())
     );
-    println!(
-        "first run (upload, dispatch, read-back): {:.1} ms",
-        wall.as_secs_f64() * 1e3
-    );
+    println!("first run (upload, dispatch, read-back): {:.1} ms", wall.as_secs_f64() * 1e3);
     if backend.info().timestamps && args.repeat > 0 {
         let mut times = Vec::new();
         for _ in 0..args.repeat {

@@ -19,11 +19,7 @@ pub struct CandidateMix {
 
 impl Default for CandidateMix {
     fn default() -> Self {
-        Self {
-            objects: 6,
-            key_levels: 16,
-            awkward: 0.05,
-        }
+        Self { objects: 6, key_levels: 16, awkward: 0.05 }
     }
 }
 
@@ -69,47 +65,18 @@ mod tests {
 
     #[test]
     fn images_contain_every_awkward_kind_and_equal_keys() {
-        let image = candidate_image(
-            128,
-            128,
-            7,
-            CandidateMix {
-                awkward: 0.2,
-                ..Default::default()
-            },
-        );
+        let image = candidate_image(128, 128, 7, CandidateMix { awkward: 0.2, ..Default::default() });
         assert!(image.iter().any(|c| c.key.is_nan()));
         assert!(image.iter().any(|c| c.key == f32::INFINITY));
         assert!(image.iter().any(|c| c.key == f32::NEG_INFINITY));
         assert!(image.iter().any(|c| c.key.is_subnormal()));
-        assert!(
-            image
-                .iter()
-                .any(|c| c.key == 0.0 && c.key.is_sign_negative())
-        );
+        assert!(image.iter().any(|c| c.key == 0.0 && c.key.is_sign_negative()));
         assert!(image.iter().any(|c| c.object_id == OBJECT_ID_NONE));
         assert!(image.iter().any(|c| c.object_id == OBJECT_ID_ENVIRONMENT));
         let equal = image.iter().filter(|c| c.key == 1.0).count();
         assert!(equal > 100, "{equal}");
-        let again = candidate_image(
-            128,
-            128,
-            7,
-            CandidateMix {
-                awkward: 0.2,
-                ..Default::default()
-            },
-        );
-        let bits = |image: &[Candidate]| {
-            image
-                .iter()
-                .map(|c| (c.key.to_bits(), c.object_id))
-                .collect::<Vec<_>>()
-        };
-        assert_eq!(
-            bits(&image),
-            bits(&again),
-            "the same seed gives the same image"
-        );
+        let again = candidate_image(128, 128, 7, CandidateMix { awkward: 0.2, ..Default::default() });
+        let bits = |image: &[Candidate]| image.iter().map(|c| (c.key.to_bits(), c.object_id)).collect::<Vec<_>>();
+        assert_eq!(bits(&image), bits(&again), "the same seed gives the same image");
     }
 }

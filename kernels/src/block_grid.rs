@@ -83,11 +83,7 @@ impl BlockGrid {
         if u64::from(width) * u64::from(height) > u64::from(u32::MAX) {
             return Err(GridError::TooLarge { width, height });
         }
-        Ok(Self {
-            width,
-            height,
-            block_size,
-        })
+        Ok(Self { width, height, block_size })
     }
 
     /// Pixels in the image.
@@ -117,13 +113,7 @@ impl BlockGrid {
         let y = block / self.blocks_x() * b;
         let width = b.min(self.width - x);
         let height = b.min(self.height - y);
-        BlockRect {
-            x,
-            y,
-            width,
-            height,
-            base: y * self.width + x * height,
-        }
+        BlockRect { x, y, width, height, base: y * self.width + x * height }
     }
 
     /// The block containing pixel (x, y).
@@ -138,13 +128,7 @@ mod tests {
 
     #[test]
     fn blocks_tile_the_sorted_list_without_gaps() {
-        for (w, h, b) in [
-            (1, 1, 4),
-            (17, 33, 8),
-            (33, 17, 16),
-            (64, 64, 32),
-            (5, 70, 4),
-        ] {
+        for (w, h, b) in [(1, 1, 4), (17, 33, 8), (33, 17, 16), (64, 64, 32), (5, 70, 4)] {
             let grid = BlockGrid::new(w, h, b).unwrap();
             let mut covered = vec![false; grid.pixel_count()];
             let mut entries = vec![false; grid.pixel_count()];
@@ -166,21 +150,10 @@ mod tests {
 
     #[test]
     fn bad_sizes_are_named() {
-        assert_eq!(
-            BlockGrid::new(0, 5, 16),
-            Err(GridError::EmptyImage {
-                width: 0,
-                height: 5
-            })
-        );
+        assert_eq!(BlockGrid::new(0, 5, 16), Err(GridError::EmptyImage { width: 0, height: 5 }));
         assert_eq!(BlockGrid::new(5, 5, 12), Err(GridError::BlockSize(12)));
         assert_eq!(BlockGrid::new(5, 5, 64), Err(GridError::BlockSize(64)));
         assert!(BlockGrid::new(1 << 20, 1 << 20, 16).is_err());
-        assert!(
-            BlockGrid::new(5, 5, 12)
-                .unwrap_err()
-                .to_string()
-                .contains("block size 12")
-        );
+        assert!(BlockGrid::new(5, 5, 12).unwrap_err().to_string().contains("block size 12"));
     }
 }

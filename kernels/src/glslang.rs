@@ -49,63 +49,30 @@ pub fn run_tool(tool: &str, args: &[&std::ffi::OsStr]) -> Result<(), ToolError> 
 
 /// Writes naga's `input` translation of `kernel` to `dir`, compiles it with glslang for
 /// Vulkan 1.1 and returns the SPIR-V words and the entry point name.
-pub fn compile(
-    kernel: &Kernel,
-    input: GlslangInput,
-    dir: &Path,
-) -> Result<(Vec<u32>, String), ToolError> {
-    std::fs::create_dir_all(dir)
-        .map_err(|e| ToolError::Failed(format!("{}: {e}", dir.display())))?;
+pub fn compile(kernel: &Kernel, input: GlslangInput, dir: &Path) -> Result<(Vec<u32>, String), ToolError> {
+    std::fs::create_dir_all(dir).map_err(|e| ToolError::Failed(format!("{}: {e}", dir.display())))?;
     let (translation, extension) = match input {
         GlslangInput::Glsl => (translate::glsl(kernel, TranslateOptions::default()), "comp"),
-        GlslangInput::Hlsl => (
-            translate::hlsl(
-                kernel,
-                TranslateOptions {
-                    workgroup_zero_init: WorkgroupZeroInit::Off,
-                },
-            ),
-            "hlsl",
-        ),
+        GlslangInput::Hlsl => {
+            (translate::hlsl(kernel, TranslateOptions { workgroup_zero_init: WorkgroupZeroInit::Off }), "hlsl")
+        }
     };
     let translation = translation.map_err(|e| ToolError::Failed(e.to_string()))?;
     let source = dir.join(format!("{}.{extension}", kernel.name()));
     let output = dir.join(format!("{}.{extension}.spv", kernel.name()));
-    std::fs::write(&source, &translation.text)
-        .map_err(|e| ToolError::Failed(format!("{}: {e}", source.display())))?;
+    std::fs::write(&source, &translation.text).map_err(|e| ToolError::Failed(format!("{}: {e}", source.display())))?;
     use std::ffi::OsStr;
     let mut args: Vec<&OsStr> = Vec::new();
     if input == GlslangInput::Hlsl {
-        args.extend([
-            OsStr::new("-D"),
-            OsStr::new("-e"),
-            OsStr::new(&translation.entry_point),
-        ]);
+        args.extend([OsStr::new("-D"), OsStr::new("-e"), OsStr::new(&translation.entry_point)]);
     }
-    args.extend([
-        OsStr::new("-V"),
-        OsStr::new("--target-env"),
-        OsStr::new("vulkan1.1"),
-    ]);
-    args.extend([
-        OsStr::new("-S"),
-        OsStr::new("comp"),
-        source.as_os_str(),
-        OsStr::new("-o"),
-        output.as_os_str(),
-    ]);
+    args.extend([OsStr::new("-V"), OsStr::new("--target-env"), OsStr::new("vulkan1.1")]);
+    args.extend([OsStr::new("-S"), OsStr::new("comp"), source.as_os_str(), OsStr::new("-o"), output.as_os_str()]);
     run_tool("glslangValidator", &args)?;
-    let bytes = std::fs::read(&output)
-        .map_err(|e| ToolError::Failed(format!("{}: {e}", output.display())))?;
+    let bytes = std::fs::read(&output).map_err(|e| ToolError::Failed(format!("{}: {e}", output.display())))?;
     if bytes.len() % 4 != 0 {
-        return Err(ToolError::Failed(format!(
-            "{}: not a SPIR-V file",
-            output.display()
-        )));
+        return Err(ToolError::Failed(format!("{}: not a SPIR-V file", output.display())));
     }
-    let words = bytes
-        .chunks_exact(4)
-        .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
-        .collect();
+    let words = bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect();
     Ok((words, translation.entry_point))
 }

@@ -51,16 +51,7 @@ shader_struct!(BlockStats, "BlockStats", [clusters, invalid, empty]);
 shader_struct!(
     HistogramParams,
     "HistogramParams",
-    [
-        width,
-        height,
-        block_size,
-        log2_block_size,
-        blocks_x,
-        blocks_y,
-        workgroups_x,
-        _pad
-    ]
+    [width, height, block_size, log2_block_size, blocks_x, blocks_y, workgroups_x, _pad]
 );
 
 /// Compares `T` with the struct `T::WGSL_NAME` of `module`; the error lists every
@@ -75,9 +66,7 @@ pub fn check_struct<T: ShaderStruct>(module: &naga::Module) -> Result<(), String
         return Err(format!("WGSL `{}` is not a struct", T::WGSL_NAME));
     };
     let mut layouter = Layouter::default();
-    layouter
-        .update(module.to_ctx())
-        .map_err(|e| format!("naga layouter: {e}"))?;
+    layouter.update(module.to_ctx()).map_err(|e| format!("naga layouter: {e}"))?;
     let mut problems = Vec::new();
     let host_size = core::mem::size_of::<T>();
     if *span as usize != host_size {
@@ -85,42 +74,25 @@ pub fn check_struct<T: ShaderStruct>(module: &naga::Module) -> Result<(), String
     }
     let host = T::fields();
     if host.len() != members.len() {
-        problems.push(format!(
-            "field count: WGSL {}, host {}",
-            members.len(),
-            host.len()
-        ));
+        problems.push(format!("field count: WGSL {}, host {}", members.len(), host.len()));
     }
     for (index, (wgsl, host)) in members.iter().zip(&host).enumerate() {
         let wgsl_name = wgsl.name.as_deref().unwrap_or("<unnamed>");
         let wgsl_size = layouter[wgsl.ty].size as usize;
         if wgsl_name != host.name {
-            problems.push(format!(
-                "field {index}: WGSL `{wgsl_name}`, host `{}`",
-                host.name
-            ));
+            problems.push(format!("field {index}: WGSL `{wgsl_name}`, host `{}`", host.name));
         }
         if wgsl.offset as usize != host.offset {
-            problems.push(format!(
-                "field `{}`: WGSL offset {}, host offset {}",
-                host.name, wgsl.offset, host.offset
-            ));
+            problems.push(format!("field `{}`: WGSL offset {}, host offset {}", host.name, wgsl.offset, host.offset));
         }
         if wgsl_size != host.size {
-            problems.push(format!(
-                "field `{}`: WGSL size {wgsl_size}, host size {}",
-                host.name, host.size
-            ));
+            problems.push(format!("field `{}`: WGSL size {wgsl_size}, host size {}", host.name, host.size));
         }
     }
     if problems.is_empty() {
         Ok(())
     } else {
-        Err(format!(
-            "host struct and WGSL `{}` differ:\n  {}",
-            T::WGSL_NAME,
-            problems.join("\n  ")
-        ))
+        Err(format!("host struct and WGSL `{}` differ:\n  {}", T::WGSL_NAME, problems.join("\n  ")))
     }
 }
 
@@ -147,14 +119,8 @@ mod tests {
         // WGSL puts a u32 right after a vec3<f32>, at offset 12: the host has it at 16.
         let bad = module("struct Padded { position: vec3<f32>, id: u32, pad: vec3<u32> }");
         let error = check_struct::<Padded>(&bad).unwrap_err();
-        assert!(
-            error.contains("field `id`: WGSL offset 12, host offset 16"),
-            "{error}"
-        );
-        assert!(
-            error.contains("field `position`: WGSL size 12, host size 16"),
-            "{error}"
-        );
+        assert!(error.contains("field `id`: WGSL offset 12, host offset 16"), "{error}");
+        assert!(error.contains("field `position`: WGSL size 12, host size 16"), "{error}");
         let good = module("struct Padded { position: vec4<f32>, id: u32, pad: array<u32, 3> }");
         check_struct::<Padded>(&good).unwrap();
     }
@@ -162,16 +128,8 @@ mod tests {
     #[test]
     fn renamed_and_missing_fields_are_caught() {
         let renamed = module("struct Padded { pos: vec4<f32>, id: u32, pad: array<u32, 3> }");
-        assert!(
-            check_struct::<Padded>(&renamed)
-                .unwrap_err()
-                .contains("`pos`")
-        );
+        assert!(check_struct::<Padded>(&renamed).unwrap_err().contains("`pos`"));
         let missing = module("struct Other { id: u32 }");
-        assert!(
-            check_struct::<Padded>(&missing)
-                .unwrap_err()
-                .contains("no WGSL struct")
-        );
+        assert!(check_struct::<Padded>(&missing).unwrap_err().contains("no WGSL struct"));
     }
 }

@@ -21,37 +21,22 @@ pub enum KernelId {
 
 impl KernelId {
     /// Every registry kernel.
-    pub const ALL: [KernelId; 3] = [
-        KernelId::BlockHistogram,
-        KernelId::BlockHistogramSubgroup,
-        KernelId::Empty,
-    ];
+    pub const ALL: [KernelId; 3] = [KernelId::BlockHistogram, KernelId::BlockHistogramSubgroup, KernelId::Empty];
 
     /// What the registry knows of this kernel before parsing it.
     pub fn spec(self) -> KernelSpec {
-        const HISTOGRAM: [Fragment; 2] = [
-            fragment!("common/candidate.wgsl"),
-            fragment!("histogram/block_sort.wgsl"),
-        ];
+        const HISTOGRAM: [Fragment; 2] = [fragment!("common/candidate.wgsl"), fragment!("histogram/block_sort.wgsl")];
         match self {
             KernelId::BlockHistogram => KernelSpec {
                 name: "block_histogram",
-                fragments: vec![
-                    HISTOGRAM[0],
-                    HISTOGRAM[1],
-                    fragment!("histogram/entry_portable.wgsl"),
-                ],
+                fragments: vec![HISTOGRAM[0], HISTOGRAM[1], fragment!("histogram/entry_portable.wgsl")],
                 entry_point: "block_histogram",
                 features: KernelFeatures::empty(),
                 float_ulp_bound: None,
             },
             KernelId::BlockHistogramSubgroup => KernelSpec {
                 name: "block_histogram_subgroup",
-                fragments: vec![
-                    HISTOGRAM[0],
-                    HISTOGRAM[1],
-                    fragment!("histogram/entry_subgroup.wgsl"),
-                ],
+                fragments: vec![HISTOGRAM[0], HISTOGRAM[1], fragment!("histogram/entry_subgroup.wgsl")],
                 entry_point: "block_histogram_subgroup",
                 features: KernelFeatures::SUBGROUP,
                 float_ulp_bound: None,
@@ -83,11 +68,7 @@ impl KernelFeatures {
     pub const SUBGROUP: Self = Self { subgroup: true };
 
     fn capabilities(self) -> Capabilities {
-        if self.subgroup {
-            Capabilities::SUBGROUP | Capabilities::SUBGROUP_BARRIER
-        } else {
-            Capabilities::empty()
-        }
+        if self.subgroup { Capabilities::SUBGROUP | Capabilities::SUBGROUP_BARRIER } else { Capabilities::empty() }
     }
 }
 
@@ -153,9 +134,7 @@ impl Kernel {
 
     /// The binding `@group(group) @binding(binding)`, if the entry point uses it.
     pub fn binding(&self, group: u32, binding: u32) -> Option<&BindingInfo> {
-        self.bindings
-            .iter()
-            .find(|b| b.group == group && b.binding == binding)
+        self.bindings.iter().find(|b| b.group == group && b.binding == binding)
     }
 
     /// The binding whose WGSL variable is `name`.
@@ -173,9 +152,7 @@ impl Kernel {
         self.module
             .global_variables
             .iter()
-            .filter(|(handle, var)| {
-                var.space == naga::AddressSpace::WorkGroup && !ep_info[*handle].is_empty()
-            })
+            .filter(|(handle, var)| var.space == naga::AddressSpace::WorkGroup && !ep_info[*handle].is_empty())
             .map(|(_, var)| u64::from(layouter[var.ty].size))
             .sum()
     }
@@ -195,15 +172,14 @@ impl Kernel {
                 message: format!("at {location}\n{}", error.emit_to_string(&source.text)),
             }
         })?;
-        let info =
-            naga::valid::Validator::new(ValidationFlags::all(), spec.features.capabilities())
-                .subgroup_stages(ShaderStages::COMPUTE)
-                .subgroup_operations(SubgroupOperationSet::all())
-                .validate(&module)
-                .map_err(|error| KernelError::Validation {
-                    kernel: spec.name.into(),
-                    message: error.emit_to_string(&source.text),
-                })?;
+        let info = naga::valid::Validator::new(ValidationFlags::all(), spec.features.capabilities())
+            .subgroup_stages(ShaderStages::COMPUTE)
+            .subgroup_operations(SubgroupOperationSet::all())
+            .validate(&module)
+            .map_err(|error| KernelError::Validation {
+                kernel: spec.name.into(),
+                message: error.emit_to_string(&source.text),
+            })?;
         let entry_index = module
             .entry_points
             .iter()
@@ -214,15 +190,7 @@ impl Kernel {
             })?;
         let workgroup_size = module.entry_points[entry_index].workgroup_size;
         let bindings = describe_bindings(spec.name, &module, &info, entry_index)?;
-        Ok(Kernel {
-            id,
-            spec,
-            source,
-            module,
-            info,
-            workgroup_size,
-            bindings,
-        })
+        Ok(Kernel { id, spec, source, module, info, workgroup_size, bindings })
     }
 }
 
@@ -235,10 +203,7 @@ fn describe_bindings(
     let mut layouter = naga::proc::Layouter::default();
     layouter
         .update(module.to_ctx())
-        .map_err(|e| KernelError::Validation {
-            kernel: kernel.into(),
-            message: e.to_string(),
-        })?;
+        .map_err(|e| KernelError::Validation { kernel: kernel.into(), message: e.to_string() })?;
     let ep_info = info.get_entry_point(entry_index);
     let mut bindings = Vec::new();
     for (handle, var) in module.global_variables.iter() {
@@ -266,15 +231,11 @@ fn describe_bindings(
                 }
             }
             _ => {
-                return Err(unsupported(
-                    "only uniform and storage buffers are supported",
-                ));
+                return Err(unsupported("only uniform and storage buffers are supported"));
             }
         };
         if resource.group != 0 {
-            return Err(unsupported(
-                "registry kernels use @group(0) only (GLSL has no descriptor sets)",
-            ));
+            return Err(unsupported("registry kernels use @group(0) only (GLSL has no descriptor sets)"));
         }
         bindings.push(BindingInfo {
             group: resource.group,
@@ -297,29 +258,19 @@ pub struct Registry {
 impl Registry {
     /// The registry of this process, loaded on first use.
     pub fn shared() -> Result<&'static Registry, KernelError> {
-        static SHARED: std::sync::OnceLock<Result<Registry, KernelError>> =
-            std::sync::OnceLock::new();
-        SHARED
-            .get_or_init(Registry::load)
-            .as_ref()
-            .map_err(Clone::clone)
+        static SHARED: std::sync::OnceLock<Result<Registry, KernelError>> = std::sync::OnceLock::new();
+        SHARED.get_or_init(Registry::load).as_ref().map_err(Clone::clone)
     }
 
     /// Loads every kernel of [`KernelId::ALL`].
     pub fn load() -> Result<Registry, KernelError> {
-        let kernels = KernelId::ALL
-            .iter()
-            .map(|&id| Kernel::load(id))
-            .collect::<Result<_, _>>()?;
+        let kernels = KernelId::ALL.iter().map(|&id| Kernel::load(id)).collect::<Result<_, _>>()?;
         Ok(Registry { kernels })
     }
 
     /// The kernel `id`.
     pub fn get(&self, id: KernelId) -> &Kernel {
-        self.kernels
-            .iter()
-            .find(|k| k.id == id)
-            .expect("the registry loads every KernelId")
+        self.kernels.iter().find(|k| k.id == id).expect("the registry loads every KernelId")
     }
 
     /// All kernels, in [`KernelId::ALL`] order.
@@ -339,30 +290,11 @@ mod tests {
         let registry = Registry::load().unwrap_or_else(|e| panic!("{e}"));
         let kernel = registry.get(KernelId::BlockHistogram);
         assert_eq!(kernel.workgroup_size, [64, 1, 1]);
-        let names: Vec<_> = kernel
-            .bindings
-            .iter()
-            .map(|b| (b.binding, b.name.as_str()))
-            .collect();
-        assert_eq!(
-            names,
-            [
-                (0, "params"),
-                (1, "candidates"),
-                (2, "sorted_pixels"),
-                (3, "spans"),
-                (4, "block_stats")
-            ]
-        );
+        let names: Vec<_> = kernel.bindings.iter().map(|b| (b.binding, b.name.as_str())).collect();
+        assert_eq!(names, [(0, "params"), (1, "candidates"), (2, "sorted_pixels"), (3, "spans"), (4, "block_stats")]);
         assert_eq!(kernel.bindings[0].kind, BindingKind::Uniform);
-        assert_eq!(
-            kernel.bindings[1].kind,
-            BindingKind::Storage(BindingAccess::ReadOnly)
-        );
-        assert_eq!(
-            kernel.bindings[3].kind,
-            BindingKind::Storage(BindingAccess::ReadWrite)
-        );
+        assert_eq!(kernel.bindings[1].kind, BindingKind::Storage(BindingAccess::ReadOnly));
+        assert_eq!(kernel.bindings[3].kind, BindingKind::Storage(BindingAccess::ReadWrite));
         assert_eq!(kernel.bindings[1].element.type_name, "Candidate");
         assert_eq!(kernel.bindings[1].element.stride, 8);
         assert_eq!(kernel.bindings[1].element.count, None);
@@ -370,17 +302,9 @@ mod tests {
         assert_eq!(kernel.bindings[0].element.count, Some(1));
         assert_eq!(kernel.bindings[0].min_size(), 32);
         // 3 x 1024 u32 of keys plus 192 counters: within WebGPU's 16 KiB minimum.
-        assert!(
-            kernel.workgroup_memory_bytes() <= 16 * 1024,
-            "{}",
-            kernel.workgroup_memory_bytes()
-        );
+        assert!(kernel.workgroup_memory_bytes() <= 16 * 1024, "{}", kernel.workgroup_memory_bytes());
         for kernel in registry.kernels() {
-            assert!(
-                kernel.bindings.iter().all(|b| b.group == 0),
-                "{}",
-                kernel.name()
-            );
+            assert!(kernel.bindings.iter().all(|b| b.group == 0), "{}", kernel.name());
         }
     }
 
@@ -410,11 +334,7 @@ mod tests {
         let source = ComposedSource::compose(&spec.fragments);
         let module = naga::front::wgsl::parse_str(&source.text).unwrap();
         let result =
-            naga::valid::Validator::new(ValidationFlags::all(), spec.features.capabilities())
-                .validate(&module);
-        assert!(
-            result.is_err(),
-            "subgroup operations must need the SUBGROUP capability"
-        );
+            naga::valid::Validator::new(ValidationFlags::all(), spec.features.capabilities()).validate(&module);
+        assert!(result.is_err(), "subgroup operations must need the SUBGROUP capability");
     }
 }

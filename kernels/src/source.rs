@@ -48,27 +48,15 @@ impl ComposedSource {
     /// The fragment and 1-based line within it of 1-based `line` of the composed text.
     pub fn locate(&self, line: usize) -> (&'static str, usize) {
         let zero_based = line.saturating_sub(1);
-        let (start, path) = self
-            .starts
-            .iter()
-            .rev()
-            .find(|(start, _)| *start <= zero_based)
-            .copied()
-            .unwrap_or((0, "<unknown>"));
+        let (start, path) =
+            self.starts.iter().rev().find(|(start, _)| *start <= zero_based).copied().unwrap_or((0, "<unknown>"));
         (path, zero_based - start + 1)
     }
 
     /// "fragment:line" for a byte offset into the composed text.
     pub fn describe_offset(&self, offset: usize) -> String {
-        let line = self.text[..offset.min(self.text.len())]
-            .lines()
-            .count()
-            .max(1);
-        let line = if self.text[..offset.min(self.text.len())].ends_with('\n') {
-            line + 1
-        } else {
-            line
-        };
+        let line = self.text[..offset.min(self.text.len())].lines().count().max(1);
+        let line = if self.text[..offset.min(self.text.len())].ends_with('\n') { line + 1 } else { line };
         let (path, local) = self.locate(line);
         format!("kernels/wgsl/{path}:{local}")
     }
@@ -81,18 +69,9 @@ mod tests {
     #[test]
     fn lines_map_back_to_fragments() {
         let source = ComposedSource::compose(&[
-            Fragment {
-                path: "a.wgsl",
-                text: "one\ntwo\n",
-            },
-            Fragment {
-                path: "b.wgsl",
-                text: "three\nfour",
-            },
-            Fragment {
-                path: "c.wgsl",
-                text: "five\n",
-            },
+            Fragment { path: "a.wgsl", text: "one\ntwo\n" },
+            Fragment { path: "b.wgsl", text: "three\nfour" },
+            Fragment { path: "c.wgsl", text: "five\n" },
         ]);
         assert_eq!(source.locate(1), ("a.wgsl", 1));
         assert_eq!(source.locate(2), ("a.wgsl", 2));

@@ -36,9 +36,7 @@ pub struct TranslateOptions {
 
 impl Default for TranslateOptions {
     fn default() -> Self {
-        Self {
-            workgroup_zero_init: WorkgroupZeroInit::Polyfill,
-        }
+        Self { workgroup_zero_init: WorkgroupZeroInit::Polyfill }
     }
 }
 
@@ -60,11 +58,7 @@ pub struct Translation {
 }
 
 fn error(kernel: &Kernel, target: &'static str, message: impl ToString) -> KernelError {
-    KernelError::Translation {
-        kernel: kernel.name().into(),
-        target,
-        message: message.to_string(),
-    }
+    KernelError::Translation { kernel: kernel.name().into(), target, message: message.to_string() }
 }
 
 /// SPIR-V for Vulkan 1.1+, the entry point alone.
@@ -82,17 +76,11 @@ pub fn spirv(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, 
         },
         ..spv::Options::default()
     };
-    let pipeline = spv::PipelineOptions {
-        shader_stage: naga::ShaderStage::Compute,
-        entry_point: kernel.entry_point().into(),
-    };
+    let pipeline =
+        spv::PipelineOptions { shader_stage: naga::ShaderStage::Compute, entry_point: kernel.entry_point().into() };
     let words = spv::write_vec(&kernel.module, &kernel.info, &spv_options, Some(&pipeline))
         .map_err(|e| error(kernel, "SPIR-V", e))?;
-    Ok(Translation {
-        text: String::new(),
-        words,
-        entry_point: kernel.entry_point().into(),
-    })
+    Ok(Translation { text: String::new(), words, entry_point: kernel.entry_point().into() })
 }
 
 /// HLSL (shader model 6.0) for DXC, or glslang's HLSL front end.
@@ -103,19 +91,14 @@ pub fn hlsl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, K
         zero_initialize_workgroup_memory: options.zero_init_in_source(),
         ..hlsl::Options::default()
     };
-    let pipeline = hlsl::PipelineOptions {
-        entry_point: Some((naga::ShaderStage::Compute, kernel.entry_point().into())),
-    };
+    let pipeline =
+        hlsl::PipelineOptions { entry_point: Some((naga::ShaderStage::Compute, kernel.entry_point().into())) };
     let mut text = String::new();
     let reflection = hlsl::Writer::new(&mut text, &hlsl_options, &pipeline)
         .write(&kernel.module, &kernel.info, None)
         .map_err(|e| error(kernel, "HLSL", e))?;
     let entry_point = translated_name(kernel, "HLSL", reflection.entry_point_names)?;
-    Ok(Translation {
-        text,
-        words: Vec::new(),
-        entry_point,
-    })
+    Ok(Translation { text, words: Vec::new(), entry_point })
 }
 
 /// Metal Shading Language 2.3.
@@ -124,10 +107,7 @@ pub fn msl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, Ke
     let mut resources = msl::BindingMap::default();
     for binding in &kernel.bindings {
         resources.insert(
-            naga::ResourceBinding {
-                group: binding.group,
-                binding: binding.binding,
-            },
+            naga::ResourceBinding { group: binding.group, binding: binding.binding },
             msl::BindTarget {
                 buffer: Some(binding.binding as u8),
                 mutable: binding.is_writable(),
@@ -138,11 +118,7 @@ pub fn msl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, Ke
     let mut per_entry_point_map = msl::EntryPointResourceMap::default();
     per_entry_point_map.insert(
         kernel.entry_point().into(),
-        msl::EntryPointResources {
-            resources,
-            immediates_buffer: None,
-            sizes_buffer: Some(30),
-        },
+        msl::EntryPointResources { resources, immediates_buffer: None, sizes_buffer: Some(30) },
     );
     let msl_options = msl::Options {
         lang_version: (2, 3),
@@ -158,11 +134,7 @@ pub fn msl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, Ke
     let (text, info) = msl::write_string(&kernel.module, &kernel.info, &msl_options, &pipeline)
         .map_err(|e| error(kernel, "MSL", e))?;
     let entry_point = translated_name(kernel, "MSL", info.entry_point_names)?;
-    Ok(Translation {
-        text,
-        words: Vec::new(),
-        entry_point,
-    })
+    Ok(Translation { text, words: Vec::new(), entry_point })
 }
 
 /// GLSL 4.50 core; bindings from WGSL's `@binding` (group 0 only).
@@ -170,13 +142,8 @@ pub fn glsl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, K
     use naga::back::glsl;
     let mut binding_map = glsl::BindingMap::default();
     for binding in &kernel.bindings {
-        binding_map.insert(
-            naga::ResourceBinding {
-                group: binding.group,
-                binding: binding.binding,
-            },
-            binding.binding as u8,
-        );
+        binding_map
+            .insert(naga::ResourceBinding { group: binding.group, binding: binding.binding }, binding.binding as u8);
     }
     let glsl_options = glsl::Options {
         version: glsl::Version::Desktop(450),
@@ -200,11 +167,7 @@ pub fn glsl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, K
     )
     .and_then(|mut writer| writer.write())
     .map_err(|e| error(kernel, "GLSL", e))?;
-    Ok(Translation {
-        text,
-        words: Vec::new(),
-        entry_point: "main".into(),
-    })
+    Ok(Translation { text, words: Vec::new(), entry_point: "main".into() })
 }
 
 fn translated_name<E: std::fmt::Display>(
@@ -215,10 +178,6 @@ fn translated_name<E: std::fmt::Display>(
     match names.into_iter().nth(kernel.entry_index()) {
         Some(Ok(name)) => Ok(name),
         Some(Err(e)) => Err(error(kernel, target, e)),
-        None => Err(error(
-            kernel,
-            target,
-            "the back end reported no entry point name",
-        )),
+        None => Err(error(kernel, target, "the back end reported no entry point name")),
     }
 }

@@ -63,12 +63,7 @@ impl Target {
     pub fn translate(self, kernel: &Kernel) -> Result<Translation, crate::KernelError> {
         match self {
             Target::Spirv => translate::spirv(kernel, TranslateOptions::default()),
-            Target::Hlsl => translate::hlsl(
-                kernel,
-                TranslateOptions {
-                    workgroup_zero_init: WorkgroupZeroInit::Off,
-                },
-            ),
+            Target::Hlsl => translate::hlsl(kernel, TranslateOptions { workgroup_zero_init: WorkgroupZeroInit::Off }),
             Target::Msl => translate::msl(kernel, TranslateOptions::default()),
             Target::Glsl => translate::glsl(kernel, TranslateOptions::default()),
         }
@@ -116,37 +111,22 @@ pub fn translate_and_validate(kernel: &Kernel, target: Target, dir: &Path) -> (P
         std::fs::write(&path, &translation.text)
     };
     if let Err(e) = written {
-        return (
-            path.clone(),
-            Verdict::Invalid(format!("cannot write {}: {e}", path.display())),
-        );
+        return (path.clone(), Verdict::Invalid(format!("cannot write {}: {e}", path.display())));
     }
     let verdict = match target {
         Target::Spirv => spirv_val(&path).map(|()| "spirv-val".to_string()).into(),
-        Target::Glsl => run_tool(
-            "glslangValidator",
-            &[OsStr::new("-S"), OsStr::new("comp"), path.as_os_str()],
-        )
-        .map(|()| "glslangValidator".to_string())
-        .into(),
+        Target::Glsl => run_tool("glslangValidator", &[OsStr::new("-S"), OsStr::new("comp"), path.as_os_str()])
+            .map(|()| "glslangValidator".to_string())
+            .into(),
         Target::Hlsl => glslang::compile(kernel, GlslangInput::Hlsl, dir)
             .and_then(|_| spirv_val(&dir.join(format!("{}.hlsl.spv", kernel.name()))))
             .map(|()| "glslangValidator (HLSL front end) + spirv-val".to_string())
             .into(),
-        Target::Msl => {
-            Verdict::Missing("no Metal compiler exists on Linux (translation succeeded)".into())
-        }
+        Target::Msl => Verdict::Missing("no Metal compiler exists on Linux (translation succeeded)".into()),
     };
     (path, verdict)
 }
 
 fn spirv_val(path: &Path) -> Result<(), ToolError> {
-    run_tool(
-        "spirv-val",
-        &[
-            OsStr::new("--target-env"),
-            OsStr::new("vulkan1.1"),
-            path.as_os_str(),
-        ],
-    )
+    run_tool("spirv-val", &[OsStr::new("--target-env"), OsStr::new("vulkan1.1"), path.as_os_str()])
 }

@@ -7,14 +7,7 @@ use strata_backends::{BackendError, GPU_REQUIRED_VARIABLE, gpu_required};
 /// the machine has no Vulkan device. Under `STRATA_REQUIRE_GPU=1` a missing device
 /// fails the test instead.
 pub fn vulkan_backend(test: &str) -> Option<WgpuBackend> {
-    open_or_skip(
-        test,
-        WgpuOptions {
-            api: WgpuApi::Vulkan,
-            validation: true,
-            subgroups: true,
-        },
-    )
+    open_or_skip(test, WgpuOptions { api: WgpuApi::Vulkan, validation: true, subgroups: true })
 }
 
 /// Like [`vulkan_backend`] with explicit options.
@@ -22,9 +15,7 @@ pub fn open_or_skip(test: &str, options: WgpuOptions) -> Option<WgpuBackend> {
     match WgpuBackend::new(options) {
         Ok(backend) => Some(backend),
         Err(error @ BackendError::NoAdapter { .. }) if !gpu_required() => {
-            eprintln!(
-                "SKIPPED {test}: {error} (set {GPU_REQUIRED_VARIABLE}=1 to make this a failure)"
-            );
+            eprintln!("SKIPPED {test}: {error} (set {GPU_REQUIRED_VARIABLE}=1 to make this a failure)");
             None
         }
         Err(error) => {
@@ -38,13 +29,7 @@ pub fn open_or_skip(test: &str, options: WgpuOptions) -> Option<WgpuBackend> {
 pub const POISON: u32 = 0xdead_beef;
 
 /// Fills a whole backend buffer with [`POISON`].
-pub fn poison(
-    backend: &mut dyn strata_backends::Backend,
-    buffer: strata_backends::BufferId,
-    bytes: u64,
-) {
+pub fn poison(backend: &mut dyn strata_backends::Backend, buffer: strata_backends::BufferId, bytes: u64) {
     let words = vec![POISON; (bytes / 4) as usize];
-    backend
-        .write_buffer(buffer, 0, bytemuck::cast_slice(&words))
-        .unwrap();
+    backend.write_buffer(buffer, 0, bytemuck::cast_slice(&words)).unwrap();
 }

@@ -19,52 +19,23 @@ fn run_poisoned(
     let pass = BlockHistogramPass::new(backend, variant, grid).unwrap_or_else(|e| panic!("{e}"));
     let pixels = grid.pixel_count() as u64;
     poison(backend, pass.sorted_pixels, pixels * 4);
-    poison(
-        backend,
-        pass.spans,
-        pixels * size_of::<ClusterSpan>() as u64,
-    );
-    poison(
-        backend,
-        pass.block_stats,
-        u64::from(grid.block_count()) * 12,
-    );
-    let output = pass
-        .run(backend, candidates)
-        .unwrap_or_else(|e| panic!("{e}"));
+    poison(backend, pass.spans, pixels * size_of::<ClusterSpan>() as u64);
+    poison(backend, pass.block_stats, u64::from(grid.block_count()) * 12);
+    let output = pass.run(backend, candidates).unwrap_or_else(|e| panic!("{e}"));
     pass.destroy(backend).unwrap();
     output
 }
 
-fn assert_same(
-    grid: BlockGrid,
-    variant: HistogramVariant,
-    got: &HistogramOutput,
-    want: &HistogramOutput,
-) {
-    let context = format!(
-        "{}x{} B={} {variant:?}",
-        grid.width, grid.height, grid.block_size
-    );
-    if let Some(i) =
-        (0..want.sorted_pixels.len()).find(|&i| got.sorted_pixels[i] != want.sorted_pixels[i])
-    {
-        panic!(
-            "{context}: sorted_pixels[{i}] = {:#x}, want {:#x}",
-            got.sorted_pixels[i], want.sorted_pixels[i]
-        );
+fn assert_same(grid: BlockGrid, variant: HistogramVariant, got: &HistogramOutput, want: &HistogramOutput) {
+    let context = format!("{}x{} B={} {variant:?}", grid.width, grid.height, grid.block_size);
+    if let Some(i) = (0..want.sorted_pixels.len()).find(|&i| got.sorted_pixels[i] != want.sorted_pixels[i]) {
+        panic!("{context}: sorted_pixels[{i}] = {:#x}, want {:#x}", got.sorted_pixels[i], want.sorted_pixels[i]);
     }
     if let Some(i) = (0..want.spans.len()).find(|&i| got.spans[i] != want.spans[i]) {
-        panic!(
-            "{context}: spans[{i}] = {:?}, want {:?}",
-            got.spans[i], want.spans[i]
-        );
+        panic!("{context}: spans[{i}] = {:?}, want {:?}", got.spans[i], want.spans[i]);
     }
     if let Some(i) = (0..want.stats.len()).find(|&i| got.stats[i] != want.stats[i]) {
-        panic!(
-            "{context}: block_stats[{i}] = {:?}, want {:?}",
-            got.stats[i], want.stats[i]
-        );
+        panic!("{context}: block_stats[{i}] = {:?}, want {:?}", got.stats[i], want.stats[i]);
     }
     assert_eq!(got, want, "{context}");
 }
@@ -74,20 +45,14 @@ fn check_sizes(variant: HistogramVariant, sizes: &[(u32, u32)], seed: u64) {
         return;
     };
     if variant == HistogramVariant::Subgroup && backend.info().subgroup_sizes.is_none() {
-        panic!(
-            "the Vulkan device has no subgroups: {}",
-            backend.info().summary()
-        );
+        panic!("the Vulkan device has no subgroups: {}", backend.info().summary());
     }
     for (index, &(width, height)) in sizes.iter().enumerate() {
         for (b, &block_size) in BLOCK_SIZES.iter().enumerate() {
             let grid = BlockGrid::new(width, height, block_size).unwrap();
             let seed = seed ^ (index as u64) << 8 ^ b as u64;
-            let mix = CandidateMix {
-                objects: 1 + (seed % 7) as u32,
-                key_levels: 1 + (seed % 23) as u32,
-                awkward: 0.08,
-            };
+            let mix =
+                CandidateMix { objects: 1 + (seed % 7) as u32, key_levels: 1 + (seed % 23) as u32, awkward: 0.08 };
             let candidates = candidate_image(width, height, seed, mix);
             let want = block_histogram(grid, &candidates);
             let got = run_poisoned(&mut backend, variant, grid, &candidates);
@@ -119,41 +84,15 @@ fn both_variants_match_reference_at_1080p() {
 #[test]
 fn portable_matches_reference_on_gl() {
     use strata_backends::wgpu_backend::{WgpuApi, WgpuOptions};
-    let options = WgpuOptions {
-        api: WgpuApi::Gl,
-        validation: false,
-        subgroups: true,
-    };
-    let Some(mut backend) = strata_tests::open_or_skip("portable_matches_reference_on_gl", options)
-    else {
+    let options = WgpuOptions { api: WgpuApi::Gl, validation: false, subgroups: true };
+    let Some(mut backend) = strata_tests::open_or_skip("portable_matches_reference_on_gl", options) else {
         return;
     };
-    assert!(
-        backend.info().subgroup_sizes.is_none(),
-        "wgpu's GL backend has no subgroups"
-    );
-    for (width, height, block_size, seed) in [
-        (17, 33, 4, 1),
-        (40, 33, 32, 3),
-        (33, 17, 8, 4),
-        (20, 20, 16, 2),
-    ] {
+    assert!(backend.info().subgroup_sizes.is_none(), "wgpu's GL backend has no subgroups");
+    for (width, height, block_size, seed) in [(17, 33, 4, 1), (40, 33, 32, 3), (33, 17, 8, 4), (20, 20, 16, 2)] {
         let grid = BlockGrid::new(width, height, block_size).unwrap();
-        let candidates = candidate_image(
-            width,
-            height,
-            seed,
-            CandidateMix {
-                awkward: 0.1,
-                ..Default::default()
-            },
-        );
+        let candidates = candidate_image(width, height, seed, CandidateMix { awkward: 0.1, ..Default::default() });
         let got = run_poisoned(&mut backend, HistogramVariant::Auto, grid, &candidates);
-        assert_same(
-            grid,
-            HistogramVariant::Auto,
-            &got,
-            &block_histogram(grid, &candidates),
-        );
+        assert_same(grid, HistogramVariant::Auto, &got, &block_histogram(grid, &candidates));
     }
 }

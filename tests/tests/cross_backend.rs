@@ -28,11 +28,7 @@ fn every_kernel_is_identical_on_every_backend() {
     if gpu_required() {
         for slot in backend_slots().iter().filter(|s| s.needs_vulkan) {
             let cell = report.cell(strata_kernels::KernelId::BlockHistogram, slot.name);
-            assert!(
-                matches!(cell, Some(CellResult::Identical { .. })),
-                "{}: {cell:?}",
-                slot.name
-            );
+            assert!(matches!(cell, Some(CellResult::Identical { .. })), "{}: {cell:?}", slot.name);
         }
     }
 }

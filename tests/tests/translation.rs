@@ -8,8 +8,7 @@ use strata_kernels::validate::{Target, Verdict, translate_and_validate};
 
 #[test]
 fn every_kernel_translates_and_validates_for_every_target() {
-    let required =
-        std::env::var("STRATA_REQUIRE_VALIDATORS").is_ok_and(|v| !v.is_empty() && v != "0");
+    let required = std::env::var("STRATA_REQUIRE_VALIDATORS").is_ok_and(|v| !v.is_empty() && v != "0");
     let dir = std::env::temp_dir().join(format!("strata-translation-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let registry = Registry::load().unwrap_or_else(|e| panic!("{e}"));
@@ -19,15 +18,9 @@ fn every_kernel_translates_and_validates_for_every_target() {
             let (path, verdict) = translate_and_validate(kernel, target, &dir);
             match verdict {
                 Verdict::Valid(_) => {}
-                Verdict::Invalid(why) => {
-                    problems.push(format!("{} {}: {why}", kernel.name(), target.name()))
-                }
+                Verdict::Invalid(why) => problems.push(format!("{} {}: {why}", kernel.name(), target.name())),
                 Verdict::Missing(why) if required && target.validator_possible() => {
-                    problems.push(format!(
-                        "{} {}: validator missing: {why}",
-                        kernel.name(),
-                        target.name()
-                    ))
+                    problems.push(format!("{} {}: validator missing: {why}", kernel.name(), target.name()))
                 }
                 Verdict::Missing(why) => {
                     assert!(path.exists(), "{} was not written", path.display());
@@ -47,30 +40,19 @@ fn translations_keep_the_entry_point_and_bindings() {
         let glsl = Target::Glsl.translate(kernel).unwrap();
         for binding in &kernel.bindings {
             assert!(
-                glsl.text
-                    .contains(&format!("binding = {}", binding.binding)),
+                glsl.text.contains(&format!("binding = {}", binding.binding)),
                 "{}: GLSL lacks layout(binding = {})",
                 kernel.name(),
                 binding.binding
             );
         }
         let hlsl = Target::Hlsl.translate(kernel).unwrap();
-        assert!(
-            hlsl.text.contains(&format!("void {}(", hlsl.entry_point)),
-            "{}",
-            kernel.name()
-        );
+        assert!(hlsl.text.contains(&format!("void {}(", hlsl.entry_point)), "{}", kernel.name());
         let msl = Target::Msl.translate(kernel).unwrap();
-        assert!(
-            msl.text
-                .contains(&format!("kernel void {}(", msl.entry_point)),
-            "{}",
-            kernel.name()
-        );
+        assert!(msl.text.contains(&format!("kernel void {}(", msl.entry_point)), "{}", kernel.name());
         for binding in &kernel.bindings {
             assert!(
-                msl.text
-                    .contains(&format!("[[buffer({})]]", binding.binding)),
+                msl.text.contains(&format!("[[buffer({})]]", binding.binding)),
                 "{}: MSL lacks [[buffer({})]] from the explicit buffer map",
                 kernel.name(),
                 binding.binding

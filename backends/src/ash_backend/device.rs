@@ -14,15 +14,9 @@ const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
 fn vk_error(operation: &str, result: vk::Result) -> BackendError {
     match result {
-        vk::Result::ERROR_DEVICE_LOST => BackendError::DeviceLost {
-            backend: "ash".into(),
-            reason: operation.into(),
-        },
+        vk::Result::ERROR_DEVICE_LOST => BackendError::DeviceLost { backend: "ash".into(), reason: operation.into() },
         vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY => {
-            BackendError::OutOfMemory {
-                backend: "ash".into(),
-                operation: operation.into(),
-            }
+            BackendError::OutOfMemory { backend: "ash".into(), operation: operation.into() }
         }
         other => BackendError::Validation {
             backend: "ash".into(),
@@ -47,9 +41,7 @@ unsafe extern "system" fn on_validation_message(
         let text = if data.is_null() || (*data).p_message.is_null() {
             "<no message>".to_string()
         } else {
-            CStr::from_ptr((*data).p_message)
-                .to_string_lossy()
-                .into_owned()
+            CStr::from_ptr((*data).p_message).to_string_lossy().into_owned()
         };
         if let Ok(mut list) = messages.lock() {
             list.push(format!("{severity:?}: {text}"));
@@ -62,11 +54,7 @@ unsafe extern "system" fn on_validation_message(
 pub(super) struct VulkanDevice {
     _entry: ash::Entry,
     instance: ash::Instance,
-    debug: Option<(
-        ash::ext::debug_utils::Instance,
-        vk::DebugUtilsMessengerEXT,
-        Box<Messages>,
-    )>,
+    debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT, Box<Messages>)>,
     physical: vk::PhysicalDevice,
     pub(super) device: ash::Device,
     queue: vk::Queue,
@@ -94,36 +82,28 @@ impl VulkanDevice {
             // SAFETY: plain enumeration.
             let available = unsafe { entry.enumerate_instance_layer_properties() }
                 .map_err(|e| vk_error("enumerating layers", e))?;
-            let found = available.iter().any(|layer| {
-                layer
-                    .layer_name_as_c_str()
-                    .is_ok_and(|name| name == VALIDATION_LAYER)
-            });
+            let found =
+                available.iter().any(|layer| layer.layer_name_as_c_str().is_ok_and(|name| name == VALIDATION_LAYER));
             if !found {
                 return Err(BackendError::DeviceCreation {
                     backend: options.source.name().into(),
-                    reason:
-                        "validation requested but VK_LAYER_KHRONOS_validation is not installed \
+                    reason: "validation requested but VK_LAYER_KHRONOS_validation is not installed \
                              (Debian: apt-get install vulkan-validationlayers)"
-                            .into(),
+                        .into(),
                 });
             }
             layers.push(VALIDATION_LAYER.as_ptr());
             extensions.push(ash::ext::debug_utils::NAME.as_ptr());
         }
-        let app = vk::ApplicationInfo::default()
-            .application_name(c"strata")
-            .api_version(vk::API_VERSION_1_3);
+        let app = vk::ApplicationInfo::default().application_name(c"strata").api_version(vk::API_VERSION_1_3);
         let create = vk::InstanceCreateInfo::default()
             .application_info(&app)
             .enabled_layer_names(&layers)
             .enabled_extension_names(&extensions);
         // SAFETY: valid create info with static strings.
-        let instance = unsafe { entry.create_instance(&create, None) }.map_err(|e| {
-            BackendError::NoAdapter {
-                backend: options.source.name().into(),
-                reason: format!("vkCreateInstance failed: {e:?}"),
-            }
+        let instance = unsafe { entry.create_instance(&create, None) }.map_err(|e| BackendError::NoAdapter {
+            backend: options.source.name().into(),
+            reason: format!("vkCreateInstance failed: {e:?}"),
         })?;
         let mut this_debug = None;
         if options.validation {
@@ -131,8 +111,7 @@ impl VulkanDevice {
             let utils = ash::ext::debug_utils::Instance::new(&entry, &instance);
             let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
                 .message_severity(
-                    vk::DebugUtilsMessageSeverityFlagsEXT::WARNING
-                        | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR,
+                    vk::DebugUtilsMessageSeverityFlagsEXT::WARNING | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR,
                 )
                 .message_type(
                     vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
@@ -151,24 +130,18 @@ impl VulkanDevice {
                 }
             }
         }
-        let mut partial = PartialInstance {
-            instance: Some(instance),
-            debug: this_debug,
-        };
+        let mut partial = PartialInstance { instance: Some(instance), debug: this_debug };
         let instance_ref = partial.instance.as_ref().expect("set above");
         let (physical, family) = pick_device(instance_ref, options)?;
         // SAFETY: valid physical device.
         let properties = unsafe { instance_ref.get_physical_device_properties(physical) };
-        let families =
-            unsafe { instance_ref.get_physical_device_queue_family_properties(physical) };
+        let families = unsafe { instance_ref.get_physical_device_queue_family_properties(physical) };
         let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
         let mut properties2 = vk::PhysicalDeviceProperties2::default().push_next(&mut subgroup);
         // SAFETY: Vulkan 1.1 core query on a 1.1 device.
         unsafe { instance_ref.get_physical_device_properties2(physical, &mut properties2) };
         let subgroup_size = (options.subgroups
-            && subgroup
-                .supported_stages
-                .contains(vk::ShaderStageFlags::COMPUTE)
+            && subgroup.supported_stages.contains(vk::ShaderStageFlags::COMPUTE)
             && subgroup.supported_operations.contains(
                 vk::SubgroupFeatureFlags::BASIC
                     | vk::SubgroupFeatureFlags::SHUFFLE
@@ -184,34 +157,25 @@ impl VulkanDevice {
             unsafe { instance_ref.get_physical_device_features2(physical, &mut features2) };
         }
         let native_zero_init = vulkan13.shader_zero_initialize_workgroup_memory == vk::TRUE;
-        let mut enable13 = vk::PhysicalDeviceVulkan13Features::default()
-            .shader_zero_initialize_workgroup_memory(native_zero_init);
+        let mut enable13 =
+            vk::PhysicalDeviceVulkan13Features::default().shader_zero_initialize_workgroup_memory(native_zero_init);
         let priorities = [1.0f32];
-        let queue_info = [vk::DeviceQueueCreateInfo::default()
-            .queue_family_index(family)
-            .queue_priorities(&priorities)];
+        let queue_info =
+            [vk::DeviceQueueCreateInfo::default().queue_family_index(family).queue_priorities(&priorities)];
         let mut device_info = vk::DeviceCreateInfo::default().queue_create_infos(&queue_info);
         if native_zero_init {
             device_info = device_info.push_next(&mut enable13);
         }
         // SAFETY: valid physical device and create info.
-        let device =
-            unsafe { instance_ref.create_device(physical, &device_info, None) }.map_err(|e| {
-                BackendError::DeviceCreation {
-                    backend: options.source.name().into(),
-                    reason: format!("{e:?}"),
-                }
-            })?;
+        let device = unsafe { instance_ref.create_device(physical, &device_info, None) }.map_err(|e| {
+            BackendError::DeviceCreation { backend: options.source.name().into(), reason: format!("{e:?}") }
+        })?;
         // SAFETY: the queue family was requested above.
         let queue = unsafe { device.get_device_queue(family, 0) };
         let memory = unsafe { instance_ref.get_physical_device_memory_properties(physical) };
         let wanted = vk::MemoryPropertyFlags::HOST_VISIBLE | vk::MemoryPropertyFlags::HOST_COHERENT;
         let memory_type = (0..memory.memory_type_count)
-            .find(|&i| {
-                memory.memory_types[i as usize]
-                    .property_flags
-                    .contains(wanted)
-            })
+            .find(|&i| memory.memory_types[i as usize].property_flags.contains(wanted))
             .ok_or_else(|| BackendError::DeviceCreation {
                 backend: options.source.name().into(),
                 reason: "no host-visible, coherent memory type".into(),
@@ -234,17 +198,9 @@ impl VulkanDevice {
             unsafe { device.destroy_device(None) };
             return Err(error);
         }
-        let DeviceObjects {
-            command_pool,
-            command_buffer,
-            fence,
-            query_pool,
-        } = objects;
-        let (command_pool, command_buffer, fence) = (
-            command_pool.expect("created"),
-            command_buffer.expect("created"),
-            fence.expect("created"),
-        );
+        let DeviceObjects { command_pool, command_buffer, fence, query_pool } = objects;
+        let (command_pool, command_buffer, fence) =
+            (command_pool.expect("created"), command_buffer.expect("created"), fence.expect("created"));
         let (instance, debug) = partial.take();
         Ok(Self {
             _entry: entry,
@@ -267,28 +223,15 @@ impl VulkanDevice {
     pub(super) fn device_info(&self, options: AshOptions) -> DeviceInfo {
         let mut maintenance3 = vk::PhysicalDeviceMaintenance3Properties::default();
         let mut driver = vk::PhysicalDeviceDriverProperties::default();
-        let mut properties2 = vk::PhysicalDeviceProperties2::default()
-            .push_next(&mut maintenance3)
-            .push_next(&mut driver);
+        let mut properties2 =
+            vk::PhysicalDeviceProperties2::default().push_next(&mut maintenance3).push_next(&mut driver);
         // SAFETY: Vulkan 1.1 core query (driver properties: 1.2, zeroed if unsupported).
-        unsafe {
-            self.instance
-                .get_physical_device_properties2(self.physical, &mut properties2)
-        };
+        unsafe { self.instance.get_physical_device_properties2(self.physical, &mut properties2) };
         let properties = properties2.properties;
         let limits = properties.limits;
-        let name = properties
-            .device_name_as_c_str()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let driver_name = driver
-            .driver_name_as_c_str()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let driver_info = driver
-            .driver_info_as_c_str()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
+        let name = properties.device_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let driver_name = driver.driver_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let driver_info = driver.driver_info_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         DeviceInfo {
             backend: options.source.name().into(),
             adapter: name,
@@ -300,12 +243,7 @@ impl VulkanDevice {
                 max_workgroup_storage: u64::from(limits.max_compute_shared_memory_size),
                 max_invocations_per_workgroup: limits.max_compute_work_group_invocations,
                 max_workgroup_size: limits.max_compute_work_group_size,
-                max_workgroups_per_dimension: limits
-                    .max_compute_work_group_count
-                    .iter()
-                    .copied()
-                    .min()
-                    .unwrap_or(0),
+                max_workgroups_per_dimension: limits.max_compute_work_group_count.iter().copied().min().unwrap_or(0),
                 max_storage_binding: u64::from(limits.max_storage_buffer_range),
                 max_uniform_binding: u64::from(limits.max_uniform_buffer_range),
                 max_buffer_size: maintenance3.max_memory_allocation_size,
@@ -365,10 +303,8 @@ impl VulkanDevice {
                 }
             };
             let bound = self.device.bind_buffer_memory(buffer, memory, 0);
-            let mapped = bound.and_then(|()| {
-                self.device
-                    .map_memory(memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty())
-            });
+            let mapped =
+                bound.and_then(|()| self.device.map_memory(memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()));
             match mapped {
                 Ok(pointer) => {
                     std::ptr::write_bytes(pointer as *mut u8, 0, size as usize);
@@ -402,55 +338,32 @@ impl VulkanDevice {
     ) -> Result<Option<Duration>, BackendError> {
         let operation = format!("dispatch of `{}`", kernel.name());
         let error = |e| vk_error(&operation, e);
-        let uniform = kernel
-            .bindings
-            .iter()
-            .filter(|b| b.kind == BindingKind::Uniform)
-            .count() as u32;
+        let uniform = kernel.bindings.iter().filter(|b| b.kind == BindingKind::Uniform).count() as u32;
         let storage = kernel.bindings.len() as u32 - uniform;
         let mut sizes = Vec::new();
         if uniform > 0 {
-            sizes.push(vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::UNIFORM_BUFFER,
-                descriptor_count: uniform,
-            });
+            sizes.push(vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: uniform });
         }
         if storage > 0 {
-            sizes.push(vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::STORAGE_BUFFER,
-                descriptor_count: storage,
-            });
+            sizes.push(vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: storage });
         }
         // SAFETY: all handles are valid; the pool is destroyed after the fence wait.
         unsafe {
             let pool = self
                 .device
-                .create_descriptor_pool(
-                    &vk::DescriptorPoolCreateInfo::default()
-                        .max_sets(1)
-                        .pool_sizes(&sizes),
-                    None,
-                )
+                .create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None)
                 .map_err(error)?;
             let result = (|| {
                 let layouts = [pipeline.set_layout];
                 let set = self
                     .device
                     .allocate_descriptor_sets(
-                        &vk::DescriptorSetAllocateInfo::default()
-                            .descriptor_pool(pool)
-                            .set_layouts(&layouts),
+                        &vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts),
                     )
                     .map_err(error)?[0];
                 let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
                     .iter()
-                    .map(|&(_, buffer)| {
-                        [vk::DescriptorBufferInfo {
-                            buffer,
-                            offset: 0,
-                            range: vk::WHOLE_SIZE,
-                        }]
-                    })
+                    .map(|&(_, buffer)| [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }])
                     .collect();
                 let writes: Vec<_> = buffers
                     .iter()
@@ -470,31 +383,19 @@ impl VulkanDevice {
                     .collect();
                 self.device.update_descriptor_sets(&writes, &[]);
                 let cb = self.command_buffer;
-                self.device
-                    .reset_command_buffer(cb, vk::CommandBufferResetFlags::empty())
-                    .map_err(error)?;
+                self.device.reset_command_buffer(cb, vk::CommandBufferResetFlags::empty()).map_err(error)?;
                 self.device
                     .begin_command_buffer(
                         cb,
-                        &vk::CommandBufferBeginInfo::default()
-                            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+                        &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
                     )
                     .map_err(error)?;
                 let queries = self.query_pool.filter(|_| timed);
                 if let Some(queries) = queries {
                     self.device.cmd_reset_query_pool(cb, queries, 0, 2);
-                    self.device.cmd_write_timestamp(
-                        cb,
-                        vk::PipelineStageFlags::TOP_OF_PIPE,
-                        queries,
-                        0,
-                    );
+                    self.device.cmd_write_timestamp(cb, vk::PipelineStageFlags::TOP_OF_PIPE, queries, 0);
                 }
-                self.device.cmd_bind_pipeline(
-                    cb,
-                    vk::PipelineBindPoint::COMPUTE,
-                    pipeline.pipeline,
-                );
+                self.device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, pipeline.pipeline);
                 self.device.cmd_bind_descriptor_sets(
                     cb,
                     vk::PipelineBindPoint::COMPUTE,
@@ -503,15 +404,9 @@ impl VulkanDevice {
                     &[set],
                     &[],
                 );
-                self.device
-                    .cmd_dispatch(cb, workgroups[0], workgroups[1], workgroups[2]);
+                self.device.cmd_dispatch(cb, workgroups[0], workgroups[1], workgroups[2]);
                 if let Some(queries) = queries {
-                    self.device.cmd_write_timestamp(
-                        cb,
-                        vk::PipelineStageFlags::BOTTOM_OF_PIPE,
-                        queries,
-                        1,
-                    );
+                    self.device.cmd_write_timestamp(cb, vk::PipelineStageFlags::BOTTOM_OF_PIPE, queries, 1);
                 }
                 let barrier = vk::MemoryBarrier::default()
                     .src_access_mask(vk::AccessFlags::SHADER_WRITE)
@@ -528,12 +423,8 @@ impl VulkanDevice {
                 self.device.end_command_buffer(cb).map_err(error)?;
                 let command_buffers = [cb];
                 let submit = [vk::SubmitInfo::default().command_buffers(&command_buffers)];
-                self.device
-                    .queue_submit(self.queue, &submit, self.fence)
-                    .map_err(error)?;
-                self.device
-                    .wait_for_fences(&[self.fence], true, u64::MAX)
-                    .map_err(error)?;
+                self.device.queue_submit(self.queue, &submit, self.fence).map_err(error)?;
+                self.device.wait_for_fences(&[self.fence], true, u64::MAX).map_err(error)?;
                 self.device.reset_fences(&[self.fence]).map_err(error)?;
                 match queries {
                     Some(queries) => {
@@ -546,8 +437,7 @@ impl VulkanDevice {
                                 vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
                             )
                             .map_err(error)?;
-                        let nanos =
-                            ticks[1].saturating_sub(ticks[0]) as f64 * self.timestamp_period;
+                        let nanos = ticks[1].saturating_sub(ticks[0]) as f64 * self.timestamp_period;
                         Ok(Some(Duration::from_nanos(nanos as u64)))
                     }
                     None => Ok(None),
@@ -594,12 +484,7 @@ struct DeviceObjects {
 }
 
 impl DeviceObjects {
-    fn create(
-        &mut self,
-        device: &ash::Device,
-        family: u32,
-        timestamps: bool,
-    ) -> Result<(), BackendError> {
+    fn create(&mut self, device: &ash::Device, family: u32, timestamps: bool) -> Result<(), BackendError> {
         // SAFETY: valid device; on error the caller destroys what was created.
         unsafe {
             let pool = device
@@ -629,9 +514,7 @@ impl DeviceObjects {
                 self.query_pool = Some(
                     device
                         .create_query_pool(
-                            &vk::QueryPoolCreateInfo::default()
-                                .query_type(vk::QueryType::TIMESTAMP)
-                                .query_count(2),
+                            &vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(2),
                             None,
                         )
                         .map_err(|e| vk_error("creating the timestamp query pool", e))?,
@@ -660,25 +543,14 @@ impl DeviceObjects {
 /// Instance and messenger until the device exists: destroyed if opening fails.
 struct PartialInstance {
     instance: Option<ash::Instance>,
-    debug: Option<(
-        ash::ext::debug_utils::Instance,
-        vk::DebugUtilsMessengerEXT,
-        Box<Messages>,
-    )>,
+    debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT, Box<Messages>)>,
 }
 
 impl PartialInstance {
     #[allow(clippy::type_complexity)]
     fn take(
         &mut self,
-    ) -> (
-        ash::Instance,
-        Option<(
-            ash::ext::debug_utils::Instance,
-            vk::DebugUtilsMessengerEXT,
-            Box<Messages>,
-        )>,
-    ) {
+    ) -> (ash::Instance, Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT, Box<Messages>)>) {
         (self.instance.take().expect("taken once"), self.debug.take())
     }
 }
@@ -698,13 +570,9 @@ impl Drop for PartialInstance {
 }
 
 /// The best physical device with a compute queue and Vulkan 1.1: discrete first, CPU last.
-fn pick_device(
-    instance: &ash::Instance,
-    options: AshOptions,
-) -> Result<(vk::PhysicalDevice, u32), BackendError> {
+fn pick_device(instance: &ash::Instance, options: AshOptions) -> Result<(vk::PhysicalDevice, u32), BackendError> {
     // SAFETY: plain enumeration.
-    let devices = unsafe { instance.enumerate_physical_devices() }
-        .map_err(|e| vk_error("enumerating devices", e))?;
+    let devices = unsafe { instance.enumerate_physical_devices() }.map_err(|e| vk_error("enumerating devices", e))?;
     let rank = |kind: vk::PhysicalDeviceType| match kind {
         vk::PhysicalDeviceType::DISCRETE_GPU => 0,
         vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
@@ -720,10 +588,7 @@ fn pick_device(
             continue;
         }
         let families = unsafe { instance.get_physical_device_queue_family_properties(device) };
-        let Some(family) = families
-            .iter()
-            .position(|f| f.queue_flags.contains(vk::QueueFlags::COMPUTE))
-        else {
+        let Some(family) = families.iter().position(|f| f.queue_flags.contains(vk::QueueFlags::COMPUTE)) else {
             continue;
         };
         let key = rank(properties.device_type);
@@ -731,9 +596,8 @@ fn pick_device(
             best = Some((key, device, family as u32));
         }
     }
-    best.map(|(_, device, family)| (device, family))
-        .ok_or_else(|| BackendError::NoAdapter {
-            backend: options.source.name().into(),
-            reason: "no Vulkan 1.1 device with a compute queue".into(),
-        })
+    best.map(|(_, device, family)| (device, family)).ok_or_else(|| BackendError::NoAdapter {
+        backend: options.source.name().into(),
+        reason: "no Vulkan 1.1 device with a compute queue".into(),
+    })
 }

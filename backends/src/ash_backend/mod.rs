@@ -56,11 +56,7 @@ pub struct AshOptions {
 
 impl Default for AshOptions {
     fn default() -> Self {
-        Self {
-            validation: false,
-            source: SpirvSource::Naga,
-            subgroups: true,
-        }
+        Self { validation: false, source: SpirvSource::Naga, subgroups: true }
     }
 }
 
@@ -86,28 +82,18 @@ impl AshBackend {
     /// Opens the best Vulkan device: a discrete GPU first, a CPU device (lavapipe) last.
     pub fn new(options: AshOptions) -> Result<Self, BackendError> {
         if options.source != SpirvSource::Naga {
-            let probe = std::process::Command::new("glslangValidator")
-                .arg("--version")
-                .output();
+            let probe = std::process::Command::new("glslangValidator").arg("--version").output();
             if !probe.is_ok_and(|out| out.status.success()) {
                 return Err(BackendError::NoAdapter {
                     backend: options.source.name().into(),
-                    reason:
-                        "glslangValidator is not installed (Debian: apt-get install glslang-tools)"
-                            .into(),
+                    reason: "glslangValidator is not installed (Debian: apt-get install glslang-tools)".into(),
                 });
             }
         }
         let vulkan = VulkanDevice::open(options)?;
         let info = vulkan.device_info(options);
         let pipelines = PipelineCache::new(options.source);
-        Ok(Self {
-            buffers: HashMap::new(),
-            next_buffer: 0,
-            pipelines,
-            vulkan,
-            info,
-        })
+        Ok(Self { buffers: HashMap::new(), next_buffer: 0, pipelines, vulkan, info })
     }
 
     /// Warnings and errors the validation layer reported so far (empty without validation).
@@ -116,9 +102,7 @@ impl AshBackend {
     }
 
     fn buffer(&self, id: BufferId) -> Result<&AshBuffer, BackendError> {
-        self.buffers
-            .get(&id.0)
-            .ok_or(BackendError::UnknownBuffer(id.0))
+        self.buffers.get(&id.0).ok_or(BackendError::UnknownBuffer(id.0))
     }
 
     fn run(
@@ -130,16 +114,13 @@ impl AshBackend {
     ) -> Result<Option<Duration>, BackendError> {
         self.check_kernel(kernel)?;
         check_workgroups(kernel, workgroups, &self.info)?;
-        check_binds(kernel, binds, &self.info, |id| {
-            self.buffer(id).map(|b| b.size)
-        })?;
+        check_binds(kernel, binds, &self.info, |id| self.buffer(id).map(|b| b.size))?;
         let pipeline = self.pipelines.get_or_create(&self.vulkan, kernel)?;
         let buffers = binds
             .iter()
             .map(|bind| Ok((bind.binding, self.buffer(bind.buffer)?.buffer)))
             .collect::<Result<Vec<_>, BackendError>>()?;
-        self.vulkan
-            .dispatch(&pipeline, kernel, &buffers, workgroups, timed)
+        self.vulkan.dispatch(&pipeline, kernel, &buffers, workgroups, timed)
     }
 }
 
@@ -165,30 +146,13 @@ impl Backend for AshBackend {
         }
         let (buffer, memory, mapped) = self.vulkan.create_buffer(label, size.div_ceil(4) * 4)?;
         self.next_buffer += 1;
-        self.buffers.insert(
-            self.next_buffer,
-            AshBuffer {
-                buffer,
-                memory,
-                mapped,
-                size,
-                label: label.into(),
-            },
-        );
+        self.buffers.insert(self.next_buffer, AshBuffer { buffer, memory, mapped, size, label: label.into() });
         Ok(BufferId(self.next_buffer))
     }
 
-    fn write_buffer(
-        &mut self,
-        buffer: BufferId,
-        offset: u64,
-        data: &[u8],
-    ) -> Result<(), BackendError> {
+    fn write_buffer(&mut self, buffer: BufferId, offset: u64, data: &[u8]) -> Result<(), BackendError> {
         let entry = self.buffer(buffer)?;
-        if !offset.is_multiple_of(4)
-            || !data.len().is_multiple_of(4)
-            || offset + data.len() as u64 > entry.size
-        {
+        if !offset.is_multiple_of(4) || !data.len().is_multiple_of(4) || offset + data.len() as u64 > entry.size {
             return Err(BackendError::Buffer {
                 label: entry.label.clone(),
                 reason: format!(
@@ -201,11 +165,7 @@ impl Backend for AshBackend {
         // SAFETY: the mapping covers the whole buffer, the range was checked above, and
         // no dispatch is in flight (dispatches complete before `dispatch` returns).
         unsafe {
-            std::ptr::copy_nonoverlapping(
-                data.as_ptr(),
-                entry.mapped.add(offset as usize),
-                data.len(),
-            );
+            std::ptr::copy_nonoverlapping(data.as_ptr(), entry.mapped.add(offset as usize), data.len());
         }
         Ok(())
     }
@@ -221,10 +181,7 @@ impl Backend for AshBackend {
     }
 
     fn destroy_buffer(&mut self, buffer: BufferId) -> Result<(), BackendError> {
-        let entry = self
-            .buffers
-            .remove(&buffer.0)
-            .ok_or(BackendError::UnknownBuffer(buffer.0))?;
+        let entry = self.buffers.remove(&buffer.0).ok_or(BackendError::UnknownBuffer(buffer.0))?;
         self.vulkan.destroy_buffer(entry.buffer, entry.memory);
         Ok(())
     }
@@ -233,12 +190,7 @@ impl Backend for AshBackend {
         check_kernel_fits(kernel, &self.info)
     }
 
-    fn dispatch(
-        &mut self,
-        kernel: &Kernel,
-        binds: &[Bind],
-        workgroups: [u32; 3],
-    ) -> Result<(), BackendError> {
+    fn dispatch(&mut self, kernel: &Kernel, binds: &[Bind], workgroups: [u32; 3]) -> Result<(), BackendError> {
         self.run(kernel, binds, workgroups, false).map(|_| ())
     }
 
@@ -251,8 +203,7 @@ impl Backend for AshBackend {
         if !self.info.timestamps {
             return Err(BackendError::NoTimestamps(self.info.backend.clone()));
         }
-        self.run(kernel, binds, workgroups, true)?
-            .ok_or_else(|| BackendError::NoTimestamps(self.info.backend.clone()))
+        self.run(kernel, binds, workgroups, true)?.ok_or_else(|| BackendError::NoTimestamps(self.info.backend.clone()))
     }
 }
 

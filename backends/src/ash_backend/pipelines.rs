@@ -26,32 +26,17 @@ pub(super) struct PipelineCache {
 
 impl PipelineCache {
     pub(super) fn new(source: SpirvSource) -> Self {
-        Self {
-            source,
-            pipelines: HashMap::new(),
-        }
+        Self { source, pipelines: HashMap::new() }
     }
 
     /// SPIR-V words and entry point name of `kernel` from this cache's source.
-    fn spirv(
-        &self,
-        kernel: &Kernel,
-        native_zero_init: bool,
-    ) -> Result<(Vec<u32>, String), BackendError> {
+    fn spirv(&self, kernel: &Kernel, native_zero_init: bool) -> Result<(Vec<u32>, String), BackendError> {
         let glslang_input = match self.source {
             SpirvSource::Naga => {
-                let workgroup_zero_init = if native_zero_init {
-                    WorkgroupZeroInit::Native
-                } else {
-                    WorkgroupZeroInit::Polyfill
-                };
+                let workgroup_zero_init =
+                    if native_zero_init { WorkgroupZeroInit::Native } else { WorkgroupZeroInit::Polyfill };
                 // No naga DEBUG flag: Debian's validation layer misreads its OpSource marker.
-                let translation = translate::spirv(
-                    kernel,
-                    TranslateOptions {
-                        workgroup_zero_init,
-                    },
-                )?;
+                let translation = translate::spirv(kernel, TranslateOptions { workgroup_zero_init })?;
                 return Ok((translation.words, translation.entry_point));
             }
             SpirvSource::GlslangFromGlsl => GlslangInput::Glsl,
@@ -108,10 +93,9 @@ impl PipelineCache {
             let module = device
                 .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), None)
                 .map_err(error)?;
-            let set_layout = match device.create_descriptor_set_layout(
-                &vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings),
-                None,
-            ) {
+            let set_layout = match device
+                .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None)
+            {
                 Ok(layout) => layout,
                 Err(e) => {
                     device.destroy_shader_module(module, None);
@@ -119,10 +103,9 @@ impl PipelineCache {
                 }
             };
             let set_layouts = [set_layout];
-            let layout = match device.create_pipeline_layout(
-                &vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts),
-                None,
-            ) {
+            let layout = match device
+                .create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts), None)
+            {
                 Ok(layout) => layout,
                 Err(e) => {
                     device.destroy_descriptor_set_layout(set_layout, None);
@@ -134,25 +117,17 @@ impl PipelineCache {
                 .stage(vk::ShaderStageFlags::COMPUTE)
                 .module(module)
                 .name(&entry_point);
-            let create = [vk::ComputePipelineCreateInfo::default()
-                .stage(stage)
-                .layout(layout)];
-            let pipeline =
-                match device.create_compute_pipelines(vk::PipelineCache::null(), &create, None) {
-                    Ok(pipelines) => pipelines[0],
-                    Err((_, e)) => {
-                        device.destroy_pipeline_layout(layout, None);
-                        device.destroy_descriptor_set_layout(set_layout, None);
-                        device.destroy_shader_module(module, None);
-                        return Err(error(e));
-                    }
-                };
-            let pipeline = Arc::new(AshPipeline {
-                module,
-                set_layout,
-                layout,
-                pipeline,
-            });
+            let create = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout)];
+            let pipeline = match device.create_compute_pipelines(vk::PipelineCache::null(), &create, None) {
+                Ok(pipelines) => pipelines[0],
+                Err((_, e)) => {
+                    device.destroy_pipeline_layout(layout, None);
+                    device.destroy_descriptor_set_layout(set_layout, None);
+                    device.destroy_shader_module(module, None);
+                    return Err(error(e));
+                }
+            };
+            let pipeline = Arc::new(AshPipeline { module, set_layout, layout, pipeline });
             self.pipelines.insert(kernel.id, Arc::clone(&pipeline));
             Ok(pipeline)
         }

@@ -55,28 +55,16 @@ impl BufferTable {
         });
         scope.finish(&format!("creation of buffer `{label}` ({size} bytes)"))?;
         self.next += 1;
-        self.entries.insert(
-            self.next,
-            BufferEntry {
-                buffer,
-                size,
-                label: label.into(),
-            },
-        );
+        self.entries.insert(self.next, BufferEntry { buffer, size, label: label.into() });
         Ok(BufferId(self.next))
     }
 
     pub(super) fn get(&self, id: BufferId) -> Result<&BufferEntry, BackendError> {
-        self.entries
-            .get(&id.0)
-            .ok_or(BackendError::UnknownBuffer(id.0))
+        self.entries.get(&id.0).ok_or(BackendError::UnknownBuffer(id.0))
     }
 
     pub(super) fn destroy(&mut self, id: BufferId) -> Result<(), BackendError> {
-        let entry = self
-            .entries
-            .remove(&id.0)
-            .ok_or(BackendError::UnknownBuffer(id.0))?;
+        let entry = self.entries.remove(&id.0).ok_or(BackendError::UnknownBuffer(id.0))?;
         entry.buffer.destroy();
         Ok(())
     }
@@ -97,9 +85,7 @@ pub(super) fn read_back(
         usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-        label: Some("read-back"),
-    });
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("read-back") });
     encoder.copy_buffer_to_buffer(&entry.buffer, 0, &staging, 0, padded);
     queue.submit([encoder.finish()]);
     scope.finish(&format!("read-back of `{}`", entry.label))?;
@@ -121,19 +107,14 @@ pub(super) fn map_read(
     slice.map_async(wgpu::MapMode::Read, move |result| {
         let _ = sender.send(result);
     });
-    device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| errors.lost_or(e.to_string()))?;
+    device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| errors.lost_or(e.to_string()))?;
     errors.check_lost()?;
     match receiver.recv() {
         Ok(Ok(())) => {}
         Ok(Err(e)) => return Err(errors.lost_or(format!("mapping for read-back failed: {e}"))),
         Err(_) => return Err(errors.lost_or("mapping callback never ran".into())),
     }
-    let bytes = slice
-        .get_mapped_range()
-        .map_err(|e| errors.lost_or(format!("mapped range: {e}")))?
-        .to_vec();
+    let bytes = slice.get_mapped_range().map_err(|e| errors.lost_or(format!("mapped range: {e}")))?.to_vec();
     buffer.unmap();
     Ok(bytes)
 }

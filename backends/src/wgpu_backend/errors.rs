@@ -18,11 +18,7 @@ pub(super) struct ErrorSink {
 
 impl ErrorSink {
     pub(super) fn install(device: &wgpu::Device, backend: &str) -> Self {
-        let sink = Self {
-            backend: backend.into(),
-            uncaptured: Arc::default(),
-            lost: Arc::default(),
-        };
+        let sink = Self { backend: backend.into(), uncaptured: Arc::default(), lost: Arc::default() };
         let uncaptured = Arc::clone(&sink.uncaptured);
         device.on_uncaptured_error(Arc::new(move |error| {
             if let Ok(mut list) = uncaptured.lock() {
@@ -45,19 +41,13 @@ impl ErrorSink {
             device.push_error_scope(wgpu::ErrorFilter::OutOfMemory),
             device.push_error_scope(wgpu::ErrorFilter::Validation),
         ];
-        Scope {
-            sink: self.clone(),
-            guards,
-        }
+        Scope { sink: self.clone(), guards }
     }
 
     /// The device-lost error, if the device was lost.
     pub(super) fn check_lost(&self) -> Result<(), BackendError> {
         match self.lost.lock().ok().and_then(|slot| slot.clone()) {
-            Some(reason) => Err(BackendError::DeviceLost {
-                backend: self.backend.clone(),
-                reason,
-            }),
+            Some(reason) => Err(BackendError::DeviceLost { backend: self.backend.clone(), reason }),
             None => Ok(()),
         }
     }
@@ -66,20 +56,15 @@ impl ErrorSink {
     pub(super) fn lost_or(&self, message: String) -> BackendError {
         match self.check_lost() {
             Err(lost) => lost,
-            Ok(()) => BackendError::Validation {
-                backend: self.backend.clone(),
-                operation: "wait".into(),
-                message,
-            },
+            Ok(()) => BackendError::Validation { backend: self.backend.clone(), operation: "wait".into(), message },
         }
     }
 
     fn convert(&self, error: wgpu::Error, operation: &str) -> BackendError {
         match error {
-            wgpu::Error::OutOfMemory { .. } => BackendError::OutOfMemory {
-                backend: self.backend.clone(),
-                operation: operation.into(),
-            },
+            wgpu::Error::OutOfMemory { .. } => {
+                BackendError::OutOfMemory { backend: self.backend.clone(), operation: operation.into() }
+            }
             other => BackendError::Validation {
                 backend: self.backend.clone(),
                 operation: operation.into(),
@@ -107,13 +92,7 @@ impl Scope {
         if let Some(error) = first {
             return Err(self.sink.convert(error, operation));
         }
-        if let Some(error) = self
-            .sink
-            .uncaptured
-            .lock()
-            .ok()
-            .and_then(|mut list| list.pop())
-        {
+        if let Some(error) = self.sink.uncaptured.lock().ok().and_then(|mut list| list.pop()) {
             return Err(self.sink.convert(error, operation));
         }
         self.sink.check_lost()

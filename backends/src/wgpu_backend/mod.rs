@@ -36,11 +36,7 @@ pub struct WgpuOptions {
 
 impl Default for WgpuOptions {
     fn default() -> Self {
-        Self {
-            api: WgpuApi::Vulkan,
-            validation: false,
-            subgroups: true,
-        }
+        Self { api: WgpuApi::Vulkan, validation: false, subgroups: true }
     }
 }
 
@@ -69,11 +65,8 @@ impl WgpuBackend {
         };
         // VALIDATION only: DEBUG makes naga's SPIR-V carry an OpSource marker that
         // Debian's validation layer misreports.
-        descriptor.flags = if options.validation {
-            wgpu::InstanceFlags::VALIDATION
-        } else {
-            wgpu::InstanceFlags::empty()
-        };
+        descriptor.flags =
+            if options.validation { wgpu::InstanceFlags::VALIDATION } else { wgpu::InstanceFlags::empty() };
         let instance = wgpu::Instance::new(descriptor);
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
@@ -81,10 +74,7 @@ impl WgpuBackend {
             compatible_surface: None,
             apply_limit_buckets: false,
         }))
-        .map_err(|e| BackendError::NoAdapter {
-            backend: backend_name.into(),
-            reason: e.to_string(),
-        })?;
+        .map_err(|e| BackendError::NoAdapter { backend: backend_name.into(), reason: e.to_string() })?;
 
         let adapter_features = adapter.features();
         let mut features = wgpu::Features::empty();
@@ -103,10 +93,7 @@ impl WgpuBackend {
             required_limits: limits.clone(),
             ..Default::default()
         }))
-        .map_err(|e| BackendError::DeviceCreation {
-            backend: backend_name.into(),
-            reason: e.to_string(),
-        })?;
+        .map_err(|e| BackendError::DeviceCreation { backend: backend_name.into(), reason: e.to_string() })?;
 
         let errors = ErrorSink::install(&device, backend_name);
         let adapter_info = adapter.get_info();
@@ -114,13 +101,8 @@ impl WgpuBackend {
             backend: backend_name.into(),
             adapter: adapter_info.name.clone(),
             device_type: format!("{:?}", adapter_info.device_type),
-            driver: format!("{} {}", adapter_info.driver, adapter_info.driver_info)
-                .trim()
-                .into(),
-            subgroup_sizes: subgroups.then_some((
-                adapter_info.subgroup_min_size,
-                adapter_info.subgroup_max_size,
-            )),
+            driver: format!("{} {}", adapter_info.driver, adapter_info.driver_info).trim().into(),
+            subgroup_sizes: subgroups.then_some((adapter_info.subgroup_min_size, adapter_info.subgroup_max_size)),
             timestamps,
             limits: DeviceLimits {
                 max_workgroup_storage: u64::from(limits.max_compute_workgroup_storage_size),
@@ -177,12 +159,8 @@ impl WgpuBackend {
     ) -> Result<(), BackendError> {
         self.check_kernel(kernel)?;
         check_workgroups(kernel, workgroups, &self.info)?;
-        check_binds(kernel, binds, &self.info, |id| {
-            self.buffers.get(id).map(|b| b.size)
-        })?;
-        let pipeline = self
-            .pipelines
-            .get_or_create(&self.device, &self.errors, kernel)?;
+        check_binds(kernel, binds, &self.info, |id| self.buffers.get(id).map(|b| b.size))?;
+        let pipeline = self.pipelines.get_or_create(&self.device, &self.errors, kernel)?;
         let scope = self.errors.scope(&self.device);
         let entries = binds
             .iter()
@@ -198,11 +176,8 @@ impl WgpuBackend {
             layout: &pipeline.layout,
             entries: &entries,
         });
-        let mut encoder = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some(kernel.name()),
-            });
+        let mut encoder =
+            self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(kernel.name()) });
         {
             let timestamp_writes = match (&self.timestamps, timed) {
                 (Some((set, _, _)), true) => Some(wgpu::ComputePassTimestampWrites {
@@ -212,10 +187,8 @@ impl WgpuBackend {
                 }),
                 _ => None,
             };
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(kernel.name()),
-                timestamp_writes,
-            });
+            let mut pass = encoder
+                .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(kernel.name()), timestamp_writes });
             pass.set_pipeline(&pipeline.pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.dispatch_workgroups(workgroups[0], workgroups[1], workgroups[2]);
@@ -229,9 +202,7 @@ impl WgpuBackend {
     }
 
     fn wait(&self) -> Result<(), BackendError> {
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| self.errors.lost_or(e.to_string()))?;
+        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| self.errors.lost_or(e.to_string()))?;
         self.errors.check_lost()
     }
 }
@@ -242,21 +213,12 @@ impl Backend for WgpuBackend {
     }
 
     fn create_buffer(&mut self, label: &str, size: u64) -> Result<BufferId, BackendError> {
-        self.buffers
-            .create(&self.device, &self.errors, &self.info, label, size)
+        self.buffers.create(&self.device, &self.errors, &self.info, label, size)
     }
 
-    fn write_buffer(
-        &mut self,
-        buffer: BufferId,
-        offset: u64,
-        data: &[u8],
-    ) -> Result<(), BackendError> {
+    fn write_buffer(&mut self, buffer: BufferId, offset: u64, data: &[u8]) -> Result<(), BackendError> {
         let entry = self.buffers.get(buffer)?;
-        if !offset.is_multiple_of(4)
-            || !data.len().is_multiple_of(4)
-            || offset + data.len() as u64 > entry.size
-        {
+        if !offset.is_multiple_of(4) || !data.len().is_multiple_of(4) || offset + data.len() as u64 > entry.size {
             return Err(BackendError::Buffer {
                 label: entry.label.clone(),
                 reason: format!(
@@ -283,12 +245,7 @@ impl Backend for WgpuBackend {
         check_kernel_fits(kernel, &self.info)
     }
 
-    fn dispatch(
-        &mut self,
-        kernel: &Kernel,
-        binds: &[Bind],
-        workgroups: [u32; 3],
-    ) -> Result<(), BackendError> {
+    fn dispatch(&mut self, kernel: &Kernel, binds: &[Bind], workgroups: [u32; 3]) -> Result<(), BackendError> {
         self.encode(kernel, binds, workgroups, false)
     }
 
@@ -306,8 +263,7 @@ impl Backend for WgpuBackend {
         let (_, _, readback) = self.timestamps.as_ref().expect("checked above");
         let bytes = buffers::map_read(&self.device, &self.errors, readback, 16)?;
         let ticks: [u64; 2] = bytemuck::pod_read_unaligned(&bytes);
-        let nanos =
-            ticks[1].saturating_sub(ticks[0]) as f64 * f64::from(self.queue.get_timestamp_period());
+        let nanos = ticks[1].saturating_sub(ticks[0]) as f64 * f64::from(self.queue.get_timestamp_period());
         Ok(Duration::from_nanos(nanos as u64))
     }
 }

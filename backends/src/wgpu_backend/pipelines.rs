@@ -39,9 +39,9 @@ impl PipelineCache {
                 ty: wgpu::BindingType::Buffer {
                     ty: match binding.kind {
                         BindingKind::Uniform => wgpu::BufferBindingType::Uniform,
-                        BindingKind::Storage(access) => wgpu::BufferBindingType::Storage {
-                            read_only: access == BindingAccess::ReadOnly,
-                        },
+                        BindingKind::Storage(access) => {
+                            wgpu::BufferBindingType::Storage { read_only: access == BindingAccess::ReadOnly }
+                        }
                     },
                     has_dynamic_offset: false,
                     min_binding_size: NonZeroU64::new(binding.min_size()),

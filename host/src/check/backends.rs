@@ -1,6 +1,7 @@
 //! The backends the check runs on. Adding a backend is one line in [`backend_slots`].
 
 use strata_backends::ash_backend::{AshBackend, AshOptions, SpirvSource};
+use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_backends::wgpu_backend::{WgpuApi, WgpuBackend, WgpuOptions};
 use strata_backends::{Backend, BackendError};
 
@@ -16,48 +17,25 @@ pub struct BackendSlot {
 
 fn wgpu(api: WgpuApi) -> Result<Box<dyn Backend>, BackendError> {
     let validation = api == WgpuApi::Vulkan;
-    Ok(Box::new(WgpuBackend::new(WgpuOptions {
-        api,
-        validation,
-        subgroups: true,
-    })?))
+    Ok(Box::new(WgpuBackend::new(WgpuOptions { api, validation, subgroups: true })?))
 }
 
 fn ash(source: SpirvSource) -> Result<Box<dyn Backend>, BackendError> {
-    Ok(Box::new(AshBackend::new(AshOptions {
-        validation: false,
-        source,
-        subgroups: true,
-    })?))
+    Ok(Box::new(AshBackend::new(AshOptions { validation: false, source, subgroups: true })?))
 }
 
 /// Every backend of the check, in report order.
 pub fn backend_slots() -> Vec<BackendSlot> {
     vec![
         BackendSlot {
-            name: "wgpu-vulkan",
-            open: || wgpu(WgpuApi::Vulkan),
-            needs_vulkan: true,
-        },
-        BackendSlot {
-            name: "wgpu-gl",
-            open: || wgpu(WgpuApi::Gl),
+            name: "cpu",
+            open: || Ok(Box::new(CpuBackend::new(CpuOptions::default())?)),
             needs_vulkan: false,
         },
-        BackendSlot {
-            name: "ash",
-            open: || ash(SpirvSource::Naga),
-            needs_vulkan: true,
-        },
-        BackendSlot {
-            name: "ash-glsl",
-            open: || ash(SpirvSource::GlslangFromGlsl),
-            needs_vulkan: true,
-        },
-        BackendSlot {
-            name: "ash-hlsl",
-            open: || ash(SpirvSource::GlslangFromHlsl),
-            needs_vulkan: true,
-        },
+        BackendSlot { name: "wgpu-vulkan", open: || wgpu(WgpuApi::Vulkan), needs_vulkan: true },
+        BackendSlot { name: "wgpu-gl", open: || wgpu(WgpuApi::Gl), needs_vulkan: false },
+        BackendSlot { name: "ash", open: || ash(SpirvSource::Naga), needs_vulkan: true },
+        BackendSlot { name: "ash-glsl", open: || ash(SpirvSource::GlslangFromGlsl), needs_vulkan: true },
+        BackendSlot { name: "ash-hlsl", open: || ash(SpirvSource::GlslangFromHlsl), needs_vulkan: true },
     ]
 }

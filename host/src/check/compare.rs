@@ -39,11 +39,7 @@ impl Agreement {
 
     /// Share of float values beyond their bound.
     pub fn outside_share(&self) -> f64 {
-        if self.floats == 0 {
-            0.0
-        } else {
-            self.outside as f64 / self.floats as f64
-        }
+        if self.floats == 0 { 0.0 } else { self.outside as f64 / self.floats as f64 }
     }
 }
 
@@ -74,11 +70,7 @@ pub struct Mismatch {
 impl std::fmt::Display for Mismatch {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self.index {
-            Some(i) => write!(
-                f,
-                "{}[{i}] = {:#x}, want {:#x}",
-                self.output, self.got, self.want
-            ),
+            Some(i) => write!(f, "{}[{i}] = {:#x}, want {:#x}", self.output, self.got, self.want),
             None => write!(f, "{}: {} words, want {}", self.output, self.got, self.want),
         }
     }
@@ -88,22 +80,10 @@ impl std::fmt::Display for Mismatch {
 pub fn ulp_distance(a: u32, b: u32) -> u32 {
     let (fa, fb) = (f32::from_bits(a), f32::from_bits(b));
     if fa.is_nan() || fb.is_nan() {
-        return if fa.is_nan() && fb.is_nan() {
-            0
-        } else {
-            u32::MAX
-        };
+        return if fa.is_nan() && fb.is_nan() { 0 } else { u32::MAX };
     }
-    let ordered = |bits: u32| -> i64 {
-        if bits >> 31 == 0 {
-            i64::from(bits)
-        } else {
-            -i64::from(bits & 0x7fff_ffff)
-        }
-    };
-    (ordered(a) - ordered(b))
-        .unsigned_abs()
-        .min(u64::from(u32::MAX)) as u32
+    let ordered = |bits: u32| -> i64 { if bits >> 31 == 0 { i64::from(bits) } else { -i64::from(bits & 0x7fff_ffff) } };
+    (ordered(a) - ordered(b)).unsigned_abs().min(u64::from(u32::MAX)) as u32
 }
 
 /// Compares `got` with `want` output by output.
@@ -111,12 +91,7 @@ pub fn compare_outputs(got: &[Output], want: &[Output]) -> Result<Agreement, Mis
     let mut agreement = Agreement::default();
     for want in want {
         let Some(got) = got.iter().find(|o| o.name == want.name) else {
-            return Err(Mismatch {
-                output: want.name,
-                index: None,
-                got: 0,
-                want: want.words.len() as u64,
-            });
+            return Err(Mismatch { output: want.name, index: None, got: 0, want: want.words.len() as u64 });
         };
         if got.words.len() != want.words.len() {
             return Err(Mismatch {
@@ -175,47 +150,22 @@ mod tests {
         assert_eq!(ulp_distance(1.0f32.to_bits(), 1.0f32.to_bits()), 0);
         assert_eq!(ulp_distance(1.0f32.to_bits(), (1.0f32.to_bits()) + 3), 3);
         assert_eq!(ulp_distance(0.0f32.to_bits(), (-0.0f32).to_bits()), 0);
-        assert_eq!(
-            ulp_distance(f32::from_bits(1).to_bits(), (-f32::from_bits(1)).to_bits()),
-            2
-        );
+        assert_eq!(ulp_distance(f32::from_bits(1).to_bits(), (-f32::from_bits(1)).to_bits()), 2);
         assert_eq!(ulp_distance(f32::NAN.to_bits(), f32::NAN.to_bits()), 0);
         assert_eq!(ulp_distance(f32::NAN.to_bits(), 1.0f32.to_bits()), u32::MAX);
     }
 
     #[test]
     fn the_first_difference_is_reported() {
-        let want = [Output {
-            name: "a",
-            words: vec![1, 2, 3],
-            compare: Compare::Exact,
-        }];
-        let got = [Output {
-            name: "a",
-            words: vec![1, 5, 3],
-            compare: Compare::Exact,
-        }];
+        let want = [Output { name: "a", words: vec![1, 2, 3], compare: Compare::Exact }];
+        let got = [Output { name: "a", words: vec![1, 5, 3], compare: Compare::Exact }];
         let mismatch = compare_outputs(&got, &want).unwrap_err();
         assert_eq!(mismatch.to_string(), "a[1] = 0x5, want 0x2");
-        let floats = [Output {
-            name: "f",
-            words: vec![1.0f32.to_bits()],
-            compare: Compare::Float {
-                ulp: 2,
-                max_outside: 0.0,
-            },
-        }];
-        let close = [Output {
-            name: "f",
-            words: vec![1.0f32.to_bits() + 2],
-            compare: Compare::Exact,
-        }];
+        let floats =
+            [Output { name: "f", words: vec![1.0f32.to_bits()], compare: Compare::Float { ulp: 2, max_outside: 0.0 } }];
+        let close = [Output { name: "f", words: vec![1.0f32.to_bits() + 2], compare: Compare::Exact }];
         assert_eq!(compare_outputs(&close, &floats).map(|a| a.max_ulp), Ok(2));
-        let far = [Output {
-            name: "f",
-            words: vec![1.0f32.to_bits() + 3],
-            compare: Compare::Exact,
-        }];
+        let far = [Output { name: "f", words: vec![1.0f32.to_bits() + 3], compare: Compare::Exact }];
         assert!(compare_outputs(&far, &floats).is_err());
     }
 
@@ -226,20 +176,9 @@ mod tests {
         noisy[10] += 1000;
         noisy[20] += 1000;
         let want = |max_outside| {
-            [Output {
-                name: "image",
-                words: values.clone(),
-                compare: Compare::Float {
-                    ulp: 4,
-                    max_outside,
-                },
-            }]
+            [Output { name: "image", words: values.clone(), compare: Compare::Float { ulp: 4, max_outside } }]
         };
-        let got = [Output {
-            name: "image",
-            words: noisy,
-            compare: Compare::Exact,
-        }];
+        let got = [Output { name: "image", words: noisy, compare: Compare::Exact }];
         let agreement = compare_outputs(&got, &want(0.002)).unwrap();
         assert_eq!((agreement.outside, agreement.floats), (2, 1000));
         assert!((agreement.outside_share() - 0.002).abs() < 1e-12);

@@ -10,9 +10,7 @@ use strata_kernels::{KernelId, Registry};
 pub struct EmptyCheck;
 
 fn contents(case: &Case) -> Vec<u32> {
-    (0..case.width)
-        .map(|i| i.wrapping_mul(0x9e37_79b9) ^ case.seed as u32)
-        .collect()
+    (0..case.width).map(|i| i.wrapping_mul(0x9e37_79b9) ^ case.seed as u32).collect()
 }
 
 impl KernelCheck for EmptyCheck {
@@ -40,18 +38,10 @@ impl KernelCheck for EmptyCheck {
         let result = backend.dispatch(kernel, &[Bind::new(0, sink)], [case.height, 1, 1]);
         let words = result.and_then(|()| download::<u32>(backend, sink));
         backend.destroy_buffer(sink)?;
-        Ok(vec![Output {
-            name: "sink",
-            words: words?,
-            compare: Compare::Exact,
-        }])
+        Ok(vec![Output { name: "sink", words: words?, compare: Compare::Exact }])
     }
 
     fn reference(&self, case: &Case) -> Vec<Output> {
-        vec![Output {
-            name: "sink",
-            words: contents(case),
-            compare: Compare::Exact,
-        }]
+        vec![Output { name: "sink", words: contents(case), compare: Compare::Exact }]
     }
 }

@@ -17,11 +17,7 @@ const FAMILIES: [&str; 3] = ["mostly valid", "mostly invalid", "no candidates"];
 
 fn candidates(case: &Case) -> Vec<Candidate> {
     let awkward = if case.family == 0 { 0.05 } else { 0.6 };
-    let mix = CandidateMix {
-        objects: 1 + (case.seed % 9) as u32,
-        key_levels: 1 + (case.seed % 17) as u32,
-        awkward,
-    };
+    let mix = CandidateMix { objects: 1 + (case.seed % 9) as u32, key_levels: 1 + (case.seed % 17) as u32, awkward };
     let mut image = candidate_image(case.width, case.height, case.seed, mix);
     if case.family == 2 {
         for candidate in &mut image {
@@ -33,21 +29,9 @@ fn candidates(case: &Case) -> Vec<Candidate> {
 
 fn outputs(output: HistogramOutput) -> Vec<Output> {
     vec![
-        Output {
-            name: "sorted_pixels",
-            words: output.sorted_pixels,
-            compare: Compare::Exact,
-        },
-        Output {
-            name: "spans",
-            words: bytemuck::cast_slice(&output.spans).to_vec(),
-            compare: Compare::Exact,
-        },
-        Output {
-            name: "block_stats",
-            words: bytemuck::cast_slice(&output.stats).to_vec(),
-            compare: Compare::Exact,
-        },
+        Output { name: "sorted_pixels", words: output.sorted_pixels, compare: Compare::Exact },
+        Output { name: "spans", words: bytemuck::cast_slice(&output.spans).to_vec(), compare: Compare::Exact },
+        Output { name: "block_stats", words: bytemuck::cast_slice(&output.stats).to_vec(), compare: Compare::Exact },
     ]
 }
 
@@ -68,10 +52,7 @@ impl KernelCheck for HistogramCheck {
             for &(width, height) in sizes {
                 for block_size in BLOCK_SIZES {
                     cases.push(Case {
-                        label: format!(
-                            "{width}x{height} B={block_size} seed {seed} ({})",
-                            FAMILIES[family as usize]
-                        ),
+                        label: format!("{width}x{height} B={block_size} seed {seed} ({})", FAMILIES[family as usize]),
                         width,
                         height,
                         block_size,
@@ -94,26 +75,17 @@ impl KernelCheck for HistogramCheck {
         let pixels = grid.pixel_count();
         // Poison the outputs so that an element the kernel fails to write is caught.
         let poison = vec![0xdead_beef_u32; pixels * 3];
-        backend.write_buffer(
-            pass.sorted_pixels,
-            0,
-            bytemuck::cast_slice(&poison[..pixels]),
-        )?;
+        backend.write_buffer(pass.sorted_pixels, 0, bytemuck::cast_slice(&poison[..pixels]))?;
         backend.write_buffer(pass.spans, 0, bytemuck::cast_slice(&poison[..pixels * 3]))?;
         let stats_words = grid.block_count() as usize * 3;
-        backend.write_buffer(
-            pass.block_stats,
-            0,
-            bytemuck::cast_slice(&vec![0xdead_beef_u32; stats_words]),
-        )?;
+        backend.write_buffer(pass.block_stats, 0, bytemuck::cast_slice(&vec![0xdead_beef_u32; stats_words]))?;
         let result = pass.run(backend, &candidates(case));
         pass.destroy(backend)?;
         Ok(outputs(result?))
     }
 
     fn reference(&self, case: &Case) -> Vec<Output> {
-        let grid = BlockGrid::new(case.width, case.height, case.block_size)
-            .expect("cases have valid grids");
+        let grid = BlockGrid::new(case.width, case.height, case.block_size).expect("cases have valid grids");
         outputs(block_histogram(grid, &candidates(case)))
     }
 }

@@ -75,11 +75,7 @@ pub fn run_check(config: CheckConfig) -> CheckReport {
             Ok(backend) => backend,
             Err(error) => {
                 for check in &checks {
-                    report.set(
-                        check.kernel(),
-                        slot.name,
-                        CellResult::Unavailable(error.to_string()),
-                    );
+                    report.set(check.kernel(), slot.name, CellResult::Unavailable(error.to_string()));
                 }
                 continue;
             }

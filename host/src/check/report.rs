@@ -37,12 +37,7 @@ pub struct CheckReport {
 
 impl CheckReport {
     pub(super) fn new(kernels: Vec<KernelId>, backends: Vec<String>) -> Self {
-        Self {
-            kernels,
-            backends,
-            devices: BTreeMap::new(),
-            cells: BTreeMap::new(),
-        }
+        Self { kernels, backends, devices: BTreeMap::new(), cells: BTreeMap::new() }
     }
 
     pub(super) fn set(&mut self, kernel: KernelId, backend: &str, result: CellResult) {
@@ -78,18 +73,8 @@ impl CheckReport {
             }
         }
         text.push('\n');
-        let name = |k: &KernelId| {
-            strata_kernels::Registry::shared()
-                .map(|r| r.get(*k).name())
-                .unwrap_or("?")
-        };
-        let width = self
-            .kernels
-            .iter()
-            .map(|k| name(k).len())
-            .max()
-            .unwrap_or(6)
-            .max(6);
+        let name = |k: &KernelId| strata_kernels::Registry::shared().map(|r| r.get(*k).name()).unwrap_or("?");
+        let width = self.kernels.iter().map(|k| name(k).len()).max().unwrap_or(6).max(6);
         text.push_str(&format!("{:<width$}", "kernel"));
         for backend in &self.backends {
             text.push_str(&format!(" | {backend:<22}"));
@@ -101,33 +86,18 @@ impl CheckReport {
             for backend in &self.backends {
                 let cell = match self.cell(*kernel, backend) {
                     Some(CellResult::Identical { cases }) => format!("identical ({cases} cases)"),
-                    Some(CellResult::WithinUlp {
-                        cases,
-                        max_ulp,
-                        outside_share,
-                    }) if *outside_share > 0.0 => {
-                        format!(
-                            "max {max_ulp} ULP, {:.3}% out ({cases})",
-                            outside_share * 100.0
-                        )
+                    Some(CellResult::WithinUlp { cases, max_ulp, outside_share }) if *outside_share > 0.0 => {
+                        format!("max {max_ulp} ULP, {:.3}% out ({cases})", outside_share * 100.0)
                     }
                     Some(CellResult::WithinUlp { cases, max_ulp, .. }) => {
                         format!("max {max_ulp} ULP ({cases})")
                     }
                     Some(CellResult::Failed(why)) => {
-                        notes.push(format!(
-                            "[{}] {} on {backend}: FAILED: {why}",
-                            notes.len() + 1,
-                            name(kernel)
-                        ));
+                        notes.push(format!("[{}] {} on {backend}: FAILED: {why}", notes.len() + 1, name(kernel)));
                         format!("FAILED [{}]", notes.len())
                     }
                     Some(CellResult::Unavailable(why)) => {
-                        notes.push(format!(
-                            "[{}] {} on {backend}: unavailable: {why}",
-                            notes.len() + 1,
-                            name(kernel)
-                        ));
+                        notes.push(format!("[{}] {} on {backend}: unavailable: {why}", notes.len() + 1, name(kernel)));
                         format!("unavailable [{}]", notes.len())
                     }
                     None => "not run".into(),

@@ -1,9 +1,7 @@
 //! What the block-histogram kernel computes, stated in plain Rust.
 
 use crate::block_grid::BlockGrid;
-use crate::types::{
-    BlockStats, Candidate, ClusterSpan, INVALID_KEY, OBJECT_ID_NONE, canonical_key,
-};
+use crate::types::{BlockStats, Candidate, ClusterSpan, INVALID_KEY, OBJECT_ID_NONE, canonical_key};
 
 /// Outputs of the block-histogram pass.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -28,11 +26,7 @@ pub fn sort_block(candidates: &[Candidate], entries: &mut [u32]) {
 
 /// The histogram pass on the CPU.
 pub fn block_histogram(grid: BlockGrid, candidates: &[Candidate]) -> HistogramOutput {
-    assert_eq!(
-        candidates.len(),
-        grid.pixel_count(),
-        "one candidate per pixel"
-    );
+    assert_eq!(candidates.len(), grid.pixel_count(), "one candidate per pixel");
     let mut sorted_pixels = vec![0u32; grid.pixel_count()];
     let mut spans = vec![ClusterSpan::default(); grid.pixel_count()];
     let mut stats = Vec::with_capacity(grid.block_count() as usize);
@@ -48,11 +42,8 @@ pub fn block_histogram(grid: BlockGrid, candidates: &[Candidate]) -> HistogramOu
         let mut start = 0;
         while start < entries.len() {
             let object = candidates[entries[start] as usize].object_id;
-            let end = start
-                + entries[start..]
-                    .iter()
-                    .take_while(|&&p| candidates[p as usize].object_id == object)
-                    .count();
+            let end =
+                start + entries[start..].iter().take_while(|&&p| candidates[p as usize].object_id == object).count();
             let valid = entries[start..end]
                 .iter()
                 .take_while(|&&p| canonical_key(candidates[p as usize]) != INVALID_KEY)
@@ -64,19 +55,12 @@ pub fn block_histogram(grid: BlockGrid, candidates: &[Candidate]) -> HistogramOu
                 block_stats.invalid += (end - start - valid) as u32;
             }
             for &pixel in &entries[start..end] {
-                spans[pixel as usize] = ClusterSpan {
-                    offset: rect.base + start as u32,
-                    length: (end - start) as u32,
-                    valid: valid as u32,
-                };
+                spans[pixel as usize] =
+                    ClusterSpan { offset: rect.base + start as u32, length: (end - start) as u32, valid: valid as u32 };
             }
             start = end;
         }
         stats.push(block_stats);
     }
-    HistogramOutput {
-        sorted_pixels,
-        spans,
-        stats,
-    }
+    HistogramOutput { sorted_pixels, spans, stats }
 }

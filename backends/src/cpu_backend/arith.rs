@@ -1,0 +1,236 @@
+//! Scalar semantics as WGSL defines them (not Rust's): wrapping integer arithmetic,
+//! division and remainder by zero, masked shift amounts, saturating float→int
+//! conversion, IEEE f32 without fused multiply-add. Values are 32-bit patterns.
+
+use naga::{BinaryOperator, MathFunction, ScalarKind};
+
+fn f(x: u32) -> f32 {
+    f32::from_bits(x)
+}
+
+fn b(x: bool) -> u32 {
+    u32::from(x)
+}
+
+/// `a op b` for one component of kind `kind`; `None` if the operator does not apply.
+pub(super) fn binary(op: BinaryOperator, kind: ScalarKind, a: u32, c: u32) -> Option<u32> {
+    use BinaryOperator as B;
+    use ScalarKind as K;
+    let (ia, ic) = (a as i32, c as i32);
+    Some(match (op, kind) {
+        (B::Add, K::Float) => (f(a) + f(c)).to_bits(),
+        (B::Subtract, K::Float) => (f(a) - f(c)).to_bits(),
+        (B::Multiply, K::Float) => (f(a) * f(c)).to_bits(),
+        (B::Divide, K::Float) => (f(a) / f(c)).to_bits(),
+        // WGSL: e1 - e2 * trunc(e1 / e2); Rust's % is fmod (the exact remainder).
+        (B::Modulo, K::Float) => (f(a) % f(c)).to_bits(),
+        (B::Add, K::Uint | K::Sint) => a.wrapping_add(c),
+        (B::Subtract, K::Uint | K::Sint) => a.wrapping_sub(c),
+        (B::Multiply, K::Uint | K::Sint) => a.wrapping_mul(c),
+        // Division by zero yields the dividend; so does i32::MIN / -1.
+        (B::Divide, K::Uint) => a.checked_div(c).unwrap_or(a),
+        (B::Divide, K::Sint) => ia.checked_div(ic).unwrap_or(ia) as u32,
+        // Remainder by zero (and of i32::MIN by -1) yields 0.
+        (B::Modulo, K::Uint) => a.checked_rem(c).unwrap_or(0),
+        (B::Modulo, K::Sint) => ia.checked_rem(ic).unwrap_or(0) as u32,
+        (B::Equal, K::Float) => b(f(a) == f(c)),
+        (B::NotEqual, K::Float) => b(f(a) != f(c)),
+        (B::Less, K::Float) => b(f(a) < f(c)),
+        (B::LessEqual, K::Float) => b(f(a) <= f(c)),
+        (B::Greater, K::Float) => b(f(a) > f(c)),
+        (B::GreaterEqual, K::Float) => b(f(a) >= f(c)),
+        (B::Equal, _) => b(a == c),
+        (B::NotEqual, _) => b(a != c),
+        (B::Less, K::Sint) => b(ia < ic),
+        (B::LessEqual, K::Sint) => b(ia <= ic),
+        (B::Greater, K::Sint) => b(ia > ic),
+        (B::GreaterEqual, K::Sint) => b(ia >= ic),
+        (B::Less, _) => b(a < c),
+        (B::LessEqual, _) => b(a <= c),
+        (B::Greater, _) => b(a > c),
+        (B::GreaterEqual, _) => b(a >= c),
+        (B::And, _) => a & c,
+        (B::ExclusiveOr, _) => a ^ c,
+        (B::InclusiveOr, _) => a | c,
+        (B::LogicalAnd, K::Bool) => b(a != 0 && c != 0),
+        (B::LogicalOr, K::Bool) => b(a != 0 || c != 0),
+        // Shift amounts are taken modulo the bit width.
+        (B::ShiftLeft, K::Uint | K::Sint) => a << (c & 31),
+        (B::ShiftRight, K::Uint) => a >> (c & 31),
+        (B::ShiftRight, K::Sint) => (ia >> (c & 31)) as u32,
+        _ => return None,
+    })
+}
+
+/// Float → int conversion as WGSL defines it: saturating, NaN → 0.
+pub(super) fn convert(value: u32, from: ScalarKind, to: ScalarKind) -> Option<u32> {
+    use ScalarKind as K;
+    Some(match (from, to) {
+        (K::Float, K::Sint) => (f(value) as i32) as u32,
+        (K::Float, K::Uint) => f(value) as u32,
+        (K::Sint, K::Float) => (value as i32 as f32).to_bits(),
+        (K::Uint, K::Float) => (value as f32).to_bits(),
+        (K::Bool, K::Float) => {
+            if value != 0 {
+                1.0f32.to_bits()
+            } else {
+                0
+            }
+        }
+        (K::Bool, K::Uint | K::Sint) => u32::from(value != 0),
+        (K::Float, K::Bool) => u32::from(f(value) != 0.0),
+        (K::Uint | K::Sint, K::Bool) => u32::from(value != 0),
+        (K::Uint | K::Sint, K::Uint | K::Sint) | (K::Float, K::Float) | (K::Bool, K::Bool) => value,
+        _ => return None,
+    })
+}
+
+/// Component-wise math functions of up to three arguments. `None`: not supported here.
+///
+/// Implementation choices where WGSL leaves results implementation-defined: `min`/`max`
+/// of a NaN return the other operand (Rust's `f32::min`), transcendental functions use
+/// Rust's `f32` functions (correctly rounded or within a few ULP on glibc), `round` rounds
+/// half to even as WGSL requires.
+pub(super) fn math(fun: MathFunction, kind: ScalarKind, x: u32, y: u32, z: u32) -> Option<u32> {
+    use MathFunction as M;
+    use ScalarKind as K;
+    let (ix, iy, iz) = (x as i32, y as i32, z as i32);
+    Some(match (fun, kind) {
+        (M::Abs, K::Float) => f(x).abs().to_bits(),
+        (M::Abs, K::Sint) => ix.wrapping_abs() as u32,
+        (M::Abs, K::Uint) => x,
+        (M::Min, K::Float) => f(x).min(f(y)).to_bits(),
+        (M::Min, K::Sint) => ix.min(iy) as u32,
+        (M::Min, K::Uint) => x.min(y),
+        (M::Max, K::Float) => f(x).max(f(y)).to_bits(),
+        (M::Max, K::Sint) => ix.max(iy) as u32,
+        (M::Max, K::Uint) => x.max(y),
+        (M::Clamp, K::Float) => f(x).max(f(y)).min(f(z)).to_bits(),
+        (M::Clamp, K::Sint) => ix.max(iy).min(iz) as u32,
+        (M::Clamp, K::Uint) => x.max(y).min(z),
+        (M::Saturate, K::Float) => f(x).clamp(0.0, 1.0).to_bits(),
+        (M::Floor, K::Float) => f(x).floor().to_bits(),
+        (M::Ceil, K::Float) => f(x).ceil().to_bits(),
+        (M::Round, K::Float) => f(x).round_ties_even().to_bits(),
+        (M::Trunc, K::Float) => f(x).trunc().to_bits(),
+        (M::Fract, K::Float) => (f(x) - f(x).floor()).to_bits(),
+        (M::Sqrt, K::Float) => f(x).sqrt().to_bits(),
+        (M::InverseSqrt, K::Float) => (1.0 / f(x).sqrt()).to_bits(),
+        (M::Exp, K::Float) => f(x).exp().to_bits(),
+        (M::Exp2, K::Float) => f(x).exp2().to_bits(),
+        (M::Log, K::Float) => f(x).ln().to_bits(),
+        (M::Log2, K::Float) => f(x).log2().to_bits(),
+        (M::Pow, K::Float) => f(x).powf(f(y)).to_bits(),
+        (M::Sin, K::Float) => f(x).sin().to_bits(),
+        (M::Cos, K::Float) => f(x).cos().to_bits(),
+        (M::Tan, K::Float) => f(x).tan().to_bits(),
+        (M::Asin, K::Float) => f(x).asin().to_bits(),
+        (M::Acos, K::Float) => f(x).acos().to_bits(),
+        (M::Atan, K::Float) => f(x).atan().to_bits(),
+        (M::Atan2, K::Float) => f(x).atan2(f(y)).to_bits(),
+        (M::Sinh, K::Float) => f(x).sinh().to_bits(),
+        (M::Cosh, K::Float) => f(x).cosh().to_bits(),
+        (M::Tanh, K::Float) => f(x).tanh().to_bits(),
+        (M::Sign, K::Float) => {
+            let v = f(x);
+            (if v > 0.0 {
+                1.0f32
+            } else if v < 0.0 {
+                -1.0
+            } else {
+                0.0
+            })
+            .to_bits()
+        }
+        (M::Sign, K::Sint) => ix.signum() as u32,
+        (M::Step, K::Float) => (if f(y) >= f(x) { 1.0f32 } else { 0.0 }).to_bits(),
+        (M::Mix, K::Float) => (f(x) * (1.0 - f(z)) + f(y) * f(z)).to_bits(),
+        (M::SmoothStep, K::Float) => {
+            let t = ((f(z) - f(x)) / (f(y) - f(x))).clamp(0.0, 1.0);
+            (t * t * (3.0 - 2.0 * t)).to_bits()
+        }
+        // Fused: one rounding, as WGSL's fma allows and Rust's mul_add guarantees.
+        (M::Fma, K::Float) => f(x).mul_add(f(y), f(z)).to_bits(),
+        (M::CountTrailingZeros, K::Uint | K::Sint) => x.trailing_zeros(),
+        (M::CountLeadingZeros, K::Uint | K::Sint) => x.leading_zeros(),
+        (M::CountOneBits, K::Uint | K::Sint) => x.count_ones(),
+        (M::ReverseBits, K::Uint | K::Sint) => x.reverse_bits(),
+        (M::FirstTrailingBit, K::Uint | K::Sint) => {
+            if x == 0 {
+                u32::MAX
+            } else {
+                x.trailing_zeros()
+            }
+        }
+        (M::FirstLeadingBit, K::Uint) => {
+            if x == 0 {
+                u32::MAX
+            } else {
+                31 - x.leading_zeros()
+            }
+        }
+        (M::FirstLeadingBit, K::Sint) => {
+            let v = if ix < 0 { !x } else { x };
+            if v == 0 { u32::MAX } else { 31 - v.leading_zeros() }
+        }
+        _ => return None,
+    })
+}
+
+/// `extractBits(e, offset, count)` and `insertBits(e, newbits, offset, count)`.
+pub(super) fn bits(fun: MathFunction, kind: ScalarKind, e: u32, a: u32, b2: u32, c: u32) -> Option<u32> {
+    match fun {
+        MathFunction::ExtractBits => {
+            let offset = a.min(32);
+            let count = b2.min(32 - offset);
+            if count == 0 {
+                return Some(0);
+            }
+            let field = (e >> offset) & if count == 32 { u32::MAX } else { (1 << count) - 1 };
+            Some(if kind == ScalarKind::Sint && count < 32 && field >> (count - 1) & 1 == 1 {
+                field | !((1 << count) - 1)
+            } else {
+                field
+            })
+        }
+        MathFunction::InsertBits => {
+            let offset = b2.min(32);
+            let count = c.min(32 - offset);
+            if count == 0 {
+                return Some(e);
+            }
+            let mask = (if count == 32 { u32::MAX } else { (1 << count) - 1 }) << offset;
+            Some((e & !mask) | ((a << offset) & mask))
+        }
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use BinaryOperator as B;
+    use ScalarKind as K;
+
+    #[test]
+    fn wgsl_integer_edge_cases() {
+        assert_eq!(binary(B::Divide, K::Uint, 7, 0), Some(7));
+        assert_eq!(binary(B::Divide, K::Sint, i32::MIN as u32, -1i32 as u32), Some(i32::MIN as u32));
+        assert_eq!(binary(B::Modulo, K::Sint, 7, 0), Some(0));
+        assert_eq!(binary(B::Modulo, K::Sint, -7i32 as u32, 3), Some(-1i32 as u32));
+        assert_eq!(binary(B::ShiftLeft, K::Uint, 1, 33), Some(2));
+        assert_eq!(binary(B::ShiftRight, K::Sint, -8i32 as u32, 1), Some(-4i32 as u32));
+        assert_eq!(binary(B::Add, K::Uint, u32::MAX, 2), Some(1));
+    }
+
+    #[test]
+    fn wgsl_float_conversions_saturate() {
+        assert_eq!(convert(f32::NAN.to_bits(), K::Float, K::Sint), Some(0));
+        assert_eq!(convert(1e20f32.to_bits(), K::Float, K::Sint), Some(i32::MAX as u32));
+        assert_eq!(convert((-5.0f32).to_bits(), K::Float, K::Uint), Some(0));
+        assert_eq!(math(MathFunction::Round, K::Float, 2.5f32.to_bits(), 0, 0), Some(2.0f32.to_bits()));
+        assert_eq!(math(MathFunction::CountTrailingZeros, K::Uint, 0, 0, 0), Some(32));
+        assert_eq!(bits(MathFunction::ExtractBits, K::Sint, 0b1100, 2, 2, 0), Some(u32::MAX));
+        assert_eq!(bits(MathFunction::InsertBits, K::Uint, 0, 0b11, 4, 2), Some(0b110000));
+    }
+}

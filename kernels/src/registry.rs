@@ -6,6 +6,7 @@ use crate::error::KernelError;
 use crate::fragment;
 use crate::source::{ComposedSource, Fragment};
 use naga::valid::{Capabilities, ModuleInfo, ShaderStages, SubgroupOperationSet, ValidationFlags};
+use std::borrow::Cow;
 
 /// Names a registry kernel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -17,6 +18,9 @@ pub enum KernelId {
     BlockHistogramSubgroup,
     /// Does nothing: measures dispatch overhead.
     Empty,
+    /// A kernel from outside the registry ([`Kernel::from_wgsl`]), keyed by a hash of its
+    /// source and entry point so that backends can cache its pipeline.
+    External(u64),
 }
 
 impl KernelId {
@@ -24,31 +28,32 @@ impl KernelId {
     pub const ALL: [KernelId; 3] = [KernelId::BlockHistogram, KernelId::BlockHistogramSubgroup, KernelId::Empty];
 
     /// What the registry knows of this kernel before parsing it.
-    pub fn spec(self) -> KernelSpec {
-        const HISTOGRAM: [Fragment; 2] = [fragment!("common/candidate.wgsl"), fragment!("histogram/block_sort.wgsl")];
-        match self {
+    pub fn spec(self) -> Option<KernelSpec> {
+        let histogram = || [fragment!("common/candidate.wgsl"), fragment!("histogram/block_sort.wgsl")];
+        Some(match self {
             KernelId::BlockHistogram => KernelSpec {
-                name: "block_histogram",
-                fragments: vec![HISTOGRAM[0], HISTOGRAM[1], fragment!("histogram/entry_portable.wgsl")],
-                entry_point: "block_histogram",
+                name: "block_histogram".into(),
+                fragments: [histogram().to_vec(), vec![fragment!("histogram/entry_portable.wgsl")]].concat(),
+                entry_point: "block_histogram".into(),
                 features: KernelFeatures::empty(),
                 float_ulp_bound: None,
             },
             KernelId::BlockHistogramSubgroup => KernelSpec {
-                name: "block_histogram_subgroup",
-                fragments: vec![HISTOGRAM[0], HISTOGRAM[1], fragment!("histogram/entry_subgroup.wgsl")],
-                entry_point: "block_histogram_subgroup",
+                name: "block_histogram_subgroup".into(),
+                fragments: [histogram().to_vec(), vec![fragment!("histogram/entry_subgroup.wgsl")]].concat(),
+                entry_point: "block_histogram_subgroup".into(),
                 features: KernelFeatures::SUBGROUP,
                 float_ulp_bound: None,
             },
             KernelId::Empty => KernelSpec {
-                name: "empty",
+                name: "empty".into(),
                 fragments: vec![fragment!("util/empty.wgsl")],
-                entry_point: "empty",
+                entry_point: "empty".into(),
                 features: KernelFeatures::empty(),
                 float_ulp_bound: None,
             },
-        }
+            KernelId::External(_) => return None,
+        })
     }
 }
 
@@ -76,11 +81,11 @@ impl KernelFeatures {
 #[derive(Clone, Debug)]
 pub struct KernelSpec {
     /// Registry name (also the name of translated files).
-    pub name: &'static str,
+    pub name: Cow<'static, str>,
     /// WGSL fragments, concatenated in order.
     pub fragments: Vec<Fragment>,
     /// The compute entry point.
-    pub entry_point: &'static str,
+    pub entry_point: Cow<'static, str>,
     /// Device features the kernel needs.
     pub features: KernelFeatures,
     /// Largest difference in ULPs allowed between backends for float outputs; `None`
@@ -109,13 +114,13 @@ pub struct Kernel {
 
 impl Kernel {
     /// Registry name.
-    pub fn name(&self) -> &'static str {
-        self.spec.name
+    pub fn name(&self) -> &str {
+        &self.spec.name
     }
 
     /// Entry point name in the WGSL source.
-    pub fn entry_point(&self) -> &'static str {
-        self.spec.entry_point
+    pub fn entry_point(&self) -> &str {
+        &self.spec.entry_point
     }
 
     /// Invocations per workgroup.
@@ -157,9 +162,32 @@ impl Kernel {
             .sum()
     }
 
-    /// Parses, validates and describes `id`.
+    /// Parses, validates and describes registry kernel `id`.
     pub fn load(id: KernelId) -> Result<Kernel, KernelError> {
-        let spec = id.spec();
+        let spec = id.spec().ok_or_else(|| KernelError::MissingEntryPoint {
+            kernel: format!("{id:?}"),
+            entry: "(external kernels are made with Kernel::from_wgsl)".into(),
+        })?;
+        Self::from_spec(id, spec)
+    }
+
+    /// A kernel that is not in the registry: WGSL source from `path`, entry point
+    /// `entry_point`, validated with subgroup operations allowed when `subgroup` is set.
+    pub fn from_wgsl(path: &str, source: String, entry_point: &str, subgroup: bool) -> Result<Kernel, KernelError> {
+        use std::hash::{Hash, Hasher};
+        let mut hasher = std::collections::hash_map::DefaultHasher::new();
+        (&source, entry_point, subgroup).hash(&mut hasher);
+        let spec = KernelSpec {
+            name: entry_point.to_string().into(),
+            fragments: vec![Fragment { path: path.to_string().into(), text: source.into() }],
+            entry_point: entry_point.to_string().into(),
+            features: if subgroup { KernelFeatures::SUBGROUP } else { KernelFeatures::empty() },
+            float_ulp_bound: None,
+        };
+        Self::from_spec(KernelId::External(hasher.finish()), spec)
+    }
+
+    fn from_spec(id: KernelId, spec: KernelSpec) -> Result<Kernel, KernelError> {
         let source = ComposedSource::compose(&spec.fragments);
         let module = naga::front::wgsl::parse_str(&source.text).map_err(|error| {
             let location = error
@@ -168,7 +196,7 @@ impl Kernel {
                 .map(|(span, _)| source.describe_offset(span.to_range().map_or(0, |r| r.start)))
                 .unwrap_or_default();
             KernelError::Parse {
-                kernel: spec.name.into(),
+                kernel: spec.name.to_string(),
                 message: format!("at {location}\n{}", error.emit_to_string(&source.text)),
             }
         })?;
@@ -177,7 +205,7 @@ impl Kernel {
             .subgroup_operations(SubgroupOperationSet::all())
             .validate(&module)
             .map_err(|error| KernelError::Validation {
-                kernel: spec.name.into(),
+                kernel: spec.name.to_string(),
                 message: error.emit_to_string(&source.text),
             })?;
         let entry_index = module
@@ -185,11 +213,11 @@ impl Kernel {
             .iter()
             .position(|ep| ep.name == spec.entry_point && ep.stage == naga::ShaderStage::Compute)
             .ok_or_else(|| KernelError::MissingEntryPoint {
-                kernel: spec.name.into(),
-                entry: spec.entry_point.into(),
+                kernel: spec.name.to_string(),
+                entry: spec.entry_point.to_string(),
             })?;
         let workgroup_size = module.entry_points[entry_index].workgroup_size;
-        let bindings = describe_bindings(spec.name, &module, &info, entry_index)?;
+        let bindings = describe_bindings(&spec.name, &module, &info, entry_index)?;
         Ok(Kernel { id, spec, source, module, info, workgroup_size, bindings })
     }
 }
@@ -329,7 +357,7 @@ mod tests {
 
     #[test]
     fn the_portable_kernel_is_validated_without_subgroups() {
-        let mut spec = KernelId::BlockHistogram.spec();
+        let mut spec = KernelId::BlockHistogram.spec().unwrap();
         spec.fragments[2] = fragment!("histogram/entry_subgroup.wgsl");
         let source = ComposedSource::compose(&spec.fragments);
         let module = naga::front::wgsl::parse_str(&source.text).unwrap();

@@ -1,13 +1,16 @@
 //! A kernel's WGSL source: fragments concatenated in order (WGSL has no includes), with
 //! the map from lines of the whole back to fragment files for diagnostics.
 
-/// One WGSL file under `kernels/wgsl/`, embedded at compile time.
-#[derive(Clone, Copy, Debug)]
+use std::borrow::Cow;
+
+/// One WGSL file: under `kernels/wgsl/` and embedded at compile time for registry
+/// kernels, or read at run time for external ones.
+#[derive(Clone, Debug)]
 pub struct Fragment {
-    /// Path relative to `kernels/wgsl/`.
-    pub path: &'static str,
+    /// Path (relative to `kernels/wgsl/` for registry kernels).
+    pub path: Cow<'static, str>,
     /// The file's text.
-    pub text: &'static str,
+    pub text: Cow<'static, str>,
 }
 
 /// Embeds `kernels/wgsl/$path` as a [`Fragment`].
@@ -15,8 +18,8 @@ pub struct Fragment {
 macro_rules! fragment {
     ($path:literal) => {
         $crate::source::Fragment {
-            path: $path,
-            text: include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/wgsl/", $path)),
+            path: std::borrow::Cow::Borrowed(concat!("kernels/wgsl/", $path)),
+            text: std::borrow::Cow::Borrowed(include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/wgsl/", $path))),
         }
     };
 }
@@ -27,7 +30,7 @@ pub struct ComposedSource {
     /// The WGSL naga parses.
     pub text: String,
     /// (first line in `text`, 0-based; fragment path) in ascending order.
-    starts: Vec<(usize, &'static str)>,
+    starts: Vec<(usize, String)>,
 }
 
 impl ComposedSource {
@@ -36,8 +39,8 @@ impl ComposedSource {
         let mut text = String::new();
         let mut starts = Vec::with_capacity(fragments.len());
         for fragment in fragments {
-            starts.push((text.lines().count(), fragment.path));
-            text.push_str(fragment.text);
+            starts.push((text.lines().count(), fragment.path.to_string()));
+            text.push_str(&fragment.text);
             if !text.ends_with('\n') {
                 text.push('\n');
             }
@@ -46,10 +49,14 @@ impl ComposedSource {
     }
 
     /// The fragment and 1-based line within it of 1-based `line` of the composed text.
-    pub fn locate(&self, line: usize) -> (&'static str, usize) {
+    pub fn locate(&self, line: usize) -> (&str, usize) {
         let zero_based = line.saturating_sub(1);
-        let (start, path) =
-            self.starts.iter().rev().find(|(start, _)| *start <= zero_based).copied().unwrap_or((0, "<unknown>"));
+        let (start, path) = self
+            .starts
+            .iter()
+            .rev()
+            .find(|(start, _)| *start <= zero_based)
+            .map_or((0, "<unknown>"), |(start, path)| (*start, path.as_str()));
         (path, zero_based - start + 1)
     }
 
@@ -58,7 +65,7 @@ impl ComposedSource {
         let line = self.text[..offset.min(self.text.len())].lines().count().max(1);
         let line = if self.text[..offset.min(self.text.len())].ends_with('\n') { line + 1 } else { line };
         let (path, local) = self.locate(line);
-        format!("kernels/wgsl/{path}:{local}")
+        format!("{path}:{local}")
     }
 }
 
@@ -69,9 +76,9 @@ mod tests {
     #[test]
     fn lines_map_back_to_fragments() {
         let source = ComposedSource::compose(&[
-            Fragment { path: "a.wgsl", text: "one\ntwo\n" },
-            Fragment { path: "b.wgsl", text: "three\nfour" },
-            Fragment { path: "c.wgsl", text: "five\n" },
+            Fragment { path: "a.wgsl".into(), text: "one\ntwo\n".into() },
+            Fragment { path: "b.wgsl".into(), text: "three\nfour".into() },
+            Fragment { path: "c.wgsl".into(), text: "five\n".into() },
         ]);
         assert_eq!(source.locate(1), ("a.wgsl", 1));
         assert_eq!(source.locate(2), ("a.wgsl", 2));
@@ -79,7 +86,7 @@ mod tests {
         assert_eq!(source.locate(4), ("b.wgsl", 2));
         assert_eq!(source.locate(5), ("c.wgsl", 1));
         let four = source.text.find("four").unwrap();
-        assert_eq!(source.describe_offset(four), "kernels/wgsl/b.wgsl:2");
-        assert_eq!(source.describe_offset(0), "kernels/wgsl/a.wgsl:1");
+        assert_eq!(source.describe_offset(four), "b.wgsl:2");
+        assert_eq!(source.describe_offset(0), "a.wgsl:1");
     }
 }

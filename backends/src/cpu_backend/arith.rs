@@ -62,12 +62,19 @@ pub(super) fn binary(op: BinaryOperator, kind: ScalarKind, a: u32, c: u32) -> Op
     })
 }
 
-/// Float → int conversion as WGSL defines it: saturating, NaN → 0.
+/// Largest f32 not above i32::MAX, and not above u32::MAX.
+const I32_MAX_F32: f32 = 2_147_483_520.0;
+const U32_MAX_F32: f32 = 4_294_967_040.0;
+
+/// Numeric conversion as WGSL defines it. Float → int truncates after clamping to the
+/// range of floats that the integer type represents (so `u32(4294967296.0)` is
+/// 4294967040, not u32::MAX); NaN → 0 (implementation-defined in WGSL: D3D and
+/// WebAssembly also give 0, lavapipe's x86 conversion gives i32::MIN).
 pub(super) fn convert(value: u32, from: ScalarKind, to: ScalarKind) -> Option<u32> {
     use ScalarKind as K;
     Some(match (from, to) {
-        (K::Float, K::Sint) => (f(value) as i32) as u32,
-        (K::Float, K::Uint) => f(value) as u32,
+        (K::Float, K::Sint) => (f(value).clamp(-2_147_483_648.0, I32_MAX_F32) as i32) as u32,
+        (K::Float, K::Uint) => f(value).clamp(0.0, U32_MAX_F32) as u32,
         (K::Sint, K::Float) => (value as i32 as f32).to_bits(),
         (K::Uint, K::Float) => (value as f32).to_bits(),
         (K::Bool, K::Float) => {
@@ -226,7 +233,8 @@ mod tests {
     #[test]
     fn wgsl_float_conversions_saturate() {
         assert_eq!(convert(f32::NAN.to_bits(), K::Float, K::Sint), Some(0));
-        assert_eq!(convert(1e20f32.to_bits(), K::Float, K::Sint), Some(i32::MAX as u32));
+        assert_eq!(convert(1e20f32.to_bits(), K::Float, K::Sint), Some(2_147_483_520));
+        assert_eq!(convert(4_294_967_296.0f32.to_bits(), K::Float, K::Uint), Some(4_294_967_040));
         assert_eq!(convert((-5.0f32).to_bits(), K::Float, K::Uint), Some(0));
         assert_eq!(math(MathFunction::Round, K::Float, 2.5f32.to_bits(), 0, 0), Some(2.0f32.to_bits()));
         assert_eq!(math(MathFunction::CountTrailingZeros, K::Uint, 0, 0, 0), Some(32));

@@ -1,0 +1,262 @@
+//! The CPU interpreter of naga IR: registry kernels at every subgroup size, control flow
+//! and atomics on hand-written kernels, WGSL integer semantics against lavapipe, and
+//! clear errors for what it does not support.
+
+use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
+use strata::synthetic::{CandidateMix, candidate_image};
+use strata_backends::backend::{download, upload};
+use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
+use strata_backends::{Backend, BackendError, Bind};
+use strata_kernels::reference::block_histogram::block_histogram;
+use strata_kernels::types::BLOCK_SIZES;
+use strata_kernels::{BlockGrid, Kernel};
+
+#[test]
+fn histogram_kernels_match_the_reference_at_every_subgroup_size() {
+    for subgroup_size in [None, Some(1), Some(8), Some(32)] {
+        let mut cpu = CpuBackend::new(CpuOptions { subgroup_size }).unwrap();
+        let variant = if subgroup_size.is_some() { HistogramVariant::Subgroup } else { HistogramVariant::Portable };
+        for (width, height) in [(17, 33), (40, 24)] {
+            for block_size in BLOCK_SIZES {
+                let grid = BlockGrid::new(width, height, block_size).unwrap();
+                let candidates = candidate_image(
+                    width,
+                    height,
+                    u64::from(block_size),
+                    CandidateMix { awkward: 0.3, ..Default::default() },
+                );
+                let pass = BlockHistogramPass::new(&mut cpu, variant, grid).unwrap();
+                let output = pass.run(&mut cpu, &candidates).unwrap();
+                pass.destroy(&mut cpu).unwrap();
+                assert_eq!(
+                    output,
+                    block_histogram(grid, &candidates),
+                    "{subgroup_size:?} {width}x{height} B={block_size}"
+                );
+            }
+        }
+    }
+}
+
+fn run_words(backend: &mut dyn Backend, kernel: &Kernel, inputs: &[u32], outputs: usize, workgroups: u32) -> Vec<u32> {
+    let input = upload(backend, "input", inputs).unwrap();
+    let output = backend.create_buffer("output", outputs as u64 * 4).unwrap();
+    backend.dispatch(kernel, &[Bind::new(0, input), Bind::new(1, output)], [workgroups, 1, 1]).unwrap();
+    let words = download(backend, output).unwrap();
+    backend.destroy_buffer(input).unwrap();
+    backend.destroy_buffer(output).unwrap();
+    words
+}
+
+const CONTROL_FLOW: &str = r#"
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+var<workgroup> total: atomic<u32>;
+var<workgroup> maximum: atomic<u32>;
+var<workgroup> exchanged: atomic<u32>;
+var<private> calls: u32 = 7u;
+
+struct Pair { a: u32, b: vec3<u32> }
+
+fn bump(p: ptr<function, u32>, by: u32) -> u32 {
+    *p += by;
+    calls += 1u;
+    return *p * 2u;
+}
+
+fn collatz(start: u32) -> u32 {
+    var n = start;
+    var steps = 0u;
+    loop {
+        if n <= 1u { break; }
+        if (n & 1u) == 0u { n = n / 2u; continue; }
+        n = 3u * n + 1u;
+        continuing {
+            steps += 1u;
+            break if steps >= 500u;
+        }
+    }
+    return steps;
+}
+
+@compute @workgroup_size(16)
+fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let x = input[id.x];
+    var acc = 0u;
+    for (var i = 0u; i < x % 7u; i++) {
+        switch i {
+            case 0u, 3u: { acc += 10u; }
+            case 5u: { acc += 100u; break; }
+            default: { acc += 1u; }
+        }
+    }
+    var local = x;
+    let doubled = bump(&local, 3u);
+    var pair = Pair(x, vec3<u32>(x, x + 1u, x + 2u));
+    pair.b.z += 1u;
+    let swizzled = pair.b.zyx;
+    atomicAdd(&total, x & 255u);
+    atomicMax(&maximum, x);
+    let old = atomicCompareExchangeWeak(&exchanged, 0u, li + 1u);
+    workgroupBarrier();
+    let base = id.x * 8u;
+    output[base] = acc;
+    output[base + 1u] = doubled + local;
+    output[base + 2u] = swizzled.x * 3u + swizzled.z;
+    output[base + 3u] = collatz(x % 1000u + 1u);
+    output[base + 4u] = atomicLoad(&total);
+    output[base + 5u] = atomicLoad(&maximum);
+    output[base + 6u] = select(0u, 1u, old.exchanged) + calls;
+    output[base + 7u] = countOneBits(x) + reverseBits(x) + (x << (x & 63u)) + extractBits(x, 3u, 5u);
+}
+"#;
+
+/// What the control-flow kernel must compute, stated in Rust.
+fn control_flow_reference(inputs: &[u32]) -> Vec<u32> {
+    let mut out = Vec::new();
+    for group in inputs.chunks(16) {
+        let total = group.iter().fold(0u32, |t, x| t.wrapping_add(x & 255));
+        let maximum = *group.iter().max().unwrap();
+        for (li, &x) in group.iter().enumerate() {
+            let mut acc = 0u32;
+            for i in 0..x % 7 {
+                acc += match i {
+                    0 | 3 => 10,
+                    5 => 100,
+                    _ => 1,
+                };
+            }
+            let local = x.wrapping_add(3);
+            let doubled = local.wrapping_mul(2);
+            let swizzled = [x.wrapping_add(3), x.wrapping_add(1), x];
+            // WGSL's loop: `continue` runs the continuing block too, so every pass counts.
+            let collatz = {
+                let (mut n, mut steps) = (x % 1000 + 1, 0u32);
+                while n > 1 {
+                    n = if n & 1 == 0 { n / 2 } else { 3 * n + 1 };
+                    steps += 1;
+                    if steps >= 500 {
+                        break;
+                    }
+                }
+                steps
+            };
+            let exchanged = u32::from(li == 0);
+            out.extend([
+                acc,
+                doubled.wrapping_add(local),
+                swizzled[0].wrapping_mul(3).wrapping_add(swizzled[2]),
+                collatz,
+                total,
+                maximum,
+                exchanged + 8,
+                x.count_ones()
+                    .wrapping_add(x.reverse_bits())
+                    .wrapping_add(x << (x & 63 & 31))
+                    .wrapping_add((x >> 3) & 31),
+            ]);
+        }
+    }
+    out
+}
+
+#[test]
+fn control_flow_calls_pointers_and_atomics_follow_wgsl() {
+    let kernel = Kernel::from_wgsl("control_flow.wgsl", CONTROL_FLOW.into(), "main", false).unwrap();
+    let inputs: Vec<u32> = (0..64u32).map(|i| i.wrapping_mul(2_654_435_761) ^ (i << 3)).collect();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &inputs, 64 * 8, 4);
+    assert_eq!(got, control_flow_reference(&inputs));
+}
+
+const INTEGER_SEMANTICS: &str = r#"
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let a = input[2u * id.x];
+    let b = input[2u * id.x + 1u];
+    let ia = bitcast<i32>(a);
+    let ib = bitcast<i32>(b);
+    let fa = bitcast<f32>(a);
+    let o = id.x * 12u;
+    output[o] = a / b;
+    output[o + 1u] = a % b;
+    output[o + 2u] = bitcast<u32>(ia / ib);
+    output[o + 3u] = bitcast<u32>(ia % ib);
+    output[o + 4u] = a << (b & 31u);
+    output[o + 5u] = bitcast<u32>(ia >> (b & 31u));
+    output[o + 6u] = bitcast<u32>(-ia);
+    output[o + 7u] = u32(fa);
+    output[o + 8u] = bitcast<u32>(i32(fa));
+    output[o + 9u] = firstLeadingBit(a) ^ bitcast<u32>(firstLeadingBit(ia)) ^ firstTrailingBit(b);
+    output[o + 10u] = min(a, b) + bitcast<u32>(max(ia, ib)) + countLeadingZeros(b);
+    output[o + 11u] = insertBits(a, b, 5u, 9u) ^ bitcast<u32>(extractBits(ia, 7u, 11u));
+}
+"#;
+
+#[test]
+fn integer_semantics_agree_with_lavapipe_bit_for_bit() {
+    let kernel = Kernel::from_wgsl("integer_semantics.wgsl", INTEGER_SEMANTICS.into(), "main", false).unwrap();
+    let edges = [0u32, 1, 2, 31, 32, 0x7fff_ffff, 0x8000_0000, 0xffff_ffff, 0xffff_fffe, 7, 0x4f80_0000, 0xcf00_0000];
+    let mut inputs = Vec::new();
+    for &a in &edges {
+        for &b in &edges {
+            inputs.extend([a, b]);
+        }
+    }
+    let mut state = 0x1234_5678_u32;
+    while inputs.len() < 2 * 256 {
+        state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        inputs.push(state ^ (state >> 13));
+    }
+    let pairs = inputs.len() / 2;
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &inputs, pairs * 12, (pairs / 64) as u32);
+    // Spot checks of WGSL's rules, independent of any GPU.
+    let at = |a_index: usize, b_index: usize, k: usize| got[(a_index * edges.len() + b_index) * 12 + k];
+    assert_eq!(at(6, 0, 0), 0x8000_0000, "division by zero yields the dividend");
+    assert_eq!(at(6, 0, 1), 0, "remainder by zero yields 0");
+    assert_eq!(at(6, 7, 2), 0x8000_0000, "i32::MIN / -1 yields the dividend");
+    assert_eq!(at(1, 4, 4), 1, "shift amounts are masked");
+    assert_eq!(at(10, 0, 8), 2_147_483_520, "float to int clamps to the largest float the type holds");
+    let Some(mut gpu) = strata_tests::vulkan_backend("integer_semantics_agree_with_lavapipe_bit_for_bit") else {
+        return;
+    };
+    let want = run_words(&mut gpu, &kernel, &inputs, pairs * 12, (pairs / 64) as u32);
+    // NaN → integer is implementation-defined: the interpreter gives 0 (as D3D and
+    // WebAssembly do), lavapipe's x86 conversion gives i32::MIN. Not compared.
+    let nan_conversion = |i: usize| (i % 12 == 7 || i % 12 == 8) && f32::from_bits(inputs[2 * (i / 12)]).is_nan();
+    if let Some(i) = (0..want.len()).find(|&i| got[i] != want[i] && !nan_conversion(i)) {
+        panic!("output[{i}] (pair {}, op {}): cpu {:#x}, lavapipe {:#x}", i / 12, i % 12, got[i], want[i]);
+    }
+}
+
+#[test]
+fn unsupported_constructs_are_named_with_their_line() {
+    let source = r#"
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<f32>;
+@compute @workgroup_size(1)
+fn main() {
+    let m = mat2x2<f32>(1.0, 2.0, 3.0, 4.0);
+    let v = m * vec2<f32>(f32(input[0]), 1.0);
+    output[0] = v.x;
+}
+"#;
+    let kernel = Kernel::from_wgsl("matrix.wgsl", source.into(), "main", false).unwrap();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let input = upload(&mut cpu, "input", &[1u32]).unwrap();
+    let output = cpu.create_buffer("output", 4).unwrap();
+    let error = cpu.dispatch(&kernel, &[Bind::new(0, input), Bind::new(1, output)], [1, 1, 1]).unwrap_err();
+    assert!(matches!(error, BackendError::Validation { .. }), "{error}");
+    let message = error.to_string();
+    assert!(message.contains("unsupported: Multiply on composites (WGSL line 7)"), "{message}");
+}
+
+#[test]
+fn bad_subgroup_sizes_are_refused() {
+    assert!(CpuBackend::new(CpuOptions { subgroup_size: Some(12) }).is_err());
+    assert!(CpuBackend::new(CpuOptions { subgroup_size: Some(0) }).is_err());
+}

@@ -1,6 +1,7 @@
 //! Picking a backend for the command line: the GPU if there is one.
 
 use strata_backends::ash_backend::{AshBackend, AshOptions};
+use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_backends::wgpu_backend::{WgpuApi, WgpuBackend, WgpuOptions};
 use strata_backends::{Backend, BackendError};
 
@@ -15,28 +16,28 @@ pub enum BackendChoice {
     WgpuGl,
     /// Raw Vulkan through ash, on naga's SPIR-V.
     Ash,
+    /// The CPU interpreter of naga IR (no GPU needed; slow).
+    Cpu,
 }
 
-/// Opens the requested backend.
-///
-/// The CPU interpreter of naga IR is the fallback without a GPU; until it exists
-/// (issue 4) a machine without any Vulkan device gets the error, which names the fix
-/// (install Mesa's lavapipe: `apt-get install mesa-vulkan-drivers`).
+/// Opens the requested backend. `Auto` falls back to the CPU interpreter of naga IR,
+/// with a one-line notice on stderr, when no Vulkan adapter exists.
 pub fn open_backend(choice: BackendChoice) -> Result<Box<dyn Backend>, BackendError> {
     let api = match choice {
         BackendChoice::Auto | BackendChoice::Wgpu => WgpuApi::Vulkan,
         BackendChoice::WgpuGl => WgpuApi::Gl,
         BackendChoice::Ash => return Ok(Box::new(AshBackend::new(AshOptions::default())?)),
+        BackendChoice::Cpu => return Ok(Box::new(CpuBackend::new(CpuOptions::default())?)),
     };
     match WgpuBackend::new(WgpuOptions { api, ..Default::default() }) {
         Ok(backend) => Ok(Box::new(backend)),
-        Err(BackendError::NoAdapter { backend, reason }) => Err(BackendError::NoAdapter {
-            backend,
-            reason: format!(
-                "{reason}; no GPU or Vulkan driver found (on Debian: apt-get install mesa-vulkan-drivers \
-                 for lavapipe); the CPU interpreter fallback is not implemented yet"
-            ),
-        }),
+        Err(BackendError::NoAdapter { reason, .. }) if choice == BackendChoice::Auto => {
+            eprintln!(
+                "notice: no GPU adapter found ({reason}); running on the CPU interpreter of naga IR, which is slow \
+                 (for a Vulkan device on the CPU: apt-get install mesa-vulkan-drivers)"
+            );
+            Ok(Box::new(CpuBackend::new(CpuOptions::default())?))
+        }
         Err(other) => Err(other),
     }
 }

@@ -6,6 +6,7 @@
 pub mod backend_choice;
 pub mod check;
 pub mod histogram_pass;
+pub mod run_kernel;
 pub mod synthetic;
 
 pub use histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};

@@ -9,6 +9,10 @@
 //!   (wgpu Vulkan and GL, ash on naga's SPIR-V and on glslang's compilation of naga's
 //!   GLSL and HLSL) with generated inputs and compares the outputs with the kernels'
 //!   references; prints a kernels × backends table and exits non-zero on any mismatch.
+//! * `cargo xtask run FILE.wgsl --entry NAME --workgroups X,Y,Z --buffer 0:B=FILE ...
+//!   [--size 0:B=BYTES] --backend cpu|wgpu|wgpu-gl|ash|ash-glsl|ash-hlsl|all [--out DIR]`:
+//!   runs any WGSL compute shader, writes every writable buffer to
+//!   `DIR/BACKEND/0_B_NAME.bin`, and with several backends says whether they agree.
 
 use anyhow::{Result, bail};
 use clap::{Parser, Subcommand};
@@ -34,6 +38,29 @@ enum Command {
         #[arg(long, default_value = "target/shaders")]
         out: PathBuf,
     },
+    /// Run any WGSL compute shader on chosen backends.
+    Run {
+        /// The WGSL file.
+        shader: PathBuf,
+        /// Compute entry point.
+        #[arg(long)]
+        entry: String,
+        /// Workgroups X,Y,Z.
+        #[arg(long, value_parser = parse_workgroups, default_value = "1,1,1")]
+        workgroups: [u32; 3],
+        /// GROUP:BINDING=FILE: buffer contents (repeatable).
+        #[arg(long = "buffer", value_parser = parse_buffer)]
+        buffers: Vec<(u32, u32, PathBuf)>,
+        /// GROUP:BINDING=BYTES: a zero-filled buffer of that size (default: the binding's minimum).
+        #[arg(long = "size", value_parser = parse_size)]
+        sizes: Vec<(u32, u32, u64)>,
+        /// Backends, comma-separated, or `all`.
+        #[arg(long, default_value = "cpu", value_delimiter = ',')]
+        backend: Vec<String>,
+        /// Output folder.
+        #[arg(long, default_value = "target/run")]
+        out: PathBuf,
+    },
     /// Check that every kernel gives identical outputs on every backend.
     Check {
         /// At least 20 seeds at several sizes per kernel (default: 3 seeds, small sizes).
@@ -46,6 +73,9 @@ fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Shaders { strict, out } => shaders(strict, out),
         Command::Check { full } => check(full),
+        Command::Run { shader, entry, workgroups, buffers, sizes, backend, out } => {
+            run(strata::run_kernel::RunRequest { shader, entry, workgroups, buffers, sizes, backends: backend, out })
+        }
     }
 }
 
@@ -89,6 +119,65 @@ fn shaders(strict: bool, out: PathBuf) -> Result<()> {
     }
     if strict && missing > 0 {
         bail!("{missing} validator(s) missing (--strict): install spirv-tools and glslang-tools");
+    }
+    Ok(())
+}
+
+fn parse_workgroups(text: &str) -> Result<[u32; 3], String> {
+    let parts: Vec<u32> = text
+        .split(',')
+        .map(|p| p.trim().parse::<u32>().map_err(|e| format!("`{p}`: {e}")))
+        .collect::<Result<_, _>>()?;
+    match parts.as_slice() {
+        [x] => Ok([*x, 1, 1]),
+        [x, y] => Ok([*x, *y, 1]),
+        [x, y, z] => Ok([*x, *y, *z]),
+        _ => Err(format!("`{text}`: expected X, X,Y or X,Y,Z")),
+    }
+}
+
+fn parse_binding(text: &str) -> Result<(u32, u32, &str), String> {
+    let (target, value) = text.split_once('=').ok_or_else(|| format!("`{text}`: expected GROUP:BINDING=VALUE"))?;
+    let (group, binding) = target.split_once(':').ok_or_else(|| format!("`{target}`: expected GROUP:BINDING"))?;
+    let group = group.parse().map_err(|e| format!("group `{group}`: {e}"))?;
+    let binding = binding.parse().map_err(|e| format!("binding `{binding}`: {e}"))?;
+    Ok((group, binding, value))
+}
+
+fn parse_buffer(text: &str) -> Result<(u32, u32, PathBuf), String> {
+    parse_binding(text).map(|(g, b, v)| (g, b, PathBuf::from(v)))
+}
+
+fn parse_size(text: &str) -> Result<(u32, u32, u64), String> {
+    let (g, b, v) = parse_binding(text)?;
+    Ok((g, b, v.parse().map_err(|e| format!("size `{v}`: {e}"))?))
+}
+
+fn run(request: strata::run_kernel::RunRequest) -> Result<()> {
+    let runs = strata::run_kernel::run_kernel(&request)?;
+    let mut failed = false;
+    for run in &runs {
+        match &run.outputs {
+            Ok(outputs) => println!(
+                "{:<12} ok: {} output buffer(s) in {}",
+                run.backend,
+                outputs.len(),
+                request.out.join(&run.backend).display()
+            ),
+            Err(error) => {
+                failed = true;
+                println!("{:<12} FAILED: {error}", run.backend);
+            }
+        }
+    }
+    if runs.iter().filter(|r| r.outputs.is_ok()).count() > 1 {
+        match strata::run_kernel::disagreement(&runs) {
+            None => println!("backends agree: every output identical"),
+            Some(difference) => bail!("backends disagree: {difference}"),
+        }
+    }
+    if failed {
+        bail!("the shader failed on at least one backend");
     }
     Ok(())
 }

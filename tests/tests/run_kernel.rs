@@ -1,0 +1,79 @@
+//! `cargo xtask run`'s library: any WGSL compute shader on chosen backends, outputs
+//! written to files, agreement reported, bad input named.
+
+use std::path::PathBuf;
+use strata::run_kernel::{RunRequest, disagreement, run_kernel};
+
+const SQUARE: &str = r#"
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+@compute @workgroup_size(64)
+fn square(@builtin(global_invocation_id) id: vec3<u32>) {
+    output[id.x] = input[id.x] * input[id.x] + id.x;
+}
+"#;
+
+fn setup(name: &str) -> (PathBuf, RunRequest) {
+    let dir = std::env::temp_dir().join(format!("strata-run-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("square.wgsl"), SQUARE).unwrap();
+    let input: Vec<u8> = (0..128u32).flat_map(|i| (i * 3).to_le_bytes()).collect();
+    std::fs::write(dir.join("in.bin"), input).unwrap();
+    let request = RunRequest {
+        shader: dir.join("square.wgsl"),
+        entry: "square".into(),
+        workgroups: [2, 1, 1],
+        buffers: vec![(0, 0, dir.join("in.bin"))],
+        sizes: vec![(0, 1, 512)],
+        backends: vec!["cpu".into()],
+        out: dir.join("out"),
+    };
+    (dir, request)
+}
+
+#[test]
+fn a_shader_runs_on_the_interpreter_and_its_output_is_written() {
+    let (dir, request) = setup("cpu");
+    let runs = run_kernel(&request).unwrap();
+    assert_eq!(runs.len(), 1);
+    let bytes = std::fs::read(dir.join("out/cpu/0_1_output.bin")).unwrap();
+    let words: Vec<u32> = bytes.chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().unwrap())).collect();
+    let want: Vec<u32> = (0..128u32).map(|i| (i * 3) * (i * 3) + i).collect();
+    assert_eq!(words, want);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn every_backend_agrees_on_a_foreign_shader() {
+    let (dir, mut request) = setup("all");
+    request.backends = vec!["all".into()];
+    let runs = run_kernel(&request).unwrap();
+    for run in &runs {
+        if let Err(error) = &run.outputs {
+            let skippable = !strata_backends::gpu_required() || run.backend == "wgpu-gl";
+            assert!(skippable, "{} failed: {error}", run.backend);
+        }
+    }
+    assert_eq!(disagreement(&runs), None);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn bad_requests_are_named() {
+    let (dir, mut request) = setup("bad");
+    request.backends = vec!["metal".into()];
+    let error = run_kernel(&request).unwrap_err().to_string();
+    assert!(error.contains("unknown backend `metal`"), "{error}");
+    request.backends = vec!["cpu".into()];
+    request.buffers = vec![(0, 7, dir.join("in.bin"))];
+    let error = run_kernel(&request).unwrap_err().to_string();
+    assert!(error.contains("--buffer 0:7") && error.contains("no such binding"), "{error}");
+    request.buffers = vec![(0, 0, dir.join("missing.bin"))];
+    let runs = run_kernel(&request).unwrap();
+    let error = runs[0].outputs.as_ref().unwrap_err();
+    assert!(error.contains("missing.bin"), "{error}");
+    request.entry = "nope".into();
+    let error = run_kernel(&request).unwrap_err().to_string();
+    assert!(error.contains("nope"), "{error}");
+    std::fs::remove_dir_all(dir).unwrap();
+}

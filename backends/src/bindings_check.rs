@@ -103,3 +103,36 @@ pub fn check_workgroups(kernel: &Kernel, workgroups: [u32; 3], device: &DeviceIn
     }
     Ok(())
 }
+
+/// Whether a buffer of `size` bytes can be created: at least one byte, at most the
+/// device's buffer size.
+pub fn check_buffer_size(label: &str, size: u64, device: &DeviceInfo) -> Result<(), BackendError> {
+    if size == 0 {
+        return Err(BackendError::Buffer {
+            label: label.into(),
+            reason: "size 0: buffers must hold at least one byte".into(),
+        });
+    }
+    if size > device.limits.max_buffer_size {
+        return Err(BackendError::LimitExceeded {
+            what: format!("buffer `{label}`"),
+            limit: "buffer bytes",
+            requested: size,
+            available: device.limits.max_buffer_size,
+        });
+    }
+    Ok(())
+}
+
+/// Whether `len` bytes can be written at `offset` into a buffer of `size` bytes.
+pub fn check_write(label: &str, size: u64, offset: u64, len: usize) -> Result<(), BackendError> {
+    if !offset.is_multiple_of(4) || !len.is_multiple_of(4) || offset + len as u64 > size {
+        return Err(BackendError::Buffer {
+            label: label.into(),
+            reason: format!(
+                "write of {len} bytes at offset {offset} into {size} bytes (offset and length must be multiples of 4)"
+            ),
+        });
+    }
+    Ok(())
+}

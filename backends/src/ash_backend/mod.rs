@@ -10,7 +10,7 @@ mod device;
 mod pipelines;
 
 use crate::backend::{Backend, Bind, BufferId};
-use crate::bindings_check::{check_binds, check_kernel_fits, check_workgroups};
+use crate::bindings_check::{check_binds, check_buffer_size, check_kernel_fits, check_workgroups, check_write};
 use crate::device_info::DeviceInfo;
 use crate::error::BackendError;
 use ash::vk;
@@ -130,20 +130,7 @@ impl Backend for AshBackend {
     }
 
     fn create_buffer(&mut self, label: &str, size: u64) -> Result<BufferId, BackendError> {
-        if size == 0 {
-            return Err(BackendError::Buffer {
-                label: label.into(),
-                reason: "size 0: buffers must hold at least one byte".into(),
-            });
-        }
-        if size > self.info.limits.max_buffer_size {
-            return Err(BackendError::LimitExceeded {
-                what: format!("buffer `{label}`"),
-                limit: "buffer bytes",
-                requested: size,
-                available: self.info.limits.max_buffer_size,
-            });
-        }
+        check_buffer_size(label, size, &self.info)?;
         let (buffer, memory, mapped) = self.vulkan.create_buffer(label, size.div_ceil(4) * 4)?;
         self.next_buffer += 1;
         self.buffers.insert(self.next_buffer, AshBuffer { buffer, memory, mapped, size, label: label.into() });
@@ -152,16 +139,7 @@ impl Backend for AshBackend {
 
     fn write_buffer(&mut self, buffer: BufferId, offset: u64, data: &[u8]) -> Result<(), BackendError> {
         let entry = self.buffer(buffer)?;
-        if !offset.is_multiple_of(4) || !data.len().is_multiple_of(4) || offset + data.len() as u64 > entry.size {
-            return Err(BackendError::Buffer {
-                label: entry.label.clone(),
-                reason: format!(
-                    "write of {} bytes at offset {offset} into {} bytes (offset and length must be multiples of 4)",
-                    data.len(),
-                    entry.size
-                ),
-            });
-        }
+        check_write(&entry.label, entry.size, offset, data.len())?;
         // SAFETY: the mapping covers the whole buffer, the range was checked above, and
         // no dispatch is in flight (dispatches complete before `dispatch` returns).
         unsafe {

@@ -27,7 +27,7 @@ mod exec;
 mod program;
 
 use crate::backend::{Backend, Bind, BufferId};
-use crate::bindings_check::{check_binds, check_kernel_fits, check_workgroups};
+use crate::bindings_check::{check_binds, check_buffer_size, check_kernel_fits, check_workgroups, check_write};
 use crate::device_info::{DeviceInfo, DeviceLimits};
 use crate::error::BackendError;
 use error::unsupported;
@@ -180,20 +180,7 @@ impl Backend for CpuBackend {
     }
 
     fn create_buffer(&mut self, label: &str, size: u64) -> Result<BufferId, BackendError> {
-        if size == 0 {
-            return Err(BackendError::Buffer {
-                label: label.into(),
-                reason: "size 0: buffers must hold at least one byte".into(),
-            });
-        }
-        if size > self.info.limits.max_buffer_size {
-            return Err(BackendError::LimitExceeded {
-                what: format!("buffer `{label}`"),
-                limit: "buffer bytes",
-                requested: size,
-                available: self.info.limits.max_buffer_size,
-            });
-        }
+        check_buffer_size(label, size, &self.info)?;
         self.next_buffer += 1;
         self.buffers.insert(
             self.next_buffer,
@@ -204,16 +191,7 @@ impl Backend for CpuBackend {
 
     fn write_buffer(&mut self, buffer: BufferId, offset: u64, data: &[u8]) -> Result<(), BackendError> {
         let entry = self.buffers.get_mut(&buffer.0).ok_or(BackendError::UnknownBuffer(buffer.0))?;
-        if !offset.is_multiple_of(4) || !data.len().is_multiple_of(4) || offset + data.len() as u64 > entry.size {
-            return Err(BackendError::Buffer {
-                label: entry.label.clone(),
-                reason: format!(
-                    "write of {} bytes at offset {offset} into {} bytes (offset and length must be multiples of 4)",
-                    data.len(),
-                    entry.size
-                ),
-            });
-        }
+        check_write(&entry.label, entry.size, offset, data.len())?;
         let start = offset as usize / 4;
         for (i, chunk) in data.chunks_exact(4).enumerate() {
             entry.words[start + i] = u32::from_le_bytes([chunk[0], chunk[1], chunk[2], chunk[3]]);

@@ -3,6 +3,7 @@
 
 use super::errors::ErrorSink;
 use crate::backend::BufferId;
+use crate::bindings_check::check_buffer_size;
 use crate::device_info::DeviceInfo;
 use crate::error::BackendError;
 use std::collections::HashMap;
@@ -28,21 +29,8 @@ impl BufferTable {
         label: &str,
         size: u64,
     ) -> Result<BufferId, BackendError> {
-        if size == 0 {
-            return Err(BackendError::Buffer {
-                label: label.into(),
-                reason: "size 0: buffers must hold at least one byte".into(),
-            });
-        }
+        check_buffer_size(label, size, info)?;
         let padded = size.div_ceil(4) * 4;
-        if padded > info.limits.max_buffer_size {
-            return Err(BackendError::LimitExceeded {
-                what: format!("buffer `{label}`"),
-                limit: "buffer bytes",
-                requested: size,
-                available: info.limits.max_buffer_size,
-            });
-        }
         let scope = errors.scope(device);
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),

@@ -5,7 +5,7 @@ mod errors;
 mod pipelines;
 
 use crate::backend::{Backend, Bind, BufferId};
-use crate::bindings_check::{check_binds, check_kernel_fits, check_workgroups};
+use crate::bindings_check::{check_binds, check_kernel_fits, check_workgroups, check_write};
 use crate::device_info::{DeviceInfo, DeviceLimits};
 use crate::error::BackendError;
 use buffers::BufferTable;
@@ -218,16 +218,7 @@ impl Backend for WgpuBackend {
 
     fn write_buffer(&mut self, buffer: BufferId, offset: u64, data: &[u8]) -> Result<(), BackendError> {
         let entry = self.buffers.get(buffer)?;
-        if !offset.is_multiple_of(4) || !data.len().is_multiple_of(4) || offset + data.len() as u64 > entry.size {
-            return Err(BackendError::Buffer {
-                label: entry.label.clone(),
-                reason: format!(
-                    "write of {} bytes at offset {offset} into {} bytes (offset and length must be multiples of 4)",
-                    data.len(),
-                    entry.size
-                ),
-            });
-        }
+        check_write(&entry.label, entry.size, offset, data.len())?;
         self.queue.write_buffer(&entry.buffer, offset, data);
         Ok(())
     }

@@ -260,3 +260,24 @@ fn bad_subgroup_sizes_are_refused() {
     assert!(CpuBackend::new(CpuOptions { subgroup_size: Some(12) }).is_err());
     assert!(CpuBackend::new(CpuOptions { subgroup_size: Some(0) }).is_err());
 }
+
+#[test]
+fn storage_atomics_are_atomic_across_parallel_workgroups() {
+    let source = r#"
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<atomic<u32>>;
+@compute @workgroup_size(32)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    atomicAdd(&output[0], input[id.x]);
+    atomicMax(&output[1], input[id.x]);
+    atomicOr(&output[2], 1u << (id.x % 32u));
+    atomicSub(&output[3], 1u);
+}
+"#;
+    let kernel = Kernel::from_wgsl("atomics.wgsl", source.into(), "main", false).unwrap();
+    let inputs: Vec<u32> = (0..32 * 64).map(|i| i * 7 % 1001).collect();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &inputs, 4, 64);
+    let sum = inputs.iter().fold(0u32, |a, &x| a.wrapping_add(x));
+    assert_eq!(got, vec![sum, *inputs.iter().max().unwrap(), u32::MAX, 0u32.wrapping_sub(32 * 64)]);
+}

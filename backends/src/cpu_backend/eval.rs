@@ -5,6 +5,10 @@ use super::error::unsupported;
 use super::exec::{Exec, Frame, Invocation};
 use crate::error::BackendError;
 use naga::{Expression, Handle, ScalarKind, TypeInner};
+use smallvec::{SmallVec, smallvec};
+
+/// A value: its words, inline up to a vec4.
+pub(super) type Words = SmallVec<[u32; 4]>;
 
 /// Scalar kind and component count of a scalar or vector type.
 pub(super) fn shape(inner: &TypeInner) -> Option<(ScalarKind, usize)> {
@@ -89,7 +93,7 @@ impl Exec<'_> {
         invocation: &Invocation,
         frame: &Frame,
         handle: Handle<Expression>,
-    ) -> Result<Vec<u32>, BackendError> {
+    ) -> Result<Words, BackendError> {
         let program = self.program;
         let function = program.function(frame.function);
         let expressions = &program.naga_function(frame.function).expressions;
@@ -103,14 +107,16 @@ impl Exec<'_> {
         let result_len = function.slots[handle.index()].len as usize;
         let fail = |what: String| unsupported(&what, line());
         Ok(match &expressions[handle] {
-            Expression::Literal(value) => vec![literal(value).ok_or_else(|| fail(format!("literal {value:?}")))?],
-            Expression::Constant(c) => program.global_values[module.constants[*c].init.index()].clone(),
-            Expression::ZeroValue(_) => vec![0; result_len],
+            Expression::Literal(value) => smallvec![literal(value).ok_or_else(|| fail(format!("literal {value:?}")))?],
+            Expression::Constant(c) => {
+                program.global_values[module.constants[*c].init.index()].iter().copied().collect()
+            }
+            Expression::ZeroValue(_) => smallvec![0; result_len],
             Expression::Compose { components, .. } => {
                 let parts: Vec<&[u32]> = components.iter().map(|c| reg(*c)).collect();
-                compose(module, ty(handle), &parts).map_err(fail)?
+                compose(module, ty(handle), &parts).map_err(fail)?.into()
             }
-            Expression::Splat { size, value } => reg(*value).repeat(*size as usize),
+            Expression::Splat { size, value } => reg(*value).repeat(*size as usize).into(),
             Expression::Swizzle { size, vector, pattern } => {
                 let v = reg(*vector);
                 pattern[..*size as usize].iter().map(|c| v[*c as usize]).collect()
@@ -157,8 +163,8 @@ impl Exec<'_> {
             Expression::Relational { fun, argument } => {
                 let v = reg(*argument);
                 match fun {
-                    naga::RelationalFunction::All => vec![u32::from(v.iter().all(|&x| x != 0))],
-                    naga::RelationalFunction::Any => vec![u32::from(v.iter().any(|&x| x != 0))],
+                    naga::RelationalFunction::All => smallvec![u32::from(v.iter().all(|&x| x != 0))],
+                    naga::RelationalFunction::Any => smallvec![u32::from(v.iter().any(|&x| x != 0))],
                     naga::RelationalFunction::IsNan => {
                         v.iter().map(|&x| u32::from(f32::from_bits(x).is_nan())).collect()
                     }
@@ -175,7 +181,7 @@ impl Exec<'_> {
             Expression::As { expr, kind, convert } => {
                 let (from, _) = shape(ty(*expr)).ok_or_else(|| fail("conversion of a composite".into()))?;
                 match convert {
-                    None => reg(*expr).to_vec(),
+                    None => reg(*expr).iter().copied().collect(),
                     Some(4) | Some(1) => reg(*expr)
                         .iter()
                         .map(|&x| arith::convert(x, from, *kind).ok_or_else(|| fail(format!("{from:?} as {kind:?}"))))
@@ -193,13 +199,13 @@ impl Exec<'_> {
                     _ => return Err(fail("arrayLength of a non-pointer".into())),
                 };
                 let words = self.memory_words(invocation, p[0]);
-                vec![(words.saturating_sub(p[1] as usize) / stride.max(1) as usize) as u32]
+                smallvec![(words.saturating_sub(p[1] as usize) / stride.max(1) as usize) as u32]
             }
             // Written by their statements (Call, Atomic, WorkGroupUniformLoad, subgroup ops).
             Expression::CallResult(_)
             | Expression::AtomicResult { .. }
             | Expression::WorkGroupUniformLoadResult { .. }
-            | Expression::SubgroupOperationResult { .. } => reg(handle).to_vec(),
+            | Expression::SubgroupOperationResult { .. } => reg(handle).iter().copied().collect(),
             other => {
                 let name = format!("{other:?}");
                 let name = name.split([' ', '(', '{']).next().unwrap_or("expression").to_string();
@@ -220,7 +226,7 @@ impl Exec<'_> {
         index: u32,
         dynamic: bool,
         result_len: usize,
-    ) -> Result<Vec<u32>, String> {
+    ) -> Result<Words, String> {
         let module = &self.program.module;
         let slot = function.slots[base.index()];
         let value = &frame.regs[slot.offset as usize..(slot.offset + slot.len) as usize];
@@ -242,27 +248,27 @@ impl Exec<'_> {
                     TypeInner::Matrix { columns, rows, .. } => clamp(columns as usize) * column_words(rows),
                     ref other => return Err(format!("indexing through a pointer to {other:?}")),
                 };
-                Ok(vec![tag, (offset + step) as u32])
+                Ok(smallvec![tag, (offset + step) as u32])
             }
             TypeInner::ValuePointer { size: Some(size), .. } => {
-                Ok(vec![value[0], value[1] + clamp(*size as usize) as u32])
+                Ok(smallvec![value[0], value[1] + clamp(*size as usize) as u32])
             }
-            TypeInner::Vector { size, .. } => Ok(vec![value[clamp(*size as usize)]]),
+            TypeInner::Vector { size, .. } => Ok(smallvec![value[clamp(*size as usize)]]),
             TypeInner::Array { size, stride, .. } => {
                 let len = match size {
                     naga::ArraySize::Constant(n) => n.get() as usize,
                     _ => return Err("indexing a runtime-sized array value".into()),
                 };
                 let at = clamp(len) * *stride as usize / 4;
-                Ok(value[at..at + result_len].to_vec())
+                Ok(value[at..at + result_len].iter().copied().collect())
             }
             TypeInner::Struct { members, .. } => {
                 let at = members[index as usize].offset as usize / 4;
-                Ok(value[at..at + result_len].to_vec())
+                Ok(value[at..at + result_len].iter().copied().collect())
             }
             TypeInner::Matrix { columns, rows, .. } => {
                 let at = clamp(*columns as usize) * column_words(*rows);
-                Ok(value[at..at + result_len].to_vec())
+                Ok(value[at..at + result_len].iter().copied().collect())
             }
             other => Err(format!("indexing {other:?}")),
         }
@@ -278,7 +284,7 @@ impl Exec<'_> {
         b: Option<&[u32]>,
         c: Option<&[u32]>,
         d: Option<&[u32]>,
-    ) -> Option<Vec<u32>> {
+    ) -> Option<Words> {
         use naga::MathFunction as M;
         let f = f32::from_bits;
         let pick = |v: Option<&[u32]>, i: usize| v.map_or(0, |v| v[if v.len() == 1 { 0 } else { i }]);
@@ -287,20 +293,20 @@ impl Exec<'_> {
                 let b = b?;
                 // Sequential sum of products, no fused multiply-add.
                 let sum = (0..comps).fold(0.0f32, |acc, i| acc + f(a[i]) * f(b[i]));
-                Some(vec![sum.to_bits()])
+                Some(smallvec![sum.to_bits()])
             }
             M::Dot => {
                 let b = b?;
-                Some(vec![(0..comps).fold(0u32, |acc, i| acc.wrapping_add(a[i].wrapping_mul(b[i])))])
+                Some(smallvec![(0..comps).fold(0u32, |acc, i| acc.wrapping_add(a[i].wrapping_mul(b[i])))])
             }
-            M::Length => Some(vec![(0..comps).fold(0.0f32, |acc, i| acc + f(a[i]) * f(a[i])).sqrt().to_bits()]),
+            M::Length => Some(smallvec![(0..comps).fold(0.0f32, |acc, i| acc + f(a[i]) * f(a[i])).sqrt().to_bits()]),
             M::Distance => {
                 let b = b?;
                 let sum = (0..comps).fold(0.0f32, |acc, i| {
                     let d = f(a[i]) - f(b[i]);
                     acc + d * d
                 });
-                Some(vec![sum.sqrt().to_bits()])
+                Some(smallvec![sum.sqrt().to_bits()])
             }
             M::Normalize => {
                 let length = (0..comps).fold(0.0f32, |acc, i| acc + f(a[i]) * f(a[i])).sqrt();
@@ -309,7 +315,7 @@ impl Exec<'_> {
             M::Cross => {
                 let b = b?;
                 let (x, y) = (|i: usize| f(a[i]), |i: usize| f(b[i]));
-                Some(vec![
+                Some(smallvec![
                     (x(1) * y(2) - x(2) * y(1)).to_bits(),
                     (x(2) * y(0) - x(0) * y(2)).to_bits(),
                     (x(0) * y(1) - x(1) * y(0)).to_bits(),

@@ -5,6 +5,7 @@ use super::error::{invalid, unsupported};
 use super::program::{CompiledFunction, Op};
 use crate::error::BackendError;
 use naga::{Expression, Handle, ScalarKind, TypeInner};
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Region tags in the first word of a pointer value.
 const BUFFER: u32 = 1 << 24;
@@ -24,6 +25,8 @@ pub(super) struct Program {
     /// naga handle of each entry of `functions`.
     pub function_handles: Vec<Handle<naga::Function>>,
     pub entry: CompiledFunction,
+    /// Index of the entry point in `module.entry_points`.
+    pub entry_index: usize,
     pub entry_arguments: Vec<Option<naga::BuiltIn>>,
     pub workgroup_size: [u32; 3],
     /// Per global variable: (region tag, word offset in its region).
@@ -47,6 +50,8 @@ pub(super) struct Frame {
 
 pub(super) struct Invocation {
     frames: Vec<Frame>,
+    /// Register and local buffers of returned frames, reused by later calls.
+    spare: Vec<(Vec<u32>, Vec<u32>)>,
     private: Vec<u32>,
     builtins: Builtins,
 }
@@ -72,10 +77,56 @@ enum Stop {
     Sync(usize, u32),
 }
 
-/// Runs `program` on `workgroups` with `buffers` bound (in `binding_slots` order).
+/// Runs `program` on `workgroups` with `buffers` bound (in the kernel's binding order).
+/// Independent workgroups run in parallel on the machine's cores; buffer words are
+/// atomics (relaxed loads and stores, real read-modify-write for WGSL atomics).
 pub(super) fn run(
     program: &Program,
     buffers: &mut [Vec<u32>],
+    workgroups: [u32; 3],
+    subgroup_size: u32,
+) -> Result<(), BackendError> {
+    let shared: Vec<Vec<AtomicU32>> =
+        buffers.iter_mut().map(|words| std::mem::take(words).into_iter().map(AtomicU32::new).collect()).collect();
+    let total = u64::from(workgroups[0]) * u64::from(workgroups[1]) * u64::from(workgroups[2]);
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(total.max(1) as usize);
+    let next = std::sync::atomic::AtomicU64::new(0);
+    let result = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..threads)
+            .map(|_| {
+                scope.spawn(|| -> Result<(), BackendError> {
+                    loop {
+                        let index = next.fetch_add(1, Ordering::Relaxed);
+                        if index >= total {
+                            return Ok(());
+                        }
+                        let wx = (index % u64::from(workgroups[0])) as u32;
+                        let wy = (index / u64::from(workgroups[0]) % u64::from(workgroups[1])) as u32;
+                        let wz = (index / (u64::from(workgroups[0]) * u64::from(workgroups[1]))) as u32;
+                        if let Err(error) = run_workgroup(program, &shared, [wx, wy, wz], workgroups, subgroup_size) {
+                            // Stop the other threads early.
+                            next.store(total, Ordering::Relaxed);
+                            return Err(error);
+                        }
+                    }
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|_| Err(invalid(&program.name, "a worker panicked".into()))))
+            .collect::<Result<Vec<()>, _>>()
+    });
+    for (words, atomics) in buffers.iter_mut().zip(shared) {
+        *words = atomics.into_iter().map(AtomicU32::into_inner).collect();
+    }
+    result.map(|_| ())
+}
+
+fn run_workgroup(
+    program: &Program,
+    buffers: &[Vec<AtomicU32>],
+    [wx, wy, wz]: [u32; 3],
     workgroups: [u32; 3],
     subgroup_size: u32,
 ) -> Result<(), BackendError> {
@@ -83,71 +134,62 @@ pub(super) fn run(
     let count = (sx * sy * sz) as usize;
     let subgroup_size = subgroup_size.max(1);
     let num_subgroups = (count as u32).div_ceil(subgroup_size);
-    for wz in 0..workgroups[2] {
-        for wy in 0..workgroups[1] {
-            for wx in 0..workgroups[0] {
-                let mut workgroup = vec![0u32; program.workgroup_words as usize];
-                let mut invocations: Vec<Invocation> = (0..count as u32)
-                    .map(|index| {
-                        let local = [index % sx, index / sx % sy, index / (sx * sy)];
-                        let builtins = Builtins {
-                            local_id: local,
-                            local_index: index,
-                            global_id: [wx * sx + local[0], wy * sy + local[1], wz * sz + local[2]],
-                            workgroup_id: [wx, wy, wz],
-                            num_workgroups: workgroups,
-                            subgroup_size,
-                            lane: index % subgroup_size,
-                            subgroup_id: index / subgroup_size,
-                            num_subgroups,
-                        };
-                        Invocation { frames: Vec::new(), private: program.private_init.clone(), builtins }
-                    })
-                    .collect();
-                let mut exec = Exec { program, buffers, workgroup: &mut workgroup };
-                for invocation in &mut invocations {
-                    exec.enter_entry(invocation)?;
+    let mut workgroup = vec![0u32; program.workgroup_words as usize];
+    let mut invocations: Vec<Invocation> = (0..count as u32)
+        .map(|index| {
+            let local = [index % sx, index / sx % sy, index / (sx * sy)];
+            let builtins = Builtins {
+                local_id: local,
+                local_index: index,
+                global_id: [wx * sx + local[0], wy * sy + local[1], wz * sz + local[2]],
+                workgroup_id: [wx, wy, wz],
+                num_workgroups: workgroups,
+                subgroup_size,
+                lane: index % subgroup_size,
+                subgroup_id: index / subgroup_size,
+                num_subgroups,
+            };
+            Invocation { frames: Vec::new(), spare: Vec::new(), private: program.private_init.clone(), builtins }
+        })
+        .collect();
+    let mut exec = Exec { program, buffers, workgroup: &mut workgroup };
+    for invocation in &mut invocations {
+        exec.enter_entry(invocation)?;
+    }
+    loop {
+        let mut stops = Vec::with_capacity(count);
+        for invocation in &mut invocations {
+            stops.push(exec.run_until_stop(invocation)?);
+        }
+        if stops.iter().all(|s| *s == Stop::Done) {
+            break;
+        }
+        let first = stops[0];
+        if let Some(other) = stops.iter().find(|s| **s != first) {
+            let describe = |stop: &Stop| match *stop {
+                Stop::Done => "the end of the kernel".to_string(),
+                Stop::Sync(function, pc) => {
+                    let f = program.function(function);
+                    format!("the barrier or subgroup operation at WGSL line {} in `{}`", f.lines[pc as usize], f.name)
                 }
-                loop {
-                    let mut stops = Vec::with_capacity(count);
-                    for invocation in &mut invocations {
-                        stops.push(exec.run_until_stop(invocation)?);
-                    }
-                    if stops.iter().all(|s| *s == Stop::Done) {
-                        break;
-                    }
-                    let first = stops[0];
-                    if let Some(other) = stops.iter().find(|s| **s != first) {
-                        let describe = |stop: &Stop| match *stop {
-                            Stop::Done => "the end of the kernel".to_string(),
-                            Stop::Sync(function, pc) => {
-                                let f = program.function(function);
-                                format!(
-                                    "the barrier or subgroup operation at WGSL line {} in `{}`",
-                                    f.lines[pc as usize], f.name
-                                )
-                            }
-                        };
-                        return Err(invalid(
-                            &program.name,
-                            format!(
-                                "a barrier or subgroup operation was reached in non-uniform control flow: one invocation is at {}, another at {}",
-                                describe(&first),
-                                describe(other)
-                            ),
-                        ));
-                    }
-                    // Everyone waits at the same op: a barrier needs nothing more; a
-                    // subgroup gather is computed for all invocations now.
-                    let Stop::Sync(function, pc) = first else { unreachable!() };
-                    if let Op::Gather { mode, argument, result } = &program.function(function).ops[pc as usize] {
-                        exec.gather(&mut invocations, function, *mode, *argument, *result)?;
-                    }
-                    for invocation in &mut invocations {
-                        invocation.frames.last_mut().expect("waiting invocations have frames").pc += 1;
-                    }
-                }
-            }
+            };
+            return Err(invalid(
+                &program.name,
+                format!(
+                    "a barrier or subgroup operation was reached in non-uniform control flow: one invocation is at {}, another at {}",
+                    describe(&first),
+                    describe(other)
+                ),
+            ));
+        }
+        // Everyone waits at the same op: a barrier needs nothing more; a
+        // subgroup gather is computed for all invocations now.
+        let Stop::Sync(function, pc) = first else { unreachable!() };
+        if let Op::Gather { mode, argument, result } = &program.function(function).ops[pc as usize] {
+            exec.gather(&mut invocations, function, *mode, *argument, *result)?;
+        }
+        for invocation in &mut invocations {
+            invocation.frames.last_mut().expect("waiting invocations have frames").pc += 1;
         }
     }
     Ok(())
@@ -160,7 +202,7 @@ impl Program {
 
     pub(super) fn naga_function(&self, index: usize) -> &naga::Function {
         if index == usize::MAX {
-            &self.module.entry_points.iter().find(|ep| ep.name == self.name).expect("entry point exists").function
+            &self.module.entry_points[self.entry_index].function
         } else {
             &self.module.functions[self.function_handles[index]]
         }
@@ -169,7 +211,7 @@ impl Program {
 
 pub(super) struct Exec<'a> {
     pub program: &'a Program,
-    buffers: &'a mut [Vec<u32>],
+    buffers: &'a [Vec<AtomicU32>],
     workgroup: &'a mut Vec<u32>,
 }
 
@@ -189,6 +231,7 @@ impl Exec<'_> {
             .iter()
             .map(|builtin| builtin_value(*builtin, &invocation.builtins))
             .collect::<Result<_, _>>()?;
+        let arguments: Vec<&[u32]> = arguments.iter().map(Vec::as_slice).collect();
         self.start_frame(&mut frame, invocation, &arguments)?;
         invocation.frames.push(frame);
         Ok(())
@@ -200,26 +243,42 @@ impl Exec<'_> {
         &mut self,
         frame: &mut Frame,
         invocation: &Invocation,
-        arguments: &[Vec<u32>],
+        arguments: &[&[u32]],
     ) -> Result<(), BackendError> {
         let function = self.program.function(frame.function);
         let naga_function = self.program.naga_function(frame.function);
         let depth = invocation.frames.len() as u32;
+        let template = match function.template.get() {
+            Some(template) => template,
+            None => {
+                // Constants and global pointers do not depend on the frame: evaluate them
+                // once, in pre-emit order (operands come first in naga's arena).
+                for &handle in &function.pre_emit {
+                    let value: Vec<u32> = match &naga_function.expressions[handle] {
+                        Expression::FunctionArgument(_) | Expression::LocalVariable(_) => continue,
+                        Expression::GlobalVariable(g) => {
+                            let (tag, offset) = self.program.globals[g.index()];
+                            vec![tag, offset]
+                        }
+                        _ => self.eval(invocation, frame, handle)?.into_vec(),
+                    };
+                    let slot = function.slots[handle.index()];
+                    frame.regs[slot.offset as usize..(slot.offset + slot.len) as usize].copy_from_slice(&value);
+                }
+                function.template.get_or_init(|| frame.regs.clone())
+            }
+        };
+        frame.regs.copy_from_slice(template);
         for &handle in &function.pre_emit {
             let slot = function.slots[handle.index()];
-            let value: Vec<u32> = match &naga_function.expressions[handle] {
-                Expression::FunctionArgument(i) => arguments[*i as usize].clone(),
-                Expression::GlobalVariable(g) => {
-                    let (tag, offset) = self.program.globals[g.index()];
-                    vec![tag, offset]
+            let range = slot.offset as usize..(slot.offset + slot.len) as usize;
+            match &naga_function.expressions[handle] {
+                Expression::FunctionArgument(i) => frame.regs[range].copy_from_slice(arguments[*i as usize]),
+                Expression::LocalVariable(l) => {
+                    frame.regs[range].copy_from_slice(&[FUNCTION | depth, function.local_offsets[l.index()]])
                 }
-                Expression::LocalVariable(l) => vec![FUNCTION | depth, function.local_offsets[l.index()]],
-                _ => {
-                    // Constant expressions: evaluated with the new frame's registers.
-                    self.eval(invocation, frame, handle)?
-                }
-            };
-            frame.regs[slot.offset as usize..(slot.offset + slot.len) as usize].copy_from_slice(&value);
+                _ => {}
+            }
         }
         for (index, (_, local)) in naga_function.local_variables.iter().enumerate() {
             if let Some(init) = local.init {
@@ -280,15 +339,14 @@ impl Exec<'_> {
                     self.set_reg(invocation, *result, &value);
                 }
                 Op::Call { function: callee, arguments, result } => {
-                    let values: Vec<Vec<u32>> = arguments.iter().map(|a| self.reg(invocation, *a).to_vec()).collect();
                     let compiled = &self.program.functions[callee.index()];
-                    let mut frame = Frame {
-                        function: callee.index(),
-                        pc: 0,
-                        regs: vec![0; compiled.register_words as usize],
-                        locals: vec![0; compiled.local_words as usize],
-                        result: *result,
-                    };
+                    let (mut regs, mut locals) = invocation.spare.pop().unwrap_or_default();
+                    regs.clear();
+                    regs.resize(compiled.register_words as usize, 0);
+                    locals.clear();
+                    locals.resize(compiled.local_words as usize, 0);
+                    let mut frame = Frame { function: callee.index(), pc: 0, regs, locals, result: *result };
+                    let values: Vec<&[u32]> = arguments.iter().map(|a| self.reg(invocation, *a)).collect();
                     if invocation.frames.len() > 256 {
                         return Err(invalid(&self.program.name, "call depth above 256 (recursion?)".into()));
                     }
@@ -301,6 +359,7 @@ impl Exec<'_> {
                     if let (Some(result), Some(value)) = (frame.result, value) {
                         self.set_reg(invocation, result, &value);
                     }
+                    invocation.spare.push((frame.regs, frame.locals));
                 }
                 Op::Atomic { pointer, fun, value, result } => {
                     self.atomic(invocation, *pointer, *fun, *value, *result, function, pc)?;
@@ -332,21 +391,32 @@ impl Exec<'_> {
     }
 
     /// Reads `len` words; out-of-bounds words read as 0.
-    pub(super) fn read(&self, invocation: &Invocation, (tag, offset): (u32, u32), len: usize) -> Vec<u32> {
+    pub(super) fn read(&self, invocation: &Invocation, (tag, offset): (u32, u32), len: usize) -> super::eval::Words {
+        let start = offset as usize;
+        if tag & TAG_MASK == BUFFER {
+            let memory = &self.buffers[(tag & !TAG_MASK) as usize];
+            return (start..start + len).map(|i| memory.get(i).map_or(0, |w| w.load(Ordering::Relaxed))).collect();
+        }
         let memory: &[u32] = match tag & TAG_MASK {
-            BUFFER => &self.buffers[(tag & !TAG_MASK) as usize],
             WORKGROUP => self.workgroup,
             PRIVATE => &invocation.private,
             _ => &invocation.frames[(tag & !TAG_MASK) as usize].locals,
         };
-        let start = offset as usize;
         (start..start + len).map(|i| memory.get(i).copied().unwrap_or(0)).collect()
     }
 
     /// Writes words; out-of-bounds words are skipped.
     fn write(&mut self, invocation: &mut Invocation, (tag, offset): (u32, u32), value: &[u32]) {
+        if tag & TAG_MASK == BUFFER {
+            let memory = &self.buffers[(tag & !TAG_MASK) as usize];
+            for (i, &word) in value.iter().enumerate() {
+                if let Some(slot) = memory.get(offset as usize + i) {
+                    slot.store(word, Ordering::Relaxed);
+                }
+            }
+            return;
+        }
         let memory: &mut [u32] = match tag & TAG_MASK {
-            BUFFER => &mut self.buffers[(tag & !TAG_MASK) as usize],
             WORKGROUP => self.workgroup,
             PRIVATE => &mut invocation.private,
             _ => &mut invocation.frames[(tag & !TAG_MASK) as usize].locals,
@@ -380,30 +450,55 @@ impl Exec<'_> {
     ) -> Result<(), BackendError> {
         use naga::AtomicFunction as A;
         let pointer_value = self.pointer(invocation, pointer);
-        let old = self.read(invocation, pointer_value, 1)[0];
         let operand = self.reg(invocation, value)[0];
+        let expected = match fun {
+            A::Exchange { compare: Some(compare) } => Some(self.reg(invocation, compare)[0]),
+            _ => None,
+        };
         let kind = match &function.types[value.index()] {
             TypeInner::Scalar(s) => s.kind,
             _ => ScalarKind::Uint,
         };
-        let (new, result_words) = match fun {
-            A::Add => (old.wrapping_add(operand), vec![old]),
-            A::Subtract => (old.wrapping_sub(operand), vec![old]),
-            A::And => (old & operand, vec![old]),
-            A::InclusiveOr => (old | operand, vec![old]),
-            A::ExclusiveOr => (old ^ operand, vec![old]),
-            A::Min if kind == ScalarKind::Sint => ((old as i32).min(operand as i32) as u32, vec![old]),
-            A::Max if kind == ScalarKind::Sint => ((old as i32).max(operand as i32) as u32, vec![old]),
-            A::Min => (old.min(operand), vec![old]),
-            A::Max => (old.max(operand), vec![old]),
-            A::Exchange { compare: None } => (operand, vec![old]),
-            A::Exchange { compare: Some(compare) } => {
-                let expected = self.reg(invocation, compare)[0];
-                if old == expected { (operand, vec![old, 1]) } else { (old, vec![old, 0]) }
+        let kind_is_signed = kind == ScalarKind::Sint;
+        let apply = move |old: u32| -> u32 {
+            match fun {
+                A::Add => old.wrapping_add(operand),
+                A::Subtract => old.wrapping_sub(operand),
+                A::And => old & operand,
+                A::InclusiveOr => old | operand,
+                A::ExclusiveOr => old ^ operand,
+                A::Min if kind_is_signed => (old as i32).min(operand as i32) as u32,
+                A::Max if kind_is_signed => (old as i32).max(operand as i32) as u32,
+                A::Min => old.min(operand),
+                A::Max => old.max(operand),
+                A::Exchange { compare: None } => operand,
+                A::Exchange { compare: Some(_) } => {
+                    if Some(old) == expected {
+                        operand
+                    } else {
+                        old
+                    }
+                }
             }
         };
+        let old = if pointer_value.0 & TAG_MASK == BUFFER {
+            // Shared between workgroups running on other threads: a real atomic.
+            match self.buffers[(pointer_value.0 & !TAG_MASK) as usize].get(pointer_value.1 as usize) {
+                Some(word) => {
+                    word.fetch_update(Ordering::Relaxed, Ordering::Relaxed, |old| Some(apply(old))).unwrap_or(0)
+                }
+                None => 0,
+            }
+        } else {
+            let old = self.read(invocation, pointer_value, 1)[0];
+            self.write(invocation, pointer_value, &[apply(old)]);
+            old
+        };
+        let result_words: super::eval::Words = match expected {
+            Some(expected) => smallvec::smallvec![old, u32::from(old == expected)],
+            None => smallvec::smallvec![old],
+        };
         let _ = pc;
-        self.write(invocation, pointer_value, &[new]);
         if let Some(result) = result {
             self.set_reg(invocation, result, &result_words);
         }

@@ -110,7 +110,7 @@ impl CpuBackend {
 
 fn build_program(kernel: &Kernel) -> Result<Program, BackendError> {
     let module = kernel.module.clone();
-    let source = &kernel.source.text;
+    let source = &program::LineIndex::new(&kernel.source.text);
     let mut global_values = Vec::with_capacity(module.global_expressions.len());
     for (handle, _) in module.global_expressions.iter() {
         let value = eval::global_value(&module, &global_values, handle).map_err(|what| unsupported(&what, 0))?;
@@ -165,6 +165,7 @@ fn build_program(kernel: &Kernel) -> Result<Program, BackendError> {
         functions,
         function_handles: module.functions.iter().map(|(h, _)| h).collect(),
         entry,
+        entry_index,
         entry_arguments,
         workgroup_size: kernel.workgroup_size,
         globals,

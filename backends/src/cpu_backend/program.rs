@@ -113,13 +113,30 @@ pub(super) struct CompiledFunction {
     pub expression_lines: Vec<u32>,
     /// Handle of each expression, by index.
     pub handles: Vec<Handle<Expression>>,
+    /// Registers with every frame-independent pre-emit value (constants, global variable
+    /// pointers) filled in, made on the first call and copied into every later frame.
+    pub template: std::sync::OnceLock<Vec<u32>>,
     pub name: String,
+}
+
+/// Byte offsets where source lines start, for span → line lookups.
+pub(super) struct LineIndex(Vec<usize>);
+
+impl LineIndex {
+    pub(super) fn new(source: &str) -> Self {
+        Self(std::iter::once(0).chain(source.match_indices('\n').map(|(i, _)| i + 1)).collect())
+    }
+
+    /// 1-based line of a span's start (0 for spans without a position).
+    pub(super) fn line(&self, span: naga::Span) -> u32 {
+        span.to_range().map_or(0, |r| self.0.partition_point(|&start| start <= r.start) as u32)
+    }
 }
 
 struct Builder<'a> {
     module: &'a Module,
     function: &'a naga::Function,
-    source: &'a str,
+    lines_of: &'a LineIndex,
     ops: Vec<Op>,
     lines: Vec<u32>,
     /// Per enclosing loop: (ops to patch for break, continue target or None while unknown,
@@ -129,7 +146,7 @@ struct Builder<'a> {
 
 impl Builder<'_> {
     fn line(&self, span: naga::Span) -> u32 {
-        span.to_range().map_or(0, |r| self.source[..r.start.min(self.source.len())].lines().count() as u32)
+        self.lines_of.line(span)
     }
 
     fn push(&mut self, op: Op, span: naga::Span) -> usize {
@@ -299,7 +316,7 @@ pub(super) fn compile_function(
     module: &Module,
     function: &naga::Function,
     info: &naga::valid::FunctionInfo,
-    source: &str,
+    lines_of: &LineIndex,
 ) -> Result<CompiledFunction, BackendError> {
     let mut slots = Vec::with_capacity(function.expressions.len());
     let mut types = Vec::with_capacity(function.expressions.len());
@@ -312,11 +329,7 @@ pub(super) fn compile_function(
     for (handle, expression) in function.expressions.iter() {
         let inner = info[handle].ty.inner_with(&module.types);
         types.push(inner.clone());
-        let line = function
-            .expressions
-            .get_span(handle)
-            .to_range()
-            .map_or(0, |r| source[..r.start.min(source.len())].lines().count() as u32);
+        let line = lines_of.line(function.expressions.get_span(handle));
         expression_lines.push(line);
         let len = words_of(module, inner).map_err(|what| unsupported(&what, line))?;
         slots.push(Slot { offset, len });
@@ -341,7 +354,7 @@ pub(super) fn compile_function(
         local_offsets.push(local_words);
         local_words += words_of(module, &module.types[local.ty].inner).map_err(|what| unsupported(&what, 0))?;
     }
-    let mut builder = Builder { module, function, source, ops: Vec::new(), lines: Vec::new(), loops: Vec::new() };
+    let mut builder = Builder { module, function, lines_of, ops: Vec::new(), lines: Vec::new(), loops: Vec::new() };
     builder.block(&function.body)?;
     let _ = (builder.module, builder.function);
     builder.ops.push(Op::Return(None));
@@ -357,6 +370,7 @@ pub(super) fn compile_function(
         types,
         expression_lines,
         handles: function.expressions.iter().map(|(h, _)| h).collect(),
+        template: std::sync::OnceLock::new(),
         name: function.name.clone().unwrap_or_default(),
     })
 }

@@ -85,7 +85,8 @@ pub(super) fn run(
     buffers: &mut [Vec<u32>],
     workgroups: [u32; 3],
     subgroup_size: u32,
-) -> Result<(), BackendError> {
+) -> Result<u64, BackendError> {
+    let executed = std::sync::atomic::AtomicU64::new(0);
     let shared: Vec<Vec<AtomicU32>> =
         buffers.iter_mut().map(|words| std::mem::take(words).into_iter().map(AtomicU32::new).collect()).collect();
     let total = u64::from(workgroups[0]) * u64::from(workgroups[1]) * u64::from(workgroups[2]);
@@ -103,10 +104,15 @@ pub(super) fn run(
                         let wx = (index % u64::from(workgroups[0])) as u32;
                         let wy = (index / u64::from(workgroups[0]) % u64::from(workgroups[1])) as u32;
                         let wz = (index / (u64::from(workgroups[0]) * u64::from(workgroups[1]))) as u32;
-                        if let Err(error) = run_workgroup(program, &shared, [wx, wy, wz], workgroups, subgroup_size) {
-                            // Stop the other threads early.
-                            next.store(total, Ordering::Relaxed);
-                            return Err(error);
+                        match run_workgroup(program, &shared, [wx, wy, wz], workgroups, subgroup_size) {
+                            Ok(count) => {
+                                executed.fetch_add(count, Ordering::Relaxed);
+                            }
+                            Err(error) => {
+                                // Stop the other threads early.
+                                next.store(total, Ordering::Relaxed);
+                                return Err(error);
+                            }
                         }
                     }
                 })
@@ -120,7 +126,7 @@ pub(super) fn run(
     for (words, atomics) in buffers.iter_mut().zip(shared) {
         *words = atomics.into_iter().map(AtomicU32::into_inner).collect();
     }
-    result.map(|_| ())
+    result.map(|_| executed.into_inner())
 }
 
 fn run_workgroup(
@@ -129,7 +135,7 @@ fn run_workgroup(
     [wx, wy, wz]: [u32; 3],
     workgroups: [u32; 3],
     subgroup_size: u32,
-) -> Result<(), BackendError> {
+) -> Result<u64, BackendError> {
     let [sx, sy, sz] = program.workgroup_size;
     let count = (sx * sy * sz) as usize;
     let subgroup_size = subgroup_size.max(1);
@@ -152,7 +158,7 @@ fn run_workgroup(
             Invocation { frames: Vec::new(), spare: Vec::new(), private: program.private_init.clone(), builtins }
         })
         .collect();
-    let mut exec = Exec { program, buffers, workgroup: &mut workgroup };
+    let mut exec = Exec { program, executed: 0, buffers, workgroup: &mut workgroup };
     for invocation in &mut invocations {
         exec.enter_entry(invocation)?;
     }
@@ -192,7 +198,7 @@ fn run_workgroup(
             invocation.frames.last_mut().expect("waiting invocations have frames").pc += 1;
         }
     }
-    Ok(())
+    Ok(exec.executed)
 }
 
 impl Program {
@@ -211,6 +217,8 @@ impl Program {
 
 pub(super) struct Exec<'a> {
     pub program: &'a Program,
+    /// Expressions evaluated so far (for ns-per-expression figures).
+    pub executed: u64,
     buffers: &'a [Vec<AtomicU32>],
     workgroup: &'a mut Vec<u32>,
 }
@@ -305,6 +313,7 @@ impl Exec<'_> {
             invocation.frames.last_mut().expect("checked").pc += 1;
             match op {
                 Op::Emit(range) => {
+                    self.executed += u64::from(range.end - range.start);
                     for index in range.clone() {
                         let handle = function.handles[index as usize];
                         let value = self.eval(invocation, invocation.frames.last().expect("checked"), handle)?;

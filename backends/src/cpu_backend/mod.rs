@@ -62,6 +62,7 @@ pub struct CpuBackend {
     buffers: HashMap<u64, CpuBuffer>,
     next_buffer: u64,
     programs: HashMap<KernelId, Program>,
+    last_expressions: u64,
 }
 
 impl CpuBackend {
@@ -93,7 +94,14 @@ impl CpuBackend {
                 max_storage_buffers_per_stage: 64,
             },
         };
-        Ok(Self { info, options, buffers: HashMap::new(), next_buffer: 0, programs: HashMap::new() })
+        Ok(Self {
+            info,
+            options,
+            buffers: HashMap::new(),
+            next_buffer: 0,
+            programs: HashMap::new(),
+            last_expressions: 0,
+        })
     }
 
     fn program(&mut self, kernel: &Kernel) -> Result<&Program, BackendError> {
@@ -101,6 +109,11 @@ impl CpuBackend {
             slot.insert(build_program(kernel)?);
         }
         Ok(&self.programs[&kernel.id])
+    }
+
+    /// IR expressions the last dispatch evaluated (for ns-per-expression figures).
+    pub fn expressions_in_last_dispatch(&self) -> u64 {
+        self.last_expressions
     }
 
     fn buffer(&self, id: BufferId) -> Result<&CpuBuffer, BackendError> {
@@ -233,7 +246,8 @@ impl Backend for CpuBackend {
         for (id, words) in ids.iter().zip(bound) {
             self.buffers.get_mut(id).expect("checked").words = words;
         }
-        result
+        self.last_expressions = result?;
+        Ok(())
     }
 
     fn dispatch_timed(

@@ -1,5 +1,7 @@
 //! Shared helpers of strata's integration tests.
 
+pub mod wgsl_fuzz;
+
 use strata_backends::wgpu_backend::{WgpuApi, WgpuBackend, WgpuOptions};
 use strata_backends::{BackendError, GPU_REQUIRED_VARIABLE, gpu_required};
 

@@ -240,19 +240,18 @@ fn unsupported_constructs_are_named_with_their_line() {
 @group(0) @binding(1) var<storage, read_write> output: array<f32>;
 @compute @workgroup_size(1)
 fn main() {
-    let m = mat2x2<f32>(1.0, 2.0, 3.0, 4.0);
-    let v = m * vec2<f32>(f32(input[0]), 1.0);
-    output[0] = v.x;
+    output[0] = f32(pack4x8unorm(vec4<f32>(f32(input[0]), 0.5, 0.25, 1.0)));
 }
 "#;
-    let kernel = Kernel::from_wgsl("matrix.wgsl", source.into(), "main", false).unwrap();
+    let kernel = Kernel::from_wgsl("pack.wgsl", source.into(), "main", false).unwrap();
     let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
     let input = upload(&mut cpu, "input", &[1u32]).unwrap();
     let output = cpu.create_buffer("output", 4).unwrap();
     let error = cpu.dispatch(&kernel, &[Bind::new(0, input), Bind::new(1, output)], [1, 1, 1]).unwrap_err();
     assert!(matches!(error, BackendError::Validation { .. }), "{error}");
     let message = error.to_string();
-    assert!(message.contains("unsupported: Multiply on composites (WGSL line 7)"), "{message}");
+    assert!(message.contains("unsupported: math function Pack4x8unorm"), "{message}");
+    assert!(message.contains("(WGSL line 6)"), "{message}");
 }
 
 #[test]
@@ -280,4 +279,66 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let got = run_words(&mut cpu, &kernel, &inputs, 4, 64);
     let sum = inputs.iter().fold(0u32, |a, &x| a.wrapping_add(x));
     assert_eq!(got, vec![sum, *inputs.iter().max().unwrap(), u32::MAX, 0u32.wrapping_sub(32 * 64)]);
+}
+
+const FLOAT_MATH: &str = r#"
+@group(0) @binding(0) var<storage, read> input: array<f32>;
+@group(0) @binding(1) var<storage, read_write> output: array<f32>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let x = input[2u * id.x];
+    let y = input[2u * id.x + 1u];
+    let m = mat3x3<f32>(vec3<f32>(x, y, 1.0), vec3<f32>(0.5, x * y, -y), vec3<f32>(2.0, 0.25, x));
+    let n = mat2x3<f32>(vec3<f32>(y, 1.0, 0.0), vec3<f32>(-x, 2.0, 3.0));
+    let v = m * vec3<f32>(1.0, y, x);
+    let w = vec3<f32>(x, 0.5, y) * m;
+    let p = m * n;
+    let t = transpose(m);
+    let o = id.x * 16u;
+    output[o] = v.x + v.y + v.z;
+    output[o + 1u] = w.x - w.y + w.z;
+    output[o + 2u] = p[0].x + p[1].z;
+    output[o + 3u] = t[1].x + t[2].y;
+    output[o + 4u] = determinant(m);
+    output[o + 5u] = x * y + x / (abs(y) + 1.0);
+    output[o + 6u] = sqrt(abs(x)) + floor(y) + ceil(x) + round(y) + fract(x) + trunc(y);
+    output[o + 7u] = min(x, y) + max(x, y) + clamp(x, -1.0, 1.0) + sign(y) + step(x, y);
+    output[o + 8u] = dot(v, w) + length(v) + distance(v, w);
+    output[o + 9u] = normalize(vec3<f32>(x, y, 1.0)).y;
+    output[o + 10u] = mix(x, y, 0.25) + smoothstep(-1.0, 1.0, x);
+    output[o + 11u] = cross(v, vec3<f32>(0.0, 1.0, 2.0)).z;
+    output[o + 12u] = f32(i32(x * 100.0)) + f32(u32(abs(y) * 10.0));
+    output[o + 13u] = exp2(clamp(x, -10.0, 10.0)) + log2(abs(y) + 1.0);
+    output[o + 14u] = sin(x) + cos(y);
+    output[o + 15u] = inverseSqrt(abs(x) + 1.0) + pow(abs(y) + 1.0, 1.5);
+}
+"#;
+
+#[test]
+fn float_math_and_matrices_agree_with_lavapipe_within_ulps() {
+    use strata::check::{Compare, Output, compare_outputs};
+    let kernel = Kernel::from_wgsl("float_math.wgsl", FLOAT_MATH.into(), "main", false).unwrap();
+    let mut state = 12345u32;
+    let inputs: Vec<u32> = (0..2 * 128)
+        .map(|_| {
+            state = state.wrapping_mul(1_103_515_245).wrapping_add(12345);
+            ((state >> 8) as f32 / (1 << 24) as f32 * 8.0 - 4.0).to_bits()
+        })
+        .collect();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &inputs, 128 * 16, 2);
+    assert!(got.iter().all(|w| f32::from_bits(*w).is_finite()), "every result is finite");
+    let Some(mut gpu) = strata_tests::vulkan_backend("float_math_and_matrices_agree_with_lavapipe_within_ulps") else {
+        return;
+    };
+    let want = run_words(&mut gpu, &kernel, &inputs, 128 * 16, 2);
+    // Sums of products may contract to fused multiply-adds on the GPU and
+    // transcendentals differ between implementations: a few ULPs, and for values that
+    // cancel to near zero a small absolute error shows up as many ULPs, so a share of
+    // outliers is allowed too.
+    let expected = [Output { name: "output", words: want, compare: Compare::Float { ulp: 64, max_outside: 0.005 } }];
+    let agreement = compare_outputs(&[Output { name: "output", words: got, compare: Compare::Exact }], &expected)
+        .unwrap_or_else(|mismatch| panic!("{mismatch}"));
+    eprintln!("float math: max {} ULP, {:.2}% beyond 64 ULP", agreement.max_ulp, agreement.outside_share() * 100.0);
 }

@@ -29,10 +29,7 @@ fn literal(value: &naga::Literal) -> Option<u32> {
     })
 }
 
-/// Words of one column of a matrix with `rows` rows (vec3 columns are padded to 4).
-fn column_words(rows: naga::VectorSize) -> usize {
-    if rows == naga::VectorSize::Tri { 4 } else { rows as usize }
-}
+use super::matrix::column_words;
 
 /// Value of a constant expression of the module (`global_expressions`).
 pub(super) fn global_value(
@@ -144,6 +141,13 @@ impl Exec<'_> {
                     })
                     .collect()
             }
+            Expression::Binary { op, left, right }
+                if matches!(ty(*left), TypeInner::Matrix { .. }) || matches!(ty(*right), TypeInner::Matrix { .. }) =>
+            {
+                super::matrix::binary(*op, ty(*left), reg(*left), ty(*right), reg(*right))
+                    .ok_or_else(|| fail(format!("{op:?} on matrices")))?
+                    .into()
+            }
             Expression::Binary { op, left, right } => {
                 let (kind, _) = shape(ty(*left)).ok_or_else(|| fail(format!("{op:?} on composites")))?;
                 let (a, b) = (reg(*left), reg(*right));
@@ -173,6 +177,14 @@ impl Exec<'_> {
                     }
                 }
             }
+            Expression::Math { fun: naga::MathFunction::Transpose, arg, .. } => match ty(*arg) {
+                TypeInner::Matrix { columns, rows, .. } => super::matrix::transpose(reg(*arg), *columns, *rows).into(),
+                other => return Err(fail(format!("transpose of {other:?}"))),
+            },
+            Expression::Math { fun: naga::MathFunction::Determinant, arg, .. } => match ty(*arg) {
+                TypeInner::Matrix { columns, .. } => smallvec![super::matrix::determinant(reg(*arg), *columns)],
+                other => return Err(fail(format!("determinant of {other:?}"))),
+            },
             Expression::Math { fun, arg, arg1, arg2, arg3 } => {
                 let (kind, comps) = shape(ty(*arg)).ok_or_else(|| fail(format!("{fun:?} on a composite")))?;
                 self.math(*fun, kind, comps, reg(*arg), arg1.map(reg), arg2.map(reg), arg3.map(reg))

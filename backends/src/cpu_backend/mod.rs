@@ -17,13 +17,14 @@
 //! Supported today: 32-bit scalars, bool, vectors, matrices as values, fixed and
 //! runtime-sized arrays, structs, pointers, function calls, loops with `continuing` and
 //! `break if`, `switch`, atomics, barriers, `workgroupUniformLoad`, subgroup shuffles and
-//! broadcasts, the compute builtins, and most math functions. Anything else is an error
+//! broadcasts, the compute builtins, matrix arithmetic, and most math functions. Anything else is an error
 //! naming the construct and its WGSL line, never a panic.
 
 mod arith;
 mod error;
 mod eval;
 mod exec;
+mod matrix;
 mod program;
 
 use crate::backend::{Backend, Bind, BufferId};

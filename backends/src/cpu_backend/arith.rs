@@ -213,6 +213,40 @@ pub(super) fn bits(fun: MathFunction, kind: ScalarKind, e: u32, a: u32, b2: u32,
     }
 }
 
+/// `pack*` builtins: a vector of floats (or integers) into one u32. `None`: not a pack.
+pub(super) fn pack(fun: MathFunction, v: &[u32]) -> Option<u32> {
+    use MathFunction as M;
+    let unorm = |x: u32, max: f32| (f(x).clamp(0.0, 1.0) * max).round_ties_even() as u32;
+    let snorm = |x: u32, max: f32| ((f(x).clamp(-1.0, 1.0) * max).round_ties_even() as i32) as u32;
+    Some(match fun {
+        M::Pack4x8unorm => (0..4).fold(0, |acc, i| acc | (unorm(v[i], 255.0) & 0xff) << (8 * i)),
+        M::Pack4x8snorm => (0..4).fold(0, |acc, i| acc | (snorm(v[i], 127.0) & 0xff) << (8 * i)),
+        M::Pack2x16unorm => (0..2).fold(0, |acc, i| acc | (unorm(v[i], 65535.0) & 0xffff) << (16 * i)),
+        M::Pack2x16snorm => (0..2).fold(0, |acc, i| acc | (snorm(v[i], 32767.0) & 0xffff) << (16 * i)),
+        M::Pack4xI8 => (0..4).fold(0, |acc, i| acc | (v[i] & 0xff) << (8 * i)),
+        M::Pack4xU8 => (0..4).fold(0, |acc, i| acc | (v[i] & 0xff) << (8 * i)),
+        M::Pack4xI8Clamp => (0..4).fold(0, |acc, i| acc | ((v[i] as i32).clamp(-128, 127) as u32 & 0xff) << (8 * i)),
+        M::Pack4xU8Clamp => (0..4).fold(0, |acc, i| acc | v[i].min(255) << (8 * i)),
+        _ => return None,
+    })
+}
+
+/// `unpack*` builtins: one u32 into a vector. `None`: not an unpack.
+pub(super) fn unpack(fun: MathFunction, x: u32) -> Option<Vec<u32>> {
+    use MathFunction as M;
+    let byte = |i: u32| (x >> (8 * i)) & 0xff;
+    let half = |i: u32| (x >> (16 * i)) & 0xffff;
+    Some(match fun {
+        M::Unpack4x8unorm => (0..4).map(|i| (byte(i) as f32 / 255.0).to_bits()).collect(),
+        M::Unpack4x8snorm => (0..4).map(|i| ((byte(i) as u8 as i8 as f32 / 127.0).max(-1.0)).to_bits()).collect(),
+        M::Unpack2x16unorm => (0..2).map(|i| (half(i) as f32 / 65535.0).to_bits()).collect(),
+        M::Unpack2x16snorm => (0..2).map(|i| ((half(i) as u16 as i16 as f32 / 32767.0).max(-1.0)).to_bits()).collect(),
+        M::Unpack4xI8 => (0..4).map(|i| byte(i) as u8 as i8 as i32 as u32).collect(),
+        M::Unpack4xU8 => (0..4).map(byte).collect(),
+        _ => return None,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -185,6 +185,12 @@ impl Exec<'_> {
                 TypeInner::Matrix { columns, .. } => smallvec![super::matrix::determinant(reg(*arg), *columns)],
                 other => return Err(fail(format!("determinant of {other:?}"))),
             },
+            Expression::Math { fun, arg, .. } if arith::pack(*fun, &[0; 4]).is_some() => {
+                smallvec![arith::pack(*fun, reg(*arg)).ok_or_else(|| fail(format!("{fun:?}")))?]
+            }
+            Expression::Math { fun, arg, .. } if arith::unpack(*fun, 0).is_some() => {
+                arith::unpack(*fun, reg(*arg)[0]).ok_or_else(|| fail(format!("{fun:?}")))?.into()
+            }
             Expression::Math { fun, arg, arg1, arg2, arg3 } => {
                 let (kind, comps) = shape(ty(*arg)).ok_or_else(|| fail(format!("{fun:?} on a composite")))?;
                 self.math(*fun, kind, comps, reg(*arg), arg1.map(reg), arg2.map(reg), arg3.map(reg))

@@ -46,7 +46,7 @@ pub fn load_shader(path: &Path, entry: &str) -> Result<Kernel> {
     }
 }
 
-fn contents(kernel: &Kernel, request: &RunRequest, binding: &strata_kernels::BindingInfo) -> Result<Vec<u8>> {
+fn contents(request: &RunRequest, binding: &strata_kernels::BindingInfo) -> Result<Vec<u8>> {
     if let Some((_, _, file)) = request.buffers.iter().find(|(g, b, _)| *g == binding.group && *b == binding.binding) {
         let mut bytes = std::fs::read(file).with_context(|| format!("cannot read buffer file {}", file.display()))?;
         if bytes.is_empty() {
@@ -61,7 +61,6 @@ fn contents(kernel: &Kernel, request: &RunRequest, binding: &strata_kernels::Bin
         }
         return Ok(vec![0; (size.div_ceil(4) * 4) as usize]);
     }
-    let _ = kernel;
     Ok(vec![0; binding.min_size().div_ceil(4) as usize * 4])
 }
 
@@ -69,7 +68,7 @@ fn run_on(backend: &mut dyn Backend, kernel: &Kernel, request: &RunRequest) -> R
     backend.check_kernel(kernel)?;
     let mut binds = Vec::new();
     for binding in &kernel.bindings {
-        let bytes = contents(kernel, request, binding)?;
+        let bytes = contents(request, binding)?;
         let buffer = backend.create_buffer(&binding.name, bytes.len() as u64)?;
         backend.write_buffer(buffer, 0, &bytes)?;
         binds.push((binding, buffer));

@@ -192,7 +192,7 @@ fn run_workgroup(
         // subgroup gather is computed for all invocations now.
         let Stop::Sync(function, pc) = first else { unreachable!() };
         if let Op::Gather { mode, argument, result } = &program.function(function).ops[pc as usize] {
-            exec.gather(&mut invocations, function, *mode, *argument, *result)?;
+            exec.gather(&mut invocations, *mode, *argument, *result)?;
         }
         for invocation in &mut invocations {
             invocation.frames.last_mut().expect("waiting invocations have frames").pc += 1;
@@ -371,7 +371,7 @@ impl Exec<'_> {
                     invocation.spare.push((frame.regs, frame.locals));
                 }
                 Op::Atomic { pointer, fun, value, result } => {
-                    self.atomic(invocation, *pointer, *fun, *value, *result, function, pc)?;
+                    self.atomic(invocation, *pointer, *fun, *value, *result, function)?;
                 }
                 Op::Barrier | Op::Gather { .. } => unreachable!("handled above"),
             }
@@ -455,7 +455,6 @@ impl Exec<'_> {
         value: Handle<Expression>,
         result: Option<Handle<Expression>>,
         function: &CompiledFunction,
-        pc: u32,
     ) -> Result<(), BackendError> {
         use naga::AtomicFunction as A;
         let pointer_value = self.pointer(invocation, pointer);
@@ -507,7 +506,6 @@ impl Exec<'_> {
             Some(expected) => smallvec::smallvec![old, u32::from(old == expected)],
             None => smallvec::smallvec![old],
         };
-        let _ = pc;
         if let Some(result) = result {
             self.set_reg(invocation, result, &result_words);
         }
@@ -518,7 +516,6 @@ impl Exec<'_> {
     fn gather(
         &mut self,
         invocations: &mut [Invocation],
-        function: usize,
         mode: naga::GatherMode,
         argument: Handle<Expression>,
         result: Handle<Expression>,
@@ -549,7 +546,6 @@ impl Exec<'_> {
             let in_range = source < b.subgroup_size && source_index < values.len();
             results.push(if in_range { values[source_index].clone() } else { values[b.local_index as usize].clone() });
         }
-        let _ = function;
         for (invocation, value) in invocations.iter_mut().zip(results) {
             self.set_reg(invocation, result, &value);
         }

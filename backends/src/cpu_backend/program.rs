@@ -29,7 +29,8 @@ pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String
             columns as u32 * row_words
         }
         TypeInner::Array { base, size, stride } => {
-            let _ = words_of(module, &module.types[base].inner)?;
+            // The element type must be supported too.
+            words_of(module, &module.types[base].inner)?;
             match size {
                 naga::ArraySize::Constant(n) => n.get() * stride / 4,
                 _ => return Err("runtime-sized arrays as values".into()),
@@ -134,8 +135,6 @@ impl LineIndex {
 }
 
 struct Builder<'a> {
-    module: &'a Module,
-    function: &'a naga::Function,
     lines_of: &'a LineIndex,
     ops: Vec<Op>,
     lines: Vec<u32>,
@@ -243,19 +242,11 @@ impl Builder<'_> {
                 let continuing_start = self.here();
                 self.block(continuing)?;
                 match break_if {
-                    Some(condition) => {
-                        // Loop again unless the condition holds.
-                        let exit = self.push(Op::JumpUnless { condition: *condition, target: start }, span);
-                        let _ = exit;
-                    }
-                    None => {
-                        self.push(Op::Jump(start), span);
-                    }
-                }
+                    // Loop again unless the condition holds; fall through to the end if it does.
+                    Some(condition) => self.push(Op::JumpUnless { condition: *condition, target: start }, span),
+                    None => self.push(Op::Jump(start), span),
+                };
                 let end = self.here();
-                if break_if.is_some() {
-                    // JumpUnless(cond, start) falls through to `end` when cond holds.
-                }
                 let (breaks, continues) = self.loops.pop().expect("pushed above");
                 for at in breaks {
                     self.patch(at, end);
@@ -354,9 +345,8 @@ pub(super) fn compile_function(
         local_offsets.push(local_words);
         local_words += words_of(module, &module.types[local.ty].inner).map_err(|what| unsupported(&what, 0))?;
     }
-    let mut builder = Builder { module, function, lines_of, ops: Vec::new(), lines: Vec::new(), loops: Vec::new() };
+    let mut builder = Builder { lines_of, ops: Vec::new(), lines: Vec::new(), loops: Vec::new() };
     builder.block(&function.body)?;
-    let _ = (builder.module, builder.function);
     builder.ops.push(Op::Return(None));
     builder.lines.push(0);
     Ok(CompiledFunction {

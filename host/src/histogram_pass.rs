@@ -33,6 +33,9 @@ pub enum PassError {
     /// The kernel failed to load.
     #[error(transparent)]
     Kernel(#[from] KernelError),
+    /// Input that a pass cannot take, described.
+    #[error("{0}")]
+    Input(String),
     /// Candidate count differs from the pixel count.
     #[error("{width}x{height} image needs {expected} candidates, got {got}")]
     CandidateCount {

@@ -8,5 +8,6 @@ pub mod check;
 pub mod histogram_pass;
 pub mod run_kernel;
 pub mod synthetic;
+pub mod trace_pass;
 
 pub use histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};

@@ -80,3 +80,49 @@ mod tests {
         assert_eq!(bits(&image), bits(&again), "the same seed gives the same image");
     }
 }
+
+/// `count` random triangles in the cube [-1, 1]³ (sizes from tiny to a third of the
+/// cube, some sharing edges and vertices, some coplanar), for BVH tests.
+pub fn triangle_soup(count: usize, seed: u64) -> Vec<[[f32; 3]; 3]> {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let mut triangles: Vec<[[f32; 3]; 3]> = Vec::with_capacity(count);
+    for i in 0..count {
+        let size = 10f32.powf(rng.random_range(-2.5..-0.5));
+        let center: [f32; 3] = [rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)];
+        let mut vertex = || center.map(|c| c + rng.random_range(-size..size));
+        let mut triangle = [vertex(), vertex(), vertex()];
+        // Every eighth triangle shares an edge with the previous one.
+        if i % 8 == 7 {
+            let previous = triangles[i - 1];
+            triangle[0] = previous[1];
+            triangle[1] = previous[0];
+        }
+        // Every sixteenth lies in the plane z = 0.25.
+        if i % 16 == 5 {
+            for v in &mut triangle {
+                v[2] = 0.25;
+            }
+        }
+        triangles.push(triangle);
+    }
+    triangles
+}
+
+/// `count` rays from points around the cube towards points inside it, with some
+/// axis-aligned directions (zero components) among them.
+pub fn rays_into_cube(count: usize, seed: u64) -> Vec<strata_kernels::trace_types::Ray> {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    (0..count)
+        .map(|i| {
+            let origin: [f32; 3] =
+                [rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0)];
+            let target: [f32; 3] =
+                [rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)];
+            let mut direction = [target[0] - origin[0], target[1] - origin[1], target[2] - origin[2]];
+            if i % 10 == 3 {
+                direction = [0.0, 0.0, if origin[2] > 0.0 { -1.0 } else { 1.0 }];
+            }
+            strata_kernels::trace_types::Ray { origin, tmin: 1e-4, direction, tmax: 100.0 }
+        })
+        .collect()
+}

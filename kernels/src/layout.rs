@@ -4,6 +4,7 @@
 //! read garbage without any error. [`check_struct`] compares the host struct's size and
 //! every field's name, offset and size with naga's layout of the WGSL struct.
 
+use crate::trace_types::{GpuBvhNode, GpuTriangle, Hit, Ray, TraceParams};
 use crate::types::{BlockStats, Candidate, ClusterSpan, HistogramParams};
 use naga::proc::Layouter;
 
@@ -53,6 +54,12 @@ shader_struct!(
     "HistogramParams",
     [width, height, block_size, log2_block_size, blocks_x, blocks_y, workgroups_x, _pad]
 );
+
+shader_struct!(GpuBvhNode, "BvhNode", [aabb_min, _pad0, aabb_max, _pad1, prim_count, first_index, meta1, meta2]);
+shader_struct!(GpuTriangle, "Triangle", [v0, _pad0, v1, _pad1, v2, _pad2]);
+shader_struct!(Ray, "Ray", [origin, tmin, direction, tmax]);
+shader_struct!(Hit, "Hit", [t, u, v, primitive]);
+shader_struct!(TraceParams, "TraceParams", [ray_count, workgroups_x, _pad0, _pad1]);
 
 /// Compares `T` with the struct `T::WGSL_NAME` of `module`; the error lists every
 /// difference.

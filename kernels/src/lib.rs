@@ -17,6 +17,7 @@ pub mod layout;
 pub mod reference;
 pub mod registry;
 pub mod source;
+pub mod trace_types;
 pub mod translate;
 pub mod types;
 pub mod validate;

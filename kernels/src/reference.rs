@@ -1,3 +1,4 @@
 //! Plain-Rust statements of what the kernels compute: the oracles of the tests.
 
 pub mod block_histogram;
+pub mod bvh_trace;

@@ -18,6 +18,8 @@ pub enum KernelId {
     BlockHistogramSubgroup,
     /// Does nothing: measures dispatch overhead.
     Empty,
+    /// Closest hit of a batch of rays through obvhs' BVH2, watertight triangle test.
+    BvhClosestHit,
     /// A kernel from outside the registry ([`Kernel::from_wgsl`]), keyed by a hash of its
     /// source and entry point so that backends can cache its pipeline.
     External(u64),
@@ -25,7 +27,8 @@ pub enum KernelId {
 
 impl KernelId {
     /// Every registry kernel.
-    pub const ALL: [KernelId; 3] = [KernelId::BlockHistogram, KernelId::BlockHistogramSubgroup, KernelId::Empty];
+    pub const ALL: [KernelId; 4] =
+        [KernelId::BlockHistogram, KernelId::BlockHistogramSubgroup, KernelId::Empty, KernelId::BvhClosestHit];
 
     /// What the registry knows of this kernel before parsing it.
     pub fn spec(self) -> Option<KernelSpec> {
@@ -51,6 +54,15 @@ impl KernelId {
                 entry_point: "empty".into(),
                 features: KernelFeatures::empty(),
                 float_ulp_bound: None,
+            },
+            KernelId::BvhClosestHit => KernelSpec {
+                name: "bvh_closest_hit".into(),
+                fragments: vec![fragment!("trace/bvh.wgsl"), fragment!("trace/entry_closest_hit.wgsl")],
+                entry_point: "bvh_closest_hit".into(),
+                features: KernelFeatures::empty(),
+                // Backends may contract products into fused multiply-adds; hits that change
+                // triangle at near-ties are counted separately (see the check).
+                float_ulp_bound: Some(8),
             },
             KernelId::External(_) => return None,
         })
@@ -341,6 +353,19 @@ mod tests {
         let registry = Registry::load().unwrap_or_else(|e| panic!("{e}"));
         for kernel in registry.kernels() {
             let module = &kernel.module;
+            if kernel.id == KernelId::BvhClosestHit {
+                use crate::trace_types::{GpuBvhNode, GpuTriangle, Hit, Ray, TraceParams};
+                for result in [
+                    check_struct::<GpuBvhNode>(module),
+                    check_struct::<GpuTriangle>(module),
+                    check_struct::<Ray>(module),
+                    check_struct::<Hit>(module),
+                    check_struct::<TraceParams>(module),
+                ] {
+                    result.unwrap_or_else(|e| panic!("{}: {e}", kernel.name()));
+                }
+                continue;
+            }
             if kernel.id == KernelId::Empty {
                 continue;
             }

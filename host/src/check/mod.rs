@@ -8,6 +8,7 @@ mod compare;
 mod empty;
 mod histogram;
 mod report;
+mod trace;
 
 pub use backends::{BackendSlot, backend_slots};
 pub use compare::{Agreement, Compare, Mismatch, Output, compare_outputs};
@@ -60,6 +61,7 @@ pub fn kernel_checks() -> Vec<Box<dyn KernelCheck>> {
         Box::new(histogram::HistogramCheck(KernelId::BlockHistogram)),
         Box::new(histogram::HistogramCheck(KernelId::BlockHistogramSubgroup)),
         Box::new(empty::EmptyCheck),
+        Box::new(trace::TraceCheck),
     ]
 }
 

@@ -1,0 +1,113 @@
+//! Ray queries against a triangle BVH on any backend: obvhs builds the BVH2 on the CPU,
+//! its nodes and triangles upload as they are, and the `bvh_closest_hit` kernel
+//! traverses it.
+
+use crate::histogram_pass::PassError;
+use glam::Vec3A;
+use obvhs::bvh2::Bvh2;
+use obvhs::triangle::Triangle;
+use strata_backends::backend::{download, upload};
+use strata_backends::{Backend, BackendError, Bind, BufferId};
+use strata_kernels::trace_types::{GpuBvhNode, GpuTriangle, Hit, Ray, TraceParams};
+use strata_kernels::{Kernel, KernelId, Registry};
+
+/// A triangle mesh with its BVH, in the layout the kernel reads.
+pub struct SceneBvh {
+    /// obvhs' nodes (root at 0).
+    pub nodes: Vec<GpuBvhNode>,
+    /// Leaf entries → triangle indices.
+    pub primitive_indices: Vec<u32>,
+    /// The triangles.
+    pub triangles: Vec<GpuTriangle>,
+}
+
+impl SceneBvh {
+    /// Builds the BVH of `triangles` (each three vertices) with obvhs' fast preset.
+    pub fn build(triangles: &[[[f32; 3]; 3]]) -> Result<Self, PassError> {
+        if triangles.is_empty() {
+            return Err(PassError::Input("a BVH needs at least one triangle".into()));
+        }
+        if let Some(index) = triangles.iter().position(|t| t.iter().flatten().any(|c| !c.is_finite())) {
+            return Err(PassError::Input(format!("triangle {index} has a NaN or infinite coordinate")));
+        }
+        let tris: Vec<Triangle> = triangles
+            .iter()
+            .map(|[a, b, c]| Triangle { v0: Vec3A::from(*a), v1: Vec3A::from(*b), v2: Vec3A::from(*c) })
+            .collect();
+        let bvh: Bvh2 = obvhs::bvh2::builder::build_bvh2_from_tris(
+            &tris,
+            obvhs::BvhBuildParams::fast_build(),
+            &mut std::time::Duration::default(),
+        );
+        Ok(Self {
+            nodes: bytemuck::cast_slice(&bvh.nodes).to_vec(),
+            primitive_indices: bvh.primitive_indices.clone(),
+            triangles: bytemuck::cast_slice(&tris).to_vec(),
+        })
+    }
+}
+
+/// The closest-hit pass with its buffers on one backend.
+pub struct TracePass {
+    kernel: &'static Kernel,
+    nodes: BufferId,
+    primitive_indices: BufferId,
+    triangles: BufferId,
+}
+
+impl TracePass {
+    /// Uploads the BVH.
+    pub fn new(backend: &mut dyn Backend, scene: &SceneBvh) -> Result<Self, PassError> {
+        let kernel = Registry::shared()?.get(KernelId::BvhClosestHit);
+        backend.check_kernel(kernel)?;
+        Ok(Self {
+            kernel,
+            nodes: upload(backend, "bvh nodes", &scene.nodes)?,
+            primitive_indices: upload(backend, "bvh primitive indices", &scene.primitive_indices)?,
+            triangles: upload(backend, "triangles", &scene.triangles)?,
+        })
+    }
+
+    /// The closest hit of every ray. Rays must have finite origins and nonzero, finite
+    /// directions; the error names the first ray that does not.
+    pub fn trace(&self, backend: &mut dyn Backend, rays: &[Ray]) -> Result<Vec<Hit>, PassError> {
+        if rays.is_empty() {
+            return Ok(Vec::new());
+        }
+        if let Some(index) = rays.iter().position(|r| {
+            r.origin.iter().chain(&r.direction).any(|c| !c.is_finite()) || r.direction.iter().all(|&c| c == 0.0)
+        }) {
+            return Err(PassError::Input(format!(
+                "ray {index}: origin and direction must be finite, direction nonzero"
+            )));
+        }
+        let groups = (rays.len() as u32).div_ceil(64);
+        let x = groups.min(backend.info().limits.max_workgroups_per_dimension.max(1));
+        let params = TraceParams { ray_count: rays.len() as u32, workgroups_x: x, _pad0: 0, _pad1: 0 };
+        let params_buffer = upload(backend, "trace params", &[params])?;
+        let rays_buffer = upload(backend, "rays", rays)?;
+        let hits_buffer = backend.create_buffer("hits", (rays.len() * size_of::<Hit>()) as u64)?;
+        let binds = [
+            Bind::new(0, params_buffer),
+            Bind::new(1, self.nodes),
+            Bind::new(2, self.primitive_indices),
+            Bind::new(3, self.triangles),
+            Bind::new(4, rays_buffer),
+            Bind::new(5, hits_buffer),
+        ];
+        let result = backend.dispatch(self.kernel, &binds, [x, groups.div_ceil(x), 1]);
+        let hits = result.and_then(|()| download::<Hit>(backend, hits_buffer));
+        for buffer in [params_buffer, rays_buffer, hits_buffer] {
+            backend.destroy_buffer(buffer)?;
+        }
+        Ok(hits?)
+    }
+
+    /// Frees the BVH buffers.
+    pub fn destroy(self, backend: &mut dyn Backend) -> Result<(), BackendError> {
+        for buffer in [self.nodes, self.primitive_indices, self.triangles] {
+            backend.destroy_buffer(buffer)?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,82 @@
+//! The BVH closest-hit kernel against obvhs' own CPU traversal (an independent
+//! implementation with Möller–Trumbore intersection) and bad input.
+
+use glam::Vec3A;
+use obvhs::ray::{Ray as ObvhsRay, RayHit};
+use strata::synthetic::{rays_into_cube, triangle_soup};
+use strata::trace_pass::{SceneBvh, TracePass};
+use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
+use strata_backends::{Backend, gpu_required};
+use strata_kernels::trace_types::{MISS, Ray};
+
+fn obvhs_closest(soup: &[[[f32; 3]; 3]], rays: &[Ray]) -> Vec<(u32, f32)> {
+    let tris: Vec<obvhs::triangle::Triangle> = soup
+        .iter()
+        .map(|[a, b, c]| obvhs::triangle::Triangle { v0: Vec3A::from(*a), v1: Vec3A::from(*b), v2: Vec3A::from(*c) })
+        .collect();
+    let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(
+        &tris,
+        obvhs::BvhBuildParams::fast_build(),
+        &mut std::time::Duration::default(),
+    );
+    rays.iter()
+        .map(|r| {
+            let ray = ObvhsRay::new(Vec3A::from(r.origin), Vec3A::from(r.direction), r.tmin, r.tmax);
+            let mut hit = RayHit::none();
+            if bvh.ray_traverse(ray, &mut hit, |ray, id| tris[bvh.primitive_indices[id] as usize].intersect(ray)) {
+                (bvh.primitive_indices[hit.primitive_id as usize], hit.t)
+            } else {
+                (MISS, r.tmax)
+            }
+        })
+        .collect()
+}
+
+fn agree_with_obvhs(backend: &mut dyn Backend) {
+    let soup = triangle_soup(3000, 77);
+    let rays = rays_into_cube(20_000, 78);
+    let scene = SceneBvh::build(&soup).unwrap();
+    let pass = TracePass::new(backend, &scene).unwrap();
+    let hits = pass.trace(backend, &rays).unwrap();
+    pass.destroy(backend).unwrap();
+    let reference = obvhs_closest(&soup, &rays);
+    let hit_count = hits.iter().filter(|h| h.primitive != MISS).count();
+    assert!(hit_count > rays.len() / 5, "only {hit_count} of {} rays hit: the test is too easy", rays.len());
+    let same = hits.iter().zip(&reference).filter(|(h, (p, _))| h.primitive == *p).count();
+    let share = same as f64 / rays.len() as f64;
+    assert!(share >= 0.999, "only {:.3}% of rays hit the same triangle as obvhs", share * 100.0);
+    for (hit, (primitive, t)) in hits.iter().zip(&reference) {
+        if hit.primitive == *primitive && hit.primitive != MISS {
+            assert!((hit.t - t).abs() <= 1e-4 * t.abs().max(1.0), "t {} vs obvhs {t}", hit.t);
+        }
+    }
+}
+
+#[test]
+fn closest_hits_agree_with_obvhs_on_the_interpreter() {
+    agree_with_obvhs(&mut CpuBackend::new(CpuOptions::default()).unwrap());
+}
+
+#[test]
+fn closest_hits_agree_with_obvhs_on_vulkan() {
+    let Some(mut backend) = strata_tests::vulkan_backend("closest_hits_agree_with_obvhs_on_vulkan") else {
+        assert!(!gpu_required());
+        return;
+    };
+    agree_with_obvhs(&mut backend);
+}
+
+#[test]
+fn bad_geometry_and_rays_are_named() {
+    assert!(SceneBvh::build(&[]).err().unwrap().to_string().contains("at least one triangle"));
+    let error = SceneBvh::build(&[[[0.0, 0.0, 0.0], [1.0, f32::NAN, 0.0], [0.0, 1.0, 0.0]]]).err().unwrap();
+    assert!(error.to_string().contains("triangle 0 has a NaN"), "{error}");
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let scene = SceneBvh::build(&triangle_soup(10, 1)).unwrap();
+    let pass = TracePass::new(&mut cpu, &scene).unwrap();
+    let mut rays = rays_into_cube(5, 2);
+    rays[3].direction = [0.0, 0.0, 0.0];
+    let error = pass.trace(&mut cpu, &rays).unwrap_err().to_string();
+    assert!(error.contains("ray 3"), "{error}");
+    assert!(pass.trace(&mut cpu, &[]).unwrap().is_empty());
+}

@@ -59,28 +59,6 @@ pub fn candidate_image(width: u32, height: u32, seed: u64, mix: CandidateMix) ->
     image
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn images_contain_every_awkward_kind_and_equal_keys() {
-        let image = candidate_image(128, 128, 7, CandidateMix { awkward: 0.2, ..Default::default() });
-        assert!(image.iter().any(|c| c.key.is_nan()));
-        assert!(image.iter().any(|c| c.key == f32::INFINITY));
-        assert!(image.iter().any(|c| c.key == f32::NEG_INFINITY));
-        assert!(image.iter().any(|c| c.key.is_subnormal()));
-        assert!(image.iter().any(|c| c.key == 0.0 && c.key.is_sign_negative()));
-        assert!(image.iter().any(|c| c.object_id == OBJECT_ID_NONE));
-        assert!(image.iter().any(|c| c.object_id == OBJECT_ID_ENVIRONMENT));
-        let equal = image.iter().filter(|c| c.key == 1.0).count();
-        assert!(equal > 100, "{equal}");
-        let again = candidate_image(128, 128, 7, CandidateMix { awkward: 0.2, ..Default::default() });
-        let bits = |image: &[Candidate]| image.iter().map(|c| (c.key.to_bits(), c.object_id)).collect::<Vec<_>>();
-        assert_eq!(bits(&image), bits(&again), "the same seed gives the same image");
-    }
-}
-
 /// `count` random triangles in the cube [-1, 1]³ (sizes from tiny to a third of the
 /// cube, some sharing edges and vertices, some coplanar), for BVH tests.
 pub fn triangle_soup(count: usize, seed: u64) -> Vec<[[f32; 3]; 3]> {
@@ -125,4 +103,26 @@ pub fn rays_into_cube(count: usize, seed: u64) -> Vec<strata_kernels::trace_type
             strata_kernels::trace_types::Ray { origin, tmin: 1e-4, direction, tmax: 100.0 }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn images_contain_every_awkward_kind_and_equal_keys() {
+        let image = candidate_image(128, 128, 7, CandidateMix { awkward: 0.2, ..Default::default() });
+        assert!(image.iter().any(|c| c.key.is_nan()));
+        assert!(image.iter().any(|c| c.key == f32::INFINITY));
+        assert!(image.iter().any(|c| c.key == f32::NEG_INFINITY));
+        assert!(image.iter().any(|c| c.key.is_subnormal()));
+        assert!(image.iter().any(|c| c.key == 0.0 && c.key.is_sign_negative()));
+        assert!(image.iter().any(|c| c.object_id == OBJECT_ID_NONE));
+        assert!(image.iter().any(|c| c.object_id == OBJECT_ID_ENVIRONMENT));
+        let equal = image.iter().filter(|c| c.key == 1.0).count();
+        assert!(equal > 100, "{equal}");
+        let again = candidate_image(128, 128, 7, CandidateMix { awkward: 0.2, ..Default::default() });
+        let bits = |image: &[Candidate]| image.iter().map(|c| (c.key.to_bits(), c.object_id)).collect::<Vec<_>>();
+        assert_eq!(bits(&image), bits(&again), "the same seed gives the same image");
+    }
 }

@@ -7,6 +7,7 @@ pub mod backend_choice;
 pub mod check;
 pub mod histogram_pass;
 pub mod run_kernel;
+pub mod scene;
 pub mod synthetic;
 pub mod trace_pass;
 

@@ -1,0 +1,202 @@
+//! The JSON scene description of `../shared/scenes/*/scene.json`, as serde types.
+
+use super::SceneError;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Pinhole camera (CONVENTIONS.md "Camera").
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Camera {
+    /// Eye position.
+    pub origin: [f32; 3],
+    /// Point looked at.
+    pub target: [f32; 3],
+    /// Up vector.
+    pub up: [f32; 3],
+    /// Full opening angle along `fov_axis`, degrees.
+    pub fov_deg: f32,
+    /// `x` (horizontal) or `smaller` (the smaller image side).
+    pub fov_axis: String,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Near clip distance.
+    pub near_clip: f32,
+    /// Far clip distance.
+    pub far_clip: f32,
+}
+
+/// Integrator settings.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Integrator {
+    /// Always `path`.
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// Maximum path segments including the camera ray.
+    pub max_depth: u32,
+    /// Russian roulette start depth.
+    pub rr_depth: u32,
+    /// Whether emitters are hidden from camera rays (false in every scene).
+    pub hide_emitters: bool,
+}
+
+/// Diffuse reflectance: a constant, a checkerboard or an sRGB texture.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum Reflectance {
+    /// Constant linear RGB.
+    Constant([f32; 3]),
+    /// Checkerboard.
+    Checkerboard {
+        /// Its colours and scale.
+        checkerboard: Checkerboard,
+    },
+    /// An 8-bit sRGB PNG, bilinear, repeat.
+    Texture {
+        /// File relative to the scene folder.
+        texture: PathBuf,
+        /// Whether the file is sRGB-encoded.
+        #[serde(default)]
+        srgb: bool,
+        /// Filter (`bilinear`).
+        #[serde(default)]
+        filter: Option<String>,
+        /// Wrap mode (`repeat`).
+        #[serde(default)]
+        wrap: Option<String>,
+        /// UV scale.
+        #[serde(default)]
+        uv_scale: Option<[f32; 2]>,
+    },
+}
+
+/// Checkerboard parameters (CONVENTIONS.md).
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Checkerboard {
+    /// Colour where frac(u') > 0.5 equals frac(v') > 0.5.
+    pub color0: [f32; 3],
+    /// The other colour.
+    pub color1: [f32; 3],
+    /// uv' = uv * uv_scale.
+    pub uv_scale: [f32; 2],
+}
+
+/// A material, by its `type`.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+pub enum MaterialDescription {
+    /// Lambertian.
+    Diffuse {
+        /// Reflectance.
+        reflectance: Reflectance,
+        /// Two-sided.
+        #[serde(default)]
+        two_sided: bool,
+    },
+    /// Diffuse with reflectance 0 (light fixtures).
+    Black {
+        /// Two-sided.
+        #[serde(default)]
+        two_sided: bool,
+    },
+    /// GGX rough conductor with complex IOR.
+    Roughconductor {
+        /// Microfacet distribution (`ggx`).
+        distribution: String,
+        /// GGX alpha.
+        alpha: f32,
+        /// Real part of the IOR per channel.
+        eta: [f32; 3],
+        /// Imaginary part of the IOR per channel.
+        k: [f32; 3],
+        /// Two-sided.
+        #[serde(default)]
+        two_sided: bool,
+    },
+    /// Smooth dielectric.
+    Dielectric {
+        /// Interior IOR.
+        int_ior: f32,
+        /// Exterior IOR.
+        ext_ior: f32,
+        /// Two-sided (false for glass).
+        #[serde(default)]
+        two_sided: bool,
+    },
+}
+
+/// A one-sided area emitter.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct EmitterDescription {
+    /// Constant RGB radiance.
+    pub radiance: [f32; 3],
+}
+
+/// A lat-long environment map.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentDescription {
+    /// RGB float EXR (relative to the scene folder in the file; resolved on load).
+    pub file: PathBuf,
+    /// Radiance scale.
+    pub scale: f32,
+    /// Row-major 4 × 4 transform; its upper-left 3 × 3 rotates the map.
+    #[serde(default)]
+    pub to_world: Option<[[f32; 4]; 4]>,
+}
+
+/// One shape entry.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ShapeDescription {
+    /// Shape id.
+    pub id: String,
+    /// PLY file relative to the scene folder.
+    pub mesh: PathBuf,
+    /// Material name.
+    pub material: String,
+    /// Normal mode (`face`: geometric normals).
+    #[serde(default)]
+    pub normals: Option<String>,
+    /// Emission, if any.
+    #[serde(default)]
+    pub emitter: Option<EmitterDescription>,
+}
+
+/// A whole `scene.json`.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SceneDescription {
+    /// Name.
+    pub name: String,
+    /// Free-text coordinate system note.
+    #[serde(default)]
+    pub coordinate_system: Option<String>,
+    /// Camera.
+    pub camera: Camera,
+    /// Integrator.
+    pub integrator: Integrator,
+    /// Materials by name.
+    pub materials: BTreeMap<String, MaterialDescription>,
+    /// Shapes.
+    pub shapes: Vec<ShapeDescription>,
+    /// Environment map, if any.
+    #[serde(default)]
+    pub environment: Option<EnvironmentDescription>,
+}
+
+/// Parses `text` (the contents of `path`), naming the field at fault on error.
+pub(super) fn parse(path: &Path, text: &str) -> Result<SceneDescription, SceneError> {
+    let deserializer = &mut serde_json::Deserializer::from_str(text);
+    serde_path_to_error::deserialize(deserializer).map_err(|error| SceneError::Json {
+        path: path.into(),
+        field: error.path().to_string(),
+        message: error.inner().to_string(),
+    })
+}

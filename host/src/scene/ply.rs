@@ -1,0 +1,245 @@
+//! Binary little-endian PLY meshes as the shared scenes store them (CONVENTIONS.md
+//! "Geometry"): vertices with float `x y z` and optional `s t`, faces as
+//! `list uchar int vertex_indices`, triangles only. Other scalar property types are
+//! read and ignored; ASCII and big-endian files are refused with a clear error.
+
+use super::SceneError;
+use std::path::{Path, PathBuf};
+
+/// A triangle mesh read from a PLY file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlyMesh {
+    /// Vertex positions.
+    pub positions: Vec<[f32; 3]>,
+    /// Texture coordinates (`s t`), if present.
+    pub uvs: Option<Vec<[f32; 2]>>,
+    /// Triangles as vertex indices.
+    pub faces: Vec<[u32; 3]>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    fn parse(name: &str) -> Option<Scalar> {
+        Some(match name {
+            "char" | "int8" => Scalar::I8,
+            "uchar" | "uint8" => Scalar::U8,
+            "short" | "int16" => Scalar::I16,
+            "ushort" | "uint16" => Scalar::U16,
+            "int" | "int32" => Scalar::I32,
+            "uint" | "uint32" => Scalar::U32,
+            "float" | "float32" => Scalar::F32,
+            "double" | "float64" => Scalar::F64,
+            _ => return None,
+        })
+    }
+
+    fn size(self) -> usize {
+        match self {
+            Scalar::I8 | Scalar::U8 => 1,
+            Scalar::I16 | Scalar::U16 => 2,
+            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
+            Scalar::F64 => 8,
+        }
+    }
+
+    /// The value at the start of `bytes` as f64 (ints exactly).
+    fn read(self, bytes: &[u8]) -> f64 {
+        match self {
+            Scalar::I8 => f64::from(bytes[0] as i8),
+            Scalar::U8 => f64::from(bytes[0]),
+            Scalar::I16 => f64::from(i16::from_le_bytes([bytes[0], bytes[1]])),
+            Scalar::U16 => f64::from(u16::from_le_bytes([bytes[0], bytes[1]])),
+            Scalar::I32 => f64::from(i32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]])),
+            Scalar::U32 => f64::from(u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]])),
+            Scalar::F32 => f64::from(f32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]])),
+            Scalar::F64 => f64::from_le_bytes(bytes[..8].try_into().expect("8 bytes")),
+        }
+    }
+}
+
+enum Property {
+    Scalar(String, Scalar),
+    List(String, Scalar, Scalar),
+}
+
+struct Element {
+    name: String,
+    count: usize,
+    properties: Vec<Property>,
+}
+
+fn ply_error(path: &Path, element: impl Into<String>, message: impl Into<String>) -> SceneError {
+    SceneError::Ply { path: PathBuf::from(path), element: element.into(), message: message.into() }
+}
+
+/// Reads a binary little-endian PLY triangle mesh.
+pub fn read_ply(path: &Path) -> Result<PlyMesh, SceneError> {
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
+    let header_end = bytes
+        .windows(11)
+        .position(|w| w == b"end_header\n")
+        .ok_or_else(|| ply_error(path, "header", "no `end_header` line"))?
+        + 11;
+    let header = std::str::from_utf8(&bytes[..header_end]).map_err(|_| ply_error(path, "header", "not text"))?;
+    let mut lines = header.lines();
+    if lines.next() != Some("ply") {
+        return Err(ply_error(path, "header line 1", "not a PLY file (first line is not `ply`)"));
+    }
+    let mut elements: Vec<Element> = Vec::new();
+    for (number, line) in lines.enumerate() {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let at = format!("header line {}", number + 2);
+        match words.as_slice() {
+            ["format", "binary_little_endian", _] => {}
+            ["format", other, _] => {
+                return Err(ply_error(
+                    path,
+                    at,
+                    format!("format `{other}` is not supported (binary_little_endian only)"),
+                ));
+            }
+            ["comment", ..] | ["obj_info", ..] | ["end_header"] | [] => {}
+            ["element", name, count] => elements.push(Element {
+                name: name.to_string(),
+                count: count.parse().map_err(|_| ply_error(path, &at, format!("bad element count `{count}`")))?,
+                properties: Vec::new(),
+            }),
+            ["property", "list", count, item, name] => {
+                let (Some(count), Some(item)) = (Scalar::parse(count), Scalar::parse(item)) else {
+                    return Err(ply_error(path, at, format!("unknown list types `{count} {item}`")));
+                };
+                let element = elements.last_mut().ok_or_else(|| ply_error(path, &at, "property before any element"))?;
+                element.properties.push(Property::List(name.to_string(), count, item));
+            }
+            ["property", kind, name] => {
+                let kind = Scalar::parse(kind).ok_or_else(|| ply_error(path, &at, format!("unknown type `{kind}`")))?;
+                let element = elements.last_mut().ok_or_else(|| ply_error(path, &at, "property before any element"))?;
+                element.properties.push(Property::Scalar(name.to_string(), kind));
+            }
+            _ => return Err(ply_error(path, at, format!("cannot read `{line}`"))),
+        }
+    }
+    let mut offset = header_end;
+    let mut mesh = PlyMesh { positions: Vec::new(), uvs: None, faces: Vec::new() };
+    let truncated = |what: String| ply_error(path, what, "the file ends early (truncated)");
+    for element in &elements {
+        for index in 0..element.count {
+            let mut values: Vec<(&str, f64)> = Vec::new();
+            let mut list: Vec<f64> = Vec::new();
+            for property in &element.properties {
+                match property {
+                    Property::Scalar(name, kind) => {
+                        let end = offset + kind.size();
+                        let slice =
+                            bytes.get(offset..end).ok_or_else(|| truncated(format!("{} {index}", element.name)))?;
+                        values.push((name, kind.read(slice)));
+                        offset = end;
+                    }
+                    Property::List(name, count, item) => {
+                        let keep = name == "vertex_indices" || name == "vertex_index";
+                        let slice = bytes
+                            .get(offset..offset + count.size())
+                            .ok_or_else(|| truncated(format!("{} {index}", element.name)))?;
+                        let n = count.read(slice) as usize;
+                        offset += count.size();
+                        for _ in 0..n {
+                            let slice = bytes
+                                .get(offset..offset + item.size())
+                                .ok_or_else(|| truncated(format!("{} {index}", element.name)))?;
+                            if keep {
+                                list.push(item.read(slice));
+                            }
+                            offset += item.size();
+                        }
+                    }
+                }
+            }
+            let get = |name: &str| values.iter().find(|(n, _)| *n == name).map(|(_, v)| *v);
+            match element.name.as_str() {
+                "vertex" => {
+                    let (Some(x), Some(y), Some(z)) = (get("x"), get("y"), get("z")) else {
+                        return Err(ply_error(path, "vertex properties", "vertices need x, y and z"));
+                    };
+                    let position = [x as f32, y as f32, z as f32];
+                    if position.iter().any(|c| !c.is_finite()) {
+                        return Err(ply_error(
+                            path,
+                            format!("vertex {index}"),
+                            format!("coordinate is not finite: {position:?}"),
+                        ));
+                    }
+                    mesh.positions.push(position);
+                    if let (Some(s), Some(t)) = (get("s").or(get("u")), get("t").or(get("v"))) {
+                        mesh.uvs.get_or_insert_with(Vec::new).push([s as f32, t as f32]);
+                    }
+                }
+                "face" => {
+                    if list.len() != 3 {
+                        return Err(ply_error(
+                            path,
+                            format!("face {index}"),
+                            format!("{} vertices: only triangles are supported", list.len()),
+                        ));
+                    }
+                    let face = [list[0], list[1], list[2]];
+                    if let Some(bad) = face.iter().find(|&&i| i < 0.0 || i as usize >= mesh.positions.len()) {
+                        return Err(ply_error(
+                            path,
+                            format!("face {index}"),
+                            format!("vertex index {bad} out of range (the mesh has {} vertices)", mesh.positions.len()),
+                        ));
+                    }
+                    mesh.faces.push(face.map(|i| i as u32));
+                }
+                _ => {}
+            }
+        }
+    }
+    if mesh.uvs.as_ref().is_some_and(|uvs| uvs.len() != mesh.positions.len()) {
+        return Err(ply_error(path, "vertex properties", "only some vertices have texture coordinates"));
+    }
+    if mesh.faces.is_empty() {
+        return Err(ply_error(path, "faces", "the mesh has no triangles"));
+    }
+    Ok(mesh)
+}
+
+/// A triangle as its three corners.
+pub type TriangleCorners = [[f32; 3]; 3];
+/// Texture coordinates at a triangle's three corners.
+pub type CornerUvs = [[f32; 2]; 3];
+
+impl PlyMesh {
+    /// The triangles (and their corner UVs) without the zero-area ones, and how many
+    /// were dropped.
+    pub fn triangles_without_degenerate(&self) -> (Vec<TriangleCorners>, Option<Vec<CornerUvs>>, usize) {
+        let mut triangles = Vec::with_capacity(self.faces.len());
+        let mut uvs = self.uvs.as_ref().map(|_| Vec::with_capacity(self.faces.len()));
+        let mut dropped = 0;
+        for face in &self.faces {
+            let [a, b, c] = face.map(|i| self.positions[i as usize]);
+            let (u, v) = ([b[0] - a[0], b[1] - a[1], b[2] - a[2]], [c[0] - a[0], c[1] - a[1], c[2] - a[2]]);
+            let cross = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+            if cross.iter().all(|&x| x == 0.0) {
+                dropped += 1;
+                continue;
+            }
+            triangles.push([a, b, c]);
+            if let (Some(out), Some(source)) = (uvs.as_mut(), self.uvs.as_ref()) {
+                out.push(face.map(|i| source[i as usize]));
+            }
+        }
+        (triangles, uvs, dropped)
+    }
+}

@@ -1,0 +1,135 @@
+//! Loading the shared test scenes (`../shared/scenes`, JSON + PLY) and refusing bad ones
+//! with errors that name the file and the field or element.
+
+use std::path::{Path, PathBuf};
+use strata::scene::{MaterialDescription, Scene, SceneError, read_ply};
+
+fn shared_scenes() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/scenes")
+}
+
+#[test]
+fn every_shared_scene_loads_with_object_ids_and_emitters() {
+    let root = shared_scenes();
+    if !root.exists() {
+        panic!("{} is missing: the shared scenes must sit beside the checkout", root.display());
+    }
+    for (name, shapes, emitters, environment) in [
+        ("cornell-box", 8, 1, false),
+        ("matpreview", 3, 0, true),
+        ("veach-ajar", 22, 1, false),
+        ("objects-grid", 102, 1, true),
+    ] {
+        let scene = Scene::load(&root.join(name).join("scene.json")).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(scene.shapes.len(), shapes, "{name}");
+        assert_eq!(scene.shapes.iter().filter(|s| s.emission.is_some()).count(), emitters, "{name}");
+        assert_eq!(scene.environment.is_some(), environment, "{name}");
+        if let Some(environment) = &scene.environment {
+            assert!(environment.file.exists(), "{}", environment.file.display());
+        }
+        for (index, shape) in scene.shapes.iter().enumerate() {
+            assert_eq!(shape.object_id, index as u32);
+            assert!(!shape.triangles.is_empty(), "{name}/{}", shape.name);
+        }
+        let (triangles, ids) = scene.triangles_with_ids();
+        assert_eq!(triangles.len(), ids.len());
+        assert_eq!(scene.max_depth, 8);
+    }
+    let veach = Scene::load(&root.join("veach-ajar/scene.json")).unwrap();
+    let dropped: usize = veach.shapes.iter().map(|s| s.degenerate_dropped).sum();
+    assert_eq!(dropped, 62, "the door handle's zero-area triangles are dropped and counted");
+    assert!(veach.materials.iter().any(|m| matches!(m, MaterialDescription::Dielectric { .. })));
+    assert!(veach.materials.iter().any(|m| matches!(m, MaterialDescription::Roughconductor { .. })));
+}
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    path
+}
+
+fn ply(vertices: &[[f32; 3]], faces: &[[i32; 3]]) -> Vec<u8> {
+    let mut bytes = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        vertices.len(),
+        faces.len()
+    )
+    .into_bytes();
+    for v in vertices {
+        for c in v {
+            bytes.extend(c.to_le_bytes());
+        }
+    }
+    for f in faces {
+        bytes.push(3);
+        for i in f {
+            bytes.extend(i.to_le_bytes());
+        }
+    }
+    bytes
+}
+
+#[test]
+fn bad_meshes_are_named() {
+    let dir = std::env::temp_dir().join(format!("strata-ply-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let good = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    assert_eq!(read_ply(&write(&dir, "good.ply", &ply(&good, &[[0, 1, 2]]))).unwrap().faces.len(), 1);
+    let nan = read_ply(&write(
+        &dir,
+        "nan.ply",
+        &ply(&[[0.0, 0.0, 0.0], [f32::NAN, 0.0, 0.0], [0.0, 1.0, 0.0]], &[[0, 1, 2]]),
+    ));
+    assert!(nan.unwrap_err().to_string().contains("nan.ply: vertex 1: coordinate is not finite"));
+    let range = read_ply(&write(&dir, "range.ply", &ply(&good, &[[0, 1, 7]])));
+    assert!(range.unwrap_err().to_string().contains("range.ply: face 0: vertex index 7 out of range"));
+    let mut truncated = ply(&good, &[[0, 1, 2]]);
+    truncated.truncate(truncated.len() - 3);
+    let error = read_ply(&write(&dir, "cut.ply", &truncated)).unwrap_err().to_string();
+    assert!(error.contains("cut.ply: face 0: the file ends early"), "{error}");
+    let ascii = read_ply(&write(&dir, "ascii.ply", b"ply\nformat ascii 1.0\nend_header\n")).unwrap_err().to_string();
+    assert!(ascii.contains("format `ascii` is not supported"), "{ascii}");
+    let missing = read_ply(&dir.join("missing.ply")).unwrap_err();
+    assert!(matches!(missing, SceneError::Io { .. }) && missing.to_string().contains("missing.ply"));
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn bad_scene_files_name_the_field() {
+    let dir = std::env::temp_dir().join(format!("strata-scene-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    write(&dir, "tri.ply", &ply(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &[[0, 1, 2]]));
+    write(&dir, "flat.ply", &ply(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]], &[[0, 1, 2]]));
+    let scene = |materials: &str, shapes: &str| {
+        format!(
+            r#"{{"name": "t", "camera": {{"origin": [0,0,-1], "target": [0,0,0], "up": [0,1,0], "fov_deg": 40, "fov_axis": "x",
+            "width": 8, "height": 8, "near_clip": 0.01, "far_clip": 100}},
+            "integrator": {{"type": "path", "max_depth": 8, "rr_depth": 5, "hide_emitters": false}},
+            "materials": {materials}, "shapes": {shapes}, "environment": null}}"#
+        )
+    };
+    let load = |name: &str, text: String| {
+        Scene::load(&write(&dir, name, text.as_bytes())).map(|_| ()).unwrap_err().to_string()
+    };
+    let ok_materials = r#"{"white": {"type": "diffuse", "reflectance": [0.5, 0.5, 0.5], "two_sided": true}}"#;
+    Scene::load(&write(
+        &dir,
+        "ok.json",
+        scene(ok_materials, r#"[{"id": "a", "mesh": "tri.ply", "material": "white"}]"#).as_bytes(),
+    ))
+    .unwrap();
+    let unknown = load("unknown.json", scene(r#"{"m": {"type": "velvet"}}"#, "[]"));
+    assert!(unknown.contains("unknown.json: field `materials.m.type`: unknown variant `velvet`"), "{unknown}");
+    let missing_material =
+        load("nomat.json", scene(ok_materials, r#"[{"id": "a", "mesh": "tri.ply", "material": "gold"}]"#));
+    assert!(missing_material.contains("field `shapes[0].material`: no material named `gold`"), "{missing_material}");
+    let typo = load("typo.json", scene(ok_materials, r#"[{"id": "a", "mesh": "tri.ply", "materail": "white"}]"#));
+    assert!(typo.contains("typo.json: field `shapes[0]") && typo.contains("materail"), "{typo}");
+    let flat = load("flat.json", scene(ok_materials, r#"[{"id": "a", "mesh": "flat.ply", "material": "white"}]"#));
+    assert!(flat.contains("flat.ply: faces: every triangle has zero area"), "{flat}");
+    let no_mesh = load("nomesh.json", scene(ok_materials, r#"[{"id": "a", "mesh": "gone.ply", "material": "white"}]"#));
+    assert!(no_mesh.contains("gone.ply"), "{no_mesh}");
+    let malformed = load("bad.json", "{\"name\": ".into());
+    assert!(malformed.contains("bad.json"), "{malformed}");
+    std::fs::remove_dir_all(dir).unwrap();
+}

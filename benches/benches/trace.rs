@@ -34,15 +34,7 @@ fn trace(c: &mut Criterion) {
     let mut group = c.benchmark_group("trace_50k_tris_262k_rays");
     group.sample_size(10).measurement_time(Duration::from_secs(10)).throughput(Throughput::Elements(rays.len() as u64));
 
-    let tris: Vec<obvhs::triangle::Triangle> = soup
-        .iter()
-        .map(|[a, b, c]| obvhs::triangle::Triangle { v0: Vec3A::from(*a), v1: Vec3A::from(*b), v2: Vec3A::from(*c) })
-        .collect();
-    let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(
-        &tris,
-        obvhs::BvhBuildParams::fast_build(),
-        &mut Duration::default(),
-    );
+    let (tris, bvh) = strata::trace_pass::build_obvhs(&soup);
     group.bench_function("obvhs_native", |b| {
         b.iter(|| {
             let mut hits = 0u32;

@@ -30,21 +30,28 @@ impl SceneBvh {
         if let Some(index) = triangles.iter().position(|t| t.iter().flatten().any(|c| !c.is_finite())) {
             return Err(PassError::Input(format!("triangle {index} has a NaN or infinite coordinate")));
         }
-        let tris: Vec<Triangle> = triangles
-            .iter()
-            .map(|[a, b, c]| Triangle { v0: Vec3A::from(*a), v1: Vec3A::from(*b), v2: Vec3A::from(*c) })
-            .collect();
-        let bvh: Bvh2 = obvhs::bvh2::builder::build_bvh2_from_tris(
-            &tris,
-            obvhs::BvhBuildParams::fast_build(),
-            &mut std::time::Duration::default(),
-        );
+        let (tris, bvh) = build_obvhs(triangles);
         Ok(Self {
             nodes: bytemuck::cast_slice(&bvh.nodes).to_vec(),
             primitive_indices: bvh.primitive_indices.clone(),
             triangles: bytemuck::cast_slice(&tris).to_vec(),
         })
     }
+}
+
+/// obvhs triangles of `triangles` and their BVH2 (fast preset): what [`SceneBvh`]
+/// uploads, and what tests and benchmarks traverse natively to compare.
+pub fn build_obvhs(triangles: &[[[f32; 3]; 3]]) -> (Vec<Triangle>, Bvh2) {
+    let tris: Vec<Triangle> = triangles
+        .iter()
+        .map(|[a, b, c]| Triangle { v0: Vec3A::from(*a), v1: Vec3A::from(*b), v2: Vec3A::from(*c) })
+        .collect();
+    let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(
+        &tris,
+        obvhs::BvhBuildParams::fast_build(),
+        &mut std::time::Duration::default(),
+    );
+    (tris, bvh)
 }
 
 /// The closest-hit pass with its buffers on one backend.

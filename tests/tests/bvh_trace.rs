@@ -10,15 +10,7 @@ use strata_backends::{Backend, gpu_required};
 use strata_kernels::trace_types::{MISS, Ray};
 
 fn obvhs_closest(soup: &[[[f32; 3]; 3]], rays: &[Ray]) -> Vec<(u32, f32)> {
-    let tris: Vec<obvhs::triangle::Triangle> = soup
-        .iter()
-        .map(|[a, b, c]| obvhs::triangle::Triangle { v0: Vec3A::from(*a), v1: Vec3A::from(*b), v2: Vec3A::from(*c) })
-        .collect();
-    let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(
-        &tris,
-        obvhs::BvhBuildParams::fast_build(),
-        &mut std::time::Duration::default(),
-    );
+    let (tris, bvh) = strata::trace_pass::build_obvhs(soup);
     rays.iter()
         .map(|r| {
             let ray = ObvhsRay::new(Vec3A::from(r.origin), Vec3A::from(r.direction), r.tmin, r.tmax);

@@ -92,6 +92,18 @@ pub fn ulp_distance(a: u32, b: u32) -> u32 {
     (ordered(a) - ordered(b)).unsigned_abs().min(u64::from(u32::MAX)) as u32
 }
 
+/// The number of `outside` words (index, got, want) if within the share `max_outside` of
+/// `want`'s words, else the first of them as a mismatch.
+fn allow_outliers(want: &Output, outside: &[(usize, u32, u32)], max_outside: f64) -> Result<usize, Mismatch> {
+    let allowed = (max_outside * want.words.len() as f64).floor() as usize;
+    match outside.first() {
+        Some(&(index, g, w)) if outside.len() > allowed => {
+            Err(Mismatch { output: want.name, index: Some(index), got: u64::from(g), want: u64::from(w) })
+        }
+        _ => Ok(outside.len()),
+    }
+}
+
 /// Compares `got` with `want` output by output.
 pub fn compare_outputs(got: &[Output], want: &[Output]) -> Result<Agreement, Mismatch> {
     let mut agreement = Agreement::default();
@@ -121,17 +133,7 @@ pub fn compare_outputs(got: &[Output], want: &[Output]) -> Result<Agreement, Mis
             }
             Compare::WordsWithOutliers { max_outside } => {
                 let outside: Vec<_> = pairs.filter(|(_, (g, w))| g != w).map(|(i, (&g, &w))| (i, g, w)).collect();
-                let allowed = (max_outside * want.words.len() as f64).floor() as usize;
-                if outside.len() > allowed {
-                    let (index, g, w) = outside[0];
-                    return Err(Mismatch {
-                        output: want.name,
-                        index: Some(index),
-                        got: u64::from(g),
-                        want: u64::from(w),
-                    });
-                }
-                agreement.outside += outside.len();
+                agreement.outside += allow_outliers(want, &outside, max_outside)?;
                 agreement.floats += want.words.len();
             }
             Compare::Float { ulp, max_outside } => {
@@ -144,17 +146,7 @@ pub fn compare_outputs(got: &[Output], want: &[Output]) -> Result<Agreement, Mis
                         outside.push((index, g, w));
                     }
                 }
-                let allowed = (max_outside * want.words.len() as f64).floor() as usize;
-                if outside.len() > allowed {
-                    let (index, g, w) = outside[0];
-                    return Err(Mismatch {
-                        output: want.name,
-                        index: Some(index),
-                        got: u64::from(g),
-                        want: u64::from(w),
-                    });
-                }
-                agreement.outside += outside.len();
+                agreement.outside += allow_outliers(want, &outside, max_outside)?;
                 agreement.floats += want.words.len();
             }
         }

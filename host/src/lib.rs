@@ -5,6 +5,7 @@
 
 pub mod backend_choice;
 pub mod check;
+pub mod estimator;
 pub mod histogram_pass;
 pub mod run_kernel;
 pub mod scene;

@@ -1,0 +1,123 @@
+//! Selection patterns of K = 4 positions in [0, 1) over a sorted pool (paper Fig. 3).
+
+use rand::Rng;
+
+/// Candidates selected per pixel.
+pub const K: usize = 4;
+
+/// How K candidates are taken from a sorted pool of n.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SelectionPattern {
+    /// K independent uniform positions (ReSTIR's random neighbours).
+    UniformRandom,
+    /// Random offset u ∈ [0, 1/K), positions u + j/K.
+    RandomOffset,
+    /// The paper's antithetic pattern: u ∈ [0, ¼), positions {u, ½ − u, ½ + u, 1 − u}.
+    Antithetic,
+}
+
+impl SelectionPattern {
+    /// Every pattern.
+    pub const ALL: [SelectionPattern; 3] =
+        [SelectionPattern::UniformRandom, SelectionPattern::RandomOffset, SelectionPattern::Antithetic];
+
+    /// Positions for the random number(s): one u ∈ [0, 1) scaled as the pattern needs;
+    /// `UniformRandom` draws its own K numbers from `rng`.
+    pub fn positions(self, u: f64, rng: &mut impl Rng) -> [f64; K] {
+        let q = u / K as f64;
+        match self {
+            SelectionPattern::UniformRandom => std::array::from_fn(|_| rng.random::<f64>()),
+            SelectionPattern::RandomOffset => std::array::from_fn(|j| q + j as f64 / K as f64),
+            SelectionPattern::Antithetic => [q, 0.5 - q, 0.5 + q, 1.0 - q],
+        }
+    }
+}
+
+/// Index of position `pos` in a pool of `n`: ⌊pos·n⌋ clamped to n − 1.
+pub fn index_of(pos: f64, n: usize) -> usize {
+    ((pos * n as f64) as usize).min(n - 1)
+}
+
+/// The K selected indices into a sorted pool of `n` (duplicates possible).
+pub fn select(pattern: SelectionPattern, n: usize, rng: &mut impl Rng) -> [usize; K] {
+    let u = rng.random::<f64>();
+    pattern.positions(u, rng).map(|pos| index_of(pos, n))
+}
+
+/// Exact expected selection count of every index of a pool of `n`: for the stratified
+/// patterns each position is affine in u ∈ [0, 1/K) (density K), so the measure of u
+/// mapping to each index is integrated in closed form; uniform random is K/n by
+/// construction.
+pub fn expected_counts(pattern: SelectionPattern, n: usize) -> Vec<f64> {
+    let mut counts = vec![0.0; n];
+    let (offsets, slopes): ([f64; K], [f64; K]) = match pattern {
+        SelectionPattern::UniformRandom => {
+            return vec![K as f64 / n as f64; n];
+        }
+        SelectionPattern::RandomOffset => (std::array::from_fn(|j| j as f64 / K as f64), [1.0; K]),
+        SelectionPattern::Antithetic => ([0.0, 0.5, 0.5, 1.0], [1.0, -1.0, 1.0, -1.0]),
+    };
+    let width = 1.0 / K as f64;
+    for (offset, slope) in offsets.into_iter().zip(slopes) {
+        // pos(u) = offset + slope·u sweeps an interval of length 1/K; the clamp only
+        // matters at pos = 1, a set of measure zero.
+        let (low, high) = if slope > 0.0 { (offset, offset + width) } else { (offset - width, offset) };
+        for (i, count) in counts.iter_mut().enumerate() {
+            let cell = (i as f64 / n as f64, (i + 1) as f64 / n as f64);
+            let overlap = (high.min(cell.1) - low.max(cell.0)).max(0.0);
+            // Density of u is K, and |dpos/du| = 1.
+            *count += K as f64 * overlap;
+        }
+    }
+    counts
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+
+    #[test]
+    fn every_candidate_is_selected_k_over_n_times_on_average() {
+        for pattern in SelectionPattern::ALL {
+            for n in [1, 2, 3, 4, 5, 7, 16, 33, 100, 256] {
+                let counts = expected_counts(pattern, n);
+                let want = K as f64 / n as f64;
+                for (i, c) in counts.iter().enumerate() {
+                    assert!((c - want).abs() < 1e-12, "{pattern:?} n={n} index {i}: {c} != {want}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn sampled_counts_agree_with_the_exact_ones() {
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(3);
+        for pattern in SelectionPattern::ALL {
+            let n = 7;
+            let trials = 200_000;
+            let mut counts = vec![0u32; n];
+            for _ in 0..trials {
+                for index in select(pattern, n, &mut rng) {
+                    counts[index] += 1;
+                }
+            }
+            for (i, &c) in counts.iter().enumerate() {
+                let mean = f64::from(c) / trials as f64;
+                // Counts per trial are at most K: standard error below K / sqrt(trials).
+                assert!(
+                    (mean - K as f64 / n as f64).abs() < 5.0 * K as f64 / (trials as f64).sqrt(),
+                    "{pattern:?} {i}: {mean}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn antithetic_positions_mirror_each_other() {
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(1);
+        let p = SelectionPattern::Antithetic.positions(0.6, &mut rng);
+        assert_eq!(p, [0.15, 0.35, 0.65, 0.85]);
+        assert_eq!(select(SelectionPattern::Antithetic, 1, &mut rng), [0; K]);
+    }
+}

@@ -9,9 +9,13 @@
 //! and counted (the reference scenes contain some: 62 in veach-ajar's door handle); they
 //! cannot be hit and carry no light.
 
+mod camera_rays;
+mod default_scene;
 mod description;
 mod ply;
 
+pub use camera_rays::CameraFrame;
+pub use default_scene::default_scene;
 pub use description::{Camera, EmitterDescription, EnvironmentDescription, MaterialDescription, Reflectance};
 pub use ply::{PlyMesh, read_ply};
 

@@ -8,7 +8,7 @@ use obvhs::bvh2::Bvh2;
 use obvhs::triangle::Triangle;
 use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, BackendError, Bind, BufferId};
-use strata_kernels::trace_types::{GpuBvhNode, GpuTriangle, Hit, Ray, TraceParams};
+use strata_kernels::trace_types::{CameraParams, GpuBvhNode, GpuTriangle, Hit, Ray, TraceParams};
 use strata_kernels::{Kernel, KernelId, Registry};
 
 /// A triangle mesh with its BVH, in the layout the kernel reads.
@@ -117,4 +117,21 @@ impl TracePass {
         }
         Ok(())
     }
+}
+
+/// One primary ray per pixel from the `camera_rays` kernel.
+pub fn camera_rays(backend: &mut dyn Backend, params: &CameraParams) -> Result<Vec<Ray>, PassError> {
+    if params.width == 0 || params.height == 0 {
+        return Err(PassError::Input(format!("image size {}x{}: must be at least 1x1", params.width, params.height)));
+    }
+    let kernel = Registry::shared()?.get(KernelId::CameraRays);
+    let pixels = params.width as u64 * params.height as u64;
+    let params_buffer = upload(backend, "camera params", std::slice::from_ref(params))?;
+    let rays_buffer = backend.create_buffer("camera rays", pixels * size_of::<Ray>() as u64)?;
+    let workgroups = [params.width.div_ceil(8), params.height.div_ceil(8), 1];
+    let result = backend.dispatch(kernel, &[Bind::new(0, params_buffer), Bind::new(1, rays_buffer)], workgroups);
+    let rays = result.and_then(|()| download::<Ray>(backend, rays_buffer));
+    backend.destroy_buffer(params_buffer)?;
+    backend.destroy_buffer(rays_buffer)?;
+    Ok(rays?)
 }

@@ -4,7 +4,7 @@
 //! read garbage without any error. [`check_struct`] compares the host struct's size and
 //! every field's name, offset and size with naga's layout of the WGSL struct.
 
-use crate::trace_types::{GpuBvhNode, GpuTriangle, Hit, Ray, TraceParams};
+use crate::trace_types::{CameraParams, GpuBvhNode, GpuTriangle, Hit, Ray, TraceParams};
 use crate::types::{BlockStats, Candidate, ClusterSpan, HistogramParams};
 use naga::proc::Layouter;
 
@@ -60,6 +60,11 @@ shader_struct!(GpuTriangle, "Triangle", [v0, _pad0, v1, _pad1, v2, _pad2]);
 shader_struct!(Ray, "Ray", [origin, tmin, direction, tmax]);
 shader_struct!(Hit, "Hit", [t, u, v, primitive]);
 shader_struct!(TraceParams, "TraceParams", [ray_count, workgroups_x, _pad0, _pad1]);
+shader_struct!(
+    CameraParams,
+    "CameraParams",
+    [origin, near_clip, forward, tan_half_x, right, tan_half_y, up, far_clip, width, height, jitter_seed, _pad]
+);
 
 /// Compares `T` with the struct `T::WGSL_NAME` of `module`; the error lists every
 /// difference.

@@ -2,3 +2,4 @@
 
 pub mod block_histogram;
 pub mod bvh_trace;
+pub mod camera_rays;

@@ -20,6 +20,8 @@ pub enum KernelId {
     Empty,
     /// Closest hit of a batch of rays through obvhs' BVH2, watertight triangle test.
     BvhClosestHit,
+    /// Primary rays of the pinhole camera, one per pixel, optionally jittered.
+    CameraRays,
     /// A kernel from outside the registry ([`Kernel::from_wgsl`]), keyed by a hash of its
     /// source and entry point so that backends can cache its pipeline.
     External(u64),
@@ -27,8 +29,13 @@ pub enum KernelId {
 
 impl KernelId {
     /// Every registry kernel.
-    pub const ALL: [KernelId; 4] =
-        [KernelId::BlockHistogram, KernelId::BlockHistogramSubgroup, KernelId::Empty, KernelId::BvhClosestHit];
+    pub const ALL: [KernelId; 5] = [
+        KernelId::BlockHistogram,
+        KernelId::BlockHistogramSubgroup,
+        KernelId::Empty,
+        KernelId::BvhClosestHit,
+        KernelId::CameraRays,
+    ];
 
     /// What the registry knows of this kernel before parsing it.
     pub fn spec(self) -> Option<KernelSpec> {
@@ -63,6 +70,15 @@ impl KernelId {
                 // Backends may contract products into fused multiply-adds; hits that change
                 // triangle at near-ties are counted separately (see the check).
                 float_ulp_bound: Some(8),
+            },
+            KernelId::CameraRays => KernelSpec {
+                name: "camera_rays".into(),
+                fragments: vec![fragment!("trace/bvh.wgsl"), fragment!("trace/camera_rays.wgsl")],
+                entry_point: "camera_rays_main".into(),
+                features: KernelFeatures::empty(),
+                // normalize() and the divisions may round differently (inverse square
+                // root, reciprocals, fused multiply-adds).
+                float_ulp_bound: Some(16),
             },
             KernelId::External(_) => return None,
         })
@@ -353,6 +369,10 @@ mod tests {
         let registry = Registry::load().unwrap_or_else(|e| panic!("{e}"));
         for kernel in registry.kernels() {
             let module = &kernel.module;
+            if kernel.id == KernelId::CameraRays {
+                check_struct::<crate::trace_types::CameraParams>(module).unwrap_or_else(|e| panic!("{e}"));
+                continue;
+            }
             if kernel.id == KernelId::BvhClosestHit {
                 use crate::trace_types::{GpuBvhNode, GpuTriangle, Hit, Ray, TraceParams};
                 for result in [

@@ -92,3 +92,33 @@ pub struct TraceParams {
     /// Padding.
     pub _pad1: u32,
 }
+
+/// The pinhole camera of the `camera_rays` kernel (WGSL `CameraParams`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct CameraParams {
+    /// Eye position.
+    pub origin: [f32; 3],
+    /// Near clip distance along `forward`.
+    pub near_clip: f32,
+    /// Unit viewing direction.
+    pub forward: [f32; 3],
+    /// tan of half the horizontal field of view.
+    pub tan_half_x: f32,
+    /// Unit right vector (image +x).
+    pub right: [f32; 3],
+    /// tan of half the vertical field of view.
+    pub tan_half_y: f32,
+    /// Unit up vector (image −y).
+    pub up: [f32; 3],
+    /// tmax of the rays.
+    pub far_clip: f32,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// 0: pixel centres; otherwise the seed of the per-pixel jitter.
+    pub jitter_seed: u32,
+    /// Padding.
+    pub _pad: u32,
+}

@@ -4,6 +4,7 @@
 //! float outputs must stay within the ULP bound the registry declares for the kernel.
 
 mod backends;
+mod camera;
 mod compare;
 mod empty;
 mod histogram;
@@ -62,6 +63,7 @@ pub fn kernel_checks() -> Vec<Box<dyn KernelCheck>> {
         Box::new(histogram::HistogramCheck(KernelId::BlockHistogramSubgroup)),
         Box::new(empty::EmptyCheck),
         Box::new(trace::TraceCheck),
+        Box::new(camera::CameraCheck),
     ]
 }
 

@@ -6,6 +6,7 @@
 
 use super::Camera;
 use glam::Vec3;
+use strata_kernels::trace_types::CameraParams;
 
 /// The camera's frame and field of view, ready to make rays.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -43,6 +44,25 @@ impl CameraFrame {
             _ => return None,
         };
         Some(CameraFrame { origin, forward, right, up, tan_half_x, tan_half_y, near_clip: camera.near_clip })
+    }
+
+    /// The `camera_rays` kernel's parameters for a `width × height` image; `jitter_seed`
+    /// 0 gives pixel centres.
+    pub fn params(&self, width: u32, height: u32, far_clip: f32, jitter_seed: u32) -> CameraParams {
+        CameraParams {
+            origin: self.origin.into(),
+            near_clip: self.near_clip,
+            forward: self.forward.into(),
+            tan_half_x: self.tan_half_x,
+            right: self.right.into(),
+            tan_half_y: self.tan_half_y,
+            up: self.up.into(),
+            far_clip,
+            width,
+            height,
+            jitter_seed,
+            _pad: 0,
+        }
     }
 
     /// The ray through film position (px, py): its start on the near plane and its unit
@@ -89,5 +109,18 @@ mod tests {
         let x_axis = CameraFrame::new(&camera(200, 100, "x")).unwrap();
         assert!((x_axis.tan_half_x - 1.0).abs() < 1e-6 && (x_axis.tan_half_y - 0.5).abs() < 1e-6);
         assert!(CameraFrame::new(&camera(8, 8, "diagonal")).is_none());
+    }
+
+    #[test]
+    fn the_kernel_reference_makes_the_same_rays() {
+        let camera = camera(16, 8, "smaller");
+        let frame = CameraFrame::new(&camera).unwrap();
+        let params = frame.params(16, 8, 100.0, 0);
+        for (x, y) in [(0, 0), (7, 3), (15, 7)] {
+            let ray = strata_kernels::reference::camera_rays::camera_ray(&params, x, y);
+            let (origin, direction) = frame.ray((x as f32 + 0.5) / 16.0, (y as f32 + 0.5) / 8.0);
+            assert!((Vec3::from(ray.direction) - direction).length() < 1e-6);
+            assert!((Vec3::from(ray.origin) - origin).length() < 1e-5);
+        }
     }
 }

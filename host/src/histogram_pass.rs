@@ -119,6 +119,21 @@ impl BlockHistogramPass {
         self.workgroups
     }
 
+    /// Fills every output buffer with `pattern`, so that an element the kernel fails to
+    /// write is caught by a comparison (tests and the cross-backend check).
+    pub fn poison_outputs(&self, backend: &mut dyn Backend, pattern: u32) -> Result<(), PassError> {
+        let pixels = self.grid.pixel_count();
+        let words = [
+            (self.sorted_pixels, pixels),
+            (self.spans, pixels * size_of::<ClusterSpan>() / 4),
+            (self.block_stats, self.grid.block_count() as usize * size_of::<BlockStats>() / 4),
+        ];
+        for (buffer, count) in words {
+            backend.write_buffer(buffer, 0, bytemuck::cast_slice(&vec![pattern; count]))?;
+        }
+        Ok(())
+    }
+
     /// Uploads one candidate per pixel.
     pub fn upload_candidates(&self, backend: &mut dyn Backend, candidates: &[Candidate]) -> Result<(), PassError> {
         if candidates.len() != self.grid.pixel_count() {

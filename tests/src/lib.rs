@@ -29,9 +29,3 @@ pub fn open_or_skip(test: &str, options: WgpuOptions) -> Option<WgpuBackend> {
 /// A 32-bit pattern written into output buffers before a run, so that elements the
 /// kernel fails to write are caught.
 pub const POISON: u32 = 0xdead_beef;
-
-/// Fills a whole backend buffer with [`POISON`].
-pub fn poison(backend: &mut dyn strata_backends::Backend, buffer: strata_backends::BufferId, bytes: u64) {
-    let words = vec![POISON; (bytes / 4) as usize];
-    backend.write_buffer(buffer, 0, bytemuck::cast_slice(&words)).unwrap();
-}

@@ -7,8 +7,8 @@ use strata::synthetic::{CandidateMix, candidate_image};
 use strata_backends::Backend;
 use strata_kernels::BlockGrid;
 use strata_kernels::reference::block_histogram::{HistogramOutput, block_histogram};
-use strata_kernels::types::{BLOCK_SIZES, Candidate, ClusterSpan};
-use strata_tests::{poison, vulkan_backend};
+use strata_kernels::types::{BLOCK_SIZES, Candidate};
+use strata_tests::{POISON, vulkan_backend};
 
 fn run_poisoned(
     backend: &mut dyn Backend,
@@ -17,10 +17,7 @@ fn run_poisoned(
     candidates: &[Candidate],
 ) -> HistogramOutput {
     let pass = BlockHistogramPass::new(backend, variant, grid).unwrap_or_else(|e| panic!("{e}"));
-    let pixels = grid.pixel_count() as u64;
-    poison(backend, pass.sorted_pixels, pixels * 4);
-    poison(backend, pass.spans, pixels * size_of::<ClusterSpan>() as u64);
-    poison(backend, pass.block_stats, u64::from(grid.block_count()) * 12);
+    pass.poison_outputs(backend, POISON).unwrap();
     let output = pass.run(backend, candidates).unwrap_or_else(|e| panic!("{e}"));
     pass.destroy(backend).unwrap();
     output

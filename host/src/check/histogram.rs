@@ -72,13 +72,7 @@ impl KernelCheck for HistogramCheck {
             _ => HistogramVariant::Portable,
         };
         let pass = BlockHistogramPass::new(backend, variant, grid)?;
-        let pixels = grid.pixel_count();
-        // Poison the outputs so that an element the kernel fails to write is caught.
-        let poison = vec![0xdead_beef_u32; pixels * 3];
-        backend.write_buffer(pass.sorted_pixels, 0, bytemuck::cast_slice(&poison[..pixels]))?;
-        backend.write_buffer(pass.spans, 0, bytemuck::cast_slice(&poison[..pixels * 3]))?;
-        let stats_words = grid.block_count() as usize * 3;
-        backend.write_buffer(pass.block_stats, 0, bytemuck::cast_slice(&vec![0xdead_beef_u32; stats_words]))?;
+        pass.poison_outputs(backend, 0xdead_beef)?;
         let result = pass.run(backend, &candidates(case));
         pass.destroy(backend)?;
         Ok(outputs(result?))

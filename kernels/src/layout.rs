@@ -4,6 +4,7 @@
 //! read garbage without any error. [`check_struct`] compares the host struct's size and
 //! every field's name, offset and size with naga's layout of the WGSL struct.
 
+use crate::render_types::{EmissiveTriangle, GpuMaterial, RenderParams, TriangleInfo};
 use crate::trace_types::{CameraParams, GpuBvhNode, GpuTriangle, Hit, Ray, TraceParams};
 use crate::types::{BlockStats, Candidate, ClusterSpan, HistogramParams};
 use naga::proc::Layouter;
@@ -65,6 +66,48 @@ shader_struct!(
     "CameraParams",
     [origin, near_clip, forward, tan_half_x, right, tan_half_y, up, far_clip, width, height, jitter_seed, _pad]
 );
+
+shader_struct!(
+    RenderParams,
+    "RenderParams",
+    [
+        width,
+        height,
+        sample_index,
+        seed,
+        max_depth,
+        rr_depth,
+        light_count,
+        flags,
+        camera_origin,
+        near_clip,
+        camera_forward,
+        tan_half_x,
+        camera_right,
+        tan_half_y,
+        camera_up,
+        environment_probability,
+        env_from_world_0,
+        env_scale,
+        env_from_world_1,
+        env_width,
+        env_from_world_2,
+        env_height,
+        env_to_world_0,
+        env_texel_offset,
+        env_to_world_1,
+        _pad0,
+        env_to_world_2,
+        ray_epsilon,
+    ]
+);
+shader_struct!(TriangleInfo, "TriangleInfo", [object_id, material, light, has_uv, uv0, uv1, uv2, _pad0, _pad1]);
+shader_struct!(
+    GpuMaterial,
+    "Material",
+    [kind, two_sided, albedo_kind, texel_offset, color0, alpha, color1, eta, uv_scale, texture_width, texture_height]
+);
+shader_struct!(EmissiveTriangle, "EmissiveTriangle", [radiance, triangle, cdf, probability, area, _pad]);
 
 /// Compares `T` with the struct `T::WGSL_NAME` of `module`; the error lists every
 /// difference.

@@ -16,6 +16,7 @@ pub mod glslang;
 pub mod layout;
 pub mod reference;
 pub mod registry;
+pub mod render_types;
 pub mod source;
 pub mod trace_types;
 pub mod translate;

@@ -22,6 +22,9 @@ pub enum KernelId {
     BvhClosestHit,
     /// Primary rays of the pinhole camera, one per pixel, optionally jittered.
     CameraRays,
+    /// Progressive path tracing: one sample per pixel added to a running sum (NEE + MIS,
+    /// area and environment lights, diffuse, GGX conductor, dielectric).
+    PathTrace,
     /// A kernel from outside the registry ([`Kernel::from_wgsl`]), keyed by a hash of its
     /// source and entry point so that backends can cache its pipeline.
     External(u64),
@@ -29,12 +32,13 @@ pub enum KernelId {
 
 impl KernelId {
     /// Every registry kernel.
-    pub const ALL: [KernelId; 5] = [
+    pub const ALL: [KernelId; 6] = [
         KernelId::BlockHistogram,
         KernelId::BlockHistogramSubgroup,
         KernelId::Empty,
         KernelId::BvhClosestHit,
         KernelId::CameraRays,
+        KernelId::PathTrace,
     ];
 
     /// What the registry knows of this kernel before parsing it.
@@ -64,7 +68,11 @@ impl KernelId {
             },
             KernelId::BvhClosestHit => KernelSpec {
                 name: "bvh_closest_hit".into(),
-                fragments: vec![fragment!("trace/bvh.wgsl"), fragment!("trace/entry_closest_hit.wgsl")],
+                fragments: vec![
+                    fragment!("trace/bvh.wgsl"),
+                    fragment!("trace/traverse.wgsl"),
+                    fragment!("trace/entry_closest_hit.wgsl"),
+                ],
                 entry_point: "bvh_closest_hit".into(),
                 features: KernelFeatures::empty(),
                 // Backends may contract products into fused multiply-adds; hits that change
@@ -79,6 +87,26 @@ impl KernelId {
                 // normalize() and the divisions may round differently (inverse square
                 // root, reciprocals, fused multiply-adds).
                 float_ulp_bound: Some(16),
+            },
+            KernelId::PathTrace => KernelSpec {
+                name: "path_trace".into(),
+                fragments: vec![
+                    fragment!("trace/bvh.wgsl"),
+                    fragment!("trace/traverse.wgsl"),
+                    fragment!("render/scene.wgsl"),
+                    fragment!("render/random.wgsl"),
+                    fragment!("render/environment.wgsl"),
+                    fragment!("render/albedo.wgsl"),
+                    fragment!("render/bsdf.wgsl"),
+                    fragment!("render/lights.wgsl"),
+                    fragment!("render/path.wgsl"),
+                    fragment!("render/entry_path_trace.wgsl"),
+                ],
+                entry_point: "path_trace".into(),
+                features: KernelFeatures::empty(),
+                // Paths branch on float comparisons: a one-ULP difference can send a
+                // path elsewhere, so pixels are compared with a bound and outliers.
+                float_ulp_bound: Some(64),
             },
             KernelId::External(_) => return None,
         })
@@ -387,6 +415,23 @@ mod tests {
                 continue;
             }
             if kernel.id == KernelId::Empty {
+                continue;
+            }
+            if kernel.id == KernelId::PathTrace {
+                use crate::render_types::{EmissiveTriangle, GpuMaterial, RenderParams, TriangleInfo};
+                use crate::trace_types::{GpuBvhNode, GpuTriangle, Hit, Ray};
+                for result in [
+                    check_struct::<RenderParams>(module),
+                    check_struct::<TriangleInfo>(module),
+                    check_struct::<GpuMaterial>(module),
+                    check_struct::<EmissiveTriangle>(module),
+                    check_struct::<GpuBvhNode>(module),
+                    check_struct::<GpuTriangle>(module),
+                    check_struct::<Ray>(module),
+                    check_struct::<Hit>(module),
+                ] {
+                    result.unwrap_or_else(|e| panic!("{}: {e}", kernel.name()));
+                }
                 continue;
             }
             for result in [

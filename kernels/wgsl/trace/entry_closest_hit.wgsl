@@ -1,4 +1,4 @@
-// Closest-hit query for a batch of rays through obvhs' BVH2 (see bvh.wgsl).
+// Closest-hit query for a batch of rays through obvhs' BVH2 (bvh.wgsl, traverse.wgsl).
 //
 // Bindings (group 0):
 //   0 uniform            TraceParams     ray count, dispatch width
@@ -19,8 +19,6 @@ struct TraceParams {
     _pad1: u32,
 }
 
-const TRACE_STACK_DEPTH: u32 = 48u;
-
 @group(0) @binding(0) var<uniform> trace_params: TraceParams;
 @group(0) @binding(1) var<storage, read> nodes: array<BvhNode>;
 @group(0) @binding(2) var<storage, read> primitive_indices: array<u32>;
@@ -39,60 +37,9 @@ fn bvh_closest_hit(
     if index >= trace_params.ray_count {
         return;
     }
-    let ray = rays[index];
-    let shear = make_shear(ray.direction);
-    let inv_dir = safe_inverse(ray.direction);
-    var best = Hit(ray.tmax, 0.0, 0.0, MISS);
-    let base = lane * TRACE_STACK_DEPTH;
-    var depth = 0u;
-    var node_index = 0u;
-    var overflow = false;
-    if enter_box(nodes[0], ray.origin, inv_dir, ray.tmin, best.t) > best.t {
-        hits[index] = best;
-        return;
-    }
-    loop {
-        let node = nodes[node_index];
-        if node.prim_count > 0u {
-            for (var i = 0u; i < node.prim_count; i++) {
-                let primitive = primitive_indices[node.first_index + i];
-                let hit = intersect_triangle(ray, shear, triangles[primitive]);
-                if hit.x > ray.tmin && hit.x < best.t {
-                    best = Hit(hit.x, hit.y, hit.z, primitive);
-                }
-            }
-        } else {
-            let left = node.first_index;
-            let right = left + 1u;
-            let t_left = enter_box(nodes[left], ray.origin, inv_dir, ray.tmin, best.t);
-            let t_right = enter_box(nodes[right], ray.origin, inv_dir, ray.tmin, best.t);
-            let hit_left = t_left <= best.t;
-            let hit_right = t_right <= best.t;
-            if hit_left && hit_right {
-                // Visit the nearer child first; the farther one waits on the stack.
-                let near_is_left = t_left <= t_right;
-                if depth == TRACE_STACK_DEPTH {
-                    overflow = true;
-                    break;
-                }
-                trace_stack[base + depth] = select(left, right, near_is_left);
-                depth += 1u;
-                node_index = select(right, left, near_is_left);
-                continue;
-            }
-            if hit_left || hit_right {
-                node_index = select(right, left, hit_left);
-                continue;
-            }
-        }
-        if depth == 0u {
-            break;
-        }
-        depth -= 1u;
-        node_index = trace_stack[base + depth];
-    }
-    if overflow {
-        best = Hit(ray.tmax, 0.0, 0.0, STACK_OVERFLOW);
-    }
-    hits[index] = best;
+    hits[index] = traverse(rays[index], lane, false);
+}
+
+fn leaf_triangle(slot: u32) -> u32 {
+    return primitive_indices[slot];
 }

@@ -1,0 +1,190 @@
+// The scene as the path-tracing kernels see it: the frame's parameters, the BVH with its
+// triangles in leaf order, per-triangle attributes, materials, emissive triangles,
+// texels (textures and the environment map) and the environment's sampling CDFs.
+// Host twins: strata_kernels::render_types.
+//
+// Bindings (group 0), shared by every kernel that includes this fragment:
+//   0 uniform            RenderParams              image, camera, environment, flags
+//   1 storage, read      array<BvhNode>            obvhs Bvh2 nodes (root at 0)
+//   2 storage, read      array<Triangle>           triangles in BVH leaf order
+//   3 storage, read      array<TriangleInfo>       object id, material, light, UVs
+//   4 storage, read      array<Material>           materials
+//   5 storage, read      array<EmissiveTriangle>   area lights with their selection CDF
+//   6 storage, read      array<vec4<f32>>          texels: textures, then the environment
+//   7 storage, read      array<f32>                environment CDFs (marginal, conditionals)
+
+// RenderParams.flags
+const FLAG_SAMPLE_LIGHTS: u32 = 1u;      // next-event estimation
+const FLAG_HIT_LIGHTS: u32 = 2u;         // emission found by BSDF sampling counts
+const FLAG_RUSSIAN_ROULETTE: u32 = 4u;   // from depth rr_depth
+
+// Material.kind
+const MATERIAL_DIFFUSE: u32 = 0u;
+const MATERIAL_CONDUCTOR: u32 = 1u;
+const MATERIAL_DIELECTRIC: u32 = 2u;
+
+// Material.albedo_kind
+const ALBEDO_CONSTANT: u32 = 0u;
+const ALBEDO_CHECKERBOARD: u32 = 1u;
+const ALBEDO_TEXTURE: u32 = 2u;
+
+// TriangleInfo.light when the triangle does not emit.
+const NO_LIGHT: u32 = 0xffffffffu;
+
+const PI: f32 = 3.14159265358979;
+const INFINITY: f32 = 3.4028235e38;
+
+struct RenderParams {
+    width: u32,
+    height: u32,
+    // Index of the sample within the pixel's sequence (the frame, progressively).
+    sample_index: u32,
+    seed: u32,
+    // Path segments including the camera ray (CONVENTIONS.md).
+    max_depth: u32,
+    rr_depth: u32,
+    light_count: u32,
+    flags: u32,
+    camera_origin: vec3<f32>,
+    near_clip: f32,
+    camera_forward: vec3<f32>,
+    tan_half_x: f32,
+    camera_right: vec3<f32>,
+    tan_half_y: f32,
+    camera_up: vec3<f32>,
+    // Probability of sampling the environment rather than an area light in NEE.
+    environment_probability: f32,
+    // Rows of inverse(R): world direction -> environment direction.
+    env_from_world_0: vec3<f32>,
+    env_scale: f32,
+    env_from_world_1: vec3<f32>,
+    env_width: u32,
+    env_from_world_2: vec3<f32>,
+    env_height: u32,
+    // Rows of R: environment direction -> world direction.
+    env_to_world_0: vec3<f32>,
+    env_texel_offset: u32,
+    env_to_world_1: vec3<f32>,
+    _pad0: u32,
+    env_to_world_2: vec3<f32>,
+    // Scale of the ray-origin offset that avoids self-intersection (scene extent).
+    ray_epsilon: f32,
+}
+
+struct TriangleInfo {
+    object_id: u32,
+    material: u32,
+    light: u32,
+    // 1 when the mesh has UVs; otherwise the surface UV is the hit's barycentrics.
+    has_uv: u32,
+    uv0: vec2<f32>,
+    uv1: vec2<f32>,
+    uv2: vec2<f32>,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+struct Material {
+    kind: u32,
+    two_sided: u32,
+    albedo_kind: u32,
+    texel_offset: u32,
+    // Diffuse reflectance, checkerboard colour 0, or the conductor's eta.
+    color0: vec3<f32>,
+    // GGX alpha of a conductor.
+    alpha: f32,
+    // Checkerboard colour 1, or the conductor's k.
+    color1: vec3<f32>,
+    // Interior / exterior IOR of a dielectric.
+    eta: f32,
+    uv_scale: vec2<f32>,
+    texture_width: u32,
+    texture_height: u32,
+}
+
+struct EmissiveTriangle {
+    radiance: vec3<f32>,
+    // Index into `triangles`.
+    triangle: u32,
+    // Inclusive CDF of selection (the last one is exactly 1).
+    cdf: f32,
+    probability: f32,
+    area: f32,
+    _pad: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: RenderParams;
+@group(0) @binding(1) var<storage, read> nodes: array<BvhNode>;
+@group(0) @binding(2) var<storage, read> triangles: array<Triangle>;
+@group(0) @binding(3) var<storage, read> triangle_info: array<TriangleInfo>;
+@group(0) @binding(4) var<storage, read> materials: array<Material>;
+@group(0) @binding(5) var<storage, read> lights: array<EmissiveTriangle>;
+@group(0) @binding(6) var<storage, read> texels: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read> environment_cdf: array<f32>;
+
+var<workgroup> trace_stack: array<u32, 3072>;
+
+// The triangles were reordered into leaf order on the host.
+fn leaf_triangle(slot: u32) -> u32 {
+    return slot;
+}
+
+// What a ray hit, in world space.
+struct Surface {
+    position: vec3<f32>,
+    // Unit geometric normal (counter-clockwise winding), not flipped.
+    normal: vec3<f32>,
+    uv: vec2<f32>,
+    object_id: u32,
+    material: u32,
+    light: u32,
+}
+
+fn surface_at(hit: Hit) -> Surface {
+    let tri = triangles[hit.primitive];
+    let info = triangle_info[hit.primitive];
+    let w = 1.0 - hit.u - hit.v;
+    let position = w * tri.v0 + hit.u * tri.v1 + hit.v * tri.v2;
+    let normal = normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
+    var uv = vec2<f32>(hit.u, hit.v);
+    if info.has_uv != 0u {
+        uv = w * info.uv0 + hit.u * info.uv1 + hit.v * info.uv2;
+    }
+    return Surface(position, normal, uv, info.object_id, info.material, info.light);
+}
+
+// A ray leaving `position` along `direction`, its origin pushed off the surface to the
+// side the ray goes, so it cannot hit the triangle it starts on.
+fn spawn_ray(position: vec3<f32>, normal: vec3<f32>, direction: vec3<f32>, tmax: f32) -> Ray {
+    let side = select(-normal, normal, dot(normal, direction) > 0.0);
+    let extent = max(max(abs(position.x), abs(position.y)), max(abs(position.z), 1.0));
+    let origin = position + side * (params.ray_epsilon * extent);
+    return Ray(origin, 0.0, direction, tmax);
+}
+
+// True when nothing blocks the segment from `position` (on a surface with `normal`) to
+// `target_point`, which lies on a light.
+fn visible(position: vec3<f32>, normal: vec3<f32>, target_point: vec3<f32>, lane: u32) -> bool {
+    let to_target = target_point - position;
+    let distance = length(to_target);
+    let direction = to_target / distance;
+    let ray = spawn_ray(position, normal, direction, distance * (1.0 - 1e-4));
+    return traverse(ray, lane, true).primitive == MISS;
+}
+
+// True when nothing blocks the ray from `position` towards the environment.
+fn unoccluded(position: vec3<f32>, normal: vec3<f32>, direction: vec3<f32>, lane: u32) -> bool {
+    return traverse(spawn_ray(position, normal, direction, INFINITY), lane, true).primitive == MISS;
+}
+
+// The camera ray through film position `film` (pixels, (0, 0) the top-left corner),
+// starting on the near plane (CONVENTIONS.md "Camera").
+fn camera_ray(film: vec2<f32>) -> Ray {
+    let px = film.x / f32(params.width);
+    let py = film.y / f32(params.height);
+    let sx = (2.0 * px - 1.0) * params.tan_half_x;
+    let sy = (2.0 * py - 1.0) * params.tan_half_y;
+    let direction = normalize(params.camera_forward + sx * params.camera_right - sy * params.camera_up);
+    let start = params.camera_origin + direction * (params.near_clip / dot(direction, params.camera_forward));
+    return Ray(start, 0.0, direction, INFINITY);
+}

@@ -7,6 +7,8 @@ pub mod backend_choice;
 pub mod check;
 pub mod estimator;
 pub mod histogram_pass;
+pub mod render;
+pub mod rgb_image;
 pub mod run_kernel;
 pub mod scene;
 pub mod synthetic;

@@ -1,10 +1,13 @@
 //! The `strata` command line.
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
+use std::path::PathBuf;
 use std::time::Instant;
 use strata::backend_choice::{BackendChoice, open_backend};
 use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
+use strata::render::{GpuScene, LightSampling, RenderSettings};
+use strata::scene::{default_scene, load_scene_file};
 use strata::synthetic::{CandidateMix, candidate_image};
 use strata_kernels::BlockGrid;
 use strata_kernels::reference::block_histogram::block_histogram;
@@ -22,6 +25,46 @@ enum Command {
     /// Run the block-histogram kernel on a generated candidate image, check it against
     /// the Rust reference and print what it did.
     Histogram(HistogramArgs),
+    /// Path-trace a scene progressively (the reference mode) and write a linear float EXR
+    /// and a tone-mapped sRGB PNG preview.
+    Render(RenderArgs),
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// Scene file (`scene.json` of the shared scenes); the built-in default scene when
+    /// left out.
+    scene: Option<PathBuf>,
+    /// Samples per pixel.
+    #[arg(long, default_value_t = 64)]
+    spp: u32,
+    /// Output folder (created if missing).
+    #[arg(long, default_value = "out/render")]
+    out: PathBuf,
+    /// Image width (default: the scene camera's).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height (default: the scene camera's).
+    #[arg(long)]
+    height: Option<u32>,
+    /// Path segments including the camera ray (default: the scene's).
+    #[arg(long)]
+    max_depth: Option<u32>,
+    /// Seed of the render.
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// How light is found.
+    #[arg(long, value_enum, default_value_t = LightSampling::Mis)]
+    light_sampling: LightSampling,
+    /// Turn Russian roulette off.
+    #[arg(long)]
+    no_russian_roulette: bool,
+    /// Exposure of the PNG preview (the EXR is never scaled).
+    #[arg(long, default_value_t = 1.0)]
+    exposure: f32,
+    /// Backend to run on.
+    #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
+    backend: BackendChoice,
 }
 
 #[derive(clap::Args)]
@@ -65,7 +108,80 @@ enum VariantArg {
 fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Histogram(args) => histogram(args),
+        Command::Render(args) => render(args),
     }
+}
+
+fn render(args: RenderArgs) -> Result<()> {
+    let scene = match &args.scene {
+        Some(path) => load_scene_file(path)?,
+        None => default_scene(),
+    };
+    let mut camera = scene.camera.clone();
+    camera.width = args.width.unwrap_or(camera.width);
+    camera.height = args.height.unwrap_or(camera.height);
+    if args.spp == 0 {
+        bail!("--spp 0: at least one sample per pixel is needed");
+    }
+    let settings = RenderSettings {
+        camera,
+        seed: args.seed,
+        max_depth: args.max_depth.unwrap_or(scene.max_depth),
+        rr_depth: scene.rr_depth,
+        light_sampling: args.light_sampling,
+        russian_roulette: !args.no_russian_roulette,
+    };
+    let gpu_scene = GpuScene::build(&scene)?;
+    let mut backend = open_backend(args.backend)?;
+    println!("backend: {}", backend.info().summary());
+    println!(
+        "scene: {} ({} triangles, {} emissive, environment: {}), {}x{}, {} spp, max depth {}",
+        scene.name,
+        gpu_scene.triangles.len(),
+        gpu_scene.light_count(),
+        if scene.environment.is_some() { "yes" } else { "no" },
+        settings.camera.width,
+        settings.camera.height,
+        args.spp,
+        settings.max_depth
+    );
+    std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create the folder", args.out.display()))?;
+    let bar = indicatif::ProgressBar::new(u64::from(args.spp));
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} spp, {elapsed} elapsed, eta {eta}")
+            .expect("a valid template"),
+    );
+    let started = Instant::now();
+    let image = strata::render::render(backend.as_mut(), &gpu_scene, &settings, args.spp, |done| {
+        bar.set_position(u64::from(done))
+    })?;
+    bar.finish_and_clear();
+    let seconds = started.elapsed().as_secs_f64();
+    let stem = args.scene.as_ref().and_then(|p| scene_stem(p)).unwrap_or_else(|| "default".into());
+    let exr = args.out.join(format!("{stem}.exr"));
+    let png = args.out.join(format!("{stem}.png"));
+    image.write_exr(&exr)?;
+    image.write_png(&png, args.exposure)?;
+    let mean = image.mean();
+    println!(
+        "rendered in {seconds:.1} s ({:.1} ms per sample per pixel); mean radiance ({:.4}, {:.4}, {:.4})",
+        seconds * 1e3 / f64::from(args.spp),
+        mean[0],
+        mean[1],
+        mean[2]
+    );
+    println!("wrote {} and {}", exr.display(), png.display());
+    Ok(())
+}
+
+/// `cornell-box` for `.../cornell-box/scene.json`, else the file stem.
+fn scene_stem(path: &std::path::Path) -> Option<String> {
+    let stem = path.file_stem()?.to_string_lossy().into_owned();
+    if stem.starts_with("scene") {
+        let folder = path.parent()?.file_name()?.to_string_lossy().into_owned();
+        return Some(format!("{folder}{}", &stem["scene".len()..]));
+    }
+    Some(stem)
 }
 
 fn histogram(args: HistogramArgs) -> Result<()> {

@@ -2,7 +2,7 @@
 //! with errors that name the file and the field or element.
 
 use std::path::{Path, PathBuf};
-use strata::scene::{MaterialDescription, Scene, SceneError, read_ply};
+use strata::scene::{Material, Scene, SceneError, read_ply};
 
 fn shared_scenes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/scenes")
@@ -26,6 +26,7 @@ fn every_shared_scene_loads_with_object_ids_and_emitters() {
         assert_eq!(scene.environment.is_some(), environment, "{name}");
         if let Some(environment) = &scene.environment {
             assert!(environment.file.exists(), "{}", environment.file.display());
+            assert!(environment.width > 0 && environment.texels.len() == (environment.width * environment.height) as usize);
         }
         for (index, shape) in scene.shapes.iter().enumerate() {
             assert_eq!(shape.object_id, index as u32);
@@ -38,8 +39,8 @@ fn every_shared_scene_loads_with_object_ids_and_emitters() {
     let veach = Scene::load(&root.join("veach-ajar/scene.json")).unwrap();
     let dropped: usize = veach.shapes.iter().map(|s| s.degenerate_dropped).sum();
     assert_eq!(dropped, 62, "the door handle's zero-area triangles are dropped and counted");
-    assert!(veach.materials.iter().any(|m| matches!(m, MaterialDescription::Dielectric { .. })));
-    assert!(veach.materials.iter().any(|m| matches!(m, MaterialDescription::Roughconductor { .. })));
+    assert!(veach.materials.iter().any(|m| matches!(m, Material::Dielectric { .. })));
+    assert!(veach.materials.iter().any(|m| matches!(m, Material::RoughConductor { .. })));
 }
 
 fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {

@@ -3,7 +3,7 @@
 //! left wall, a green right wall, two white boxes and a one-sided area light under the
 //! ceiling.
 
-use super::{Camera, MaterialDescription, Reflectance, Scene, Shape};
+use super::{Camera, Material, Scene, Shape};
 
 type Quad = [[f32; 3]; 4];
 
@@ -33,10 +33,10 @@ pub fn default_scene() -> Scene {
     let green = 2;
     let black = 3;
     let materials = vec![
-        MaterialDescription::Diffuse { reflectance: Reflectance::Constant([0.73, 0.73, 0.73]), two_sided: true },
-        MaterialDescription::Diffuse { reflectance: Reflectance::Constant([0.65, 0.05, 0.05]), two_sided: true },
-        MaterialDescription::Diffuse { reflectance: Reflectance::Constant([0.12, 0.45, 0.15]), two_sided: true },
-        MaterialDescription::Black { two_sided: true },
+        Material::diffuse([0.73, 0.73, 0.73]),
+        Material::diffuse([0.65, 0.05, 0.05]),
+        Material::diffuse([0.12, 0.45, 0.15]),
+        Material::black(true),
     ];
     let material_names = ["white", "red", "green", "light"].map(String::from).to_vec();
     let mut shapes = Vec::new();
@@ -84,6 +84,7 @@ pub fn default_scene() -> Scene {
         materials,
         material_names,
         shapes,
+        textures: Vec::new(),
         environment: None,
     }
 }

@@ -12,12 +12,18 @@
 mod camera_rays;
 mod default_scene;
 mod description;
+mod environment;
+mod material;
 mod ply;
+mod texture;
 
 pub use camera_rays::CameraFrame;
 pub use default_scene::default_scene;
 pub use description::{Camera, EmitterDescription, EnvironmentDescription, MaterialDescription, Reflectance};
+pub use environment::Environment;
+pub use material::{Albedo, Material};
 pub use ply::{PlyMesh, read_ply};
+pub use texture::{Texture, srgb_to_linear};
 
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -40,6 +46,14 @@ pub enum SceneError {
         path: PathBuf,
         /// JSON path, e.g. `materials.glass.type`.
         field: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// An image (texture or environment map) that cannot be used.
+    #[error("{path}: {message}")]
+    Image {
+        /// The file.
+        path: PathBuf,
         /// What is wrong.
         message: String,
     },
@@ -86,13 +100,15 @@ pub struct Scene {
     /// Depth from which Russian roulette runs.
     pub rr_depth: u32,
     /// Materials, by index; `material_names[i]` is the name of `materials[i]`.
-    pub materials: Vec<MaterialDescription>,
+    pub materials: Vec<Material>,
     /// Material names in the scene file.
     pub material_names: Vec<String>,
     /// Shapes; shape `i` has object id `i`.
     pub shapes: Vec<Shape>,
-    /// The environment map, with its file resolved against the scene folder.
-    pub environment: Option<EnvironmentDescription>,
+    /// Textures that materials refer to, decoded to linear RGB.
+    pub textures: Vec<Texture>,
+    /// The environment map.
+    pub environment: Option<Environment>,
 }
 
 impl Scene {
@@ -103,7 +119,11 @@ impl Scene {
         let folder = path.parent().unwrap_or(Path::new("."));
         let mut material_names: Vec<String> = description.materials.keys().cloned().collect();
         material_names.sort();
-        let materials = material_names.iter().map(|name| description.materials[name].clone()).collect();
+        let mut textures = Vec::new();
+        let materials = material_names
+            .iter()
+            .map(|name| resolve_material(path, folder, name, &description.materials[name], &mut textures))
+            .collect::<Result<Vec<_>, _>>()?;
         let mut shapes = Vec::with_capacity(description.shapes.len());
         for (index, shape) in description.shapes.iter().enumerate() {
             let material =
@@ -136,10 +156,10 @@ impl Scene {
                 degenerate_dropped,
             });
         }
-        let environment = description.environment.map(|mut environment| {
-            environment.file = folder.join(&environment.file);
-            environment
-        });
+        let environment = match description.environment {
+            Some(e) => Some(Environment::load(&folder.join(&e.file), e.scale, e.to_world)?),
+            None => None,
+        };
         Ok(Scene {
             name: description.name,
             camera: description.camera,
@@ -148,6 +168,7 @@ impl Scene {
             materials,
             material_names,
             shapes,
+            textures,
             environment,
         })
     }
@@ -162,4 +183,71 @@ impl Scene {
         }
         (triangles, ids)
     }
+}
+
+/// Loads a scene file by its extension: `.json` (the shared scenes' description).
+pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
+    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        Some("json") => Scene::load(path),
+        other => Err(SceneError::Json {
+            path: path.into(),
+            field: "(file)".into(),
+            message: format!(
+                "unknown scene format `{}`: expected a .json scene description",
+                other.unwrap_or("(no extension)")
+            ),
+        }),
+    }
+}
+
+/// The renderer's material for the description `name` of scene file `path`, loading its
+/// texture (relative to `folder`) into `textures`.
+fn resolve_material(
+    path: &Path,
+    folder: &Path,
+    name: &str,
+    description: &MaterialDescription,
+    textures: &mut Vec<Texture>,
+) -> Result<Material, SceneError> {
+    let field = |field: &str, message: String| SceneError::Json {
+        path: path.into(),
+        field: format!("materials.{name}.{field}"),
+        message,
+    };
+    let positive = |value: f32, what: &str| {
+        if value.is_finite() && value > 0.0 { Ok(value) } else { Err(field(what, format!("{value} must be > 0"))) }
+    };
+    Ok(match description {
+        MaterialDescription::Diffuse { reflectance, two_sided } => {
+            let albedo = match reflectance {
+                Reflectance::Constant(c) => Albedo::Constant(*c),
+                Reflectance::Checkerboard { checkerboard } => Albedo::Checkerboard {
+                    color0: checkerboard.color0,
+                    color1: checkerboard.color1,
+                    uv_scale: checkerboard.uv_scale,
+                },
+                Reflectance::Texture { texture, srgb, filter, wrap, uv_scale } => {
+                    if let Some(filter) = filter.as_deref().filter(|f| *f != "bilinear") {
+                        return Err(field("reflectance.filter", format!("`{filter}`: only `bilinear` is supported")));
+                    }
+                    if let Some(wrap) = wrap.as_deref().filter(|w| *w != "repeat") {
+                        return Err(field("reflectance.wrap", format!("`{wrap}`: only `repeat` is supported")));
+                    }
+                    textures.push(Texture::load(&folder.join(texture), *srgb)?);
+                    Albedo::Texture { texture: textures.len() - 1, uv_scale: uv_scale.unwrap_or([1.0, 1.0]) }
+                }
+            };
+            Material::Diffuse { albedo, two_sided: *two_sided }
+        }
+        MaterialDescription::Black { two_sided } => Material::black(*two_sided),
+        MaterialDescription::Roughconductor { distribution, alpha, eta, k, two_sided } => {
+            if distribution != "ggx" {
+                return Err(field("distribution", format!("`{distribution}`: only `ggx` is supported")));
+            }
+            Material::RoughConductor { alpha: positive(*alpha, "alpha")?, eta: *eta, k: *k, two_sided: *two_sided }
+        }
+        MaterialDescription::Dielectric { int_ior, ext_ior, .. } => {
+            Material::Dielectric { int_ior: positive(*int_ior, "int_ior")?, ext_ior: positive(*ext_ior, "ext_ior")? }
+        }
+    })
 }

@@ -1,0 +1,233 @@
+//! The progressive path tracer on any backend: a [`GpuScene`] uploaded once, then one
+//! `path_trace` dispatch per sample per pixel, summed on the device.
+
+use super::gpu_scene::GpuScene;
+use crate::histogram_pass::PassError;
+use crate::rgb_image::RgbImage;
+use crate::scene::{Camera, CameraFrame};
+use strata_backends::backend::{download, upload};
+use strata_backends::{Backend, BackendError, Bind, BufferId};
+use strata_kernels::render_types::{FLAG_HIT_LIGHTS, FLAG_RUSSIAN_ROULETTE, FLAG_SAMPLE_LIGHTS, RenderParams};
+use strata_kernels::{Kernel, KernelId, Registry};
+
+/// How light is found (all three estimate the same image).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum LightSampling {
+    /// Next-event estimation and BSDF sampling, combined by the power heuristic.
+    #[default]
+    Mis,
+    /// Next-event estimation only (emission reached by BSDF sampling counts only after
+    /// a specular bounce).
+    Nee,
+    /// BSDF sampling only.
+    Bsdf,
+}
+
+/// What one render computes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    /// The camera; its `width` and `height` are the image size.
+    pub camera: Camera,
+    /// Seed of every random number (samples of different seeds are independent).
+    pub seed: u32,
+    /// Path segments including the camera ray (CONVENTIONS.md).
+    pub max_depth: u32,
+    /// Depth from which Russian roulette runs.
+    pub rr_depth: u32,
+    /// How light is found.
+    pub light_sampling: LightSampling,
+    /// Russian roulette on (unbiased either way).
+    pub russian_roulette: bool,
+}
+
+impl RenderSettings {
+    /// The flags and per-render fields of the kernel's parameters, checked.
+    fn params(&self, scene: &GpuScene) -> Result<RenderParams, PassError> {
+        let camera = &self.camera;
+        if camera.width == 0 || camera.height == 0 {
+            return Err(PassError::Input(format!(
+                "image size {}x{}: must be at least 1x1",
+                camera.width, camera.height
+            )));
+        }
+        if self.max_depth == 0 {
+            return Err(PassError::Input("max_depth 0: a path needs at least its camera ray".into()));
+        }
+        let frame = CameraFrame::new(camera).ok_or_else(|| {
+            PassError::Input(format!(
+                "camera: fov_axis `{}` must be `x` or `smaller`, and the view direction must not be parallel to `up`",
+                camera.fov_axis
+            ))
+        })?;
+        if !(camera.fov_deg > 0.0 && camera.fov_deg < 180.0) {
+            return Err(PassError::Input(format!("camera: fov_deg {} must be in (0, 180)", camera.fov_deg)));
+        }
+        let flags = match self.light_sampling {
+            LightSampling::Mis => FLAG_SAMPLE_LIGHTS | FLAG_HIT_LIGHTS,
+            LightSampling::Nee => FLAG_SAMPLE_LIGHTS,
+            LightSampling::Bsdf => FLAG_HIT_LIGHTS,
+        } | if self.russian_roulette { FLAG_RUSSIAN_ROULETTE } else { 0 };
+        Ok(RenderParams {
+            width: camera.width,
+            height: camera.height,
+            sample_index: 0,
+            seed: self.seed,
+            max_depth: self.max_depth,
+            rr_depth: self.rr_depth,
+            flags,
+            camera_origin: frame.origin.into(),
+            near_clip: frame.near_clip,
+            camera_forward: frame.forward.into(),
+            tan_half_x: frame.tan_half_x,
+            camera_right: frame.right.into(),
+            tan_half_y: frame.tan_half_y,
+            camera_up: frame.up.into(),
+            ..scene.params
+        })
+    }
+}
+
+/// The scene's device buffers, bound at 1–7 of every path-tracing kernel.
+pub struct SceneBuffers {
+    buffers: [BufferId; 7],
+}
+
+impl SceneBuffers {
+    /// Uploads `scene`; a buffer larger than the device's storage-binding limit is
+    /// refused with its name and both sizes (splitting across bindings is not done).
+    pub fn upload(backend: &mut dyn Backend, scene: &GpuScene) -> Result<SceneBuffers, PassError> {
+        let limit = backend.info().limits.max_storage_binding;
+        let sizes = [
+            ("BVH nodes", std::mem::size_of_val(scene.nodes.as_slice())),
+            ("triangles", std::mem::size_of_val(scene.triangles.as_slice())),
+            ("triangle attributes", std::mem::size_of_val(scene.triangle_info.as_slice())),
+            ("materials", std::mem::size_of_val(scene.materials.as_slice())),
+            ("emissive triangles", std::mem::size_of_val(scene.lights.as_slice())),
+            ("texels", std::mem::size_of_val(scene.texels.as_slice())),
+            ("environment CDF", std::mem::size_of_val(scene.environment_cdf.as_slice())),
+        ];
+        for (name, size) in sizes {
+            if size as u64 > limit {
+                return Err(PassError::Input(format!(
+                    "the scene is too large for this device: its {name} take {:.1} MiB, and the device binds at \
+                     most {:.1} MiB per storage buffer",
+                    size as f64 / 1048576.0,
+                    limit as f64 / 1048576.0
+                )));
+            }
+        }
+        Ok(SceneBuffers {
+            buffers: [
+                upload(backend, "bvh nodes", &scene.nodes)?,
+                upload(backend, "triangles", &scene.triangles)?,
+                upload(backend, "triangle attributes", &scene.triangle_info)?,
+                upload(backend, "materials", &scene.materials)?,
+                upload(backend, "emissive triangles", &scene.lights)?,
+                upload(backend, "texels", &scene.texels)?,
+                upload(backend, "environment cdf", &scene.environment_cdf)?,
+            ],
+        })
+    }
+
+    /// Binds 1–7, after the parameters at 0.
+    pub fn binds(&self, params: BufferId) -> Vec<Bind> {
+        let mut binds = vec![Bind::new(0, params)];
+        binds.extend(self.buffers.iter().enumerate().map(|(i, &b)| Bind::new(i as u32 + 1, b)));
+        binds
+    }
+
+    /// Frees the buffers.
+    pub fn destroy(self, backend: &mut dyn Backend) -> Result<(), BackendError> {
+        self.buffers.into_iter().try_for_each(|b| backend.destroy_buffer(b))
+    }
+}
+
+/// A progressive render: samples are added one dispatch at a time.
+pub struct PathTracer {
+    kernel: &'static Kernel,
+    scene: SceneBuffers,
+    params: RenderParams,
+    params_buffer: BufferId,
+    accumulation: BufferId,
+    samples: u32,
+}
+
+impl PathTracer {
+    /// Uploads `scene` and clears the running sum.
+    pub fn new(backend: &mut dyn Backend, scene: &GpuScene, settings: &RenderSettings) -> Result<Self, PassError> {
+        let kernel = Registry::shared()?.get(KernelId::PathTrace);
+        backend.check_kernel(kernel)?;
+        let params = settings.params(scene)?;
+        let pixels = params.width as u64 * params.height as u64;
+        let scene = SceneBuffers::upload(backend, scene)?;
+        let params_buffer = upload(backend, "render params", &[params])?;
+        let accumulation = backend.create_buffer("accumulation", pixels * 16)?;
+        backend.write_buffer(accumulation, 0, &vec![0u8; pixels as usize * 16])?;
+        Ok(PathTracer { kernel, scene, params, params_buffer, accumulation, samples: 0 })
+    }
+
+    /// Samples per pixel so far.
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    /// Adds one sample per pixel.
+    pub fn add_sample(&mut self, backend: &mut dyn Backend) -> Result<(), PassError> {
+        let params = RenderParams { sample_index: self.samples, ..self.params };
+        backend.write_buffer(self.params_buffer, 0, bytemuck::bytes_of(&params))?;
+        let mut binds = self.scene.binds(self.params_buffer);
+        binds.push(Bind::new(8, self.accumulation));
+        let workgroups = [params.width.div_ceil(8), params.height.div_ceil(8), 1];
+        backend.dispatch(self.kernel, &binds, workgroups)?;
+        self.samples += 1;
+        Ok(())
+    }
+
+    /// The mean of the samples so far. Samples the kernel dropped (non-finite radiance,
+    /// a BVH too deep for the traversal stack) are an error naming the first pixel.
+    pub fn image(&self, backend: &mut dyn Backend) -> Result<RgbImage, PassError> {
+        let sums: Vec<[f32; 4]> = download(backend, self.accumulation)?;
+        if let Some(index) = sums.iter().position(|s| s[3] != 0.0) {
+            let dropped: f64 = sums.iter().map(|s| f64::from(s[3])).sum();
+            return Err(PassError::Input(format!(
+                "{dropped} samples were invalid (non-finite radiance or a traversal stack overflow), the first at \
+                 pixel ({}, {})",
+                index % self.params.width as usize,
+                index / self.params.width as usize
+            )));
+        }
+        let scale = 1.0 / self.samples.max(1) as f32;
+        Ok(RgbImage {
+            width: self.params.width,
+            height: self.params.height,
+            pixels: sums.iter().map(|s| [s[0] * scale, s[1] * scale, s[2] * scale]).collect(),
+        })
+    }
+
+    /// Frees every buffer.
+    pub fn destroy(self, backend: &mut dyn Backend) -> Result<(), BackendError> {
+        self.scene.destroy(backend)?;
+        backend.destroy_buffer(self.params_buffer)?;
+        backend.destroy_buffer(self.accumulation)
+    }
+}
+
+/// Renders `samples` samples per pixel of `scene`; `progress` is called after each.
+pub fn render(
+    backend: &mut dyn Backend,
+    scene: &GpuScene,
+    settings: &RenderSettings,
+    samples: u32,
+    mut progress: impl FnMut(u32),
+) -> Result<RgbImage, PassError> {
+    let mut tracer = PathTracer::new(backend, scene, settings)?;
+    let result = (|| {
+        for i in 0..samples {
+            tracer.add_sample(backend)?;
+            progress(i + 1);
+        }
+        tracer.image(backend)
+    })();
+    tracer.destroy(backend)?;
+    result
+}

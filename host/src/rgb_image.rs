@@ -1,0 +1,84 @@
+//! Linear RGB images: the renderer's output, read and written as float EXR (through the
+//! exr crate) and previewed as tone-mapped sRGB PNG.
+
+use std::path::Path;
+use thiserror::Error;
+
+/// An image file that cannot be read or written.
+#[derive(Debug, Error)]
+#[error("{path}: {message}")]
+pub struct ImageError {
+    /// The file.
+    pub path: String,
+    /// What went wrong.
+    pub message: String,
+}
+
+/// A row-major linear RGB image, row 0 at the top.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RgbImage {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Pixels, `width × height`.
+    pub pixels: Vec<[f32; 3]>,
+}
+
+impl RgbImage {
+    /// A black image.
+    pub fn new(width: u32, height: u32) -> RgbImage {
+        RgbImage { width, height, pixels: vec![[0.0; 3]; width as usize * height as usize] }
+    }
+
+    /// Mean of every channel of every pixel.
+    pub fn mean(&self) -> [f64; 3] {
+        let mut sum = [0.0f64; 3];
+        for p in &self.pixels {
+            for c in 0..3 {
+                sum[c] += f64::from(p[c]);
+            }
+        }
+        sum.map(|s| s / self.pixels.len().max(1) as f64)
+    }
+
+    /// Reads the R, G and B channels of an EXR's first layer.
+    pub fn read_exr(path: &Path) -> Result<RgbImage, ImageError> {
+        let error = |message: String| ImageError { path: path.display().to_string(), message };
+        let image = exr::prelude::read_first_rgba_layer_from_file(
+            path,
+            |resolution, _| RgbImage::new(resolution.width() as u32, resolution.height() as u32),
+            |image: &mut RgbImage, position: exr::math::Vec2<usize>, (r, g, b, _a): (f32, f32, f32, f32)| {
+                let index = position.y() * image.width as usize + position.x();
+                image.pixels[index] = [r, g, b];
+            },
+        )
+        .map_err(|e| error(e.to_string()))?;
+        Ok(image.layer_data.channel_data.pixels)
+    }
+
+    /// Writes a float32 RGB EXR.
+    pub fn write_exr(&self, path: &Path) -> Result<(), ImageError> {
+        let width = self.width as usize;
+        exr::prelude::write_rgb_file(path, width, self.height as usize, |x, y| {
+            let p = self.pixels[y * width + x];
+            (p[0], p[1], p[2])
+        })
+        .map_err(|e| ImageError { path: path.display().to_string(), message: e.to_string() })
+    }
+
+    /// Writes an 8-bit sRGB PNG: radiance × `exposure`, clamped to [0, 1], sRGB-encoded.
+    pub fn write_png(&self, path: &Path, exposure: f32) -> Result<(), ImageError> {
+        let bytes: Vec<u8> =
+            self.pixels.iter().flat_map(|p| p.map(|c| linear_to_srgb8(c * exposure))).collect::<Vec<_>>();
+        image::save_buffer(path, &bytes, self.width, self.height, image::ExtendedColorType::Rgb8)
+            .map_err(|e| ImageError { path: path.display().to_string(), message: e.to_string() })
+    }
+}
+
+/// sRGB OETF of a linear value, clamped to [0, 1] and rounded to 8 bits (NaN gives 0).
+pub fn linear_to_srgb8(linear: f32) -> u8 {
+    let c = if linear.is_nan() { 0.0 } else { linear.clamp(0.0, 1.0) };
+    let encoded = if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
+    (encoded * 255.0 + 0.5) as u8
+}

@@ -7,6 +7,7 @@ pub mod backend_choice;
 pub mod check;
 pub mod estimator;
 pub mod histogram_pass;
+pub mod metrics;
 pub mod render;
 pub mod rgb_image;
 pub mod run_kernel;

@@ -1,0 +1,254 @@
+//! Image error metrics against a reference, as the paper and the literature print them.
+//!
+//! Every metric is computed per RGB channel and pixel, then averaged over both:
+//! - [`mse`]: (f − ref)²;
+//! - [`relmse`]: the paper's form, (f − ref)² / (ref + 1e-4) (its Table 2 numbers);
+//! - [`relmse_common`]: the form most renderers print, (f − ref)² / (ref² + 1e-2);
+//! - [`prelmse`]: [`relmse`] after blurring both images with a Gaussian of σ = 1 px
+//!   (perceptual RelMSE: blue-noise error distributions score lower than white noise).
+//!
+//! [`error_map`] gives the per-pixel value of a metric (channel-averaged) for error
+//! images. [`MeanInterval`] reports a mean with its 95 % confidence interval over
+//! independent seeds.
+
+use crate::rgb_image::RgbImage;
+
+/// Which per-pixel error a map or a mean is made of.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Metric {
+    /// Squared error.
+    Mse,
+    /// (f − ref)² / (ref + 1e-4): the paper's RelMSE.
+    Relmse,
+    /// (f − ref)² / (ref² + 1e-2): the common RelMSE.
+    RelmseCommon,
+}
+
+impl Metric {
+    /// The error of one channel value `f` against the reference value `reference`.
+    pub fn of(self, f: f32, reference: f32) -> f64 {
+        let (f, r) = (f64::from(f), f64::from(reference));
+        let squared = (f - r) * (f - r);
+        match self {
+            Metric::Mse => squared,
+            Metric::Relmse => squared / (r + 1e-4),
+            Metric::RelmseCommon => squared / (r * r + 1e-2),
+        }
+    }
+}
+
+/// Why two images cannot be compared.
+#[derive(Debug, thiserror::Error)]
+pub enum MetricError {
+    /// The sizes differ.
+    #[error("image is {0}x{1} but the reference is {2}x{3}")]
+    Size(u32, u32, u32, u32),
+    /// An image is empty.
+    #[error("the images are empty (0 pixels)")]
+    Empty,
+    /// A pixel is NaN or infinite.
+    #[error("the {which} has a non-finite value at pixel ({x}, {y})")]
+    NonFinite {
+        /// `image` or `reference`.
+        which: &'static str,
+        /// Column.
+        x: u32,
+        /// Row.
+        y: u32,
+    },
+}
+
+fn check(image: &RgbImage, reference: &RgbImage) -> Result<(), MetricError> {
+    if (image.width, image.height) != (reference.width, reference.height) {
+        return Err(MetricError::Size(image.width, image.height, reference.width, reference.height));
+    }
+    if image.pixels.is_empty() {
+        return Err(MetricError::Empty);
+    }
+    for (which, img) in [("image", image), ("reference", reference)] {
+        if let Some(i) = img.pixels.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+            let (x, y) = ((i % img.width as usize) as u32, (i / img.width as usize) as u32);
+            return Err(MetricError::NonFinite { which, x, y });
+        }
+    }
+    Ok(())
+}
+
+/// The per-pixel error of `image` against `reference` (mean over R, G, B), row-major.
+pub fn error_map(image: &RgbImage, reference: &RgbImage, metric: Metric) -> Result<Vec<f64>, MetricError> {
+    check(image, reference)?;
+    Ok(image
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(f, r)| (0..3).map(|c| metric.of(f[c], r[c])).sum::<f64>() / 3.0)
+        .collect())
+}
+
+/// The mean of [`error_map`].
+pub fn mean_error(image: &RgbImage, reference: &RgbImage, metric: Metric) -> Result<f64, MetricError> {
+    let map = error_map(image, reference, metric)?;
+    Ok(map.iter().sum::<f64>() / map.len() as f64)
+}
+
+/// Mean squared error.
+pub fn mse(image: &RgbImage, reference: &RgbImage) -> Result<f64, MetricError> {
+    mean_error(image, reference, Metric::Mse)
+}
+
+/// The paper's RelMSE: mean of (f − ref)² / (ref + 1e-4).
+pub fn relmse(image: &RgbImage, reference: &RgbImage) -> Result<f64, MetricError> {
+    mean_error(image, reference, Metric::Relmse)
+}
+
+/// The common RelMSE: mean of (f − ref)² / (ref² + 1e-2).
+pub fn relmse_common(image: &RgbImage, reference: &RgbImage) -> Result<f64, MetricError> {
+    mean_error(image, reference, Metric::RelmseCommon)
+}
+
+/// Perceptual RelMSE: [`relmse`] of both images blurred by a Gaussian of σ = 1 px.
+pub fn prelmse(image: &RgbImage, reference: &RgbImage) -> Result<f64, MetricError> {
+    check(image, reference)?;
+    relmse(&gaussian_blur(image, 1.0), &gaussian_blur(reference, 1.0))
+}
+
+/// `image` convolved with a normalised Gaussian of standard deviation `sigma` pixels,
+/// truncated at 3σ, with clamp-to-edge borders (separable).
+pub fn gaussian_blur(image: &RgbImage, sigma: f32) -> RgbImage {
+    let radius = (3.0 * sigma).ceil() as i64;
+    let weights: Vec<f32> = (-radius..=radius).map(|i| (-(i * i) as f32 / (2.0 * sigma * sigma)).exp()).collect();
+    let total: f32 = weights.iter().sum();
+    let weights: Vec<f32> = weights.iter().map(|w| w / total).collect();
+    let (w, h) = (image.width as i64, image.height as i64);
+    let pass = |source: &[[f32; 3]], horizontal: bool| -> Vec<[f32; 3]> {
+        let mut out = vec![[0.0f32; 3]; source.len()];
+        for y in 0..h {
+            for x in 0..w {
+                let mut sum = [0.0f32; 3];
+                for (k, weight) in weights.iter().enumerate() {
+                    let offset = k as i64 - radius;
+                    let (sx, sy) =
+                        if horizontal { ((x + offset).clamp(0, w - 1), y) } else { (x, (y + offset).clamp(0, h - 1)) };
+                    let p = source[(sy * w + sx) as usize];
+                    for c in 0..3 {
+                        sum[c] += weight * p[c];
+                    }
+                }
+                out[(y * w + x) as usize] = sum;
+            }
+        }
+        out
+    };
+    let horizontal = pass(&image.pixels, true);
+    RgbImage { width: image.width, height: image.height, pixels: pass(&horizontal, false) }
+}
+
+/// A mean over independent samples with its 95 % confidence half-width (Student t).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeanInterval {
+    /// Sample mean.
+    pub mean: f64,
+    /// Half-width of the 95 % confidence interval (infinite for fewer than 2 samples).
+    pub half_width: f64,
+    /// Number of samples.
+    pub count: usize,
+}
+
+impl MeanInterval {
+    /// The mean and 95 % interval of `values`.
+    pub fn of(values: &[f64]) -> MeanInterval {
+        let count = values.len();
+        let mean = values.iter().sum::<f64>() / count.max(1) as f64;
+        if count < 2 {
+            return MeanInterval { mean, half_width: f64::INFINITY, count };
+        }
+        let variance = values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (count - 1) as f64;
+        let half_width = student_t_975(count - 1) * (variance / count as f64).sqrt();
+        MeanInterval { mean, half_width, count }
+    }
+}
+
+impl std::fmt::Display for MeanInterval {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{:.4e} ± {:.1e}", self.mean, self.half_width)
+    }
+}
+
+/// The 97.5 % quantile of Student's t distribution with `dof` degrees of freedom
+/// (table to 30, then the normal approximation with the first Cornish–Fisher term).
+pub fn student_t_975(dof: usize) -> f64 {
+    const TABLE: [f64; 30] = [
+        12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160, 2.145, 2.131,
+        2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056, 2.052, 2.048, 2.045, 2.042,
+    ];
+    match dof {
+        0 => f64::INFINITY,
+        1..=30 => TABLE[dof - 1],
+        _ => {
+            let z = 1.959964;
+            z + (z * z * z + z) / (4.0 * dof as f64)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(width: u32, height: u32, f: impl Fn(u32, u32) -> [f32; 3]) -> RgbImage {
+        let pixels = (0..height).flat_map(|y| (0..width).map(move |x| (x, y))).map(|(x, y)| f(x, y)).collect();
+        RgbImage { width, height, pixels }
+    }
+
+    #[test]
+    fn metrics_of_a_known_difference() {
+        let reference = image(4, 2, |_, _| [1.0, 0.5, 0.0]);
+        let f = image(4, 2, |_, _| [1.5, 0.5, 0.1]);
+        let mse_expected = (0.25 + 0.0 + 0.01) / 3.0;
+        assert!((mse(&f, &reference).unwrap() - mse_expected).abs() < 1e-7);
+        let rel = (0.25 / (1.0 + 1e-4) + 0.01 / 1e-4) / 3.0;
+        assert!((relmse(&f, &reference).unwrap() - rel).abs() < 1e-6);
+        let common = (0.25 / 1.01 + 0.01 / 1e-2) / 3.0;
+        assert!((relmse_common(&f, &reference).unwrap() - common).abs() < 1e-6);
+        assert_eq!(relmse(&reference, &reference).unwrap(), 0.0);
+    }
+
+    #[test]
+    fn blur_keeps_constants_and_the_mean_and_lowers_white_noise() {
+        let constant = image(9, 7, |_, _| [2.0, 3.0, 4.0]);
+        for (a, b) in gaussian_blur(&constant, 1.0).pixels.iter().zip(&constant.pixels) {
+            for c in 0..3 {
+                assert!((a[c] - b[c]).abs() < 1e-5);
+            }
+        }
+        let noise = image(32, 32, |x, y| {
+            let v = if (x * 7 + y * 13) % 3 == 0 { 1.5 } else { 0.75 };
+            [v; 3]
+        });
+        let reference = image(32, 32, |_, _| [1.0; 3]);
+        let plain = relmse(&noise, &reference).unwrap();
+        let perceptual = prelmse(&noise, &reference).unwrap();
+        assert!(perceptual < plain * 0.5, "pRelMSE {perceptual} vs RelMSE {plain}");
+    }
+
+    #[test]
+    fn bad_inputs_are_errors() {
+        let a = image(2, 2, |_, _| [1.0; 3]);
+        let b = image(3, 2, |_, _| [1.0; 3]);
+        assert!(matches!(mse(&a, &b), Err(MetricError::Size(2, 2, 3, 2))));
+        let nan = image(2, 2, |x, y| if (x, y) == (1, 1) { [f32::NAN; 3] } else { [1.0; 3] });
+        let message = mse(&nan, &a).unwrap_err().to_string();
+        assert!(message.contains("(1, 1)") && message.contains("image"), "{message}");
+        let empty = image(0, 0, |_, _| [0.0; 3]);
+        assert!(matches!(mse(&empty, &empty), Err(MetricError::Empty)));
+    }
+
+    #[test]
+    fn interval_of_known_values() {
+        let interval = MeanInterval::of(&[1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(interval.mean, 2.5);
+        let sd = (5.0f64 / 3.0).sqrt();
+        assert!((interval.half_width - 3.182 * sd / 2.0).abs() < 1e-9);
+        assert!(MeanInterval::of(&[1.0]).half_width.is_infinite());
+    }
+}

@@ -6,6 +6,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 use strata::backend_choice::{BackendChoice, open_backend};
 use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
+use strata::metrics::{self, Metric};
+use strata::rgb_image::RgbImage;
 use strata::render::{GpuScene, LightSampling, RenderSettings};
 use strata::scene::{default_scene, load_scene_file};
 use strata::synthetic::{CandidateMix, candidate_image};
@@ -28,6 +30,24 @@ enum Command {
     /// Path-trace a scene progressively (the reference mode) and write a linear float EXR
     /// and a tone-mapped sRGB PNG preview.
     Render(RenderArgs),
+    /// Compare an EXR image with a reference EXR: MSE, RelMSE (paper and common forms),
+    /// pRelMSE; optionally write the per-pixel RelMSE map as EXR and false-colour PNG.
+    Metrics(MetricsArgs),
+}
+
+#[derive(clap::Args)]
+struct MetricsArgs {
+    /// The image (linear RGB EXR).
+    image: PathBuf,
+    /// The reference (linear RGB EXR of the same size).
+    reference: PathBuf,
+    /// Write the per-pixel error map of `--map-metric` to this EXR, and a false-colour
+    /// PNG beside it.
+    #[arg(long)]
+    map: Option<PathBuf>,
+    /// Metric of the error map.
+    #[arg(long, value_enum, default_value_t = Metric::Relmse)]
+    map_metric: Metric,
 }
 
 #[derive(clap::Args)]
@@ -109,7 +129,34 @@ fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Histogram(args) => histogram(args),
         Command::Render(args) => render(args),
+        Command::Metrics(args) => metrics(args),
     }
+}
+
+fn metrics(args: MetricsArgs) -> Result<()> {
+    let image = RgbImage::read_exr(&args.image)?;
+    let reference = RgbImage::read_exr(&args.reference)?;
+    let context = || format!("{} against {}", args.image.display(), args.reference.display());
+    println!("mse            {:.6e}", metrics::mse(&image, &reference).with_context(context)?);
+    println!("relmse         {:.6e}", metrics::relmse(&image, &reference).with_context(context)?);
+    println!("relmse-common  {:.6e}", metrics::relmse_common(&image, &reference).with_context(context)?);
+    println!("prelmse        {:.6e}", metrics::prelmse(&image, &reference).with_context(context)?);
+    let (m, r) = (image.mean(), reference.mean());
+    println!("mean image     ({:.5}, {:.5}, {:.5})", m[0], m[1], m[2]);
+    println!("mean reference ({:.5}, {:.5}, {:.5})", r[0], r[1], r[2]);
+    if let Some(path) = &args.map {
+        let map = metrics::error_map(&image, &reference, args.map_metric)?;
+        let map_image = RgbImage {
+            width: image.width,
+            height: image.height,
+            pixels: map.iter().map(|&e| [e as f32; 3]).collect(),
+        };
+        map_image.write_exr(path)?;
+        let png = path.with_extension("png");
+        metrics::false_colour(&map, image.width, image.height).write_png(&png, 1.0)?;
+        println!("wrote {} and {}", path.display(), png.display());
+    }
+    Ok(())
 }
 
 fn render(args: RenderArgs) -> Result<()> {

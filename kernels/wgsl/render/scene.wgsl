@@ -163,12 +163,19 @@ fn spawn_ray(position: vec3<f32>, normal: vec3<f32>, direction: vec3<f32>, tmax:
 }
 
 // True when nothing blocks the segment from `position` (on a surface with `normal`) to
-// `target_point`, which lies on a light.
+// `target_point`, which lies on a light. The segment starts at the offset origin of
+// spawn_ray and stops the same scale-relative epsilon short of the target, so neither
+// the surface nor the light's own triangle can occlude it.
 fn visible(position: vec3<f32>, normal: vec3<f32>, target_point: vec3<f32>, lane: u32) -> bool {
-    let to_target = target_point - position;
+    let start = spawn_ray(position, normal, target_point - position, 0.0).origin;
+    let to_target = target_point - start;
     let distance = length(to_target);
-    let direction = to_target / distance;
-    let ray = spawn_ray(position, normal, direction, distance * (1.0 - 1e-4));
+    let extent = max(max(abs(target_point.x), abs(target_point.y)), max(abs(target_point.z), 1.0));
+    let tmax = distance - params.ray_epsilon * extent;
+    if tmax <= 0.0 {
+        return true;
+    }
+    let ray = Ray(start, 0.0, to_target / distance, tmax);
     return traverse(ray, lane, true).primitive == MISS;
 }
 

@@ -72,3 +72,45 @@ fn bad_geometry_and_rays_are_named() {
     assert!(error.contains("ray 3"), "{error}");
     assert!(pass.trace(&mut cpu, &[]).unwrap().is_empty());
 }
+
+/// Camera rays of a real scene (the shared matpreview: 61 600 triangles, a large ground
+/// plane and a dense mesh) hit what obvhs hits. Rays with an unbounded tmax (1e30) once
+/// made every box count as hit (limit + 1 == limit) and half the rays missed on lavapipe.
+fn scene_camera_rays_agree_with_obvhs(backend: &mut dyn Backend) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/scenes/matpreview/scene.json");
+    let scene = strata::scene::Scene::load(&path).unwrap();
+    let (soup, _) = scene.triangles_with_ids();
+    let frame = strata::scene::CameraFrame::new(&scene.camera).unwrap();
+    let (w, h) = (40u32, 30u32);
+    let mut rays = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let (origin, direction) = frame.ray((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+            rays.push(Ray { origin: origin.into(), tmin: 0.0, direction: direction.into(), tmax: 1e30 });
+        }
+    }
+    let bvh = SceneBvh::build(&soup).unwrap();
+    let pass = TracePass::new(backend, &bvh).unwrap();
+    let hits = pass.trace(backend, &rays).unwrap();
+    pass.destroy(backend).unwrap();
+    let reference = obvhs_closest(&soup, &rays);
+    let hit_count = reference.iter().filter(|(p, _)| *p != MISS).count();
+    assert!(hit_count > rays.len() / 3, "only {hit_count} of {} rays hit", rays.len());
+    let same = hits.iter().zip(&reference).filter(|(h, (p, _))| h.primitive == *p).count();
+    assert!(same as f64 >= 0.995 * rays.len() as f64, "only {same} of {} rays agree with obvhs", rays.len());
+}
+
+#[test]
+fn scene_camera_rays_agree_with_obvhs_on_the_interpreter() {
+    scene_camera_rays_agree_with_obvhs(&mut CpuBackend::new(CpuOptions::default()).unwrap());
+}
+
+#[test]
+fn scene_camera_rays_agree_with_obvhs_on_vulkan() {
+    let Some(mut backend) = strata_tests::vulkan_backend("scene_camera_rays_agree_with_obvhs_on_vulkan") else {
+        assert!(!gpu_required());
+        return;
+    };
+    scene_camera_rays_agree_with_obvhs(&mut backend);
+}
+

@@ -87,7 +87,7 @@ fn enter_box(node: &GpuBvhNode, origin: V3, inv: V3, tmin: f32, limit: f32) -> f
     }
     let enter = near[0].max(near[1]).max(near[2].max(tmin));
     let leave = far[0].min(far[1]).min(far[2].min(limit));
-    if enter <= leave { enter } else { limit + 1.0 }
+    if enter <= leave { enter } else { -1.0 }
 }
 
 /// The closest hit of `ray` through the BVH (`nodes`, root at 0).
@@ -95,7 +95,7 @@ pub fn closest_hit(nodes: &[GpuBvhNode], primitive_indices: &[u32], triangles: &
     let shear = make_shear(ray.direction);
     let inv = safe_inverse(ray.direction);
     let mut best = Hit { t: ray.tmax, u: 0.0, v: 0.0, primitive: MISS };
-    if enter_box(&nodes[0], ray.origin, inv, ray.tmin, best.t) > best.t {
+    if enter_box(&nodes[0], ray.origin, inv, ray.tmin, best.t) < 0.0 {
         return best;
     }
     let mut stack = Vec::with_capacity(TRACE_STACK_DEPTH as usize);
@@ -114,7 +114,7 @@ pub fn closest_hit(nodes: &[GpuBvhNode], primitive_indices: &[u32], triangles: &
             let (left, right) = (node.first_index as usize, node.first_index as usize + 1);
             let t_left = enter_box(&nodes[left], ray.origin, inv, ray.tmin, best.t);
             let t_right = enter_box(&nodes[right], ray.origin, inv, ray.tmin, best.t);
-            let (hit_left, hit_right) = (t_left <= best.t, t_right <= best.t);
+            let (hit_left, hit_right) = (t_left >= 0.0, t_right >= 0.0);
             if hit_left && hit_right {
                 let near_is_left = t_left <= t_right;
                 if stack.len() == TRACE_STACK_DEPTH as usize {

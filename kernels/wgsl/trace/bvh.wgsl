@@ -121,7 +121,9 @@ fn safe_inverse(d: vec3<f32>) -> vec3<f32> {
     return 1.0 / select(d, tiny, abs(d) < vec3<f32>(1e-30));
 }
 
-// Entry distance of the ray into the node's box, or a value > limit if it misses.
+// Entry distance of the ray into the node's box within [tmin, limit], or -1 if the ray
+// misses the box there (entry distances are never negative: tmin >= 0). A sentinel above
+// `limit` would not do: limit + 1 == limit for rays with an unbounded tmax.
 fn enter_box(node: BvhNode, origin: vec3<f32>, inv_dir: vec3<f32>, tmin: f32, limit: f32) -> f32 {
     let t0 = (node.aabb_min - origin) * inv_dir;
     let t1 = (node.aabb_max - origin) * inv_dir;
@@ -129,5 +131,5 @@ fn enter_box(node: BvhNode, origin: vec3<f32>, inv_dir: vec3<f32>, tmin: f32, li
     let far = max(t0, t1);
     let enter = max(max(near.x, near.y), max(near.z, tmin));
     let leave = min(min(far.x, far.y), min(far.z, limit));
-    return select(limit + 1.0, enter, enter <= leave);
+    return select(-1.0, enter, enter <= leave);
 }

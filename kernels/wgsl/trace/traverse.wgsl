@@ -18,7 +18,7 @@ fn traverse(ray: Ray, lane: u32, any_hit: bool) -> Hit {
     let base = lane * TRACE_STACK_DEPTH;
     var depth = 0u;
     var node_index = 0u;
-    if enter_box(nodes[0], ray.origin, inv_dir, ray.tmin, best.t) > best.t {
+    if enter_box(nodes[0], ray.origin, inv_dir, ray.tmin, best.t) < 0.0 {
         return best;
     }
     loop {
@@ -39,8 +39,8 @@ fn traverse(ray: Ray, lane: u32, any_hit: bool) -> Hit {
             let right = left + 1u;
             let t_left = enter_box(nodes[left], ray.origin, inv_dir, ray.tmin, best.t);
             let t_right = enter_box(nodes[right], ray.origin, inv_dir, ray.tmin, best.t);
-            let hit_left = t_left <= best.t;
-            let hit_right = t_right <= best.t;
+            let hit_left = t_left >= 0.0;
+            let hit_right = t_right >= 0.0;
             if hit_left && hit_right {
                 // Visit the nearer child first; the farther one waits on the stack.
                 let near_is_left = t_left <= t_right;

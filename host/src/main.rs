@@ -7,8 +7,8 @@ use std::time::Instant;
 use strata::backend_choice::{BackendChoice, open_backend};
 use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
 use strata::metrics::{self, Metric};
-use strata::rgb_image::RgbImage;
 use strata::render::{GpuScene, LightSampling, RenderSettings};
+use strata::rgb_image::RgbImage;
 use strata::scene::{default_scene, load_scene_file};
 use strata::synthetic::{CandidateMix, candidate_image};
 use strata_kernels::BlockGrid;
@@ -146,11 +146,8 @@ fn metrics(args: MetricsArgs) -> Result<()> {
     println!("mean reference ({:.5}, {:.5}, {:.5})", r[0], r[1], r[2]);
     if let Some(path) = &args.map {
         let map = metrics::error_map(&image, &reference, args.map_metric)?;
-        let map_image = RgbImage {
-            width: image.width,
-            height: image.height,
-            pixels: map.iter().map(|&e| [e as f32; 3]).collect(),
-        };
+        let map_image =
+            RgbImage { width: image.width, height: image.height, pixels: map.iter().map(|&e| [e as f32; 3]).collect() };
         map_image.write_exr(path)?;
         let png = path.with_extension("png");
         metrics::false_colour(&map, image.width, image.height).write_png(&png, 1.0)?;

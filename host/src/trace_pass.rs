@@ -82,10 +82,12 @@ impl TracePass {
             return Ok(Vec::new());
         }
         if let Some(index) = rays.iter().position(|r| {
-            r.origin.iter().chain(&r.direction).any(|c| !c.is_finite()) || r.direction.iter().all(|&c| c == 0.0)
+            r.origin.iter().chain(&r.direction).any(|c| !c.is_finite())
+                || r.direction.iter().all(|&c| c == 0.0)
+                || !(r.tmin >= 0.0 && r.tmin <= r.tmax)
         }) {
             return Err(PassError::Input(format!(
-                "ray {index}: origin and direction must be finite, direction nonzero"
+                "ray {index}: origin and direction must be finite, direction nonzero, 0 <= tmin <= tmax"
             )));
         }
         let groups = (rays.len() as u32).div_ceil(64);

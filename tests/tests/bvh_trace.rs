@@ -113,4 +113,3 @@ fn scene_camera_rays_agree_with_obvhs_on_vulkan() {
     };
     scene_camera_rays_agree_with_obvhs(&mut backend);
 }
-

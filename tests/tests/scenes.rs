@@ -26,7 +26,9 @@ fn every_shared_scene_loads_with_object_ids_and_emitters() {
         assert_eq!(scene.environment.is_some(), environment, "{name}");
         if let Some(environment) = &scene.environment {
             assert!(environment.file.exists(), "{}", environment.file.display());
-            assert!(environment.width > 0 && environment.texels.len() == (environment.width * environment.height) as usize);
+            assert!(
+                environment.width > 0 && environment.texels.len() == (environment.width * environment.height) as usize
+            );
         }
         for (index, shape) in scene.shapes.iter().enumerate() {
             assert_eq!(shape.object_id, index as u32);

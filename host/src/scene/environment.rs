@@ -43,7 +43,9 @@ impl Environment {
         let image = exr::prelude::read_first_rgba_layer_from_file(
             file,
             |resolution, _| (resolution.width(), vec![[0.0f32; 3]; resolution.width() * resolution.height()]),
-            |(width, texels): &mut (usize, Vec<[f32; 3]>), position: exr::math::Vec2<usize>, (r, g, b, _a): (f32, f32, f32, f32)| {
+            |(width, texels): &mut (usize, Vec<[f32; 3]>),
+             position: exr::math::Vec2<usize>,
+             (r, g, b, _a): (f32, f32, f32, f32)| {
                 texels[position.y() * *width + position.x()] = [r, g, b];
             },
         )
@@ -76,6 +78,13 @@ impl Environment {
         if !gram.abs_diff_eq(glam::Mat3::IDENTITY, 1e-3) || (r.determinant() - 1.0).abs() > 1e-3 {
             return Err(error(format!("to_world {rotation:?} is not a rotation (the map can only be rotated)")));
         }
-        Ok(Environment { file: file.into(), width: width as u32, height: height as u32, texels, scale, to_world: rotation })
+        Ok(Environment {
+            file: file.into(),
+            width: width as u32,
+            height: height as u32,
+            texels,
+            scale,
+            to_world: rotation,
+        })
     }
 }

@@ -1,6 +1,9 @@
 //! Scenes: the JSON + PLY description of the shared test scenes (`../shared/scenes`,
 //! every formula in their CONVENTIONS.md), loaded into triangles with object ids (the
-//! paper's masking key, §4.3), materials, emitters, a camera and an environment.
+//! paper's masking key, §4.3), materials, emitters, a camera and an environment. glTF 2.0
+//! (`.gltf`, `.glb`) and Wavefront OBJ + MTL files load into the same [`Scene`]
+//! ([`load_gltf`], [`load_obj`]; what they keep and how they map materials and cameras is
+//! in their modules' documentation); [`load_scene_file`] picks the loader by extension.
 //!
 //! Bad input is an error naming the file and the field or element: a missing file,
 //! malformed JSON or PLY, a NaN or infinite vertex, an index out of range, a mesh whose
@@ -13,7 +16,10 @@ mod camera_rays;
 mod default_scene;
 mod description;
 mod environment;
+mod gltf_scene;
 mod material;
+mod mesh_util;
+mod obj_scene;
 mod ply;
 mod texture;
 
@@ -21,7 +27,9 @@ pub use camera_rays::CameraFrame;
 pub use default_scene::default_scene;
 pub use description::{Camera, EmitterDescription, EnvironmentDescription, MaterialDescription, Reflectance};
 pub use environment::Environment;
+pub use gltf_scene::load_gltf;
 pub use material::{Albedo, Material};
+pub use obj_scene::load_obj;
 pub use ply::{PlyMesh, read_ply};
 pub use texture::{Texture, srgb_to_linear};
 
@@ -185,15 +193,19 @@ impl Scene {
     }
 }
 
-/// Loads a scene file by its extension: `.json` (the shared scenes' description).
+/// Loads a scene file by its extension: `.json` (the shared scenes' description), `.gltf`
+/// or `.glb` (glTF 2.0), `.obj` (Wavefront OBJ with its MTL libraries).
 pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
     match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
         Some("json") => Scene::load(path),
+        Some("gltf" | "glb") => load_gltf(path),
+        Some("obj") => load_obj(path),
         other => Err(SceneError::Json {
             path: path.into(),
             field: "(file)".into(),
             message: format!(
-                "unknown scene format `{}`: expected a .json scene description",
+                "unknown scene format `{}`: expected a .json scene description, a .gltf or .glb (glTF 2.0) \
+                 or an .obj (Wavefront OBJ + MTL) file",
                 other.unwrap_or("(no extension)")
             ),
         }),

@@ -1,0 +1,530 @@
+//! glTF 2.0 scenes (`.gltf` with its buffers and images, or binary `.glb`) through the
+//! `gltf` crate, turned into the renderer's world-space triangles, materials and camera.
+//!
+//! * Geometry: every instance of a mesh primitive in the default scene (or the first
+//!   scene; without scenes, every root node) becomes one [`Shape`] with its own object id,
+//!   in world space through the whole node hierarchy. Triangles, strips and fans are read;
+//!   points and lines are an error naming the mesh and primitive. An instance whose
+//!   transform mirrors (negative determinant) has its winding swapped, so that the
+//!   geometric normal stays on the glTF front side. Zero-area triangles are dropped and
+//!   counted as in PLY meshes; NaN or infinite vertices are errors. Skins and morph targets
+//!   are ignored (the bind pose is used).
+//! * Camera: the first perspective camera met in the node hierarchy (depth first). Its
+//!   image is 512 pixels wide, and 512 / `aspectRatio` high (512 × 512 without one); `yfov`
+//!   becomes the horizontal opening angle 2·atan(tan(yfov/2)·width/height) with `fov_axis`
+//!   `x`, so the vertical field of view is exactly `yfov`. Without `zfar`, the far clip lies
+//!   beyond the whole scene. Without a perspective camera: a camera framing the scene,
+//!   looking down −Z.
+//! * Materials (metallic-roughness): `metallicFactor` ≥ 0.5 gives a GGX conductor with
+//!   alpha = max(roughness², 10⁻³) whose complex IOR reproduces the base colour
+//!   (Gulbrandsen 2014, edge tint = base colour); otherwise a diffuse material with the
+//!   base colour factor, times the base colour texture (decoded as sRGB, the factor baked
+//!   into its texels) read with the texture's `texCoord` set. `doubleSided` gives
+//!   `two_sided`. Emission is `emissiveFactor` × `KHR_materials_emissive_strength`. Not
+//!   used: metallic-roughness, normal, occlusion and emissive textures, alpha, samplers
+//!   (always bilinear with repeat wrap), texture transforms, transmission and other
+//!   extensions. A primitive without a material gets grey diffuse 0.8 (not the glTF default
+//!   white metal, which nobody means).
+//!
+//! Errors name the file and the glTF field (`meshes[0].primitives[1].mode`,
+//! `accessors[3]`, ...): a missing file, malformed JSON or GLB, an invalid document, data
+//! outside its buffer, an accessor of the wrong type. The `gltf` crate can panic on some
+//! malformed documents; such a panic becomes an error too.
+
+use super::mesh_util::{
+    DEFAULT_IMAGE_SIDE, MIN_ALPHA, assemble_scene, bounds, checked_triangles, default_material, emission,
+    far_clip_beyond, metal, tinted, without_panic,
+};
+use super::{Albedo, Camera, Material, Scene, SceneError, Shape, Texture};
+use glam::{Mat3, Mat4, Vec3};
+use gltf::Document;
+use gltf::accessor::{Accessor, DataType, Dimensions};
+use gltf::camera::Perspective;
+use gltf::mesh::Mode;
+use std::collections::HashMap;
+use std::path::Path;
+
+/// Loads a glTF 2.0 file (`.gltf` or `.glb`) as a scene (module documentation).
+pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
+    without_panic(|| load_bytes(path, &bytes)).unwrap_or_else(|message| Err(json_error(path, "(document)", message)))
+}
+
+/// A glTF error: `field` is the JSON path of the problem.
+fn json_error(path: &Path, field: impl Into<String>, message: impl Into<String>) -> SceneError {
+    SceneError::Json { path: path.into(), field: field.into(), message: message.into() }
+}
+
+/// Loads the document in `bytes`, read from `path`.
+fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, SceneError> {
+    let raw = raw_json(bytes);
+    check_position_accessors(path, &raw)?;
+    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(bytes).map_err(|e| document_error(path, e))?;
+    let folder = path.parent().unwrap_or(Path::new("."));
+    let buffers = gltf::import_buffers(&document, Some(folder), blob).map_err(|e| {
+        let field = match e {
+            gltf::Error::BufferLength { buffer, .. } => format!("buffers[{buffer}]"),
+            _ => "buffers".into(),
+        };
+        json_error(path, field, format!("cannot load the buffer data: {e}"))
+    })?;
+    for view in document.views() {
+        let available = buffers.get(view.buffer().index()).map_or(0, |b| b.len());
+        if view.offset().checked_add(view.length()).is_none_or(|end| end > available) {
+            return Err(json_error(
+                path,
+                format!("bufferViews[{}]", view.index()),
+                format!(
+                    "bytes {}..+{} lie outside buffer {} ({available} bytes)",
+                    view.offset(),
+                    view.length(),
+                    view.buffer().index()
+                ),
+            ));
+        }
+    }
+    let mut loader = Loader {
+        path,
+        folder,
+        raw,
+        buffers,
+        materials: Vec::new(),
+        material_names: Vec::new(),
+        material_info: Vec::new(),
+        default_material: None,
+        textures: Vec::new(),
+        texture_cache: HashMap::new(),
+    };
+    for material in document.materials() {
+        loader.add_material(&material)?;
+    }
+    let (shapes, camera_node) = loader.instances(&document)?;
+    let camera = match camera_node {
+        Some((node, world, view)) => match view.projection() {
+            gltf::camera::Projection::Perspective(perspective) => {
+                Some(loader.camera(node, world, &perspective, bounds(&shapes))?)
+            }
+            gltf::camera::Projection::Orthographic(_) => None,
+        },
+        None => None,
+    };
+    let name = path.file_stem().map_or_else(|| path.display().to_string(), |s| s.to_string_lossy().into_owned());
+    Ok(assemble_scene(name, camera, (loader.materials, loader.material_names), shapes, loader.textures))
+}
+
+/// The error of a document the `gltf` crate refuses.
+fn document_error(path: &Path, error: gltf::Error) -> SceneError {
+    match error {
+        gltf::Error::Validation(problems) => {
+            let more = match problems.len() {
+                0 | 1 => String::new(),
+                n => format!(" (and {} more problems)", n - 1),
+            };
+            match problems.first() {
+                Some((field, problem)) => json_error(path, field.to_string(), format!("{problem}{more}")),
+                None => json_error(path, "(document)", "invalid glTF"),
+            }
+        }
+        gltf::Error::Deserialize(e) => json_error(path, "(document)", format!("not valid glTF JSON: {e}")),
+        gltf::Error::Binary(e) => json_error(path, "(GLB container)", format!("not a valid GLB file: {e}")),
+        other => json_error(path, "(document)", other.to_string()),
+    }
+}
+
+/// The document's JSON as plain values (for the extensions the `gltf` crate drops);
+/// `Null` if it cannot be read (the crate has accepted it by then, so this does not happen).
+fn raw_json(bytes: &[u8]) -> serde_json::Value {
+    let json = if bytes.starts_with(b"glTF") {
+        match gltf::Glb::from_slice(bytes) {
+            Ok(glb) => glb.json.into_owned(),
+            Err(_) => return serde_json::Value::Null,
+        }
+    } else {
+        bytes.to_vec()
+    };
+    serde_json::from_slice(&json).unwrap_or(serde_json::Value::Null)
+}
+
+/// Refuses a POSITION attribute naming an accessor that does not exist, which the `gltf`
+/// crate's validation indexes without checking (a panic).
+fn check_position_accessors(path: &Path, raw: &serde_json::Value) -> Result<(), SceneError> {
+    let accessors = raw.get("accessors").and_then(serde_json::Value::as_array).map_or(0, Vec::len);
+    let meshes = raw.get("meshes").and_then(serde_json::Value::as_array).into_iter().flatten();
+    for (m, mesh) in meshes.enumerate() {
+        let primitives = mesh.get("primitives").and_then(serde_json::Value::as_array).into_iter().flatten();
+        for (p, primitive) in primitives.enumerate() {
+            let index = primitive.pointer("/attributes/POSITION").and_then(serde_json::Value::as_u64);
+            if let Some(index) = index.filter(|&i| i >= accessors as u64) {
+                return Err(json_error(
+                    path,
+                    format!("meshes[{m}].primitives[{p}].attributes.POSITION"),
+                    format!("accessor {index} does not exist (the file has {accessors})"),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// What a shape needs from its material beyond the BSDF.
+struct MaterialInfo {
+    /// Emitted radiance, if any.
+    emission: Option<[f32; 3]>,
+    /// Texture coordinate set of the colour texture (0 without one).
+    tex_coord: u32,
+}
+
+/// The conversion's state.
+struct Loader<'a> {
+    /// The file, for messages.
+    path: &'a Path,
+    /// Where relative URIs start.
+    folder: &'a Path,
+    /// The document as plain JSON.
+    raw: serde_json::Value,
+    /// Buffer contents, by index.
+    buffers: Vec<gltf::buffer::Data>,
+    /// Renderer materials: the document's, by index, then the default one if needed.
+    materials: Vec<Material>,
+    /// Names of `materials`.
+    material_names: Vec<String>,
+    /// Emission and texture coordinate set of the document's materials, by index.
+    material_info: Vec<MaterialInfo>,
+    /// Index of the grey default material, once a primitive needs it.
+    default_material: Option<usize>,
+    /// Decoded textures.
+    textures: Vec<Texture>,
+    /// Texture index by (image index, tint bits).
+    texture_cache: HashMap<(usize, [u32; 3]), usize>,
+}
+
+/// The first perspective camera: its node index, world matrix and camera.
+type CameraNode<'d> = (usize, Mat4, gltf::Camera<'d>);
+
+impl Loader<'_> {
+    /// An error about `field`.
+    fn error(&self, field: impl Into<String>, message: impl Into<String>) -> SceneError {
+        json_error(self.path, field, message)
+    }
+
+    /// Converts material `material` of the document (module documentation).
+    fn add_material(&mut self, material: &gltf::Material) -> Result<(), SceneError> {
+        let index = material.index().unwrap_or(self.materials.len());
+        let field = format!("materials[{index}]");
+        let pbr = material.pbr_metallic_roughness();
+        let [r, g, b, _] = pbr.base_color_factor();
+        let (metallic, roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
+        if [r, g, b, metallic, roughness].iter().any(|c| !c.is_finite() || *c < 0.0) {
+            return Err(self.error(
+                format!("{field}.pbrMetallicRoughness"),
+                format!(
+                    "base colour {:?}, metallic {metallic}, roughness {roughness}: must be finite and ≥ 0",
+                    [r, g, b]
+                ),
+            ));
+        }
+        let two_sided = material.double_sided();
+        let mut tex_coord = 0;
+        let bsdf = if metallic >= 0.5 {
+            metal([r, g, b], (roughness * roughness).max(MIN_ALPHA), two_sided)
+        } else if let Some(info) = pbr.base_color_texture() {
+            tex_coord = info.tex_coord();
+            let texture = self.texture(info.texture().source(), [r, g, b])?;
+            Material::Diffuse { albedo: Albedo::Texture { texture, uv_scale: [1.0, 1.0] }, two_sided }
+        } else {
+            Material::Diffuse { albedo: Albedo::Constant([r, g, b]), two_sided }
+        };
+        let pointer = format!("/materials/{index}/extensions/KHR_materials_emissive_strength/emissiveStrength");
+        let strength = self.raw.pointer(&pointer).and_then(serde_json::Value::as_f64).unwrap_or(1.0) as f32;
+        let radiance = material.emissive_factor().map(|c| c * strength);
+        let emission = emission(radiance).map_err(|message| self.error(format!("{field}.emissiveFactor"), message))?;
+        self.materials.push(bsdf);
+        self.material_names.push(material.name().map_or_else(|| field.clone(), String::from));
+        self.material_info.push(MaterialInfo { emission, tex_coord });
+        Ok(())
+    }
+
+    /// Index of the renderer material of a primitive's material (the default if it has none).
+    fn material_index(&mut self, material: &gltf::Material) -> usize {
+        if let Some(index) = material.index() {
+            return index;
+        }
+        *self.default_material.get_or_insert_with(|| {
+            self.materials.push(default_material());
+            self.material_names.push("(default)".into());
+            self.materials.len() - 1
+        })
+    }
+
+    /// Index of the texture decoding `image` as sRGB, times `tint`.
+    fn texture(&mut self, image: gltf::Image, tint: [f32; 3]) -> Result<usize, SceneError> {
+        let key = (image.index(), tint.map(f32::to_bits));
+        if let Some(&index) = self.texture_cache.get(&key) {
+            return Ok(index);
+        }
+        let field = format!("images[{}]", image.index());
+        let json = self.raw.pointer(&format!("/images/{}", image.index()));
+        let has = |name: &str| json.and_then(|j| j.get(name)).is_some();
+        if has("bufferView") && !has("mimeType") {
+            return Err(self.error(field, "an image in a buffer view needs a `mimeType`"));
+        }
+        if !has("bufferView") && !has("uri") {
+            return Err(self.error(field, "the image has neither `uri` nor `bufferView`"));
+        }
+        let what = match image.source() {
+            gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => format!("`{uri}`"),
+            _ => "the image".into(),
+        };
+        let data = gltf::image::Data::from_source(image.source(), Some(self.folder), &self.buffers)
+            .map_err(|e| self.error(field.clone(), format!("cannot decode {what}: {e}")))?;
+        let rgba = rgba8(&data);
+        if data.width == 0 || data.height == 0 || rgba.len() != 4 * data.width as usize * data.height as usize {
+            return Err(
+                self.error(field, format!("{what}: {}×{} pixels do not match its data", data.width, data.height))
+            );
+        }
+        let name = format!("{}#{field}", self.path.display());
+        self.textures.push(tinted(Texture::from_rgba8(name, data.width, data.height, &rgba, true), tint));
+        self.texture_cache.insert(key, self.textures.len() - 1);
+        Ok(self.textures.len() - 1)
+    }
+
+    /// Every mesh-primitive instance of the scene as a shape, and the first perspective camera.
+    fn instances<'d>(&mut self, document: &'d Document) -> Result<(Vec<Shape>, Option<CameraNode<'d>>), SceneError> {
+        let roots: Vec<gltf::Node> = match document.default_scene().or_else(|| document.scenes().next()) {
+            Some(scene) => scene.nodes().collect(),
+            None => {
+                let children: Vec<usize> = document.nodes().flat_map(|n| n.children().map(|c| c.index())).collect();
+                document.nodes().filter(|n| !children.contains(&n.index())).collect()
+            }
+        };
+        let mut reached = vec![false; document.nodes().len()];
+        let mut stack: Vec<(gltf::Node, Mat4)> = roots.into_iter().rev().map(|n| (n, Mat4::IDENTITY)).collect();
+        let mut shapes = Vec::new();
+        let mut camera = None;
+        while let Some((node, parent)) = stack.pop() {
+            let field = format!("nodes[{}]", node.index());
+            if std::mem::replace(&mut reached[node.index()], true) {
+                return Err(self.error(field, "the node is reached twice: the node hierarchy must be a tree"));
+            }
+            let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+            if !world.is_finite() {
+                return Err(self.error(field, format!("the world transform is not finite: {world:?}")));
+            }
+            if let Some(mesh) = node.mesh() {
+                for primitive in mesh.primitives() {
+                    shapes.push(self.shape(&node, world, &mesh, &primitive, shapes.len() as u32)?);
+                }
+            }
+            if let (None, Some(view)) = (&camera, node.camera())
+                && matches!(view.projection(), gltf::camera::Projection::Perspective(_))
+            {
+                camera = Some((node.index(), world, view));
+            }
+            stack.extend(node.children().collect::<Vec<_>>().into_iter().rev().map(|c| (c, world)));
+        }
+        if shapes.is_empty() {
+            return Err(self.error("(scene)", "the scene has no mesh instances"));
+        }
+        Ok((shapes, camera))
+    }
+
+    /// Checks that `accessor` holds `dimensions` of one of `types` and can be read, for `use`.
+    fn check_accessor(
+        &self,
+        accessor: &Accessor,
+        what: &str,
+        dimensions: Dimensions,
+        types: &[DataType],
+    ) -> Result<(), SceneError> {
+        let field = format!("accessors[{}]", accessor.index());
+        let fail = |message: String| Err(self.error(field.clone(), format!("{what}: {message}")));
+        if accessor.dimensions() != dimensions || !types.contains(&accessor.data_type()) {
+            return fail(format!(
+                "{:?} of {:?}: expected {dimensions:?} of {types:?}",
+                accessor.dimensions(),
+                accessor.data_type()
+            ));
+        }
+        if accessor.count() == 0 || accessor.sparse().is_some_and(|s| s.count() == 0) {
+            return fail("no elements".into());
+        }
+        if let Some(stride) = accessor.view().and_then(|v| v.stride())
+            && stride < accessor.size()
+        {
+            return fail(format!("byte stride {stride} is smaller than an element ({} bytes)", accessor.size()));
+        }
+        Ok(())
+    }
+
+    /// The shape of one instance of `primitive` of `mesh` under `node` (world matrix `world`).
+    fn shape(
+        &mut self,
+        node: &gltf::Node,
+        world: Mat4,
+        mesh: &gltf::Mesh,
+        primitive: &gltf::Primitive,
+        object_id: u32,
+    ) -> Result<Shape, SceneError> {
+        let field = format!("meshes[{}].primitives[{}]", mesh.index(), primitive.index());
+        let material = primitive.material();
+        let material_index = self.material_index(&material);
+        let info = material.index().and_then(|i| self.material_info.get(i));
+        let (emission, tex_coord) = info.map_or((None, 0), |i| (i.emission, i.tex_coord));
+        let buffers = &self.buffers;
+        let reader = primitive.reader(|b| buffers.get(b.index()).map(|data| data.0.as_slice()));
+        let outside = |accessor: &Accessor| {
+            self.error(format!("accessors[{}]", accessor.index()), "its data lies outside its buffer view")
+        };
+        let Some(position_accessor) = primitive.get(&gltf::Semantic::Positions) else {
+            return Err(self.error(format!("{field}.attributes"), "no POSITION"));
+        };
+        self.check_accessor(&position_accessor, "POSITION", Dimensions::Vec3, &[DataType::F32])?;
+        let positions: Vec<[f32; 3]> = reader.read_positions().ok_or_else(|| outside(&position_accessor))?.collect();
+        let indices: Vec<u32> = match primitive.indices() {
+            Some(accessor) => {
+                self.check_accessor(
+                    &accessor,
+                    "indices",
+                    Dimensions::Scalar,
+                    &[DataType::U8, DataType::U16, DataType::U32],
+                )?;
+                reader.read_indices().ok_or_else(|| outside(&accessor))?.into_u32().collect()
+            }
+            None => (0..positions.len() as u32).collect(),
+        };
+        let mut faces: Vec<[u32; 3]> = match primitive.mode() {
+            Mode::Triangles if indices.len().is_multiple_of(3) => {
+                indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect()
+            }
+            Mode::Triangles => {
+                return Err(self.error(field, format!("{} indices: not a multiple of 3", indices.len())));
+            }
+            Mode::TriangleStrip => (0..indices.len().saturating_sub(2))
+                .map(|i| [indices[i], indices[i + 1 + i % 2], indices[i + 2 - i % 2]])
+                .collect(),
+            Mode::TriangleFan => {
+                (1..indices.len().saturating_sub(1)).map(|i| [indices[i], indices[i + 1], indices[0]]).collect()
+            }
+            other => {
+                let name = mesh.name().map(|n| format!(" (mesh `{n}`)")).unwrap_or_default();
+                return Err(self.error(
+                    format!("{field}.mode"),
+                    format!("{other:?}{name}: only triangle primitives (triangles, strips, fans) are supported"),
+                ));
+            }
+        };
+        let uvs = match primitive.get(&gltf::Semantic::TexCoords(tex_coord)) {
+            Some(accessor) => {
+                let what = format!("TEXCOORD_{tex_coord}");
+                self.check_accessor(&accessor, &what, Dimensions::Vec2, &[DataType::F32, DataType::U8, DataType::U16])?;
+                Some(reader.read_tex_coords(tex_coord).ok_or_else(|| outside(&accessor))?.into_f32().collect())
+            }
+            None => None,
+        };
+        if Mat3::from_mat4(world).determinant() < 0.0 {
+            faces.iter_mut().for_each(|f| f.swap(1, 2));
+        }
+        let to_world = |p: [f32; 3]| world.transform_point3(Vec3::from(p)).into();
+        let mesh_triangles = checked_triangles(positions, to_world, uvs, faces).map_err(|problem| {
+            self.error(
+                field.clone(),
+                format!("{} (instance of nodes[{}]): {}", problem.element, node.index(), problem.message),
+            )
+        })?;
+        let mut name = node.name().or(mesh.name()).map_or_else(|| format!("nodes[{}]", node.index()), String::from);
+        if mesh.primitives().len() > 1 {
+            name = format!("{name}#{}", primitive.index());
+        }
+        Ok(Shape {
+            name,
+            object_id,
+            material: material_index,
+            emission,
+            triangles: mesh_triangles.triangles,
+            uvs: mesh_triangles.uvs,
+            degenerate_dropped: mesh_triangles.degenerate_dropped,
+        })
+    }
+
+    /// The renderer's camera for the perspective camera of node `node` (module documentation).
+    fn camera(
+        &self,
+        node: usize,
+        world: Mat4,
+        perspective: &Perspective,
+        scene_bounds: (Vec3, Vec3),
+    ) -> Result<Camera, SceneError> {
+        let field = format!("nodes[{node}].camera");
+        let yfov = perspective.yfov();
+        if !(yfov > 0.0 && yfov < std::f32::consts::PI) {
+            return Err(self.error(field, format!("yfov {yfov} must lie in (0, π)")));
+        }
+        let (width, height) = match perspective.aspect_ratio() {
+            Some(aspect) if aspect.is_finite() && aspect > 0.0 => {
+                (DEFAULT_IMAGE_SIDE, ((DEFAULT_IMAGE_SIDE as f32 / aspect).round() as u32).max(1))
+            }
+            Some(aspect) => return Err(self.error(field, format!("aspectRatio {aspect} must be > 0"))),
+            None => (DEFAULT_IMAGE_SIDE, DEFAULT_IMAGE_SIDE),
+        };
+        let near_clip = perspective.znear();
+        if !(near_clip.is_finite() && near_clip > 0.0) {
+            return Err(self.error(field, format!("znear {near_clip} must be > 0")));
+        }
+        let origin = world.transform_point3(Vec3::ZERO);
+        let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+        let up = world.transform_vector3(Vec3::Y);
+        if forward == Vec3::ZERO || forward.cross(up).length_squared() <= 0.0 {
+            return Err(self.error(format!("nodes[{node}]"), "the camera's transform has no view direction or up"));
+        }
+        let fov_x = 2.0 * ((yfov * 0.5).tan() * width as f32 / height as f32).atan();
+        Ok(Camera {
+            origin: origin.into(),
+            target: (origin + forward).into(),
+            up: up.normalize().into(),
+            fov_deg: fov_x.to_degrees(),
+            fov_axis: "x".into(),
+            width,
+            height,
+            near_clip,
+            far_clip: perspective.zfar().unwrap_or_else(|| far_clip_beyond(origin, scene_bounds)),
+        })
+    }
+}
+
+/// The pixels of a decoded image as 8-bit RGBA (grey replicated, 16-bit and float
+/// channels rounded to 8 bits, alpha 255 where there is none).
+fn rgba8(data: &gltf::image::Data) -> Vec<u8> {
+    use gltf::image::Format;
+    let (channels, bytes) = match data.format {
+        Format::R8 => (1, 1),
+        Format::R8G8 => (2, 1),
+        Format::R8G8B8 => (3, 1),
+        Format::R8G8B8A8 => (4, 1),
+        Format::R16 => (1, 2),
+        Format::R16G16 => (2, 2),
+        Format::R16G16B16 => (3, 2),
+        Format::R16G16B16A16 => (4, 2),
+        Format::R32G32B32FLOAT => (3, 4),
+        Format::R32G32B32A32FLOAT => (4, 4),
+    };
+    let channel = |c: &[u8]| -> u8 {
+        match bytes {
+            1 => c[0],
+            2 => ((u32::from(u16::from_ne_bytes([c[0], c[1]])) * 255 + 32767) / 65535) as u8,
+            _ => (f32::from_ne_bytes([c[0], c[1], c[2], c[3]]).clamp(0.0, 1.0) * 255.0).round() as u8,
+        }
+    };
+    data.pixels
+        .chunks_exact(channels * bytes)
+        .flat_map(|pixel| {
+            let value: Vec<u8> = pixel.chunks_exact(bytes).map(channel).collect();
+            match channels {
+                1 => [value[0], value[0], value[0], 255],
+                2 => [value[0], value[0], value[0], value[1]],
+                3 => [value[0], value[1], value[2], 255],
+                _ => [value[0], value[1], value[2], value[3]],
+            }
+        })
+        .collect()
+}

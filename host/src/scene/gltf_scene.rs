@@ -20,8 +20,10 @@
 //!   (Gulbrandsen 2014, edge tint = base colour); otherwise a diffuse material with the
 //!   base colour factor, times the base colour texture (decoded as sRGB, the factor baked
 //!   into its texels) read with the texture's `texCoord` set. `doubleSided` gives
-//!   `two_sided`. Emission is `emissiveFactor` × `KHR_materials_emissive_strength`. Not
-//!   used: metallic-roughness, normal, occlusion and emissive textures, alpha, samplers
+//!   `two_sided`. Emission is `emissiveFactor` × `KHR_materials_emissive_strength`, from
+//!   the front side only (the renderer's area lights are one-sided). Not used: the base
+//!   colour texture of metals, metallic-roughness, normal, occlusion and emissive textures,
+//!   alpha, samplers
 //!   (always bilinear with repeat wrap), texture transforms, transmission and other
 //!   extensions. A primitive without a material gets grey diffuse 0.8 (not the glTF default
 //!   white metal, which nobody means).

@@ -21,7 +21,8 @@
 //!     relative to the MTL file; `Kd` is baked into its texels, 1 when absent; map options
 //!     such as `-s` are ignored and the file name is the last word).
 //!
-//!   All are two-sided except the dielectric. `Ke` is the shape's emitted radiance.
+//!   All are two-sided except the dielectric. `Ke` is the shape's emitted radiance, from
+//!   the front (counter-clockwise) side only, as every area light of the renderer.
 //!   Specular highlights of `illum` 2 and every other texture are not used. An object without
 //!   a material, or whose material library is missing (reported on stderr), is grey diffuse
 //!   0.8.

@@ -221,9 +221,9 @@ fn render(args: RenderArgs) -> Result<()> {
 /// `cornell-box` for `.../cornell-box/scene.json`, else the file stem.
 fn scene_stem(path: &std::path::Path) -> Option<String> {
     let stem = path.file_stem()?.to_string_lossy().into_owned();
-    if stem.starts_with("scene") {
+    if let Some(variant) = stem.strip_prefix("scene") {
         let folder = path.parent()?.file_name()?.to_string_lossy().into_owned();
-        return Some(format!("{folder}{}", &stem["scene".len()..]));
+        return Some(format!("{folder}{variant}"));
     }
     Some(stem)
 }

@@ -5,7 +5,7 @@
 //!   the external validator for its language (see `strata_kernels::validate`). Exits
 //!   non-zero if any output is invalid; with `--strict`, also if a validator that can
 //!   exist on this machine is missing (CI uses this).
-//! * `cargo xtask check [--full]`: runs every registry kernel on every available backend
+//! * `cargo xtask check [--full] [--kernel NAME,...]`: runs every registry kernel on every available backend
 //!   (wgpu Vulkan and GL, ash on naga's SPIR-V and on glslang's compilation of naga's
 //!   GLSL and HLSL) with generated inputs and compares the outputs with the kernels'
 //!   references; prints a kernels × backends table and exits non-zero on any mismatch.
@@ -66,21 +66,33 @@ enum Command {
         /// At least 20 seeds at several sizes per kernel (default: 3 seeds, small sizes).
         #[arg(long)]
         full: bool,
+        /// Only these kernels (registry names, comma-separated); all when left out.
+        #[arg(long, value_delimiter = ',')]
+        kernel: Vec<String>,
     },
 }
 
 fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Shaders { strict, out } => shaders(strict, out),
-        Command::Check { full } => check(full),
+        Command::Check { full, kernel } => check(full, &kernel),
         Command::Run { shader, entry, workgroups, buffers, sizes, backend, out } => {
             run(strata::run_kernel::RunRequest { shader, entry, workgroups, buffers, sizes, backends: backend, out })
         }
     }
 }
 
-fn check(full: bool) -> Result<()> {
-    let report = strata::check::run_check(strata::check::CheckConfig { full });
+fn check(full: bool, only: &[String]) -> Result<()> {
+    let registry = Registry::shared()?;
+    let mut checks = strata::check::kernel_checks();
+    if let Some(unknown) = only.iter().find(|name| !checks.iter().any(|c| registry.get(c.kernel()).name() == *name)) {
+        let names: Vec<&str> = checks.iter().map(|c| registry.get(c.kernel()).name()).collect();
+        bail!("--kernel {unknown}: no such kernel (kernels: {})", names.join(", "));
+    }
+    if !only.is_empty() {
+        checks.retain(|c| only.iter().any(|name| registry.get(c.kernel()).name() == name));
+    }
+    let report = strata::check::run_checks(strata::check::CheckConfig { full }, checks);
     print!("{}", report.render());
     let failures = report.failures();
     if !failures.is_empty() {

@@ -8,6 +8,7 @@ mod camera;
 mod compare;
 mod empty;
 mod histogram;
+mod path;
 mod report;
 mod trace;
 
@@ -64,12 +65,19 @@ pub fn kernel_checks() -> Vec<Box<dyn KernelCheck>> {
         Box::new(empty::EmptyCheck),
         Box::new(trace::TraceCheck),
         Box::new(camera::CameraCheck),
+        Box::new(path::PathTraceCheck),
     ]
 }
 
 /// Runs every kernel check on every backend slot.
 pub fn run_check(config: CheckConfig) -> CheckReport {
-    let checks = kernel_checks();
+    run_checks(config, kernel_checks())
+}
+
+/// Runs `checks` on every backend slot. Each case's reference is computed once and
+/// shared by the slots (for the path tracer it is an interpreter run).
+pub fn run_checks(config: CheckConfig, checks: Vec<Box<dyn KernelCheck>>) -> CheckReport {
+    let mut references = ReferenceCache::default();
     let mut report = CheckReport::new(
         checks.iter().map(|c| c.kernel()).collect(),
         backend_slots().iter().map(|s| s.name.to_string()).collect(),
@@ -86,14 +94,22 @@ pub fn run_check(config: CheckConfig) -> CheckReport {
         };
         report.set_device(slot.name, backend.info().summary());
         for check in &checks {
-            let result = run_one(check.as_ref(), backend.as_mut(), config);
+            let result = run_one(check.as_ref(), backend.as_mut(), config, &mut references);
             report.set(check.kernel(), slot.name, result);
         }
     }
     report
 }
 
-fn run_one(check: &dyn KernelCheck, backend: &mut dyn Backend, config: CheckConfig) -> CellResult {
+/// Reference outputs by kernel and case label.
+type ReferenceCache = std::collections::HashMap<(KernelId, String), Vec<Output>>;
+
+fn run_one(
+    check: &dyn KernelCheck,
+    backend: &mut dyn Backend,
+    config: CheckConfig,
+    references: &mut ReferenceCache,
+) -> CellResult {
     let kernel = match strata_kernels::Registry::shared() {
         Ok(registry) => registry.get(check.kernel()),
         Err(error) => return CellResult::Failed(error.to_string()),
@@ -108,7 +124,8 @@ fn run_one(check: &dyn KernelCheck, backend: &mut dyn Backend, config: CheckConf
             Ok(outputs) => outputs,
             Err(error) => return CellResult::Failed(format!("{}: {error}", case.label)),
         };
-        match compare_outputs(&outputs, &check.reference(case)) {
+        let reference = references.entry((check.kernel(), case.label.clone())).or_insert_with(|| check.reference(case));
+        match compare_outputs(&outputs, reference) {
             Ok(case_agreement) => agreement = agreement.merge(case_agreement),
             Err(mismatch) => return CellResult::Failed(format!("{}: {mismatch}", case.label)),
         }

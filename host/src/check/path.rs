@@ -1,0 +1,115 @@
+//! Check of the path-tracing kernel. It has no Rust mirror: its reference executor is
+//! the CPU interpreter of the same WGSL (issue 4's role for the interpreter), so on the
+//! `cpu` slot the check only shows that the interpreter is deterministic. Paths branch
+//! on float results (which triangle, which lobe, Russian roulette), so one rounding
+//! difference can send a path elsewhere: the registry's ULP bound holds for most
+//! values, and a share of pixels (at most 5 %) may differ beyond it. Inputs: the default
+//! scene (area light, diffuse) and a furnace-like scene with a conductor, a dielectric and
+//! an environment map, at a few sizes with partial workgroups, one sample per pixel.
+
+use super::{Case, CheckConfig, Compare, KernelCheck, Output};
+use crate::histogram_pass::PassError;
+use crate::render::{GpuScene, LightSampling, RenderSettings, render};
+use crate::scene::{Environment, Material, Scene, default_scene};
+use strata_backends::Backend;
+use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
+use strata_kernels::{KernelId, Registry};
+
+/// Checks [`KernelId::PathTrace`].
+pub struct PathTraceCheck;
+
+/// The default room with its tall box turned to glass, its short box to rough metal and
+/// a small environment map shining in (family 1), or the plain default scene (family 0).
+fn scene(case: &Case) -> Scene {
+    let mut scene = default_scene();
+    if case.family == 1 {
+        scene.materials.push(Material::Dielectric { int_ior: 1.5, ext_ior: 1.0 });
+        scene.materials.push(Material::RoughConductor {
+            alpha: 0.2,
+            eta: [0.2, 0.9, 1.1],
+            k: [3.9, 2.4, 2.2],
+            two_sided: true,
+        });
+        let count = scene.materials.len();
+        for shape in &mut scene.shapes {
+            if shape.name.contains("tall") {
+                shape.material = count - 2;
+            } else if shape.name.contains("short") {
+                shape.material = count - 1;
+            }
+        }
+        let (width, height) = (8u32, 4u32);
+        scene.environment = Some(Environment {
+            file: "generated".into(),
+            width,
+            height,
+            texels: (0..width * height).map(|i| [0.1 + (i % 5) as f32 * 0.3, 0.5, 0.2 + (i % 3) as f32]).collect(),
+            scale: 1.0,
+            to_world: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        });
+    }
+    scene
+}
+
+fn settings(case: &Case, scene: &Scene) -> RenderSettings {
+    let mut camera = scene.camera.clone();
+    camera.width = case.width;
+    camera.height = case.height;
+    RenderSettings {
+        camera,
+        seed: case.seed as u32,
+        max_depth: scene.max_depth,
+        rr_depth: 2,
+        light_sampling: LightSampling::Mis,
+        russian_roulette: true,
+    }
+}
+
+fn run_on(backend: &mut dyn Backend, case: &Case) -> Result<Vec<Output>, PassError> {
+    let scene = scene(case);
+    let image = render(backend, &GpuScene::build(&scene)?, &settings(case, &scene), 1, |_| {})?;
+    let ulp = Registry::shared()?.get(KernelId::PathTrace).spec.float_ulp_bound.unwrap_or(0);
+    Ok(vec![Output {
+        name: "accumulation.rgb",
+        words: image.pixels.iter().flatten().map(|c| c.to_bits()).collect(),
+        compare: Compare::Float { ulp, max_outside: 0.05 },
+    }])
+}
+
+impl KernelCheck for PathTraceCheck {
+    fn kernel(&self) -> KernelId {
+        KernelId::PathTrace
+    }
+
+    fn cases(&self, config: CheckConfig) -> Vec<Case> {
+        let seeds = if config.full { 20 } else { 2 };
+        let sizes: &[(u32, u32)] = if config.full { &[(1, 1), (13, 9), (32, 24)] } else { &[(13, 9)] };
+        let mut cases = Vec::new();
+        for seed in 0..seeds {
+            for &(width, height) in sizes {
+                let family = (seed % 2) as u32;
+                cases.push(Case {
+                    label: format!(
+                        "{width}x{height} seed {seed} {}",
+                        ["default scene", "glass, metal, environment"][family as usize]
+                    ),
+                    width,
+                    height,
+                    block_size: 0,
+                    seed: 7 + seed,
+                    family,
+                });
+            }
+        }
+        cases
+    }
+
+    fn run(&self, backend: &mut dyn Backend, case: &Case) -> Result<Vec<Output>, PassError> {
+        run_on(backend, case)
+    }
+
+    fn reference(&self, case: &Case) -> Vec<Output> {
+        let mut interpreter = CpuBackend::new(CpuOptions::default()).expect("the interpreter always opens");
+        run_on(&mut interpreter, case).expect("the interpreter runs the path tracer")
+    }
+}

@@ -11,6 +11,7 @@ pub mod metrics;
 pub mod render;
 pub mod rgb_image;
 pub mod run_kernel;
+pub mod sampler;
 pub mod scene;
 pub mod synthetic;
 pub mod trace_pass;

@@ -5,10 +5,12 @@
 
 pub mod backend_choice;
 pub mod check;
+pub mod compare;
 pub mod estimator;
 pub mod histogram_pass;
 pub mod metrics;
 pub mod render;
+pub mod restir;
 pub mod rgb_image;
 pub mod run_kernel;
 pub mod sampler;

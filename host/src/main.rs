@@ -5,7 +5,10 @@ use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::time::Instant;
 use strata::backend_choice::{BackendChoice, open_backend};
+use strata::compare::{Comparison, errors_csv, relmse_over_seeds, relmse_ratio, run_comparison};
 use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
+use strata::restir::{Method, RestirSettings};
+use strata::sampler::SamplerVariant;
 use strata::metrics::{self, Metric};
 use strata::render::{GpuScene, LightSampling, RenderSettings};
 use strata::rgb_image::RgbImage;
@@ -30,9 +33,61 @@ enum Command {
     /// Path-trace a scene progressively (the reference mode) and write a linear float EXR
     /// and a tone-mapped sRGB PNG preview.
     Render(RenderArgs),
+    /// Render the ReSTIR methods from the same seeds and measure every frame against a
+    /// reference: images, error maps, a CSV and a summary table.
+    Compare(CompareArgs),
     /// Compare an EXR image with a reference EXR: MSE, RelMSE (paper and common forms),
     /// pRelMSE; optionally write the per-pixel RelMSE map as EXR and false-colour PNG.
     Metrics(MetricsArgs),
+}
+
+#[derive(clap::Args)]
+struct CompareArgs {
+    /// Scene file; the built-in default scene when left out.
+    scene: Option<PathBuf>,
+    /// Frames per seed.
+    #[arg(long, default_value_t = 32)]
+    frames: u32,
+    /// Methods, comma-separated.
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [Method::Restir, Method::RestirDisc, Method::Strata])]
+    methods: Vec<Method>,
+    /// Independent renders (seeds 1..=N) per method.
+    #[arg(long, default_value_t = 8)]
+    seeds: u32,
+    /// Output folder.
+    #[arg(long, default_value = "out/compare")]
+    out: PathBuf,
+    /// Reference image (linear EXR of the same size); rendered by the path tracer when
+    /// left out.
+    #[arg(long)]
+    reference: Option<PathBuf>,
+    /// Samples per pixel of the rendered reference.
+    #[arg(long, default_value_t = 1024)]
+    reference_spp: u32,
+    /// Image width (default: the scene camera's).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height (default: the scene camera's).
+    #[arg(long)]
+    height: Option<u32>,
+    /// Histogram block size (4, 8, 16, 32).
+    #[arg(long, default_value_t = 16)]
+    block_size: u32,
+    /// Sampler variant of the selection (the paper's Table 2).
+    #[arg(long, value_enum, default_value_t = SamplerVariant::Antithetic)]
+    sampler: SamplerVariant,
+    /// No temporal reuse: frames are accumulated instead (Fig. 5 / 10).
+    #[arg(long)]
+    accumulate: bool,
+    /// No object-id masking: one histogram cluster per block.
+    #[arg(long)]
+    no_masking: bool,
+    /// Exposure of the PNG previews.
+    #[arg(long, default_value_t = 1.0)]
+    exposure: f32,
+    /// Backend to run on.
+    #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
+    backend: BackendChoice,
 }
 
 #[derive(clap::Args)]
@@ -130,7 +185,150 @@ fn main() -> Result<()> {
         Command::Histogram(args) => histogram(args),
         Command::Render(args) => render(args),
         Command::Metrics(args) => metrics(args),
+        Command::Compare(args) => compare(args),
     }
+}
+
+fn compare(args: CompareArgs) -> Result<()> {
+    let scene = match &args.scene {
+        Some(path) => load_scene_file(path)?,
+        None => default_scene(),
+    };
+    let mut camera = scene.camera.clone();
+    camera.width = args.width.unwrap_or(camera.width);
+    camera.height = args.height.unwrap_or(camera.height);
+    if args.frames == 0 || args.seeds == 0 {
+        bail!("--frames and --seeds must be at least 1");
+    }
+    let render = RenderSettings {
+        camera,
+        seed: 1,
+        max_depth: scene.max_depth,
+        rr_depth: scene.rr_depth,
+        light_sampling: LightSampling::Mis,
+        russian_roulette: true,
+    };
+    let gpu_scene = GpuScene::build(&scene)?;
+    let mut backend = open_backend(args.backend)?;
+    println!("backend: {}", backend.info().summary());
+    std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create the folder", args.out.display()))?;
+    let reference = match &args.reference {
+        Some(path) => RgbImage::read_exr(path)?,
+        None => {
+            println!("rendering the reference: {} spp path tracing", args.reference_spp);
+            let settings = RenderSettings { seed: 0x7ef, ..render.clone() };
+            let bar = indicatif::ProgressBar::new(u64::from(args.reference_spp));
+            let image = strata::render::render(backend.as_mut(), &gpu_scene, &settings, args.reference_spp, |done| {
+                bar.set_position(u64::from(done))
+            })?;
+            bar.finish_and_clear();
+            let path = args.out.join("reference.exr");
+            image.write_exr(&path)?;
+            image.write_png(&args.out.join("reference.png"), args.exposure)?;
+            image
+        }
+    };
+    if (reference.width, reference.height) != (render.camera.width, render.camera.height) {
+        bail!(
+            "the reference is {}x{} but the render is {}x{}",
+            reference.width,
+            reference.height,
+            render.camera.width,
+            render.camera.height
+        );
+    }
+    let comparison = Comparison {
+        methods: args.methods.clone(),
+        frames: args.frames,
+        seeds: (1..=args.seeds).collect(),
+        restir: RestirSettings {
+            block_size: args.block_size,
+            sampler: args.sampler,
+            temporal: !args.accumulate,
+            masking: !args.no_masking,
+            ..RestirSettings::default()
+        },
+        accumulate: args.accumulate,
+    };
+    let total = u64::from(args.frames) * u64::from(args.seeds) * args.methods.len() as u64;
+    let bar = indicatif::ProgressBar::new(total);
+    let started = Instant::now();
+    let mut write_error: Option<anyhow::Error> = None;
+    let errors = run_comparison(
+        backend.as_mut(),
+        &gpu_scene,
+        &render,
+        scene.extent(),
+        &comparison,
+        &reference,
+        |method, seed, frame, image| {
+            bar.inc(1);
+            // Images of the first seed: the first frame and every power of two.
+            if seed == 1 && ((frame + 1).is_power_of_two() || frame + 1 == args.frames) {
+                let stem = args.out.join(format!("{}_frame{:03}", method.name(), frame + 1));
+                let result = (|| -> Result<()> {
+                    image.write_exr(&stem.with_extension("exr"))?;
+                    image.write_png(&stem.with_extension("png"), args.exposure)?;
+                    let map = metrics::error_map(image, &reference, Metric::Relmse)?;
+                    let error_stem = args.out.join(format!("{}_frame{:03}_relmse", method.name(), frame + 1));
+                    metrics::false_colour(&map, image.width, image.height)
+                        .write_png(&error_stem.with_extension("png"), 1.0)?;
+                    RgbImage {
+                        width: image.width,
+                        height: image.height,
+                        pixels: map.iter().map(|&e| [e as f32; 3]).collect(),
+                    }
+                    .write_exr(&error_stem.with_extension("exr"))?;
+                    Ok(())
+                })();
+                if let Err(error) = result {
+                    write_error.get_or_insert(error);
+                }
+            }
+        },
+    )?;
+    bar.finish_and_clear();
+    if let Some(error) = write_error {
+        return Err(error);
+    }
+    let csv = args.out.join("errors.csv");
+    std::fs::write(&csv, errors_csv(&errors)).with_context(|| format!("{}: cannot write", csv.display()))?;
+    println!(
+        "{} frames x {} seeds x {} methods in {:.1} s; RelMSE (paper's form), mean ± 95% CI over seeds:",
+        args.frames,
+        args.seeds,
+        args.methods.len(),
+        started.elapsed().as_secs_f64()
+    );
+    let shown: Vec<u32> = (0..args.frames).filter(|f| (f + 1).is_power_of_two() || f + 1 == args.frames).collect();
+    print!("{:<12}", "method");
+    for f in &shown {
+        print!(" | {:>20}", format!("frame {}", f + 1));
+    }
+    println!();
+    for &method in &args.methods {
+        print!("{:<12}", method.name());
+        for &f in &shown {
+            print!(" | {:>20}", relmse_over_seeds(&errors, method, f).to_string());
+        }
+        println!();
+    }
+    if args.methods.contains(&Method::Strata) {
+        for baseline in [Method::Restir, Method::RestirDisc] {
+            if !args.methods.contains(&baseline) {
+                continue;
+            }
+            print!("{:<12}", format!("÷ {}", baseline.name()));
+            for &f in &shown {
+                let ratio = relmse_ratio(&errors, Method::Strata, baseline, f);
+                let text = ratio.map(|r| format!("{:.3} ± {:.3}", r.mean, r.half_width)).unwrap_or_default();
+                print!(" | {text:>20}");
+            }
+            println!();
+        }
+    }
+    println!("wrote {} and images in {}", csv.display(), args.out.display());
+    Ok(())
 }
 
 fn metrics(args: MetricsArgs) -> Result<()> {

@@ -5,6 +5,7 @@
 //! every field's name, offset and size with naga's layout of the WGSL struct.
 
 use crate::render_types::{EmissiveTriangle, GpuMaterial, RenderParams, TriangleInfo};
+use crate::restir_types::{PathCandidate, Primary, Reservoir, RestirParams};
 use crate::trace_types::{CameraParams, GpuBvhNode, GpuTriangle, Hit, Ray, TraceParams};
 use crate::types::{BlockStats, Candidate, ClusterSpan, HistogramParams};
 use naga::proc::Layouter;
@@ -108,6 +109,32 @@ shader_struct!(
     [kind, two_sided, albedo_kind, texel_offset, color0, alpha, color1, eta, uv_scale, texture_width, texture_height]
 );
 shader_struct!(EmissiveTriangle, "EmissiveTriangle", [radiance, triangle, cdf, probability, area, _pad]);
+
+shader_struct!(
+    RestirParams,
+    "RestirParams",
+    [
+        method,
+        candidates,
+        masking,
+        temporal,
+        temporal_cap,
+        disc_radius,
+        min_distance,
+        min_roughness,
+        previous_origin,
+        previous_tan_half_x,
+        previous_forward,
+        previous_tan_half_y,
+        previous_right,
+        _pad0,
+        previous_up,
+        _pad1,
+    ]
+);
+shader_struct!(Primary, "Primary", [position, object_id, normal, material, wo, flags, albedo, depth]);
+shader_struct!(PathCandidate, "PathCandidate", [position, kind, normal, light, reflected, source_pdf]);
+shader_struct!(Reservoir, "Reservoir", [sample, weight, count, target_value, _pad]);
 
 /// Compares `T` with the struct `T::WGSL_NAME` of `module`; the error lists every
 /// difference.

@@ -17,6 +17,7 @@ pub mod layout;
 pub mod reference;
 pub mod registry;
 pub mod render_types;
+pub mod restir_types;
 pub mod source;
 pub mod trace_types;
 pub mod translate;

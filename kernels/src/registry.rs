@@ -25,6 +25,15 @@ pub enum KernelId {
     /// Progressive path tracing: one sample per pixel added to a running sum (NEE + MIS,
     /// area and environment lights, diffuse, GGX conductor, dielectric).
     PathTrace,
+    /// ReSTIR pass 1: G-buffer, each pixel's own estimate and its path candidate.
+    RestirCandidates,
+    /// ReSTIR pass 3: selection of K candidates (strata, restir or restir-disc) and
+    /// resampling with the pixel's canonical candidate.
+    RestirSelect,
+    /// ReSTIR pass 4: temporal reuse (M cap, reprojection).
+    RestirTemporal,
+    /// ReSTIR pass 5: shading of the reservoirs' samples with one shadow ray.
+    RestirShade,
     /// A kernel from outside the registry ([`Kernel::from_wgsl`]), keyed by a hash of its
     /// source and entry point so that backends can cache its pipeline.
     External(u64),
@@ -32,18 +41,46 @@ pub enum KernelId {
 
 impl KernelId {
     /// Every registry kernel.
-    pub const ALL: [KernelId; 6] = [
+    pub const ALL: [KernelId; 10] = [
         KernelId::BlockHistogram,
         KernelId::BlockHistogramSubgroup,
         KernelId::Empty,
         KernelId::BvhClosestHit,
         KernelId::CameraRays,
         KernelId::PathTrace,
+        KernelId::RestirCandidates,
+        KernelId::RestirSelect,
+        KernelId::RestirTemporal,
+        KernelId::RestirShade,
     ];
 
     /// What the registry knows of this kernel before parsing it.
     pub fn spec(self) -> Option<KernelSpec> {
         let histogram = || [fragment!("common/candidate.wgsl"), fragment!("histogram/block_sort.wgsl")];
+        // Every ReSTIR pass: the scene and the path tracer's functions, the candidate
+        // records of the histogram, then its own entry point.
+        let restir = |name: &'static str, entry: Fragment| KernelSpec {
+            name: name.into(),
+            fragments: vec![
+                fragment!("trace/bvh.wgsl"),
+                fragment!("trace/traverse.wgsl"),
+                fragment!("render/scene.wgsl"),
+                fragment!("render/random.wgsl"),
+                fragment!("render/environment.wgsl"),
+                fragment!("render/albedo.wgsl"),
+                fragment!("render/bsdf.wgsl"),
+                fragment!("render/lights.wgsl"),
+                fragment!("render/path.wgsl"),
+                fragment!("common/candidate.wgsl"),
+                fragment!("restir/reservoir.wgsl"),
+                entry,
+            ],
+            entry_point: name.into(),
+            features: KernelFeatures::empty(),
+            // Paths and reconnections branch on float results, and environment lookups
+            // use atan2/acos (4096 ULP in Vulkan): as for path_trace.
+            float_ulp_bound: Some(4096),
+        };
         Some(match self {
             KernelId::BlockHistogram => KernelSpec {
                 name: "block_histogram".into(),
@@ -112,6 +149,10 @@ impl KernelId {
                 // functions by ~2100 ULP in environment-lit pixels.
                 float_ulp_bound: Some(4096),
             },
+            KernelId::RestirCandidates => restir("restir_candidates", fragment!("restir/entry_candidates.wgsl")),
+            KernelId::RestirSelect => restir("restir_select", fragment!("restir/entry_select.wgsl")),
+            KernelId::RestirTemporal => restir("restir_temporal", fragment!("restir/entry_temporal.wgsl")),
+            KernelId::RestirShade => restir("restir_shade", fragment!("restir/entry_shade.wgsl")),
             KernelId::External(_) => return None,
         })
     }
@@ -419,6 +460,24 @@ mod tests {
                 continue;
             }
             if kernel.id == KernelId::Empty {
+                continue;
+            }
+            if matches!(
+                kernel.id,
+                KernelId::RestirCandidates | KernelId::RestirSelect | KernelId::RestirTemporal | KernelId::RestirShade
+            ) {
+                use crate::restir_types::{PathCandidate, Primary, Reservoir, RestirParams};
+                for result in [
+                    check_struct::<crate::render_types::RenderParams>(module),
+                    check_struct::<RestirParams>(module),
+                    check_struct::<Primary>(module),
+                    check_struct::<PathCandidate>(module),
+                    check_struct::<Reservoir>(module),
+                    check_struct::<Candidate>(module),
+                    check_struct::<ClusterSpan>(module),
+                ] {
+                    result.unwrap_or_else(|e| panic!("{}: {e}", kernel.name()));
+                }
                 continue;
             }
             if kernel.id == KernelId::PathTrace {

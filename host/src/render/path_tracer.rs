@@ -41,8 +41,10 @@ pub struct RenderSettings {
 }
 
 impl RenderSettings {
-    /// The flags and per-render fields of the kernel's parameters, checked.
-    fn params(&self, scene: &GpuScene) -> Result<RenderParams, PassError> {
+    /// The kernels' parameters: the scene-wide fields of `scene` (a
+    /// [`GpuScene::params`]) with this render's image size, camera, seed, depths and
+    /// flags, checked.
+    pub fn params(&self, scene: &RenderParams) -> Result<RenderParams, PassError> {
         let camera = &self.camera;
         if camera.width == 0 || camera.height == 0 {
             return Err(PassError::Input(format!(
@@ -82,7 +84,7 @@ impl RenderSettings {
             camera_right: frame.right.into(),
             tan_half_y: frame.tan_half_y,
             camera_up: frame.up.into(),
-            ..scene.params
+            ..*scene
         })
     }
 }
@@ -157,7 +159,7 @@ impl PathTracer {
     pub fn new(backend: &mut dyn Backend, scene: &GpuScene, settings: &RenderSettings) -> Result<Self, PassError> {
         let kernel = Registry::shared()?.get(KernelId::PathTrace);
         backend.check_kernel(kernel)?;
-        let params = settings.params(scene)?;
+        let params = settings.params(&scene.params)?;
         let pixels = params.width as u64 * params.height as u64;
         let scene = SceneBuffers::upload(backend, scene)?;
         let params_buffer = upload(backend, "render params", &[params])?;

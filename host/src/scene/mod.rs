@@ -181,6 +181,20 @@ impl Scene {
         })
     }
 
+    /// Length of the diagonal of the bounding box of every triangle (1 when empty).
+    pub fn extent(&self) -> f32 {
+        let mut low = [f32::INFINITY; 3];
+        let mut high = [f32::NEG_INFINITY; 3];
+        for v in self.shapes.iter().flat_map(|s| s.triangles.iter().flatten()) {
+            for c in 0..3 {
+                low[c] = low[c].min(v[c]);
+                high[c] = high[c].max(v[c]);
+            }
+        }
+        let diagonal = (0..3).map(|c| (high[c] - low[c]).powi(2)).sum::<f32>().sqrt();
+        if diagonal.is_finite() && diagonal > 0.0 { diagonal } else { 1.0 }
+    }
+
     /// Triangles of every shape, in shape order, with their object ids.
     pub fn triangles_with_ids(&self) -> (Vec<[[f32; 3]; 3]>, Vec<u32>) {
         let mut triangles = Vec::new();

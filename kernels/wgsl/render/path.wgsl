@@ -10,16 +10,23 @@ struct PathSample {
 }
 
 fn trace_path(camera: Ray, lane: u32) -> PathSample {
+    // The camera ray counts as specular: nothing else could have found what it hits.
+    return trace_path_from(camera, 1u, 0.0, true, lane);
+}
+
+// The radiance arriving along `start`, the path's segment number `first_depth`, made by
+// a BSDF sample of density `start_pdf` (`start_specular` for a specular one), estimated
+// by continuing the path to params.max_depth segments in all.
+fn trace_path_from(start: Ray, first_depth: u32, start_pdf: f32, start_specular: bool, lane: u32) -> PathSample {
     let sample_lights = (params.flags & FLAG_SAMPLE_LIGHTS) != 0u;
     let hit_lights = (params.flags & FLAG_HIT_LIGHTS) != 0u;
-    var ray = camera;
+    var ray = start;
     var throughput = vec3<f32>(1.0);
     var radiance = vec3<f32>(0.0);
-    // Density of the BSDF sample that made `ray`, and whether it was specular (the camera
-    // ray counts as specular: nothing else could have found what it hits).
-    var previous_pdf = 0.0;
-    var previous_specular = true;
-    for (var depth = 1u; depth <= params.max_depth; depth++) {
+    // Density of the BSDF sample that made `ray`, and whether it was specular.
+    var previous_pdf = start_pdf;
+    var previous_specular = start_specular;
+    for (var depth = first_depth; depth <= params.max_depth; depth++) {
         let hit = traverse(ray, lane, false);
         if hit.primitive == STACK_OVERFLOW {
             return PathSample(vec3<f32>(0.0), true);
@@ -81,4 +88,38 @@ fn trace_path(camera: Ray, lane: u32) -> PathSample {
         }
     }
     return PathSample(radiance, false);
+}
+
+// The radiance leaving `surface` (hit by path segment number `depth`) towards
+// `wo_world` by reflection or refraction, emission excluded: next-event estimation there
+// and one BSDF-sampled continuation, exactly as trace_path_from does at that vertex.
+fn scatter_from(surface: Surface, wo_world: vec3<f32>, depth: u32, lane: u32) -> PathSample {
+    if depth >= params.max_depth {
+        return PathSample(vec3<f32>(0.0), false);
+    }
+    let material = materials[surface.material];
+    let cos_out = dot(surface.normal, wo_world);
+    var shading_normal = surface.normal;
+    if material.kind != MATERIAL_DIELECTRIC && cos_out < 0.0 {
+        if material.two_sided == 0u {
+            return PathSample(vec3<f32>(0.0), false);
+        }
+        shading_normal = -shading_normal;
+    }
+    let frame = make_frame(shading_normal);
+    let wo = to_local(frame, wo_world);
+    let albedo = albedo_at(material, surface.uv);
+    var radiance = vec3<f32>(0.0);
+    if (params.flags & FLAG_SAMPLE_LIGHTS) != 0u && !is_specular(material) {
+        radiance = direct_light(surface.position, surface.normal, frame, material, albedo, wo, lane);
+    }
+    let u = random2();
+    let sample = bsdf_sample(material, albedo, wo, u, random());
+    if all(sample.weight == vec3<f32>(0.0)) {
+        return PathSample(radiance, false);
+    }
+    let direction = normalize(to_world(frame, sample.wi));
+    let ray = spawn_ray(surface.position, surface.normal, direction, INFINITY);
+    let rest = trace_path_from(ray, depth + 1u, sample.pdf, sample.specular, lane);
+    return PathSample(radiance + sample.weight * rest.radiance, rest.invalid);
 }

@@ -1,0 +1,249 @@
+//! One ReSTIR frame after another on any backend: the scene uploaded once, per-frame
+//! buffers (two G-buffers and two reservoir buffers alternate for temporal reuse), and
+//! the five passes dispatched in order.
+
+use super::{Method, RestirSettings, selection_numbers};
+use crate::histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};
+use crate::render::{GpuScene, RenderSettings, SceneBuffers};
+use crate::rgb_image::RgbImage;
+use crate::sampler::BlueNoiseTables;
+use crate::scene::{Camera, CameraFrame};
+use strata_backends::backend::{download, upload};
+use strata_backends::{Backend, BackendError, Bind, BufferId};
+use strata_kernels::render_types::{FLAG_HIT_LIGHTS, FLAG_RUSSIAN_ROULETTE, FLAG_SAMPLE_LIGHTS, RenderParams};
+use strata_kernels::restir_types::{
+    METHOD_RESTIR, METHOD_RESTIR_DISC, METHOD_STRATA, PathCandidate, Primary, Reservoir, RestirParams,
+};
+use strata_kernels::types::Candidate;
+use strata_kernels::{BlockGrid, Kernel, KernelId, Registry};
+
+/// What one frame did besides its image.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameStats {
+    /// Pixels whose sample was dropped as invalid (non-finite, traversal overflow).
+    pub invalid_pixels: u32,
+}
+
+/// The ReSTIR renderer of one scene, image size and settings.
+pub struct RestirRenderer {
+    kernels: [&'static Kernel; 4],
+    settings: RestirSettings,
+    render: RenderSettings,
+    params: RenderParams,
+    scene: SceneBuffers,
+    histogram: BlockHistogramPass,
+    tables: BlueNoiseTables,
+    render_params: BufferId,
+    restir_params: BufferId,
+    primaries: [BufferId; 2],
+    candidates: BufferId,
+    base_radiance: BufferId,
+    selected: BufferId,
+    reservoirs: [BufferId; 2],
+    numbers: BufferId,
+    frame_out: BufferId,
+    /// Frames rendered; the next frame's index.
+    frame: u32,
+    previous_camera: Option<CameraFrame>,
+    min_distance: f32,
+}
+
+impl RestirRenderer {
+    /// Uploads the scene and creates every buffer; `render` gives the camera (its image
+    /// size), seed, depths and Russian roulette (light sampling is always MIS).
+    pub fn new(
+        backend: &mut dyn Backend,
+        scene: &GpuScene,
+        render: &RenderSettings,
+        settings: RestirSettings,
+        scene_extent: f32,
+    ) -> Result<Self, PassError> {
+        settings.check()?;
+        let registry = Registry::shared()?;
+        let kernels = [KernelId::RestirCandidates, KernelId::RestirSelect, KernelId::RestirTemporal, KernelId::RestirShade]
+            .map(|id| registry.get(id));
+        for kernel in kernels {
+            backend.check_kernel(kernel)?;
+        }
+        let camera = &render.camera;
+        if camera.width == 0 || camera.height == 0 {
+            return Err(PassError::Input(format!("image size {}x{}: must be at least 1x1", camera.width, camera.height)));
+        }
+        let grid = BlockGrid::new(camera.width, camera.height, settings.block_size)?;
+        let histogram = BlockHistogramPass::new(backend, HistogramVariant::Auto, grid)?;
+        let pixels = u64::from(camera.width) * u64::from(camera.height);
+        let scene_buffers = SceneBuffers::upload(backend, scene)?;
+        let mut params = render.params(&scene.params)?;
+        params.flags = FLAG_SAMPLE_LIGHTS | FLAG_HIT_LIGHTS | if render.russian_roulette { FLAG_RUSSIAN_ROULETTE } else { 0 };
+        let buffer = |backend: &mut dyn Backend, name: &str, bytes: u64| backend.create_buffer(name, bytes);
+        let primary_size = pixels * size_of::<Primary>() as u64;
+        let reservoir_size = pixels * size_of::<Reservoir>() as u64;
+        let renderer = RestirRenderer {
+            kernels,
+            settings,
+            render: render.clone(),
+            params,
+            scene: scene_buffers,
+            histogram,
+            tables: BlueNoiseTables::new(),
+            render_params: upload(backend, "render params", &[params])?,
+            restir_params: upload(backend, "restir params", &[RestirParams::default()])?,
+            primaries: [buffer(backend, "primary hits A", primary_size)?, buffer(backend, "primary hits B", primary_size)?],
+            candidates: buffer(backend, "path candidates", pixels * size_of::<PathCandidate>() as u64)?,
+            base_radiance: buffer(backend, "base radiance", pixels * 16)?,
+            selected: buffer(backend, "selected reservoirs", reservoir_size)?,
+            reservoirs: [buffer(backend, "reservoirs A", reservoir_size)?, buffer(backend, "reservoirs B", reservoir_size)?],
+            numbers: buffer(backend, "selection numbers", pixels * 32)?,
+            frame_out: buffer(backend, "frame", pixels * 16)?,
+            frame: 0,
+            previous_camera: None,
+            min_distance: if settings.min_distance > 0.0 { settings.min_distance } else { 1e-3 * scene_extent },
+        };
+        Ok(renderer)
+    }
+
+    /// Frames rendered so far.
+    pub fn frames(&self) -> u32 {
+        self.frame
+    }
+
+    /// Renders the next frame seen from `camera` (same image size as at creation; `None`:
+    /// the creation camera) and returns its image.
+    pub fn render_frame(
+        &mut self,
+        backend: &mut dyn Backend,
+        camera: Option<&Camera>,
+    ) -> Result<(RgbImage, FrameStats), PassError> {
+        let camera = camera.unwrap_or(&self.render.camera).clone();
+        if (camera.width, camera.height) != (self.render.camera.width, self.render.camera.height) {
+            return Err(PassError::Input(format!(
+                "camera image size {}x{} differs from the renderer's {}x{}",
+                camera.width, camera.height, self.render.camera.width, self.render.camera.height
+            )));
+        }
+        let render = RenderSettings { camera: camera.clone(), ..self.render.clone() };
+        let frame_camera = CameraFrame::new(&camera)
+            .ok_or_else(|| PassError::Input("camera: invalid frame (fov axis or up vector)".into()))?;
+        let params = RenderParams { sample_index: self.frame, flags: self.params.flags, ..render.params(&self.params)? };
+        backend.write_buffer(self.render_params, 0, bytemuck::bytes_of(&params))?;
+        let previous = self.previous_camera.unwrap_or(frame_camera);
+        let restir = RestirParams {
+            method: match self.settings.method {
+                Method::Strata => METHOD_STRATA,
+                Method::Restir => METHOD_RESTIR,
+                Method::RestirDisc => METHOD_RESTIR_DISC,
+            },
+            candidates: self.settings.candidates,
+            masking: u32::from(self.settings.masking),
+            temporal: u32::from(self.settings.temporal && self.frame > 0),
+            temporal_cap: self.settings.temporal_cap,
+            disc_radius: self.settings.disc_radius,
+            min_distance: self.min_distance,
+            min_roughness: self.settings.min_roughness,
+            previous_origin: previous.origin.into(),
+            previous_tan_half_x: previous.tan_half_x,
+            previous_forward: previous.forward.into(),
+            previous_tan_half_y: previous.tan_half_y,
+            previous_right: previous.right.into(),
+            _pad0: 0,
+            previous_up: previous.up.into(),
+            _pad1: 0,
+        };
+        backend.write_buffer(self.restir_params, 0, bytemuck::bytes_of(&restir))?;
+        let (width, height) = (camera.width, camera.height);
+        let numbers = selection_numbers(&self.tables, &self.settings, width, height, self.frame, self.render.seed);
+        backend.write_buffer(self.numbers, 0, bytemuck::cast_slice(&numbers))?;
+
+        let current = (self.frame % 2) as usize;
+        let previous_index = 1 - current;
+        let groups = [width.div_ceil(8), height.div_ceil(8), 1];
+        // The scene, the settings and `extra`, restricted to what `kernel` declares (naga
+        // drops bindings an entry point never reaches).
+        let with = |kernel: &Kernel, extra: &[(u32, BufferId)]| -> Vec<Bind> {
+            let mut binds = self.scene.binds(self.render_params);
+            binds.push(Bind::new(8, self.restir_params));
+            binds.extend(extra.iter().map(|&(slot, buffer)| Bind::new(slot, buffer)));
+            binds.retain(|bind| kernel.bindings.iter().any(|b| b.binding == bind.binding));
+            binds
+        };
+        let [candidates_kernel, select_kernel, temporal_kernel, shade_kernel] = self.kernels;
+        backend.dispatch(
+            candidates_kernel,
+            &with(candidates_kernel, &[
+                (9, self.primaries[current]),
+                (10, self.candidates),
+                (11, self.histogram.candidates),
+                (12, self.base_radiance),
+            ]),
+            groups,
+        )?;
+        if self.settings.method.uses_histogram() {
+            self.histogram.dispatch(backend)?;
+        }
+        backend.dispatch(
+            select_kernel,
+            &with(select_kernel, &[
+                (9, self.primaries[current]),
+                (10, self.candidates),
+                (11, self.histogram.sorted_pixels),
+                (12, self.histogram.spans),
+                (13, self.selected),
+                (14, self.numbers),
+            ]),
+            groups,
+        )?;
+        backend.dispatch(
+            temporal_kernel,
+            &with(temporal_kernel, &[
+                (9, self.primaries[current]),
+                (10, self.primaries[previous_index]),
+                (11, self.selected),
+                (12, self.reservoirs[previous_index]),
+                (13, self.reservoirs[current]),
+            ]),
+            groups,
+        )?;
+        backend.dispatch(
+            shade_kernel,
+            &with(shade_kernel, &[
+                (9, self.primaries[current]),
+                (10, self.reservoirs[current]),
+                (11, self.base_radiance),
+                (12, self.frame_out),
+            ]),
+            groups,
+        )?;
+        let pixels: Vec<[f32; 4]> = download(backend, self.frame_out)?;
+        self.frame += 1;
+        self.previous_camera = Some(frame_camera);
+        let invalid_pixels = pixels.iter().filter(|p| p[3] != 0.0).count() as u32;
+        let image =
+            RgbImage { width, height, pixels: pixels.iter().map(|p| [p[0], p[1], p[2]]).collect() };
+        Ok((image, FrameStats { invalid_pixels }))
+    }
+
+    /// The histogram candidates of the last frame (key and object id per pixel).
+    pub fn histogram_candidates(&self, backend: &mut dyn Backend) -> Result<Vec<Candidate>, PassError> {
+        Ok(download(backend, self.histogram.candidates)?)
+    }
+
+    /// Frees every buffer.
+    pub fn destroy(self, backend: &mut dyn Backend) -> Result<(), PassError> {
+        self.scene.destroy(backend)?;
+        self.histogram.destroy(backend)?;
+        let buffers = [
+            self.render_params,
+            self.restir_params,
+            self.primaries[0],
+            self.primaries[1],
+            self.candidates,
+            self.base_radiance,
+            self.selected,
+            self.reservoirs[0],
+            self.reservoirs[1],
+            self.numbers,
+            self.frame_out,
+        ];
+        buffers.into_iter().try_for_each(|b| backend.destroy_buffer(b)).map_err(|e: BackendError| e.into())
+    }
+}

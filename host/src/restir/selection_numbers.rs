@@ -1,0 +1,122 @@
+//! The numbers each pixel's selection and resampling use in one frame, by sampler
+//! variant (the paper's Table 2, [`SamplerVariant`]).
+//!
+//! Per pixel two `[f32; 4]`: the K selection positions in [0, 1), then the resampling
+//! number in `.0`. Blue-noise values come from [`BlueNoiseTables`] at sample index
+//! frame mod 256 (dimension 0 for selection, 1 for resampling: the first optimised pair).
+//!
+//! Unbiasedness needs every position to be uniform on [0, 1) over independent renders:
+//! the blue-noise strata (k + 0.5)/256 are replaced by (k + ξ)/256 with ξ white per pixel
+//! and frame, and every value is shifted by one offset per render seed (a toroidal
+//! shift of all pixels and frames together). Neither changes the stratification across
+//! frames nor the blue-noise distribution across pixels.
+
+use super::RestirSettings;
+use crate::sampler::{BlueNoiseTables, SamplerVariant};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg32;
+
+/// Two `[f32; 4]` per pixel, row-major (see the module docs).
+pub fn selection_numbers(
+    tables: &BlueNoiseTables,
+    settings: &RestirSettings,
+    width: u32,
+    height: u32,
+    frame: u32,
+    seed: u32,
+) -> Vec<[f32; 4]> {
+    let k = settings.candidates.clamp(1, 4) as usize;
+    let mut render_rng = Pcg32::seed_from_u64(u64::from(seed) ^ 0x5eed_0ff5e7);
+    let shift: [f64; 2] = [render_rng.random(), render_rng.random()];
+    let mut rng = Pcg32::seed_from_u64((u64::from(seed) << 32) ^ u64::from(frame).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+    let sample_index = frame % 256;
+    let mut numbers = Vec::with_capacity(2 * (width * height) as usize);
+    for y in 0..height {
+        for x in 0..width {
+            let mut blue = |index: u32, dimension: u32| -> f64 {
+                let stratum = f64::from(tables.stratum(x, y, index, dimension));
+                let value = (stratum + rng.random::<f64>()) / 256.0 + shift[dimension as usize & 1];
+                value.fract()
+            };
+            let (positions, resample): ([f64; 4], f64) = match settings.sampler {
+                SamplerVariant::Antithetic => {
+                    let u = blue(sample_index, 0) / 4.0;
+                    ([u, 0.5 - u, 0.5 + u, 1.0 - u], blue(sample_index, 1))
+                }
+                SamplerVariant::RandomOffsetBlueNoise => {
+                    let u = blue(sample_index, 0) / k as f64;
+                    (std::array::from_fn(|j| u + j as f64 / k as f64), blue(sample_index, 1))
+                }
+                SamplerVariant::Heitz => {
+                    let positions = std::array::from_fn(|j| blue((4 * frame + j as u32) % 256, 0));
+                    (positions, blue((4 * frame) % 256, 1))
+                }
+                SamplerVariant::RandomOffset => {
+                    let u = rng.random::<f64>() / k as f64;
+                    (std::array::from_fn(|j| u + j as f64 / k as f64), rng.random())
+                }
+                SamplerVariant::Random => (std::array::from_fn(|_| rng.random()), rng.random()),
+            };
+            // Positions stay below 1 in f32 (1 - u rounds to 1 for tiny u).
+            let clamp = |v: f64| (v as f32).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+            numbers.push(positions.map(clamp));
+            numbers.push([clamp(resample), 0.0, 0.0, 0.0]);
+        }
+    }
+    numbers
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Over many renders (seeds), each selection position is uniform on [0, 1): the
+    /// histogram of position values is flat for every variant and slot.
+    #[test]
+    fn positions_are_uniform_over_renders() {
+        let tables = BlueNoiseTables::new();
+        for sampler in [
+            SamplerVariant::Antithetic,
+            SamplerVariant::RandomOffsetBlueNoise,
+            SamplerVariant::Heitz,
+            SamplerVariant::RandomOffset,
+            SamplerVariant::Random,
+        ] {
+            let settings = RestirSettings { sampler, ..Default::default() };
+            let bins = 8;
+            let mut counts = vec![[0u32; 5]; bins];
+            let renders = 4000;
+            for seed in 0..renders {
+                let numbers = selection_numbers(&tables, &settings, 1, 1, 3, seed);
+                for slot in 0..4 {
+                    let v = numbers[0][slot];
+                    assert!((0.0..1.0).contains(&v), "{sampler:?}: {v}");
+                    counts[(v * bins as f32) as usize][slot] += 1;
+                }
+                counts[(numbers[1][0] * bins as f32) as usize][4] += 1;
+            }
+            let expected = f64::from(renders) / bins as f64;
+            for (bin, row) in counts.iter().enumerate() {
+                for (slot, &count) in row.iter().enumerate() {
+                    // 6 sigma of a binomial(4000, 1/8) count.
+                    let sigma = (expected * (1.0 - 1.0 / bins as f64)).sqrt();
+                    assert!(
+                        (f64::from(count) - expected).abs() < 6.0 * sigma,
+                        "{sampler:?} slot {slot} bin {bin}: {count} vs {expected}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// The antithetic positions of one frame are the pattern of Fig. 3.
+    #[test]
+    fn antithetic_positions_mirror() {
+        let tables = BlueNoiseTables::new();
+        let numbers = selection_numbers(&tables, &RestirSettings::default(), 4, 4, 0, 1);
+        for pixel in numbers.chunks_exact(2) {
+            let [a, b, c, d] = pixel[0];
+            assert!(a < 0.25 && (a + b - 0.5).abs() < 1e-6 && (c - 0.5 - a).abs() < 1e-6 && (d + a - 1.0).abs() < 1e-6);
+        }
+    }
+}

@@ -1,0 +1,120 @@
+//! What a ReSTIR render does, one documented setting per field.
+
+use crate::histogram_pass::PassError;
+use crate::sampler::SamplerVariant;
+
+/// How each pixel chooses the K candidates it resamples.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
+pub enum Method {
+    /// The paper: the block's candidates clustered by object id and sorted by luminance,
+    /// K taken by the sampler variant's pattern (antithetic by default), resampled by
+    /// inverse CDF.
+    #[default]
+    Strata,
+    /// Baseline: K uniformly random candidates (with replacement) of the same block
+    /// cluster, streaming weighted reservoir sampling.
+    Restir,
+    /// Baseline: standard ReSTIR, K uniformly random pixels in a disc of
+    /// `disc_radius` pixels, rejected unless normal and depth are similar.
+    RestirDisc,
+}
+
+impl Method {
+    /// The name used on the command line and in CSV files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Strata => "strata",
+            Method::Restir => "restir",
+            Method::RestirDisc => "restir-disc",
+        }
+    }
+
+    /// Whether the method needs the block histogram.
+    pub fn uses_histogram(self) -> bool {
+        !matches!(self, Method::RestirDisc)
+    }
+}
+
+/// Settings of a ReSTIR render; the defaults are the paper's (§5.1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RestirSettings {
+    /// Candidate selection. Default: strata.
+    pub method: Method,
+    /// K, candidates resampled per pixel besides its own (1 to 4). More candidates lower
+    /// the variance and cost 2 shadow rays each. Default 4 (the paper's antithetic
+    /// pattern is defined for 4).
+    pub candidates: u32,
+    /// Block size B of the histogram (4, 8, 16 or 32; blocks are B x B pixels). Larger
+    /// blocks give a finer histogram and more candidates to choose from, at a higher
+    /// sorting cost and with candidates from farther away. Default 16.
+    pub block_size: u32,
+    /// Cluster the histogram by object id (§4.3 masking): only candidates whose primary
+    /// hit is on the same object are shared. Off: one cluster per block. Default on.
+    pub masking: bool,
+    /// Merge each frame's reservoir with the previous frame's (temporal reuse). Off: each
+    /// frame stands alone (the accumulation mode of Fig. 5 / 10). Default on.
+    pub temporal: bool,
+    /// Cap of the previous reservoir's M before a merge; beyond it the history decays as
+    /// an exponential moving average. Higher: more reuse, slower reaction. Default 20.
+    pub temporal_cap: f32,
+    /// Neighbourhood radius in pixels of `restir-disc`. Default 30.
+    pub disc_radius: f32,
+    /// Where the selection and resampling numbers come from (Table 2). Default: the
+    /// antithetic pattern with temporal blue noise (ours).
+    pub sampler: SamplerVariant,
+    /// A conductor at the primary hit resamples only from this GGX alpha up (smoother ones
+    /// path-trace on their own: reconnecting through them is noisy). Default 0.2.
+    pub min_roughness: f32,
+    /// No reconnection to a vertex closer than this (scene units) to a primary hit
+    /// (the geometry term is singular there). Default: 1e-3 of the scene's extent, set by
+    /// the renderer when 0.
+    pub min_distance: f32,
+}
+
+impl Default for RestirSettings {
+    fn default() -> Self {
+        RestirSettings {
+            method: Method::Strata,
+            candidates: 4,
+            block_size: 16,
+            masking: true,
+            temporal: true,
+            temporal_cap: 20.0,
+            disc_radius: 30.0,
+            sampler: SamplerVariant::Antithetic,
+            min_roughness: 0.2,
+            min_distance: 0.0,
+        }
+    }
+}
+
+impl RestirSettings {
+    /// Refuses settings the kernels cannot run, naming the field and value.
+    pub fn check(&self) -> Result<(), PassError> {
+        if !(1..=4).contains(&self.candidates) {
+            return Err(PassError::Input(format!("candidates {}: must be 1 to 4", self.candidates)));
+        }
+        if !matches!(self.block_size, 4 | 8 | 16 | 32) {
+            return Err(PassError::Input(format!(
+                "block size {}: must be 4, 8, 16 or 32 (a power of two the histogram kernel holds)",
+                self.block_size
+            )));
+        }
+        if !(self.temporal_cap >= 1.0 && self.temporal_cap.is_finite()) {
+            return Err(PassError::Input(format!("temporal cap {}: must be at least 1", self.temporal_cap)));
+        }
+        if !(self.disc_radius > 0.0 && self.disc_radius.is_finite()) {
+            return Err(PassError::Input(format!("disc radius {}: must be positive", self.disc_radius)));
+        }
+        if self.method == Method::Strata
+            && self.candidates != 4
+            && matches!(self.sampler, SamplerVariant::Antithetic | SamplerVariant::Heitz)
+        {
+            return Err(PassError::Input(format!(
+                "sampler {:?} takes exactly 4 candidates, not {}",
+                self.sampler, self.candidates
+            )));
+        }
+        Ok(())
+    }
+}

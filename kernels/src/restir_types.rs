@@ -1,0 +1,119 @@
+//! Host twins of the ReSTIR passes' records (`wgsl/restir/reservoir.wgsl`), checked
+//! against naga's layout by [`crate::layout::check_struct`].
+
+use bytemuck::{Pod, Zeroable};
+
+/// `PathCandidate.kind`: no candidate (zero contribution).
+pub const KIND_NONE: u32 = 0;
+/// `PathCandidate.kind`: a Lambertian x2 other pixels may reconnect to.
+pub const KIND_SURFACE: u32 = 1;
+/// `PathCandidate.kind`: an environment direction.
+pub const KIND_ENVIRONMENT: u32 = 2;
+/// `PathCandidate.kind`: a non-Lambertian x2, usable by its own pixel only.
+pub const KIND_PRIVATE: u32 = 3;
+
+/// `Primary.flags`: the camera ray hit a surface.
+pub const PRIMARY_HIT: u32 = 1;
+/// `Primary.flags`: the pixel resamples (its primary hit is rough enough).
+pub const PRIMARY_RESAMPLE: u32 = 2;
+
+/// `RestirParams.method`: histogram + antithetic selection, inverse-CDF resampling.
+pub const METHOD_STRATA: u32 = 0;
+/// `RestirParams.method`: K uniformly random candidates of the same cluster.
+pub const METHOD_RESTIR: u32 = 1;
+/// `RestirParams.method`: K uniformly random pixels in a disc.
+pub const METHOD_RESTIR_DISC: u32 = 2;
+
+/// Settings of the ReSTIR kernels (WGSL `RestirParams`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct RestirParams {
+    /// `METHOD_*`.
+    pub method: u32,
+    /// K, candidates selected per pixel.
+    pub candidates: u32,
+    /// 1: clusters by object id; 0: one cluster per block.
+    pub masking: u32,
+    /// 1: temporal reuse on.
+    pub temporal: u32,
+    /// Cap of the previous reservoir's M before a merge.
+    pub temporal_cap: f32,
+    /// restir-disc's radius in pixels.
+    pub disc_radius: f32,
+    /// No reconnection to an x2 closer than this to a primary hit.
+    pub min_distance: f32,
+    /// Smallest GGX alpha of a conductor primary hit that resamples.
+    pub min_roughness: f32,
+    /// Previous frame's camera origin.
+    pub previous_origin: [f32; 3],
+    /// Previous frame's tan(horizontal half fov).
+    pub previous_tan_half_x: f32,
+    /// Previous frame's forward vector.
+    pub previous_forward: [f32; 3],
+    /// Previous frame's tan(vertical half fov).
+    pub previous_tan_half_y: f32,
+    /// Previous frame's right vector.
+    pub previous_right: [f32; 3],
+    /// Padding.
+    pub _pad0: u32,
+    /// Previous frame's up vector.
+    pub previous_up: [f32; 3],
+    /// Padding.
+    pub _pad1: u32,
+}
+
+/// One pixel's primary hit (WGSL `Primary`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Primary {
+    /// Hit position.
+    pub position: [f32; 3],
+    /// Object id (the histogram's masking key).
+    pub object_id: u32,
+    /// Geometric normal, flipped towards the camera for two-sided materials.
+    pub normal: [f32; 3],
+    /// Material index.
+    pub material: u32,
+    /// Unit direction towards the camera.
+    pub wo: [f32; 3],
+    /// `PRIMARY_*` bits.
+    pub flags: u32,
+    /// Albedo at the hit.
+    pub albedo: [f32; 3],
+    /// Distance from the camera.
+    pub depth: f32,
+}
+
+/// One pixel's candidate (WGSL `PathCandidate`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct PathCandidate {
+    /// x2, or the direction of an environment candidate.
+    pub position: [f32; 3],
+    /// `KIND_*`.
+    pub kind: u32,
+    /// x2's geometric normal flipped towards the y1 that found it.
+    pub normal: [f32; 3],
+    /// x2's emissive triangle when seen from its emitting side, else `NO_LIGHT`.
+    pub light: u32,
+    /// Radiance x2 reflects towards y1 (emission excluded).
+    pub reflected: [f32; 3],
+    /// Solid-angle density of the BSDF sample at y1 that found x2.
+    pub source_pdf: f32,
+}
+
+/// One pixel's reservoir (WGSL `Reservoir`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Reservoir {
+    /// The sample.
+    pub sample: PathCandidate,
+    /// Unbiased contribution weight W.
+    pub weight: f32,
+    /// M, canonical samples behind the reservoir.
+    pub count: f32,
+    /// p̂ of the sample at its pixel.
+    pub target_value: f32,
+    /// Padding.
+    pub _pad: u32,
+}

@@ -1,0 +1,201 @@
+// ReSTIR pass 3: each resampling pixel takes K candidates and resamples one, combined
+// with its own canonical candidate (paper §4.2; the canonical candidate comes on top of
+// the K, not among them).
+//
+// Selection, by RestirParams.method:
+//   strata      from its own cluster's run of the block's luminance-sorted list (the
+//               histogram pass), at K positions in [0, 1) that the host computes per
+//               pixel and frame from the sampler variant (the antithetic pattern of Fig. 3
+//               by default: u in [0, 1/4), {u, 1/2 - u, 1/2 + u, 1 - u});
+//               index = offset + min(floor(pos n), n - 1); resampling by inverse CDF with
+//               the host's second number (no streaming reservoir).
+//   restir      K uniformly random members of the same cluster (with replacement),
+//               streaming weighted reservoir sampling.
+//   restir-disc K uniformly random pixels in a disc of RestirParams.disc_radius pixels,
+//               rejected unless their primary hit faces the same way (normals within
+//               25 degrees) and lies at a similar depth (10 %); streaming reservoir.
+//
+// Weights: pairwise balance heuristic between the canonical candidate c and each
+// selected candidate j, each pair sharing 1/K, on the candidates' own source densities:
+//   w_c = sum_j (1/K) p̂(x_c) / (p_c(x_c) + p_j(x_c)),  w_j = (1/K) p̂(x_j) / (p_c(x_j) + p_j(x_j))
+// with p_j(x) = 0 where pixel j cannot reconnect to x (and p_j(x_c) including the
+// visibility from j's primary hit). Each pair term depends on c and j only, never on
+// which other candidates were drawn, and every selection here draws each member of the
+// run (or of the disc) with a probability that does not depend on the candidates' own
+// paths given their keys' order: E[count_j | candidates] = K/n for the histogram
+// patterns. So the sum of weights, and the RIS estimate f(Y)/p̂(Y) sum(w), are unbiased
+// (derivation: host/src/estimator/mod.rs and README "Why the selection stays unbiased").
+//
+// Bindings (group 0): 0-7 the scene, 8 RestirParams, and
+//   9  storage, read     array<Primary>        G-buffer
+//   10 storage, read     array<PathCandidate>  every pixel's candidate
+//   11 storage, read     array<u32>            the histogram's sorted_pixels
+//   12 storage, read     array<ClusterSpan>    the histogram's per-pixel cluster run
+//   13 storage, rw       array<Reservoir>      this frame's reservoir per pixel (M = 1)
+//   14 storage, read     array<vec4<f32>>      per pixel two entries: [2p] the K <= 4 selection
+//                                          positions, [2p + 1].x the resampling number
+//
+// Dispatch: 8 x 8 pixels per workgroup. Shadow rays: up to 2K per pixel.
+
+// K is at most 4: the per-slot values live in vec4s (registers on every target; local
+// arrays would need array constructors, which glslang's HLSL front end rejects).
+const MAX_CANDIDATES: u32 = 4u;
+
+@group(0) @binding(9) var<storage, read> primaries: array<Primary>;
+@group(0) @binding(10) var<storage, read> path_candidates: array<PathCandidate>;
+@group(0) @binding(11) var<storage, read> sorted_pixels: array<u32>;
+@group(0) @binding(12) var<storage, read> spans: array<ClusterSpan>;
+@group(0) @binding(13) var<storage, read_write> reservoirs_out: array<Reservoir>;
+@group(0) @binding(14) var<storage, read> selection_numbers: array<vec4<f32>>;
+
+fn empty_reservoir() -> Reservoir {
+    return Reservoir(PathCandidate(vec3<f32>(0.0), KIND_NONE, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), 0.0), 0.0, 0.0, 0.0, 0u);
+}
+
+// The pixel that selection slot `slot` of pixel (x, y) takes, or 0xffffffff for none.
+fn selected_pixel(x: u32, y: u32, pixel: u32, p: Primary, slot: u32, positions: vec4<f32>) -> u32 {
+    if restir.method == METHOD_RESTIR_DISC {
+        let r = restir.disc_radius * sqrt(random());
+        let phi = 2.0 * PI * random();
+        let qx = i32(floor(f32(x) + 0.5 + r * cos(phi)));
+        let qy = i32(floor(f32(y) + 0.5 + r * sin(phi)));
+        if qx < 0 || qy < 0 || qx >= i32(params.width) || qy >= i32(params.height) {
+            return 0xffffffffu;
+        }
+        let q = u32(qy) * params.width + u32(qx);
+        let n = primaries[q];
+        if (n.flags & PRIMARY_RESAMPLE) == 0u || dot(n.normal, p.normal) < 0.906
+            || abs(n.depth - p.depth) > 0.1 * p.depth {
+            return 0xffffffffu;
+        }
+        return q;
+    }
+    let span = spans[pixel];
+    let n = span.length;
+    if n == 0u {
+        return 0xffffffffu;
+    }
+    var position = positions[slot];
+    if restir.method == METHOD_RESTIR {
+        position = random();
+    }
+    let index = span.offset + min(u32(floor(position * f32(n))), n - 1u);
+    return sorted_pixels[index];
+}
+
+@compute @workgroup_size(8, 8)
+fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    if id.x >= params.width || id.y >= params.height {
+        return;
+    }
+    let pixel = id.y * params.width + id.x;
+    let p = primaries[pixel];
+    if (p.flags & PRIMARY_RESAMPLE) == 0u {
+        reservoirs_out[pixel] = empty_reservoir();
+        return;
+    }
+    rng_seed(pixel, params.sample_index, params.seed ^ 0x5e1ec7u);
+    let positions = selection_numbers[2u * pixel];
+    let resample_number = selection_numbers[2u * pixel + 1u].x;
+    let k = min(restir.candidates, MAX_CANDIDATES);
+    let c = path_candidates[pixel];
+    let target_c = luminance(integrand(p, c));
+    let density_c = source_density(p, c);
+    let c_shareable = reconnectable(p, c);
+    var weight_c = 0.0;
+    // Per slot: resampling weight, target p̂ here, and the pixel whose candidate it is.
+    var weights = vec4<f32>(0.0);
+    var targets = vec4<f32>(0.0);
+    var sources = vec4<u32>(pixel);
+    for (var slot = 0u; slot < k; slot++) {
+        let q = selected_pixel(id.x, id.y, pixel, p, slot, positions);
+        if q == 0xffffffffu {
+            // No candidate in this slot: the canonical sample alone covers its share.
+            if density_c > 0.0 {
+                weight_c += target_c / density_c / f32(k);
+            }
+            continue;
+        }
+        let neighbour = primaries[q];
+        let x = path_candidates[q];
+        sources[slot] = q;
+        if q == pixel {
+            // The pixel's own candidate drawn again: both halves of the pair are c.
+            if density_c > 0.0 {
+                let own_density = select(0.0, density_c, c_shareable);
+                weight_c += target_c / (density_c + own_density) / f32(k);
+                weights[slot] = select(0.0, target_c / (2.0 * density_c) / f32(k), c_shareable);
+                targets[slot] = target_c;
+            }
+            continue;
+        }
+        // The canonical candidate's half: could the neighbour have found x_c?
+        if density_c > 0.0 {
+            var density_neighbour_c = 0.0;
+            if c_shareable && reconnectable(neighbour, c) {
+                density_neighbour_c = source_density(neighbour, c);
+                if density_neighbour_c > 0.0 && !candidate_visible(neighbour, c, lane) {
+                    density_neighbour_c = 0.0;
+                }
+            }
+            weight_c += target_c / (density_c + density_neighbour_c) / f32(k);
+        }
+        // The neighbour's half: x_j reconnected to this pixel.
+        if reconnectable(p, x) && reconnectable(neighbour, x) {
+            let value = luminance(integrand(p, x));
+            if value > 0.0 && candidate_visible(p, x, lane) {
+                let density = source_density(p, x) + source_density(neighbour, x);
+                if density > 0.0 {
+                    weights[slot] = value / density / f32(k);
+                    targets[slot] = value;
+                }
+            }
+        }
+    }
+    // Pick one of {c, samples...} in proportion to its weight.
+    var total = weight_c;
+    for (var slot = 0u; slot < k; slot++) {
+        total += weights[slot];
+    }
+    if !(total > 0.0) || !(total < INFINITY) {
+        reservoirs_out[pixel] = empty_reservoir();
+        reservoirs_out[pixel].count = 1.0;
+        return;
+    }
+    var chosen = c;
+    var chosen_target = target_c;
+    if restir.method == METHOD_STRATA {
+        // Inverse CDF with the second sampler dimension.
+        // Rounding may leave u past the last partial sum: then the last candidate of
+        // positive weight is taken.
+        let u = resample_number * total;
+        var running = weight_c;
+        var found = u < running;
+        for (var slot = 0u; slot < k; slot++) {
+            if !found && weights[slot] > 0.0 {
+                running += weights[slot];
+                chosen = path_candidates[sources[slot]];
+                chosen_target = targets[slot];
+                found = u < running;
+            }
+        }
+    } else {
+        // Streaming weighted reservoir sampling, in slot order after the canonical.
+        var running = weight_c;
+        for (var slot = 0u; slot < k; slot++) {
+            if weights[slot] > 0.0 {
+                running += weights[slot];
+                if random() * running < weights[slot] {
+                    chosen = path_candidates[sources[slot]];
+                    chosen_target = targets[slot];
+                }
+            }
+        }
+    }
+    var result = empty_reservoir();
+    result.count = 1.0;
+    if chosen_target > 0.0 {
+        result = Reservoir(chosen, total / chosen_target, 1.0, chosen_target, 0u);
+    }
+    reservoirs_out[pixel] = result;
+}

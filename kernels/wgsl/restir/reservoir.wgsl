@@ -1,0 +1,193 @@
+// Records shared by the ReSTIR passes (paper §4; reconnection shift of ReSTIR GI /
+// ReSTIR PT, Lin et al. 2022) and the functions every pass evaluates the same way.
+// Host twins: strata_kernels::restir_types (a test checks every offset).
+//
+// A pixel's candidate is the BSDF-sampled continuation of its path at the primary hit
+// y1: the next vertex x2 with the radiance x2 reflects towards y1 (kind SURFACE, shared
+// with other pixels by reconnecting their own y1 to x2), or the environment direction
+// the path escaped along (kind ENVIRONMENT), or, when x2 is not Lambertian (its
+// reflected radiance depends on the direction it is seen from), a candidate only its
+// own pixel may use (kind PRIVATE). Surface candidates live in area measure at x2,
+// environment candidates in solid angle: the reconnection shift then has Jacobian 1.
+//
+// Bindings used with this fragment (group 0): 0-7 the scene (render/scene.wgsl) and
+//   8 uniform            RestirParams      the method and its settings
+
+const KIND_NONE: u32 = 0u;
+const KIND_SURFACE: u32 = 1u;
+const KIND_ENVIRONMENT: u32 = 2u;
+const KIND_PRIVATE: u32 = 3u;
+
+// Primary.flags
+const PRIMARY_HIT: u32 = 1u;       // the camera ray hit a surface
+const PRIMARY_RESAMPLE: u32 = 2u;  // y1 is rough enough to reconnect from: the pixel resamples
+
+// RestirParams.method
+const METHOD_STRATA: u32 = 0u;       // histogram + antithetic selection, inverse-CDF resampling (ours)
+const METHOD_RESTIR: u32 = 1u;       // K uniformly random from the same cluster, streaming reservoir
+const METHOD_RESTIR_DISC: u32 = 2u;  // K uniformly random in a disc, normal/depth rejection
+
+struct RestirParams {
+    method: u32,
+    // K: candidates selected per pixel (4).
+    candidates: u32,
+    // 1: the histogram clusters by object id (§4.3); 0: one cluster per block.
+    masking: u32,
+    // 1: merge with the previous frame's reservoir.
+    temporal: u32,
+    // Cap of the previous reservoir's M before a temporal merge (paper: 20).
+    temporal_cap: f32,
+    // Radius in pixels of restir-disc's neighbourhood.
+    disc_radius: f32,
+    // No reconnection to an x2 closer than this to either primary hit.
+    min_distance: f32,
+    // A conductor at y1 resamples only from this GGX alpha up.
+    min_roughness: f32,
+    // The previous frame's camera, for reprojection.
+    previous_origin: vec3<f32>,
+    previous_tan_half_x: f32,
+    previous_forward: vec3<f32>,
+    previous_tan_half_y: f32,
+    previous_right: vec3<f32>,
+    _pad0: u32,
+    previous_up: vec3<f32>,
+    _pad1: u32,
+}
+
+// The G-buffer: what the camera ray of a pixel hit.
+struct Primary {
+    position: vec3<f32>,
+    object_id: u32,
+    // Geometric normal, flipped towards the camera for two-sided materials.
+    normal: vec3<f32>,
+    material: u32,
+    // Unit direction towards the camera.
+    wo: vec3<f32>,
+    flags: u32,
+    albedo: vec3<f32>,
+    // Distance from the camera.
+    depth: f32,
+}
+
+struct PathCandidate {
+    // x2, or the direction of an environment candidate.
+    position: vec3<f32>,
+    kind: u32,
+    // x2's geometric normal, flipped towards the y1 that found it.
+    normal: vec3<f32>,
+    // x2's emissive triangle when y1 sees its emitting side, else NO_LIGHT.
+    light: u32,
+    // Radiance x2 reflects towards y1 (emission excluded), one-sample estimate.
+    reflected: vec3<f32>,
+    // Solid-angle density of the BSDF sample at y1 that found x2.
+    source_pdf: f32,
+}
+
+struct Reservoir {
+    sample: PathCandidate,
+    // Unbiased contribution weight W of `sample` for this pixel.
+    weight: f32,
+    // M: canonical samples behind the reservoir (one per frame).
+    count: f32,
+    // p̂ of `sample` at this pixel (luminance of its contribution, visibility included).
+    target_value: f32,
+    _pad: u32,
+}
+
+@group(0) @binding(8) var<uniform> restir: RestirParams;
+
+fn luminance(c: vec3<f32>) -> f32 {
+    return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
+}
+
+fn finite3(v: vec3<f32>) -> bool {
+    let bits = bitcast<vec3<u32>>(v) & vec3<u32>(0x7f800000u);
+    return all(bits != vec3<u32>(0x7f800000u));
+}
+
+// Direction from y1 to the candidate and the area-to-solid-angle factor |cos x2| / d²
+// (1 for an environment candidate); w = distance (0 for the environment).
+fn towards(p: Primary, x: PathCandidate) -> vec4<f32> {
+    if x.kind == KIND_ENVIRONMENT {
+        return vec4<f32>(x.position, 0.0);
+    }
+    let to = x.position - p.position;
+    let distance = length(to);
+    return vec4<f32>(to / distance, distance);
+}
+
+fn geometry_factor(x: PathCandidate, direction: vec3<f32>, distance: f32) -> f32 {
+    if x.kind == KIND_ENVIRONMENT {
+        return 1.0;
+    }
+    return abs(dot(x.normal, direction)) / (distance * distance);
+}
+
+// The contribution of candidate `x` to the pixel whose primary hit is `p`, in the
+// candidate's measure, visibility excluded: f(y1) cos (w_bsdf Le(x2) + Lr(x2)) |cos x2| / d²,
+// with x2's emission weighted by the power heuristic against next-event estimation at y1
+// (which the pixel does itself), exactly as the path tracer weighs it.
+fn integrand(p: Primary, x: PathCandidate) -> vec3<f32> {
+    if x.kind == KIND_NONE || (p.flags & PRIMARY_RESAMPLE) == 0u {
+        return vec3<f32>(0.0);
+    }
+    let t = towards(p, x);
+    let direction = t.xyz;
+    let material = materials[p.material];
+    let frame = make_frame(p.normal);
+    let wo = to_local(frame, p.wo);
+    let wi = to_local(frame, direction);
+    let f = bsdf_eval(material, p.albedo, wo, wi);
+    if all(f == vec3<f32>(0.0)) {
+        return vec3<f32>(0.0);
+    }
+    let pdf_bsdf = bsdf_pdf(material, wo, wi);
+    var emitted = vec3<f32>(0.0);
+    if x.kind == KIND_ENVIRONMENT {
+        if params.env_width > 0u {
+            emitted = environment_radiance(direction) * mis_power(pdf_bsdf, environment_light_pdf(direction));
+        }
+    } else if x.light != NO_LIGHT {
+        let cos_light = -dot(x.normal, direction);
+        if cos_light > 0.0 {
+            emitted = lights[x.light].radiance * mis_power(pdf_bsdf, area_light_pdf(x.light, t.w, cos_light));
+        }
+    }
+    return f * (emitted + x.reflected) * geometry_factor(x, direction, t.w);
+}
+
+// Density with which the BSDF sampling at `p` finds candidate `x`, in the candidate's
+// measure (visibility not included).
+fn source_density(p: Primary, x: PathCandidate) -> f32 {
+    if x.kind == KIND_NONE || (p.flags & PRIMARY_RESAMPLE) == 0u {
+        return 0.0;
+    }
+    let t = towards(p, x);
+    let frame = make_frame(p.normal);
+    let pdf = bsdf_pdf(materials[p.material], to_local(frame, p.wo), to_local(frame, t.xyz));
+    return pdf * geometry_factor(x, t.xyz, t.w);
+}
+
+// Whether the pixel of `p` may reconnect to candidate `x`: both rough, x shareable,
+// x2 far enough from y1 and seen from the side its reflected radiance was computed for.
+fn reconnectable(p: Primary, x: PathCandidate) -> bool {
+    if (p.flags & PRIMARY_RESAMPLE) == 0u {
+        return false;
+    }
+    if x.kind == KIND_ENVIRONMENT {
+        return true;
+    }
+    if x.kind != KIND_SURFACE {
+        return false;
+    }
+    let to_primary = p.position - x.position;
+    return length(to_primary) >= restir.min_distance && dot(x.normal, to_primary) > 0.0;
+}
+
+// Visibility between y1 and the candidate.
+fn candidate_visible(p: Primary, x: PathCandidate, lane: u32) -> bool {
+    if x.kind == KIND_ENVIRONMENT {
+        return unoccluded(p.position, p.normal, x.position, lane);
+    }
+    return visible(p.position, p.normal, x.position, lane);
+}

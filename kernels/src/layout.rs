@@ -133,7 +133,7 @@ shader_struct!(
     ]
 );
 shader_struct!(Primary, "Primary", [position, object_id, normal, material, wo, flags, albedo, depth]);
-shader_struct!(PathCandidate, "PathCandidate", [position, kind, normal, light, reflected, source_pdf]);
+shader_struct!(PathCandidate, "PathCandidate", [position, kind, normal, light, reflected, weight]);
 shader_struct!(Reservoir, "Reservoir", [sample, weight, count, target_value, _pad]);
 
 /// Compares `T` with the struct `T::WGSL_NAME` of `module`; the error lists every

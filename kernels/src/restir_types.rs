@@ -98,8 +98,8 @@ pub struct PathCandidate {
     pub light: u32,
     /// Radiance x2 reflects towards y1 (emission excluded).
     pub reflected: [f32; 3],
-    /// Solid-angle density of the BSDF sample at y1 that found x2.
-    pub source_pdf: f32,
+    /// Unbiased contribution weight W for its own pixel (0 for none).
+    pub weight: f32,
 }
 
 /// One pixel's reservoir (WGSL `Reservoir`).

@@ -1,9 +1,12 @@
 // ReSTIR pass 1 (paper §5.1 "candidate generation"): every pixel traces one path. Its
 // primary hit y1 goes to the G-buffer, with the object id that the histogram clusters
-// by (§4.3); what the pixel estimates on its own (emission at y1 and next-event
-// estimation there) goes to `base_radiance`; the BSDF-sampled continuation from y1 is
-// its candidate, keyed for the histogram by the luminance of its own one-sample
-// estimate f/p (§4.1). A pixel whose y1 is not rough enough to reconnect from (smooth
+// by (§4.3). The pixel draws two samples of the next vertex x2, one by BSDF sampling
+// (the path's continuation, with the radiance the rest of the path brings back) and one
+// by next-event estimation (a light point or environment direction), and keeps one by
+// RIS with balance-heuristic weights p̂ / (p_bsdf + p_light): its candidate, with its
+// unbiased contribution weight W, keyed for the histogram by the luminance of its own
+// estimate f(Y) W (§4.1). `base_radiance` holds what is not resampled: the emission y1
+// shows the camera. A pixel whose y1 is not rough enough to reconnect from (smooth
 // dielectric, a conductor below RestirParams.min_roughness) or whose camera ray escaped
 // does not resample: its whole path estimate goes to `base_radiance` and its histogram
 // candidate is OBJECT_ID_NONE.
@@ -15,7 +18,7 @@
 //   12 storage, rw       array<vec4<f32>>      base radiance: rgb; a = 1 for an invalid sample
 //
 // Random numbers: PCG stream of (pixel, params.sample_index = frame, params.seed): film
-// jitter, then next-event estimation, BSDF sampling and the rest of the path.
+// jitter, BSDF sampling and the rest of that path, the light sample, the RIS choice.
 // Dispatch: 8 x 8 pixels per workgroup.
 
 @group(0) @binding(9) var<storage, read_write> primary_out: array<Primary>;
@@ -26,6 +29,29 @@
 fn no_candidate() -> PathCandidate {
     return PathCandidate(vec3<f32>(0.0), KIND_NONE, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), 0.0);
 }
+
+// Area density with which next-event estimation picks a point on emissive triangle `light`.
+fn light_area_density(light: u32) -> f32 {
+    let entry = lights[light];
+    return (1.0 - params.environment_probability) * entry.probability / entry.area;
+}
+
+// The candidate of surface point `vertex` seen from `origin`, reflecting `reflected`
+// towards it: its normal flipped towards the origin, its light only when the origin sees
+// the emitting side, shareable when Lambertian.
+fn vertex_candidate(vertex: Surface, origin: vec3<f32>, reflected: vec3<f32>) -> PathCandidate {
+    let seen_front = dot(vertex.normal, origin - vertex.position) > 0.0;
+    let kind = select(KIND_PRIVATE, KIND_SURFACE, materials[vertex.material].kind == MATERIAL_DIFFUSE);
+    return PathCandidate(
+        vertex.position,
+        kind,
+        select(-vertex.normal, vertex.normal, seen_front),
+        select(NO_LIGHT, vertex.light, seen_front),
+        reflected,
+        0.0,
+    );
+}
+
 
 @compute @workgroup_size(8, 8)
 fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
@@ -71,7 +97,9 @@ fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
             primary.flags |= PRIMARY_RESAMPLE;
             let frame = make_frame(normal);
             let wo = to_local(frame, wo_world);
-            base += direct_light(surface.position, surface.normal, frame, material, albedo, wo, lane);
+            // Technique 1, BSDF sampling: the next vertex of the path.
+            var bsdf_candidate = no_candidate();
+            var bsdf_light_density = 0.0;
             let sample = bsdf_sample(material, albedo, wo, random2(), random());
             if any(sample.weight != vec3<f32>(0.0)) && sample.pdf > 0.0 {
                 let direction = normalize(to_world(frame, sample.wi));
@@ -80,35 +108,96 @@ fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
                     invalid = true;
                 } else if next.primitive == MISS {
                     if params.env_width > 0u {
-                        candidate = PathCandidate(direction, KIND_ENVIRONMENT, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), sample.pdf);
+                        bsdf_candidate = PathCandidate(direction, KIND_ENVIRONMENT, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), 0.0);
+                        bsdf_light_density = environment_light_pdf(direction);
                     }
                 } else {
                     let vertex = surface_at(next);
-                    let wo_vertex = -direction;
-                    let seen_front = dot(vertex.normal, wo_vertex) > 0.0;
-                    let kind = select(KIND_PRIVATE, KIND_SURFACE, materials[vertex.material].kind == MATERIAL_DIFFUSE);
-                    let rest = scatter_from(vertex, wo_vertex, 2u, lane);
-                    invalid = rest.invalid;
-                    candidate = PathCandidate(
-                        vertex.position,
-                        kind,
-                        select(-vertex.normal, vertex.normal, seen_front),
-                        select(NO_LIGHT, vertex.light, seen_front),
-                        rest.radiance,
-                        sample.pdf,
-                    );
+                    let rest = scatter_from(vertex, -direction, 2u, lane);
+                    invalid = invalid || rest.invalid;
+                    bsdf_candidate = vertex_candidate(vertex, surface.position, rest.radiance);
+                    if vertex.light != NO_LIGHT {
+                        bsdf_light_density = light_area_density(vertex.light);
+                    }
+                }
+            }
+            // Technique 2, next-event estimation: a point on a light or an environment
+            // direction, drawn as render/lights.wgsl draws them.
+            var light_candidate = no_candidate();
+            var light_density = 0.0;
+            let u_choice = random();
+            let u_light = random2();
+            if u_choice < params.environment_probability {
+                let direction = sample_environment(u_light);
+                light_density = environment_light_pdf(direction);
+                if light_density > 0.0 && unoccluded(surface.position, normal, direction, lane) {
+                    light_candidate = PathCandidate(direction, KIND_ENVIRONMENT, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), 0.0);
+                }
+            } else if params.light_count > 0u {
+                let light = find_light(random());
+                let entry = lights[light];
+                let tri = triangles[entry.triangle];
+                let su = sqrt(u_light.x);
+                let b1 = u_light.y * su;
+                let b2 = su - u_light.y * su;
+                let point = (1.0 - su) * tri.v0 + b1 * tri.v1 + b2 * tri.v2;
+                let info = triangle_info[entry.triangle];
+                var uv = vec2<f32>(b1, b2);
+                if info.has_uv != 0u {
+                    uv = (1.0 - su) * info.uv0 + b1 * info.uv1 + b2 * info.uv2;
+                }
+                let light_normal = normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
+                let light_surface = Surface(point, light_normal, uv, info.object_id, info.material, light);
+                light_density = light_area_density(light);
+                if visible(surface.position, normal, point, lane) {
+                    // What the light reflects towards y1 (nothing for a black fixture).
+                    var reflected = vec3<f32>(0.0);
+                    let light_material = materials[info.material];
+                    if light_material.kind != MATERIAL_DIFFUSE || any(albedo_at(light_material, uv) != vec3<f32>(0.0)) {
+                        let rest = scatter_from(light_surface, normalize(surface.position - point), 2u, lane);
+                        invalid = invalid || rest.invalid;
+                        reflected = rest.radiance;
+                    }
+                    light_candidate = vertex_candidate(light_surface, surface.position, reflected);
+                }
+            }
+            // RIS over the two samples, balance heuristic: w = p̂ / (p_bsdf + p_light).
+            var weight_bsdf = 0.0;
+            var target_bsdf = 0.0;
+            if bsdf_candidate.kind != KIND_NONE {
+                target_bsdf = target_function(primary, bsdf_candidate);
+                let density = bsdf_density(primary, bsdf_candidate) + bsdf_light_density;
+                if density > 0.0 {
+                    weight_bsdf = target_bsdf / density;
+                }
+            }
+            var weight_light = 0.0;
+            var target_light = 0.0;
+            if light_candidate.kind != KIND_NONE {
+                target_light = target_function(primary, light_candidate);
+                let density = bsdf_density(primary, light_candidate) + light_density;
+                if density > 0.0 {
+                    weight_light = target_light / density;
+                }
+            }
+            let total = weight_bsdf + weight_light;
+            if total > 0.0 && total < INFINITY {
+                if random() * total < weight_light {
+                    candidate = light_candidate;
+                    candidate.weight = total / target_light;
+                } else {
+                    candidate = bsdf_candidate;
+                    candidate.weight = total / target_bsdf;
                 }
             }
         }
     }
     var key = 0.0;
-    if candidate.kind != KIND_NONE {
-        let density = source_density(primary, candidate);
-        key = luminance(integrand(primary, candidate)) / density;
-        if !(density > 0.0) || !finite3(candidate.reflected) {
-            candidate = no_candidate();
-            key = 0.0;
-        }
+    if candidate.kind != KIND_NONE && candidate.weight > 0.0 && finite3(candidate.reflected) {
+        // The luminance of the pixel's own one-sample estimate f(Y) W.
+        key = target_function(primary, candidate) * candidate.weight;
+    } else {
+        candidate = no_candidate();
     }
     if invalid || !finite3(base) {
         base = vec3<f32>(0.0);

@@ -15,11 +15,15 @@
 //               rejected unless their primary hit faces the same way (normals within
 //               25 degrees) and lies at a similar depth (10 %); streaming reservoir.
 //
-// Weights: pairwise balance heuristic between the canonical candidate c and each
-// selected candidate j, each pair sharing 1/K, on the candidates' own source densities:
-//   w_c = sum_j (1/K) p̂(x_c) / (p_c(x_c) + p_j(x_c)),  w_j = (1/K) p̂(x_j) / (p_c(x_j) + p_j(x_j))
-// with p_j(x) = 0 where pixel j cannot reconnect to x (and p_j(x_c) including the
-// visibility from j's primary hit). Each pair term depends on c and j only, never on
+// Weights: pairwise MIS between the canonical candidate c and each selected candidate j
+// (Bitterli 2022, Lin et al. 2022), each pair sharing 1/K and counting the neighbours as
+// K samples against the canonical one, with the target functions as densities and W the
+// candidates' own unbiased contribution weights:
+//   w_c = sum_j (1/K) p̂_i(x_c) / (p̂_i(x_c) + K p̂_j(x_c)) p̂_i(x_c) W_c
+//   w_j = (1/K) K p̂_j(x_j) / (p̂_i(x_j) + K p̂_j(x_j)) p̂_i(x_j) W_j
+// (with equal targets the canonical and each neighbour weigh 1 / (K + 1)).
+// with p̂_j(x) = 0 where pixel j cannot reconnect to x, visibility included (a shadow ray
+// from j's primary hit to x_c, one from ours to x_j). Each pair term depends on c and j only, never on
 // which other candidates were drawn, and every selection here draws each member of the
 // run (or of the disc) with a probability that does not depend on the candidates' own
 // paths given their keys' order: E[count_j | candidates] = K/n for the histogram
@@ -99,8 +103,8 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
     let resample_number = selection_numbers[2u * pixel + 1u].x;
     let k = min(restir.candidates, MAX_CANDIDATES);
     let c = path_candidates[pixel];
-    let target_c = luminance(integrand(p, c));
-    let density_c = source_density(p, c);
+    // p̂_i(x_c) W_c: the canonical candidate was found from y1, so it is visible.
+    let target_c = target_function(p, c);
     let c_shareable = reconnectable(p, c);
     var weight_c = 0.0;
     // Per slot: resampling weight, target p̂ here, and the pixel whose candidate it is.
@@ -111,9 +115,7 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
         let q = selected_pixel(id.x, id.y, pixel, p, slot, positions);
         if q == 0xffffffffu {
             // No candidate in this slot: the canonical sample alone covers its share.
-            if density_c > 0.0 {
-                weight_c += target_c / density_c / f32(k);
-            }
+            weight_c += target_c * c.weight / f32(k);
             continue;
         }
         let neighbour = primaries[q];
@@ -121,34 +123,36 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
         sources[slot] = q;
         if q == pixel {
             // The pixel's own candidate drawn again: both halves of the pair are c.
-            if density_c > 0.0 {
-                let own_density = select(0.0, density_c, c_shareable);
-                weight_c += target_c / (density_c + own_density) / f32(k);
-                weights[slot] = select(0.0, target_c / (2.0 * density_c) / f32(k), c_shareable);
+            if c_shareable {
+                let share = 1.0 / (1.0 + f32(k));
+                weight_c += share * target_c * c.weight / f32(k);
+                weights[slot] = (1.0 - share) * target_c * c.weight / f32(k);
                 targets[slot] = target_c;
+            } else {
+                weight_c += target_c * c.weight / f32(k);
             }
             continue;
         }
-        // The canonical candidate's half: could the neighbour have found x_c?
-        if density_c > 0.0 {
-            var density_neighbour_c = 0.0;
+        // The canonical candidate's half: m_c = p̂_i / (p̂_i + p̂_j) at x_c, with p̂_j
+        // including the visibility from the neighbour's primary hit.
+        if target_c > 0.0 {
+            var target_neighbour_c = 0.0;
             if c_shareable && reconnectable(neighbour, c) {
-                density_neighbour_c = source_density(neighbour, c);
-                if density_neighbour_c > 0.0 && !candidate_visible(neighbour, c, lane) {
-                    density_neighbour_c = 0.0;
+                target_neighbour_c = target_function(neighbour, c);
+                if target_neighbour_c > 0.0 && !candidate_visible(neighbour, c, lane) {
+                    target_neighbour_c = 0.0;
                 }
             }
-            weight_c += target_c / (density_c + density_neighbour_c) / f32(k);
+            weight_c += target_c / (target_c + f32(k) * target_neighbour_c) * target_c * c.weight / f32(k);
         }
-        // The neighbour's half: x_j reconnected to this pixel.
-        if reconnectable(p, x) && reconnectable(neighbour, x) {
-            let value = luminance(integrand(p, x));
+        // The neighbour's half: x_j reconnected here, m_j = p̂_j / (p̂_i + p̂_j) at x_j
+        // (p̂_j(x_j) > 0 and visible wherever W_j > 0).
+        if x.weight > 0.0 && reconnectable(p, x) && reconnectable(neighbour, x) {
+            let value = target_function(p, x);
             if value > 0.0 && candidate_visible(p, x, lane) {
-                let density = source_density(p, x) + source_density(neighbour, x);
-                if density > 0.0 {
-                    weights[slot] = value / density / f32(k);
-                    targets[slot] = value;
-                }
+                let there = target_function(neighbour, x);
+                weights[slot] = f32(k) * there / (value + f32(k) * there) * value * x.weight / f32(k);
+                targets[slot] = value;
             }
         }
     }

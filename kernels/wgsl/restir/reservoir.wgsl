@@ -2,13 +2,15 @@
 // ReSTIR PT, Lin et al. 2022) and the functions every pass evaluates the same way.
 // Host twins: strata_kernels::restir_types (a test checks every offset).
 //
-// A pixel's candidate is the BSDF-sampled continuation of its path at the primary hit
-// y1: the next vertex x2 with the radiance x2 reflects towards y1 (kind SURFACE, shared
-// with other pixels by reconnecting their own y1 to x2), or the environment direction
-// the path escaped along (kind ENVIRONMENT), or, when x2 is not Lambertian (its
-// reflected radiance depends on the direction it is seen from), a candidate only its
-// own pixel may use (kind PRIVATE). Surface candidates live in area measure at x2,
-// environment candidates in solid angle: the reconnection shift then has Jacobian 1.
+// A pixel's candidate is the vertex x2 after its primary hit y1, with the radiance x2
+// emits and reflects towards y1: either the BSDF-sampled continuation of its path or its
+// next-event light sample, one of the two chosen by RIS (balance heuristic over the two
+// techniques), with its unbiased contribution weight. x2 is a surface point (kind
+// SURFACE, shared with other pixels by reconnecting their own y1 to x2), an environment
+// direction (kind ENVIRONMENT), or, when x2 is not Lambertian (its reflected radiance
+// depends on the direction it is seen from), a point only its own pixel may use (kind
+// PRIVATE). Surface candidates live in area measure at x2, environment candidates in
+// solid angle: the reconnection shift then has Jacobian 1.
 //
 // Bindings used with this fragment (group 0): 0-7 the scene (render/scene.wgsl) and
 //   8 uniform            RestirParams      the method and its settings
@@ -79,8 +81,9 @@ struct PathCandidate {
     light: u32,
     // Radiance x2 reflects towards y1 (emission excluded), one-sample estimate.
     reflected: vec3<f32>,
-    // Solid-angle density of the BSDF sample at y1 that found x2.
-    source_pdf: f32,
+    // Unbiased contribution weight W of the candidate for its own pixel (RIS over its
+    // BSDF and light samples); 0 for none.
+    weight: f32,
 }
 
 struct Reservoir {
@@ -124,9 +127,9 @@ fn geometry_factor(x: PathCandidate, direction: vec3<f32>, distance: f32) -> f32
 }
 
 // The contribution of candidate `x` to the pixel whose primary hit is `p`, in the
-// candidate's measure, visibility excluded: f(y1) cos (w_bsdf Le(x2) + Lr(x2)) |cos x2| / d²,
-// with x2's emission weighted by the power heuristic against next-event estimation at y1
-// (which the pixel does itself), exactly as the path tracer weighs it.
+// candidate's measure, visibility excluded: f(y1) cos (Le(x2) + Lr(x2)) |cos x2| / d².
+// Emission and reflection are both resampled: nothing of the first bounce is left to
+// the pixel alone but the emission it sees directly.
 fn integrand(p: Primary, x: PathCandidate) -> vec3<f32> {
     if x.kind == KIND_NONE || (p.flags & PRIMARY_RESAMPLE) == 0u {
         return vec3<f32>(0.0);
@@ -135,33 +138,29 @@ fn integrand(p: Primary, x: PathCandidate) -> vec3<f32> {
     let direction = t.xyz;
     let material = materials[p.material];
     let frame = make_frame(p.normal);
-    let wo = to_local(frame, p.wo);
-    let wi = to_local(frame, direction);
-    let f = bsdf_eval(material, p.albedo, wo, wi);
+    let f = bsdf_eval(material, p.albedo, to_local(frame, p.wo), to_local(frame, direction));
     if all(f == vec3<f32>(0.0)) {
         return vec3<f32>(0.0);
     }
-    let pdf_bsdf = bsdf_pdf(material, wo, wi);
     var emitted = vec3<f32>(0.0);
     if x.kind == KIND_ENVIRONMENT {
         if params.env_width > 0u {
-            emitted = environment_radiance(direction) * mis_power(pdf_bsdf, environment_light_pdf(direction));
+            emitted = environment_radiance(direction);
         }
-    } else if x.light != NO_LIGHT {
-        let cos_light = -dot(x.normal, direction);
-        if cos_light > 0.0 {
-            emitted = lights[x.light].radiance * mis_power(pdf_bsdf, area_light_pdf(x.light, t.w, cos_light));
-        }
+    } else if x.light != NO_LIGHT && -dot(x.normal, direction) > 0.0 {
+        emitted = lights[x.light].radiance;
     }
     return f * (emitted + x.reflected) * geometry_factor(x, direction, t.w);
 }
 
+// p̂: the luminance of `integrand`.
+fn target_function(p: Primary, x: PathCandidate) -> f32 {
+    return luminance(integrand(p, x));
+}
+
 // Density with which the BSDF sampling at `p` finds candidate `x`, in the candidate's
 // measure (visibility not included).
-fn source_density(p: Primary, x: PathCandidate) -> f32 {
-    if x.kind == KIND_NONE || (p.flags & PRIMARY_RESAMPLE) == 0u {
-        return 0.0;
-    }
+fn bsdf_density(p: Primary, x: PathCandidate) -> f32 {
     let t = towards(p, x);
     let frame = make_frame(p.normal);
     let pdf = bsdf_pdf(materials[p.material], to_local(frame, p.wo), to_local(frame, t.xyz));

@@ -222,6 +222,12 @@ impl RestirRenderer {
         Ok((image, FrameStats { invalid_pixels }))
     }
 
+    /// The final reservoirs of the last frame, one per pixel.
+    pub fn reservoirs(&self, backend: &mut dyn Backend) -> Result<Vec<Reservoir>, PassError> {
+        let last = ((self.frame + 1) % 2) as usize;
+        Ok(download(backend, self.reservoirs[last])?)
+    }
+
     /// The histogram candidates of the last frame (key and object id per pixel).
     pub fn histogram_candidates(&self, backend: &mut dyn Backend) -> Result<Vec<Candidate>, PassError> {
         Ok(download(backend, self.histogram.candidates)?)

@@ -175,14 +175,33 @@ impl PathTracer {
 
     /// Adds one sample per pixel.
     pub fn add_sample(&mut self, backend: &mut dyn Backend) -> Result<(), PassError> {
+        self.add_sample_with(backend, false).map(|_| ())
+    }
+
+    /// Adds one sample per pixel and returns the dispatch's device time (timestamp
+    /// queries; the wall time of the dispatch where the backend has none).
+    pub fn add_sample_timed(&mut self, backend: &mut dyn Backend) -> Result<std::time::Duration, PassError> {
+        self.add_sample_with(backend, true)
+    }
+
+    fn add_sample_with(&mut self, backend: &mut dyn Backend, timed: bool) -> Result<std::time::Duration, PassError> {
         let params = RenderParams { sample_index: self.samples, ..self.params };
         backend.write_buffer(self.params_buffer, 0, bytemuck::bytes_of(&params))?;
         let mut binds = self.scene.binds(self.params_buffer);
         binds.push(Bind::new(8, self.accumulation));
         let workgroups = [params.width.div_ceil(8), params.height.div_ceil(8), 1];
-        backend.dispatch(self.kernel, &binds, workgroups)?;
+        let time = if timed && backend.info().timestamps {
+            backend.dispatch_timed(self.kernel, &binds, workgroups)?
+        } else {
+            let started = std::time::Instant::now();
+            backend.dispatch(self.kernel, &binds, workgroups)?;
+            if timed {
+                backend.read_buffer(self.params_buffer)?;
+            }
+            started.elapsed()
+        };
         self.samples += 1;
-        Ok(())
+        Ok(time)
     }
 
     /// The mean of the samples so far. Samples the kernel dropped (non-finite radiance,

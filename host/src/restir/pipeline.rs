@@ -22,6 +22,10 @@ use strata_kernels::{BlockGrid, Kernel, KernelId, Registry};
 pub struct FrameStats {
     /// Pixels whose sample was dropped as invalid (non-finite, traversal overflow).
     pub invalid_pixels: u32,
+    /// Device time of each pass (candidates, histogram, select, temporal, shade) from
+    /// timestamp queries, when [`RestirRenderer::set_timed`] is on and the backend has
+    /// them; zero otherwise (and for the histogram of restir-disc, which skips it).
+    pub pass_times: [std::time::Duration; 5],
 }
 
 /// The ReSTIR renderer of one scene, image size and settings.
@@ -46,6 +50,7 @@ pub struct RestirRenderer {
     frame: u32,
     previous_camera: Option<CameraFrame>,
     min_distance: f32,
+    timed: bool,
 }
 
 impl RestirRenderer {
@@ -60,21 +65,26 @@ impl RestirRenderer {
     ) -> Result<Self, PassError> {
         settings.check()?;
         let registry = Registry::shared()?;
-        let kernels = [KernelId::RestirCandidates, KernelId::RestirSelect, KernelId::RestirTemporal, KernelId::RestirShade]
-            .map(|id| registry.get(id));
+        let kernels =
+            [KernelId::RestirCandidates, KernelId::RestirSelect, KernelId::RestirTemporal, KernelId::RestirShade]
+                .map(|id| registry.get(id));
         for kernel in kernels {
             backend.check_kernel(kernel)?;
         }
         let camera = &render.camera;
         if camera.width == 0 || camera.height == 0 {
-            return Err(PassError::Input(format!("image size {}x{}: must be at least 1x1", camera.width, camera.height)));
+            return Err(PassError::Input(format!(
+                "image size {}x{}: must be at least 1x1",
+                camera.width, camera.height
+            )));
         }
         let grid = BlockGrid::new(camera.width, camera.height, settings.block_size)?;
         let histogram = BlockHistogramPass::new(backend, HistogramVariant::Auto, grid)?;
         let pixels = u64::from(camera.width) * u64::from(camera.height);
         let scene_buffers = SceneBuffers::upload(backend, scene)?;
         let mut params = render.params(&scene.params)?;
-        params.flags = FLAG_SAMPLE_LIGHTS | FLAG_HIT_LIGHTS | if render.russian_roulette { FLAG_RUSSIAN_ROULETTE } else { 0 };
+        params.flags =
+            FLAG_SAMPLE_LIGHTS | FLAG_HIT_LIGHTS | if render.russian_roulette { FLAG_RUSSIAN_ROULETTE } else { 0 };
         let buffer = |backend: &mut dyn Backend, name: &str, bytes: u64| backend.create_buffer(name, bytes);
         let primary_size = pixels * size_of::<Primary>() as u64;
         let reservoir_size = pixels * size_of::<Reservoir>() as u64;
@@ -88,18 +98,30 @@ impl RestirRenderer {
             tables: BlueNoiseTables::new(),
             render_params: upload(backend, "render params", &[params])?,
             restir_params: upload(backend, "restir params", &[RestirParams::default()])?,
-            primaries: [buffer(backend, "primary hits A", primary_size)?, buffer(backend, "primary hits B", primary_size)?],
+            primaries: [
+                buffer(backend, "primary hits A", primary_size)?,
+                buffer(backend, "primary hits B", primary_size)?,
+            ],
             candidates: buffer(backend, "path candidates", pixels * size_of::<PathCandidate>() as u64)?,
             base_radiance: buffer(backend, "base radiance", pixels * 16)?,
             selected: buffer(backend, "selected reservoirs", reservoir_size)?,
-            reservoirs: [buffer(backend, "reservoirs A", reservoir_size)?, buffer(backend, "reservoirs B", reservoir_size)?],
+            reservoirs: [
+                buffer(backend, "reservoirs A", reservoir_size)?,
+                buffer(backend, "reservoirs B", reservoir_size)?,
+            ],
             numbers: buffer(backend, "selection numbers", pixels * 32)?,
             frame_out: buffer(backend, "frame", pixels * 16)?,
             frame: 0,
             previous_camera: None,
             min_distance: if settings.min_distance > 0.0 { settings.min_distance } else { 1e-3 * scene_extent },
+            timed: false,
         };
         Ok(renderer)
+    }
+
+    /// Time every pass with timestamp queries (each dispatch then waits for the device).
+    pub fn set_timed(&mut self, timed: bool) {
+        self.timed = timed;
     }
 
     /// Frames rendered so far.
@@ -124,7 +146,8 @@ impl RestirRenderer {
         let render = RenderSettings { camera: camera.clone(), ..self.render.clone() };
         let frame_camera = CameraFrame::new(&camera)
             .ok_or_else(|| PassError::Input("camera: invalid frame (fov axis or up vector)".into()))?;
-        let params = RenderParams { sample_index: self.frame, flags: self.params.flags, ..render.params(&self.params)? };
+        let params =
+            RenderParams { sample_index: self.frame, flags: self.params.flags, ..render.params(&self.params)? };
         backend.write_buffer(self.render_params, 0, bytemuck::bytes_of(&params))?;
         let previous = self.previous_camera.unwrap_or(frame_camera);
         let restir = RestirParams {
@@ -167,59 +190,84 @@ impl RestirRenderer {
             binds
         };
         let [candidates_kernel, select_kernel, temporal_kernel, shade_kernel] = self.kernels;
-        backend.dispatch(
+        let timed = self.timed && backend.info().timestamps;
+        let mut pass_times = [std::time::Duration::ZERO; 5];
+        let run =
+            |backend: &mut dyn Backend, kernel: &Kernel, binds: &[Bind]| -> Result<std::time::Duration, PassError> {
+                if timed {
+                    return Ok(backend.dispatch_timed(kernel, binds, groups)?);
+                }
+                backend.dispatch(kernel, binds, groups)?;
+                Ok(std::time::Duration::ZERO)
+            };
+        pass_times[0] = run(
+            backend,
             candidates_kernel,
-            &with(candidates_kernel, &[
-                (9, self.primaries[current]),
-                (10, self.candidates),
-                (11, self.histogram.candidates),
-                (12, self.base_radiance),
-            ]),
-            groups,
+            &with(
+                candidates_kernel,
+                &[
+                    (9, self.primaries[current]),
+                    (10, self.candidates),
+                    (11, self.histogram.candidates),
+                    (12, self.base_radiance),
+                ],
+            ),
         )?;
         if self.settings.method.uses_histogram() {
-            self.histogram.dispatch(backend)?;
+            if timed {
+                pass_times[1] = self.histogram.dispatch_timed(backend)?;
+            } else {
+                self.histogram.dispatch(backend)?;
+            }
         }
-        backend.dispatch(
+        pass_times[2] = run(
+            backend,
             select_kernel,
-            &with(select_kernel, &[
-                (9, self.primaries[current]),
-                (10, self.candidates),
-                (11, self.histogram.sorted_pixels),
-                (12, self.histogram.spans),
-                (13, self.selected),
-                (14, self.numbers),
-            ]),
-            groups,
+            &with(
+                select_kernel,
+                &[
+                    (9, self.primaries[current]),
+                    (10, self.candidates),
+                    (11, self.histogram.sorted_pixels),
+                    (12, self.histogram.spans),
+                    (13, self.selected),
+                    (14, self.numbers),
+                ],
+            ),
         )?;
-        backend.dispatch(
+        pass_times[3] = run(
+            backend,
             temporal_kernel,
-            &with(temporal_kernel, &[
-                (9, self.primaries[current]),
-                (10, self.primaries[previous_index]),
-                (11, self.selected),
-                (12, self.reservoirs[previous_index]),
-                (13, self.reservoirs[current]),
-            ]),
-            groups,
+            &with(
+                temporal_kernel,
+                &[
+                    (9, self.primaries[current]),
+                    (10, self.primaries[previous_index]),
+                    (11, self.selected),
+                    (12, self.reservoirs[previous_index]),
+                    (13, self.reservoirs[current]),
+                ],
+            ),
         )?;
-        backend.dispatch(
+        pass_times[4] = run(
+            backend,
             shade_kernel,
-            &with(shade_kernel, &[
-                (9, self.primaries[current]),
-                (10, self.reservoirs[current]),
-                (11, self.base_radiance),
-                (12, self.frame_out),
-            ]),
-            groups,
+            &with(
+                shade_kernel,
+                &[
+                    (9, self.primaries[current]),
+                    (10, self.reservoirs[current]),
+                    (11, self.base_radiance),
+                    (12, self.frame_out),
+                ],
+            ),
         )?;
         let pixels: Vec<[f32; 4]> = download(backend, self.frame_out)?;
         self.frame += 1;
         self.previous_camera = Some(frame_camera);
         let invalid_pixels = pixels.iter().filter(|p| p[3] != 0.0).count() as u32;
-        let image =
-            RgbImage { width, height, pixels: pixels.iter().map(|p| [p[0], p[1], p[2]]).collect() };
-        Ok((image, FrameStats { invalid_pixels }))
+        let image = RgbImage { width, height, pixels: pixels.iter().map(|p| [p[0], p[1], p[2]]).collect() };
+        Ok((image, FrameStats { invalid_pixels, pass_times }))
     }
 
     /// The final reservoirs of the last frame, one per pixel.

@@ -125,7 +125,8 @@ fn restir_frames(
     let gpu_scene = GpuScene::build(scene).unwrap();
     let mut stats = RegionStats::new();
     for seed in seeds {
-        let mut renderer = RestirRenderer::new(backend, &gpu_scene, &settings(scene, seed), restir, scene.extent()).unwrap();
+        let mut renderer =
+            RestirRenderer::new(backend, &gpu_scene, &settings(scene, seed), restir, scene.extent()).unwrap();
         let mut last = None;
         for _ in 0..frames {
             let (image, frame_stats) = renderer.render_frame(backend, None).unwrap();
@@ -180,4 +181,32 @@ fn temporal_reuse_stays_unbiased() {
         let ours = restir_frames(&mut backend, &scene, restir, 1..257, 6);
         assert_unbiased(&format!("{} with temporal reuse, frame 6", method.name()), &z_scores(&ours, &reference));
     }
+}
+
+#[test]
+fn bad_restir_settings_are_errors_naming_the_value() {
+    let mut backend = strata_backends::cpu_backend::CpuBackend::new(Default::default()).unwrap();
+    let scene = default_scene();
+    let gpu_scene = GpuScene::build(&scene).unwrap();
+    let render = settings(&scene, 1);
+    let cases: [(RestirSettings, &str); 4] = [
+        (RestirSettings { block_size: 12, ..Default::default() }, "block size 12"),
+        (RestirSettings { candidates: 5, ..Default::default() }, "candidates 5"),
+        (RestirSettings { temporal_cap: 0.5, ..Default::default() }, "temporal cap 0.5"),
+        (
+            RestirSettings { candidates: 3, sampler: strata::sampler::SamplerVariant::Antithetic, ..Default::default() },
+            "exactly 4",
+        ),
+    ];
+    for (restir, expected) in cases {
+        let error = RestirRenderer::new(&mut backend, &gpu_scene, &render, restir, 1.0).err().unwrap().to_string();
+        assert!(error.contains(expected), "{error}");
+    }
+    let mut empty = settings(&scene, 1);
+    empty.camera.width = 0;
+    let error = RestirRenderer::new(&mut backend, &gpu_scene, &empty, RestirSettings::default(), 1.0)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(error.contains("0x32"), "{error}");
 }

@@ -136,3 +136,57 @@ fn bad_scene_files_name_the_field() {
     assert!(malformed.contains("bad.json"), "{malformed}");
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// Environment maps and textures that cannot be used are errors naming the file and
+/// what is wrong: missing, not RGB, NaN or negative radiance, a `to_world` that is not a
+/// rotation, a file that is not an image.
+#[test]
+fn bad_environment_maps_and_textures_are_named() {
+    use exr::prelude::WritableImage;
+    use strata::rgb_image::RgbImage;
+    use strata::scene::{Environment, Texture};
+    let dir = std::env::temp_dir().join(format!("strata-bad-images-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let missing = dir.join("missing.exr");
+    let error = Environment::load(&missing, 1.0, None).unwrap_err().to_string();
+    assert!(error.contains("missing.exr"), "{error}");
+
+    let nan = dir.join("nan.exr");
+    let mut image = RgbImage::new(4, 2);
+    image.pixels[5] = [f32::NAN, 0.0, 0.0];
+    image.write_exr(&nan).unwrap();
+    let error = Environment::load(&nan, 1.0, None).unwrap_err().to_string();
+    assert!(error.contains("nan.exr") && error.contains("(1, 1)"), "{error}");
+
+    let negative = dir.join("negative.exr");
+    let mut image = RgbImage::new(4, 2);
+    image.pixels[0] = [-1.0, 0.0, 0.0];
+    image.write_exr(&negative).unwrap();
+    let error = Environment::load(&negative, 1.0, None).unwrap_err().to_string();
+    assert!(error.contains("negative.exr") && error.contains("non-negative"), "{error}");
+
+    let good = dir.join("good.exr");
+    RgbImage::new(4, 2).write_exr(&good).unwrap();
+    let scaled = [[2.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]];
+    let error = Environment::load(&good, 1.0, Some(scaled)).unwrap_err().to_string();
+    assert!(error.contains("good.exr") && error.contains("not a rotation"), "{error}");
+    let error = Environment::load(&good, f32::NAN, None).unwrap_err().to_string();
+    assert!(error.contains("scale"), "{error}");
+
+    let gray = dir.join("gray.exr");
+    exr::prelude::Image::from_channels(
+        (2, 2),
+        exr::prelude::SpecificChannels::build().with_channel("Y").with_pixel_fn(|_| (0.5f32,)),
+    )
+    .write()
+    .to_file(&gray)
+    .unwrap();
+    let error = Environment::load(&gray, 1.0, None).unwrap_err().to_string();
+    assert!(error.contains("gray.exr") && error.contains("not an RGB image"), "{error}");
+
+    let not_png = dir.join("texture.png");
+    std::fs::write(&not_png, b"this is not a PNG").unwrap();
+    let error = Texture::load(&not_png, true).unwrap_err().to_string();
+    assert!(error.contains("texture.png"), "{error}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -12,6 +12,7 @@
 //! and counted (the reference scenes contain some: 62 in veach-ajar's door handle); they
 //! cannot be hit and carry no light.
 
+mod camera_path;
 mod camera_rays;
 mod default_scene;
 mod description;
@@ -23,6 +24,7 @@ mod obj_scene;
 mod ply;
 mod texture;
 
+pub use camera_path::{CameraKeyframe, CameraPath, parse_camera_path};
 pub use camera_rays::CameraFrame;
 pub use default_scene::default_scene;
 pub use description::{Camera, EmitterDescription, EnvironmentDescription, MaterialDescription, Reflectance};

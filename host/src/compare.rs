@@ -7,6 +7,7 @@ use crate::metrics::{self, MeanInterval};
 use crate::render::{GpuScene, RenderSettings};
 use crate::restir::{Method, RestirRenderer, RestirSettings};
 use crate::rgb_image::RgbImage;
+use crate::scene::Camera;
 use strata_backends::Backend;
 
 /// One frame's errors against the reference.
@@ -40,17 +41,20 @@ pub struct Comparison {
     /// Average the frames instead of showing each (the accumulation mode): frame f's
     /// image is then the mean of frames 0..=f.
     pub accumulate: bool,
+    /// The camera of each frame (empty: the render settings' camera throughout).
+    pub cameras: Vec<Camera>,
 }
 
 /// Renders every method × seed × frame of `comparison` and measures each frame against
-/// `reference`; `on_frame` sees every image (method, seed, frame, image).
+/// its reference (`references[frame]`, or `references[0]` for every frame); `on_frame`
+/// sees every image (method, seed, frame, image).
 pub fn run_comparison(
     backend: &mut dyn Backend,
     scene: &GpuScene,
     render: &RenderSettings,
     scene_extent: f32,
     comparison: &Comparison,
-    reference: &RgbImage,
+    references: &[RgbImage],
     mut on_frame: impl FnMut(Method, u32, u32, &RgbImage),
 ) -> Result<Vec<FrameError>, PassError> {
     let mut errors = Vec::new();
@@ -62,7 +66,9 @@ pub fn run_comparison(
             let mut sum: Option<RgbImage> = None;
             let result = (|| {
                 for frame in 0..comparison.frames {
-                    let (image, stats) = renderer.render_frame(backend, None)?;
+                    let camera = comparison.cameras.get(frame as usize);
+                    let (image, stats) = renderer.render_frame(backend, camera)?;
+                    let reference = references.get(frame as usize).unwrap_or(&references[0]);
                     if stats.invalid_pixels > 0 {
                         return Err(PassError::Input(format!(
                             "{}: frame {frame}, seed {seed}: {} pixels had invalid samples",
@@ -131,8 +137,7 @@ pub fn errors_csv(errors: &[FrameError]) -> String {
 
 /// RelMSE of `method` at `frame` (0-based) over seeds.
 pub fn relmse_over_seeds(errors: &[FrameError], method: Method, frame: u32) -> MeanInterval {
-    let values: Vec<f64> =
-        errors.iter().filter(|e| e.method == method && e.frame == frame).map(|e| e.relmse).collect();
+    let values: Vec<f64> = errors.iter().filter(|e| e.method == method && e.frame == frame).map(|e| e.relmse).collect();
     MeanInterval::of(&values)
 }
 
@@ -143,9 +148,7 @@ pub fn relmse_ratio(errors: &[FrameError], method: Method, baseline: Method, fra
         errors.iter().filter(|e| e.method == m && e.frame == frame).map(|e| (e.seed, e.relmse)).collect()
     };
     let (ours, theirs) = (of(method), of(baseline));
-    let ratios: Vec<f64> = ours
-        .iter()
-        .filter_map(|(seed, a)| theirs.iter().find(|(s, _)| s == seed).map(|(_, b)| a / b))
-        .collect();
+    let ratios: Vec<f64> =
+        ours.iter().filter_map(|(seed, a)| theirs.iter().find(|(s, _)| s == seed).map(|(_, b)| a / b)).collect();
     (!ratios.is_empty()).then(|| MeanInterval::of(&ratios))
 }

@@ -7,12 +7,12 @@ use std::time::Instant;
 use strata::backend_choice::{BackendChoice, open_backend};
 use strata::compare::{Comparison, errors_csv, relmse_over_seeds, relmse_ratio, run_comparison};
 use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
-use strata::restir::{Method, RestirSettings};
-use strata::sampler::SamplerVariant;
 use strata::metrics::{self, Metric};
 use strata::render::{GpuScene, LightSampling, RenderSettings};
+use strata::restir::{Method, RestirSettings};
 use strata::rgb_image::RgbImage;
-use strata::scene::{default_scene, load_scene_file};
+use strata::sampler::SamplerVariant;
+use strata::scene::{default_scene, load_scene_file, parse_camera_path};
 use strata::synthetic::{CandidateMix, candidate_image};
 use strata_kernels::BlockGrid;
 use strata_kernels::reference::block_histogram::block_histogram;
@@ -82,6 +82,11 @@ struct CompareArgs {
     /// No object-id masking: one histogram cluster per block.
     #[arg(long)]
     no_masking: bool,
+    /// Camera motion: `static`, `orbit:DEGREES_PER_FRAME`, `dolly:DISTANCE_PER_FRAME` or
+    /// a keyframe JSON file. A moving camera needs a reference per frame: they are
+    /// path-traced (`--reference-spp` each) and `--reference` is refused.
+    #[arg(long, default_value = "static")]
+    camera_path: String,
     /// Exposure of the PNG previews.
     #[arg(long, default_value_t = 1.0)]
     exposure: f32,
@@ -212,22 +217,36 @@ fn compare(args: CompareArgs) -> Result<()> {
     let mut backend = open_backend(args.backend)?;
     println!("backend: {}", backend.info().summary());
     std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create the folder", args.out.display()))?;
-    let reference = match &args.reference {
-        Some(path) => RgbImage::read_exr(path)?,
-        None => {
-            println!("rendering the reference: {} spp path tracing", args.reference_spp);
-            let settings = RenderSettings { seed: 0x7ef, ..render.clone() };
-            let bar = indicatif::ProgressBar::new(u64::from(args.reference_spp));
-            let image = strata::render::render(backend.as_mut(), &gpu_scene, &settings, args.reference_spp, |done| {
-                bar.set_position(u64::from(done))
-            })?;
-            bar.finish_and_clear();
-            let path = args.out.join("reference.exr");
-            image.write_exr(&path)?;
-            image.write_png(&args.out.join("reference.png"), args.exposure)?;
-            image
-        }
+    let camera_path = parse_camera_path(&args.camera_path, &render.camera)?;
+    let cameras: Vec<_> = if camera_path.is_static() {
+        Vec::new()
+    } else {
+        (0..args.frames).map(|f| camera_path.camera_at(&render.camera, f)).collect()
     };
+    if !cameras.is_empty() && args.reference.is_some() {
+        bail!("--reference: a moving camera (--camera-path {}) needs a reference per frame", args.camera_path);
+    }
+    let references = if cameras.is_empty() {
+        vec![single_reference(&args, backend.as_mut(), &gpu_scene, &render)?]
+    } else {
+        println!(
+            "rendering {} references (one per frame): {} spp path tracing each",
+            cameras.len(),
+            args.reference_spp
+        );
+        let bar = indicatif::ProgressBar::new(cameras.len() as u64);
+        let mut references = Vec::new();
+        for (frame, camera) in cameras.iter().enumerate() {
+            let settings = RenderSettings { seed: 0x7ef + frame as u32, camera: camera.clone(), ..render.clone() };
+            let image = strata::render::render(backend.as_mut(), &gpu_scene, &settings, args.reference_spp, |_| {})?;
+            image.write_exr(&args.out.join(format!("reference_frame{:03}.exr", frame + 1)))?;
+            references.push(image);
+            bar.inc(1);
+        }
+        bar.finish_and_clear();
+        references
+    };
+    let reference = &references[0];
     if (reference.width, reference.height) != (render.camera.width, render.camera.height) {
         bail!(
             "the reference is {}x{} but the render is {}x{}",
@@ -249,19 +268,53 @@ fn compare(args: CompareArgs) -> Result<()> {
             ..RestirSettings::default()
         },
         accumulate: args.accumulate,
+        cameras,
     };
+    run_and_report(&args, backend.as_mut(), &gpu_scene, &render, scene.extent(), &comparison, &references)
+}
+
+/// The reference image: `--reference`, or path-traced at `--reference-spp` and written
+/// to the output folder.
+fn single_reference(
+    args: &CompareArgs,
+    backend: &mut dyn strata_backends::Backend,
+    gpu_scene: &GpuScene,
+    render: &RenderSettings,
+) -> Result<RgbImage> {
+    Ok(match &args.reference {
+        Some(path) => RgbImage::read_exr(path)?,
+        None => {
+            println!("rendering the reference: {} spp path tracing", args.reference_spp);
+            let settings = RenderSettings { seed: 0x7ef, ..render.clone() };
+            let bar = indicatif::ProgressBar::new(u64::from(args.reference_spp));
+            let image = strata::render::render(backend, gpu_scene, &settings, args.reference_spp, |done| {
+                bar.set_position(u64::from(done))
+            })?;
+            bar.finish_and_clear();
+            let path = args.out.join("reference.exr");
+            image.write_exr(&path)?;
+            image.write_png(&args.out.join("reference.png"), args.exposure)?;
+            image
+        }
+    })
+}
+
+/// Runs `comparison`, writes its images, error maps and CSV, prints the summary.
+fn run_and_report(
+    args: &CompareArgs,
+    backend: &mut dyn strata_backends::Backend,
+    gpu_scene: &GpuScene,
+    render: &RenderSettings,
+    extent: f32,
+    comparison: &Comparison,
+    references: &[RgbImage],
+) -> Result<()> {
     let total = u64::from(args.frames) * u64::from(args.seeds) * args.methods.len() as u64;
     let bar = indicatif::ProgressBar::new(total);
     let started = Instant::now();
     let mut write_error: Option<anyhow::Error> = None;
-    let errors = run_comparison(
-        backend.as_mut(),
-        &gpu_scene,
-        &render,
-        scene.extent(),
-        &comparison,
-        &reference,
-        |method, seed, frame, image| {
+    let errors =
+        run_comparison(backend, gpu_scene, render, extent, comparison, references, |method, seed, frame, image| {
             bar.inc(1);
             // Images of the first seed: the first frame and every power of two.
             if seed == 1 && ((frame + 1).is_power_of_two() || frame + 1 == args.frames) {
@@ -269,7 +322,8 @@ fn compare(args: CompareArgs) -> Result<()> {
                 let result = (|| -> Result<()> {
                     image.write_exr(&stem.with_extension("exr"))?;
                     image.write_png(&stem.with_extension("png"), args.exposure)?;
-                    let map = metrics::error_map(image, &reference, Metric::Relmse)?;
+                    let reference = references.get(frame as usize).unwrap_or(&references[0]);
+                    let map = metrics::error_map(image, reference, Metric::Relmse)?;
                     let error_stem = args.out.join(format!("{}_frame{:03}_relmse", method.name(), frame + 1));
                     metrics::false_colour(&map, image.width, image.height)
                         .write_png(&error_stem.with_extension("png"), 1.0)?;
@@ -285,8 +339,7 @@ fn compare(args: CompareArgs) -> Result<()> {
                     write_error.get_or_insert(error);
                 }
             }
-        },
-    )?;
+        })?;
     bar.finish_and_clear();
     if let Some(error) = write_error {
         return Err(error);

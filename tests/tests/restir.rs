@@ -13,7 +13,7 @@
 use strata::render::{GpuScene, LightSampling, PathTracer, RenderSettings};
 use strata::restir::{Method, RestirRenderer, RestirSettings};
 use strata::rgb_image::RgbImage;
-use strata::scene::{Scene, default_scene};
+use strata::scene::{Camera, CameraPath, Scene, default_scene};
 use strata_backends::{Backend, gpu_required};
 
 const SIZE: u32 = 32;
@@ -79,11 +79,17 @@ fn settings(scene: &Scene, seed: u32) -> RenderSettings {
 
 /// Path-traced reference: `samples` one-sample frames.
 fn reference(backend: &mut dyn Backend, scene: &Scene, samples: u32) -> RegionStats {
+    reference_from(backend, scene, samples, &settings(scene, 0).camera)
+}
+
+/// Path-traced reference seen from `camera`.
+fn reference_from(backend: &mut dyn Backend, scene: &Scene, samples: u32, camera: &Camera) -> RegionStats {
     let gpu_scene = GpuScene::build(scene).unwrap();
     let mut stats = RegionStats::new();
     // Batches of 4 samples, each batch one i.i.d. estimate.
     for batch in 0..samples / 4 {
-        let mut tracer = PathTracer::new(backend, &gpu_scene, &settings(scene, 50_000 + batch)).unwrap();
+        let render = RenderSettings { camera: camera.clone(), ..settings(scene, 50_000 + batch) };
+        let mut tracer = PathTracer::new(backend, &gpu_scene, &render).unwrap();
         for _ in 0..4 {
             tracer.add_sample(backend).unwrap();
         }
@@ -122,14 +128,26 @@ fn restir_frames(
     seeds: std::ops::Range<u32>,
     frames: u32,
 ) -> RegionStats {
+    restir_frames_moving(backend, scene, restir, seeds, frames, &CameraPath::Static)
+}
+
+fn restir_frames_moving(
+    backend: &mut dyn Backend,
+    scene: &Scene,
+    restir: RestirSettings,
+    seeds: std::ops::Range<u32>,
+    frames: u32,
+    path: &CameraPath,
+) -> RegionStats {
     let gpu_scene = GpuScene::build(scene).unwrap();
     let mut stats = RegionStats::new();
     for seed in seeds {
         let mut renderer =
             RestirRenderer::new(backend, &gpu_scene, &settings(scene, seed), restir, scene.extent()).unwrap();
         let mut last = None;
-        for _ in 0..frames {
-            let (image, frame_stats) = renderer.render_frame(backend, None).unwrap();
+        for frame in 0..frames {
+            let camera = path.camera_at(&settings(scene, seed).camera, frame);
+            let (image, frame_stats) = renderer.render_frame(backend, Some(&camera)).unwrap();
             assert_eq!(frame_stats.invalid_pixels, 0);
             if restir.temporal {
                 last = Some(image);
@@ -194,7 +212,11 @@ fn bad_restir_settings_are_errors_naming_the_value() {
         (RestirSettings { candidates: 5, ..Default::default() }, "candidates 5"),
         (RestirSettings { temporal_cap: 0.5, ..Default::default() }, "temporal cap 0.5"),
         (
-            RestirSettings { candidates: 3, sampler: strata::sampler::SamplerVariant::Antithetic, ..Default::default() },
+            RestirSettings {
+                candidates: 3,
+                sampler: strata::sampler::SamplerVariant::Antithetic,
+                ..Default::default()
+            },
             "exactly 4",
         ),
     ];
@@ -209,4 +231,22 @@ fn bad_restir_settings_are_errors_naming_the_value() {
         .unwrap()
         .to_string();
     assert!(error.contains("0x32"), "{error}");
+}
+
+/// With the camera orbiting, reprojection and the disocclusion test decide what is
+/// reused: the 6th frame of 128 independent renders matches the path-traced image of
+/// that frame's camera.
+#[test]
+fn temporal_reuse_with_a_moving_camera_stays_unbiased() {
+    let Some(mut backend) = strata_tests::vulkan_backend("temporal_reuse_with_a_moving_camera_stays_unbiased") else {
+        assert!(!gpu_required());
+        return;
+    };
+    let scene = default_scene();
+    let base = settings(&scene, 0).camera;
+    let path = CameraPath::orbit(&base, 1.5);
+    let reference = reference_from(&mut backend, &scene, 2048, &path.camera_at(&base, 5));
+    let restir = RestirSettings { block_size: 8, ..RestirSettings::default() };
+    let ours = restir_frames_moving(&mut backend, &scene, restir, 1..129, 6, &path);
+    assert_unbiased("strata with temporal reuse, orbiting camera, frame 6", &z_scores(&ours, &reference));
 }

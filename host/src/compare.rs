@@ -152,3 +152,52 @@ pub fn relmse_ratio(errors: &[FrameError], method: Method, baseline: Method, fra
         ours.iter().filter_map(|(seed, a)| theirs.iter().find(|(s, _)| s == seed).map(|(_, b)| a / b)).collect();
     (!ratios.is_empty()).then(|| MeanInterval::of(&ratios))
 }
+
+/// Reads the CSV [`errors_csv`] writes; an error names the line and what is wrong.
+pub fn parse_errors_csv(text: &str) -> Result<Vec<FrameError>, String> {
+    let mut lines = text.lines();
+    if lines.next().map(str::trim) != Some("method,frame,seed,relmse,prelmse,mse") {
+        return Err("line 1: expected the header `method,frame,seed,relmse,prelmse,mse`".into());
+    }
+    let mut errors = Vec::new();
+    for (index, line) in lines.enumerate().filter(|(_, l)| !l.trim().is_empty()) {
+        let number = index + 2;
+        let fields: Vec<&str> = line.split(',').collect();
+        if fields.len() != 6 {
+            return Err(format!("line {number}: expected 6 fields, found {}", fields.len()));
+        }
+        let method = <Method as clap::ValueEnum>::from_str(fields[0], false)
+            .map_err(|_| format!("line {number}: unknown method `{}`", fields[0]))?;
+        let int = |i: usize| fields[i].parse::<u32>().map_err(|e| format!("line {number}, field {}: {e}", i + 1));
+        let float = |i: usize| fields[i].parse::<f64>().map_err(|e| format!("line {number}, field {}: {e}", i + 1));
+        let frame = int(1)?;
+        if frame == 0 {
+            return Err(format!("line {number}: frames are counted from 1"));
+        }
+        errors.push(FrameError {
+            method,
+            frame: frame - 1,
+            seed: int(2)?,
+            relmse: float(3)?,
+            prelmse: float(4)?,
+            mse: float(5)?,
+        });
+    }
+    Ok(errors)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_csv_reads_back_and_bad_lines_are_named() {
+        let errors =
+            vec![FrameError { method: Method::RestirDisc, frame: 2, seed: 7, relmse: 0.5, prelmse: 0.25, mse: 1e-3 }];
+        assert_eq!(parse_errors_csv(&errors_csv(&errors)).unwrap(), errors);
+        let bad = "method,frame,seed,relmse,prelmse,mse\nstrata,1,1,0.1,0.1\n";
+        assert!(parse_errors_csv(bad).unwrap_err().contains("line 2"));
+        let unknown = "method,frame,seed,relmse,prelmse,mse\nfoo,1,1,0.1,0.1,0.1\n";
+        assert!(parse_errors_csv(unknown).unwrap_err().contains("`foo`"));
+    }
+}

@@ -9,6 +9,7 @@ pub mod compare;
 pub mod estimator;
 pub mod histogram_pass;
 pub mod metrics;
+pub mod plot;
 pub mod render;
 pub mod restir;
 pub mod rgb_image;

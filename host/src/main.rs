@@ -36,6 +36,8 @@ enum Command {
     /// Render the ReSTIR methods from the same seeds and measure every frame against a
     /// reference: images, error maps, a CSV and a summary table.
     Compare(CompareArgs),
+    /// Plot RelMSE against frame from a `strata compare` errors.csv as an SVG.
+    Plot(PlotArgs),
     /// Compare an EXR image with a reference EXR: MSE, RelMSE (paper and common forms),
     /// pRelMSE; optionally write the per-pixel RelMSE map as EXR and false-colour PNG.
     Metrics(MetricsArgs),
@@ -93,6 +95,18 @@ struct CompareArgs {
     /// Backend to run on.
     #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
     backend: BackendChoice,
+}
+
+#[derive(clap::Args)]
+struct PlotArgs {
+    /// errors.csv written by `strata compare`.
+    csv: PathBuf,
+    /// The SVG to write.
+    #[arg(long, default_value = "relmse.svg")]
+    out: PathBuf,
+    /// Title of the plot.
+    #[arg(long, default_value = "RelMSE against frame")]
+    title: String,
 }
 
 #[derive(clap::Args)]
@@ -191,6 +205,7 @@ fn main() -> Result<()> {
         Command::Render(args) => render(args),
         Command::Metrics(args) => metrics(args),
         Command::Compare(args) => compare(args),
+        Command::Plot(args) => plot(args),
     }
 }
 
@@ -346,6 +361,17 @@ fn run_and_report(
     }
     let csv = args.out.join("errors.csv");
     std::fs::write(&csv, errors_csv(&errors)).with_context(|| format!("{}: cannot write", csv.display()))?;
+    let title = format!(
+        "{} {}x{}, {} seeds{}",
+        args.scene.as_ref().and_then(|p| scene_stem(p)).unwrap_or_else(|| "default scene".into()),
+        render.camera.width,
+        render.camera.height,
+        args.seeds,
+        if args.accumulate { ", accumulated frames" } else { ", temporal reuse" }
+    );
+    let plot = args.out.join("relmse.svg");
+    std::fs::write(&plot, strata::plot::relmse_svg(&errors, &args.methods, args.frames, &title))
+        .with_context(|| format!("{}: cannot write", plot.display()))?;
     println!(
         "{} frames x {} seeds x {} methods in {:.1} s; RelMSE (paper's form), mean ± 95% CI over seeds:",
         args.frames,
@@ -380,7 +406,24 @@ fn run_and_report(
             println!();
         }
     }
-    println!("wrote {} and images in {}", csv.display(), args.out.display());
+    println!("wrote {}, {} and images in {}", csv.display(), plot.display(), args.out.display());
+    Ok(())
+}
+
+fn plot(args: PlotArgs) -> Result<()> {
+    let text = std::fs::read_to_string(&args.csv).with_context(|| format!("{}: cannot read", args.csv.display()))?;
+    let errors =
+        strata::compare::parse_errors_csv(&text).map_err(|e| anyhow::anyhow!("{}: {e}", args.csv.display()))?;
+    let mut methods: Vec<Method> = Vec::new();
+    for e in &errors {
+        if !methods.contains(&e.method) {
+            methods.push(e.method);
+        }
+    }
+    let frames = errors.iter().map(|e| e.frame + 1).max().unwrap_or(1);
+    std::fs::write(&args.out, strata::plot::relmse_svg(&errors, &methods, frames, &args.title))
+        .with_context(|| format!("{}: cannot write", args.out.display()))?;
+    println!("wrote {}", args.out.display());
     Ok(())
 }
 

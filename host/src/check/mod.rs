@@ -10,6 +10,7 @@ mod empty;
 mod histogram;
 mod path;
 mod report;
+mod restir;
 mod trace;
 
 pub use backends::{BackendSlot, backend_slots};
@@ -55,6 +56,12 @@ pub trait KernelCheck {
     fn run(&self, backend: &mut dyn Backend, case: &Case) -> Result<Vec<Output>, PassError>;
     /// What the outputs must be.
     fn reference(&self, case: &Case) -> Vec<Output>;
+    /// The backend slots the quick check (not `--full`) runs this kernel on; `None`: all.
+    /// Whole-renderer kernels name a few: llvmpipe compiles each of them for minutes on a
+    /// machine without a warm shader cache, once per slot whose shader code differs.
+    fn quick_slots(&self) -> Option<&'static [&'static str]> {
+        None
+    }
 }
 
 /// Every kernel check: one line per registry kernel.
@@ -66,6 +73,10 @@ pub fn kernel_checks() -> Vec<Box<dyn KernelCheck>> {
         Box::new(trace::TraceCheck),
         Box::new(camera::CameraCheck),
         Box::new(path::PathTraceCheck),
+        Box::new(restir::RestirCheck(KernelId::RestirCandidates)),
+        Box::new(restir::RestirCheck(KernelId::RestirSelect)),
+        Box::new(restir::RestirCheck(KernelId::RestirTemporal)),
+        Box::new(restir::RestirCheck(KernelId::RestirShade)),
     ]
 }
 
@@ -94,6 +105,13 @@ pub fn run_checks(config: CheckConfig, checks: Vec<Box<dyn KernelCheck>>) -> Che
         };
         report.set_device(slot.name, backend.info().summary());
         for check in &checks {
+            if let Some(slots) = check.quick_slots().filter(|_| !config.full)
+                && !slots.contains(&slot.name)
+            {
+                let why = format!("the quick check runs it on {} only", slots.join(", "));
+                report.set(check.kernel(), slot.name, CellResult::FullRunOnly(why));
+                continue;
+            }
             let result = run_one(check.as_ref(), backend.as_mut(), config, &mut references);
             report.set(check.kernel(), slot.name, result);
         }

@@ -20,7 +20,7 @@ pub struct PathTraceCheck;
 
 /// The default room with its tall box turned to glass, its short box to rough metal and
 /// a small environment map shining in (family 1), or the plain default scene (family 0).
-fn scene(case: &Case) -> Scene {
+pub(super) fn scene(case: &Case) -> Scene {
     let mut scene = default_scene();
     if case.family == 1 {
         scene.materials.push(Material::Dielectric { int_ior: 1.5, ext_ior: 1.0 });
@@ -106,6 +106,10 @@ impl KernelCheck for PathTraceCheck {
 
     fn run(&self, backend: &mut dyn Backend, case: &Case) -> Result<Vec<Output>, PassError> {
         run_on(backend, case)
+    }
+
+    fn quick_slots(&self) -> Option<&'static [&'static str]> {
+        Some(&["cpu", "wgpu-vulkan", "ash"])
     }
 
     fn reference(&self, case: &Case) -> Vec<Output> {

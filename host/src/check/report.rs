@@ -24,6 +24,8 @@ pub enum CellResult {
     Failed(String),
     /// The backend or the kernel's needs are not available here, and why.
     Unavailable(String),
+    /// Not run in the quick check (only `--full` runs it), and why.
+    FullRunOnly(String),
 }
 
 /// Results of a whole check.
@@ -99,6 +101,10 @@ impl CheckReport {
                     Some(CellResult::Unavailable(why)) => {
                         notes.push(format!("[{}] {} on {backend}: unavailable: {why}", notes.len() + 1, name(kernel)));
                         format!("unavailable [{}]", notes.len())
+                    }
+                    Some(CellResult::FullRunOnly(why)) => {
+                        notes.push(format!("[{}] {} on {backend}: --full only: {why}", notes.len() + 1, name(kernel)));
+                        format!("--full only [{}]", notes.len())
                     }
                     None => "not run".into(),
                 };

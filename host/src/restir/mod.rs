@@ -14,6 +14,6 @@ mod pipeline;
 mod selection_numbers;
 mod settings;
 
-pub use pipeline::{FrameStats, RestirRenderer};
+pub use pipeline::{FrameBuffers, FrameStats, RestirRenderer};
 pub use selection_numbers::selection_numbers;
 pub use settings::{Method, RestirSettings};

@@ -28,6 +28,25 @@ pub struct FrameStats {
     pub pass_times: [std::time::Duration; 5],
 }
 
+/// The last frame's per-pixel buffers, as the kernels wrote them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameBuffers {
+    /// `restir_candidates`: the G-buffer.
+    pub primaries: Vec<Primary>,
+    /// `restir_candidates`: each pixel's candidate.
+    pub candidates: Vec<PathCandidate>,
+    /// `restir_candidates`: the histogram's input.
+    pub histogram_candidates: Vec<Candidate>,
+    /// `restir_candidates`: what each pixel estimates alone (rgb, invalid flag).
+    pub base_radiance: Vec<[f32; 4]>,
+    /// `restir_select`: the reservoirs after selection.
+    pub selected: Vec<Reservoir>,
+    /// `restir_temporal`: the final reservoirs.
+    pub reservoirs: Vec<Reservoir>,
+    /// `restir_shade`: the frame (rgb, invalid flag).
+    pub image: Vec<[f32; 4]>,
+}
+
 /// The ReSTIR renderer of one scene, image size and settings.
 pub struct RestirRenderer {
     kernels: [&'static Kernel; 4],
@@ -274,6 +293,21 @@ impl RestirRenderer {
     pub fn reservoirs(&self, backend: &mut dyn Backend) -> Result<Vec<Reservoir>, PassError> {
         let last = ((self.frame + 1) % 2) as usize;
         Ok(download(backend, self.reservoirs[last])?)
+    }
+
+    /// Every per-pixel buffer of the last frame, read back (tests and the cross-backend
+    /// check).
+    pub fn frame_buffers(&self, backend: &mut dyn Backend) -> Result<FrameBuffers, PassError> {
+        let last = ((self.frame + 1) % 2) as usize;
+        Ok(FrameBuffers {
+            primaries: download(backend, self.primaries[last])?,
+            candidates: download(backend, self.candidates)?,
+            histogram_candidates: download(backend, self.histogram.candidates)?,
+            base_radiance: download(backend, self.base_radiance)?,
+            selected: download(backend, self.selected)?,
+            reservoirs: download(backend, self.reservoirs[last])?,
+            image: download(backend, self.frame_out)?,
+        })
     }
 
     /// The histogram candidates of the last frame (key and object id per pixel).

@@ -13,7 +13,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::Duration;
-use strata::render::{GpuScene, LightSampling, PathTracer, RenderSettings};
+use strata::render::{GpuScene, PathTracer, RenderSettings};
 use strata::restir::{Method, RestirRenderer, RestirSettings};
 use strata::scene::{Scene, default_scene};
 use strata_backends::Backend;
@@ -21,17 +21,7 @@ use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_backends::wgpu_backend::{WgpuBackend, WgpuOptions};
 
 fn settings(scene: &Scene, size: u32) -> RenderSettings {
-    let mut camera = scene.camera.clone();
-    camera.width = size;
-    camera.height = size;
-    RenderSettings {
-        camera,
-        seed: 1,
-        max_depth: scene.max_depth,
-        rr_depth: scene.rr_depth,
-        light_sampling: LightSampling::Mis,
-        russian_roulette: true,
-    }
+    RenderSettings::for_scene(scene, size, size, 1)
 }
 
 fn path_trace(c: &mut Criterion, name: &str, backend: &mut dyn Backend, size: u32) {

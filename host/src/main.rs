@@ -12,7 +12,7 @@ use strata::render::{GpuScene, LightSampling, RenderSettings};
 use strata::restir::{Method, RestirSettings};
 use strata::rgb_image::RgbImage;
 use strata::sampler::SamplerVariant;
-use strata::scene::{default_scene, load_scene_file, parse_camera_path};
+use strata::scene::{Scene, default_scene, load_scene_file, parse_camera_path};
 use strata::synthetic::{CandidateMix, candidate_image};
 use strata_kernels::BlockGrid;
 use strata_kernels::reference::block_histogram::block_histogram;
@@ -209,25 +209,27 @@ fn main() -> Result<()> {
     }
 }
 
-fn compare(args: CompareArgs) -> Result<()> {
-    let scene = match &args.scene {
+/// The scene file (or the built-in scene) and its render settings at the requested size.
+fn scene_and_settings(
+    scene: &Option<PathBuf>,
+    width: Option<u32>,
+    height: Option<u32>,
+) -> Result<(Scene, RenderSettings)> {
+    let scene = match scene {
         Some(path) => load_scene_file(path)?,
         None => default_scene(),
     };
-    let mut camera = scene.camera.clone();
-    camera.width = args.width.unwrap_or(camera.width);
-    camera.height = args.height.unwrap_or(camera.height);
+    let width = width.unwrap_or(scene.camera.width);
+    let height = height.unwrap_or(scene.camera.height);
+    let settings = RenderSettings::for_scene(&scene, width, height, 1);
+    Ok((scene, settings))
+}
+
+fn compare(args: CompareArgs) -> Result<()> {
+    let (scene, render) = scene_and_settings(&args.scene, args.width, args.height)?;
     if args.frames == 0 || args.seeds == 0 {
         bail!("--frames and --seeds must be at least 1");
     }
-    let render = RenderSettings {
-        camera,
-        seed: 1,
-        max_depth: scene.max_depth,
-        rr_depth: scene.rr_depth,
-        light_sampling: LightSampling::Mis,
-        russian_roulette: true,
-    };
     let gpu_scene = GpuScene::build(&scene)?;
     let mut backend = open_backend(args.backend)?;
     println!("backend: {}", backend.info().summary());
@@ -451,23 +453,16 @@ fn metrics(args: MetricsArgs) -> Result<()> {
 }
 
 fn render(args: RenderArgs) -> Result<()> {
-    let scene = match &args.scene {
-        Some(path) => load_scene_file(path)?,
-        None => default_scene(),
-    };
-    let mut camera = scene.camera.clone();
-    camera.width = args.width.unwrap_or(camera.width);
-    camera.height = args.height.unwrap_or(camera.height);
+    let (scene, defaults) = scene_and_settings(&args.scene, args.width, args.height)?;
     if args.spp == 0 {
         bail!("--spp 0: at least one sample per pixel is needed");
     }
     let settings = RenderSettings {
-        camera,
         seed: args.seed,
         max_depth: args.max_depth.unwrap_or(scene.max_depth),
-        rr_depth: scene.rr_depth,
         light_sampling: args.light_sampling,
         russian_roulette: !args.no_russian_roulette,
+        ..defaults
     };
     let gpu_scene = GpuScene::build(&scene)?;
     let mut backend = open_backend(args.backend)?;

@@ -9,9 +9,12 @@ const HEIGHT: f64 = 400.0;
 const MARGIN: f64 = 60.0;
 const COLOURS: [&str; 3] = ["#d62728", "#1f77b4", "#2ca02c"];
 
+/// Per frame: (frame number, mean RelMSE, half-width of its 95 % interval).
+type Series = Vec<(f64, f64, f64)>;
+
 /// The SVG document: x = frame (log2 axis), y = RelMSE (log10 axis).
 pub fn relmse_svg(errors: &[FrameError], methods: &[Method], frames: u32, title: &str) -> String {
-    let series: Vec<(Method, Vec<(f64, f64, f64)>)> = methods
+    let series: Vec<(Method, Series)> = methods
         .iter()
         .map(|&m| {
             let points = (0..frames)

@@ -59,9 +59,9 @@ impl KernelId {
         let histogram = || [fragment!("common/candidate.wgsl"), fragment!("histogram/block_sort.wgsl")];
         // Every ReSTIR pass: the scene and the path tracer's functions, the candidate
         // records of the histogram, then its own entry point.
-        let restir = |name: &'static str, entry: Fragment| KernelSpec {
-            name: name.into(),
-            fragments: vec![
+        // The path tracer's functions, shared by path_trace and the ReSTIR passes.
+        let renderer = || {
+            vec![
                 fragment!("trace/bvh.wgsl"),
                 fragment!("trace/traverse.wgsl"),
                 fragment!("render/scene.wgsl"),
@@ -71,10 +71,15 @@ impl KernelId {
                 fragment!("render/bsdf.wgsl"),
                 fragment!("render/lights.wgsl"),
                 fragment!("render/path.wgsl"),
-                fragment!("common/candidate.wgsl"),
-                fragment!("restir/reservoir.wgsl"),
-                entry,
-            ],
+            ]
+        };
+        let restir = |name: &'static str, entry: Fragment| KernelSpec {
+            name: name.into(),
+            fragments: [
+                renderer(),
+                vec![fragment!("common/candidate.wgsl"), fragment!("restir/reservoir.wgsl"), entry],
+            ]
+            .concat(),
             entry_point: name.into(),
             features: KernelFeatures::empty(),
             // Paths and reconnections branch on float results, and environment lookups
@@ -127,18 +132,7 @@ impl KernelId {
             },
             KernelId::PathTrace => KernelSpec {
                 name: "path_trace".into(),
-                fragments: vec![
-                    fragment!("trace/bvh.wgsl"),
-                    fragment!("trace/traverse.wgsl"),
-                    fragment!("render/scene.wgsl"),
-                    fragment!("render/random.wgsl"),
-                    fragment!("render/environment.wgsl"),
-                    fragment!("render/albedo.wgsl"),
-                    fragment!("render/bsdf.wgsl"),
-                    fragment!("render/lights.wgsl"),
-                    fragment!("render/path.wgsl"),
-                    fragment!("render/entry_path_trace.wgsl"),
-                ],
+                fragments: [renderer(), vec![fragment!("render/entry_path_trace.wgsl")]].concat(),
                 entry_point: "path_trace".into(),
                 features: KernelFeatures::empty(),
                 // Paths branch on float comparisons: a one-ULP difference can send a

@@ -10,7 +10,7 @@
 //!
 //! Needs Vulkan (skips without it unless `STRATA_REQUIRE_GPU=1`).
 
-use strata::render::{GpuScene, LightSampling, PathTracer, RenderSettings};
+use strata::render::{GpuScene, PathTracer, RenderSettings};
 use strata::restir::{Method, RestirRenderer, RestirSettings};
 use strata::rgb_image::RgbImage;
 use strata::scene::{Camera, CameraPath, Scene, default_scene};
@@ -64,17 +64,7 @@ impl RegionStats {
 }
 
 fn settings(scene: &Scene, seed: u32) -> RenderSettings {
-    let mut camera = scene.camera.clone();
-    camera.width = SIZE;
-    camera.height = SIZE;
-    RenderSettings {
-        camera,
-        seed,
-        max_depth: scene.max_depth,
-        rr_depth: scene.rr_depth,
-        light_sampling: LightSampling::Mis,
-        russian_roulette: true,
-    }
+    RenderSettings::for_scene(scene, SIZE, SIZE, seed)
 }
 
 /// Path-traced reference: `samples` one-sample frames.

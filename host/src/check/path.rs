@@ -9,7 +9,7 @@
 
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
 use crate::histogram_pass::PassError;
-use crate::render::{GpuScene, LightSampling, RenderSettings, render};
+use crate::render::{GpuScene, RenderSettings, render};
 use crate::scene::{Environment, Material, Scene, default_scene};
 use strata_backends::Backend;
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
@@ -52,17 +52,7 @@ pub(super) fn scene(case: &Case) -> Scene {
 }
 
 fn settings(case: &Case, scene: &Scene) -> RenderSettings {
-    let mut camera = scene.camera.clone();
-    camera.width = case.width;
-    camera.height = case.height;
-    RenderSettings {
-        camera,
-        seed: case.seed as u32,
-        max_depth: scene.max_depth,
-        rr_depth: 2,
-        light_sampling: LightSampling::Mis,
-        russian_roulette: true,
-    }
+    RenderSettings { rr_depth: 2, ..RenderSettings::for_scene(scene, case.width, case.height, case.seed as u32) }
 }
 
 fn run_on(backend: &mut dyn Backend, case: &Case) -> Result<Vec<Output>, PassError> {

@@ -12,7 +12,7 @@
 
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
 use crate::histogram_pass::PassError;
-use crate::render::{GpuScene, LightSampling, RenderSettings};
+use crate::render::{GpuScene, RenderSettings};
 use crate::restir::{FrameBuffers, Method, RestirRenderer, RestirSettings};
 use strata_backends::Backend;
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
@@ -24,17 +24,8 @@ pub struct RestirCheck(pub KernelId);
 fn frame(backend: &mut dyn Backend, case: &Case) -> Result<FrameBuffers, PassError> {
     let scene = super::path::scene(case);
     let gpu_scene = GpuScene::build(&scene)?;
-    let mut camera = scene.camera.clone();
-    camera.width = case.width;
-    camera.height = case.height;
-    let render = RenderSettings {
-        camera,
-        seed: case.seed as u32,
-        max_depth: scene.max_depth,
-        rr_depth: 2,
-        light_sampling: LightSampling::Mis,
-        russian_roulette: true,
-    };
+    let render =
+        RenderSettings { rr_depth: 2, ..RenderSettings::for_scene(&scene, case.width, case.height, case.seed as u32) };
     let method = [Method::Strata, Method::Restir, Method::RestirDisc][(case.seed % 3) as usize];
     let settings =
         RestirSettings { method, block_size: case.block_size, disc_radius: 4.0, ..RestirSettings::default() };

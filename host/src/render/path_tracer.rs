@@ -41,6 +41,19 @@ pub struct RenderSettings {
 }
 
 impl RenderSettings {
+    /// The scene's own integrator settings (depths, MIS, Russian roulette) and camera at
+    /// `width` x `height`, with `seed`.
+    pub fn for_scene(scene: &crate::scene::Scene, width: u32, height: u32, seed: u32) -> RenderSettings {
+        RenderSettings {
+            camera: Camera { width, height, ..scene.camera.clone() },
+            seed,
+            max_depth: scene.max_depth,
+            rr_depth: scene.rr_depth,
+            light_sampling: LightSampling::Mis,
+            russian_roulette: true,
+        }
+    }
+
     /// The kernels' parameters: the scene-wide fields of `scene` (a
     /// [`GpuScene::params`]) with this render's image size, camera, seed, depths and
     /// flags, checked.

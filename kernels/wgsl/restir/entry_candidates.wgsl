@@ -36,6 +36,20 @@ fn light_area_density(light: u32) -> f32 {
     return (1.0 - params.environment_probability) * entry.probability / entry.area;
 }
 
+// (p̂, RIS weight p̂ / (p_bsdf + p_light)) of `candidate` at `primary`, given the
+// density with which next-event estimation draws it; zero for no candidate.
+fn ris_weight(primary: Primary, candidate: PathCandidate, light_density: f32) -> vec2<f32> {
+    if candidate.kind == KIND_NONE {
+        return vec2<f32>(0.0);
+    }
+    let target_value = target_function(primary, candidate);
+    let density = bsdf_density(primary, candidate) + light_density;
+    if !(density > 0.0) {
+        return vec2<f32>(target_value, 0.0);
+    }
+    return vec2<f32>(target_value, target_value / density);
+}
+
 // The candidate of surface point `vertex` seen from `origin`, reflecting `reflected`
 // towards it: its normal flipped towards the origin, its light only when the origin sees
 // the emitting side, shareable when Lambertian.
@@ -162,32 +176,16 @@ fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
                 }
             }
             // RIS over the two samples, balance heuristic: w = p̂ / (p_bsdf + p_light).
-            var weight_bsdf = 0.0;
-            var target_bsdf = 0.0;
-            if bsdf_candidate.kind != KIND_NONE {
-                target_bsdf = target_function(primary, bsdf_candidate);
-                let density = bsdf_density(primary, bsdf_candidate) + bsdf_light_density;
-                if density > 0.0 {
-                    weight_bsdf = target_bsdf / density;
-                }
-            }
-            var weight_light = 0.0;
-            var target_light = 0.0;
-            if light_candidate.kind != KIND_NONE {
-                target_light = target_function(primary, light_candidate);
-                let density = bsdf_density(primary, light_candidate) + light_density;
-                if density > 0.0 {
-                    weight_light = target_light / density;
-                }
-            }
-            let total = weight_bsdf + weight_light;
+            let bsdf_ris = ris_weight(primary, bsdf_candidate, bsdf_light_density);
+            let light_ris = ris_weight(primary, light_candidate, light_density);
+            let total = bsdf_ris.y + light_ris.y;
             if total > 0.0 && total < INFINITY {
-                if random() * total < weight_light {
+                if random() * total < light_ris.y {
                     candidate = light_candidate;
-                    candidate.weight = total / target_light;
+                    candidate.weight = total / light_ris.x;
                 } else {
                     candidate = bsdf_candidate;
-                    candidate.weight = total / target_bsdf;
+                    candidate.weight = total / bsdf_ris.x;
                 }
             }
         }

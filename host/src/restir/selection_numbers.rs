@@ -70,8 +70,10 @@ pub fn selection_numbers(
 mod tests {
     use super::*;
 
-    /// Over many renders (seeds), each selection position is uniform on [0, 1): the
-    /// histogram of position values is flat for every variant and slot.
+    /// Over many renders (seeds), the K selection positions together are uniform on
+    /// [0, 1) (each stratified pattern puts one position in each quarter, uniform there;
+    /// the independent ones are each uniform), which is what gives every member of a run
+    /// the expected selection count K/n; and the resampling number is uniform.
     #[test]
     fn positions_are_uniform_over_renders() {
         let tables = BlueNoiseTables::new();
@@ -84,25 +86,25 @@ mod tests {
         ] {
             let settings = RestirSettings { sampler, ..Default::default() };
             let bins = 8;
-            let mut counts = vec![[0u32; 5]; bins];
+            let mut positions = vec![0u32; bins];
+            let mut resample = vec![0u32; bins];
             let renders = 4000;
             for seed in 0..renders {
                 let numbers = selection_numbers(&tables, &settings, 1, 1, 3, seed);
-                for slot in 0..4 {
-                    let v = numbers[0][slot];
+                for &v in &numbers[0] {
                     assert!((0.0..1.0).contains(&v), "{sampler:?}: {v}");
-                    counts[(v * bins as f32) as usize][slot] += 1;
+                    positions[(v * bins as f32) as usize] += 1;
                 }
-                counts[(numbers[1][0] * bins as f32) as usize][4] += 1;
+                resample[(numbers[1][0] * bins as f32) as usize] += 1;
             }
-            let expected = f64::from(renders) / bins as f64;
-            for (bin, row) in counts.iter().enumerate() {
-                for (slot, &count) in row.iter().enumerate() {
-                    // 6 sigma of a binomial(4000, 1/8) count.
-                    let sigma = (expected * (1.0 - 1.0 / bins as f64)).sqrt();
+            for (counts, draws) in [(&positions, 4 * renders), (&resample, renders)] {
+                let expected = f64::from(draws) / bins as f64;
+                // 6 sigma of a binomial count (an upper bound for the stratified ones).
+                let sigma = (expected * (1.0 - 1.0 / bins as f64)).sqrt();
+                for (bin, &count) in counts.iter().enumerate() {
                     assert!(
                         (f64::from(count) - expected).abs() < 6.0 * sigma,
-                        "{sampler:?} slot {slot} bin {bin}: {count} vs {expected}"
+                        "{sampler:?} bin {bin}: {count} vs {expected}"
                     );
                 }
             }

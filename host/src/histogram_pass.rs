@@ -3,7 +3,7 @@
 use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, BackendError, Bind, BufferId};
 use strata_kernels::reference::block_histogram::HistogramOutput;
-use strata_kernels::types::{BlockStats, Candidate, ClusterSpan, HistogramParams};
+use strata_kernels::types::{BlockStats, Candidate, ClusterSpan};
 use strata_kernels::{BlockGrid, GridError, Kernel, KernelError, KernelId, Registry};
 use thiserror::Error;
 
@@ -68,8 +68,20 @@ pub struct BlockHistogramPass {
 }
 
 impl BlockHistogramPass {
-    /// Creates the buffers and checks that `backend` can run the chosen variant.
+    /// Creates the buffers and checks that `backend` can run the chosen variant; clusters
+    /// by object id.
     pub fn new(backend: &mut dyn Backend, variant: HistogramVariant, grid: BlockGrid) -> Result<Self, PassError> {
+        Self::with_masking(backend, variant, grid, true)
+    }
+
+    /// [`Self::new`] with object masking (§4.3) on or off: off puts every candidate of a
+    /// block in one cluster.
+    pub fn with_masking(
+        backend: &mut dyn Backend,
+        variant: HistogramVariant,
+        grid: BlockGrid,
+        masking: bool,
+    ) -> Result<Self, PassError> {
         let registry = Registry::shared()?;
         let id = match variant {
             HistogramVariant::Portable => KernelId::BlockHistogram,
@@ -84,16 +96,7 @@ impl BlockHistogramPass {
         let max = backend.info().limits.max_workgroups_per_dimension.max(1);
         let x = total.min(max);
         let workgroups = [x, total.div_ceil(x), 1];
-        let params = HistogramParams {
-            width: grid.width,
-            height: grid.height,
-            block_size: grid.block_size,
-            log2_block_size: grid.block_size.trailing_zeros(),
-            blocks_x: grid.blocks_x(),
-            blocks_y: grid.blocks_y(),
-            workgroups_x: x,
-            _pad: 0,
-        };
+        let params = grid.histogram_params(x, masking);
         let pixels = grid.pixel_count() as u64;
         let params = upload(backend, "histogram params", &[params])?;
         let candidates = backend.create_buffer("candidates", pixels * size_of::<Candidate>() as u64)?;

@@ -1,10 +1,14 @@
 //! The B × B block grid of the histogram pass: which pixels form which block, and
 //! where each block's entries start in the sorted list.
 
-use crate::types::BLOCK_SIZES;
+use crate::types::{BLOCK_SIZES, HistogramParams};
 use thiserror::Error;
 
-/// An image cut into B × B blocks; edge blocks are partial when B does not divide the size.
+/// An image cut into B × B blocks; edge blocks are partial when B does not divide the
+/// size. The grid may be shifted (paper §5.3, "block shifting"): with shift (sx, sy) the
+/// block boundaries lie at x ≡ -sx and y ≡ -sy (mod B), so the first row and column of
+/// blocks are partial too; shifting the grid every frame keeps block edges from staying
+/// visible as seams over time.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BlockGrid {
     /// Image width in pixels (> 0).
@@ -13,6 +17,10 @@ pub struct BlockGrid {
     pub height: u32,
     /// B, one of [`BLOCK_SIZES`].
     pub block_size: u32,
+    /// Horizontal grid shift sx in 0..B (0: blocks start at column 0).
+    pub shift_x: u32,
+    /// Vertical grid shift sy in 0..B (0: blocks start at row 0).
+    pub shift_y: u32,
 }
 
 /// An image size or block size the histogram pass cannot take.
@@ -29,6 +37,16 @@ pub enum GridError {
     /// The block size is not one of 4, 8, 16, 32.
     #[error("block size {0}: must be a power of two from 4 to 32 (4, 8, 16 or 32)")]
     BlockSize(u32),
+    /// A grid shift of B or more.
+    #[error("block grid shift ({x}, {y}): each must be below the block size {block_size}")]
+    Shift {
+        /// Requested horizontal shift.
+        x: u32,
+        /// Requested vertical shift.
+        y: u32,
+        /// B.
+        block_size: u32,
+    },
     /// More pixels than a u32 index can address.
     #[error("image size {width}x{height}: more than 2^32 - 1 pixels")]
     TooLarge {
@@ -83,7 +101,35 @@ impl BlockGrid {
         if u64::from(width) * u64::from(height) > u64::from(u32::MAX) {
             return Err(GridError::TooLarge { width, height });
         }
-        Ok(Self { width, height, block_size })
+        Ok(Self { width, height, block_size, shift_x: 0, shift_y: 0 })
+    }
+
+    /// The same grid shifted by (sx, sy), each in 0..B.
+    pub fn with_shift(self, shift_x: u32, shift_y: u32) -> Result<Self, GridError> {
+        if shift_x >= self.block_size || shift_y >= self.block_size {
+            return Err(GridError::Shift { x: shift_x, y: shift_y, block_size: self.block_size });
+        }
+        Ok(Self { shift_x, shift_y, ..self })
+    }
+
+    /// The `HistogramParams` of a dispatch over this grid with `workgroups_x` workgroups
+    /// per row of the dispatch grid; `masking` false puts every candidate with an object id
+    /// in one cluster per block (paper §4.3 without object masking).
+    pub fn histogram_params(&self, workgroups_x: u32, masking: bool) -> HistogramParams {
+        HistogramParams {
+            width: self.width,
+            height: self.height,
+            block_size: self.block_size,
+            log2_block_size: self.block_size.trailing_zeros(),
+            blocks_x: self.blocks_x(),
+            blocks_y: self.blocks_y(),
+            workgroups_x,
+            shift_x: self.shift_x,
+            shift_y: self.shift_y,
+            masking: u32::from(masking),
+            _pad0: 0,
+            _pad1: 0,
+        }
     }
 
     /// Pixels in the image.
@@ -93,12 +139,12 @@ impl BlockGrid {
 
     /// Blocks per row.
     pub fn blocks_x(&self) -> u32 {
-        self.width.div_ceil(self.block_size)
+        (self.width + self.shift_x).div_ceil(self.block_size)
     }
 
     /// Blocks per column.
     pub fn blocks_y(&self) -> u32 {
-        self.height.div_ceil(self.block_size)
+        (self.height + self.shift_y).div_ceil(self.block_size)
     }
 
     /// Blocks in the image.
@@ -109,16 +155,18 @@ impl BlockGrid {
     /// The block with row-major index `block`.
     pub fn block(&self, block: u32) -> BlockRect {
         let b = self.block_size;
-        let x = block % self.blocks_x() * b;
-        let y = block / self.blocks_x() * b;
-        let width = b.min(self.width - x);
-        let height = b.min(self.height - y);
+        // Virtual (unshifted) edges of the block, clipped to the image.
+        let (vx, vy) = (block % self.blocks_x() * b, block / self.blocks_x() * b);
+        let x = vx.saturating_sub(self.shift_x);
+        let y = vy.saturating_sub(self.shift_y);
+        let width = (vx + b - self.shift_x).min(self.width) - x;
+        let height = (vy + b - self.shift_y).min(self.height) - y;
         BlockRect { x, y, width, height, base: y * self.width + x * height }
     }
 
     /// The block containing pixel (x, y).
     pub fn block_of(&self, x: u32, y: u32) -> u32 {
-        y / self.block_size * self.blocks_x() + x / self.block_size
+        (y + self.shift_y) / self.block_size * self.blocks_x() + (x + self.shift_x) / self.block_size
     }
 }
 
@@ -128,8 +176,15 @@ mod tests {
 
     #[test]
     fn blocks_tile_the_sorted_list_without_gaps() {
-        for (w, h, b) in [(1, 1, 4), (17, 33, 8), (33, 17, 16), (64, 64, 32), (5, 70, 4)] {
-            let grid = BlockGrid::new(w, h, b).unwrap();
+        for (w, h, b, sx, sy) in [
+            (1, 1, 4, 0, 0),
+            (17, 33, 8, 0, 0),
+            (33, 17, 16, 5, 15),
+            (64, 64, 32, 31, 1),
+            (5, 70, 4, 3, 2),
+            (1, 1, 4, 3, 3),
+        ] {
+            let grid = BlockGrid::new(w, h, b).unwrap().with_shift(sx, sy).unwrap();
             let mut covered = vec![false; grid.pixel_count()];
             let mut entries = vec![false; grid.pixel_count()];
             for block in 0..grid.block_count() {

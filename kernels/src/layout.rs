@@ -54,7 +54,20 @@ shader_struct!(BlockStats, "BlockStats", [clusters, invalid, empty]);
 shader_struct!(
     HistogramParams,
     "HistogramParams",
-    [width, height, block_size, log2_block_size, blocks_x, blocks_y, workgroups_x, _pad]
+    [
+        width,
+        height,
+        block_size,
+        log2_block_size,
+        blocks_x,
+        blocks_y,
+        workgroups_x,
+        shift_x,
+        shift_y,
+        masking,
+        _pad0,
+        _pad1
+    ]
 );
 
 shader_struct!(GpuBvhNode, "BvhNode", [aabb_min, _pad0, aabb_max, _pad1, prim_count, first_index, meta1, meta2]);

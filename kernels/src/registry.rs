@@ -423,7 +423,7 @@ mod tests {
         assert_eq!(kernel.bindings[1].element.count, None);
         assert_eq!(kernel.bindings[3].element.stride, 12);
         assert_eq!(kernel.bindings[0].element.count, Some(1));
-        assert_eq!(kernel.bindings[0].min_size(), 32);
+        assert_eq!(kernel.bindings[0].min_size(), 48);
         // 3 x 1024 u32 of keys plus 192 counters: within WebGPU's 16 KiB minimum.
         assert!(kernel.workgroup_memory_bytes() <= 16 * 1024, "{}", kernel.workgroup_memory_bytes());
         for kernel in registry.kernels() {

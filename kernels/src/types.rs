@@ -66,8 +66,17 @@ pub struct HistogramParams {
     pub blocks_y: u32,
     /// Workgroups per row of the 2-D dispatch grid.
     pub workgroups_x: u32,
-    /// Padding to 32 bytes.
-    pub _pad: u32,
+    /// Block grid shift sx in 0..B (paper §5.3); blocks_x counts the shifted grid.
+    pub shift_x: u32,
+    /// Block grid shift sy in 0..B.
+    pub shift_y: u32,
+    /// 1: candidates cluster by object id (§4.3); 0: one cluster per block (pixels without
+    /// a candidate still form their own run).
+    pub masking: u32,
+    /// Padding.
+    pub _pad0: u32,
+    /// Padding to 48 bytes.
+    pub _pad1: u32,
 }
 
 /// Canonical sort key of a candidate, decided on its bit pattern so that every backend

@@ -62,16 +62,7 @@ fn ash_errors_are_typed() {
     backend.destroy_buffer(buffers[1]).unwrap();
     assert!(matches!(backend.read_buffer(buffers[1]), Err(BackendError::UnknownBuffer(_))));
     // A dispatch of zero-filled buffers must still run: blocks of 4, a 1x1 image.
-    let params = strata_kernels::types::HistogramParams {
-        width: 1,
-        height: 1,
-        block_size: 4,
-        log2_block_size: 2,
-        blocks_x: 1,
-        blocks_y: 1,
-        workgroups_x: 1,
-        _pad: 0,
-    };
+    let params = strata_kernels::BlockGrid::new(1, 1, 4).unwrap().histogram_params(1, true);
     backend.write_buffer(buffers[0], 0, bytemuck::bytes_of(&params)).unwrap();
     let fresh = backend.create_buffer("stats", 64).unwrap();
     let mut binds = binds.clone();

@@ -6,7 +6,7 @@ use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
 use strata::synthetic::{CandidateMix, candidate_image};
 use strata_backends::Backend;
 use strata_kernels::BlockGrid;
-use strata_kernels::reference::block_histogram::{HistogramOutput, block_histogram};
+use strata_kernels::reference::block_histogram::{HistogramOutput, block_histogram, unmasked};
 use strata_kernels::types::{BLOCK_SIZES, Candidate};
 use strata_tests::{POISON, vulkan_backend};
 
@@ -91,5 +91,35 @@ fn portable_matches_reference_on_gl() {
         let candidates = candidate_image(width, height, seed, CandidateMix { awkward: 0.1, ..Default::default() });
         let got = run_poisoned(&mut backend, HistogramVariant::Auto, grid, &candidates);
         assert_same(grid, HistogramVariant::Auto, &got, &block_histogram(grid, &candidates));
+    }
+}
+
+/// Shifted block grids (§5.3: the first row and column of blocks partial too) and object
+/// masking off (one cluster per block), both variants, against the reference.
+#[test]
+fn shifted_grids_and_unmasked_clusters_match_reference() {
+    let Some(mut backend) = vulkan_backend("block_histogram") else {
+        return;
+    };
+    for (index, &(width, height)) in [(1, 1), (17, 33), (64, 64), (129, 65)].iter().enumerate() {
+        for &block_size in &BLOCK_SIZES {
+            let shift = (index as u32 * 7 + 1) % block_size;
+            let grid =
+                BlockGrid::new(width, height, block_size).unwrap().with_shift(shift, block_size - 1 - shift).unwrap();
+            for masking in [true, false] {
+                let seed = 0x5eed_0005 ^ u64::from(width * block_size);
+                let candidates =
+                    candidate_image(width, height, seed, CandidateMix { awkward: 0.08, ..Default::default() });
+                let want = if masking { candidates.clone() } else { unmasked(&candidates) };
+                let want = block_histogram(grid, &want);
+                for variant in [HistogramVariant::Portable, HistogramVariant::Subgroup] {
+                    let pass = BlockHistogramPass::with_masking(&mut backend, variant, grid, masking).unwrap();
+                    pass.poison_outputs(&mut backend, POISON).unwrap();
+                    let got = pass.run(&mut backend, &candidates).unwrap_or_else(|e| panic!("{e}"));
+                    pass.destroy(&mut backend).unwrap();
+                    assert_same(grid, variant, &got, &want);
+                }
+            }
+        }
     }
 }

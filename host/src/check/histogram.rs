@@ -1,12 +1,14 @@
 //! Check of the block-histogram kernels: generated candidate images, every block size,
 //! partial blocks, equal keys, NaN / ±Inf / negative / denormal keys, blocks with no
-//! valid candidate; all outputs are integers and must match the reference bit for bit.
+//! valid candidate; shifted block grids (§5.3) and object masking off (odd loop seeds
+//! are unmasked, those not divisible by 3 shifted); all outputs are integers and must match
+//! the reference bit for bit.
 
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
 use crate::histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};
 use crate::synthetic::{CandidateMix, candidate_image};
 use strata_backends::Backend;
-use strata_kernels::reference::block_histogram::{HistogramOutput, block_histogram};
+use strata_kernels::reference::block_histogram::{HistogramOutput, block_histogram, unmasked};
 use strata_kernels::types::{BLOCK_SIZES, Candidate, OBJECT_ID_NONE};
 use strata_kernels::{BlockGrid, KernelId};
 
@@ -25,6 +27,27 @@ fn candidates(case: &Case) -> Vec<Candidate> {
         }
     }
     image
+}
+
+/// The case's loop seed (bits 16 and up of its seed, see `cases`).
+fn loop_seed(case: &Case) -> u64 {
+    case.seed >> 16
+}
+
+/// Odd loop seeds run without object masking.
+fn masking(case: &Case) -> bool {
+    loop_seed(case).is_multiple_of(2)
+}
+
+/// Seeds not divisible by 3 shift the block grid.
+fn grid(case: &Case) -> Result<BlockGrid, strata_kernels::GridError> {
+    let grid = BlockGrid::new(case.width, case.height, case.block_size)?;
+    let seed = loop_seed(case);
+    if seed.is_multiple_of(3) {
+        return Ok(grid);
+    }
+    let b = u64::from(case.block_size);
+    grid.with_shift((seed * 5 % b) as u32, (seed * 3 % b) as u32)
 }
 
 fn outputs(output: HistogramOutput) -> Vec<Output> {
@@ -66,12 +89,12 @@ impl KernelCheck for HistogramCheck {
     }
 
     fn run(&self, backend: &mut dyn Backend, case: &Case) -> Result<Vec<Output>, PassError> {
-        let grid = BlockGrid::new(case.width, case.height, case.block_size)?;
+        let grid = grid(case)?;
         let variant = match self.0 {
             KernelId::BlockHistogramSubgroup => HistogramVariant::Subgroup,
             _ => HistogramVariant::Portable,
         };
-        let pass = BlockHistogramPass::new(backend, variant, grid)?;
+        let pass = BlockHistogramPass::with_masking(backend, variant, grid, masking(case))?;
         pass.poison_outputs(backend, 0xdead_beef)?;
         let result = pass.run(backend, &candidates(case));
         pass.destroy(backend)?;
@@ -79,7 +102,9 @@ impl KernelCheck for HistogramCheck {
     }
 
     fn reference(&self, case: &Case) -> Vec<Output> {
-        let grid = BlockGrid::new(case.width, case.height, case.block_size).expect("cases have valid grids");
-        outputs(block_histogram(grid, &candidates(case)))
+        let grid = grid(case).expect("cases have valid grids");
+        let candidates = candidates(case);
+        let candidates = if masking(case) { candidates } else { unmasked(&candidates) };
+        outputs(block_histogram(grid, &candidates))
     }
 }

@@ -14,6 +14,15 @@ pub struct HistogramOutput {
     pub stats: Vec<BlockStats>,
 }
 
+/// The candidates as the kernel clusters them without object masking
+/// (`HistogramParams.masking` = 0): every object id becomes 0, except `OBJECT_ID_NONE`.
+pub fn unmasked(candidates: &[Candidate]) -> Vec<Candidate> {
+    candidates
+        .iter()
+        .map(|&c| Candidate { object_id: if c.object_id == OBJECT_ID_NONE { c.object_id } else { 0 }, ..c })
+        .collect()
+}
+
 /// Sort key of a pixel's candidate.
 pub fn sort_key(candidate: Candidate, pixel: u32) -> (u32, u32, u32) {
     (candidate.object_id, canonical_key(candidate), pixel)

@@ -51,7 +51,14 @@ struct HistogramParams {
     blocks_y: u32,
     // Workgroups per row of the 2-D dispatch grid.
     workgroups_x: u32,
-    _pad: u32,
+    // Block grid shift (paper §5.3) in 0..B: block edges at x = -shift_x, y = -shift_y
+    // (mod B); blocks_x, blocks_y count the shifted grid.
+    shift_x: u32,
+    shift_y: u32,
+    // 1: cluster by object id (§4.3); 0: one cluster per block.
+    masking: u32,
+    _pad0: u32,
+    _pad1: u32,
 }
 
 // Canonical (cluster, key) of a candidate. Decided on the bit pattern alone, so every

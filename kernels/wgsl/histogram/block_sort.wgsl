@@ -1,6 +1,9 @@
 // Per-block histogram pass (paper §4.1 "histogram of candidates", §4.3 object masking).
 //
-// The image is cut into B x B blocks (B in {4, 8, 16, 32}; edge blocks are partial).
+// The image is cut into B x B blocks (B in {4, 8, 16, 32}; edge blocks are partial),
+// optionally shifted by (shift_x, shift_y) (§5.3 block shifting: the first row and
+// column of blocks are then partial too). Without masking (params.masking = 0) every
+// candidate of a block is in one cluster.
 // Each block's candidates are ordered by (object id, canonical key, pixel index), so
 // that every object's candidates form one contiguous run sorted by luminance: the
 // histogram the stratified selection pass draws from. Invalid candidates (NaN, +-Inf,
@@ -11,8 +14,9 @@
 //   0 uniform            HistogramParams   sizes of the dispatch
 //   1 storage, read      array<Candidate>  one per pixel, row-major
 //   2 storage, rw        array<u32>        sorted_pixels: per block, its pixel indices
-//                                          in sorted order; block (bx, by) starts at
-//                                          by*B*width + bx*B*bh (bh: the block's height)
+//                                          in sorted order; a block whose top-left pixel
+//                                          is (x, y) starts at y*width + x*bh (bh: the
+//                                          block's height)
 //   3 storage, rw        array<ClusterSpan> per pixel: its own cluster's run
 //   4 storage, rw        array<BlockStats> per block
 //
@@ -282,10 +286,13 @@ fn block_rect(block: u32) -> BlockRect {
     let exists = block < params.blocks_x * params.blocks_y;
     let bx = block % params.blocks_x;
     let by = block / params.blocks_x;
-    let x = bx * b;
-    let y = by * b;
-    let w = select(0u, min(b, params.width - x), exists);
-    let h = select(0u, min(b, params.height - y), exists);
+    // Virtual edges of the unshifted block, shifted and clipped to the image.
+    let vx = bx * b;
+    let vy = by * b;
+    let x = max(vx, params.shift_x) - params.shift_x;
+    let y = max(vy, params.shift_y) - params.shift_y;
+    let w = select(0u, min(vx + b - params.shift_x, params.width) - x, exists);
+    let h = select(0u, min(vy + b - params.shift_y, params.height) - y, exists);
     return BlockRect(exists, x, y, w, h, y * params.width + x * h);
 }
 
@@ -306,7 +313,10 @@ fn pixel_of(rect: BlockRect, local: u32) -> u32 {
 fn load_element(rect: BlockRect, local: u32) -> vec3<u32> {
     if column_of(local) < rect.width && row_of(local) < rect.height {
         let candidate = candidates[pixel_of(rect, local)];
-        return vec3<u32>(candidate.object_id, canonical_key(candidate), local);
+        // Without masking every candidate of the block is in cluster 0 (pixels without a
+        // candidate keep OBJECT_ID_NONE, the block's last run).
+        let unmasked = params.masking == 0u && candidate.object_id != OBJECT_ID_NONE;
+        return vec3<u32>(select(candidate.object_id, 0u, unmasked), canonical_key(candidate), local);
     }
     return vec3<u32>(OBJECT_ID_NONE, SENTINEL_KEY, local);
 }

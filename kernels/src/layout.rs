@@ -4,6 +4,7 @@
 //! read garbage without any error. [`check_struct`] compares the host struct's size and
 //! every field's name, offset and size with naga's layout of the WGSL struct.
 
+use crate::embed_types::{ResampleInput, ResampleOutput, SelectedCandidates, SelectionParams};
 use crate::render_types::{EmissiveTriangle, GpuMaterial, RenderParams, TriangleInfo};
 use crate::restir_types::{PathCandidate, Primary, Reservoir, RestirParams};
 use crate::trace_types::{CameraParams, GpuBvhNode, GpuTriangle, Hit, Ray, TraceParams};
@@ -69,6 +70,19 @@ shader_struct!(
         _pad1
     ]
 );
+
+shader_struct!(
+    SelectionParams,
+    "SelectionParams",
+    [width, height, frame, seed, candidates, sampler, identity_payload, _pad]
+);
+shader_struct!(SelectedCandidates, "SelectedCandidates", [payloads, resample_number, run_length, run_valid, selected]);
+shader_struct!(
+    ResampleInput,
+    "ResampleInput",
+    [weights, targets, canonical_weight, canonical_target, canonical_payload, _pad]
+);
+shader_struct!(ResampleOutput, "ResampleOutput", [payload, slot, weight, weight_sum]);
 
 shader_struct!(GpuBvhNode, "BvhNode", [aabb_min, _pad0, aabb_max, _pad1, prim_count, first_index, meta1, meta2]);
 shader_struct!(GpuTriangle, "Triangle", [v0, _pad0, v1, _pad1, v2, _pad2]);

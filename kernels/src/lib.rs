@@ -11,6 +11,8 @@
 
 pub mod binding;
 pub mod block_grid;
+pub mod blue_noise;
+pub mod embed_types;
 pub mod error;
 pub mod glslang;
 pub mod layout;

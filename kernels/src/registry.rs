@@ -34,6 +34,11 @@ pub enum KernelId {
     RestirTemporal,
     /// ReSTIR pass 5: shading of the reservoirs' samples with one shadow ray.
     RestirShade,
+    /// Embedding: K payload indices per pixel from its cluster's run at the stratified
+    /// positions of the chosen sampler variant (paper §4.2, Fig. 3, Table 2).
+    StrataSelect,
+    /// Embedding: inverse-CDF resampling of the engine's weights (paper §4.2).
+    StrataResample,
     /// A kernel from outside the registry ([`Kernel::from_wgsl`]), keyed by a hash of its
     /// source and entry point so that backends can cache its pipeline.
     External(u64),
@@ -41,7 +46,7 @@ pub enum KernelId {
 
 impl KernelId {
     /// Every registry kernel.
-    pub const ALL: [KernelId; 10] = [
+    pub const ALL: [KernelId; 12] = [
         KernelId::BlockHistogram,
         KernelId::BlockHistogramSubgroup,
         KernelId::Empty,
@@ -52,6 +57,8 @@ impl KernelId {
         KernelId::RestirSelect,
         KernelId::RestirTemporal,
         KernelId::RestirShade,
+        KernelId::StrataSelect,
+        KernelId::StrataResample,
     ];
 
     /// What the registry knows of this kernel before parsing it.
@@ -147,6 +154,29 @@ impl KernelId {
             KernelId::RestirSelect => restir("restir_select", fragment!("restir/entry_select.wgsl")),
             KernelId::RestirTemporal => restir("restir_temporal", fragment!("restir/entry_temporal.wgsl")),
             KernelId::RestirShade => restir("restir_shade", fragment!("restir/entry_shade.wgsl")),
+            KernelId::StrataSelect => KernelSpec {
+                name: "strata_select".into(),
+                fragments: vec![
+                    fragment!("common/candidate.wgsl"),
+                    fragment!("restir/sampler.wgsl"),
+                    fragment!("embed/selection.wgsl"),
+                    fragment!("embed/selection_numbers.wgsl"),
+                    fragment!("embed/entry_select.wgsl"),
+                ],
+                entry_point: "strata_select".into(),
+                features: KernelFeatures::empty(),
+                // Payload indices are integers; the resampling number is the one float
+                // output (divisions and fract: a few ULP).
+                float_ulp_bound: Some(4),
+            },
+            KernelId::StrataResample => KernelSpec {
+                name: "strata_resample".into(),
+                fragments: vec![fragment!("embed/selection.wgsl"), fragment!("embed/entry_resample.wgsl")],
+                entry_point: "strata_resample".into(),
+                features: KernelFeatures::empty(),
+                // W = sum / target: one division after K + 1 additions.
+                float_ulp_bound: Some(4),
+            },
             KernelId::External(_) => return None,
         })
     }
@@ -487,6 +517,22 @@ mod tests {
                     check_struct::<Ray>(module),
                     check_struct::<Hit>(module),
                 ] {
+                    result.unwrap_or_else(|e| panic!("{}: {e}", kernel.name()));
+                }
+                continue;
+            }
+            if matches!(kernel.id, KernelId::StrataSelect | KernelId::StrataResample) {
+                use crate::embed_types::{ResampleInput, ResampleOutput, SelectedCandidates, SelectionParams};
+                let mut results = vec![
+                    check_struct::<SelectionParams>(module),
+                    check_struct::<SelectedCandidates>(module),
+                    check_struct::<ResampleInput>(module),
+                    check_struct::<ResampleOutput>(module),
+                ];
+                if kernel.id == KernelId::StrataSelect {
+                    results.extend([check_struct::<Candidate>(module), check_struct::<ClusterSpan>(module)]);
+                }
+                for result in results {
                     result.unwrap_or_else(|e| panic!("{}: {e}", kernel.name()));
                 }
                 continue;

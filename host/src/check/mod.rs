@@ -11,6 +11,7 @@ mod histogram;
 mod path;
 mod report;
 mod restir;
+mod selection;
 mod trace;
 
 pub use backends::{BackendSlot, backend_slots};
@@ -77,6 +78,8 @@ pub fn kernel_checks() -> Vec<Box<dyn KernelCheck>> {
         Box::new(restir::RestirCheck(KernelId::RestirSelect)),
         Box::new(restir::RestirCheck(KernelId::RestirTemporal)),
         Box::new(restir::RestirCheck(KernelId::RestirShade)),
+        Box::new(selection::SelectionCheck(KernelId::StrataSelect)),
+        Box::new(selection::SelectionCheck(KernelId::StrataResample)),
     ]
 }
 

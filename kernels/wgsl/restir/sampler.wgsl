@@ -15,17 +15,22 @@ const BLUE_NOISE_TILE: u32 = 128u;
 const BLUE_NOISE_DIMENSIONS_PER_PIXEL: u32 = 8u;
 const BLUE_NOISE_RANKING_WORDS: u32 = 131072u; // 128 * 128 * 8
 
-// The sample in (0, 1) of `dimension` at `sample_index` for `pixel`: (0.5 + k) / 256.
-// The pixel wraps to the tile, the sample index and dimension to 0..=255. For dimensions
-// >= 8 the reference code reads a neighbouring pixel's ranking and, at the tile's last
-// pixels, past the table: that index wraps modulo the table (the host does the same).
-fn blue_noise_sample(pixel: vec2<u32>, sample_index: u32, dimension: u32) -> f32 {
+// The stratum k in 0..=255 of the sample of `dimension` at `sample_index` for `pixel`
+// (the sample is (0.5 + k) / 256). The pixel wraps to the tile, the sample index and
+// dimension to 0..=255. For dimensions >= 8 the reference code reads a neighbouring
+// pixel's ranking and, at the tile's last pixels, past the table: that index wraps modulo
+// the table (the host does the same).
+fn blue_noise_stratum(pixel: vec2<u32>, sample_index: u32, dimension: u32) -> u32 {
     let tile_pixel = (pixel.x & 127u) + (pixel.y & 127u) * BLUE_NOISE_TILE;
     let sample = sample_index & 255u;
     let dim = dimension & 255u;
     let ranking_index = (dim + tile_pixel * BLUE_NOISE_DIMENSIONS_PER_PIXEL) % BLUE_NOISE_RANKING_WORDS;
     let ranked = sample ^ blue_noise_ranking[ranking_index];
-    let value = blue_noise_sobol[dim + ranked * 256u]
+    return blue_noise_sobol[dim + ranked * 256u]
         ^ blue_noise_scrambling[(dim & 7u) + tile_pixel * BLUE_NOISE_DIMENSIONS_PER_PIXEL];
-    return (0.5 + f32(value)) / 256.0;
+}
+
+// The sample in (0, 1): (0.5 + k) / 256 with k = blue_noise_stratum(...).
+fn blue_noise_sample(pixel: vec2<u32>, sample_index: u32, dimension: u32) -> f32 {
+    return (0.5 + f32(blue_noise_stratum(pixel, sample_index, dimension))) / 256.0;
 }

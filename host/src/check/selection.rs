@@ -1,0 +1,220 @@
+//! Check of the embeddable selection kernels: `strata_select` on generated candidate
+//! images (the reference histogram's runs, shifted grids, every sampler variant, K from 1
+//! to 4, identity and engine payloads) and `strata_resample` on generated weights (zero,
+//! NaN, infinite and negative ones included), against the Rust reference of
+//! `strata_kernels::reference::stratified_selection`. Payloads and slots bit for bit;
+//! resampling numbers and weights within the registry's ULP bound.
+
+use super::{Case, CheckConfig, Compare, KernelCheck, Output};
+use crate::histogram_pass::PassError;
+use crate::synthetic::{CandidateMix, candidate_image};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg32;
+use strata_backends::backend::{download, upload};
+use strata_backends::{Backend, Bind};
+use strata_kernels::blue_noise::{BlueNoiseTables, SamplerVariant};
+use strata_kernels::embed_types::{ResampleInput, ResampleOutput, SelectedCandidates, SelectionParams, sampler_id};
+use strata_kernels::reference::block_histogram::{HistogramOutput, block_histogram};
+use strata_kernels::reference::stratified_selection::{resample, select};
+use strata_kernels::types::Candidate;
+use strata_kernels::{BlockGrid, KernelId, Registry};
+
+/// Checks [`KernelId::StrataSelect`] or [`KernelId::StrataResample`].
+pub struct SelectionCheck(pub KernelId);
+
+const SAMPLERS: [SamplerVariant; 5] = [
+    SamplerVariant::Antithetic,
+    SamplerVariant::Random,
+    SamplerVariant::Heitz,
+    SamplerVariant::RandomOffset,
+    SamplerVariant::RandomOffsetBlueNoise,
+];
+
+/// The generated inputs of one case.
+struct Inputs {
+    params: SelectionParams,
+    candidates: Vec<Candidate>,
+    payloads: Vec<u32>,
+    histogram: HistogramOutput,
+    resample_inputs: Vec<ResampleInput>,
+}
+
+fn inputs(case: &Case) -> Inputs {
+    let (width, height) = (case.width, case.height);
+    let mix = CandidateMix { objects: 1 + (case.seed % 5) as u32, key_levels: 7, awkward: 0.05 };
+    let candidates = candidate_image(width, height, case.seed, mix);
+    let b = case.block_size;
+    let grid = BlockGrid::new(width, height, b)
+        .and_then(|g| g.with_shift((case.seed % u64::from(b)) as u32, (case.seed * 3 % u64::from(b)) as u32))
+        .expect("cases have valid grids");
+    let histogram = block_histogram(grid, &candidates);
+    let mut rng = Pcg32::seed_from_u64(case.seed);
+    let pixels = (width * height) as usize;
+    let payloads = (0..pixels).map(|_| rng.random::<u32>() >> 4).collect();
+    let params = SelectionParams {
+        width,
+        height,
+        frame: (case.seed * 37 % 1000) as u32,
+        seed: case.seed as u32,
+        candidates: 1 + (case.seed % 4) as u32,
+        sampler: sampler_id(SAMPLERS[case.family as usize % SAMPLERS.len()]),
+        identity_payload: (case.seed % 2) as u32,
+        _pad: 0,
+    };
+    let weight = |rng: &mut Pcg32| match rng.random_range(0..40) {
+        0..8 => 0.0,
+        8 => f32::NAN,
+        9 => f32::INFINITY,
+        10 => -1.0,
+        _ => rng.random::<f32>() * 10.0,
+    };
+    let resample_inputs = (0..pixels)
+        .map(|_| ResampleInput {
+            weights: std::array::from_fn(|_| weight(&mut rng)),
+            targets: std::array::from_fn(|_| rng.random::<f32>() + 0.01),
+            canonical_weight: weight(&mut rng),
+            canonical_target: rng.random::<f32>() + 0.01,
+            canonical_payload: rng.random(),
+            _pad: 0,
+        })
+        .collect();
+    Inputs { params, candidates, payloads, histogram, resample_inputs }
+}
+
+fn reference_selections(inputs: &Inputs, tables: &BlueNoiseTables) -> Vec<SelectedCandidates> {
+    select(
+        &inputs.params,
+        tables,
+        &inputs.candidates,
+        &inputs.payloads,
+        &inputs.histogram.sorted_pixels,
+        &inputs.histogram.spans,
+    )
+}
+
+fn ulp(kernel: KernelId) -> u32 {
+    Registry::shared().ok().and_then(|r| r.get(kernel).spec.float_ulp_bound).unwrap_or(0)
+}
+
+fn selection_outputs(selections: &[SelectedCandidates]) -> Vec<Output> {
+    let words: Vec<u32> = bytemuck::cast_slice(selections).to_vec();
+    let (mut integers, mut floats) = (Vec::new(), Vec::new());
+    for record in words.chunks_exact(8) {
+        integers.extend_from_slice(&record[..4]);
+        integers.extend_from_slice(&record[5..]);
+        floats.push(record[4]);
+    }
+    vec![
+        Output { name: "payloads and run counts", words: integers, compare: Compare::Exact },
+        Output {
+            name: "resample_number",
+            words: floats,
+            compare: Compare::Float { ulp: ulp(KernelId::StrataSelect), max_outside: 0.0 },
+        },
+    ]
+}
+
+fn resample_outputs(outputs: &[ResampleOutput]) -> Vec<Output> {
+    let words: Vec<u32> = bytemuck::cast_slice(outputs).to_vec();
+    let (mut integers, mut floats) = (Vec::new(), Vec::new());
+    for record in words.chunks_exact(4) {
+        integers.extend_from_slice(&record[..2]);
+        floats.extend_from_slice(&record[2..]);
+    }
+    vec![
+        Output { name: "payload and slot", words: integers, compare: Compare::Exact },
+        Output {
+            name: "weight and weight_sum",
+            words: floats,
+            compare: Compare::Float { ulp: ulp(KernelId::StrataResample), max_outside: 0.0 },
+        },
+    ]
+}
+
+impl KernelCheck for SelectionCheck {
+    fn kernel(&self) -> KernelId {
+        self.0
+    }
+
+    fn cases(&self, config: CheckConfig) -> Vec<Case> {
+        let (seeds, sizes): (u64, &[(u32, u32, u32)]) = if config.full {
+            (20, &[(1, 1, 4), (17, 33, 8), (64, 64, 16), (129, 65, 32)])
+        } else {
+            (5, &[(1, 1, 4), (17, 33, 8), (40, 24, 16)])
+        };
+        let mut cases = Vec::new();
+        for seed in 0..seeds {
+            for &(width, height, block_size) in sizes {
+                let family = (seed % SAMPLERS.len() as u64) as u32;
+                cases.push(Case {
+                    label: format!("{width}x{height} B={block_size} seed {seed} {:?}", SAMPLERS[family as usize]),
+                    width,
+                    height,
+                    block_size,
+                    seed: 0x5e1ec7 ^ seed << 12 ^ u64::from(width),
+                    family,
+                });
+            }
+        }
+        cases
+    }
+
+    fn run(&self, backend: &mut dyn Backend, case: &Case) -> Result<Vec<Output>, PassError> {
+        let registry = Registry::shared()?;
+        let kernel = registry.get(self.0);
+        let inputs = inputs(case);
+        let pixels = inputs.candidates.len() as u64;
+        let workgroups = [case.width.div_ceil(8), case.height.div_ceil(8), 1];
+        let params = upload(backend, "selection params", &[inputs.params])?;
+        let mut buffers = vec![params];
+        let result = if self.0 == KernelId::StrataSelect {
+            let tables = BlueNoiseTables::new();
+            let mut binds = vec![Bind::new(0, params)];
+            let inputs_words: [(u32, &[u32]); 7] = [
+                (1, bytemuck::cast_slice(&inputs.candidates)),
+                (2, &inputs.payloads),
+                (3, &inputs.histogram.sorted_pixels),
+                (4, bytemuck::cast_slice(&inputs.histogram.spans)),
+                (5, &tables.sobol),
+                (6, &tables.scrambling),
+                (7, &tables.ranking),
+            ];
+            for (binding, words) in inputs_words {
+                let buffer = upload(backend, "selection input", words)?;
+                buffers.push(buffer);
+                binds.push(Bind::new(binding, buffer));
+            }
+            let out = backend.create_buffer("selections", pixels * size_of::<SelectedCandidates>() as u64)?;
+            buffers.push(out);
+            backend.write_buffer(out, 0, &vec![0xa5; (pixels as usize) * size_of::<SelectedCandidates>()])?;
+            binds.push(Bind::new(8, out));
+            backend.dispatch(kernel, &binds, workgroups)?;
+            download::<SelectedCandidates>(backend, out).map(|s| selection_outputs(&s))
+        } else {
+            let selections = reference_selections(&inputs, &BlueNoiseTables::new());
+            let selections = upload(backend, "selections", &selections)?;
+            let resample_inputs = upload(backend, "resample inputs", &inputs.resample_inputs)?;
+            let out = backend.create_buffer("resampled", pixels * size_of::<ResampleOutput>() as u64)?;
+            buffers.extend([selections, resample_inputs, out]);
+            backend.write_buffer(out, 0, &vec![0xa5; (pixels as usize) * size_of::<ResampleOutput>()])?;
+            let binds =
+                [Bind::new(0, params), Bind::new(1, selections), Bind::new(2, resample_inputs), Bind::new(3, out)];
+            backend.dispatch(kernel, &binds, workgroups)?;
+            download::<ResampleOutput>(backend, out).map(|r| resample_outputs(&r))
+        };
+        for buffer in buffers {
+            backend.destroy_buffer(buffer)?;
+        }
+        Ok(result?)
+    }
+
+    fn reference(&self, case: &Case) -> Vec<Output> {
+        let inputs = inputs(case);
+        let selections = reference_selections(&inputs, &BlueNoiseTables::new());
+        if self.0 == KernelId::StrataSelect {
+            selection_outputs(&selections)
+        } else {
+            resample_outputs(&resample(&selections, &inputs.resample_inputs))
+        }
+    }
+}

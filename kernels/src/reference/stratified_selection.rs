@@ -92,11 +92,10 @@ pub fn select(
                 result.run_length = n;
                 result.run_valid = span.valid;
                 result.selected = k;
-                for slot in 0..k as usize {
-                    let index = span.offset + ((positions[slot] * n as f32).floor() as u32).min(n - 1);
+                for (payload, position) in result.payloads.iter_mut().zip(positions).take(k as usize) {
+                    let index = span.offset + ((position * n as f32).floor() as u32).min(n - 1);
                     let source = sorted_pixels[index as usize];
-                    result.payloads[slot] =
-                        if params.identity_payload != 0 { source } else { payloads[source as usize] };
+                    *payload = if params.identity_payload != 0 { source } else { payloads[source as usize] };
                 }
             }
             out.push(result);

@@ -8,7 +8,7 @@ use strata_kernels::{BlockGrid, GridError, Kernel, KernelError, KernelId, Regist
 use thiserror::Error;
 
 /// Slots one workgroup sorts (`SLOTS` in `block_sort.wgsl`).
-pub const SLOTS_PER_WORKGROUP: u32 = 1024;
+pub const SLOTS_PER_WORKGROUP: u32 = strata_kernels::types::HISTOGRAM_SLOTS_PER_WORKGROUP;
 
 /// Which entry point of the histogram kernel to run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

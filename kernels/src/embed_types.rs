@@ -100,3 +100,15 @@ pub struct ResampleOutput {
     /// Sum of the weights.
     pub weight_sum: f32,
 }
+
+/// WGSL declarations of the contract's records and constants (`Candidate`,
+/// `ClusterSpan`, `SelectionParams`, `SelectedCandidates`, `ResampleInput`,
+/// `ResampleOutput`, `NO_PAYLOAD`, ...), for an engine's own shaders that read the
+/// selections and write the resampling inputs: prepend it to the shader source.
+pub fn contract_wgsl() -> String {
+    crate::source::ComposedSource::compose(&[
+        crate::fragment!("common/candidate.wgsl"),
+        crate::fragment!("embed/selection.wgsl"),
+    ])
+    .text
+}

@@ -1,0 +1,620 @@
+//! [`AshSelection`]: the pass on an engine's own Vulkan device through `ash`, from naga's
+//! SPIR-V of the same WGSL kernels, recording into the engine's command buffer with the
+//! engine's buffers.
+
+use crate::contract::{BufferRole, check_size};
+use crate::error::EmbedError;
+use crate::frame::{FrameParams, frame_params, max_blocks};
+use crate::limits::{DeviceLimits, VULKAN_NAMES, check_limits};
+use crate::settings::SelectionSettings;
+use crate::wgsl::{ModuleId, WgslModule, module};
+use ash::vk;
+use strata_kernels::Registry;
+use strata_kernels::blue_noise::BlueNoiseTables;
+use strata_kernels::embed_types::SelectionParams;
+use strata_kernels::translate::{TranslateOptions, spirv};
+use strata_kernels::types::HistogramParams;
+
+/// The engine's Vulkan objects the pass is created on (the device must be Vulkan 1.1 or
+/// newer; nothing has to be enabled beyond core features).
+#[derive(Clone, Copy)]
+pub struct AshDevice<'a> {
+    /// The instance.
+    pub instance: &'a ash::Instance,
+    /// The physical device behind `device`.
+    pub physical_device: vk::PhysicalDevice,
+    /// The logical device.
+    pub device: &'a ash::Device,
+}
+
+/// A range of an engine buffer: records start at `offset` (a multiple of
+/// `minStorageBufferOffsetAlignment`) and `size` bytes may be used.
+#[derive(Clone, Copy, Debug)]
+pub struct AshBufferSlice {
+    /// The buffer (created with `STORAGE_BUFFER` usage).
+    pub buffer: vk::Buffer,
+    /// Byte offset of the first record.
+    pub offset: u64,
+    /// Bytes from `offset` the pass may use.
+    pub size: u64,
+}
+
+/// The engine's buffers for [`AshSelection::bind`] (see [`crate::contract`]).
+#[derive(Clone, Copy, Debug)]
+pub struct AshBuffers {
+    /// One `Candidate` per pixel, written by the engine before the selection.
+    pub candidates: AshBufferSlice,
+    /// One payload per pixel; `None`: a pixel's payload is its index.
+    pub payloads: Option<AshBufferSlice>,
+    /// One `SelectedCandidates` per pixel, written by the pass.
+    pub selections: AshBufferSlice,
+    /// The resampling buffers, if the engine resamples with the pass.
+    pub resample: Option<AshResampleBuffers>,
+}
+
+/// The engine's buffers of the resampling pass.
+#[derive(Clone, Copy, Debug)]
+pub struct AshResampleBuffers {
+    /// One `ResampleInput` per pixel, written by the engine after the selection.
+    pub inputs: AshBufferSlice,
+    /// One `ResampleOutput` per pixel, written by the pass.
+    pub outputs: AshBufferSlice,
+}
+
+/// Descriptor sets of one set of engine buffers, made by [`AshSelection::bind`]; free
+/// them with [`AshSelection::destroy_bindings`].
+#[derive(Debug)]
+pub struct AshBindings {
+    pool: vk::DescriptorPool,
+    histogram: vk::DescriptorSet,
+    select: vk::DescriptorSet,
+    resample: Option<vk::DescriptorSet>,
+    identity_payload: bool,
+}
+
+struct Pipeline {
+    pipeline: vk::Pipeline,
+    layout: vk::PipelineLayout,
+    set_layout: vk::DescriptorSetLayout,
+    bindings: Vec<vk::DescriptorType>,
+}
+
+/// (buffer, offset, size) of one descriptor.
+type BufferRange = (vk::Buffer, u64, u64);
+
+struct OwnBuffer {
+    buffer: vk::Buffer,
+    memory: vk::DeviceMemory,
+    size: u64,
+}
+
+/// The stratified selection on an engine's Vulkan device (see [`crate::WgpuSelection`]
+/// for the frame's sequence; here the uniforms are written inside the command buffer with
+/// `vkCmdUpdateBuffer`, so several frames may be recorded into one submission).
+///
+/// The pass inserts its own barriers: before its first dispatch, a global memory barrier
+/// from the engine's shader and transfer writes; between its dispatches; and after the
+/// last, one making its outputs visible to the engine's later shader and transfer reads.
+/// Destroy it with [`Self::destroy`] once the device no longer uses it.
+pub struct AshSelection {
+    device: ash::Device,
+    settings: SelectionSettings,
+    width: u32,
+    height: u32,
+    max_workgroups: u32,
+    offset_alignment: u64,
+    histogram: Pipeline,
+    select: Pipeline,
+    resample: Pipeline,
+    histogram_params: OwnBuffer,
+    selection_params: OwnBuffer,
+    sorted_pixels: OwnBuffer,
+    spans: OwnBuffer,
+    block_stats: OwnBuffer,
+    tables: [OwnBuffer; 3],
+    unused_payloads: OwnBuffer,
+}
+
+fn vk_error(operation: &str, result: vk::Result) -> EmbedError {
+    EmbedError::Api { api: "Vulkan", operation: operation.into(), message: format!("{result:?}") }
+}
+
+/// Whether compute shaders may use subgroup shuffles (Vulkan 1.1 subgroup properties).
+fn subgroup_shuffles(instance: &ash::Instance, physical_device: vk::PhysicalDevice) -> bool {
+    let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
+    let mut properties = vk::PhysicalDeviceProperties2::default().push_next(&mut subgroup);
+    // SAFETY: valid instance and physical device handles from the engine.
+    unsafe { instance.get_physical_device_properties2(physical_device, &mut properties) };
+    let operations = vk::SubgroupFeatureFlags::BASIC | vk::SubgroupFeatureFlags::SHUFFLE;
+    subgroup.supported_stages.contains(vk::ShaderStageFlags::COMPUTE)
+        && subgroup.supported_operations.contains(operations)
+}
+
+impl AshSelection {
+    /// Builds the pipelines (naga's SPIR-V) and the pass's own buffers for a `width` ×
+    /// `height` image; fails, naming the setting or the device limit, when the settings
+    /// are out of range or the device cannot run the pass at this size. Uses the subgroup
+    /// histogram where compute shaders have subgroup shuffles.
+    pub fn new(vulkan: AshDevice, settings: SelectionSettings, width: u32, height: u32) -> Result<Self, EmbedError> {
+        settings.validate()?;
+        crate::frame::grid(&settings, width, height)?;
+        // SAFETY: valid handles from the engine.
+        let properties = unsafe { vulkan.instance.get_physical_device_properties(vulkan.physical_device) };
+        if properties.api_version < vk::API_VERSION_1_1 {
+            return Err(EmbedError::DeviceLimit {
+                limit: "apiVersion",
+                available: u64::from(properties.api_version),
+                needed: u64::from(vk::API_VERSION_1_1),
+                why: "naga's SPIR-V 1.3 needs Vulkan 1.1".into(),
+            });
+        }
+        let histogram_module = if subgroup_shuffles(vulkan.instance, vulkan.physical_device) {
+            ModuleId::HistogramSubgroup
+        } else {
+            ModuleId::Histogram
+        };
+        let limits = properties.limits;
+        let blocks = max_blocks(&settings, width, height);
+        check_limits(DeviceLimits::vulkan(&limits), &VULKAN_NAMES, histogram_module, width, height, blocks)?;
+        // SAFETY: valid handles from the engine.
+        let memory = unsafe { vulkan.instance.get_physical_device_memory_properties(vulkan.physical_device) };
+        let device = vulkan.device.clone();
+        let mut created = Created { device: &device, pipelines: Vec::new(), buffers: Vec::new() };
+        let histogram = created.pipeline(&module(histogram_module)?)?;
+        let select = created.pipeline(&module(ModuleId::Select)?)?;
+        let resample = created.pipeline(&module(ModuleId::Resample)?)?;
+        let pixels = u64::from(width) * u64::from(height);
+        let uniform = vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC;
+        let local = vk::MemoryPropertyFlags::DEVICE_LOCAL;
+        let histogram_params = created.buffer(&memory, size_of::<HistogramParams>() as u64, uniform, local, None)?;
+        let selection_params = created.buffer(&memory, size_of::<SelectionParams>() as u64, uniform, local, None)?;
+        let sorted_pixels = created.buffer(&memory, pixels * 4, storage, local, None)?;
+        let spans = created.buffer(&memory, pixels * 12, storage, local, None)?;
+        let block_stats = created.buffer(&memory, blocks * 12, storage, local, None)?;
+        let tables = BlueNoiseTables::new();
+        let host = vk::MemoryPropertyFlags::HOST_VISIBLE | vk::MemoryPropertyFlags::HOST_COHERENT;
+        let mut table = |words: &[u32]| {
+            let bytes: &[u8] = bytemuck::cast_slice(words);
+            created.buffer(&memory, bytes.len() as u64, vk::BufferUsageFlags::STORAGE_BUFFER, host, Some(bytes))
+        };
+        let tables = [table(&tables.sobol)?, table(&tables.scrambling)?, table(&tables.ranking)?];
+        let unused_payloads = created.buffer(&memory, 4, vk::BufferUsageFlags::STORAGE_BUFFER, local, None)?;
+        created.keep();
+        Ok(Self {
+            device,
+            settings,
+            width,
+            height,
+            max_workgroups: limits.max_compute_work_group_count.iter().copied().min().unwrap_or(1),
+            offset_alignment: limits.min_storage_buffer_offset_alignment.max(1),
+            histogram,
+            select,
+            resample,
+            histogram_params,
+            selection_params,
+            sorted_pixels,
+            spans,
+            block_stats,
+            tables,
+            unused_payloads,
+        })
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &SelectionSettings {
+        &self.settings
+    }
+
+    /// The parameters frame `frame` runs with.
+    pub fn frame_params(&self, frame: u32, identity_payload: bool) -> Result<FrameParams, EmbedError> {
+        frame_params(&self.settings, self.width, self.height, frame, identity_payload, self.max_workgroups)
+    }
+
+    /// Checks the engine's buffers against the contract and writes their descriptor sets.
+    pub fn bind(&self, buffers: &AshBuffers) -> Result<AshBindings, EmbedError> {
+        let (w, h) = (self.width, self.height);
+        let mut checked =
+            vec![(BufferRole::Candidates, buffers.candidates), (BufferRole::Selections, buffers.selections)];
+        if let Some(payloads) = buffers.payloads {
+            checked.push((BufferRole::Payloads, payloads));
+        }
+        if let Some(resample) = buffers.resample {
+            checked.extend([(BufferRole::ResampleInputs, resample.inputs), (BufferRole::Resampled, resample.outputs)]);
+        }
+        for &(role, slice) in &checked {
+            if !slice.offset.is_multiple_of(self.offset_alignment) {
+                return Err(EmbedError::BufferOffset {
+                    buffer: role.name(),
+                    offset: slice.offset,
+                    alignment: self.offset_alignment,
+                });
+            }
+            check_size(role, slice.size, w, h)?;
+        }
+        let sets = 3u32;
+        let pool_sizes = [
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: sets },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 16 },
+        ];
+        let info = vk::DescriptorPoolCreateInfo::default().max_sets(sets).pool_sizes(&pool_sizes);
+        // SAFETY: valid device; the pool is destroyed by destroy_bindings.
+        let pool = unsafe { self.device.create_descriptor_pool(&info, None) }
+            .map_err(|e| vk_error("creating the descriptor pool", e))?;
+        let layouts = [self.histogram.set_layout, self.select.set_layout, self.resample.set_layout];
+        let count = if buffers.resample.is_some() { 3 } else { 2 };
+        let allocate = vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts[..count]);
+        // SAFETY: the pool has room for these sets.
+        let allocated = match unsafe { self.device.allocate_descriptor_sets(&allocate) } {
+            Ok(sets) => sets,
+            Err(error) => {
+                // SAFETY: the pool is unused.
+                unsafe { self.device.destroy_descriptor_pool(pool, None) };
+                return Err(vk_error("allocating descriptor sets", error));
+            }
+        };
+        let own = |b: &OwnBuffer| (b.buffer, 0, b.size);
+        let engine = |s: AshBufferSlice| (s.buffer, s.offset, s.size);
+        let payloads = buffers.payloads.map_or_else(|| own(&self.unused_payloads), engine);
+        let mut writes: Vec<(vk::DescriptorSet, &Pipeline, Vec<BufferRange>)> = vec![
+            (
+                allocated[0],
+                &self.histogram,
+                vec![
+                    own(&self.histogram_params),
+                    engine(buffers.candidates),
+                    own(&self.sorted_pixels),
+                    own(&self.spans),
+                    own(&self.block_stats),
+                ],
+            ),
+            (
+                allocated[1],
+                &self.select,
+                vec![
+                    own(&self.selection_params),
+                    engine(buffers.candidates),
+                    payloads,
+                    own(&self.sorted_pixels),
+                    own(&self.spans),
+                    own(&self.tables[0]),
+                    own(&self.tables[1]),
+                    own(&self.tables[2]),
+                    engine(buffers.selections),
+                ],
+            ),
+        ];
+        if let Some(resample) = buffers.resample {
+            writes.push((
+                allocated[2],
+                &self.resample,
+                vec![
+                    own(&self.selection_params),
+                    engine(buffers.selections),
+                    engine(resample.inputs),
+                    engine(resample.outputs),
+                ],
+            ));
+        }
+        for (set, pipeline, resources) in &writes {
+            let infos: Vec<[vk::DescriptorBufferInfo; 1]> = resources
+                .iter()
+                .map(|&(buffer, offset, range)| [vk::DescriptorBufferInfo { buffer, offset, range }])
+                .collect();
+            let descriptor_writes: Vec<_> = infos
+                .iter()
+                .enumerate()
+                .map(|(binding, info)| {
+                    vk::WriteDescriptorSet::default()
+                        .dst_set(*set)
+                        .dst_binding(binding as u32)
+                        .descriptor_type(pipeline.bindings[binding])
+                        .buffer_info(info)
+                })
+                .collect();
+            // SAFETY: the sets and buffers are valid; sizes were checked above.
+            unsafe { self.device.update_descriptor_sets(&descriptor_writes, &[]) };
+        }
+        Ok(AshBindings {
+            pool,
+            histogram: allocated[0],
+            select: allocated[1],
+            resample: allocated.get(2).copied(),
+            identity_payload: buffers.payloads.is_none(),
+        })
+    }
+
+    /// Frees the descriptor sets of `bindings`.
+    ///
+    /// # Safety
+    /// No pending command buffer may still use them.
+    pub unsafe fn destroy_bindings(&self, bindings: AshBindings) {
+        // SAFETY: the caller guarantees the sets are no longer in use.
+        unsafe { self.device.destroy_descriptor_pool(bindings.pool, None) };
+    }
+
+    fn barrier(&self, command_buffer: vk::CommandBuffer, src: vk::PipelineStageFlags, src_access: vk::AccessFlags) {
+        let barrier = vk::MemoryBarrier::default().src_access_mask(src_access).dst_access_mask(
+            vk::AccessFlags::SHADER_READ
+                | vk::AccessFlags::SHADER_WRITE
+                | vk::AccessFlags::UNIFORM_READ
+                | vk::AccessFlags::TRANSFER_READ
+                | vk::AccessFlags::TRANSFER_WRITE,
+        );
+        let dst = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER;
+        // SAFETY: the caller of the recording functions guarantees a recording command buffer.
+        unsafe {
+            self.device.cmd_pipeline_barrier(
+                command_buffer,
+                src,
+                dst,
+                vk::DependencyFlags::empty(),
+                &[barrier],
+                &[],
+                &[],
+            )
+        };
+    }
+
+    fn dispatch(
+        &self,
+        command_buffer: vk::CommandBuffer,
+        pipeline: &Pipeline,
+        set: vk::DescriptorSet,
+        groups: [u32; 3],
+    ) {
+        // SAFETY: as for `barrier`; the set matches the pipeline's layout.
+        unsafe {
+            self.device.cmd_bind_pipeline(command_buffer, vk::PipelineBindPoint::COMPUTE, pipeline.pipeline);
+            self.device.cmd_bind_descriptor_sets(
+                command_buffer,
+                vk::PipelineBindPoint::COMPUTE,
+                pipeline.layout,
+                0,
+                &[set],
+                &[],
+            );
+            self.device.cmd_dispatch(command_buffer, groups[0], groups[1], groups[2]);
+        }
+        self.barrier(command_buffer, vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE);
+    }
+
+    /// Records frame `frame`'s uniform updates, histogram and selection.
+    ///
+    /// # Safety
+    /// `command_buffer` must be in the recording state, outside a render pass, on a queue
+    /// with compute support, of the device the pass was made on; `bindings` must come from
+    /// this pass and its buffers must stay alive until the commands complete.
+    pub unsafe fn record_selection(
+        &self,
+        command_buffer: vk::CommandBuffer,
+        bindings: &AshBindings,
+        frame: u32,
+    ) -> Result<(), EmbedError> {
+        let params = self.frame_params(frame, bindings.identity_payload)?;
+        // Earlier work (the engine's candidate writes, an earlier frame's reads of the
+        // uniforms) before the updates and dispatches.
+        let everything = vk::PipelineStageFlags::ALL_COMMANDS;
+        let writes = vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE;
+        self.barrier(command_buffer, everything, writes);
+        // SAFETY: per this function's contract.
+        unsafe {
+            self.device.cmd_update_buffer(
+                command_buffer,
+                self.histogram_params.buffer,
+                0,
+                bytemuck::bytes_of(&params.histogram),
+            );
+            self.device.cmd_update_buffer(
+                command_buffer,
+                self.selection_params.buffer,
+                0,
+                bytemuck::bytes_of(&params.selection),
+            );
+        }
+        self.barrier(command_buffer, vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE);
+        self.dispatch(command_buffer, &self.histogram, bindings.histogram, params.histogram_workgroups);
+        self.dispatch(command_buffer, &self.select, bindings.select, params.pixel_workgroups);
+        Ok(())
+    }
+
+    /// Records the resampling of the engine's `resample_inputs`.
+    ///
+    /// # Safety
+    /// As for [`Self::record_selection`], after it in the same or an earlier submission.
+    pub unsafe fn record_resampling(
+        &self,
+        command_buffer: vk::CommandBuffer,
+        bindings: &AshBindings,
+    ) -> Result<(), EmbedError> {
+        let set = bindings.resample.ok_or(EmbedError::NoResampleBuffers)?;
+        let writes = vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE;
+        self.barrier(command_buffer, vk::PipelineStageFlags::ALL_COMMANDS, writes);
+        self.dispatch(command_buffer, &self.resample, set, [self.width.div_ceil(8), self.height.div_ceil(8), 1]);
+        Ok(())
+    }
+
+    /// Destroys the pipelines and the pass's own buffers.
+    ///
+    /// # Safety
+    /// No pending command buffer may still use the pass.
+    pub unsafe fn destroy(self) {
+        let buffers = [
+            &self.histogram_params,
+            &self.selection_params,
+            &self.sorted_pixels,
+            &self.spans,
+            &self.block_stats,
+            &self.tables[0],
+            &self.tables[1],
+            &self.tables[2],
+            &self.unused_payloads,
+        ];
+        // SAFETY: the caller guarantees nothing uses them any more.
+        unsafe {
+            for buffer in buffers {
+                self.device.destroy_buffer(buffer.buffer, None);
+                self.device.free_memory(buffer.memory, None);
+            }
+            for pipeline in [&self.histogram, &self.select, &self.resample] {
+                destroy_pipeline(&self.device, pipeline);
+            }
+        }
+    }
+}
+
+/// # Safety
+/// The pipeline must be unused.
+unsafe fn destroy_pipeline(device: &ash::Device, pipeline: &Pipeline) {
+    // SAFETY: per the function's contract.
+    unsafe {
+        device.destroy_pipeline(pipeline.pipeline, None);
+        device.destroy_pipeline_layout(pipeline.layout, None);
+        device.destroy_descriptor_set_layout(pipeline.set_layout, None);
+    }
+}
+
+/// Objects made so far by [`AshSelection::new`], destroyed if it fails half-way.
+struct Created<'a> {
+    device: &'a ash::Device,
+    pipelines: Vec<(vk::Pipeline, vk::PipelineLayout, vk::DescriptorSetLayout)>,
+    buffers: Vec<(vk::Buffer, vk::DeviceMemory)>,
+}
+
+impl Created<'_> {
+    fn pipeline(&mut self, module: &WgslModule) -> Result<Pipeline, EmbedError> {
+        let kernel = Registry::shared()?.get(module.id.kernel());
+        let code = spirv(kernel, TranslateOptions::default())?;
+        let bindings: Vec<vk::DescriptorType> = module
+            .bindings
+            .iter()
+            .map(|b| if b.uniform { vk::DescriptorType::UNIFORM_BUFFER } else { vk::DescriptorType::STORAGE_BUFFER })
+            .collect();
+        let layout_bindings: Vec<_> = bindings
+            .iter()
+            .enumerate()
+            .map(|(binding, &ty)| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(binding as u32)
+                    .descriptor_type(ty)
+                    .descriptor_count(1)
+                    .stage_flags(vk::ShaderStageFlags::COMPUTE)
+            })
+            .collect();
+        let device = self.device;
+        let operation = format!("creating the `{}` pipeline", module.entry_point);
+        // SAFETY: valid device; every object is destroyed by `Drop` on failure or by
+        // AshSelection::destroy.
+        unsafe {
+            let set_layout = device
+                .create_descriptor_set_layout(
+                    &vk::DescriptorSetLayoutCreateInfo::default().bindings(&layout_bindings),
+                    None,
+                )
+                .map_err(|e| vk_error(&operation, e))?;
+            let layouts = [set_layout];
+            let layout = match device
+                .create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts), None)
+            {
+                Ok(layout) => layout,
+                Err(e) => {
+                    device.destroy_descriptor_set_layout(set_layout, None);
+                    return Err(vk_error(&operation, e));
+                }
+            };
+            self.pipelines.push((vk::Pipeline::null(), layout, set_layout));
+            let shader = device
+                .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&code.words), None)
+                .map_err(|e| vk_error(&operation, e))?;
+            let entry = std::ffi::CString::new(code.entry_point).expect("entry points have no NUL");
+            let stage = vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::COMPUTE)
+                .module(shader)
+                .name(&entry);
+            let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout);
+            let result = device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None);
+            device.destroy_shader_module(shader, None);
+            let pipeline = result.map_err(|(_, e)| vk_error(&operation, e))?[0];
+            self.pipelines.last_mut().expect("pushed above").0 = pipeline;
+            Ok(Pipeline { pipeline, layout, set_layout, bindings })
+        }
+    }
+
+    fn buffer(
+        &mut self,
+        memory: &vk::PhysicalDeviceMemoryProperties,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        preferred: vk::MemoryPropertyFlags,
+        contents: Option<&[u8]>,
+    ) -> Result<OwnBuffer, EmbedError> {
+        let device = self.device;
+        let info = vk::BufferCreateInfo::default().size(size).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
+        // SAFETY: valid device; objects are recorded for cleanup right after creation.
+        unsafe {
+            let buffer = device.create_buffer(&info, None).map_err(|e| vk_error("creating a buffer", e))?;
+            let requirements = device.get_buffer_memory_requirements(buffer);
+            let candidates = (0..memory.memory_type_count).filter(|&i| requirements.memory_type_bits & (1 << i) != 0);
+            let flags = |i: u32| memory.memory_types[i as usize].property_flags;
+            let required = if contents.is_some() {
+                vk::MemoryPropertyFlags::HOST_VISIBLE | vk::MemoryPropertyFlags::HOST_COHERENT
+            } else {
+                vk::MemoryPropertyFlags::empty()
+            };
+            let chosen = candidates
+                .clone()
+                .find(|&i| flags(i).contains(preferred | required))
+                .or_else(|| candidates.clone().find(|&i| flags(i).contains(required)));
+            let Some(type_index) = chosen else {
+                device.destroy_buffer(buffer, None);
+                return Err(EmbedError::Api {
+                    api: "Vulkan",
+                    operation: "allocating buffer memory".into(),
+                    message: format!("no memory type with {required:?} for a buffer of usage {usage:?}"),
+                });
+            };
+            let allocate =
+                vk::MemoryAllocateInfo::default().allocation_size(requirements.size).memory_type_index(type_index);
+            let memory = match device.allocate_memory(&allocate, None) {
+                Ok(memory) => memory,
+                Err(e) => {
+                    device.destroy_buffer(buffer, None);
+                    return Err(vk_error("allocating buffer memory", e));
+                }
+            };
+            self.buffers.push((buffer, memory));
+            device.bind_buffer_memory(buffer, memory, 0).map_err(|e| vk_error("binding buffer memory", e))?;
+            if let Some(bytes) = contents {
+                let mapped = device
+                    .map_memory(memory, 0, size, vk::MemoryMapFlags::empty())
+                    .map_err(|e| vk_error("mapping buffer memory", e))?;
+                std::ptr::copy_nonoverlapping(bytes.as_ptr(), mapped.cast::<u8>(), bytes.len());
+                device.unmap_memory(memory);
+            }
+            Ok(OwnBuffer { buffer, memory, size })
+        }
+    }
+
+    /// Everything succeeded: ownership passes to the AshSelection.
+    fn keep(mut self) {
+        self.pipelines.clear();
+        self.buffers.clear();
+    }
+}
+
+impl Drop for Created<'_> {
+    fn drop(&mut self) {
+        // SAFETY: these objects were never used by a command buffer.
+        unsafe {
+            for &(pipeline, layout, set_layout) in &self.pipelines {
+                self.device.destroy_pipeline(pipeline, None);
+                self.device.destroy_pipeline_layout(layout, None);
+                self.device.destroy_descriptor_set_layout(set_layout, None);
+            }
+            for &(buffer, memory) in &self.buffers {
+                self.device.destroy_buffer(buffer, None);
+                self.device.free_memory(memory, None);
+            }
+        }
+    }
+}

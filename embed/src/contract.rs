@@ -1,0 +1,119 @@
+//! The buffer contract between an engine and the pass: which buffers exist, their record
+//! layouts (the `#[repr(C)]` twins of the WGSL structs, checked against naga's layout by
+//! a test), who writes each and when.
+//!
+//! | buffer | record (bytes per pixel) | written by | read by |
+//! |---|---|---|---|
+//! | `candidates` | [`Candidate`] (8): luminance key, cluster id | the engine, before [`selection`](crate) | histogram, `strata_select` |
+//! | `payloads` (optional) | `u32` (4): index into the engine's reservoir storage | the engine | `strata_select` |
+//! | `selections` | [`SelectedCandidates`] (32): K payloads, resampling number, run size | `strata_select` | the engine; `strata_resample` |
+//! | `resample_inputs` | [`ResampleInput`] (48): the engine's weights and targets | the engine, after selection | `strata_resample` |
+//! | `resampled` | [`ResampleOutput`] (16): chosen payload, slot, W | `strata_resample` | the engine |
+//!
+//! All buffers are row-major, one record per pixel, pixel index `y * width + x`, at an
+//! offset that is a multiple of the device's storage-buffer offset alignment. Every
+//! buffer needs storage usage; the pass reads `candidates`, `payloads` and
+//! `resample_inputs` only and writes `selections` and `resampled` whole (every pixel).
+//!
+//! Candidate keys: the luminance of the candidate's own one-sample estimate (f/p at its
+//! pixel), ≥ 0. NaN, ±∞ and negative keys mark a candidate invalid: it sorts after the
+//! valid ones of its cluster (its weight should be 0). Cluster id: the object id of the
+//! pixel's primary hit (any u32 below 0xfffffffe), [`OBJECT_ID_ENVIRONMENT`] for a pixel
+//! that sees the environment, [`OBJECT_ID_NONE`] for a pixel without a candidate (it gets
+//! no selection).
+//!
+//! Payloads: without a payloads buffer, a pixel's payload is its pixel index (engines
+//! with one reservoir per pixel). With one, `payloads[p]` is returned for pixel p.
+//!
+//! Resampling weights (engine side): for the canonical sample c of pixel i and each
+//! selected slot j, the engine evaluates its own shift mapping and target function and
+//! writes w = m · p̂_i · W with an MIS weight m whose pair terms depend only on (c, j), a
+//! fixed 1/K normalisation, and W the sample's unbiased contribution weight (strata's own
+//! renderer uses pairwise MIS; see the README's "Why the selection stays unbiased").
+
+pub use strata_kernels::embed_types::{
+    CANONICAL_SLOT, INVALID_SLOT, MAX_SELECTED, NO_PAYLOAD, NO_SLOT, ResampleInput, ResampleOutput, SelectedCandidates,
+    SelectionParams,
+};
+pub use strata_kernels::types::{Candidate, ClusterSpan, OBJECT_ID_ENVIRONMENT, OBJECT_ID_NONE};
+
+/// The engine-visible buffers of the contract.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BufferRole {
+    /// One [`Candidate`] per pixel.
+    Candidates,
+    /// One `u32` payload per pixel (optional).
+    Payloads,
+    /// One [`SelectedCandidates`] per pixel.
+    Selections,
+    /// One [`ResampleInput`] per pixel.
+    ResampleInputs,
+    /// One [`ResampleOutput`] per pixel.
+    Resampled,
+}
+
+impl BufferRole {
+    /// Every role, in pipeline order.
+    pub const ALL: [BufferRole; 5] = [
+        BufferRole::Candidates,
+        BufferRole::Payloads,
+        BufferRole::Selections,
+        BufferRole::ResampleInputs,
+        BufferRole::Resampled,
+    ];
+
+    /// The name used in errors and docs.
+    pub fn name(self) -> &'static str {
+        match self {
+            BufferRole::Candidates => "candidates",
+            BufferRole::Payloads => "payloads",
+            BufferRole::Selections => "selections",
+            BufferRole::ResampleInputs => "resample_inputs",
+            BufferRole::Resampled => "resampled",
+        }
+    }
+
+    /// Bytes per pixel.
+    pub fn bytes_per_pixel(self) -> u64 {
+        (match self {
+            BufferRole::Candidates => size_of::<Candidate>(),
+            BufferRole::Payloads => size_of::<u32>(),
+            BufferRole::Selections => size_of::<SelectedCandidates>(),
+            BufferRole::ResampleInputs => size_of::<ResampleInput>(),
+            BufferRole::Resampled => size_of::<ResampleOutput>(),
+        }) as u64
+    }
+
+    /// Bytes for a `width` × `height` image.
+    pub fn size(self, width: u32, height: u32) -> u64 {
+        self.bytes_per_pixel() * u64::from(width) * u64::from(height)
+    }
+
+    /// The WGSL element type and (kernel, binding) pairs this buffer is bound to.
+    pub fn wgsl_bindings(self) -> (&'static str, &'static [(&'static str, u32)]) {
+        match self {
+            BufferRole::Candidates => ("Candidate", &[("block_histogram", 1), ("strata_select", 1)]),
+            BufferRole::Payloads => ("u32", &[("strata_select", 2)]),
+            BufferRole::Selections => ("SelectedCandidates", &[("strata_select", 8), ("strata_resample", 1)]),
+            BufferRole::ResampleInputs => ("ResampleInput", &[("strata_resample", 2)]),
+            BufferRole::Resampled => ("ResampleOutput", &[("strata_resample", 3)]),
+        }
+    }
+}
+
+/// Checks that a buffer of `size` bytes (from its binding offset) holds `role` for the
+/// image.
+pub(crate) fn check_size(role: BufferRole, size: u64, width: u32, height: u32) -> Result<(), crate::EmbedError> {
+    let needed = role.size(width, height);
+    if size < needed {
+        return Err(crate::EmbedError::BufferTooSmall {
+            buffer: role.name(),
+            size,
+            needed,
+            per_pixel: role.bytes_per_pixel(),
+            width,
+            height,
+        });
+    }
+    Ok(())
+}

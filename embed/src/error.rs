@@ -1,0 +1,93 @@
+//! [`EmbedError`]: everything the pass refuses, reported when the pass is configured or
+//! its buffers are bound, never as a validation panic at dispatch.
+
+use thiserror::Error;
+
+/// Why the pass cannot be configured, bound or recorded.
+#[derive(Debug, Error)]
+pub enum EmbedError {
+    /// A [`crate::SelectionSettings`] field is out of range.
+    #[error("SelectionSettings.{field} = {value}: must be {expected}")]
+    Setting {
+        /// The field.
+        field: &'static str,
+        /// Its value.
+        value: String,
+        /// What it may be.
+        expected: &'static str,
+    },
+    /// Zero or too many pixels.
+    #[error("image size {width}x{height}: {why}")]
+    ImageSize {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+        /// What is wrong.
+        why: String,
+    },
+    /// The device's limit is below what the pass needs.
+    #[error("device limit {limit} is {available}, but the stratified selection needs {needed} ({why})")]
+    DeviceLimit {
+        /// The limit's name as the API spells it.
+        limit: &'static str,
+        /// The device's value.
+        available: u64,
+        /// What the pass needs.
+        needed: u64,
+        /// What needs it.
+        why: String,
+    },
+    /// An engine buffer is smaller than the contract requires.
+    #[error(
+        "buffer `{buffer}` has {size} bytes from its offset, but a {width}x{height} image needs {needed} ({per_pixel} bytes per pixel)"
+    )]
+    BufferTooSmall {
+        /// The buffer's role in the contract.
+        buffer: &'static str,
+        /// Its size.
+        size: u64,
+        /// Bytes needed.
+        needed: u64,
+        /// Record size.
+        per_pixel: u64,
+        /// Image width.
+        width: u32,
+        /// Image height.
+        height: u32,
+    },
+    /// An engine buffer was created without a usage the pass needs.
+    #[error("buffer `{buffer}` lacks the usage {usage} (create it with it)")]
+    BufferUsage {
+        /// The buffer's role in the contract.
+        buffer: &'static str,
+        /// The missing usage.
+        usage: &'static str,
+    },
+    /// An engine buffer's offset is not aligned as the API requires.
+    #[error("buffer `{buffer}` is bound at offset {offset}, which is not a multiple of {alignment}")]
+    BufferOffset {
+        /// The buffer's role.
+        buffer: &'static str,
+        /// Its offset.
+        offset: u64,
+        /// The device's storage-buffer offset alignment.
+        alignment: u64,
+    },
+    /// Resampling was recorded with bindings that have no resampling buffers.
+    #[error("the bindings were made without resampling buffers (ResampleBuffers), so resampling cannot be recorded")]
+    NoResampleBuffers,
+    /// A kernel failed to load (a bug of this crate; the message names the kernel).
+    #[error(transparent)]
+    Kernel(#[from] strata_kernels::KernelError),
+    /// The graphics API failed.
+    #[error("{api} error during {operation}: {message}")]
+    Api {
+        /// `wgpu` or `Vulkan`.
+        api: &'static str,
+        /// What was being done.
+        operation: String,
+        /// The API's message.
+        message: String,
+    },
+}

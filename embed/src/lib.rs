@@ -1,0 +1,44 @@
+//! # strata-embed: the paper's stratified selection in your engine
+//!
+//! Histogram stratification (Salaün et al., SIGGRAPH 2025) replaces ReSTIR's uniform
+//! random choice of spatial candidates by a stratified one: per B × B block, candidates
+//! are clustered by object and sorted by luminance (a histogram), and each pixel takes K
+//! candidates of its own cluster at antithetic, temporally blue-noise positions of that
+//! sorted run; resampling then picks one by inverse CDF. The method is independent of
+//! how candidates are made or shaded (§4.2), so this crate gives an engine that already
+//! runs ReSTIR just that pass, over its own buffers:
+//!
+//! * [`WgpuSelection`] (feature `wgpu`) records into the engine's `wgpu` command encoder;
+//! * [`AshSelection`] (feature `ash`) records into the engine's Vulkan command buffer;
+//! * [`wgsl::module`] hands out the same kernels as WGSL source with their bind-group
+//!   layouts, for engines that compose shaders themselves.
+//!
+//! The engine writes, per pixel, a [`contract::Candidate`] (luminance key and cluster
+//! id) and optionally a payload index into its own reservoir storage; it gets back K
+//! payload indices per pixel ([`contract::SelectedCandidates`]) and keeps its own shift
+//! mapping, target function and shading. If it writes its resampling weights
+//! ([`contract::ResampleInput`]), the pass also makes the stratified inverse-CDF choice
+//! and the unbiased contribution weight ([`contract::ResampleOutput`]). The layouts, who
+//! writes what and when: [`contract`]. The knobs: [`SelectionSettings`].
+//!
+//! Examples that run: `cargo run -p strata-embed --example wgpu_embed` and
+//! `--example ash_embed`.
+
+pub mod contract;
+mod error;
+pub mod frame;
+mod limits;
+mod settings;
+pub mod wgsl;
+
+#[cfg(feature = "ash")]
+mod ash_selection;
+#[cfg(feature = "wgpu")]
+mod wgpu_selection;
+
+#[cfg(feature = "ash")]
+pub use ash_selection::{AshBindings, AshBufferSlice, AshBuffers, AshDevice, AshResampleBuffers, AshSelection};
+pub use error::EmbedError;
+pub use settings::{SamplerVariant, SelectionSettings};
+#[cfg(feature = "wgpu")]
+pub use wgpu_selection::{WgpuBindings, WgpuBufferSlice, WgpuBuffers, WgpuResampleBuffers, WgpuSelection};

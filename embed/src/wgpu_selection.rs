@@ -1,0 +1,374 @@
+//! [`WgpuSelection`]: the pass on an engine's own `wgpu::Device`, recording into the
+//! engine's command encoder with the engine's buffers.
+
+use crate::contract::{BufferRole, check_size};
+use crate::error::EmbedError;
+use crate::frame::{FrameParams, frame_params, max_blocks};
+use crate::limits::{DeviceLimits, WGPU_NAMES, check_limits};
+use crate::settings::SelectionSettings;
+use crate::wgsl::{ModuleId, WgslModule, module};
+use std::num::NonZeroU64;
+use strata_kernels::blue_noise::BlueNoiseTables;
+use strata_kernels::embed_types::SelectionParams;
+use strata_kernels::types::HistogramParams;
+use wgpu::util::DeviceExt;
+
+/// An engine buffer bound to the pass: the buffer and the byte offset where its records
+/// start (a multiple of the device's `min_storage_buffer_offset_alignment`).
+#[derive(Clone, Copy, Debug)]
+pub struct WgpuBufferSlice<'a> {
+    /// The buffer (created with `BufferUsages::STORAGE`).
+    pub buffer: &'a wgpu::Buffer,
+    /// Byte offset of the first record.
+    pub offset: u64,
+}
+
+impl<'a> From<&'a wgpu::Buffer> for WgpuBufferSlice<'a> {
+    fn from(buffer: &'a wgpu::Buffer) -> Self {
+        Self { buffer, offset: 0 }
+    }
+}
+
+/// The engine's buffers for [`WgpuSelection::bind`] (see [`crate::contract`]).
+#[derive(Clone, Copy, Debug)]
+pub struct WgpuBuffers<'a> {
+    /// One `Candidate` per pixel, written by the engine before the selection.
+    pub candidates: WgpuBufferSlice<'a>,
+    /// One payload per pixel; `None`: a pixel's payload is its index.
+    pub payloads: Option<WgpuBufferSlice<'a>>,
+    /// One `SelectedCandidates` per pixel, written by the pass.
+    pub selections: WgpuBufferSlice<'a>,
+    /// The resampling buffers, if the engine resamples with the pass.
+    pub resample: Option<WgpuResampleBuffers<'a>>,
+}
+
+/// The engine's buffers of the resampling pass.
+#[derive(Clone, Copy, Debug)]
+pub struct WgpuResampleBuffers<'a> {
+    /// One `ResampleInput` per pixel, written by the engine after the selection.
+    pub inputs: WgpuBufferSlice<'a>,
+    /// One `ResampleOutput` per pixel, written by the pass.
+    pub outputs: WgpuBufferSlice<'a>,
+}
+
+/// Bind groups of one set of engine buffers, made by [`WgpuSelection::bind`].
+#[derive(Debug)]
+pub struct WgpuBindings {
+    histogram: wgpu::BindGroup,
+    select: wgpu::BindGroup,
+    resample: Option<wgpu::BindGroup>,
+    identity_payload: bool,
+}
+
+struct Pipeline {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+/// The stratified selection on an engine's wgpu device: the histogram pass, the
+/// selection and (optionally) the resampling, for one image size and settings.
+///
+/// Per frame: the engine writes its candidates, calls [`Self::encode_selection`] (which
+/// writes the frame's uniforms with `queue.write_buffer`, so encode at most one frame per
+/// queue submission), reads `selections` in its own shaders, writes `resample_inputs`,
+/// and calls [`Self::encode_resampling`] if it resamples with the pass.
+pub struct WgpuSelection {
+    settings: SelectionSettings,
+    width: u32,
+    height: u32,
+    max_workgroups: u32,
+    offset_alignment: u64,
+    histogram: Pipeline,
+    select: Pipeline,
+    resample: Pipeline,
+    histogram_params: wgpu::Buffer,
+    selection_params: wgpu::Buffer,
+    sorted_pixels: wgpu::Buffer,
+    spans: wgpu::Buffer,
+    block_stats: wgpu::Buffer,
+    tables: [wgpu::Buffer; 3],
+    unused_payloads: wgpu::Buffer,
+}
+
+fn api_error(operation: &str, error: wgpu::Error) -> EmbedError {
+    EmbedError::Api { api: "wgpu", operation: operation.into(), message: error.to_string() }
+}
+
+/// Runs `f` in a validation and an out-of-memory error scope.
+fn scoped<T>(device: &wgpu::Device, operation: &str, f: impl FnOnce() -> T) -> Result<T, EmbedError> {
+    let memory = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+    let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let value = f();
+    let validation = pollster::block_on(validation.pop());
+    let memory = pollster::block_on(memory.pop());
+    match validation.or(memory) {
+        Some(error) => Err(api_error(operation, error)),
+        None => Ok(value),
+    }
+}
+
+/// A pipeline with an explicit bind-group layout from the module's bindings.
+fn pipeline(device: &wgpu::Device, module: &WgslModule) -> Pipeline {
+    let entries: Vec<_> = module
+        .bindings
+        .iter()
+        .map(|binding| wgpu::BindGroupLayoutEntry {
+            binding: binding.binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: if binding.uniform {
+                    wgpu::BufferBindingType::Uniform
+                } else {
+                    wgpu::BufferBindingType::Storage { read_only: !binding.writable }
+                },
+                has_dynamic_offset: false,
+                min_binding_size: NonZeroU64::new(binding.min_size),
+            },
+            count: None,
+        })
+        .collect();
+    let label = Some(module.entry_point.as_str());
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label, entries: &entries });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label,
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label,
+        source: wgpu::ShaderSource::Wgsl(module.source.as_str().into()),
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label,
+        layout: Some(&pipeline_layout),
+        module: &shader,
+        entry_point: Some(&module.entry_point),
+        compilation_options: wgpu::PipelineCompilationOptions::default(),
+        cache: None,
+    });
+    Pipeline { pipeline, layout }
+}
+
+fn check_usage(role: BufferRole, slice: WgpuBufferSlice, alignment: u64) -> Result<(), EmbedError> {
+    if !slice.buffer.usage().contains(wgpu::BufferUsages::STORAGE) {
+        return Err(EmbedError::BufferUsage { buffer: role.name(), usage: "BufferUsages::STORAGE" });
+    }
+    if !slice.offset.is_multiple_of(alignment) {
+        return Err(EmbedError::BufferOffset { buffer: role.name(), offset: slice.offset, alignment });
+    }
+    Ok(())
+}
+
+impl WgpuSelection {
+    /// Builds the pipelines and the pass's own buffers (sorted lists, cluster spans, block
+    /// counters, the blue-noise tables: about 1.3 MiB + 16 bytes per pixel) for a
+    /// `width` × `height` image. Fails, naming the setting or the device limit, when the
+    /// settings are out of range or the device cannot run the pass at this size. Uses
+    /// the subgroup histogram when the device was created with `Features::SUBGROUP`.
+    pub fn new(
+        device: &wgpu::Device,
+        settings: SelectionSettings,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, EmbedError> {
+        settings.validate()?;
+        crate::frame::grid(&settings, width, height)?;
+        let histogram_module = if device.features().contains(wgpu::Features::SUBGROUP) {
+            ModuleId::HistogramSubgroup
+        } else {
+            ModuleId::Histogram
+        };
+        let limits = device.limits();
+        let blocks = max_blocks(&settings, width, height);
+        check_limits(DeviceLimits::wgpu(&limits), &WGPU_NAMES, histogram_module, width, height, blocks)?;
+        let (histogram_module, select_module, resample_module) =
+            (module(histogram_module)?, module(ModuleId::Select)?, module(ModuleId::Resample)?);
+        let pixels = u64::from(width) * u64::from(height);
+        let tables = BlueNoiseTables::new();
+        scoped(device, "creating the stratified selection's pipelines and buffers", || {
+            let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size,
+                    usage,
+                    mapped_at_creation: false,
+                })
+            };
+            let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
+            let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+            let table = |label: &str, words: &[u32]| {
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents: bytemuck::cast_slice(words),
+                    usage: wgpu::BufferUsages::STORAGE,
+                })
+            };
+            Self {
+                settings,
+                width,
+                height,
+                max_workgroups: limits.max_compute_workgroups_per_dimension,
+                offset_alignment: limits.min_storage_buffer_offset_alignment.into(),
+                histogram: pipeline(device, &histogram_module),
+                select: pipeline(device, &select_module),
+                resample: pipeline(device, &resample_module),
+                histogram_params: buffer("strata histogram params", size_of::<HistogramParams>() as u64, uniform),
+                selection_params: buffer("strata selection params", size_of::<SelectionParams>() as u64, uniform),
+                sorted_pixels: buffer("strata sorted pixels", pixels * 4, storage),
+                spans: buffer("strata cluster spans", pixels * 12, storage),
+                block_stats: buffer("strata block stats", blocks * 12, storage),
+                tables: [
+                    table("blue_noise_sobol", &tables.sobol),
+                    table("blue_noise_scrambling", &tables.scrambling),
+                    table("blue_noise_ranking", &tables.ranking),
+                ],
+                unused_payloads: buffer("strata unused payloads", 4, wgpu::BufferUsages::STORAGE),
+            }
+        })
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &SelectionSettings {
+        &self.settings
+    }
+
+    /// The image size.
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// The histogram's outputs, for engines that read the sorted runs themselves:
+    /// `sorted_pixels` (per block, pixel indices in cluster-then-key order) and `spans`
+    /// (one `ClusterSpan` per pixel), valid after [`Self::encode_selection`].
+    pub fn histogram_buffers(&self) -> (&wgpu::Buffer, &wgpu::Buffer) {
+        (&self.sorted_pixels, &self.spans)
+    }
+
+    /// The parameters frame `frame` runs with.
+    pub fn frame_params(&self, frame: u32, identity_payload: bool) -> Result<FrameParams, EmbedError> {
+        frame_params(&self.settings, self.width, self.height, frame, identity_payload, self.max_workgroups)
+    }
+
+    /// Checks the engine's buffers against the contract and makes their bind groups.
+    pub fn bind(&self, device: &wgpu::Device, buffers: &WgpuBuffers) -> Result<WgpuBindings, EmbedError> {
+        let (w, h) = (self.width, self.height);
+        let mut checked =
+            vec![(BufferRole::Candidates, buffers.candidates), (BufferRole::Selections, buffers.selections)];
+        if let Some(payloads) = buffers.payloads {
+            checked.push((BufferRole::Payloads, payloads));
+        }
+        if let Some(resample) = buffers.resample {
+            checked.extend([(BufferRole::ResampleInputs, resample.inputs), (BufferRole::Resampled, resample.outputs)]);
+        }
+        for &(role, slice) in &checked {
+            check_usage(role, slice, self.offset_alignment)?;
+            check_size(role, slice.buffer.size().saturating_sub(slice.offset), w, h)?;
+        }
+        fn engine(slice: WgpuBufferSlice<'_>) -> wgpu::BindingResource<'_> {
+            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: slice.buffer,
+                offset: slice.offset,
+                size: None,
+            })
+        }
+        fn whole(buffer: &wgpu::Buffer) -> wgpu::BindingResource<'_> {
+            buffer.as_entire_binding()
+        }
+        let group = |pipeline: &Pipeline, resources: Vec<wgpu::BindingResource>| {
+            let entries: Vec<_> = resources
+                .into_iter()
+                .enumerate()
+                .map(|(binding, resource)| wgpu::BindGroupEntry { binding: binding as u32, resource })
+                .collect();
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("strata selection"),
+                layout: &pipeline.layout,
+                entries: &entries,
+            })
+        };
+        let payloads = buffers.payloads.map_or_else(|| whole(&self.unused_payloads), engine);
+        scoped(device, "binding the engine's buffers", || WgpuBindings {
+            histogram: group(
+                &self.histogram,
+                vec![
+                    whole(&self.histogram_params),
+                    engine(buffers.candidates),
+                    whole(&self.sorted_pixels),
+                    whole(&self.spans),
+                    whole(&self.block_stats),
+                ],
+            ),
+            select: group(
+                &self.select,
+                vec![
+                    whole(&self.selection_params),
+                    engine(buffers.candidates),
+                    payloads,
+                    whole(&self.sorted_pixels),
+                    whole(&self.spans),
+                    whole(&self.tables[0]),
+                    whole(&self.tables[1]),
+                    whole(&self.tables[2]),
+                    engine(buffers.selections),
+                ],
+            ),
+            resample: buffers.resample.map(|resample| {
+                group(
+                    &self.resample,
+                    vec![
+                        whole(&self.selection_params),
+                        engine(buffers.selections),
+                        engine(resample.inputs),
+                        engine(resample.outputs),
+                    ],
+                )
+            }),
+            identity_payload: buffers.payloads.is_none(),
+        })
+    }
+
+    /// Records frame `frame`'s histogram and selection into `encoder` (two compute
+    /// passes) after writing the frame's uniforms through `queue`.
+    pub fn encode_selection(
+        &self,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        bindings: &WgpuBindings,
+        frame: u32,
+    ) -> Result<(), EmbedError> {
+        let params = self.frame_params(frame, bindings.identity_payload)?;
+        queue.write_buffer(&self.histogram_params, 0, bytemuck::bytes_of(&params.histogram));
+        queue.write_buffer(&self.selection_params, 0, bytemuck::bytes_of(&params.selection));
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("strata histogram + selection"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.histogram.pipeline);
+        pass.set_bind_group(0, &bindings.histogram, &[]);
+        let [x, y, z] = params.histogram_workgroups;
+        pass.dispatch_workgroups(x, y, z);
+        pass.set_pipeline(&self.select.pipeline);
+        pass.set_bind_group(0, &bindings.select, &[]);
+        let [x, y, z] = params.pixel_workgroups;
+        pass.dispatch_workgroups(x, y, z);
+        Ok(())
+    }
+
+    /// Records the resampling of the engine's `resample_inputs` (written after the
+    /// selection of the same frame) into `encoder`.
+    pub fn encode_resampling(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        bindings: &WgpuBindings,
+    ) -> Result<(), EmbedError> {
+        let group = bindings.resample.as_ref().ok_or(EmbedError::NoResampleBuffers)?;
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("strata resampling"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.resample.pipeline);
+        pass.set_bind_group(0, group, &[]);
+        pass.dispatch_workgroups(self.width.div_ceil(8), self.height.div_ceil(8), 1);
+        Ok(())
+    }
+}

@@ -206,6 +206,12 @@ impl AshSelection {
         &self.settings
     }
 
+    /// Starts an independent render: a new seed for the frames recorded from now on
+    /// (for example per run of an unbiasedness test); costs nothing.
+    pub fn set_seed(&mut self, seed: u32) {
+        self.settings.seed = seed;
+    }
+
     /// The parameters frame `frame` runs with.
     pub fn frame_params(&self, frame: u32, identity_payload: bool) -> Result<FrameParams, EmbedError> {
         frame_params(&self.settings, self.width, self.height, frame, identity_payload, self.max_workgroups)

@@ -117,3 +117,46 @@ pub(crate) fn check_size(role: BufferRole, size: u64, width: u32, height: u32) -
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::wgsl::{ModuleId, module};
+
+    /// Every engine buffer of the contract is bound where the docs say, with the WGSL
+    /// element type and stride of its host record (layouts: strata_kernels' layout test).
+    #[test]
+    fn contract_matches_the_kernels_bindings() {
+        for role in BufferRole::ALL {
+            let (element, places) = role.wgsl_bindings();
+            for &(entry, binding) in places {
+                let id = match entry {
+                    "block_histogram" => ModuleId::Histogram,
+                    "strata_select" => ModuleId::Select,
+                    _ => ModuleId::Resample,
+                };
+                let module = module(id).unwrap();
+                assert_eq!(module.entry_point, entry);
+                let bound = module.bindings.iter().find(|b| b.binding == binding).unwrap();
+                assert_eq!(bound.element, element, "{role:?} in {entry}");
+                assert_eq!(u64::from(bound.stride), role.bytes_per_pixel(), "{role:?} in {entry}");
+                let writes =
+                    matches!(role, BufferRole::Selections | BufferRole::Resampled) && entry != "strata_resample";
+                let writes = writes || (role == BufferRole::Resampled);
+                assert_eq!(bound.writable, writes, "{role:?} in {entry}: written by the pass?");
+            }
+        }
+    }
+
+    /// Block shifting moves the grid by a different offset in 0..B most frames.
+    #[test]
+    fn block_shift_varies_per_frame() {
+        let settings = crate::SelectionSettings { block_shift: true, ..Default::default() };
+        let shifts: Vec<_> = (0..64).map(|frame| crate::frame::grid_shift(&settings, frame)).collect();
+        assert!(shifts.iter().all(|&(x, y)| x < 16 && y < 16));
+        let distinct: std::collections::HashSet<_> = shifts.iter().collect();
+        assert!(distinct.len() > 40, "{} distinct shifts", distinct.len());
+        let off = crate::SelectionSettings::default();
+        assert!((0..64).all(|frame| crate::frame::grid_shift(&off, frame) == (0, 0)));
+    }
+}

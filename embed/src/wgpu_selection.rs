@@ -232,6 +232,12 @@ impl WgpuSelection {
         &self.settings
     }
 
+    /// Starts an independent render: a new seed for the frames recorded from now on
+    /// (for example per run of an unbiasedness test); costs nothing.
+    pub fn set_seed(&mut self, seed: u32) {
+        self.settings.seed = seed;
+    }
+
     /// The image size.
     pub fn size(&self) -> (u32, u32) {
         (self.width, self.height)

@@ -73,3 +73,154 @@ pub fn read_wgpu_buffer<T: bytemuck::Pod>(device: &wgpu::Device, queue: &wgpu::Q
     let view = staging.slice(..).get_mapped_range().expect("mapped");
     bytemuck::cast_slice(&view).to_vec()
 }
+
+/// A raw Vulkan device made through ash, as an embedding engine would own one: the
+/// first physical device with a compute queue, that queue, a command pool. `None` (with
+/// a note) without a Vulkan loader or device; a failure under `STRATA_REQUIRE_GPU=1`.
+pub struct AshEngine {
+    _entry: ash::Entry,
+    /// The instance.
+    pub instance: ash::Instance,
+    /// The physical device.
+    pub physical_device: ash::vk::PhysicalDevice,
+    /// The device.
+    pub device: ash::Device,
+    /// Its compute queue.
+    pub queue: ash::vk::Queue,
+    /// A pool for one-shot command buffers.
+    pub command_pool: ash::vk::CommandPool,
+}
+
+impl AshEngine {
+    /// Opens the device, or `None` (see the type's docs).
+    pub fn open(test: &str) -> Option<Self> {
+        use ash::vk;
+        let fail = |why: String| -> Option<Self> {
+            if gpu_required() {
+                panic!("{test}: {why} ({GPU_REQUIRED_VARIABLE} is set)");
+            }
+            eprintln!("SKIPPED {test}: {why} (set {GPU_REQUIRED_VARIABLE}=1 to make this a failure)");
+            None
+        };
+        // SAFETY: loading the system's Vulkan loader, then plain object creation with
+        // valid create infos; every object is destroyed in Drop.
+        unsafe {
+            let entry = match ash::Entry::load() {
+                Ok(entry) => entry,
+                Err(error) => return fail(format!("no Vulkan loader: {error}")),
+            };
+            let app = vk::ApplicationInfo::default().api_version(vk::API_VERSION_1_2);
+            let instance = match entry.create_instance(&vk::InstanceCreateInfo::default().application_info(&app), None)
+            {
+                Ok(instance) => instance,
+                Err(error) => return fail(format!("vkCreateInstance: {error:?}")),
+            };
+            let found = instance.enumerate_physical_devices().unwrap_or_default().into_iter().find_map(|pd| {
+                instance
+                    .get_physical_device_queue_family_properties(pd)
+                    .iter()
+                    .position(|f| f.queue_flags.contains(vk::QueueFlags::COMPUTE))
+                    .map(|family| (pd, family as u32))
+            });
+            let Some((physical_device, family)) = found else {
+                instance.destroy_instance(None);
+                return fail("no Vulkan device with a compute queue".into());
+            };
+            let priorities = [1.0];
+            let queues =
+                [vk::DeviceQueueCreateInfo::default().queue_family_index(family).queue_priorities(&priorities)];
+            let device = instance
+                .create_device(physical_device, &vk::DeviceCreateInfo::default().queue_create_infos(&queues), None)
+                .unwrap_or_else(|e| panic!("{test}: vkCreateDevice: {e:?}"));
+            let queue = device.get_device_queue(family, 0);
+            let command_pool = device
+                .create_command_pool(&vk::CommandPoolCreateInfo::default().queue_family_index(family), None)
+                .unwrap_or_else(|e| panic!("{test}: vkCreateCommandPool: {e:?}"));
+            Some(Self { _entry: entry, instance, physical_device, device, queue, command_pool })
+        }
+    }
+
+    /// A host-visible, coherent storage buffer filled with `contents` (zeros past it).
+    pub fn buffer(&self, size: u64, contents: &[u8]) -> (ash::vk::Buffer, ash::vk::DeviceMemory) {
+        use ash::vk;
+        // SAFETY: valid device; the caller frees the buffer with `free`.
+        unsafe {
+            let info = vk::BufferCreateInfo::default().size(size).usage(vk::BufferUsageFlags::STORAGE_BUFFER);
+            let buffer = self.device.create_buffer(&info, None).expect("buffer");
+            let requirements = self.device.get_buffer_memory_requirements(buffer);
+            let memory = self.instance.get_physical_device_memory_properties(self.physical_device);
+            let wanted = vk::MemoryPropertyFlags::HOST_VISIBLE | vk::MemoryPropertyFlags::HOST_COHERENT;
+            let index = (0..memory.memory_type_count)
+                .find(|&i| {
+                    requirements.memory_type_bits & (1 << i) != 0
+                        && memory.memory_types[i as usize].property_flags.contains(wanted)
+                })
+                .expect("host-visible memory");
+            let allocate =
+                vk::MemoryAllocateInfo::default().allocation_size(requirements.size).memory_type_index(index);
+            let memory = self.device.allocate_memory(&allocate, None).expect("memory");
+            self.device.bind_buffer_memory(buffer, memory, 0).expect("bind");
+            let mapped =
+                self.device.map_memory(memory, 0, size, vk::MemoryMapFlags::empty()).expect("map").cast::<u8>();
+            std::ptr::write_bytes(mapped, 0, size as usize);
+            std::ptr::copy_nonoverlapping(contents.as_ptr(), mapped, contents.len().min(size as usize));
+            self.device.unmap_memory(memory);
+            (buffer, memory)
+        }
+    }
+
+    /// Reads a buffer made by [`Self::buffer`].
+    pub fn read<T: bytemuck::Pod>(&self, memory: ash::vk::DeviceMemory, size: u64) -> Vec<T> {
+        // SAFETY: host-visible memory of at least `size` bytes; the queue is idle.
+        unsafe {
+            let mapped =
+                self.device.map_memory(memory, 0, size, ash::vk::MemoryMapFlags::empty()).expect("map").cast::<u8>();
+            let data = bytemuck::cast_slice(std::slice::from_raw_parts(mapped, size as usize)).to_vec();
+            self.device.unmap_memory(memory);
+            data
+        }
+    }
+
+    /// Frees a buffer made by [`Self::buffer`].
+    pub fn free(&self, (buffer, memory): (ash::vk::Buffer, ash::vk::DeviceMemory)) {
+        // SAFETY: the queue is idle.
+        unsafe {
+            self.device.destroy_buffer(buffer, None);
+            self.device.free_memory(memory, None);
+        }
+    }
+
+    /// Records with `record`, submits, waits.
+    pub fn submit(&self, record: impl FnOnce(ash::vk::CommandBuffer)) {
+        use ash::vk;
+        // SAFETY: valid pool and queue; waited for before freeing.
+        unsafe {
+            let info = vk::CommandBufferAllocateInfo::default()
+                .command_pool(self.command_pool)
+                .level(vk::CommandBufferLevel::PRIMARY)
+                .command_buffer_count(1);
+            let command_buffer = self.device.allocate_command_buffers(&info).expect("command buffer")[0];
+            self.device.begin_command_buffer(command_buffer, &vk::CommandBufferBeginInfo::default()).expect("begin");
+            record(command_buffer);
+            self.device.end_command_buffer(command_buffer).expect("end");
+            let buffers = [command_buffer];
+            self.device
+                .queue_submit(self.queue, &[vk::SubmitInfo::default().command_buffers(&buffers)], vk::Fence::null())
+                .expect("submit");
+            self.device.queue_wait_idle(self.queue).expect("wait");
+            self.device.free_command_buffers(self.command_pool, &buffers);
+        }
+    }
+}
+
+impl Drop for AshEngine {
+    fn drop(&mut self) {
+        // SAFETY: children are destroyed by their owners first; the device is idle.
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            self.device.destroy_command_pool(self.command_pool, None);
+            self.device.destroy_device(None);
+            self.instance.destroy_instance(None);
+        }
+    }
+}

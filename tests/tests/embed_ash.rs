@@ -1,0 +1,144 @@
+//! The embedding API's ash flavour on a raw Vulkan device: the same selections and
+//! resampling as the wgpu flavour for the same frames (block shifting on, engine
+//! payloads), and bind-time errors naming the buffer.
+
+use strata_embed::contract::{Candidate, ResampleInput, ResampleOutput, SelectedCandidates};
+use strata_embed::{
+    AshBufferSlice, AshBuffers, AshDevice, AshResampleBuffers, AshSelection, SelectionSettings, WgpuBuffers,
+    WgpuResampleBuffers, WgpuSelection,
+};
+use strata_tests::{AshEngine, engine_device, read_wgpu_buffer};
+use wgpu::util::DeviceExt;
+
+const WIDTH: u32 = 50;
+const HEIGHT: u32 = 27;
+
+fn inputs() -> (Vec<Candidate>, Vec<u32>, Vec<ResampleInput>) {
+    let pixels = WIDTH * HEIGHT;
+    let candidates = (0..pixels)
+        .map(|p| Candidate { key: ((p * 7919) % 101) as f32 * 0.1, object_id: (p % WIDTH) / 17 + 3 * (p / WIDTH / 9) })
+        .collect();
+    let payloads = (0..pixels).map(|p| p ^ 0x55).collect();
+    let resample = (0..pixels)
+        .map(|p| ResampleInput {
+            weights: [1.0, 0.5 * (p % 3) as f32, 2.0, 0.0],
+            targets: [1.0, 2.0, 3.0, 4.0],
+            canonical_weight: 0.25,
+            canonical_target: 0.5,
+            canonical_payload: p,
+            _pad: 0,
+        })
+        .collect();
+    (candidates, payloads, resample)
+}
+
+fn settings() -> SelectionSettings {
+    SelectionSettings { block_size: 8, candidates: 3, block_shift: true, seed: 9, ..Default::default() }
+}
+
+/// Frames 0-3 on the wgpu flavour.
+fn wgpu_frames() -> Option<Vec<(Vec<SelectedCandidates>, Vec<ResampleOutput>)>> {
+    let (device, queue) = engine_device("ash_flavour_matches_wgpu_flavour", None)?;
+    let (candidates, payloads, resample) = inputs();
+    let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+    let init =
+        |contents: &[u8]| device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents, usage });
+    let pixels = (WIDTH * HEIGHT) as usize;
+    let candidates = init(bytemuck::cast_slice(&candidates));
+    let payloads = init(bytemuck::cast_slice(&payloads));
+    let selections = init(&vec![0; pixels * size_of::<SelectedCandidates>()]);
+    let weights = init(bytemuck::cast_slice(&resample));
+    let outputs = init(&vec![0; pixels * size_of::<ResampleOutput>()]);
+    let pass = WgpuSelection::new(&device, settings(), WIDTH, HEIGHT).unwrap();
+    let bindings = pass
+        .bind(
+            &device,
+            &WgpuBuffers {
+                candidates: (&candidates).into(),
+                payloads: Some((&payloads).into()),
+                selections: (&selections).into(),
+                resample: Some(WgpuResampleBuffers { inputs: (&weights).into(), outputs: (&outputs).into() }),
+            },
+        )
+        .unwrap();
+    Some(
+        (0..4)
+            .map(|frame| {
+                let mut encoder = device.create_command_encoder(&Default::default());
+                pass.encode_selection(&queue, &mut encoder, &bindings, frame).unwrap();
+                pass.encode_resampling(&mut encoder, &bindings).unwrap();
+                queue.submit([encoder.finish()]);
+                (read_wgpu_buffer(&device, &queue, &selections), read_wgpu_buffer(&device, &queue, &outputs))
+            })
+            .collect(),
+    )
+}
+
+#[test]
+fn ash_flavour_matches_wgpu_flavour() {
+    let Some(engine) = AshEngine::open("ash_flavour_matches_wgpu_flavour") else {
+        return;
+    };
+    let Some(want) = wgpu_frames() else {
+        return;
+    };
+    let (candidates, payloads, resample) = inputs();
+    let pixels = u64::from(WIDTH * HEIGHT);
+    let sizes = [8 * pixels, 4 * pixels, 32 * pixels, 48 * pixels, 16 * pixels];
+    let buffers = [
+        engine.buffer(sizes[0], bytemuck::cast_slice(&candidates)),
+        engine.buffer(sizes[1], bytemuck::cast_slice(&payloads)),
+        engine.buffer(sizes[2], &[]),
+        engine.buffer(sizes[3], bytemuck::cast_slice(&resample)),
+        engine.buffer(sizes[4], &[]),
+    ];
+    let slice = |i: usize| AshBufferSlice { buffer: buffers[i].0, offset: 0, size: sizes[i] };
+    let vulkan =
+        AshDevice { instance: &engine.instance, physical_device: engine.physical_device, device: &engine.device };
+    let pass = AshSelection::new(vulkan, settings(), WIDTH, HEIGHT).unwrap();
+    let good = AshBuffers {
+        candidates: slice(0),
+        payloads: Some(slice(1)),
+        selections: slice(2),
+        resample: Some(AshResampleBuffers { inputs: slice(3), outputs: slice(4) }),
+    };
+    // Bind-time errors name the buffer.
+    let mut bad = good;
+    bad.selections.size -= 1;
+    let error = pass.bind(&bad).unwrap_err().to_string();
+    assert!(error.contains("`selections`") && error.contains("50x27"), "{error}");
+    let mut bad = good;
+    bad.candidates.offset = 3;
+    let error = pass.bind(&bad).unwrap_err().to_string();
+    assert!(error.contains("`candidates`") && error.contains("offset 3"), "{error}");
+    let error = AshSelection::new(vulkan, SelectionSettings { block_size: 3, ..settings() }, WIDTH, HEIGHT)
+        .err()
+        .expect("block size 3 refused")
+        .to_string();
+    assert!(error.contains("block_size = 3"), "{error}");
+
+    let bindings = pass.bind(&good).unwrap();
+    for (frame, (want_selections, want_outputs)) in want.iter().enumerate() {
+        // SAFETY: the command buffer is recording; buffers outlive the wait in submit.
+        engine.submit(|cb| unsafe {
+            pass.record_selection(cb, &bindings, frame as u32).unwrap();
+            pass.record_resampling(cb, &bindings).unwrap();
+        });
+        let selections: Vec<SelectedCandidates> = engine.read(buffers[2].1, sizes[2]);
+        let outputs: Vec<ResampleOutput> = engine.read(buffers[4].1, sizes[4]);
+        assert_eq!(
+            bytemuck::cast_slice::<_, u32>(&selections),
+            bytemuck::cast_slice::<_, u32>(want_selections),
+            "frame {frame}: selections"
+        );
+        assert_eq!(&outputs, want_outputs, "frame {frame}: resampling");
+    }
+    // SAFETY: every submission was waited for.
+    unsafe {
+        pass.destroy_bindings(bindings);
+        pass.destroy();
+    }
+    for buffer in buffers {
+        engine.free(buffer);
+    }
+}

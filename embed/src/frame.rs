@@ -4,7 +4,6 @@
 use crate::error::EmbedError;
 use crate::settings::SelectionSettings;
 use strata_kernels::embed_types::{SelectionParams, sampler_id};
-use strata_kernels::reference::stratified_selection::selection_hash;
 use strata_kernels::types::{HISTOGRAM_SLOTS_PER_WORKGROUP, HistogramParams};
 use strata_kernels::{BlockGrid, GridError};
 
@@ -39,15 +38,16 @@ pub fn grid_shift(settings: &SelectionSettings, frame: u32) -> (u32, u32) {
     if !settings.block_shift {
         return (0, 0);
     }
-    let h = selection_hash(frame ^ selection_hash(settings.seed ^ 0xb10c));
-    (h % settings.block_size, (h >> 16) % settings.block_size)
+    strata_kernels::block_grid::frame_shift(settings.block_size, frame, settings.seed)
 }
 
 /// Most blocks any frame's grid has (a shifted grid has up to one more row and column).
 pub(crate) fn max_blocks(settings: &SelectionSettings, width: u32, height: u32) -> u64 {
-    let b = settings.block_size;
-    let extra = u32::from(settings.block_shift) * (b - 1);
-    u64::from((width + extra).div_ceil(b)) * u64::from((height + extra).div_ceil(b))
+    match grid(settings, width, height) {
+        Ok(grid) if settings.block_shift => u64::from(grid.max_shifted_block_count()),
+        Ok(grid) => u64::from(grid.block_count()),
+        Err(_) => 0,
+    }
 }
 
 /// The parameters of frame `frame`; `max_workgroups` is the device's per-dimension limit.

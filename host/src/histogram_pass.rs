@@ -10,6 +10,15 @@ use thiserror::Error;
 /// Slots one workgroup sorts (`SLOTS` in `block_sort.wgsl`).
 pub const SLOTS_PER_WORKGROUP: u32 = strata_kernels::types::HISTOGRAM_SLOTS_PER_WORKGROUP;
 
+/// Workgroups of a dispatch over `grid`, in rows of at most the backend's limit.
+fn workgroups_of(backend: &dyn Backend, grid: BlockGrid) -> [u32; 3] {
+    let block_area = grid.block_size * grid.block_size;
+    let total = grid.block_count().div_ceil(SLOTS_PER_WORKGROUP / block_area);
+    let max = backend.info().limits.max_workgroups_per_dimension.max(1);
+    let x = total.min(max);
+    [x, total.div_ceil(x), 1]
+}
+
 /// Which entry point of the histogram kernel to run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum HistogramVariant {
@@ -54,6 +63,7 @@ pub enum PassError {
 pub struct BlockHistogramPass {
     kernel: &'static Kernel,
     grid: BlockGrid,
+    masking: bool,
     workgroups: [u32; 3],
     /// Uniform `HistogramParams`.
     pub params: BufferId,
@@ -91,20 +101,30 @@ impl BlockHistogramPass {
         };
         let kernel = registry.get(id);
         backend.check_kernel(kernel)?;
-        let block_area = grid.block_size * grid.block_size;
-        let total = grid.block_count().div_ceil(SLOTS_PER_WORKGROUP / block_area);
-        let max = backend.info().limits.max_workgroups_per_dimension.max(1);
-        let x = total.min(max);
-        let workgroups = [x, total.div_ceil(x), 1];
+        let workgroups = workgroups_of(backend, grid);
+        let x = workgroups[0];
         let params = grid.histogram_params(x, masking);
         let pixels = grid.pixel_count() as u64;
         let params = upload(backend, "histogram params", &[params])?;
         let candidates = backend.create_buffer("candidates", pixels * size_of::<Candidate>() as u64)?;
         let sorted_pixels = backend.create_buffer("sorted pixels", pixels * 4)?;
         let spans = backend.create_buffer("cluster spans", pixels * size_of::<ClusterSpan>() as u64)?;
-        let block_stats =
-            backend.create_buffer("block stats", u64::from(grid.block_count()) * size_of::<BlockStats>() as u64)?;
-        Ok(Self { kernel, grid, workgroups, params, candidates, sorted_pixels, spans, block_stats })
+        // Room for every shift of the grid (set_grid_shift).
+        let blocks = grid.max_shifted_block_count().max(grid.block_count());
+        let block_stats = backend.create_buffer("block stats", u64::from(blocks) * size_of::<BlockStats>() as u64)?;
+        Ok(Self { kernel, grid, masking, workgroups, params, candidates, sorted_pixels, spans, block_stats })
+    }
+
+    /// Moves the block grid to shift (sx, sy), each in 0..B (§5.3 / limitations: a
+    /// different shift every frame), for the next dispatches.
+    pub fn set_grid_shift(&mut self, backend: &mut dyn Backend, shift_x: u32, shift_y: u32) -> Result<(), PassError> {
+        let grid = self.grid.with_shift(shift_x, shift_y)?;
+        let workgroups = workgroups_of(backend, grid);
+        let params = grid.histogram_params(workgroups[0], self.masking);
+        backend.write_buffer(self.params, 0, bytemuck::bytes_of(&params))?;
+        self.grid = grid;
+        self.workgroups = workgroups;
+        Ok(())
     }
 
     /// The kernel this pass runs.
@@ -177,7 +197,11 @@ impl BlockHistogramPass {
         Ok(HistogramOutput {
             sorted_pixels: download(backend, self.sorted_pixels)?,
             spans: download(backend, self.spans)?,
-            stats: download(backend, self.block_stats)?,
+            stats: {
+                let mut stats: Vec<BlockStats> = download(backend, self.block_stats)?;
+                stats.truncate(self.grid.block_count() as usize);
+                stats
+            },
         })
     }
 

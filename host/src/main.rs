@@ -81,6 +81,9 @@ struct CompareArgs {
     /// No temporal reuse: frames are accumulated instead (Fig. 5 / 10).
     #[arg(long)]
     accumulate: bool,
+    /// Shift the block grid by a different offset every frame.
+    #[arg(long)]
+    block_shift: bool,
     /// No object-id masking: one histogram cluster per block.
     #[arg(long)]
     no_masking: bool,
@@ -282,6 +285,7 @@ fn compare(args: CompareArgs) -> Result<()> {
             sampler: args.sampler,
             temporal: !args.accumulate,
             masking: !args.no_masking,
+            block_shift: args.block_shift,
             ..RestirSettings::default()
         },
         accumulate: args.accumulate,

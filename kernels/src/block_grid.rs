@@ -112,6 +112,13 @@ impl BlockGrid {
         Ok(Self { shift_x, shift_y, ..self })
     }
 
+    /// Blocks of the largest grid any shift gives (a shifted grid has up to one more
+    /// row and column): what per-block buffers must hold when the shift changes per frame.
+    pub fn max_shifted_block_count(&self) -> u32 {
+        let extra = self.block_size - 1;
+        (self.width + extra).div_ceil(self.block_size) * (self.height + extra).div_ceil(self.block_size)
+    }
+
     /// The `HistogramParams` of a dispatch over this grid with `workgroups_x` workgroups
     /// per row of the dispatch grid; `masking` false puts every candidate with an object id
     /// in one cluster per block (paper §4.3 without object masking).
@@ -168,6 +175,15 @@ impl BlockGrid {
     pub fn block_of(&self, x: u32, y: u32) -> u32 {
         (y + self.shift_y) / self.block_size * self.blocks_x() + (x + self.shift_x) / self.block_size
     }
+}
+
+/// The block-grid shift of frame `frame` of render `seed` when the grid moves every frame
+/// (the paper's limitations section): a hash of both, in 0..B per axis.
+pub fn frame_shift(block_size: u32, frame: u32, seed: u32) -> (u32, u32) {
+    let h = crate::reference::stratified_selection::selection_hash(
+        frame ^ crate::reference::stratified_selection::selection_hash(seed ^ 0xb10c),
+    );
+    (h % block_size, (h >> 16) % block_size)
 }
 
 #[cfg(test)]

@@ -123,3 +123,23 @@ fn shifted_grids_and_unmasked_clusters_match_reference() {
         }
     }
 }
+
+/// Moving the grid of an existing pass (per frame in the renderer) gives the reference
+/// of the shifted grid, and moving it back the unshifted one.
+#[test]
+fn set_grid_shift_moves_the_blocks() {
+    let Some(mut backend) = vulkan_backend("block_histogram") else {
+        return;
+    };
+    let grid = BlockGrid::new(45, 38, 16).unwrap();
+    let candidates = candidate_image(45, 38, 77, CandidateMix::default());
+    let mut pass = BlockHistogramPass::new(&mut backend, HistogramVariant::Auto, grid).unwrap();
+    for (sx, sy) in [(5, 11), (15, 0), (0, 0)] {
+        pass.set_grid_shift(&mut backend, sx, sy).unwrap();
+        let shifted = grid.with_shift(sx, sy).unwrap();
+        let got = pass.run(&mut backend, &candidates).unwrap();
+        assert_same(shifted, HistogramVariant::Auto, &got, &block_histogram(shifted, &candidates));
+    }
+    assert!(pass.set_grid_shift(&mut backend, 16, 0).is_err());
+    pass.destroy(&mut backend).unwrap();
+}

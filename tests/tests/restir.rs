@@ -224,8 +224,8 @@ fn bad_restir_settings_are_errors_naming_the_value() {
 }
 
 /// With the camera orbiting, reprojection and the disocclusion test decide what is
-/// reused: the 6th frame of 128 independent renders matches the path-traced image of
-/// that frame's camera.
+/// reused, and the block grid shifts every frame: the 6th frame of 128 independent
+/// renders matches the path-traced image of that frame's camera.
 #[test]
 fn temporal_reuse_with_a_moving_camera_stays_unbiased() {
     let Some(mut backend) = strata_tests::vulkan_backend("temporal_reuse_with_a_moving_camera_stays_unbiased") else {
@@ -236,7 +236,10 @@ fn temporal_reuse_with_a_moving_camera_stays_unbiased() {
     let base = settings(&scene, 0).camera;
     let path = CameraPath::orbit(&base, 1.5);
     let reference = reference_from(&mut backend, &scene, 2048, &path.camera_at(&base, 5));
-    let restir = RestirSettings { block_size: 8, ..RestirSettings::default() };
+    let restir = RestirSettings { block_size: 8, block_shift: true, ..RestirSettings::default() };
     let ours = restir_frames_moving(&mut backend, &scene, restir, 1..129, 6, &path);
-    assert_unbiased("strata with temporal reuse, orbiting camera, frame 6", &z_scores(&ours, &reference));
+    assert_unbiased(
+        "strata with temporal reuse, orbiting camera, shifting grid, frame 6",
+        &z_scores(&ours, &reference),
+    );
 }

@@ -10,6 +10,7 @@ use crate::sampler::BlueNoiseTables;
 use crate::scene::{Camera, CameraFrame};
 use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, BackendError, Bind, BufferId};
+use strata_kernels::block_grid::frame_shift;
 use strata_kernels::render_types::{FLAG_HIT_LIGHTS, FLAG_RUSSIAN_ROULETTE, FLAG_SAMPLE_LIGHTS, RenderParams};
 use strata_kernels::restir_types::{
     METHOD_RESTIR, METHOD_RESTIR_DISC, METHOD_STRATA, PathCandidate, Primary, Reservoir, RestirParams,
@@ -165,6 +166,10 @@ impl RestirRenderer {
         let render = RenderSettings { camera: camera.clone(), ..self.render.clone() };
         let frame_camera = CameraFrame::new(&camera)
             .ok_or_else(|| PassError::Input("camera: invalid frame (fov axis or up vector)".into()))?;
+        if self.settings.block_shift && self.settings.method.uses_histogram() {
+            let (sx, sy) = frame_shift(self.settings.block_size, self.frame, self.render.seed);
+            self.histogram.set_grid_shift(backend, sx, sy)?;
+        }
         let params =
             RenderParams { sample_index: self.frame, flags: self.params.flags, ..render.params(&self.params)? };
         backend.write_buffer(self.render_params, 0, bytemuck::bytes_of(&params))?;

@@ -51,6 +51,11 @@ pub struct RestirSettings {
     /// Cluster the histogram by object id (§4.3 masking): only candidates whose primary
     /// hit is on the same object are shared. Off: one cluster per block. Default on.
     pub masking: bool,
+    /// Shift the block grid by a different offset every frame (the paper's limitations
+    /// section: block-shaped error patterns average out over time), at no cost; pixels
+    /// then share histograms with different neighbours each frame. Default off, as in
+    /// the paper's measurements.
+    pub block_shift: bool,
     /// Merge each frame's reservoir with the previous frame's (temporal reuse). Off: each
     /// frame stands alone (the accumulation mode of Fig. 5 / 10). Default on.
     pub temporal: bool,
@@ -78,6 +83,7 @@ impl Default for RestirSettings {
             candidates: 4,
             block_size: 16,
             masking: true,
+            block_shift: false,
             temporal: true,
             temporal_cap: 20.0,
             disc_radius: 30.0,

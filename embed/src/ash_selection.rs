@@ -2,7 +2,8 @@
 //! SPIR-V of the same WGSL kernels, recording into the engine's command buffer with the
 //! engine's buffers.
 
-use crate::contract::{BufferRole, check_size};
+use crate::binding_plan::{EngineBuffers, OwnBuffers, ResampleBuffers, Resource};
+use crate::contract::check_size;
 use crate::error::EmbedError;
 use crate::frame::{FrameParams, frame_params, max_blocks};
 use crate::limits::{DeviceLimits, VULKAN_NAMES, check_limits};
@@ -40,26 +41,10 @@ pub struct AshBufferSlice {
 }
 
 /// The engine's buffers for [`AshSelection::bind`] (see [`crate::contract`]).
-#[derive(Clone, Copy, Debug)]
-pub struct AshBuffers {
-    /// One `Candidate` per pixel, written by the engine before the selection.
-    pub candidates: AshBufferSlice,
-    /// One payload per pixel; `None`: a pixel's payload is its index.
-    pub payloads: Option<AshBufferSlice>,
-    /// One `SelectedCandidates` per pixel, written by the pass.
-    pub selections: AshBufferSlice,
-    /// The resampling buffers, if the engine resamples with the pass.
-    pub resample: Option<AshResampleBuffers>,
-}
+pub type AshBuffers = EngineBuffers<AshBufferSlice>;
 
 /// The engine's buffers of the resampling pass.
-#[derive(Clone, Copy, Debug)]
-pub struct AshResampleBuffers {
-    /// One `ResampleInput` per pixel, written by the engine after the selection.
-    pub inputs: AshBufferSlice,
-    /// One `ResampleOutput` per pixel, written by the pass.
-    pub outputs: AshBufferSlice,
-}
+pub type AshResampleBuffers = ResampleBuffers<AshBufferSlice>;
 
 /// Descriptor sets of one set of engine buffers, made by [`AshSelection::bind`]; free
 /// them with [`AshSelection::destroy_bindings`].
@@ -78,9 +63,6 @@ struct Pipeline {
     set_layout: vk::DescriptorSetLayout,
     bindings: Vec<vk::DescriptorType>,
 }
-
-/// (buffer, offset, size) of one descriptor.
-type BufferRange = (vk::Buffer, u64, u64);
 
 struct OwnBuffer {
     buffer: vk::Buffer,
@@ -106,13 +88,7 @@ pub struct AshSelection {
     histogram: Pipeline,
     select: Pipeline,
     resample: Pipeline,
-    histogram_params: OwnBuffer,
-    selection_params: OwnBuffer,
-    sorted_pixels: OwnBuffer,
-    spans: OwnBuffer,
-    block_stats: OwnBuffer,
-    tables: [OwnBuffer; 3],
-    unused_payloads: OwnBuffer,
+    own: OwnBuffers<OwnBuffer>,
 }
 
 fn vk_error(operation: &str, result: vk::Result) -> EmbedError {
@@ -191,13 +167,15 @@ impl AshSelection {
             histogram,
             select,
             resample,
-            histogram_params,
-            selection_params,
-            sorted_pixels,
-            spans,
-            block_stats,
-            tables,
-            unused_payloads,
+            own: OwnBuffers {
+                histogram_params,
+                selection_params,
+                sorted_pixels,
+                spans,
+                block_stats,
+                tables,
+                unused_payloads,
+            },
         })
     }
 
@@ -219,16 +197,7 @@ impl AshSelection {
 
     /// Checks the engine's buffers against the contract and writes their descriptor sets.
     pub fn bind(&self, buffers: &AshBuffers) -> Result<AshBindings, EmbedError> {
-        let (w, h) = (self.width, self.height);
-        let mut checked =
-            vec![(BufferRole::Candidates, buffers.candidates), (BufferRole::Selections, buffers.selections)];
-        if let Some(payloads) = buffers.payloads {
-            checked.push((BufferRole::Payloads, payloads));
-        }
-        if let Some(resample) = buffers.resample {
-            checked.extend([(BufferRole::ResampleInputs, resample.inputs), (BufferRole::Resampled, resample.outputs)]);
-        }
-        for &(role, slice) in &checked {
+        for (role, slice) in buffers.roles() {
             if !slice.offset.is_multiple_of(self.offset_alignment) {
                 return Err(EmbedError::BufferOffset {
                     buffer: role.name(),
@@ -236,7 +205,7 @@ impl AshSelection {
                     alignment: self.offset_alignment,
                 });
             }
-            check_size(role, slice.size, w, h)?;
+            check_size(role, slice.size, self.width, self.height)?;
         }
         let sets = 3u32;
         let pool_sizes = [
@@ -259,53 +228,25 @@ impl AshSelection {
                 return Err(vk_error("allocating descriptor sets", error));
             }
         };
-        let own = |b: &OwnBuffer| (b.buffer, 0, b.size);
-        let engine = |s: AshBufferSlice| (s.buffer, s.offset, s.size);
-        let payloads = buffers.payloads.map_or_else(|| own(&self.unused_payloads), engine);
-        let mut writes: Vec<(vk::DescriptorSet, &Pipeline, Vec<BufferRange>)> = vec![
-            (
-                allocated[0],
-                &self.histogram,
-                vec![
-                    own(&self.histogram_params),
-                    engine(buffers.candidates),
-                    own(&self.sorted_pixels),
-                    own(&self.spans),
-                    own(&self.block_stats),
-                ],
-            ),
-            (
-                allocated[1],
-                &self.select,
-                vec![
-                    own(&self.selection_params),
-                    engine(buffers.candidates),
-                    payloads,
-                    own(&self.sorted_pixels),
-                    own(&self.spans),
-                    own(&self.tables[0]),
-                    own(&self.tables[1]),
-                    own(&self.tables[2]),
-                    engine(buffers.selections),
-                ],
-            ),
-        ];
-        if let Some(resample) = buffers.resample {
-            writes.push((
-                allocated[2],
-                &self.resample,
-                vec![
-                    own(&self.selection_params),
-                    engine(buffers.selections),
-                    engine(resample.inputs),
-                    engine(resample.outputs),
-                ],
-            ));
+        let plan = buffers.plan(&self.own);
+        let mut writes =
+            vec![(allocated[0], &self.histogram, plan.histogram), (allocated[1], &self.select, plan.select)];
+        if let Some(resources) = plan.resample {
+            writes.push((allocated[2], &self.resample, resources));
         }
         for (set, pipeline, resources) in &writes {
             let infos: Vec<[vk::DescriptorBufferInfo; 1]> = resources
                 .iter()
-                .map(|&(buffer, offset, range)| [vk::DescriptorBufferInfo { buffer, offset, range }])
+                .map(|resource| {
+                    [match *resource {
+                        Resource::Own(own) => {
+                            vk::DescriptorBufferInfo { buffer: own.buffer, offset: 0, range: own.size }
+                        }
+                        Resource::Engine(s) => {
+                            vk::DescriptorBufferInfo { buffer: s.buffer, offset: s.offset, range: s.size }
+                        }
+                    }]
+                })
                 .collect();
             let descriptor_writes: Vec<_> = infos
                 .iter()
@@ -407,13 +348,13 @@ impl AshSelection {
         unsafe {
             self.device.cmd_update_buffer(
                 command_buffer,
-                self.histogram_params.buffer,
+                self.own.histogram_params.buffer,
                 0,
                 bytemuck::bytes_of(&params.histogram),
             );
             self.device.cmd_update_buffer(
                 command_buffer,
-                self.selection_params.buffer,
+                self.own.selection_params.buffer,
                 0,
                 bytemuck::bytes_of(&params.selection),
             );
@@ -445,17 +386,7 @@ impl AshSelection {
     /// # Safety
     /// No pending command buffer may still use the pass.
     pub unsafe fn destroy(self) {
-        let buffers = [
-            &self.histogram_params,
-            &self.selection_params,
-            &self.sorted_pixels,
-            &self.spans,
-            &self.block_stats,
-            &self.tables[0],
-            &self.tables[1],
-            &self.tables[2],
-            &self.unused_payloads,
-        ];
+        let buffers = self.own.all();
         // SAFETY: the caller guarantees nothing uses them any more.
         unsafe {
             for buffer in buffers {

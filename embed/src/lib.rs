@@ -24,6 +24,7 @@
 //! Examples that run: `cargo run -p strata-embed --example wgpu_embed` and
 //! `--example ash_embed`.
 
+mod binding_plan;
 pub mod contract;
 mod error;
 pub mod frame;
@@ -38,6 +39,7 @@ mod wgpu_selection;
 
 #[cfg(feature = "ash")]
 pub use ash_selection::{AshBindings, AshBufferSlice, AshBuffers, AshDevice, AshResampleBuffers, AshSelection};
+pub use binding_plan::{EngineBuffers, ResampleBuffers};
 pub use error::EmbedError;
 pub use settings::{SamplerVariant, SelectionSettings};
 #[cfg(feature = "wgpu")]

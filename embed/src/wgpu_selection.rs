@@ -1,13 +1,13 @@
 //! [`WgpuSelection`]: the pass on an engine's own `wgpu::Device`, recording into the
 //! engine's command encoder with the engine's buffers.
 
+use crate::binding_plan::{EngineBuffers, OwnBuffers, ResampleBuffers, Resource};
 use crate::contract::{BufferRole, check_size};
 use crate::error::EmbedError;
 use crate::frame::{FrameParams, frame_params, max_blocks};
 use crate::limits::{DeviceLimits, WGPU_NAMES, check_limits};
 use crate::settings::SelectionSettings;
 use crate::wgsl::{ModuleId, WgslModule, module};
-use std::num::NonZeroU64;
 use strata_kernels::blue_noise::BlueNoiseTables;
 use strata_kernels::embed_types::SelectionParams;
 use strata_kernels::types::HistogramParams;
@@ -30,26 +30,10 @@ impl<'a> From<&'a wgpu::Buffer> for WgpuBufferSlice<'a> {
 }
 
 /// The engine's buffers for [`WgpuSelection::bind`] (see [`crate::contract`]).
-#[derive(Clone, Copy, Debug)]
-pub struct WgpuBuffers<'a> {
-    /// One `Candidate` per pixel, written by the engine before the selection.
-    pub candidates: WgpuBufferSlice<'a>,
-    /// One payload per pixel; `None`: a pixel's payload is its index.
-    pub payloads: Option<WgpuBufferSlice<'a>>,
-    /// One `SelectedCandidates` per pixel, written by the pass.
-    pub selections: WgpuBufferSlice<'a>,
-    /// The resampling buffers, if the engine resamples with the pass.
-    pub resample: Option<WgpuResampleBuffers<'a>>,
-}
+pub type WgpuBuffers<'a> = EngineBuffers<WgpuBufferSlice<'a>>;
 
 /// The engine's buffers of the resampling pass.
-#[derive(Clone, Copy, Debug)]
-pub struct WgpuResampleBuffers<'a> {
-    /// One `ResampleInput` per pixel, written by the engine after the selection.
-    pub inputs: WgpuBufferSlice<'a>,
-    /// One `ResampleOutput` per pixel, written by the pass.
-    pub outputs: WgpuBufferSlice<'a>,
-}
+pub type WgpuResampleBuffers<'a> = ResampleBuffers<WgpuBufferSlice<'a>>;
 
 /// Bind groups of one set of engine buffers, made by [`WgpuSelection::bind`].
 #[derive(Debug)]
@@ -81,13 +65,7 @@ pub struct WgpuSelection {
     histogram: Pipeline,
     select: Pipeline,
     resample: Pipeline,
-    histogram_params: wgpu::Buffer,
-    selection_params: wgpu::Buffer,
-    sorted_pixels: wgpu::Buffer,
-    spans: wgpu::Buffer,
-    block_stats: wgpu::Buffer,
-    tables: [wgpu::Buffer; 3],
-    unused_payloads: wgpu::Buffer,
+    own: OwnBuffers<wgpu::Buffer>,
 }
 
 fn api_error(operation: &str, error: wgpu::Error) -> EmbedError {
@@ -109,24 +87,7 @@ fn scoped<T>(device: &wgpu::Device, operation: &str, f: impl FnOnce() -> T) -> R
 
 /// A pipeline with an explicit bind-group layout from the module's bindings.
 fn pipeline(device: &wgpu::Device, module: &WgslModule) -> Pipeline {
-    let entries: Vec<_> = module
-        .bindings
-        .iter()
-        .map(|binding| wgpu::BindGroupLayoutEntry {
-            binding: binding.binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: if binding.uniform {
-                    wgpu::BufferBindingType::Uniform
-                } else {
-                    wgpu::BufferBindingType::Storage { read_only: !binding.writable }
-                },
-                has_dynamic_offset: false,
-                min_binding_size: NonZeroU64::new(binding.min_size),
-            },
-            count: None,
-        })
-        .collect();
+    let entries = module.wgpu_layout_entries();
     let label = Some(module.entry_point.as_str());
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label, entries: &entries });
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -212,17 +173,19 @@ impl WgpuSelection {
                 histogram: pipeline(device, &histogram_module),
                 select: pipeline(device, &select_module),
                 resample: pipeline(device, &resample_module),
-                histogram_params: buffer("strata histogram params", size_of::<HistogramParams>() as u64, uniform),
-                selection_params: buffer("strata selection params", size_of::<SelectionParams>() as u64, uniform),
-                sorted_pixels: buffer("strata sorted pixels", pixels * 4, storage),
-                spans: buffer("strata cluster spans", pixels * 12, storage),
-                block_stats: buffer("strata block stats", blocks * 12, storage),
-                tables: [
-                    table("blue_noise_sobol", &tables.sobol),
-                    table("blue_noise_scrambling", &tables.scrambling),
-                    table("blue_noise_ranking", &tables.ranking),
-                ],
-                unused_payloads: buffer("strata unused payloads", 4, wgpu::BufferUsages::STORAGE),
+                own: OwnBuffers {
+                    histogram_params: buffer("strata histogram params", size_of::<HistogramParams>() as u64, uniform),
+                    selection_params: buffer("strata selection params", size_of::<SelectionParams>() as u64, uniform),
+                    sorted_pixels: buffer("strata sorted pixels", pixels * 4, storage),
+                    spans: buffer("strata cluster spans", pixels * 12, storage),
+                    block_stats: buffer("strata block stats", blocks * 12, storage),
+                    tables: [
+                        table("blue_noise_sobol", &tables.sobol),
+                        table("blue_noise_scrambling", &tables.scrambling),
+                        table("blue_noise_ranking", &tables.ranking),
+                    ],
+                    unused_payloads: buffer("strata unused payloads", 4, wgpu::BufferUsages::STORAGE),
+                },
             }
         })
     }
@@ -247,7 +210,7 @@ impl WgpuSelection {
     /// `sorted_pixels` (per block, pixel indices in cluster-then-key order) and `spans`
     /// (one `ClusterSpan` per pixel), valid after [`Self::encode_selection`].
     pub fn histogram_buffers(&self) -> (&wgpu::Buffer, &wgpu::Buffer) {
-        (&self.sorted_pixels, &self.spans)
+        (&self.own.sorted_pixels, &self.own.spans)
     }
 
     /// The parameters frame `frame` runs with.
@@ -257,34 +220,25 @@ impl WgpuSelection {
 
     /// Checks the engine's buffers against the contract and makes their bind groups.
     pub fn bind(&self, device: &wgpu::Device, buffers: &WgpuBuffers) -> Result<WgpuBindings, EmbedError> {
-        let (w, h) = (self.width, self.height);
-        let mut checked =
-            vec![(BufferRole::Candidates, buffers.candidates), (BufferRole::Selections, buffers.selections)];
-        if let Some(payloads) = buffers.payloads {
-            checked.push((BufferRole::Payloads, payloads));
-        }
-        if let Some(resample) = buffers.resample {
-            checked.extend([(BufferRole::ResampleInputs, resample.inputs), (BufferRole::Resampled, resample.outputs)]);
-        }
-        for &(role, slice) in &checked {
+        for (role, slice) in buffers.roles() {
             check_usage(role, slice, self.offset_alignment)?;
-            check_size(role, slice.buffer.size().saturating_sub(slice.offset), w, h)?;
+            check_size(role, slice.buffer.size().saturating_sub(slice.offset), self.width, self.height)?;
         }
-        fn engine(slice: WgpuBufferSlice<'_>) -> wgpu::BindingResource<'_> {
-            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                buffer: slice.buffer,
-                offset: slice.offset,
-                size: None,
-            })
+        fn resource<'a>(resource: &Resource<'a, wgpu::Buffer, WgpuBufferSlice<'a>>) -> wgpu::BindingResource<'a> {
+            match *resource {
+                Resource::Own(buffer) => buffer.as_entire_binding(),
+                Resource::Engine(slice) => wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: slice.buffer,
+                    offset: slice.offset,
+                    size: None,
+                }),
+            }
         }
-        fn whole(buffer: &wgpu::Buffer) -> wgpu::BindingResource<'_> {
-            buffer.as_entire_binding()
-        }
-        let group = |pipeline: &Pipeline, resources: Vec<wgpu::BindingResource>| {
+        let group = |pipeline: &Pipeline, resources: &[Resource<'_, wgpu::Buffer, WgpuBufferSlice>]| {
             let entries: Vec<_> = resources
-                .into_iter()
+                .iter()
                 .enumerate()
-                .map(|(binding, resource)| wgpu::BindGroupEntry { binding: binding as u32, resource })
+                .map(|(binding, r)| wgpu::BindGroupEntry { binding: binding as u32, resource: resource(r) })
                 .collect();
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("strata selection"),
@@ -292,43 +246,11 @@ impl WgpuSelection {
                 entries: &entries,
             })
         };
-        let payloads = buffers.payloads.map_or_else(|| whole(&self.unused_payloads), engine);
+        let plan = buffers.plan(&self.own);
         scoped(device, "binding the engine's buffers", || WgpuBindings {
-            histogram: group(
-                &self.histogram,
-                vec![
-                    whole(&self.histogram_params),
-                    engine(buffers.candidates),
-                    whole(&self.sorted_pixels),
-                    whole(&self.spans),
-                    whole(&self.block_stats),
-                ],
-            ),
-            select: group(
-                &self.select,
-                vec![
-                    whole(&self.selection_params),
-                    engine(buffers.candidates),
-                    payloads,
-                    whole(&self.sorted_pixels),
-                    whole(&self.spans),
-                    whole(&self.tables[0]),
-                    whole(&self.tables[1]),
-                    whole(&self.tables[2]),
-                    engine(buffers.selections),
-                ],
-            ),
-            resample: buffers.resample.map(|resample| {
-                group(
-                    &self.resample,
-                    vec![
-                        whole(&self.selection_params),
-                        engine(buffers.selections),
-                        engine(resample.inputs),
-                        engine(resample.outputs),
-                    ],
-                )
-            }),
+            histogram: group(&self.histogram, &plan.histogram),
+            select: group(&self.select, &plan.select),
+            resample: plan.resample.as_ref().map(|resources| group(&self.resample, resources)),
             identity_payload: buffers.payloads.is_none(),
         })
     }
@@ -343,8 +265,8 @@ impl WgpuSelection {
         frame: u32,
     ) -> Result<(), EmbedError> {
         let params = self.frame_params(frame, bindings.identity_payload)?;
-        queue.write_buffer(&self.histogram_params, 0, bytemuck::bytes_of(&params.histogram));
-        queue.write_buffer(&self.selection_params, 0, bytemuck::bytes_of(&params.selection));
+        queue.write_buffer(&self.own.histogram_params, 0, bytemuck::bytes_of(&params.histogram));
+        queue.write_buffer(&self.own.selection_params, 0, bytemuck::bytes_of(&params.selection));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("strata histogram + selection"),
             timestamp_writes: None,

@@ -78,6 +78,31 @@ pub struct WgslModule {
     pub bindings: Vec<ModuleBinding>,
 }
 
+#[cfg(feature = "wgpu")]
+impl WgslModule {
+    /// The module's bind-group layout as wgpu entries (compute stage, no dynamic offsets,
+    /// minimum binding sizes from the WGSL types).
+    pub fn wgpu_layout_entries(&self) -> Vec<wgpu::BindGroupLayoutEntry> {
+        self.bindings
+            .iter()
+            .map(|binding| wgpu::BindGroupLayoutEntry {
+                binding: binding.binding,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: if binding.uniform {
+                        wgpu::BufferBindingType::Uniform
+                    } else {
+                        wgpu::BufferBindingType::Storage { read_only: !binding.writable }
+                    },
+                    has_dynamic_offset: false,
+                    min_binding_size: std::num::NonZeroU64::new(binding.min_size),
+                },
+                count: None,
+            })
+            .collect()
+    }
+}
+
 /// The module `id`.
 pub fn module(id: ModuleId) -> Result<WgslModule, EmbedError> {
     let kernel = Registry::shared()?.get(id.kernel());

@@ -263,24 +263,7 @@ fn exported_wgsl_modules_give_the_same_outputs() {
     for (id, resources, [x, y, z]) in &runs {
         let module = module(*id).unwrap();
         assert_eq!(module.bindings.len(), resources.len(), "{id:?}: binding count");
-        let entries: Vec<_> = module
-            .bindings
-            .iter()
-            .map(|b| wgpu::BindGroupLayoutEntry {
-                binding: b.binding,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty: if b.uniform {
-                        wgpu::BufferBindingType::Uniform
-                    } else {
-                        wgpu::BufferBindingType::Storage { read_only: !b.writable }
-                    },
-                    has_dynamic_offset: false,
-                    min_binding_size: std::num::NonZeroU64::new(b.min_size),
-                },
-                count: None,
-            })
-            .collect();
+        let entries = module.wgpu_layout_entries();
         let layout =
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: None, entries: &entries });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

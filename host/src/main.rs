@@ -81,6 +81,10 @@ struct CompareArgs {
     /// No temporal reuse: frames are accumulated instead (Fig. 5 / 10).
     #[arg(long)]
     accumulate: bool,
+    /// Previous reservoirs merged per pixel, 1 to 4 (2-4: drawn like spatial candidates,
+    /// the paper's Fig. 11).
+    #[arg(long, default_value_t = 1)]
+    temporal_candidates: u32,
     /// Shift the block grid by a different offset every frame.
     #[arg(long)]
     block_shift: bool,
@@ -286,6 +290,7 @@ fn compare(args: CompareArgs) -> Result<()> {
             temporal: !args.accumulate,
             masking: !args.no_masking,
             block_shift: args.block_shift,
+            temporal_candidates: args.temporal_candidates,
             ..RestirSettings::default()
         },
         accumulate: args.accumulate,

@@ -154,7 +154,7 @@ shader_struct!(
         previous_forward,
         previous_tan_half_y,
         previous_right,
-        _pad0,
+        temporal_candidates,
         previous_up,
         _pad1,
     ]

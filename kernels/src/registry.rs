@@ -30,7 +30,10 @@ pub enum KernelId {
     /// ReSTIR pass 3: selection of K candidates (strata, restir or restir-disc) and
     /// resampling with the pixel's canonical candidate.
     RestirSelect,
-    /// ReSTIR pass 4: temporal reuse (M cap, reprojection).
+    /// ReSTIR pass 4a: temporal sources (reprojection, disocclusion) and the temporal
+    /// histogram's input.
+    RestirTemporalKeys,
+    /// ReSTIR pass 4b: temporal reuse (M cap, one or several previous reservoirs).
     RestirTemporal,
     /// ReSTIR pass 5: shading of the reservoirs' samples with one shadow ray.
     RestirShade,
@@ -46,7 +49,7 @@ pub enum KernelId {
 
 impl KernelId {
     /// Every registry kernel.
-    pub const ALL: [KernelId; 12] = [
+    pub const ALL: [KernelId; 13] = [
         KernelId::BlockHistogram,
         KernelId::BlockHistogramSubgroup,
         KernelId::Empty,
@@ -55,6 +58,7 @@ impl KernelId {
         KernelId::PathTrace,
         KernelId::RestirCandidates,
         KernelId::RestirSelect,
+        KernelId::RestirTemporalKeys,
         KernelId::RestirTemporal,
         KernelId::RestirShade,
         KernelId::StrataSelect,
@@ -152,6 +156,9 @@ impl KernelId {
             },
             KernelId::RestirCandidates => restir("restir_candidates", fragment!("restir/entry_candidates.wgsl")),
             KernelId::RestirSelect => restir("restir_select", fragment!("restir/entry_select.wgsl")),
+            KernelId::RestirTemporalKeys => {
+                restir("restir_temporal_keys", fragment!("restir/entry_temporal_keys.wgsl"))
+            }
             KernelId::RestirTemporal => restir("restir_temporal", fragment!("restir/entry_temporal.wgsl")),
             KernelId::RestirShade => restir("restir_shade", fragment!("restir/entry_shade.wgsl")),
             KernelId::StrataSelect => KernelSpec {
@@ -488,7 +495,11 @@ mod tests {
             }
             if matches!(
                 kernel.id,
-                KernelId::RestirCandidates | KernelId::RestirSelect | KernelId::RestirTemporal | KernelId::RestirShade
+                KernelId::RestirCandidates
+                    | KernelId::RestirSelect
+                    | KernelId::RestirTemporalKeys
+                    | KernelId::RestirTemporal
+                    | KernelId::RestirShade
             ) {
                 use crate::restir_types::{PathCandidate, Primary, Reservoir, RestirParams};
                 for result in [

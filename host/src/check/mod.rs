@@ -76,6 +76,7 @@ pub fn kernel_checks() -> Vec<Box<dyn KernelCheck>> {
         Box::new(path::PathTraceCheck),
         Box::new(restir::RestirCheck(KernelId::RestirCandidates)),
         Box::new(restir::RestirCheck(KernelId::RestirSelect)),
+        Box::new(restir::RestirCheck(KernelId::RestirTemporalKeys)),
         Box::new(restir::RestirCheck(KernelId::RestirTemporal)),
         Box::new(restir::RestirCheck(KernelId::RestirShade)),
         Box::new(selection::SelectionCheck(KernelId::StrataSelect)),

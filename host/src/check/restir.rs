@@ -1,4 +1,4 @@
-//! Check of the four ReSTIR kernels. Like the path tracer they have no Rust mirror: the
+//! Check of the five ReSTIR kernels. Like the path tracer they have no Rust mirror: the
 //! reference executor is the CPU interpreter running the same frames. Each case renders
 //! two frames (so the temporal merge has a history) of the default scene, or of the same
 //! room with a glass box, a rough-metal box and an environment, at a size with partial
@@ -18,7 +18,7 @@ use strata_backends::Backend;
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_kernels::{KernelId, Registry};
 
-/// Checks one of the ReSTIR kernels ([`KernelId::RestirCandidates`] and the three after it).
+/// Checks one of the ReSTIR kernels ([`KernelId::RestirCandidates`] and the four after it).
 pub struct RestirCheck(pub KernelId);
 
 fn frame(backend: &mut dyn Backend, case: &Case) -> Result<FrameBuffers, PassError> {
@@ -27,8 +27,16 @@ fn frame(backend: &mut dyn Backend, case: &Case) -> Result<FrameBuffers, PassErr
     let render =
         RenderSettings { rr_depth: 2, ..RenderSettings::for_scene(&scene, case.width, case.height, case.seed as u32) };
     let method = [Method::Strata, Method::Restir, Method::RestirDisc][(case.seed % 3) as usize];
-    let settings =
-        RestirSettings { method, block_size: case.block_size, disc_radius: 4.0, ..RestirSettings::default() };
+    // strata merges 4 temporal reservoirs from the temporal histogram, restir the
+    // reprojected one, restir-disc 2 from its disc.
+    let temporal_candidates = [4, 1, 2][(case.seed % 3) as usize];
+    let settings = RestirSettings {
+        method,
+        block_size: case.block_size,
+        disc_radius: 4.0,
+        temporal_candidates,
+        ..RestirSettings::default()
+    };
     let mut renderer = RestirRenderer::new(backend, &gpu_scene, &render, settings, scene.extent())?;
     let result = (|| {
         renderer.render_frame(backend, None)?;
@@ -76,6 +84,14 @@ impl RestirCheck {
                     .collect();
                 vec![Output { name: "reservoirs_out.w_m_target", words: values, compare: float }]
             }
+            KernelId::RestirTemporalKeys => vec![
+                Output { name: "temporal_keys", words: words(&buffers.temporal_keys), compare: float },
+                Output {
+                    name: "temporal_sources",
+                    words: buffers.temporal_sources.clone(),
+                    compare: words_with_outliers,
+                },
+            ],
             KernelId::RestirTemporal => {
                 let values: Vec<u32> = buffers
                     .reservoirs
@@ -106,7 +122,7 @@ impl KernelCheck for RestirCheck {
                 cases.push(Case {
                     label: format!(
                         "{width}x{height} seed {seed} B{block_size} {} {}",
-                        ["strata", "restir", "restir-disc"][(seed % 3) as usize],
+                        ["strata T=4", "restir T=1", "restir-disc T=2"][(seed % 3) as usize],
                         ["default scene", "glass, metal, environment"][family as usize]
                     ),
                     width,

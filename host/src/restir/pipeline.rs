@@ -23,7 +23,8 @@ use strata_kernels::{BlockGrid, Kernel, KernelId, Registry};
 pub struct FrameStats {
     /// Pixels whose sample was dropped as invalid (non-finite, traversal overflow).
     pub invalid_pixels: u32,
-    /// Device time of each pass (candidates, histogram, select, temporal, shade) from
+    /// Device time of each pass (candidates, histogram, select, temporal (sources,
+    /// temporal histogram and merge), shade) from
     /// timestamp queries, when [`RestirRenderer::set_timed`] is on and the backend has
     /// them; zero otherwise (and for the histogram of restir-disc, which skips it).
     pub pass_times: [std::time::Duration; 5],
@@ -42,6 +43,10 @@ pub struct FrameBuffers {
     pub base_radiance: Vec<[f32; 4]>,
     /// `restir_select`: the reservoirs after selection.
     pub selected: Vec<Reservoir>,
+    /// `restir_temporal_keys`: the temporal histogram's input.
+    pub temporal_keys: Vec<Candidate>,
+    /// `restir_temporal_keys`: each pixel's temporal source pixel.
+    pub temporal_sources: Vec<u32>,
     /// `restir_temporal`: the final reservoirs.
     pub reservoirs: Vec<Reservoir>,
     /// `restir_shade`: the frame (rgb, invalid flag).
@@ -50,12 +55,18 @@ pub struct FrameBuffers {
 
 /// The ReSTIR renderer of one scene, image size and settings.
 pub struct RestirRenderer {
-    kernels: [&'static Kernel; 4],
+    kernels: [&'static Kernel; 5],
     settings: RestirSettings,
     render: RenderSettings,
     params: RenderParams,
     scene: SceneBuffers,
     histogram: BlockHistogramPass,
+    /// The histogram of the temporal candidates (T > 1 with a histogram method).
+    temporal_histogram: Option<BlockHistogramPass>,
+    /// Per pixel its temporal source pixel (`restir_temporal_keys`).
+    temporal_sources: BufferId,
+    /// The temporal keys when there is no temporal histogram to hold them (T = 1).
+    temporal_keys: BufferId,
     tables: BlueNoiseTables,
     render_params: BufferId,
     restir_params: BufferId,
@@ -85,9 +96,14 @@ impl RestirRenderer {
     ) -> Result<Self, PassError> {
         settings.check()?;
         let registry = Registry::shared()?;
-        let kernels =
-            [KernelId::RestirCandidates, KernelId::RestirSelect, KernelId::RestirTemporal, KernelId::RestirShade]
-                .map(|id| registry.get(id));
+        let kernels = [
+            KernelId::RestirCandidates,
+            KernelId::RestirSelect,
+            KernelId::RestirTemporalKeys,
+            KernelId::RestirTemporal,
+            KernelId::RestirShade,
+        ]
+        .map(|id| registry.get(id));
         for kernel in kernels {
             backend.check_kernel(kernel)?;
         }
@@ -100,6 +116,11 @@ impl RestirRenderer {
         }
         let grid = BlockGrid::new(camera.width, camera.height, settings.block_size)?;
         let histogram = BlockHistogramPass::new(backend, HistogramVariant::Auto, grid)?;
+        let temporal_histogram = if settings.temporal_candidates > 1 && settings.method.uses_histogram() {
+            Some(BlockHistogramPass::new(backend, HistogramVariant::Auto, grid)?)
+        } else {
+            None
+        };
         let pixels = u64::from(camera.width) * u64::from(camera.height);
         let scene_buffers = SceneBuffers::upload(backend, scene)?;
         let mut params = render.params(&scene.params)?;
@@ -115,6 +136,9 @@ impl RestirRenderer {
             params,
             scene: scene_buffers,
             histogram,
+            temporal_histogram,
+            temporal_sources: buffer(backend, "temporal sources", pixels * 4)?,
+            temporal_keys: buffer(backend, "temporal keys", pixels * size_of::<Candidate>() as u64)?,
             tables: BlueNoiseTables::new(),
             render_params: upload(backend, "render params", &[params])?,
             restir_params: upload(backend, "restir params", &[RestirParams::default()])?,
@@ -129,7 +153,7 @@ impl RestirRenderer {
                 buffer(backend, "reservoirs A", reservoir_size)?,
                 buffer(backend, "reservoirs B", reservoir_size)?,
             ],
-            numbers: buffer(backend, "selection numbers", pixels * 32)?,
+            numbers: buffer(backend, "selection numbers", pixels * 48)?,
             frame_out: buffer(backend, "frame", pixels * 16)?,
             frame: 0,
             previous_camera: None,
@@ -169,6 +193,9 @@ impl RestirRenderer {
         if self.settings.block_shift && self.settings.method.uses_histogram() {
             let (sx, sy) = frame_shift(self.settings.block_size, self.frame, self.render.seed);
             self.histogram.set_grid_shift(backend, sx, sy)?;
+            if let Some(temporal) = &mut self.temporal_histogram {
+                temporal.set_grid_shift(backend, sx, sy)?;
+            }
         }
         let params =
             RenderParams { sample_index: self.frame, flags: self.params.flags, ..render.params(&self.params)? };
@@ -192,7 +219,7 @@ impl RestirRenderer {
             previous_forward: previous.forward.into(),
             previous_tan_half_y: previous.tan_half_y,
             previous_right: previous.right.into(),
-            _pad0: 0,
+            temporal_candidates: self.settings.temporal_candidates,
             previous_up: previous.up.into(),
             _pad1: 0,
         };
@@ -213,7 +240,7 @@ impl RestirRenderer {
             binds.retain(|bind| kernel.bindings.iter().any(|b| b.binding == bind.binding));
             binds
         };
-        let [candidates_kernel, select_kernel, temporal_kernel, shade_kernel] = self.kernels;
+        let [candidates_kernel, select_kernel, keys_kernel, temporal_kernel, shade_kernel] = self.kernels;
         let timed = self.timed && backend.info().timestamps;
         let mut pass_times = [std::time::Duration::ZERO; 5];
         let run =
@@ -259,7 +286,35 @@ impl RestirRenderer {
                 ],
             ),
         )?;
-        pass_times[3] = run(
+        // Temporal sources, and with T > 1 their histogram (the spatial histogram's runs
+        // stand in for it when unused: the merge reads them only with T > 1).
+        let temporal_on = self.settings.temporal && self.frame > 0;
+        if temporal_on {
+            pass_times[3] = run(
+                backend,
+                keys_kernel,
+                &with(
+                    keys_kernel,
+                    &[
+                        (9, self.primaries[current]),
+                        (10, self.primaries[previous_index]),
+                        (11, self.reservoirs[previous_index]),
+                        (12, self.temporal_keys_buffer()),
+                        (13, self.temporal_sources),
+                    ],
+                ),
+            )?;
+            if let Some(temporal) = &self.temporal_histogram {
+                pass_times[3] += if timed {
+                    temporal.dispatch_timed(backend)?
+                } else {
+                    temporal.dispatch(backend)?;
+                    std::time::Duration::ZERO
+                };
+            }
+        }
+        let temporal_runs = self.temporal_histogram.as_ref().unwrap_or(&self.histogram);
+        pass_times[3] += run(
             backend,
             temporal_kernel,
             &with(
@@ -270,6 +325,10 @@ impl RestirRenderer {
                     (11, self.selected),
                     (12, self.reservoirs[previous_index]),
                     (13, self.reservoirs[current]),
+                    (14, temporal_runs.sorted_pixels),
+                    (15, temporal_runs.spans),
+                    (16, self.temporal_sources),
+                    (17, self.numbers),
                 ],
             ),
         )?;
@@ -310,9 +369,17 @@ impl RestirRenderer {
             histogram_candidates: download(backend, self.histogram.candidates)?,
             base_radiance: download(backend, self.base_radiance)?,
             selected: download(backend, self.selected)?,
+            temporal_keys: download(backend, self.temporal_keys_buffer())?,
+            temporal_sources: download(backend, self.temporal_sources)?,
             reservoirs: download(backend, self.reservoirs[last])?,
             image: download(backend, self.frame_out)?,
         })
+    }
+
+    /// Where `restir_temporal_keys` writes: the temporal histogram's input, or a buffer
+    /// of its own without one.
+    fn temporal_keys_buffer(&self) -> BufferId {
+        self.temporal_histogram.as_ref().map_or(self.temporal_keys, |histogram| histogram.candidates)
     }
 
     /// The histogram candidates of the last frame (key and object id per pixel).
@@ -324,7 +391,12 @@ impl RestirRenderer {
     pub fn destroy(self, backend: &mut dyn Backend) -> Result<(), PassError> {
         self.scene.destroy(backend)?;
         self.histogram.destroy(backend)?;
+        if let Some(temporal) = self.temporal_histogram {
+            temporal.destroy(backend)?;
+        }
         let buffers = [
+            self.temporal_sources,
+            self.temporal_keys,
             self.render_params,
             self.restir_params,
             self.primaries[0],

@@ -59,6 +59,12 @@ pub struct RestirSettings {
     /// Merge each frame's reservoir with the previous frame's (temporal reuse). Off: each
     /// frame stands alone (the accumulation mode of Fig. 5 / 10). Default on.
     pub temporal: bool,
+    /// T, previous reservoirs merged per pixel (1 to 4). 1: the reprojected pixel's
+    /// (standard temporal reuse). 2-4: the paper's Fig. 11, temporal reservoirs drawn like
+    /// spatial candidates: strata from a histogram of the block's reprojected reservoirs
+    /// at stratified positions (sampler dimensions 2 and 3), restir uniformly from the
+    /// same cluster, restir-disc from a disc; each costs 2 shadow rays. Default 1.
+    pub temporal_candidates: u32,
     /// Cap of the previous reservoir's M before a merge; beyond it the history decays as
     /// an exponential moving average. Higher: more reuse, slower reaction. Default 20.
     pub temporal_cap: f32,
@@ -84,6 +90,7 @@ impl Default for RestirSettings {
             block_size: 16,
             masking: true,
             block_shift: false,
+            temporal_candidates: 1,
             temporal: true,
             temporal_cap: 20.0,
             disc_radius: 30.0,
@@ -105,6 +112,9 @@ impl RestirSettings {
                 "block size {}: must be 4, 8, 16 or 32 (a power of two the histogram kernel holds)",
                 self.block_size
             )));
+        }
+        if !(1..=4).contains(&self.temporal_candidates) {
+            return Err(PassError::Input(format!("temporal candidates {}: must be 1 to 4", self.temporal_candidates)));
         }
         if !(self.temporal_cap >= 1.0 && self.temporal_cap.is_finite()) {
             return Err(PassError::Input(format!("temporal cap {}: must be at least 1", self.temporal_cap)));

@@ -36,8 +36,9 @@
 //   11 storage, read     array<u32>            the histogram's sorted_pixels
 //   12 storage, read     array<ClusterSpan>    the histogram's per-pixel cluster run
 //   13 storage, rw       array<Reservoir>      this frame's reservoir per pixel (M = 1)
-//   14 storage, read     array<vec4<f32>>      per pixel two entries: [2p] the K <= 4 selection
-//                                          positions, [2p + 1].x the resampling number
+//   14 storage, read     array<vec4<f32>>      per pixel three entries: [3p] the K <= 4 selection
+//                                          positions, [3p + 1].x the resampling number
+//                                          (.y and [3p + 2]: restir_temporal's)
 //
 // Dispatch: 8 x 8 pixels per workgroup. Shadow rays: up to 2K per pixel.
 
@@ -99,8 +100,8 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
         return;
     }
     rng_seed(pixel, params.sample_index, params.seed ^ 0x5e1ec7u);
-    let positions = selection_numbers[2u * pixel];
-    let resample_number = selection_numbers[2u * pixel + 1u].x;
+    let positions = selection_numbers[3u * pixel];
+    let resample_number = selection_numbers[3u * pixel + 1u].x;
     let k = min(restir.candidates, MAX_CANDIDATES);
     let c = path_candidates[pixel];
     // p̂_i(x_c) W_c: the canonical candidate was found from y1, so it is visible.

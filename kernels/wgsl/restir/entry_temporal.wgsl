@@ -1,50 +1,56 @@
-// ReSTIR pass 4: temporal reuse. Each resampling pixel merges this frame's reservoir
-// with the previous frame's reservoir of the pixel its primary hit reprojects to
-// (RestirParams.previous_* camera), unless that pixel saw another object, faces another
-// way (normals beyond 25 degrees) or lies at another depth (10 %): a disocclusion keeps
-// the current reservoir alone. The previous M is capped first, M_prev <- min(M_prev,
-// temporal_cap) (paper §5.1: cap 20); merging with weights M_prev and M_cur = 1 then makes
-// the history an exponential moving average with factor cap / (cap + 1) once the cap is
-// reached, which is the paper's EMA beyond the cap.
+// ReSTIR pass 4b: temporal reuse. Each resampling pixel merges this frame's reservoir c
+// (restir_select) with T previous reservoirs (RestirParams.temporal_candidates):
+//   T = 1   the previous reservoir of its own temporal source (restir_temporal_keys: the
+//           reprojected pixel, unless disoccluded), for every method;
+//   T = 2-4 (paper Fig. 11) T temporal candidates drawn like the spatial ones: strata
+//           from its cluster's run of the temporal histogram (the block's reprojected
+//           reservoirs sorted by p̂ W) at the temporal sampler positions, restir uniformly
+//           from the same run, restir-disc from random pixels within disc_radius with a
+//           similar normal and depth; each drawn pixel contributes its temporal source's
+//           reservoir (none: an empty slot).
+// Each previous M is capped first, M_j <- min(M_j, temporal_cap) (paper §5.1: cap 20);
+// with M_c = 1 the history becomes an exponential moving average with factor
+// cap / (cap + 1) once the cap is reached (the paper's EMA beyond the cap).
 //
-// Weights: generalized balance heuristic with the targets as densities (Lin et al. 2022):
-//   m_cur(y)  = M_cur p̂_cur(y) / (M_cur p̂_cur(y) + M_prev p̂_prev(y))
-//   m_prev(y) = M_prev p̂_prev(y) / (M_cur p̂_cur(y) + M_prev p̂_prev(y))
-// with p̂_prev evaluated at the previous frame's primary hit (visibility included);
-// w = m(y) p̂_cur(y) W; one sample is kept in proportion to w; W = sum(w) / p̂_cur(Y).
+// Weights: pairwise MIS with confidence weights between c and each slot j, the targets as
+// densities, each pair sharing 1/T (Lin et al. 2022; for T = 1 this is the generalized
+// balance heuristic):
+//   w_c = sum_j (1/T) M_c p̂_c(y_c) / (M_c p̂_c(y_c) + M_j p̂_j(y_c)) p̂_c(y_c) W_c
+//   w_j = (1/T) M_j p̂_j(y_j) / (M_c p̂_c(y_j) + M_j p̂_j(y_j)) p̂_c(y_j) W_j
+// with p̂_j evaluated at the source's previous primary hit (visibility included) and an
+// empty slot giving c its whole share. Each pair term depends on c and j only and every
+// drawing pattern gives each run member the expected count T/n, so the merge stays
+// unbiased whatever the sort did (as for the spatial selection). One sample is kept in
+// proportion to w: by inverse CDF with the temporal resampling number for strata with
+// T > 1, by a streaming reservoir otherwise; W = sum(w) / p̂_c(Y); M = M_c + mean_j M_j.
 // The shift is the identity on x2 (area measure) or on the direction (environment).
 //
 // Bindings (group 0): 0-7 the scene, 8 RestirParams, and
-//   9  storage, read     array<Primary>    this frame's G-buffer
-//   10 storage, read     array<Primary>    the previous frame's G-buffer
-//   11 storage, read     array<Reservoir>  this frame's reservoirs (restir_select)
-//   12 storage, read     array<Reservoir>  the previous frame's final reservoirs
-//   13 storage, rw       array<Reservoir>  this frame's final reservoirs
+//   9  storage, read     array<Primary>      this frame's G-buffer
+//   10 storage, read     array<Primary>      the previous frame's G-buffer
+//   11 storage, read     array<Reservoir>    this frame's reservoirs (restir_select)
+//   12 storage, read     array<Reservoir>    the previous frame's final reservoirs
+//   13 storage, rw       array<Reservoir>    this frame's final reservoirs
+//   14 storage, read     array<u32>          the temporal histogram's sorted_pixels
+//   15 storage, read     array<ClusterSpan>  the temporal histogram's spans
+//   16 storage, read     array<u32>          temporal sources (restir_temporal_keys)
+//   17 storage, read     array<vec4<f32>>    selection numbers: [3p + 2] the T temporal
+//                                            positions, [3p + 1].y the temporal resampling number
 //
-// Dispatch: 8 x 8 pixels per workgroup. Shadow rays: 2 per merging pixel.
+// Dispatch: 8 x 8 pixels per workgroup. Shadow rays: 2 per merged slot.
 
 @group(0) @binding(9) var<storage, read> primaries: array<Primary>;
 @group(0) @binding(10) var<storage, read> previous_primaries: array<Primary>;
 @group(0) @binding(11) var<storage, read> current_reservoirs: array<Reservoir>;
 @group(0) @binding(12) var<storage, read> previous_reservoirs: array<Reservoir>;
 @group(0) @binding(13) var<storage, read_write> merged_reservoirs: array<Reservoir>;
+@group(0) @binding(14) var<storage, read> temporal_sorted_pixels: array<u32>;
+@group(0) @binding(15) var<storage, read> temporal_spans: array<ClusterSpan>;
+@group(0) @binding(16) var<storage, read> temporal_sources: array<u32>;
+@group(0) @binding(17) var<storage, read> selection_numbers: array<vec4<f32>>;
 
-// The previous frame's pixel that saw `position`, or 0xffffffff outside its image.
-fn reproject(position: vec3<f32>) -> u32 {
-    let d = position - restir.previous_origin;
-    let z = dot(d, restir.previous_forward);
-    if z <= 0.0 {
-        return 0xffffffffu;
-    }
-    let sx = dot(d, restir.previous_right) / (z * restir.previous_tan_half_x);
-    let sy = dot(d, restir.previous_up) / (z * restir.previous_tan_half_y);
-    let px = (sx + 1.0) * 0.5 * f32(params.width);
-    let py = (1.0 - sy) * 0.5 * f32(params.height);
-    if !(px >= 0.0 && py >= 0.0 && px < f32(params.width) && py < f32(params.height)) {
-        return 0xffffffffu;
-    }
-    return u32(py) * params.width + u32(px);
-}
+const NO_SOURCE: u32 = 0xffffffffu;
+const MAX_TEMPORAL: u32 = 4u;
 
 // p̂ of `y` at primary hit `p`: luminance of its contribution, visibility included.
 fn target_at(p: Primary, y: PathCandidate, lane: u32) -> f32 {
@@ -56,6 +62,40 @@ fn target_at(p: Primary, y: PathCandidate, lane: u32) -> f32 {
         return value;
     }
     return 0.0;
+}
+
+// The previous frame's pixel whose reservoir temporal slot `slot` of pixel (x, y) merges,
+// or NO_SOURCE for an empty slot.
+fn temporal_source(x: u32, y: u32, pixel: u32, p: Primary, slot: u32, positions: vec4<f32>) -> u32 {
+    if restir.temporal_candidates <= 1u {
+        return temporal_sources[pixel];
+    }
+    if restir.method == METHOD_RESTIR_DISC {
+        let r = restir.disc_radius * sqrt(random());
+        let phi = 2.0 * PI * random();
+        let qx = i32(floor(f32(x) + 0.5 + r * cos(phi)));
+        let qy = i32(floor(f32(y) + 0.5 + r * sin(phi)));
+        if qx < 0 || qy < 0 || qx >= i32(params.width) || qy >= i32(params.height) {
+            return NO_SOURCE;
+        }
+        let q = u32(qy) * params.width + u32(qx);
+        let n = primaries[q];
+        if (n.flags & PRIMARY_RESAMPLE) == 0u || dot(n.normal, p.normal) < 0.906
+            || abs(n.depth - p.depth) > 0.1 * p.depth {
+            return NO_SOURCE;
+        }
+        return temporal_sources[q];
+    }
+    let span = temporal_spans[pixel];
+    let n = span.length;
+    if n == 0u {
+        return NO_SOURCE;
+    }
+    var position = positions[slot];
+    if restir.method == METHOD_RESTIR {
+        position = random();
+    }
+    return temporal_sources[temporal_sorted_pixels[span.offset + min(u32(floor(position * f32(n))), n - 1u)]];
 }
 
 @compute @workgroup_size(8, 8)
@@ -70,51 +110,90 @@ fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
     if restir.temporal == 0u || (p.flags & PRIMARY_RESAMPLE) == 0u {
         return;
     }
-    let q = reproject(p.position);
-    if q == 0xffffffffu {
-        return;
-    }
-    let previous_primary = previous_primaries[q];
-    if (previous_primary.flags & PRIMARY_RESAMPLE) == 0u || previous_primary.object_id != p.object_id
-        || dot(previous_primary.normal, p.normal) < 0.906 || abs(previous_primary.depth - p.depth) > 0.1 * p.depth {
-        return;
-    }
-    let previous = previous_reservoirs[q];
-    let m_previous = min(previous.count, restir.temporal_cap);
-    let m_current = current.count;
-    if !(m_previous > 0.0) {
-        return;
-    }
     rng_seed(pixel, params.sample_index, params.seed ^ 0x7e3907u);
-    // The current sample: its target here is stored; there, evaluate it.
+    let slots = clamp(restir.temporal_candidates, 1u, MAX_TEMPORAL);
+    let share = 1.0 / f32(slots);
+    let positions = selection_numbers[3u * pixel + 2u];
+    let m_current = current.count;
+    let target_current = current.target_value;
     var weight_current = 0.0;
-    if current.target_value > 0.0 {
-        let there = target_at(previous_primary, current.sample, lane);
-        let m = m_current * current.target_value / (m_current * current.target_value + m_previous * there);
-        weight_current = m * current.target_value * current.weight;
-    }
-    // The previous sample shifted here.
-    var weight_previous = 0.0;
-    var target_previous_here = 0.0;
-    if previous.target_value > 0.0 {
-        target_previous_here = target_at(p, previous.sample, lane);
-        if target_previous_here > 0.0 {
-            let m = m_previous * previous.target_value
-                / (m_current * target_previous_here + m_previous * previous.target_value);
-            weight_previous = m * target_previous_here * previous.weight;
+    // Per slot: resampling weight, target here, source pixel.
+    var weights = vec4<f32>(0.0);
+    var targets = vec4<f32>(0.0);
+    var sources = vec4<u32>(NO_SOURCE);
+    var m_sum = 0.0;
+    for (var slot = 0u; slot < slots; slot++) {
+        let s = temporal_source(id.x, id.y, pixel, p, slot, positions);
+        var m_previous = 0.0;
+        var previous = current;
+        if s != NO_SOURCE {
+            previous = previous_reservoirs[s];
+            m_previous = min(previous.count, restir.temporal_cap);
+        }
+        if !(m_previous > 0.0) {
+            // An empty slot: the current reservoir alone covers its share.
+            weight_current += share * target_current * current.weight;
+            continue;
+        }
+        m_sum += m_previous;
+        let previous_primary = previous_primaries[s];
+        // The current sample's half: its target here is stored; there, evaluate it.
+        if target_current > 0.0 {
+            let there = target_at(previous_primary, current.sample, lane);
+            let m = m_current * target_current / (m_current * target_current + m_previous * there);
+            weight_current += share * m * target_current * current.weight;
+        }
+        // The previous sample shifted here.
+        if previous.target_value > 0.0 {
+            let here = target_at(p, previous.sample, lane);
+            if here > 0.0 {
+                let m = m_previous * previous.target_value / (m_current * here + m_previous * previous.target_value);
+                weights[slot] = share * m * here * previous.weight;
+                targets[slot] = here;
+                sources[slot] = s;
+            }
         }
     }
-    let total = weight_current + weight_previous;
+    var total = weight_current;
+    for (var slot = 0u; slot < slots; slot++) {
+        total += weights[slot];
+    }
     var merged = current;
-    merged.count = m_current + m_previous;
+    merged.count = m_current + m_sum * share;
     if !(total > 0.0) || !(total < INFINITY) {
         merged.weight = 0.0;
         merged_reservoirs[pixel] = merged;
         return;
     }
-    if random() * total < weight_previous {
-        merged.sample = previous.sample;
-        merged.target_value = target_previous_here;
+    var chosen = MAX_TEMPORAL;
+    if restir.method == METHOD_STRATA && slots > 1u {
+        // Inverse CDF with the temporal resampling number; rounding may leave u past the
+        // last partial sum: then the last slot of positive weight is taken.
+        let u = selection_numbers[3u * pixel + 1u].y * total;
+        var running = weight_current;
+        var found = u < running;
+        for (var slot = 0u; slot < slots; slot++) {
+            if !found && weights[slot] > 0.0 {
+                running += weights[slot];
+                chosen = slot;
+                found = u < running;
+            }
+        }
+    } else {
+        // Streaming weighted reservoir sampling, in slot order after the current sample.
+        var running = weight_current;
+        for (var slot = 0u; slot < slots; slot++) {
+            if weights[slot] > 0.0 {
+                running += weights[slot];
+                if random() * running < weights[slot] {
+                    chosen = slot;
+                }
+            }
+        }
+    }
+    if chosen < MAX_TEMPORAL {
+        merged.sample = previous_reservoirs[sources[chosen]].sample;
+        merged.target_value = targets[chosen];
     }
     merged.weight = total / merged.target_value;
     merged_reservoirs[pixel] = merged;

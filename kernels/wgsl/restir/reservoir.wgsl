@@ -51,7 +51,9 @@ struct RestirParams {
     previous_forward: vec3<f32>,
     previous_tan_half_y: f32,
     previous_right: vec3<f32>,
-    _pad0: u32,
+    // T: previous reservoirs merged per pixel (1: the reprojected one; 2-4: drawn from the
+    // block's histogram of reprojected reservoirs, Fig. 11).
+    temporal_candidates: u32,
     previous_up: vec3<f32>,
     _pad1: u32,
 }

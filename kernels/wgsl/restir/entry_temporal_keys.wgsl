@@ -1,0 +1,74 @@
+// ReSTIR pass 4a: the temporal candidates. Each resampling pixel finds the previous
+// frame's pixel its primary hit reprojects to (RestirParams.previous_* camera) and keeps
+// it as its temporal source unless that pixel saw another object, faces another way
+// (normals beyond 25 degrees) or lies at another depth (10 %): a disocclusion. For the
+// multiple-temporal-reservoir mode (paper Fig. 11: "sampling temporal reservoirs
+// similarly to spatial candidates"), it also writes the histogram input of the temporal
+// candidates: key = luminance of the source reservoir's own estimate p̂ W (its f(Y) W),
+// cluster = the pixel's object id (§4.3). A pixel without a source keeps its cluster with
+// an invalid key (it sorts last in the run; drawing it gives an empty slot), so a
+// disoccluded pixel can still draw its neighbours' histories.
+//
+// Bindings (group 0): 0-7 the scene, 8 RestirParams, and
+//   9  storage, read     array<Primary>    this frame's G-buffer
+//   10 storage, read     array<Primary>    the previous frame's G-buffer
+//   11 storage, read     array<Reservoir>  the previous frame's final reservoirs
+//   12 storage, rw       array<Candidate>  the temporal histogram's input
+//   13 storage, rw       array<u32>        per pixel its temporal source pixel (0xffffffff: none)
+//
+// Dispatch: 8 x 8 pixels per workgroup.
+
+@group(0) @binding(9) var<storage, read> primaries: array<Primary>;
+@group(0) @binding(10) var<storage, read> previous_primaries: array<Primary>;
+@group(0) @binding(11) var<storage, read> previous_reservoirs: array<Reservoir>;
+@group(0) @binding(12) var<storage, read_write> temporal_keys: array<Candidate>;
+@group(0) @binding(13) var<storage, read_write> temporal_sources: array<u32>;
+
+const NO_SOURCE: u32 = 0xffffffffu;
+
+// The previous frame's pixel that saw `position`, or NO_SOURCE outside its image.
+fn reproject(position: vec3<f32>) -> u32 {
+    let d = position - restir.previous_origin;
+    let z = dot(d, restir.previous_forward);
+    if z <= 0.0 {
+        return NO_SOURCE;
+    }
+    let sx = dot(d, restir.previous_right) / (z * restir.previous_tan_half_x);
+    let sy = dot(d, restir.previous_up) / (z * restir.previous_tan_half_y);
+    let px = (sx + 1.0) * 0.5 * f32(params.width);
+    let py = (1.0 - sy) * 0.5 * f32(params.height);
+    if !(px >= 0.0 && py >= 0.0 && px < f32(params.width) && py < f32(params.height)) {
+        return NO_SOURCE;
+    }
+    return u32(py) * params.width + u32(px);
+}
+
+@compute @workgroup_size(8, 8)
+fn restir_temporal_keys(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= params.width || id.y >= params.height {
+        return;
+    }
+    let pixel = id.y * params.width + id.x;
+    let p = primaries[pixel];
+    var source = NO_SOURCE;
+    var key = -1.0;
+    var object = OBJECT_ID_NONE;
+    if restir.temporal != 0u && (p.flags & PRIMARY_RESAMPLE) != 0u {
+        object = select(0u, p.object_id, restir.masking != 0u);
+        let q = reproject(p.position);
+        if q != NO_SOURCE {
+            let previous = previous_primaries[q];
+            if (previous.flags & PRIMARY_RESAMPLE) != 0u && previous.object_id == p.object_id
+                && dot(previous.normal, p.normal) >= 0.906 && abs(previous.depth - p.depth) <= 0.1 * p.depth {
+                source = q;
+                let reservoir = previous_reservoirs[q];
+                let estimate = reservoir.target_value * reservoir.weight;
+                if estimate >= 0.0 && estimate < INFINITY {
+                    key = estimate;
+                }
+            }
+        }
+    }
+    temporal_keys[pixel] = Candidate(key, object);
+    temporal_sources[pixel] = source;
+}

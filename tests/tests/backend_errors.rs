@@ -4,7 +4,7 @@
 use strata::histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};
 use strata_backends::wgpu_backend::{WgpuApi, WgpuOptions};
 use strata_backends::{Backend, BackendError, Bind};
-use strata_kernels::types::Candidate;
+use strata_kernels::types::{Candidate, HistogramParams};
 use strata_kernels::{BlockGrid, GridError, KernelId, Registry};
 use strata_tests::{open_or_skip, vulkan_backend};
 
@@ -55,7 +55,8 @@ fn bindings_that_do_not_fit_the_kernel_are_named() {
     let mut too_small = binds.clone();
     too_small[0] = Bind::new(0, small);
     let error = backend.dispatch(kernel, &too_small, [1, 1, 1]).unwrap_err();
-    assert!(error.to_string().contains("`params` needs at least 32 bytes"), "{error}");
+    let params_bytes = std::mem::size_of::<HistogramParams>();
+    assert!(error.to_string().contains(&format!("`params` needs at least {params_bytes} bytes")), "{error}");
 
     let limit = backend.info().limits.max_workgroups_per_dimension;
     let error = backend.dispatch(kernel, &binds, [limit + 1, 1, 1]).unwrap_err();

@@ -81,9 +81,9 @@ struct CompareArgs {
     /// No temporal reuse: frames are accumulated instead (Fig. 5 / 10).
     #[arg(long)]
     accumulate: bool,
-    /// Previous reservoirs merged per pixel, 1 to 4 (2-4: drawn like spatial candidates,
-    /// the paper's Fig. 11).
-    #[arg(long, default_value_t = 1)]
+    /// Previous reservoirs drawn per pixel like spatial candidates (the paper's Fig. 11),
+    /// 0 to 4, merged besides the pixel's own reprojected one.
+    #[arg(long, default_value_t = 0)]
     temporal_candidates: u32,
     /// Shift the block grid by a different offset every frame.
     #[arg(long)]

@@ -54,7 +54,7 @@ pub struct RestirParams {
     pub previous_tan_half_y: f32,
     /// Previous frame's right vector.
     pub previous_right: [f32; 3],
-    /// T, previous reservoirs merged per pixel (1 to 4).
+    /// T, previous reservoirs drawn per pixel besides its own (0 to 4).
     pub temporal_candidates: u32,
     /// Previous frame's up vector.
     pub previous_up: [f32; 3],

@@ -61,11 +61,11 @@ pub struct RestirRenderer {
     params: RenderParams,
     scene: SceneBuffers,
     histogram: BlockHistogramPass,
-    /// The histogram of the temporal candidates (T > 1 with a histogram method).
+    /// The histogram of the temporal candidates (T > 0 with a histogram method).
     temporal_histogram: Option<BlockHistogramPass>,
     /// Per pixel its temporal source pixel (`restir_temporal_keys`).
     temporal_sources: BufferId,
-    /// The temporal keys when there is no temporal histogram to hold them (T = 1).
+    /// The temporal keys when there is no temporal histogram to hold them (T = 0).
     temporal_keys: BufferId,
     tables: BlueNoiseTables,
     render_params: BufferId,
@@ -116,7 +116,7 @@ impl RestirRenderer {
         }
         let grid = BlockGrid::new(camera.width, camera.height, settings.block_size)?;
         let histogram = BlockHistogramPass::new(backend, HistogramVariant::Auto, grid)?;
-        let temporal_histogram = if settings.temporal_candidates > 1 && settings.method.uses_histogram() {
+        let temporal_histogram = if settings.temporal_candidates > 0 && settings.method.uses_histogram() {
             Some(BlockHistogramPass::new(backend, HistogramVariant::Auto, grid)?)
         } else {
             None
@@ -286,8 +286,8 @@ impl RestirRenderer {
                 ],
             ),
         )?;
-        // Temporal sources, and with T > 1 their histogram (the spatial histogram's runs
-        // stand in for it when unused: the merge reads them only with T > 1).
+        // Temporal sources, and with T > 0 their histogram (the spatial histogram's runs
+        // stand in for it when unused: the merge reads them only with T > 0).
         let temporal_on = self.settings.temporal && self.frame > 0;
         if temporal_on {
             pass_times[3] = run(

@@ -59,11 +59,12 @@ pub struct RestirSettings {
     /// Merge each frame's reservoir with the previous frame's (temporal reuse). Off: each
     /// frame stands alone (the accumulation mode of Fig. 5 / 10). Default on.
     pub temporal: bool,
-    /// T, previous reservoirs merged per pixel (1 to 4). 1: the reprojected pixel's
-    /// (standard temporal reuse). 2-4: the paper's Fig. 11, temporal reservoirs drawn like
-    /// spatial candidates: strata from a histogram of the block's reprojected reservoirs
-    /// at stratified positions (sampler dimensions 2 and 3), restir uniformly from the
-    /// same cluster, restir-disc from a disc; each costs 2 shadow rays. Default 1.
+    /// T, previous reservoirs drawn per pixel (0 to 4) and merged besides the pixel's own
+    /// reprojected one. 0: standard temporal reuse. 1-4: the paper's Fig. 11, temporal
+    /// reservoirs drawn like spatial candidates: strata from a histogram of the block's
+    /// reprojected reservoirs at stratified positions (sampler dimensions 2 and 3),
+    /// restir uniformly from the same cluster, restir-disc from a disc; each costs 2
+    /// shadow rays and lets disoccluded pixels use their neighbours' histories. Default 0.
     pub temporal_candidates: u32,
     /// Cap of the previous reservoir's M before a merge; beyond it the history decays as
     /// an exponential moving average. Higher: more reuse, slower reaction. Default 20.
@@ -90,7 +91,7 @@ impl Default for RestirSettings {
             block_size: 16,
             masking: true,
             block_shift: false,
-            temporal_candidates: 1,
+            temporal_candidates: 0,
             temporal: true,
             temporal_cap: 20.0,
             disc_radius: 30.0,
@@ -113,8 +114,8 @@ impl RestirSettings {
                 self.block_size
             )));
         }
-        if !(1..=4).contains(&self.temporal_candidates) {
-            return Err(PassError::Input(format!("temporal candidates {}: must be 1 to 4", self.temporal_candidates)));
+        if self.temporal_candidates > 4 {
+            return Err(PassError::Input(format!("temporal candidates {}: must be 0 to 4", self.temporal_candidates)));
         }
         if !(self.temporal_cap >= 1.0 && self.temporal_cap.is_finite()) {
             return Err(PassError::Input(format!("temporal cap {}: must be at least 1", self.temporal_cap)));

@@ -1,28 +1,30 @@
 // ReSTIR pass 4b: temporal reuse. Each resampling pixel merges this frame's reservoir c
-// (restir_select) with T previous reservoirs (RestirParams.temporal_candidates):
-//   T = 1   the previous reservoir of its own temporal source (restir_temporal_keys: the
-//           reprojected pixel, unless disoccluded), for every method;
-//   T = 2-4 (paper Fig. 11) T temporal candidates drawn like the spatial ones: strata
-//           from its cluster's run of the temporal histogram (the block's reprojected
-//           reservoirs sorted by p̂ W) at the temporal sampler positions, restir uniformly
-//           from the same run, restir-disc from random pixels within disc_radius with a
-//           similar normal and depth; each drawn pixel contributes its temporal source's
-//           reservoir (none: an empty slot).
+// (restir_select) with the previous reservoir of its own temporal source
+// (restir_temporal_keys: the reprojected pixel, unless disoccluded) and, with
+// T = RestirParams.temporal_candidates of 1 to 4 (paper Fig. 11), T more previous
+// reservoirs drawn like the spatial candidates: strata from its cluster's run of the
+// temporal histogram (the block's reprojected reservoirs sorted by p̂ W) at the temporal
+// sampler positions, restir uniformly from the same run, restir-disc from random pixels
+// within disc_radius with a similar normal and depth; each drawn pixel contributes its
+// temporal source's reservoir (none: an empty slot). The own reservoir stays in: in a
+// static view it is the best-matched history, and replacing it by neighbours' raised the
+// error (measured, BENCHMARKS.md).
 // Each previous M is capped first, M_j <- min(M_j, temporal_cap) (paper §5.1: cap 20);
 // with M_c = 1 the history becomes an exponential moving average with factor
 // cap / (cap + 1) once the cap is reached (the paper's EMA beyond the cap).
 //
-// Weights: pairwise MIS with confidence weights between c and each slot j, the targets as
-// densities, each pair sharing 1/T (Lin et al. 2022; for T = 1 this is the generalized
-// balance heuristic):
-//   w_c = sum_j (1/T) M_c p̂_c(y_c) / (M_c p̂_c(y_c) + M_j p̂_j(y_c)) p̂_c(y_c) W_c
-//   w_j = (1/T) M_j p̂_j(y_j) / (M_c p̂_c(y_j) + M_j p̂_j(y_j)) p̂_c(y_j) W_j
+// Weights: pairwise MIS with confidence weights between c and each of the S = 1 + T
+// previous reservoirs j, the targets as densities, each pair sharing 1/S (Lin et al.
+// 2022; with T = 0 this is the generalized balance heuristic):
+//   w_c = sum_j (1/S) M_c p̂_c(y_c) / (M_c p̂_c(y_c) + M_j p̂_j(y_c)) p̂_c(y_c) W_c
+//   w_j = (1/S) M_j p̂_j(y_j) / (M_c p̂_c(y_j) + M_j p̂_j(y_j)) p̂_c(y_j) W_j
 // with p̂_j evaluated at the source's previous primary hit (visibility included) and an
-// empty slot giving c its whole share. Each pair term depends on c and j only and every
-// drawing pattern gives each run member the expected count T/n, so the merge stays
-// unbiased whatever the sort did (as for the spatial selection). One sample is kept in
-// proportion to w: by inverse CDF with the temporal resampling number for strata with
-// T > 1, by a streaming reservoir otherwise; W = sum(w) / p̂_c(Y); M = M_c + mean_j M_j.
+// empty slot giving c its whole share. Each pair term depends on c and j only, the own
+// pair is always there and every drawing pattern gives each run member the expected count
+// T/n, so the merge stays unbiased whatever the sort did (as for the spatial selection).
+// One sample is kept in proportion to w: by inverse CDF with the temporal resampling
+// number for strata with T > 0, by a streaming reservoir otherwise; W = sum(w) / p̂_c(Y);
+// M = M_c + mean_j M_j.
 // The shift is the identity on x2 (area measure) or on the direction (environment).
 //
 // Bindings (group 0): 0-7 the scene, 8 RestirParams, and
@@ -37,7 +39,7 @@
 //   17 storage, read     array<vec4<f32>>    selection numbers: [3p + 2] the T temporal
 //                                            positions, [3p + 1].y the temporal resampling number
 //
-// Dispatch: 8 x 8 pixels per workgroup. Shadow rays: 2 per merged slot.
+// Dispatch: 8 x 8 pixels per workgroup. Shadow rays: 2 per merged previous reservoir.
 
 @group(0) @binding(9) var<storage, read> primaries: array<Primary>;
 @group(0) @binding(10) var<storage, read> previous_primaries: array<Primary>;
@@ -64,12 +66,9 @@ fn target_at(p: Primary, y: PathCandidate, lane: u32) -> f32 {
     return 0.0;
 }
 
-// The previous frame's pixel whose reservoir temporal slot `slot` of pixel (x, y) merges,
-// or NO_SOURCE for an empty slot.
-fn temporal_source(x: u32, y: u32, pixel: u32, p: Primary, slot: u32, positions: vec4<f32>) -> u32 {
-    if restir.temporal_candidates <= 1u {
-        return temporal_sources[pixel];
-    }
+// The previous frame's pixel whose reservoir drawn temporal slot `slot` of pixel (x, y)
+// merges, or NO_SOURCE for an empty slot.
+fn drawn_source(x: u32, y: u32, pixel: u32, p: Primary, slot: u32, positions: vec4<f32>) -> u32 {
     if restir.method == METHOD_RESTIR_DISC {
         let r = restir.disc_radius * sqrt(random());
         let phi = 2.0 * PI * random();
@@ -98,6 +97,51 @@ fn temporal_source(x: u32, y: u32, pixel: u32, p: Primary, slot: u32, positions:
     return temporal_sources[temporal_sorted_pixels[span.offset + min(u32(floor(position * f32(n))), n - 1u)]];
 }
 
+// One pair (current c, previous reservoir of source s) of the merge, each pair sharing
+// `share`: c's half goes to `current_part`, the previous sample's resampling weight and
+// target here to `weight` and `target_here`, its capped M to `m`.
+struct PairTerms {
+    current_part: f32,
+    weight: f32,
+    target_here: f32,
+    m: f32,
+}
+
+fn pair_terms(p: Primary, current: Reservoir, s: u32, share: f32, lane: u32) -> PairTerms {
+    var terms = PairTerms(0.0, 0.0, 0.0, 0.0);
+    var m_previous = 0.0;
+    var previous = current;
+    if s != NO_SOURCE {
+        previous = previous_reservoirs[s];
+        m_previous = min(previous.count, restir.temporal_cap);
+    }
+    let target_current = current.target_value;
+    if !(m_previous > 0.0) {
+        // An empty slot: the current reservoir alone covers its share.
+        terms.current_part = share * target_current * current.weight;
+        return terms;
+    }
+    terms.m = m_previous;
+    let m_current = current.count;
+    let previous_primary = previous_primaries[s];
+    // The current sample's half: its target here is stored; there, evaluate it.
+    if target_current > 0.0 {
+        let there = target_at(previous_primary, current.sample, lane);
+        let m = m_current * target_current / (m_current * target_current + m_previous * there);
+        terms.current_part = share * m * target_current * current.weight;
+    }
+    // The previous sample shifted here.
+    if previous.target_value > 0.0 {
+        let here = target_at(p, previous.sample, lane);
+        if here > 0.0 {
+            let m = m_previous * previous.target_value / (m_current * here + m_previous * previous.target_value);
+            terms.weight = share * m * here * previous.weight;
+            terms.target_here = here;
+        }
+    }
+    return terms;
+}
+
 @compute @workgroup_size(8, 8)
 fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     if id.x >= params.width || id.y >= params.height {
@@ -111,68 +155,54 @@ fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
         return;
     }
     rng_seed(pixel, params.sample_index, params.seed ^ 0x7e3907u);
-    let slots = clamp(restir.temporal_candidates, 1u, MAX_TEMPORAL);
-    let share = 1.0 / f32(slots);
+    let drawn = min(restir.temporal_candidates, MAX_TEMPORAL);
+    let share = 1.0 / f32(1u + drawn);
+    // The pixel's own reprojected reservoir.
+    let own_source = temporal_sources[pixel];
+    let own = pair_terms(p, current, own_source, share, lane);
+    var weight_current = own.current_part;
+    var m_sum = own.m;
+    // The drawn ones: per slot resampling weight, target here, source pixel.
     let positions = selection_numbers[3u * pixel + 2u];
-    let m_current = current.count;
-    let target_current = current.target_value;
-    var weight_current = 0.0;
-    // Per slot: resampling weight, target here, source pixel.
     var weights = vec4<f32>(0.0);
     var targets = vec4<f32>(0.0);
     var sources = vec4<u32>(NO_SOURCE);
-    var m_sum = 0.0;
-    for (var slot = 0u; slot < slots; slot++) {
-        let s = temporal_source(id.x, id.y, pixel, p, slot, positions);
-        var m_previous = 0.0;
-        var previous = current;
-        if s != NO_SOURCE {
-            previous = previous_reservoirs[s];
-            m_previous = min(previous.count, restir.temporal_cap);
-        }
-        if !(m_previous > 0.0) {
-            // An empty slot: the current reservoir alone covers its share.
-            weight_current += share * target_current * current.weight;
-            continue;
-        }
-        m_sum += m_previous;
-        let previous_primary = previous_primaries[s];
-        // The current sample's half: its target here is stored; there, evaluate it.
-        if target_current > 0.0 {
-            let there = target_at(previous_primary, current.sample, lane);
-            let m = m_current * target_current / (m_current * target_current + m_previous * there);
-            weight_current += share * m * target_current * current.weight;
-        }
-        // The previous sample shifted here.
-        if previous.target_value > 0.0 {
-            let here = target_at(p, previous.sample, lane);
-            if here > 0.0 {
-                let m = m_previous * previous.target_value / (m_current * here + m_previous * previous.target_value);
-                weights[slot] = share * m * here * previous.weight;
-                targets[slot] = here;
-                sources[slot] = s;
-            }
-        }
+    for (var slot = 0u; slot < drawn; slot++) {
+        let s = drawn_source(id.x, id.y, pixel, p, slot, positions);
+        let terms = pair_terms(p, current, s, share, lane);
+        weight_current += terms.current_part;
+        m_sum += terms.m;
+        weights[slot] = terms.weight;
+        targets[slot] = terms.target_here;
+        sources[slot] = s;
     }
-    var total = weight_current;
-    for (var slot = 0u; slot < slots; slot++) {
+    var total = weight_current + own.weight;
+    for (var slot = 0u; slot < drawn; slot++) {
         total += weights[slot];
     }
     var merged = current;
-    merged.count = m_current + m_sum * share;
+    merged.count = current.count + m_sum * share;
     if !(total > 0.0) || !(total < INFINITY) {
         merged.weight = 0.0;
         merged_reservoirs[pixel] = merged;
         return;
     }
-    var chosen = MAX_TEMPORAL;
-    if restir.method == METHOD_STRATA && slots > 1u {
+    // Choice among (current, own, drawn 0..T-1): OWN or a drawn slot, or none for current.
+    let OWN = MAX_TEMPORAL;
+    let NONE = MAX_TEMPORAL + 1u;
+    var chosen = NONE;
+    if restir.method == METHOD_STRATA && drawn > 0u {
         // Inverse CDF with the temporal resampling number; rounding may leave u past the
-        // last partial sum: then the last slot of positive weight is taken.
+        // last partial sum: then the last entry of positive weight is taken.
         let u = selection_numbers[3u * pixel + 1u].y * total;
         var running = weight_current;
         var found = u < running;
-        for (var slot = 0u; slot < slots; slot++) {
+        if !found && own.weight > 0.0 {
+            running += own.weight;
+            chosen = OWN;
+            found = u < running;
+        }
+        for (var slot = 0u; slot < drawn; slot++) {
             if !found && weights[slot] > 0.0 {
                 running += weights[slot];
                 chosen = slot;
@@ -180,9 +210,15 @@ fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
             }
         }
     } else {
-        // Streaming weighted reservoir sampling, in slot order after the current sample.
+        // Streaming weighted reservoir sampling: current, own, then the drawn slots.
         var running = weight_current;
-        for (var slot = 0u; slot < slots; slot++) {
+        if own.weight > 0.0 {
+            running += own.weight;
+            if random() * running < own.weight {
+                chosen = OWN;
+            }
+        }
+        for (var slot = 0u; slot < drawn; slot++) {
             if weights[slot] > 0.0 {
                 running += weights[slot];
                 if random() * running < weights[slot] {
@@ -191,7 +227,10 @@ fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
             }
         }
     }
-    if chosen < MAX_TEMPORAL {
+    if chosen == OWN {
+        merged.sample = previous_reservoirs[own_source].sample;
+        merged.target_value = own.target_here;
+    } else if chosen < MAX_TEMPORAL {
         merged.sample = previous_reservoirs[sources[chosen]].sample;
         merged.target_value = targets[chosen];
     }

@@ -51,8 +51,8 @@ struct RestirParams {
     previous_forward: vec3<f32>,
     previous_tan_half_y: f32,
     previous_right: vec3<f32>,
-    // T: previous reservoirs merged per pixel (1: the reprojected one; 2-4: drawn from the
-    // block's histogram of reprojected reservoirs, Fig. 11).
+    // T: previous reservoirs drawn per pixel from the block's histogram of reprojected
+    // reservoirs (Fig. 11), 0 to 4, merged besides the pixel's own reprojected one.
     temporal_candidates: u32,
     previous_up: vec3<f32>,
     _pad1: u32,

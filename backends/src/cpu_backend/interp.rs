@@ -43,6 +43,18 @@ fn bool_bits(b: bool) -> u32 {
     u32::from(b)
 }
 
+/// `regs[dst + i] = f(regs[a + i * sa], regs[b + i * sb])` for `i < n`.
+#[inline(always)]
+fn component_wise(
+    regs: &mut [u32],
+    (dst, a, b, n, sa, sb): (usize, usize, usize, usize, usize, usize),
+    f: impl Fn(u32, u32) -> u32,
+) {
+    for i in 0..n {
+        regs[dst + i] = f(regs[a + i * sa], regs[b + i * sb]);
+    }
+}
+
 /// Runs `invocation` until it stops; counts executed instructions into `executed`.
 pub(super) fn run(
     program: &Program,
@@ -83,11 +95,20 @@ pub(super) fn run(
                     };
                 }
                 Insn::BinV { op, dst, a, b, n, sa, sb } => {
-                    let (dst, a, b) = (*dst as usize, *a as usize, *b as usize);
-                    let (sa, sb) = (*sa as usize, *sb as usize);
-                    for i in 0..*n as usize {
-                        regs[dst + i] = op.apply(regs[a + i * sa], regs[b + i * sb]);
+                    let operands = (*dst as usize, *a as usize, *b as usize, *n as usize, *sa as usize, *sb as usize);
+                    // One loop per operator, the operator's match outside it.
+                    macro_rules! per_operator {
+                        ($($variant:ident),*) => {
+                            match op {
+                                $(BinOp::$variant => component_wise(regs, operands, |x, y| BinOp::$variant.apply(x, y)),)*
+                            }
+                        };
                     }
+                    per_operator!(
+                        AddF, SubF, MulF, DivF, ModF, AddI, SubI, MulI, DivU, DivS, ModU, ModS, EqF, NeF, LtF, LeF,
+                        GtF, GeF, Eq, Ne, LtS, LeS, GtS, GeS, LtU, LeU, GtU, GeU, And, Xor, Or, LogicalAnd, LogicalOr,
+                        Shl, ShrU, ShrS
+                    );
                 }
                 Insn::Un { op, dst, src, n } => {
                     for i in 0..*n as usize {

@@ -27,11 +27,11 @@ fn interpreter(c: &mut Criterion) {
     let started = Instant::now();
     pass.dispatch(&mut cpu).expect("dispatch");
     let elapsed = started.elapsed();
-    let expressions = cpu.expressions_in_last_dispatch();
+    let instructions = cpu.instructions_in_last_dispatch();
     eprintln!(
-        "cpu: {expressions} IR expressions in {:.1} ms: {:.1} ns per expression (2 threads)",
+        "cpu: {instructions} bytecode instructions in {:.1} ms: {:.1} ns per instruction (2 threads)",
         elapsed.as_secs_f64() * 1e3,
-        elapsed.as_secs_f64() * 1e9 / expressions as f64
+        elapsed.as_secs_f64() * 1e9 / instructions as f64
     );
     group.bench_function("histogram_128x128/cpu", |b| b.iter(|| pass.dispatch_timed(&mut cpu).expect("dispatch")));
 

@@ -255,6 +255,39 @@ fn main() {
 }
 
 #[test]
+fn barrier_in_nonuniform_control_flow_error_names_line_and_function() {
+    // The barrier is in a small function, which the interpreter inlines into its caller:
+    // the error must still name the barrier's own line and function.
+    let source = r#"
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+var<workgroup> scratch: array<u32, 64>;
+
+fn sync_step(i: u32) {
+    scratch[i] = i;
+    workgroupBarrier();
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(local_invocation_index) i: u32) {
+    if input[i] < 32u {
+        sync_step(i);
+    }
+    output[i] = scratch[i];
+}
+"#;
+    let kernel = Kernel::from_wgsl("nonuniform.wgsl", source.into(), "main", false).unwrap();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let inputs: Vec<u32> = (0..64).collect();
+    let input = upload(&mut cpu, "input", &inputs).unwrap();
+    let output = cpu.create_buffer("output", 256).unwrap();
+    let error = cpu.dispatch(&kernel, &[Bind::new(0, input), Bind::new(1, output)], [1, 1, 1]).unwrap_err();
+    let message = error.to_string();
+    assert!(message.contains("non-uniform control flow"), "{message}");
+    assert!(message.contains("WGSL line 8 in `sync_step`"), "{message}");
+}
+
+#[test]
 fn bad_subgroup_sizes_are_refused() {
     assert!(CpuBackend::new(CpuOptions { subgroup_size: Some(12) }).is_err());
     assert!(CpuBackend::new(CpuOptions { subgroup_size: Some(0) }).is_err());

@@ -2,17 +2,23 @@
 //! division and remainder by zero, masked shift amounts, saturating float→int
 //! conversion, IEEE f32 without fused multiply-add. Values are 32-bit patterns.
 
-use naga::{BinaryOperator, MathFunction, ScalarKind};
+#[cfg(test)]
+use naga::BinaryOperator;
+use naga::{MathFunction, ScalarKind};
 
 fn f(x: u32) -> f32 {
     f32::from_bits(x)
 }
 
+#[cfg(test)]
 fn b(x: bool) -> u32 {
     u32::from(x)
 }
 
 /// `a op b` for one component of kind `kind`; `None` if the operator does not apply.
+/// The reference that the bytecode's resolved operators ([`super::insn::BinOp`]) are
+/// tested against.
+#[cfg(test)]
 pub(super) fn binary(op: BinaryOperator, kind: ScalarKind, a: u32, c: u32) -> Option<u32> {
     use BinaryOperator as B;
     use ScalarKind as K;

@@ -2,12 +2,16 @@
 //! kernels on the CPU. It is the reference executor of the cross-backend check and the
 //! command line's fallback when no GPU adapter exists.
 //!
-//! Each kernel is compiled once into flat per-function programs ([`program`]): a
-//! register slot per expression and ops with jumps. Workgroups run one after another; the
-//! invocations of a workgroup run round-robin from barrier to barrier, each a resumable
-//! stack of frames, so every invocation reaches a barrier before any passes it. A barrier
-//! or subgroup operation reached in non-uniform control flow is an error naming the
-//! line. Subgroup operations run with a configurable subgroup size (1, 8, 32, ...).
+//! Each kernel is compiled once into a register bytecode ([`insn`], compiled by
+//! [`decode`] and [`expression`]): instructions whose operands are word offsets in the
+//! frame's register file, small callees inlined, fields and bitcasts aliasing their
+//! source's registers, compile-time values in a register template. [`interp`] runs it;
+//! [`memory`] is the pointer model. Workgroups run in parallel on the machine's cores;
+//! the invocations of a workgroup run round-robin from barrier to barrier ([`exec`]), each
+//! a resumable stack of frames, so every invocation reaches a barrier before any passes
+//! it. A barrier or subgroup operation reached in non-uniform control flow is an error
+//! naming the line and function. Subgroup operations run with a configurable subgroup
+//! size (1, 8, 32, ...).
 //!
 //! Semantics follow WGSL, not Rust ([`arith`]): wrapping integers, division and remainder
 //! by zero as WGSL defines them, masked shifts, saturating float→int conversion, IEEE
@@ -21,18 +25,20 @@
 //! naming the construct and its WGSL line, never a panic.
 
 mod arith;
+mod decode;
 mod error;
-mod eval;
 mod exec;
+mod expression;
+mod insn;
+mod interp;
 mod matrix;
-mod program;
+mod memory;
 
 use crate::backend::{Backend, Bind, BufferId};
 use crate::bindings_check::{check_binds, check_buffer_size, check_kernel_fits, check_workgroups, check_write};
 use crate::device_info::{DeviceInfo, DeviceLimits};
 use crate::error::BackendError;
-use error::unsupported;
-use exec::Program;
+use decode::Program;
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
 use strata_kernels::{Kernel, KernelId};
@@ -63,7 +69,7 @@ pub struct CpuBackend {
     buffers: HashMap<u64, CpuBuffer>,
     next_buffer: u64,
     programs: HashMap<KernelId, Program>,
-    last_expressions: u64,
+    last_instructions: u64,
 }
 
 impl CpuBackend {
@@ -101,92 +107,27 @@ impl CpuBackend {
             buffers: HashMap::new(),
             next_buffer: 0,
             programs: HashMap::new(),
-            last_expressions: 0,
+            last_instructions: 0,
         })
     }
 
     fn program(&mut self, kernel: &Kernel) -> Result<&Program, BackendError> {
         if let std::collections::hash_map::Entry::Vacant(slot) = self.programs.entry(kernel.id) {
-            slot.insert(build_program(kernel)?);
+            slot.insert(decode::compile_program(kernel)?);
         }
         Ok(&self.programs[&kernel.id])
     }
 
-    /// IR expressions the last dispatch evaluated (for ns-per-expression figures).
-    pub fn expressions_in_last_dispatch(&self) -> u64 {
-        self.last_expressions
+    /// Bytecode instructions the last dispatch executed (for ns-per-instruction
+    /// figures; one instruction stands for one IR expression or statement or less,
+    /// since inlining, register aliasing and compile-time constants remove some).
+    pub fn instructions_in_last_dispatch(&self) -> u64 {
+        self.last_instructions
     }
 
     fn buffer(&self, id: BufferId) -> Result<&CpuBuffer, BackendError> {
         self.buffers.get(&id.0).ok_or(BackendError::UnknownBuffer(id.0))
     }
-}
-
-fn build_program(kernel: &Kernel) -> Result<Program, BackendError> {
-    let module = kernel.module.clone();
-    let source = &program::LineIndex::new(&kernel.source.text);
-    let mut global_values = Vec::with_capacity(module.global_expressions.len());
-    for (handle, _) in module.global_expressions.iter() {
-        let value = eval::global_value(&module, &global_values, handle).map_err(|what| unsupported(&what, 0))?;
-        global_values.push(value);
-    }
-    let mut functions = Vec::new();
-    for (handle, function) in module.functions.iter() {
-        functions.push(program::compile_function(&module, function, &kernel.info[handle], source)?);
-    }
-    let entry_index = kernel.entry_index();
-    let entry_point = &module.entry_points[entry_index];
-    let entry =
-        program::compile_function(&module, &entry_point.function, kernel.info.get_entry_point(entry_index), source)?;
-    let entry_arguments = entry_point
-        .function
-        .arguments
-        .iter()
-        .map(|argument| match argument.binding {
-            Some(naga::Binding::BuiltIn(builtin)) => Ok(Some(builtin)),
-            _ => Err(unsupported("entry point arguments other than builtins", 0)),
-        })
-        .collect::<Result<_, _>>()?;
-    let mut globals = Vec::new();
-    let (mut workgroup_words, mut private_words) = (0u32, 0u32);
-    let mut private_init = Vec::new();
-    for (_, variable) in module.global_variables.iter() {
-        let words = program::words_of(&module, &module.types[variable.ty].inner).unwrap_or(0);
-        let entry = match variable.space {
-            naga::AddressSpace::Uniform | naga::AddressSpace::Storage { .. } => {
-                let binding = variable.binding.as_ref().map_or(u32::MAX, |b| b.binding);
-                let slot = kernel.bindings.iter().position(|b| b.binding == binding).unwrap_or(usize::MAX);
-                (exec::BUFFER_TAG | slot as u32 & 0xff_ffff, 0)
-            }
-            naga::AddressSpace::WorkGroup => {
-                workgroup_words += words;
-                (exec::WORKGROUP_TAG, workgroup_words - words)
-            }
-            naga::AddressSpace::Private => {
-                private_words += words;
-                let value =
-                    variable.init.map(|i| global_values[i.index()].clone()).unwrap_or_else(|| vec![0; words as usize]);
-                private_init.extend_from_slice(&value);
-                (exec::PRIVATE_TAG, private_words - words)
-            }
-            _ => (0, 0),
-        };
-        globals.push(entry);
-    }
-    Ok(Program {
-        module: kernel.module.clone(),
-        name: kernel.entry_point().to_string(),
-        functions,
-        function_handles: module.functions.iter().map(|(h, _)| h).collect(),
-        entry,
-        entry_index,
-        entry_arguments,
-        workgroup_size: kernel.workgroup_size,
-        globals,
-        workgroup_words,
-        private_init,
-        global_values,
-    })
 }
 
 impl Backend for CpuBackend {
@@ -247,7 +188,7 @@ impl Backend for CpuBackend {
         for (id, words) in ids.iter().zip(bound) {
             self.buffers.get_mut(id).expect("checked").words = words;
         }
-        self.last_expressions = result?;
+        self.last_instructions = result?;
         Ok(())
     }
 

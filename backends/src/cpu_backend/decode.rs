@@ -1,0 +1,807 @@
+//! Compiling naga IR into the register bytecode ([`super::insn`]), once per kernel.
+//!
+//! Each function becomes a [`Code`]: its instructions, a register template with every
+//! value known at compile time filled in, and the registers that receive its arguments.
+//! Calls of small functions (at most [`INLINE_EXPRESSIONS`] IR expressions, up to
+//! [`INLINE_DEPTH`] levels deep) are inlined: the callee's expressions and local
+//! variables get registers of the caller's frame, its arguments are the caller's
+//! registers, its returns jump to the end of its body. Every expression gets its own
+//! register range (naga evaluates each expression once where it is emitted, and an
+//! expression's uses are dominated by its emission), so a field of a struct value, a
+//! component of a vector or a bitcast is the source's register range itself, not a copy.
+//!
+//! Statements lower to jumps as a structured program would: `if` to a conditional jump
+//! around the accept block, loops to a backward jump, `break`/`continue` to forward
+//! jumps patched when the construct closes, `switch` to a table of (value, target).
+
+use super::error::unsupported;
+use super::expression::{Place, const_value, global_value};
+use super::insn::{CallInsn, GatherInsn, Insn, Reg};
+use super::memory;
+use crate::error::BackendError;
+use naga::{Expression, Handle, Module, Statement, TypeInner};
+use strata_kernels::Kernel;
+
+/// Callees with at most this many IR expressions are inlined.
+pub(super) const INLINE_EXPRESSIONS: usize = 400;
+/// Inlining stops this many calls deep.
+pub(super) const INLINE_DEPTH: u32 = 8;
+/// Marks an expression without a register yet.
+const NONE: Reg = Reg::MAX;
+
+/// Words of a value of type `inner` (bool and every 32-bit scalar: one word).
+pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String> {
+    Ok(match *inner {
+        TypeInner::Scalar(s) | TypeInner::Atomic(s) => {
+            if s.width != 4 && s.kind != naga::ScalarKind::Bool {
+                return Err(format!("{}-bit scalars", s.width * 8));
+            }
+            1
+        }
+        TypeInner::Vector { size, scalar } => {
+            if scalar.width != 4 && scalar.kind != naga::ScalarKind::Bool {
+                return Err(format!("{}-bit vectors", scalar.width * 8));
+            }
+            size as u32
+        }
+        TypeInner::Pointer { .. } | TypeInner::ValuePointer { .. } => 2,
+        TypeInner::Matrix { columns, rows, .. } => {
+            // Columns are padded like vec3 → 4 words in memory.
+            let row_words = if rows == naga::VectorSize::Tri { 4 } else { rows as u32 };
+            columns as u32 * row_words
+        }
+        TypeInner::Array { base, size, stride } => {
+            // The element type must be supported too.
+            words_of(module, &module.types[base].inner)?;
+            match size {
+                naga::ArraySize::Constant(n) => n.get() * stride / 4,
+                _ => return Err("runtime-sized arrays as values".into()),
+            }
+        }
+        TypeInner::Struct { span, .. } => span / 4,
+        _ => return Err(format!("type {inner:?}")),
+    })
+}
+
+/// Byte offsets where source lines start, for span → line lookups.
+pub(super) struct LineIndex(Vec<usize>);
+
+impl LineIndex {
+    /// The index of `source`'s lines.
+    pub(super) fn new(source: &str) -> Self {
+        Self(std::iter::once(0).chain(source.match_indices('\n').map(|(i, _)| i + 1)).collect())
+    }
+
+    /// 1-based line of a span's start (0 for spans without a position).
+    pub(super) fn line(&self, span: naga::Span) -> u32 {
+        span.to_range().map_or(0, |r| self.0.partition_point(|&start| start <= r.start) as u32)
+    }
+}
+
+/// One compiled function (with its inlined callees).
+pub(super) struct Code {
+    /// The bytecode.
+    pub insns: Vec<Insn>,
+    /// WGSL line of each instruction, for messages.
+    pub lines: Vec<u32>,
+    /// Per instruction: index in [`Program::names`] of the function it came from.
+    pub sources: Vec<u32>,
+    /// Initial register file: compile-time values filled in, zeros elsewhere.
+    pub template: Vec<u32>,
+    /// Registers of pointers to local variables: (register, variable's register), set
+    /// to (function tag | frame depth, variable's register) when a frame starts.
+    pub local_pointers: Vec<(Reg, u32)>,
+    /// Per argument read by the function: (argument index, register, words).
+    pub arguments: Vec<(u32, Reg, u32)>,
+}
+
+/// A kernel ready to run: its compiled functions and global layout.
+pub(super) struct Program {
+    /// The entry point's name.
+    pub name: String,
+    /// Per module function (by handle index), then the entry point.
+    pub codes: Vec<Code>,
+    /// Index of the entry point's code.
+    pub entry: u32,
+    /// Function names, for messages.
+    pub names: Vec<String>,
+    /// Per entry-point argument: its builtin.
+    pub entry_arguments: Vec<naga::BuiltIn>,
+    /// `@workgroup_size`.
+    pub workgroup_size: [u32; 3],
+    /// Words of workgroup memory.
+    pub workgroup_words: u32,
+    /// Initial contents of private memory.
+    pub private_init: Vec<u32>,
+}
+
+/// Per function being compiled into a code (the function itself or an inlined callee):
+/// where its expressions and variables live.
+pub(super) struct Scope<'a> {
+    /// The function.
+    pub function: &'a naga::Function,
+    /// Its validation info (expression types).
+    pub info: &'a naga::valid::FunctionInfo,
+    /// Index of its name in the program's names.
+    pub source: u32,
+    /// Per expression: its register (`NONE` until it has one).
+    pub regs: Vec<Reg>,
+    /// Per expression: its words.
+    pub lens: Vec<u32>,
+    /// Per expression: its line.
+    pub lines: Vec<u32>,
+    /// Per pointer expression whose target is known when compiling: that target.
+    pub places: Vec<Option<Place>>,
+    /// Per expression: whether its value is in the template (a compile-time constant).
+    pub constant: Vec<bool>,
+    /// Per expression: evaluated when the scope starts (not again where emitted).
+    pub pre_emitted: Vec<bool>,
+    /// Per local variable: its register.
+    pub locals: Vec<Reg>,
+    /// Inlined: register and words that receive the return value.
+    pub result: Option<(Reg, u32)>,
+    /// Inlined: the body's return jumps, patched to its end.
+    pub returns: Vec<usize>,
+    /// Inlined into another function (returns are jumps).
+    pub inlined: bool,
+    /// Inlining depth.
+    pub depth: u32,
+    /// Per enclosing breakable construct: (break jumps, continue jumps).
+    loops: Vec<(Vec<usize>, Vec<usize>)>,
+}
+
+/// Compiles one code: instructions, registers and the module context they need.
+pub(super) struct Compiler<'a> {
+    /// The kernel's module.
+    pub module: &'a Module,
+    /// Its validation info.
+    pub info: &'a naga::valid::ModuleInfo,
+    lines_of: &'a LineIndex,
+    /// Per global variable: (region tag, word offset).
+    pub globals: &'a [(u32, u32)],
+    /// Values of the module's constant expressions.
+    pub global_values: &'a [Vec<u32>],
+    /// Bound buffers (for checking static buffer slots).
+    pub buffer_count: usize,
+    names: &'a mut Vec<String>,
+    /// Per module function already compiled: its arguments' registers.
+    arguments: &'a [Vec<(u32, Reg, u32)>],
+    /// The code being built.
+    pub insns: Vec<Insn>,
+    insn_lines: Vec<u32>,
+    insn_sources: Vec<u32>,
+    /// The register template being built.
+    pub template: Vec<u32>,
+    /// Local-variable pointer registers being built.
+    pub local_pointers: Vec<(Reg, u32)>,
+    /// Line of the instructions being pushed.
+    pub line: u32,
+    /// Source function of the instructions being pushed.
+    pub source: u32,
+}
+
+impl Compiler<'_> {
+    /// Allocates `len` registers.
+    pub(super) fn alloc(&mut self, len: u32) -> Reg {
+        let at = self.template.len() as Reg;
+        self.template.resize(self.template.len() + len as usize, 0);
+        at
+    }
+
+    /// Appends an instruction; returns its index.
+    pub(super) fn push(&mut self, insn: Insn) -> usize {
+        self.insns.push(insn);
+        self.insn_lines.push(self.line);
+        self.insn_sources.push(self.source);
+        self.insns.len() - 1
+    }
+
+    /// Appends a copy of `len` words (nothing when `len` is 0 or source and target agree).
+    pub(super) fn copy(&mut self, dst: Reg, src: Reg, len: u32) {
+        if len == 0 || dst == src {
+            return;
+        }
+        self.push(match len {
+            1 => Insn::Copy1 { dst, src },
+            2 => Insn::Copy2 { dst, src },
+            3 => Insn::Copy3 { dst, src },
+            4 => Insn::Copy4 { dst, src },
+            _ => Insn::Copy { dst, src, len },
+        });
+    }
+
+    /// Appends a runtime failure for an unsupported construct.
+    pub(super) fn fail(&mut self, what: String, line: u32) {
+        self.push(Insn::Fail(Box::new((what, line))));
+    }
+
+    fn here(&self) -> u32 {
+        self.insns.len() as u32
+    }
+
+    fn patch(&mut self, at: usize, to: u32) {
+        match &mut self.insns[at] {
+            Insn::Jump(target) | Insn::JumpUnless { target, .. } => *target = to,
+            _ => unreachable!("only jumps are patched"),
+        }
+    }
+
+    /// The type of expression `handle` of `scope`.
+    pub(super) fn ty<'s>(&'s self, scope: &'s Scope, handle: Handle<Expression>) -> &'s TypeInner {
+        scope.info[handle].ty.inner_with(&self.module.types)
+    }
+
+    /// The register of expression `handle` (allocated, zero, if it has none yet).
+    pub(super) fn reg(&mut self, scope: &mut Scope, handle: Handle<Expression>) -> Reg {
+        let index = handle.index();
+        if scope.regs[index] == NONE {
+            scope.regs[index] = self.alloc(scope.lens[index]);
+        }
+        scope.regs[index]
+    }
+
+    /// Opens the scope of `function`: registers for its expressions and variables,
+    /// compile-time values into the template, the pre-emitted expressions (arguments,
+    /// variables, constants) and the variables' initialisation.
+    #[allow(clippy::too_many_arguments)]
+    fn open<'f>(
+        &mut self,
+        function: &'f naga::Function,
+        info: &'f naga::valid::FunctionInfo,
+        arguments: Option<&[(Reg, Option<Place>)]>,
+        result: Option<(Reg, u32)>,
+        depth: u32,
+        code_arguments: &mut Vec<(u32, Reg, u32)>,
+    ) -> Result<Scope<'f>, BackendError> {
+        let count = function.expressions.len();
+        let name = function.name.clone().unwrap_or_default();
+        let source = match self.names.iter().position(|n| *n == name) {
+            Some(at) => at as u32,
+            None => {
+                self.names.push(name);
+                self.names.len() as u32 - 1
+            }
+        };
+        let mut scope = Scope {
+            function,
+            info,
+            source,
+            regs: vec![NONE; count],
+            lens: Vec::with_capacity(count),
+            lines: Vec::with_capacity(count),
+            places: vec![None; count],
+            constant: vec![false; count],
+            pre_emitted: vec![false; count],
+            locals: Vec::new(),
+            result,
+            returns: Vec::new(),
+            inlined: arguments.is_some(),
+            depth,
+            loops: Vec::new(),
+        };
+        for (handle, _) in function.expressions.iter() {
+            let line = self.lines_of.line(function.expressions.get_span(handle));
+            let inner = info[handle].ty.inner_with(&self.module.types);
+            scope.lines.push(line);
+            scope.lens.push(words_of(self.module, inner).map_err(|what| unsupported(&what, line))?);
+        }
+        for (_, local) in function.local_variables.iter() {
+            let words =
+                words_of(self.module, &self.module.types[local.ty].inner).map_err(|what| unsupported(&what, 0))?;
+            let reg = self.alloc(words);
+            scope.locals.push(reg);
+        }
+        let saved_source = self.source;
+        self.source = source;
+        // Constant expressions (literals, constants, and compositions of them) are never
+        // emitted: they are evaluated when the scope starts, like variables and arguments.
+        let kinds = naga::proc::ExpressionKindTracker::from_arena(&function.expressions);
+        for (handle, expression) in function.expressions.iter() {
+            let index = handle.index();
+            let pre_emit = kinds.is_const(handle)
+                || matches!(
+                    expression,
+                    Expression::Literal(_)
+                        | Expression::Constant(_)
+                        | Expression::ZeroValue(_)
+                        | Expression::FunctionArgument(_)
+                        | Expression::GlobalVariable(_)
+                        | Expression::LocalVariable(_)
+                );
+            if !pre_emit {
+                continue;
+            }
+            scope.pre_emitted[index] = true;
+            self.line = scope.lines[index];
+            match *expression {
+                Expression::FunctionArgument(i) => match arguments {
+                    Some(arguments) => {
+                        let (reg, place) = arguments[i as usize];
+                        scope.regs[index] = reg;
+                        scope.places[index] = place;
+                    }
+                    None => {
+                        let reg = self.reg(&mut scope, handle);
+                        code_arguments.push((i, reg, scope.lens[index]));
+                    }
+                },
+                Expression::GlobalVariable(g) => {
+                    let (tag, offset) = self.globals[g.index()];
+                    let reg = self.reg(&mut scope, handle);
+                    self.template[reg as usize] = tag;
+                    self.template[reg as usize + 1] = offset;
+                    scope.constant[index] = true;
+                    scope.places[index] = match tag & memory::TAG_MASK {
+                        memory::WORKGROUP => Some(Place::Workgroup(offset)),
+                        memory::PRIVATE => Some(Place::Private(offset)),
+                        memory::BUFFER if ((tag & !memory::TAG_MASK) as usize) < self.buffer_count => {
+                            Some(Place::Buffer(tag & !memory::TAG_MASK, offset))
+                        }
+                        _ => None,
+                    };
+                }
+                Expression::LocalVariable(l) => {
+                    let variable = scope.locals[l.index()];
+                    let reg = self.reg(&mut scope, handle);
+                    self.local_pointers.push((reg, variable));
+                    scope.places[index] = Some(Place::Local(variable));
+                }
+                _ => match const_value(self, &scope, handle) {
+                    Some(value) => {
+                        let reg = self.reg(&mut scope, handle);
+                        self.template[reg as usize..reg as usize + value.len()].copy_from_slice(&value);
+                        scope.constant[index] = true;
+                    }
+                    None => self.expression(&mut scope, handle)?,
+                },
+            }
+        }
+        for (index, (_, local)) in function.local_variables.iter().enumerate() {
+            let variable = scope.locals[index];
+            let words = words_of(self.module, &self.module.types[local.ty].inner).unwrap_or(0);
+            if scope.inlined && words > 0 {
+                // A fresh frame's variables start zeroed; an inlined call's must be too.
+                self.push(Insn::Zero { dst: variable, len: words });
+            }
+            if let Some(init) = local.init {
+                let src = self.reg(&mut scope, init);
+                let len = scope.lens[init.index()].min(words);
+                self.copy(variable, src, len);
+            }
+        }
+        self.source = saved_source;
+        Ok(scope)
+    }
+
+    fn block(&mut self, scope: &mut Scope, block: &naga::Block) -> Result<(), BackendError> {
+        for (statement, span) in block.span_iter() {
+            self.statement(scope, statement, *span)?;
+        }
+        Ok(())
+    }
+
+    /// The place an expression points to, if known when compiling.
+    fn place(&self, scope: &Scope, pointer: Handle<Expression>) -> Option<Place> {
+        scope.places[pointer.index()]
+    }
+
+    /// Stores `len` words of register `src` through pointer expression `pointer`.
+    pub(super) fn store(&mut self, scope: &mut Scope, pointer: Handle<Expression>, src: Reg, len: u32) {
+        match self.place(scope, pointer) {
+            Some(Place::Local(variable)) => self.copy(variable, src, len),
+            Some(Place::Workgroup(address)) => {
+                self.push(Insn::StoreWorkgroup { address, src, len });
+            }
+            Some(Place::Private(address)) => {
+                self.push(Insn::StorePrivate { address, src, len });
+            }
+            Some(Place::Buffer(buffer, address)) => {
+                self.push(Insn::StoreBuffer { buffer, address, src, len });
+            }
+            None => {
+                let pointer = self.reg(scope, pointer);
+                self.push(Insn::Store { pointer, src, len });
+            }
+        }
+    }
+
+    /// Loads `len` words through pointer expression `pointer` into register `dst`.
+    pub(super) fn load(&mut self, scope: &mut Scope, pointer: Handle<Expression>, dst: Reg, len: u32) {
+        match self.place(scope, pointer) {
+            Some(Place::Local(variable)) => self.copy(dst, variable, len),
+            Some(Place::Workgroup(address)) => {
+                self.push(Insn::LoadWorkgroup { dst, address, len });
+            }
+            Some(Place::Private(address)) => {
+                self.push(Insn::LoadPrivate { dst, address, len });
+            }
+            Some(Place::Buffer(buffer, address)) => {
+                self.push(Insn::LoadBuffer { dst, buffer, address, len });
+            }
+            None => {
+                let pointer = self.reg(scope, pointer);
+                self.push(Insn::Load { dst, pointer, len });
+            }
+        }
+    }
+
+    fn statement(&mut self, scope: &mut Scope, statement: &Statement, span: naga::Span) -> Result<(), BackendError> {
+        let line = self.lines_of.line(span);
+        self.line = line;
+        self.source = scope.source;
+        match statement {
+            Statement::Emit(range) => {
+                for handle in range.clone() {
+                    if !scope.pre_emitted[handle.index()] {
+                        self.expression(scope, handle)?;
+                    }
+                }
+            }
+            Statement::Block(block) => self.block(scope, block)?,
+            Statement::If { condition, accept, reject } => {
+                let cond = self.reg(scope, *condition);
+                self.line = line;
+                let jump_reject = self.push(Insn::JumpUnless { cond, target: 0 });
+                self.block(scope, accept)?;
+                self.line = line;
+                self.source = scope.source;
+                if reject.is_empty() {
+                    let end = self.here();
+                    self.patch(jump_reject, end);
+                } else {
+                    let jump_end = self.push(Insn::Jump(0));
+                    let reject_start = self.here();
+                    self.patch(jump_reject, reject_start);
+                    self.block(scope, reject)?;
+                    let end = self.here();
+                    self.patch(jump_end, end);
+                }
+            }
+            Statement::Switch { selector, cases } => {
+                let selector = self.reg(scope, *selector);
+                let switch_at = self.push(Insn::Switch { selector, cases: Box::new([]), default: 0 });
+                // A switch is a breakable construct.
+                scope.loops.push((Vec::new(), Vec::new()));
+                let mut targets = Vec::new();
+                let mut fallthrough_jumps: Vec<usize> = Vec::new();
+                let mut end_jumps = Vec::new();
+                for case in cases {
+                    let start = self.here();
+                    for at in fallthrough_jumps.drain(..) {
+                        self.patch(at, start);
+                    }
+                    let value = match case.value {
+                        naga::SwitchValue::I32(v) => Some(v as u32),
+                        naga::SwitchValue::U32(v) => Some(v),
+                        naga::SwitchValue::Default => None,
+                    };
+                    targets.push((value, start));
+                    self.block(scope, &case.body)?;
+                    self.line = line;
+                    self.source = scope.source;
+                    let jump = self.push(Insn::Jump(0));
+                    if case.fall_through {
+                        fallthrough_jumps.push(jump);
+                    } else {
+                        end_jumps.push(jump);
+                    }
+                }
+                let end = self.here();
+                for at in end_jumps.into_iter().chain(fallthrough_jumps) {
+                    self.patch(at, end);
+                }
+                let (breaks, continues) = scope.loops.pop().expect("pushed above");
+                for at in breaks {
+                    self.patch(at, end);
+                }
+                // `continue` inside a switch belongs to the enclosing loop.
+                if let Some(outer) = scope.loops.last_mut() {
+                    outer.1.extend(continues);
+                }
+                // The first case with the selector's value, else the first default, else the end.
+                let mut listed: Vec<(u32, u32)> = Vec::new();
+                for (value, target) in &targets {
+                    if let Some(value) = value
+                        && !listed.iter().any(|(v, _)| v == value)
+                    {
+                        listed.push((*value, *target));
+                    }
+                }
+                let default = targets.iter().find(|(v, _)| v.is_none()).map_or(end, |(_, t)| *t);
+                self.insns[switch_at] = Insn::Switch { selector, cases: listed.into_boxed_slice(), default };
+            }
+            Statement::Loop { body, continuing, break_if } => {
+                let start = self.here();
+                scope.loops.push((Vec::new(), Vec::new()));
+                self.block(scope, body)?;
+                let continuing_start = self.here();
+                self.block(scope, continuing)?;
+                self.line = line;
+                self.source = scope.source;
+                match break_if {
+                    // Loop again unless the condition holds; fall through to the end if it does.
+                    Some(condition) => {
+                        let cond = self.reg(scope, *condition);
+                        self.push(Insn::JumpUnless { cond, target: start })
+                    }
+                    None => self.push(Insn::Jump(start)),
+                };
+                let end = self.here();
+                let (breaks, continues) = scope.loops.pop().expect("pushed above");
+                for at in breaks {
+                    self.patch(at, end);
+                }
+                for at in continues {
+                    self.patch(at, continuing_start);
+                }
+            }
+            Statement::Break => {
+                let at = self.push(Insn::Jump(0));
+                scope.loops.last_mut().ok_or_else(|| unsupported("`break` outside a loop", line))?.0.push(at);
+            }
+            Statement::Continue => {
+                let at = self.push(Insn::Jump(0));
+                // Continue skips enclosing switches: recorded on the innermost construct
+                // and moved outwards when a switch closes.
+                scope.loops.last_mut().ok_or_else(|| unsupported("`continue` outside a loop", line))?.1.push(at);
+            }
+            Statement::Return { value } => {
+                let value = value.map(|v| (self.reg(scope, v), scope.lens[v.index()]));
+                self.line = line;
+                if scope.inlined {
+                    if let (Some((src, len)), Some((dst, words))) = (value, scope.result) {
+                        self.copy(dst, src, len.min(words));
+                    }
+                    let at = self.push(Insn::Jump(0));
+                    scope.returns.push(at);
+                } else {
+                    let (src, len) = value.unwrap_or((0, 0));
+                    self.push(Insn::Return { src, len });
+                }
+            }
+            Statement::ControlBarrier(_) => {
+                self.push(Insn::Barrier);
+            }
+            // Memory barriers order memory only; one thread runs a workgroup in order.
+            Statement::MemoryBarrier(_) => {}
+            Statement::Store { pointer, value } => {
+                let src = self.reg(scope, *value);
+                let len = scope.lens[value.index()];
+                self.store(scope, *pointer, src, len);
+            }
+            Statement::Call { function, arguments, result } => self.call(scope, *function, arguments, *result)?,
+            Statement::WorkGroupUniformLoad { pointer, result } => {
+                self.push(Insn::Barrier);
+                let dst = self.reg(scope, *result);
+                let len = scope.lens[result.index()];
+                self.line = line;
+                self.load(scope, *pointer, dst, len);
+                self.push(Insn::Barrier);
+            }
+            Statement::Atomic { pointer, fun, value, result } => {
+                let signed = matches!(self.ty(scope, *value), TypeInner::Scalar(s) if s.kind == naga::ScalarKind::Sint);
+                let compare = match fun {
+                    naga::AtomicFunction::Exchange { compare: Some(compare) } => Some(self.reg(scope, *compare)),
+                    _ => None,
+                };
+                let atomic = super::insn::AtomicInsn {
+                    pointer: self.reg(scope, *pointer),
+                    fun: *fun,
+                    value: self.reg(scope, *value),
+                    compare,
+                    signed,
+                    result: result.map(|r| self.reg(scope, r)),
+                };
+                self.line = line;
+                self.push(Insn::Atomic(Box::new(atomic)));
+            }
+            Statement::SubgroupGather { mode, argument, result } => {
+                use naga::GatherMode as G;
+                let index = match mode {
+                    G::BroadcastFirst | G::QuadSwap(_) => None,
+                    G::Broadcast(h)
+                    | G::Shuffle(h)
+                    | G::ShuffleDown(h)
+                    | G::ShuffleUp(h)
+                    | G::ShuffleXor(h)
+                    | G::QuadBroadcast(h) => Some(self.reg(scope, *h)),
+                };
+                let gather = GatherInsn {
+                    mode: *mode,
+                    index,
+                    argument: self.reg(scope, *argument),
+                    len: scope.lens[argument.index()],
+                    result: self.reg(scope, *result),
+                };
+                self.line = line;
+                self.push(Insn::Gather(Box::new(gather)));
+            }
+            other => {
+                let name = format!("{other:?}");
+                let name = name.split([' ', '(', '{']).next().unwrap_or("statement").to_string();
+                return Err(unsupported(&format!("statement `{name}`"), line));
+            }
+        }
+        Ok(())
+    }
+
+    /// A call: inlined if the callee is small and the nesting shallow, else a `Call`.
+    fn call(
+        &mut self,
+        scope: &mut Scope,
+        function: Handle<naga::Function>,
+        arguments: &[Handle<Expression>],
+        result: Option<Handle<Expression>>,
+    ) -> Result<(), BackendError> {
+        let module = self.module;
+        let info = self.info;
+        let callee = &module.functions[function];
+        let line = self.line;
+        let result = result.map(|r| (self.reg(scope, r), scope.lens[r.index()]));
+        if callee.expressions.len() <= INLINE_EXPRESSIONS && scope.depth < INLINE_DEPTH {
+            let values: Vec<(Reg, Option<Place>)> =
+                arguments.iter().map(|a| (self.reg(scope, *a), scope.places[a.index()])).collect();
+            let mut unused = Vec::new();
+            let mut inner = self.open(callee, &info[function], Some(&values), result, scope.depth + 1, &mut unused)?;
+            self.block(&mut inner, &callee.body)?;
+            let end = self.here();
+            for at in std::mem::take(&mut inner.returns) {
+                self.patch(at, end);
+            }
+        } else {
+            let callee_arguments = &self.arguments[function.index()];
+            let arguments = callee_arguments
+                .iter()
+                .map(|&(i, dst, len)| {
+                    let src = self.reg(scope, arguments[i as usize]);
+                    (src, len, dst)
+                })
+                .collect();
+            self.line = line;
+            self.source = scope.source;
+            self.push(Insn::Call(Box::new(CallInsn { code: function.index() as u32, arguments, result })));
+        }
+        self.line = line;
+        self.source = scope.source;
+        Ok(())
+    }
+}
+
+/// Compiles `function` into a code.
+#[allow(clippy::too_many_arguments)]
+fn compile_code(
+    module: &Module,
+    info: &naga::valid::ModuleInfo,
+    function: &naga::Function,
+    function_info: &naga::valid::FunctionInfo,
+    lines_of: &LineIndex,
+    globals: &[(u32, u32)],
+    global_values: &[Vec<u32>],
+    buffer_count: usize,
+    names: &mut Vec<String>,
+    arguments: &[Vec<(u32, Reg, u32)>],
+) -> Result<Code, BackendError> {
+    let mut compiler = Compiler {
+        module,
+        info,
+        lines_of,
+        globals,
+        global_values,
+        buffer_count,
+        names,
+        arguments,
+        insns: Vec::new(),
+        insn_lines: Vec::new(),
+        insn_sources: Vec::new(),
+        template: Vec::new(),
+        local_pointers: Vec::new(),
+        line: 0,
+        source: 0,
+    };
+    let mut code_arguments = Vec::new();
+    let mut scope = compiler.open(function, function_info, None, None, 0, &mut code_arguments)?;
+    compiler.block(&mut scope, &function.body)?;
+    compiler.line = 0;
+    compiler.source = scope.source;
+    compiler.push(Insn::Return { src: 0, len: 0 });
+    Ok(Code {
+        insns: compiler.insns,
+        lines: compiler.insn_lines,
+        sources: compiler.insn_sources,
+        template: compiler.template,
+        local_pointers: compiler.local_pointers,
+        arguments: code_arguments,
+    })
+}
+
+/// Compiles `kernel`'s entry point and the functions of its module.
+pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> {
+    let module = &kernel.module;
+    let lines_of = &LineIndex::new(&kernel.source.text);
+    let mut global_values = Vec::with_capacity(module.global_expressions.len());
+    for (handle, _) in module.global_expressions.iter() {
+        let value = global_value(module, &global_values, handle).map_err(|what| unsupported(&what, 0))?;
+        global_values.push(value);
+    }
+    let entry_index = kernel.entry_index();
+    let entry_point = &module.entry_points[entry_index];
+    let entry_arguments = entry_point
+        .function
+        .arguments
+        .iter()
+        .map(|argument| match argument.binding {
+            Some(naga::Binding::BuiltIn(builtin)) => Ok(builtin),
+            _ => Err(unsupported("entry point arguments other than builtins", 0)),
+        })
+        .collect::<Result<_, _>>()?;
+    let mut globals = Vec::new();
+    let (mut workgroup_words, mut private_words) = (0u32, 0u32);
+    let mut private_init = Vec::new();
+    for (_, variable) in module.global_variables.iter() {
+        let words = words_of(module, &module.types[variable.ty].inner).unwrap_or(0);
+        let entry = match variable.space {
+            naga::AddressSpace::Uniform | naga::AddressSpace::Storage { .. } => {
+                let binding = variable.binding.as_ref().map_or(u32::MAX, |b| b.binding);
+                let slot = kernel.bindings.iter().position(|b| b.binding == binding).unwrap_or(usize::MAX);
+                (memory::BUFFER | slot as u32 & 0xff_ffff, 0)
+            }
+            naga::AddressSpace::WorkGroup => {
+                workgroup_words += words;
+                (memory::WORKGROUP, workgroup_words - words)
+            }
+            naga::AddressSpace::Private => {
+                private_words += words;
+                let value =
+                    variable.init.map(|i| global_values[i.index()].clone()).unwrap_or_else(|| vec![0; words as usize]);
+                private_init.extend_from_slice(&value);
+                (memory::PRIVATE, private_words - words)
+            }
+            _ => (0, 0),
+        };
+        globals.push(entry);
+    }
+    let mut names = Vec::new();
+    let mut codes = Vec::new();
+    let mut arguments: Vec<Vec<(u32, Reg, u32)>> = Vec::new();
+    let buffer_count = kernel.bindings.len();
+    // naga orders functions so that callees come before their callers.
+    for (handle, function) in module.functions.iter() {
+        let code = compile_code(
+            module,
+            &kernel.info,
+            function,
+            &kernel.info[handle],
+            lines_of,
+            &globals,
+            &global_values,
+            buffer_count,
+            &mut names,
+            &arguments,
+        )?;
+        arguments.push(code.arguments.clone());
+        codes.push(code);
+    }
+    let entry = compile_code(
+        module,
+        &kernel.info,
+        &entry_point.function,
+        kernel.info.get_entry_point(entry_index),
+        lines_of,
+        &globals,
+        &global_values,
+        buffer_count,
+        &mut names,
+        &arguments,
+    )?;
+    codes.push(entry);
+    Ok(Program {
+        name: kernel.entry_point().to_string(),
+        entry: codes.len() as u32 - 1,
+        codes,
+        names,
+        entry_arguments,
+        workgroup_size: kernel.workgroup_size,
+        workgroup_words,
+        private_init,
+    })
+}

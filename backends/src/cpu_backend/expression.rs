@@ -1,0 +1,624 @@
+//! Lowering one naga expression to bytecode: its operands' registers resolved, its
+//! types looked at once here and never again at run time. Field and component
+//! extraction with a constant index, and bitcasts, cost no instruction: the result is
+//! the source's register range. Constructs the interpreter does not support lower to a
+//! [`Insn::Fail`] naming the construct and its line, reported only if reached.
+
+use super::arith;
+use super::decode::{Compiler, Scope, words_of};
+use super::insn::{BinOp, Insn, Reg, UnOp};
+use super::matrix::column_words;
+use crate::error::BackendError;
+use naga::{Expression, Handle, ScalarKind, TypeInner};
+use smallvec::{SmallVec, smallvec};
+
+/// A value: its words, inline up to a vec4.
+pub(super) type Words = SmallVec<[u32; 4]>;
+
+/// Where a pointer points, when that is known at compile time.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Place {
+    /// A local variable: its register in the running frame.
+    Local(Reg),
+    /// Workgroup memory at this word.
+    Workgroup(u32),
+    /// Private memory at this word.
+    Private(u32),
+    /// Bound buffer (slot, word).
+    Buffer(u32, u32),
+}
+
+impl Place {
+    fn offset(self, step: u32) -> Self {
+        match self {
+            Place::Local(r) => Place::Local(r + step),
+            Place::Workgroup(a) => Place::Workgroup(a + step),
+            Place::Private(a) => Place::Private(a + step),
+            Place::Buffer(b, a) => Place::Buffer(b, a + step),
+        }
+    }
+}
+
+/// Scalar kind and component count of a scalar or vector type.
+pub(super) fn shape(inner: &TypeInner) -> Option<(ScalarKind, usize)> {
+    match *inner {
+        TypeInner::Scalar(s) | TypeInner::Atomic(s) => Some((s.kind, 1)),
+        TypeInner::Vector { size, scalar } => Some((scalar.kind, size as usize)),
+        _ => None,
+    }
+}
+
+fn literal(value: &naga::Literal) -> Option<u32> {
+    Some(match *value {
+        naga::Literal::F32(v) => v.to_bits(),
+        naga::Literal::U32(v) => v,
+        naga::Literal::I32(v) => v as u32,
+        naga::Literal::Bool(v) => u32::from(v),
+        _ => return None,
+    })
+}
+
+/// Value of a constant expression of the module (`global_expressions`).
+pub(super) fn global_value(
+    module: &naga::Module,
+    values: &[Vec<u32>],
+    handle: Handle<Expression>,
+) -> Result<Vec<u32>, String> {
+    let inner_of = |ty: Handle<naga::Type>| &module.types[ty].inner;
+    Ok(match &module.global_expressions[handle] {
+        Expression::Literal(value) => vec![literal(value).ok_or_else(|| format!("literal {value:?}"))?],
+        Expression::Constant(c) => values[module.constants[*c].init.index()].clone(),
+        Expression::ZeroValue(ty) => vec![0; words_of(module, inner_of(*ty))? as usize],
+        Expression::Splat { size, value } => values[value.index()].repeat(*size as usize),
+        Expression::Compose { ty, components } => {
+            let parts: Vec<&[u32]> = components.iter().map(|c| values[c.index()].as_slice()).collect();
+            compose(module, inner_of(*ty), &parts)?
+        }
+        other => return Err(format!("constant expression {other:?}")),
+    })
+}
+
+/// Word offset of each part of a value of type `inner` composed of parts of `lens` words.
+fn compose_offsets(inner: &TypeInner, lens: &[u32]) -> Result<Vec<u32>, String> {
+    Ok(match *inner {
+        TypeInner::Vector { .. } => lens.iter().scan(0, |at, len| Some(std::mem::replace(at, *at + len))).collect(),
+        TypeInner::Struct { ref members, .. } => members.iter().take(lens.len()).map(|m| m.offset / 4).collect(),
+        TypeInner::Array { stride, .. } => (0..lens.len() as u32).map(|i| i * stride / 4).collect(),
+        TypeInner::Matrix { rows, .. } => (0..lens.len()).map(|i| (i * column_words(rows)) as u32).collect(),
+        _ => return Err(format!("composing {inner:?}")),
+    })
+}
+
+/// Lays out `parts` as a value of type `inner`.
+pub(super) fn compose(module: &naga::Module, inner: &TypeInner, parts: &[&[u32]]) -> Result<Vec<u32>, String> {
+    let mut out = vec![0u32; words_of(module, inner)? as usize];
+    let lens: Vec<u32> = parts.iter().map(|p| p.len() as u32).collect();
+    let offsets = compose_offsets(inner, &lens)?;
+    for (part, at) in parts.iter().zip(offsets) {
+        let at = at as usize;
+        let len = part.len().min(out.len().saturating_sub(at));
+        out[at..at + len].copy_from_slice(&part[..len]);
+    }
+    Ok(out)
+}
+
+/// The value of a constant expression of a function, if it can be computed from values
+/// already in the template (literals, constants, zero values, splats and compositions).
+pub(super) fn const_value(compiler: &Compiler, scope: &Scope, handle: Handle<Expression>) -> Option<Vec<u32>> {
+    let module = compiler.module;
+    let value_of = |h: Handle<Expression>| -> Option<&[u32]> {
+        let i = h.index();
+        if !scope.constant[i] {
+            return None;
+        }
+        let reg = scope.regs[i] as usize;
+        Some(&compiler.template[reg..reg + scope.lens[i] as usize])
+    };
+    let len = scope.lens[handle.index()] as usize;
+    let value = match &scope.function.expressions[handle] {
+        Expression::Literal(value) => vec![literal(value)?],
+        Expression::Constant(c) => compiler.global_values[module.constants[*c].init.index()].clone(),
+        Expression::ZeroValue(_) => vec![0; len],
+        Expression::Splat { size, value } => value_of(*value)?.repeat(*size as usize),
+        Expression::Compose { components, .. } => {
+            let parts: Option<Vec<&[u32]>> = components.iter().map(|c| value_of(*c)).collect();
+            compose(module, compiler.ty(scope, handle), &parts?).ok()?
+        }
+        _ => return None,
+    };
+    (value.len() == len).then_some(value)
+}
+
+/// Math functions on vectors and scalars (the reference implementation, value by value).
+#[allow(clippy::too_many_arguments)]
+fn math(
+    fun: naga::MathFunction,
+    kind: ScalarKind,
+    comps: usize,
+    a: &[u32],
+    b: Option<&[u32]>,
+    c: Option<&[u32]>,
+    d: Option<&[u32]>,
+) -> Option<Words> {
+    use naga::MathFunction as M;
+    let f = f32::from_bits;
+    let pick = |v: Option<&[u32]>, i: usize| v.map_or(0, |v| v[if v.len() == 1 { 0 } else { i }]);
+    match fun {
+        M::Dot if kind == ScalarKind::Float => {
+            let b = b?;
+            // Sequential sum of products, no fused multiply-add.
+            let sum = (0..comps).fold(0.0f32, |acc, i| acc + f(a[i]) * f(b[i]));
+            Some(smallvec![sum.to_bits()])
+        }
+        M::Dot => {
+            let b = b?;
+            Some(smallvec![(0..comps).fold(0u32, |acc, i| acc.wrapping_add(a[i].wrapping_mul(b[i])))])
+        }
+        M::Length => Some(smallvec![(0..comps).fold(0.0f32, |acc, i| acc + f(a[i]) * f(a[i])).sqrt().to_bits()]),
+        M::Distance => {
+            let b = b?;
+            let sum = (0..comps).fold(0.0f32, |acc, i| {
+                let d = f(a[i]) - f(b[i]);
+                acc + d * d
+            });
+            Some(smallvec![sum.sqrt().to_bits()])
+        }
+        M::Normalize => {
+            let length = (0..comps).fold(0.0f32, |acc, i| acc + f(a[i]) * f(a[i])).sqrt();
+            Some(a.iter().map(|&x| (f(x) / length).to_bits()).collect())
+        }
+        M::Cross => {
+            let b = b?;
+            let (x, y) = (|i: usize| f(a[i]), |i: usize| f(b[i]));
+            Some(smallvec![
+                (x(1) * y(2) - x(2) * y(1)).to_bits(),
+                (x(2) * y(0) - x(0) * y(2)).to_bits(),
+                (x(0) * y(1) - x(1) * y(0)).to_bits(),
+            ])
+        }
+        M::ExtractBits | M::InsertBits => {
+            (0..comps).map(|i| arith::bits(fun, kind, a[i], pick(b, i), pick(c, i), pick(d, i))).collect()
+        }
+        _ => (0..comps).map(|i| arith::math(fun, kind, a[i], pick(b, i), pick(c, i))).collect(),
+    }
+}
+
+/// Reads `len` words at `reg` of a register file.
+fn slice(regs: &[u32], (reg, len): (Reg, u32)) -> &[u32] {
+    &regs[reg as usize..(reg + len) as usize]
+}
+
+/// Writes `value` at `dst`, at most `len` words.
+fn put(regs: &mut [u32], dst: Reg, len: u32, value: &[u32]) {
+    let n = (len as usize).min(value.len());
+    regs[dst as usize..dst as usize + n].copy_from_slice(&value[..n]);
+}
+
+impl Compiler<'_> {
+    /// Lowers expression `handle` of `scope`: gives it a register (its own or its
+    /// source's) and appends the instructions that compute it.
+    pub(super) fn expression(&mut self, scope: &mut Scope, handle: Handle<Expression>) -> Result<(), BackendError> {
+        let module = self.module;
+        let index = handle.index();
+        let line = scope.lines[index];
+        self.line = line;
+        let len = scope.lens[index];
+        let function = scope.function;
+        let expression = &function.expressions[handle];
+        // Operand registers and words.
+        macro_rules! operand {
+            ($h:expr) => {{
+                let h = $h;
+                (self.reg(scope, h), scope.lens[h.index()])
+            }};
+        }
+        match *expression {
+            Expression::Literal(ref value) => {
+                let dst = self.reg(scope, handle);
+                match literal(value) {
+                    Some(v) => self.template[dst as usize] = v,
+                    None => self.fail(format!("literal {value:?}"), line),
+                }
+            }
+            Expression::Constant(c) => {
+                let dst = self.reg(scope, handle);
+                let value = &self.global_values[module.constants[c].init.index()];
+                let n = value.len().min(len as usize);
+                self.template[dst as usize..dst as usize + n].copy_from_slice(&value[..n]);
+            }
+            Expression::ZeroValue(_) => {
+                let dst = self.reg(scope, handle);
+                self.push(Insn::Zero { dst, len });
+            }
+            Expression::Compose { ref components, .. } => {
+                let parts: Vec<(Reg, u32)> = components.iter().map(|c| operand!(*c)).collect();
+                let lens: Vec<u32> = parts.iter().map(|p| p.1).collect();
+                match compose_offsets(self.ty(scope, handle), &lens) {
+                    Ok(offsets) => {
+                        let dst = self.reg(scope, handle);
+                        for ((src, part), at) in parts.into_iter().zip(offsets) {
+                            self.copy(dst + at, src, part.min(len.saturating_sub(at)));
+                        }
+                    }
+                    Err(what) => {
+                        self.reg(scope, handle);
+                        self.fail(what, line);
+                    }
+                }
+            }
+            Expression::Splat { size, value } => {
+                let (src, _) = operand!(value);
+                let dst = self.reg(scope, handle);
+                self.push(Insn::Splat { dst, src, n: size as u8 });
+            }
+            Expression::Swizzle { size, vector, pattern } => {
+                let (src, _) = operand!(vector);
+                let dst = self.reg(scope, handle);
+                let mut p = [0u8; 4];
+                for (i, c) in pattern.iter().enumerate() {
+                    p[i] = *c as u8;
+                }
+                self.push(Insn::Swizzle { dst, src, pattern: p, n: size as u8 });
+            }
+            Expression::Access { base, index: index_handle } => {
+                let (base_reg, _) = operand!(base);
+                let (index_reg, _) = operand!(index_handle);
+                let dst = self.reg(scope, handle);
+                let insn = match self.ty(scope, base) {
+                    TypeInner::Pointer { base: pointee, .. } => match module.types[*pointee].inner {
+                        TypeInner::Array { size: naga::ArraySize::Constant(n), stride, .. } => Ok(Insn::PtrIndex {
+                            dst,
+                            base: base_reg,
+                            index: index_reg,
+                            count: n.get(),
+                            stride: stride / 4,
+                        }),
+                        TypeInner::Array { stride, .. } => {
+                            Ok(Insn::PtrIndexRt { dst, base: base_reg, index: index_reg, stride: stride / 4 })
+                        }
+                        TypeInner::Vector { size, .. } => {
+                            Ok(Insn::PtrIndex { dst, base: base_reg, index: index_reg, count: size as u32, stride: 1 })
+                        }
+                        TypeInner::Matrix { columns, rows, .. } => Ok(Insn::PtrIndex {
+                            dst,
+                            base: base_reg,
+                            index: index_reg,
+                            count: columns as u32,
+                            stride: column_words(rows) as u32,
+                        }),
+                        ref other => Err(format!("indexing through a pointer to {other:?}")),
+                    },
+                    TypeInner::ValuePointer { size: Some(size), .. } => {
+                        Ok(Insn::PtrIndex { dst, base: base_reg, index: index_reg, count: *size as u32, stride: 1 })
+                    }
+                    TypeInner::Vector { size, .. } => Ok(Insn::Extract {
+                        dst,
+                        base: base_reg,
+                        index: index_reg,
+                        count: *size as u32,
+                        stride: 1,
+                        len: 1,
+                    }),
+                    TypeInner::Array { size: naga::ArraySize::Constant(n), stride, .. } => Ok(Insn::Extract {
+                        dst,
+                        base: base_reg,
+                        index: index_reg,
+                        count: n.get(),
+                        stride: stride / 4,
+                        len,
+                    }),
+                    TypeInner::Array { .. } => Err("indexing a runtime-sized array value".to_string()),
+                    TypeInner::Matrix { columns, rows, .. } => Ok(Insn::Extract {
+                        dst,
+                        base: base_reg,
+                        index: index_reg,
+                        count: *columns as u32,
+                        stride: column_words(*rows) as u32,
+                        len,
+                    }),
+                    other => Err(format!("indexing {other:?}")),
+                };
+                match insn {
+                    Ok(insn) => {
+                        self.push(insn);
+                    }
+                    Err(what) => self.fail(what, line),
+                }
+            }
+            Expression::AccessIndex { base, index: i } => self.access_index(scope, handle, base, i),
+            Expression::Load { pointer } => {
+                self.reg(scope, pointer);
+                let dst = self.reg(scope, handle);
+                self.load(scope, pointer, dst, len);
+            }
+            Expression::Unary { op, expr } => {
+                let (src, n) = operand!(expr);
+                let dst = self.reg(scope, handle);
+                match shape(self.ty(scope, expr)) {
+                    Some((kind, _)) => {
+                        let op = match (op, kind) {
+                            (naga::UnaryOperator::Negate, ScalarKind::Float) => UnOp::NegF,
+                            (naga::UnaryOperator::Negate, _) => UnOp::NegI,
+                            (naga::UnaryOperator::LogicalNot, _) => UnOp::Not,
+                            (naga::UnaryOperator::BitwiseNot, _) => UnOp::BitNot,
+                        };
+                        self.push(Insn::Un { op, dst, src, n: n as u8 });
+                    }
+                    None => self.fail("unary operator on a composite".into(), line),
+                }
+            }
+            Expression::Binary { op, left, right }
+                if matches!(self.ty(scope, left), TypeInner::Matrix { .. })
+                    || matches!(self.ty(scope, right), TypeInner::Matrix { .. }) =>
+            {
+                let a = operand!(left);
+                let b = operand!(right);
+                let dst = self.reg(scope, handle);
+                let (ta, tb) = (self.ty(scope, left).clone(), self.ty(scope, right).clone());
+                let probe = super::matrix::binary(op, &ta, &vec![0; a.1 as usize], &tb, &vec![0; b.1 as usize]);
+                if probe.is_none() {
+                    self.fail(format!("{op:?} on matrices"), line);
+                } else {
+                    self.push(Insn::Compute(Box::new(move |regs: &mut [u32]| {
+                        let value =
+                            super::matrix::binary(op, &ta, slice(regs, a), &tb, slice(regs, b)).expect("probed");
+                        put(regs, dst, len, &value);
+                    })));
+                }
+            }
+            Expression::Binary { op, left, right } => {
+                let (a, la) = operand!(left);
+                let (b, lb) = operand!(right);
+                let dst = self.reg(scope, handle);
+                let Some((kind, _)) = shape(self.ty(scope, left)) else {
+                    self.fail(format!("{op:?} on composites"), line);
+                    return Ok(());
+                };
+                let Some(resolved) = BinOp::resolve(op, kind) else {
+                    self.fail(format!("{op:?} on {kind:?}"), line);
+                    return Ok(());
+                };
+                let n = la.max(lb);
+                if n == 1 {
+                    self.push(Insn::Bin { op: resolved, dst, a, b });
+                } else {
+                    let (sa, sb) = (u8::from(la != 1), u8::from(lb != 1));
+                    self.push(Insn::BinV { op: resolved, dst, a, b, n: n as u8, sa, sb });
+                }
+            }
+            Expression::Select { condition, accept, reject } => {
+                let (cond, lc) = operand!(condition);
+                let (accept, n) = operand!(accept);
+                let (reject, _) = operand!(reject);
+                let dst = self.reg(scope, handle);
+                self.push(Insn::Select { dst, cond, accept, reject, n: n as u8, sc: u8::from(lc != 1) });
+            }
+            Expression::Relational { fun, argument } => {
+                let v = operand!(argument);
+                let dst = self.reg(scope, handle);
+                self.push(Insn::Compute(Box::new(move |regs: &mut [u32]| {
+                    let value: Words = {
+                        let v = slice(regs, v);
+                        match fun {
+                            naga::RelationalFunction::All => smallvec![u32::from(v.iter().all(|&x| x != 0))],
+                            naga::RelationalFunction::Any => smallvec![u32::from(v.iter().any(|&x| x != 0))],
+                            naga::RelationalFunction::IsNan => {
+                                v.iter().map(|&x| u32::from(f32::from_bits(x).is_nan())).collect()
+                            }
+                            naga::RelationalFunction::IsInf => {
+                                v.iter().map(|&x| u32::from(f32::from_bits(x).is_infinite())).collect()
+                            }
+                        }
+                    };
+                    put(regs, dst, len, &value);
+                })));
+            }
+            Expression::Math { fun, arg, arg1, arg2, arg3 } => {
+                self.math(scope, handle, fun, [Some(arg), arg1, arg2, arg3])
+            }
+            Expression::As { expr, kind, convert } => {
+                let (src, n) = operand!(expr);
+                let Some((from, _)) = shape(self.ty(scope, expr)) else {
+                    self.reg(scope, handle);
+                    self.fail("conversion of a composite".into(), line);
+                    return Ok(());
+                };
+                match convert {
+                    // A bitcast: the same words.
+                    None if n == len => scope.regs[index] = src,
+                    None => {
+                        let dst = self.reg(scope, handle);
+                        self.copy(dst, src, n.min(len));
+                    }
+                    Some(4) | Some(1) => {
+                        let dst = self.reg(scope, handle);
+                        if arith::convert(0, from, kind).is_some() {
+                            self.push(Insn::Convert { from, to: kind, dst, src, n: n as u8 });
+                        } else {
+                            self.fail(format!("{from:?} as {kind:?}"), line);
+                        }
+                    }
+                    Some(width) => {
+                        self.reg(scope, handle);
+                        self.fail(format!("conversion to {}-bit", width * 8), line);
+                    }
+                }
+            }
+            Expression::ArrayLength(pointer) => {
+                let (p, _) = operand!(pointer);
+                let dst = self.reg(scope, handle);
+                let stride = match self.ty(scope, pointer) {
+                    TypeInner::Pointer { base, .. } => match module.types[*base].inner {
+                        TypeInner::Array { stride, .. } => Ok(stride / 4),
+                        _ => Err("arrayLength of a non-array"),
+                    },
+                    _ => Err("arrayLength of a non-pointer"),
+                };
+                match stride {
+                    Ok(stride) => {
+                        self.push(Insn::ArrayLength { dst, pointer: p, stride });
+                    }
+                    Err(what) => self.fail(what.into(), line),
+                }
+            }
+            // Written by their statements (Call, Atomic, WorkGroupUniformLoad, subgroup ops).
+            Expression::CallResult(_)
+            | Expression::AtomicResult { .. }
+            | Expression::WorkGroupUniformLoadResult { .. }
+            | Expression::SubgroupOperationResult { .. } => {
+                self.reg(scope, handle);
+            }
+            // Pre-emitted when the scope opens.
+            Expression::FunctionArgument(_) | Expression::GlobalVariable(_) | Expression::LocalVariable(_) => {
+                self.reg(scope, handle);
+            }
+            ref other => {
+                self.reg(scope, handle);
+                let name = format!("{other:?}");
+                let name = name.split([' ', '(', '{']).next().unwrap_or("expression").to_string();
+                self.fail(format!("expression `{name}`"), line);
+            }
+        }
+        Ok(())
+    }
+
+    /// `base.index` with a constant index: a pointer offset (known when compiling if
+    /// the base's target is), or the base's own registers for a value.
+    fn access_index(&mut self, scope: &mut Scope, handle: Handle<Expression>, base: Handle<Expression>, index: u32) {
+        let module = self.module;
+        let line = self.line;
+        let base_reg = self.reg(scope, base);
+        let step = match self.ty(scope, base) {
+            TypeInner::Pointer { base: pointee, .. } => match module.types[*pointee].inner {
+                TypeInner::Array { stride, .. } => Ok((true, index * stride / 4)),
+                TypeInner::Struct { ref members, .. } => Ok((true, members[index as usize].offset / 4)),
+                TypeInner::Vector { .. } => Ok((true, index)),
+                TypeInner::Matrix { rows, .. } => Ok((true, index * column_words(rows) as u32)),
+                ref other => Err(format!("indexing through a pointer to {other:?}")),
+            },
+            TypeInner::ValuePointer { size: Some(_), .. } => Ok((true, index)),
+            TypeInner::Vector { .. } => Ok((false, index)),
+            TypeInner::Array { size: naga::ArraySize::Constant(_), stride, .. } => Ok((false, index * stride / 4)),
+            TypeInner::Array { .. } => Err("indexing a runtime-sized array value".to_string()),
+            TypeInner::Struct { members, .. } => Ok((false, members[index as usize].offset / 4)),
+            TypeInner::Matrix { rows, .. } => Ok((false, index * column_words(*rows) as u32)),
+            other => Err(format!("indexing {other:?}")),
+        };
+        let i = handle.index();
+        match step {
+            Err(what) => {
+                self.reg(scope, handle);
+                self.fail(what, line);
+            }
+            // A component or field of a value: the value's registers.
+            Ok((false, step)) => scope.regs[i] = base_reg + step,
+            Ok((true, step)) => match scope.places[base.index()] {
+                Some(place) => {
+                    let place = place.offset(step);
+                    scope.places[i] = Some(place);
+                    let dst = self.reg(scope, handle);
+                    match place {
+                        // Pointer values known now: in the template, or set when the frame starts.
+                        Place::Local(variable) => self.local_pointers.push((dst, variable)),
+                        _ => {
+                            self.template[dst as usize] = self.template[base_reg as usize];
+                            self.template[dst as usize + 1] = self.template[base_reg as usize + 1] + step;
+                            scope.constant[i] = true;
+                        }
+                    }
+                }
+                None => {
+                    let dst = self.reg(scope, handle);
+                    self.push(Insn::PtrAdd { dst, base: base_reg, add: step });
+                }
+            },
+        }
+    }
+
+    /// A math function: a closure over the reference implementation.
+    fn math(
+        &mut self,
+        scope: &mut Scope,
+        handle: Handle<Expression>,
+        fun: naga::MathFunction,
+        args: [Option<Handle<Expression>>; 4],
+    ) {
+        use naga::MathFunction as M;
+        let line = self.line;
+        let len = scope.lens[handle.index()];
+        let operands: Vec<Option<(Reg, u32)>> =
+            args.iter().map(|a| a.map(|h| (self.reg(scope, h), scope.lens[h.index()]))).collect();
+        let dst = self.reg(scope, handle);
+        let arg = args[0].expect("math functions have an argument");
+        let a = operands[0].expect("first argument");
+        let arg_type = self.ty(scope, arg).clone();
+        let compute: Result<super::insn::Compute, String> = match fun {
+            M::Transpose => match arg_type {
+                TypeInner::Matrix { columns, rows, .. } => Ok(Box::new(move |regs: &mut [u32]| {
+                    let value = super::matrix::transpose(slice(regs, a), columns, rows);
+                    put(regs, dst, len, &value);
+                })),
+                other => Err(format!("transpose of {other:?}")),
+            },
+            M::Determinant => match arg_type {
+                TypeInner::Matrix { columns, .. } => Ok(Box::new(move |regs: &mut [u32]| {
+                    let value = super::matrix::determinant(slice(regs, a), columns);
+                    put(regs, dst, len, &[value]);
+                })),
+                other => Err(format!("determinant of {other:?}")),
+            },
+            _ if arith::pack(fun, &[0; 4]).is_some() => Ok(Box::new(move |regs: &mut [u32]| {
+                let value = arith::pack(fun, slice(regs, a)).expect("a pack function");
+                put(regs, dst, len, &[value]);
+            })),
+            _ if arith::unpack(fun, 0).is_some() => Ok(Box::new(move |regs: &mut [u32]| {
+                let value = arith::unpack(fun, regs[a.0 as usize]).expect("an unpack function");
+                put(regs, dst, len, &value);
+            })),
+            _ => match shape(&arg_type) {
+                None => Err(format!("{fun:?} on a composite")),
+                Some((kind, comps)) => {
+                    let zeros = [0u32; 4];
+                    let z = |o: Option<(Reg, u32)>| o.map(|(_, l)| &zeros[..(l as usize).min(4)]);
+                    let probe = math(fun, kind, comps, &zeros[..comps], z(operands[1]), z(operands[2]), z(operands[3]));
+                    if probe.is_none() {
+                        Err(format!("math function {fun:?} on {kind:?}"))
+                    } else {
+                        let (b, c, d) = (operands[1], operands[2], operands[3]);
+                        if let (M::Min | M::Max | M::Clamp | M::Abs, 1, ScalarKind::Uint | ScalarKind::Sint) =
+                            (fun, comps, kind)
+                        {
+                            // Integer clamps are common enough for a closure without allocation.
+                            Ok(Box::new(move |regs: &mut [u32]| {
+                                let x = regs[a.0 as usize];
+                                let y = b.map_or(0, |b| regs[b.0 as usize]);
+                                let z = c.map_or(0, |c| regs[c.0 as usize]);
+                                regs[dst as usize] = arith::math(fun, kind, x, y, z).expect("probed");
+                            }))
+                        } else {
+                            Ok(Box::new(move |regs: &mut [u32]| {
+                                let value = math(
+                                    fun,
+                                    kind,
+                                    comps,
+                                    slice(regs, a),
+                                    b.map(|b| slice(regs, b)),
+                                    c.map(|c| slice(regs, c)),
+                                    d.map(|d| slice(regs, d)),
+                                )
+                                .expect("probed");
+                                put(regs, dst, len, &value);
+                            }))
+                        }
+                    }
+                }
+            },
+        };
+        match compute {
+            Ok(compute) => {
+                self.push(Insn::Compute(compute));
+            }
+            Err(what) => self.fail(what, line),
+        }
+    }
+}

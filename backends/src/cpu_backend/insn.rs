@@ -1,0 +1,348 @@
+//! The interpreter's register bytecode: one [`Insn`] per operation, its operands
+//! resolved at compile time to word offsets in the frame's register file (a `Reg`), so
+//! that running an instruction needs no look-up of types, slots or expressions.
+//!
+//! A frame's register file holds, in this order, the value of every expression that
+//! needs storage, the function's local variables (and those of every callee inlined into
+//! it), all as 32-bit words. Values that are known when the kernel is compiled
+//! (literals, constants, pointers to globals) are filled into each code's register
+//! template once and never recomputed.
+
+use naga::ScalarKind;
+
+/// Word offset of a value in the frame's register file.
+pub(super) type Reg = u32;
+
+/// A scalar binary operator resolved for its operand kind (WGSL semantics, see
+/// [`BinOp::apply`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum BinOp {
+    AddF,
+    SubF,
+    MulF,
+    DivF,
+    ModF,
+    AddI,
+    SubI,
+    MulI,
+    DivU,
+    DivS,
+    ModU,
+    ModS,
+    EqF,
+    NeF,
+    LtF,
+    LeF,
+    GtF,
+    GeF,
+    Eq,
+    Ne,
+    LtS,
+    LeS,
+    GtS,
+    GeS,
+    LtU,
+    LeU,
+    GtU,
+    GeU,
+    And,
+    Xor,
+    Or,
+    LogicalAnd,
+    LogicalOr,
+    Shl,
+    ShrU,
+    ShrS,
+}
+
+impl BinOp {
+    /// The operator `op` on components of kind `kind`; `None` where WGSL has none
+    /// (mirrors [`super::arith::binary`] case by case).
+    pub(super) fn resolve(op: naga::BinaryOperator, kind: ScalarKind) -> Option<Self> {
+        use BinOp as O;
+        use ScalarKind as K;
+        use naga::BinaryOperator as B;
+        Some(match (op, kind) {
+            (B::Add, K::Float) => O::AddF,
+            (B::Subtract, K::Float) => O::SubF,
+            (B::Multiply, K::Float) => O::MulF,
+            (B::Divide, K::Float) => O::DivF,
+            (B::Modulo, K::Float) => O::ModF,
+            (B::Add, K::Uint | K::Sint) => O::AddI,
+            (B::Subtract, K::Uint | K::Sint) => O::SubI,
+            (B::Multiply, K::Uint | K::Sint) => O::MulI,
+            (B::Divide, K::Uint) => O::DivU,
+            (B::Divide, K::Sint) => O::DivS,
+            (B::Modulo, K::Uint) => O::ModU,
+            (B::Modulo, K::Sint) => O::ModS,
+            (B::Equal, K::Float) => O::EqF,
+            (B::NotEqual, K::Float) => O::NeF,
+            (B::Less, K::Float) => O::LtF,
+            (B::LessEqual, K::Float) => O::LeF,
+            (B::Greater, K::Float) => O::GtF,
+            (B::GreaterEqual, K::Float) => O::GeF,
+            (B::Equal, _) => O::Eq,
+            (B::NotEqual, _) => O::Ne,
+            (B::Less, K::Sint) => O::LtS,
+            (B::LessEqual, K::Sint) => O::LeS,
+            (B::Greater, K::Sint) => O::GtS,
+            (B::GreaterEqual, K::Sint) => O::GeS,
+            (B::Less, _) => O::LtU,
+            (B::LessEqual, _) => O::LeU,
+            (B::Greater, _) => O::GtU,
+            (B::GreaterEqual, _) => O::GeU,
+            (B::And, _) => O::And,
+            (B::ExclusiveOr, _) => O::Xor,
+            (B::InclusiveOr, _) => O::Or,
+            (B::LogicalAnd, K::Bool) => O::LogicalAnd,
+            (B::LogicalOr, K::Bool) => O::LogicalOr,
+            (B::ShiftLeft, K::Uint | K::Sint) => O::Shl,
+            (B::ShiftRight, K::Uint) => O::ShrU,
+            (B::ShiftRight, K::Sint) => O::ShrS,
+            _ => return None,
+        })
+    }
+
+    /// `a op c` on one component.
+    #[inline(always)]
+    pub(super) fn apply(self, a: u32, c: u32) -> u32 {
+        use BinOp as O;
+        let f = f32::from_bits;
+        let b = u32::from;
+        let (ia, ic) = (a as i32, c as i32);
+        match self {
+            O::AddF => (f(a) + f(c)).to_bits(),
+            O::SubF => (f(a) - f(c)).to_bits(),
+            O::MulF => (f(a) * f(c)).to_bits(),
+            O::DivF => (f(a) / f(c)).to_bits(),
+            O::ModF => (f(a) % f(c)).to_bits(),
+            O::AddI => a.wrapping_add(c),
+            O::SubI => a.wrapping_sub(c),
+            O::MulI => a.wrapping_mul(c),
+            O::DivU => a.checked_div(c).unwrap_or(a),
+            O::DivS => ia.checked_div(ic).unwrap_or(ia) as u32,
+            O::ModU => a.checked_rem(c).unwrap_or(0),
+            O::ModS => ia.checked_rem(ic).unwrap_or(0) as u32,
+            O::EqF => b(f(a) == f(c)),
+            O::NeF => b(f(a) != f(c)),
+            O::LtF => b(f(a) < f(c)),
+            O::LeF => b(f(a) <= f(c)),
+            O::GtF => b(f(a) > f(c)),
+            O::GeF => b(f(a) >= f(c)),
+            O::Eq => b(a == c),
+            O::Ne => b(a != c),
+            O::LtS => b(ia < ic),
+            O::LeS => b(ia <= ic),
+            O::GtS => b(ia > ic),
+            O::GeS => b(ia >= ic),
+            O::LtU => b(a < c),
+            O::LeU => b(a <= c),
+            O::GtU => b(a > c),
+            O::GeU => b(a >= c),
+            O::And => a & c,
+            O::Xor => a ^ c,
+            O::Or => a | c,
+            O::LogicalAnd => b(a != 0 && c != 0),
+            O::LogicalOr => b(a != 0 || c != 0),
+            O::Shl => a << (c & 31),
+            O::ShrU => a >> (c & 31),
+            O::ShrS => (ia >> (c & 31)) as u32,
+        }
+    }
+}
+
+/// A unary operator resolved for its operand kind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum UnOp {
+    /// Float negation: flips the sign bit.
+    NegF,
+    /// Wrapping integer negation.
+    NegI,
+    /// `!b`.
+    Not,
+    /// `~x`.
+    BitNot,
+}
+
+impl UnOp {
+    /// `op x` on one component.
+    #[inline(always)]
+    pub(super) fn apply(self, x: u32) -> u32 {
+        match self {
+            UnOp::NegF => x ^ 0x8000_0000,
+            UnOp::NegI => (x as i32).wrapping_neg() as u32,
+            UnOp::Not => u32::from(x == 0),
+            UnOp::BitNot => !x,
+        }
+    }
+}
+
+/// A computation too rare to deserve its own instruction (matrix products, most math
+/// functions, packing): a closure over the register file, operands captured.
+pub(super) type Compute = Box<dyn Fn(&mut [u32]) + Send + Sync>;
+
+/// A call of a function that was not inlined.
+pub(super) struct CallInsn {
+    /// Index of the callee's code in the program.
+    pub code: u32,
+    /// Per argument: (caller register, words, callee register).
+    pub arguments: Box<[(Reg, u32, Reg)]>,
+    /// Caller register and words of the return value.
+    pub result: Option<(Reg, u32)>,
+}
+
+/// A WGSL atomic read-modify-write.
+pub(super) struct AtomicInsn {
+    /// Register of the pointer.
+    pub pointer: Reg,
+    pub fun: naga::AtomicFunction,
+    /// Register of the operand.
+    pub value: Reg,
+    /// Register of `compare` for a compare-exchange.
+    pub compare: Option<Reg>,
+    /// Min and max compare as signed integers.
+    pub signed: bool,
+    /// Register receiving the old value (and the `exchanged` flag after it).
+    pub result: Option<Reg>,
+}
+
+/// A subgroup gather (shuffle, broadcast): every invocation of the workgroup stops
+/// here and the values are exchanged between them.
+pub(super) struct GatherInsn {
+    pub mode: naga::GatherMode,
+    /// Register of the lane index or delta, if the mode has one.
+    pub index: Option<Reg>,
+    pub argument: Reg,
+    pub len: u32,
+    pub result: Reg,
+}
+
+/// One bytecode instruction. Unless said otherwise operands are registers, `n` counts
+/// components, and a `s*` stride is 1 for a vector operand and 0 for a scalar one
+/// broadcast over the components.
+pub(super) enum Insn {
+    /// Copies one word.
+    Copy1 { dst: Reg, src: Reg },
+    /// Copies two words.
+    Copy2 { dst: Reg, src: Reg },
+    /// Copies three words.
+    Copy3 { dst: Reg, src: Reg },
+    /// Copies four words.
+    Copy4 { dst: Reg, src: Reg },
+    /// Copies `len` words.
+    Copy { dst: Reg, src: Reg, len: u32 },
+    /// Zeroes `len` words.
+    Zero { dst: Reg, len: u32 },
+    /// Scalar binary operation.
+    Bin { op: BinOp, dst: Reg, a: Reg, b: Reg },
+    /// Component-wise binary operation.
+    BinV { op: BinOp, dst: Reg, a: Reg, b: Reg, n: u8, sa: u8, sb: u8 },
+    /// Component-wise unary operation.
+    Un { op: UnOp, dst: Reg, src: Reg, n: u8 },
+    /// `select(reject, accept, cond)` component-wise.
+    Select { dst: Reg, cond: Reg, accept: Reg, reject: Reg, n: u8, sc: u8 },
+    /// `dst[i] = src[pattern[i]]`.
+    Swizzle { dst: Reg, src: Reg, pattern: [u8; 4], n: u8 },
+    /// `dst[i] = src[0]`.
+    Splat { dst: Reg, src: Reg, n: u8 },
+    /// Numeric conversion component-wise.
+    Convert { from: ScalarKind, to: ScalarKind, dst: Reg, src: Reg, n: u8 },
+    /// `len` words of a value at `base + min(index, count - 1) * stride` (dynamic index
+    /// into a vector, matrix or array value).
+    Extract { dst: Reg, base: Reg, index: Reg, count: u32, stride: u32, len: u32 },
+    /// Pointer plus a constant word offset.
+    PtrAdd { dst: Reg, base: Reg, add: u32 },
+    /// Pointer to element `min(index, count - 1)` of stride `stride` words.
+    PtrIndex { dst: Reg, base: Reg, index: Reg, count: u32, stride: u32 },
+    /// Pointer into a runtime-sized array: the count comes from the memory's size.
+    PtrIndexRt { dst: Reg, base: Reg, index: Reg, stride: u32 },
+    /// Reads `len` words through a pointer register.
+    Load { dst: Reg, pointer: Reg, len: u32 },
+    /// Writes `len` words through a pointer register.
+    Store { pointer: Reg, src: Reg, len: u32 },
+    /// Reads workgroup memory at a word address known when compiling.
+    LoadWorkgroup { dst: Reg, address: u32, len: u32 },
+    /// Writes workgroup memory at a known word address.
+    StoreWorkgroup { address: u32, src: Reg, len: u32 },
+    /// Reads private memory at a known word address.
+    LoadPrivate { dst: Reg, address: u32, len: u32 },
+    /// Writes private memory at a known word address.
+    StorePrivate { address: u32, src: Reg, len: u32 },
+    /// Reads bound buffer `buffer` at a known word address.
+    LoadBuffer { dst: Reg, buffer: u32, address: u32, len: u32 },
+    /// Writes bound buffer `buffer` at a known word address.
+    StoreBuffer { buffer: u32, address: u32, src: Reg, len: u32 },
+    /// `arrayLength(pointer)` of an array whose elements are `stride` words.
+    ArrayLength { dst: Reg, pointer: Reg, stride: u32 },
+    /// A rare computation.
+    Compute(Compute),
+    /// Continues at `target`.
+    Jump(u32),
+    /// Continues at `target` when the bool register is false.
+    JumpUnless { cond: Reg, target: u32 },
+    /// Continues at the target of the first case equal to the selector, else at `default`.
+    Switch { selector: Reg, cases: Box<[(u32, u32)]>, default: u32 },
+    /// Calls a function that was not inlined.
+    Call(Box<CallInsn>),
+    /// Returns `len` words from `src` (`len` 0: no value).
+    Return { src: Reg, len: u32 },
+    /// Workgroup control barrier.
+    Barrier,
+    /// Atomic read-modify-write.
+    Atomic(Box<AtomicInsn>),
+    /// Subgroup gather.
+    Gather(Box<GatherInsn>),
+    /// An unsupported construct reached at run time: (what, WGSL line).
+    Fail(Box<(String, u32)>),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resolved_operators_match_the_reference_arithmetic() {
+        use naga::BinaryOperator as B;
+        let ops = [
+            B::Add,
+            B::Subtract,
+            B::Multiply,
+            B::Divide,
+            B::Modulo,
+            B::Equal,
+            B::NotEqual,
+            B::Less,
+            B::LessEqual,
+            B::Greater,
+            B::GreaterEqual,
+            B::And,
+            B::ExclusiveOr,
+            B::InclusiveOr,
+            B::LogicalAnd,
+            B::LogicalOr,
+            B::ShiftLeft,
+            B::ShiftRight,
+        ];
+        let values = [0u32, 1, 2, 7, 31, 33, 0x8000_0000, 0xffff_ffff, 0x7fff_ffff, 0x3f80_0000, 0x7fc0_0000];
+        for op in ops {
+            for kind in [ScalarKind::Float, ScalarKind::Sint, ScalarKind::Uint, ScalarKind::Bool] {
+                let resolved = BinOp::resolve(op, kind);
+                assert_eq!(
+                    resolved.is_some(),
+                    super::super::arith::binary(op, kind, 0, 0).is_some(),
+                    "{op:?} {kind:?}"
+                );
+                let Some(resolved) = resolved else { continue };
+                for &a in &values {
+                    for &c in &values {
+                        assert_eq!(
+                            Some(resolved.apply(a, c)),
+                            super::super::arith::binary(op, kind, a, c),
+                            "{op:?} {kind:?} {a:#x} {c:#x}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}

@@ -240,18 +240,19 @@ fn unsupported_constructs_are_named_with_their_line() {
 @group(0) @binding(1) var<storage, read_write> output: array<f32>;
 @compute @workgroup_size(1)
 fn main() {
-    output[0] = modf(f32(input[0]) * 0.5).fract;
+    let v = vec2<f32>(f32(input[0]), 1.0);
+    output[0] = reflect(v, vec2<f32>(0.0, 1.0)).x;
 }
 "#;
-    let kernel = Kernel::from_wgsl("pack.wgsl", source.into(), "main", false).unwrap();
+    let kernel = Kernel::from_wgsl("reflect.wgsl", source.into(), "main", false).unwrap();
     let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
     let input = upload(&mut cpu, "input", &[1u32]).unwrap();
     let output = cpu.create_buffer("output", 4).unwrap();
     let error = cpu.dispatch(&kernel, &[Bind::new(0, input), Bind::new(1, output)], [1, 1, 1]).unwrap_err();
     assert!(matches!(error, BackendError::Validation { .. }), "{error}");
     let message = error.to_string();
-    assert!(message.contains("unsupported: math function Modf"), "{message}");
-    assert!(message.contains("(WGSL line 6)"), "{message}");
+    assert!(message.contains("unsupported: math function Reflect on Float"), "{message}");
+    assert!(message.contains("(WGSL line 7)"), "{message}");
 }
 
 #[test]
@@ -378,4 +379,165 @@ fn float_math_and_matrices_agree_with_lavapipe_within_ulps() {
     let agreement = compare_outputs(&[Output { name: "output", words: got, compare: Compare::Exact }], &expected)
         .unwrap_or_else(|mismatch| panic!("{mismatch}"));
     eprintln!("float math: max {} ULP, {:.2}% beyond 64 ULP", agreement.max_ulp, agreement.outside_share() * 100.0);
+}
+
+const HALF_AND_SPLIT: &str = r#"
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let n = arrayLength(&input);
+    let a = input[id.x];
+    let b = input[(id.x * 7u + 3u) % n];
+    let x = bitcast<f32>(a);
+    let y = bitcast<f32>(b);
+    let m = modf(x);
+    let e = frexp(x);
+    let mv = modf(vec3<f32>(x, y, -x));
+    let ev = frexp(vec2<f32>(y, x));
+    let u = unpack2x16float(a);
+    let q = quantizeToF16(vec2<f32>(y, x));
+    let o = id.x * 20u;
+    output[o] = bitcast<u32>(m.fract);
+    output[o + 1u] = bitcast<u32>(m.whole);
+    output[o + 2u] = bitcast<u32>(e.fract);
+    output[o + 3u] = bitcast<u32>(e.exp);
+    output[o + 4u] = bitcast<u32>(quantizeToF16(x));
+    output[o + 5u] = pack2x16float(vec2<f32>(x, y));
+    output[o + 6u] = bitcast<u32>(u.x);
+    output[o + 7u] = bitcast<u32>(u.y);
+    output[o + 8u] = bitcast<u32>(mv.fract.x);
+    output[o + 9u] = bitcast<u32>(mv.fract.y);
+    output[o + 10u] = bitcast<u32>(mv.fract.z);
+    output[o + 11u] = bitcast<u32>(mv.whole.x);
+    output[o + 12u] = bitcast<u32>(mv.whole.y);
+    output[o + 13u] = bitcast<u32>(mv.whole.z);
+    output[o + 14u] = bitcast<u32>(ev.fract.x);
+    output[o + 15u] = bitcast<u32>(ev.fract.y);
+    output[o + 16u] = bitcast<u32>(ev.exp.x);
+    output[o + 17u] = bitcast<u32>(ev.exp.y);
+    output[o + 18u] = bitcast<u32>(q.x);
+    output[o + 19u] = bitcast<u32>(q.y);
+}
+"#;
+
+/// f32 bit patterns at the edges of f32 and of binary16.
+fn half_edge_inputs() -> Vec<u32> {
+    let mut inputs: Vec<u32> = vec![
+        0,
+        0x8000_0000,
+        1,
+        0x8000_0001,
+        0x007f_ffff,
+        0x0080_0000,
+        0x7fc0_0000,
+        0xffc0_0000,
+        0x7f80_0001,
+        0x7fc0_1234,
+        0x7f80_0000,
+        0xff80_0000,
+        0x7f7f_ffff,
+    ];
+    let floats = [
+        65504.0f32,
+        -65504.0,
+        65519.99,
+        65520.0,
+        -65520.0,
+        65536.0,
+        1e10,
+        -1e-10,
+        5.960_464_5e-8, // 2^-24, the smallest binary16 denormal
+        2.980_232_2e-8, // 2^-25: halfway to zero, ties to even (zero)
+        4.470_348_4e-8, // 3 * 2^-26: rounds up to 2^-24
+        8.940_697e-8,   // 3 * 2^-25: halfway between 2^-24 and 2^-23, ties to even
+        6.103_515_6e-5, // 2^-14, the smallest normal binary16
+        6.097_555e-5,   // just below: the largest denormal region
+        1.0 + 1.0 / 2048.0,
+        1.0 + 3.0 / 2048.0,
+        1.0 + 1.0 / 4096.0,
+        -2.5,
+        0.5,
+        1.5,
+        3.0,
+        -7.75,
+        0.999_999_94,
+        1e-30,
+        -123.456,
+        2049.0,
+        2051.0,
+        4097.0,
+    ];
+    inputs.extend(floats.iter().map(|v| v.to_bits()));
+    // Pairs of binary16 edges for unpack2x16float: ±0, denormals, NaNs, ±Inf, max.
+    inputs.extend([0x7c00_fc00u32, 0x7e01_7c01, 0x0001_0400, 0x83ff_8001, 0x7bff_fbff, 0x3c00_bc00, 0x8000_0000]);
+    let mut state = 0x9e37_79b9u32;
+    while inputs.len() < 256 {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        // Half of them random bits, half floats around binary16's range.
+        inputs.push(if inputs.len().is_multiple_of(2) {
+            state
+        } else {
+            let exponent = 100 + (state >> 24) % 48;
+            (state & 0x807f_ffff) | exponent << 23
+        });
+    }
+    inputs
+}
+
+#[test]
+fn modf_frexp_and_binary16_conversions_agree_with_lavapipe_bit_for_bit() {
+    let kernel = Kernel::from_wgsl("half_and_split.wgsl", HALF_AND_SPLIT.into(), "main", false).unwrap();
+    let inputs = half_edge_inputs();
+    let count = inputs.len();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &inputs, count * 20, (count / 64) as u32);
+    // Spot checks independent of any GPU.
+    let at = |value: f32, k: usize| got[inputs.iter().position(|&w| w == value.to_bits()).unwrap() * 20 + k];
+    assert_eq!(at(-7.75, 0), (-0.75f32).to_bits(), "modf fract");
+    assert_eq!(at(-7.75, 1), (-7.0f32).to_bits(), "modf whole");
+    assert_eq!((at(-7.75, 2), at(-7.75, 3)), ((-0.968_75f32).to_bits(), 3), "frexp");
+    assert_eq!(at(65520.0, 4), f32::INFINITY.to_bits(), "quantizeToF16 overflows to infinity");
+    assert_eq!(at(65519.99, 4), 65504.0f32.to_bits(), "below the rounding boundary: f16 max");
+    assert_eq!(at(2.980_232_2e-8, 4), 0, "ties to even: zero");
+    assert_eq!(at(4.470_348_4e-8, 4), 5.960_464_5e-8f32.to_bits(), "rounds up to the smallest denormal");
+    assert_eq!(at(1.0 + 1.0 / 2048.0, 4), 1.0f32.to_bits(), "tie to even, down");
+    assert_eq!(at(1.0 + 3.0 / 2048.0, 4), (1.0f32 + 2.0 / 1024.0).to_bits(), "tie to even, up");
+    let Some(mut gpu) =
+        strata_tests::vulkan_backend("modf_frexp_and_binary16_conversions_agree_with_lavapipe_bit_for_bit")
+    else {
+        return;
+    };
+    let want = run_words(&mut gpu, &kernel, &inputs, count * 20, (count / 64) as u32);
+    let denormal = |w: u32| w & 0x7f80_0000 == 0 && w & 0x007f_ffff != 0;
+    // Excused, each only where lavapipe's result is the stated one:
+    // - quantizeToF16 of a value in binary16's denormal range: the interpreter keeps the
+    //   denormal (WGSL: the same as unpack2x16float(pack2x16float(e)), and both of those
+    //   keep denormals on lavapipe too); lavapipe's OpQuantizeToF16 flushes it to +0,
+    //   which SPIR-V allows.
+    // - frexp of an f32 denormal: the interpreter normalises it; lavapipe returns the
+    //   raw mantissa with exponent -126 (fract outside [0.5, 1)).
+    let excused = |i: usize| {
+        let (x, y) = (inputs[i / 20], inputs[(i / 20 * 7 + 3) % count]);
+        let value = f32::from_bits(got[i]).abs();
+        match i % 20 {
+            4 | 18 | 19 => value > 0.0 && value < 6.103_515_6e-5 && want[i] == 0,
+            2 | 3 | 15 | 17 => denormal(x),
+            14 | 16 => denormal(y),
+            _ => false,
+        }
+    };
+    let mismatches: Vec<String> = (0..want.len())
+        .filter(|&i| got[i] != want[i] && !excused(i))
+        .map(|i| {
+            let (x, y) = (inputs[i / 20], inputs[(i / 20 * 7 + 3) % count]);
+            format!("x {x:#010x} y {y:#010x} op {}: cpu {:#010x}, lavapipe {:#010x}", i % 20, got[i], want[i])
+        })
+        .collect();
+    assert!(mismatches.is_empty(), "{} mismatches:\n{}", mismatches.len(), mismatches.join("\n"));
+    let excused_count = (0..want.len()).filter(|&i| got[i] != want[i]).count();
+    eprintln!("binary16/modf/frexp: {} words, {excused_count} excused differences", want.len());
 }

@@ -567,6 +567,23 @@ impl Compiler<'_> {
                 })),
                 other => Err(format!("determinant of {other:?}")),
             },
+            // Results are naga's predeclared structs: (fract, whole) and (fract, exp).
+            M::Modf | M::Frexp => match (shape(&arg_type), self.ty(scope, handle)) {
+                (Some((ScalarKind::Float, comps)), TypeInner::Struct { members, .. })
+                    if members.len() == 2 && a.1 as usize == comps =>
+                {
+                    let second = dst + members[1].offset / 4;
+                    Ok(Box::new(move |regs: &mut [u32]| {
+                        for i in 0..comps {
+                            let x = regs[a.0 as usize + i];
+                            let (first, other) = if fun == M::Modf { arith::modf(x) } else { arith::frexp(x) };
+                            regs[dst as usize + i] = first;
+                            regs[second as usize + i] = other;
+                        }
+                    }))
+                }
+                _ => Err(format!("{fun:?} of {arg_type:?}")),
+            },
             _ if arith::pack(fun, &[0; 4]).is_some() => Ok(Box::new(move |regs: &mut [u32]| {
                 let value = arith::pack(fun, slice(regs, a)).expect("a pack function");
                 put(regs, dst, len, &[value]);

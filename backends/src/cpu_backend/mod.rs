@@ -21,8 +21,11 @@
 //! Supported today: 32-bit scalars, bool, vectors, matrices as values, fixed and
 //! runtime-sized arrays, structs, pointers, function calls, loops with `continuing` and
 //! `break if`, `switch`, atomics, barriers, `workgroupUniformLoad`, subgroup shuffles and
-//! broadcasts, the compute builtins, matrix arithmetic, and most math functions. Anything else is an error
-//! naming the construct and its WGSL line, never a panic.
+//! broadcasts, the compute builtins, matrix arithmetic, and most math functions
+//! (`modf` and `frexp` with their result structs; `pack2x16float`, `unpack2x16float`
+//! and `quantizeToF16` through IEEE binary16, rounding to nearest even, keeping
+//! denormals). Anything else is an error naming the construct and its WGSL line, never
+//! a panic.
 
 mod arith;
 mod decode;

@@ -4,6 +4,7 @@
 
 use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
 use strata::synthetic::{CandidateMix, candidate_image};
+use strata_backends::ash_backend::{AshBackend, AshOptions, SpirvSource};
 use strata_backends::backend::{download, upload};
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_backends::{Backend, BackendError, Bind};
@@ -540,4 +541,138 @@ fn modf_frexp_and_binary16_conversions_agree_with_lavapipe_bit_for_bit() {
     assert!(mismatches.is_empty(), "{} mismatches:\n{}", mismatches.len(), mismatches.join("\n"));
     let excused_count = (0..want.len()).filter(|&i| got[i] != want[i]).count();
     eprintln!("binary16/modf/frexp: {} words, {excused_count} excused differences", want.len());
+}
+
+const INT64_SEMANTICS: &str = r#"
+@group(0) @binding(0) var<storage, read> input: array<u64>;
+@group(0) @binding(1) var<storage, read_write> output: array<u64>;
+
+struct Tagged { tag: u32, value: i64, halves: vec2<u32> }
+var<workgroup> shared_values: array<Tagged, 64>;
+var<private> bias: i64 = -5000000000li;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let a = input[2u * id.x];
+    let b = input[2u * id.x + 1u];
+    let ia = bitcast<i64>(a);
+    let ib = bitcast<i64>(b);
+    let s = u32(b);
+    let fa = bitcast<f32>(u32(a));
+    shared_values[li] = Tagged(li, ia + bias, vec2<u32>(u32(b), u32(b >> 32u)));
+    workgroupBarrier();
+    let other = shared_values[63u - li];
+    let o = id.x * 24u;
+    output[o] = a + b;
+    output[o + 1u] = a - b;
+    output[o + 2u] = a * b;
+    output[o + 3u] = a / b;
+    output[o + 4u] = a % b;
+    output[o + 5u] = bitcast<u64>(ia / ib);
+    output[o + 6u] = bitcast<u64>(ia % ib);
+    output[o + 7u] = (a & b) ^ (a | ~b);
+    output[o + 8u] = a << s;
+    output[o + 9u] = a >> s;
+    output[o + 10u] = bitcast<u64>(ia >> s);
+    output[o + 11u] = bitcast<u64>(-ia);
+    output[o + 12u] = u64(select(0u, 1u, a < b)) | u64(select(0u, 2u, ia < ib)) | u64(select(0u, 4u, a == b))
+        | u64(select(0u, 8u, ia >= ib)) | u64(select(0u, 16u, a > b)) | u64(select(0u, 32u, ia <= ib))
+        | u64(select(0u, 64u, a != b)) | u64(select(0u, 128u, ia > ib)) | u64(select(0u, 256u, a <= b));
+    output[o + 13u] = u64(fa);
+    output[o + 14u] = bitcast<u64>(i64(fa));
+    output[o + 15u] = u64(bitcast<u32>(f32(ia))) | (u64(bitcast<u32>(f32(a))) << 32u);
+    output[o + 16u] = u64(i32(s)) ^ (bitcast<u64>(i64(u32(a))) << 1u);
+    output[o + 17u] = bitcast<u64>(i64(i32(s))) ^ u64(u32(a >> 32u)) ^ (u64(bitcast<u32>(i32(ib))) << 7u);
+    // naga 30 cannot express bitcast<vec2<u32>>(u64) (its `As` keeps the width): halves by shifts.
+    output[o + 18u] = (a << 32u) | (a >> 32u);
+    let va = vec2<i64>(ia, ib);
+    let vb = vec2<i64>(ib, 3li);
+    let vr = va * vb + select(va, vb, va < vb) - vec2<i64>(7li);
+    output[o + 19u] = bitcast<u64>(vr.x);
+    output[o + 20u] = bitcast<u64>(vr.y) ^ u64(all(va == vb)) ^ u64(i64(true));
+    output[o + 21u] = bitcast<u64>(abs(ia)) ^ min(a, b) ^ bitcast<u64>(max(ia, ib)) ^ max(a, 1000lu);
+    output[o + 22u] = bitcast<u64>(clamp(ia, -1000li, 1000li) + sign(ib) + other.value) ^ u64(other.tag)
+        ^ (u64(other.halves.x) << 3u) ^ (u64(other.halves.y) << 32u);
+    let vs = vec2<u64>(a, b) << vec2<u32>(s, 63u);
+    output[o + 23u] = vs.x ^ (vs.y >> 1u) ^ vec3<u64>(a, b, a ^ b)[s % 3u] ^ u64(f32(a) > 1e18);
+}
+"#;
+
+#[test]
+fn int64_semantics_agree_with_lavapipe_bit_for_bit() {
+    let kernel = Kernel::from_wgsl("int64_semantics.wgsl", INT64_SEMANTICS.into(), "main", false).unwrap();
+    let edges: [u64; 16] = [
+        0,
+        1,
+        2,
+        63,
+        64,
+        65,
+        i64::MAX as u64,
+        i64::MIN as u64,
+        u64::MAX,
+        u64::MAX - 1,
+        0xffff_ffff,
+        0x1_0000_0000,
+        0x5f00_0000,           // low word 2^63 as f32
+        0xffff_ffff_df00_0000, // low word -2^63 as f32
+        0x0000_0003_5f80_0000, // low word 2^64 as f32
+        0x8000_0000_4f80_0000, // low word 2^32 as f32
+    ];
+    let mut values = Vec::new();
+    for &a in &edges {
+        for &b in &edges {
+            values.extend([a, b]);
+        }
+    }
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    while values.len() < 2 * 320 {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        // Some small magnitudes too, where the operators' edge cases live.
+        values.push(if values.len() % 3 == 0 { state % 200 } else { state });
+    }
+    let inputs: Vec<u32> = values.iter().flat_map(|v| [*v as u32, (*v >> 32) as u32]).collect();
+    let pairs = values.len() / 2;
+    let words = pairs * 24 * 2;
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &inputs, words, (pairs / 64) as u32);
+    let wide = |w: &[u32], i: usize| u64::from(w[2 * i]) | u64::from(w[2 * i + 1]) << 32;
+    // Spot checks of WGSL's rules, independent of any GPU.
+    let at = |ai: usize, bi: usize, k: usize| wide(&got, (ai * edges.len() + bi) * 24 + k);
+    assert_eq!(at(7, 0, 5), i64::MIN as u64, "division by zero yields the dividend");
+    assert_eq!(at(7, 8, 5), i64::MIN as u64, "i64::MIN / -1 yields the dividend");
+    assert_eq!(at(7, 8, 6), 0, "i64::MIN % -1 yields 0");
+    assert_eq!(at(1, 5, 8), 2, "shift amounts are taken modulo 64");
+    assert_eq!(at(12, 0, 14), 9_223_371_487_098_961_920, "f32 to i64 clamps to the largest float below 2^63");
+    assert_eq!(at(1, 0, 18), 1 << 32, "halves swapped");
+    let Some(mut gpu) = strata_tests::vulkan_backend("int64_semantics_agree_with_lavapipe_bit_for_bit") else {
+        return;
+    };
+    let want = run_words(&mut gpu, &kernel, &inputs, words, (pairs / 64) as u32);
+    // NaN → integer is implementation-defined (see the 32-bit test): not compared.
+    let nan_conversion = |i: usize| matches!(i % 24, 13 | 14) && f32::from_bits(values[2 * (i / 24)] as u32).is_nan();
+    // Widening between signednesses (u64(i32), i64(u32)): the interpreter extends by
+    // the source's signedness, preserving the value, as naga's constant evaluator does
+    // (so folded and run-time conversions agree); naga's SPIR-V extends by the target's
+    // (UConvert / SConvert). Excused where both follow their rule exactly.
+    let mixed_widening = |i: usize| {
+        let (a, b) = (values[2 * (i / 24)] as u32, values[2 * (i / 24) + 1] as u32);
+        let (sext, zext) = (|x: u32| x as i32 as i64 as u64, |x: u32| u64::from(x));
+        i % 24 == 16 && wide(&got, i) == sext(b) ^ (zext(a) << 1) && wide(&want, i) == zext(b) ^ (sext(a) << 1)
+    };
+    let mismatches: Vec<String> = (0..words / 2)
+        .filter(|&i| wide(&got, i) != wide(&want, i) && !nan_conversion(i) && !mixed_widening(i))
+        .map(|i| {
+            let (a, b) = (values[2 * (i / 24)], values[2 * (i / 24) + 1]);
+            format!("a {a:#x} b {b:#x} op {}: cpu {:#x}, lavapipe {:#x}", i % 24, wide(&got, i), wide(&want, i))
+        })
+        .collect();
+    assert!(mismatches.is_empty(), "{} mismatches:\n{}", mismatches.len(), mismatches.join("\n"));
+    // The ash backend runs it too (it enables shaderInt64, which Vulkan requires for
+    // naga's Int64 capability; lavapipe's validation layer did not flag its absence).
+    let options = AshOptions { validation: true, source: SpirvSource::Naga, subgroups: false };
+    let mut ash = AshBackend::new(options).expect("lavapipe through ash");
+    assert_eq!(run_words(&mut ash, &kernel, &inputs, words, (pairs / 64) as u32), want, "ash and wgpu agree");
 }

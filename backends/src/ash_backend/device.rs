@@ -162,7 +162,13 @@ impl VulkanDevice {
         let priorities = [1.0f32];
         let queue_info =
             [vk::DeviceQueueCreateInfo::default().queue_family_index(family).queue_priorities(&priorities)];
-        let mut device_info = vk::DeviceCreateInfo::default().queue_create_infos(&queue_info);
+        // 64-bit integers in shaders where the device has them (naga's SPIR-V for a
+        // kernel using `i64`/`u64` declares the Int64 capability).
+        // SAFETY: valid physical device.
+        let core_features = unsafe { instance_ref.get_physical_device_features(physical) };
+        let enabled = vk::PhysicalDeviceFeatures::default().shader_int64(core_features.shader_int64 == vk::TRUE);
+        let mut device_info =
+            vk::DeviceCreateInfo::default().queue_create_infos(&queue_info).enabled_features(&enabled);
         if native_zero_init {
             device_info = device_info.push_next(&mut enable13);
         }

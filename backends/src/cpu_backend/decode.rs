@@ -29,20 +29,16 @@ pub(super) const INLINE_DEPTH: u32 = 8;
 /// Marks an expression without a register yet.
 const NONE: Reg = Reg::MAX;
 
-/// Words of a value of type `inner` (bool and every 32-bit scalar: one word).
+/// Words of a value of type `inner` (bool and every 32-bit scalar: one word; 64-bit
+/// integers: two, the low word first).
 pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String> {
     Ok(match *inner {
+        TypeInner::Atomic(s) if s.width != 4 => return Err(format!("{}-bit atomics", s.width * 8)),
         TypeInner::Scalar(s) | TypeInner::Atomic(s) => {
-            if s.width != 4 && s.kind != naga::ScalarKind::Bool {
-                return Err(format!("{}-bit scalars", s.width * 8));
-            }
-            1
+            scalar_words(s).ok_or_else(|| format!("{}-bit scalars", s.width * 8))?
         }
         TypeInner::Vector { size, scalar } => {
-            if scalar.width != 4 && scalar.kind != naga::ScalarKind::Bool {
-                return Err(format!("{}-bit vectors", scalar.width * 8));
-            }
-            size as u32
+            size as u32 * scalar_words(scalar).ok_or_else(|| format!("{}-bit vectors", scalar.width * 8))?
         }
         TypeInner::Pointer { .. } | TypeInner::ValuePointer { .. } => 2,
         TypeInner::Matrix { columns, rows, .. } => {
@@ -61,6 +57,16 @@ pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String
         TypeInner::Struct { span, .. } => span / 4,
         _ => return Err(format!("type {inner:?}")),
     })
+}
+
+/// Words of one scalar: 1 for bool and 32-bit scalars, 2 for 64-bit integers; `None`
+/// for scalars the interpreter does not support.
+pub(super) fn scalar_words(scalar: naga::Scalar) -> Option<u32> {
+    match (scalar.kind, scalar.width) {
+        (naga::ScalarKind::Bool, _) | (_, 4) => Some(1),
+        (naga::ScalarKind::Sint | naga::ScalarKind::Uint, 8) => Some(2),
+        _ => None,
+    }
 }
 
 /// Byte offsets where source lines start, for span → line lookups.

@@ -8,6 +8,7 @@ use super::arith;
 use super::decode::{Compiler, Scope, words_of};
 use super::insn::{BinOp, Insn, Reg, UnOp};
 use super::matrix::column_words;
+use super::wide;
 use crate::error::BackendError;
 use naga::{Expression, Handle, ScalarKind, TypeInner};
 use smallvec::{SmallVec, smallvec};
@@ -48,14 +49,37 @@ pub(super) fn shape(inner: &TypeInner) -> Option<(ScalarKind, usize)> {
     }
 }
 
-fn literal(value: &naga::Literal) -> Option<u32> {
+/// A literal's words (64-bit integers: low word first).
+fn literal(value: &naga::Literal) -> Option<Vec<u32>> {
+    let wide = |v: u64| vec![v as u32, (v >> 32) as u32];
     Some(match *value {
-        naga::Literal::F32(v) => v.to_bits(),
-        naga::Literal::U32(v) => v,
-        naga::Literal::I32(v) => v as u32,
-        naga::Literal::Bool(v) => u32::from(v),
+        naga::Literal::F32(v) => vec![v.to_bits()],
+        naga::Literal::U32(v) => vec![v],
+        naga::Literal::I32(v) => vec![v as u32],
+        naga::Literal::Bool(v) => vec![u32::from(v)],
+        naga::Literal::U64(v) => wide(v),
+        naga::Literal::I64(v) => wide(v as u64),
         _ => return None,
     })
+}
+
+/// Scalar and component count of a scalar or vector type.
+pub(super) fn scalar_shape(inner: &TypeInner) -> Option<(naga::Scalar, usize)> {
+    match *inner {
+        TypeInner::Scalar(s) | TypeInner::Atomic(s) => Some((s, 1)),
+        TypeInner::Vector { size, scalar } => Some((scalar, size as usize)),
+        _ => None,
+    }
+}
+
+/// Whether `inner` is a 64-bit integer scalar or vector.
+fn is_wide(inner: &TypeInner) -> bool {
+    scalar_shape(inner).is_some_and(|(s, _)| wide::is_wide(s))
+}
+
+/// Words per component of a vector (or of a pointer to one) of scalar `scalar`.
+fn component_words(scalar: naga::Scalar) -> u32 {
+    if wide::is_wide(scalar) { 2 } else { 1 }
 }
 
 /// Value of a constant expression of the module (`global_expressions`).
@@ -66,7 +90,7 @@ pub(super) fn global_value(
 ) -> Result<Vec<u32>, String> {
     let inner_of = |ty: Handle<naga::Type>| &module.types[ty].inner;
     Ok(match &module.global_expressions[handle] {
-        Expression::Literal(value) => vec![literal(value).ok_or_else(|| format!("literal {value:?}"))?],
+        Expression::Literal(value) => literal(value).ok_or_else(|| format!("literal {value:?}"))?,
         Expression::Constant(c) => values[module.constants[*c].init.index()].clone(),
         Expression::ZeroValue(ty) => vec![0; words_of(module, inner_of(*ty))? as usize],
         Expression::Splat { size, value } => values[value.index()].repeat(*size as usize),
@@ -116,7 +140,7 @@ pub(super) fn const_value(compiler: &Compiler, scope: &Scope, handle: Handle<Exp
     };
     let len = scope.lens[handle.index()] as usize;
     let value = match &scope.function.expressions[handle] {
-        Expression::Literal(value) => vec![literal(value)?],
+        Expression::Literal(value) => literal(value)?,
         Expression::Constant(c) => compiler.global_values[module.constants[*c].init.index()].clone(),
         Expression::ZeroValue(_) => vec![0; len],
         Expression::Splat { size, value } => value_of(*value)?.repeat(*size as usize),
@@ -216,7 +240,10 @@ impl Compiler<'_> {
             Expression::Literal(ref value) => {
                 let dst = self.reg(scope, handle);
                 match literal(value) {
-                    Some(v) => self.template[dst as usize] = v,
+                    Some(v) => {
+                        let n = v.len().min(len as usize);
+                        self.template[dst as usize..dst as usize + n].copy_from_slice(&v[..n]);
+                    }
                     None => self.fail(format!("literal {value:?}"), line),
                 }
             }
@@ -247,9 +274,22 @@ impl Compiler<'_> {
                 }
             }
             Expression::Splat { size, value } => {
-                let (src, _) = operand!(value);
+                let (src, w) = operand!(value);
                 let dst = self.reg(scope, handle);
-                self.push(Insn::Splat { dst, src, n: size as u8 });
+                if w == 1 {
+                    self.push(Insn::Splat { dst, src, n: size as u8 });
+                } else {
+                    for i in 0..size as u32 {
+                        self.copy(dst + i * w, src, w);
+                    }
+                }
+            }
+            Expression::Swizzle { size, vector, pattern } if is_wide(self.ty(scope, vector)) => {
+                let (src, _) = operand!(vector);
+                let dst = self.reg(scope, handle);
+                for (i, c) in pattern.iter().take(size as usize).enumerate() {
+                    self.copy(dst + 2 * i as u32, src + 2 * *c as u32, 2);
+                }
             }
             Expression::Swizzle { size, vector, pattern } => {
                 let (src, _) = operand!(vector);
@@ -276,9 +316,13 @@ impl Compiler<'_> {
                         TypeInner::Array { stride, .. } => {
                             Ok(Insn::PtrIndexRt { dst, base: base_reg, index: index_reg, stride: stride / 4 })
                         }
-                        TypeInner::Vector { size, .. } => {
-                            Ok(Insn::PtrIndex { dst, base: base_reg, index: index_reg, count: size as u32, stride: 1 })
-                        }
+                        TypeInner::Vector { size, scalar } => Ok(Insn::PtrIndex {
+                            dst,
+                            base: base_reg,
+                            index: index_reg,
+                            count: size as u32,
+                            stride: component_words(scalar),
+                        }),
                         TypeInner::Matrix { columns, rows, .. } => Ok(Insn::PtrIndex {
                             dst,
                             base: base_reg,
@@ -288,16 +332,20 @@ impl Compiler<'_> {
                         }),
                         ref other => Err(format!("indexing through a pointer to {other:?}")),
                     },
-                    TypeInner::ValuePointer { size: Some(size), .. } => {
-                        Ok(Insn::PtrIndex { dst, base: base_reg, index: index_reg, count: *size as u32, stride: 1 })
-                    }
-                    TypeInner::Vector { size, .. } => Ok(Insn::Extract {
+                    TypeInner::ValuePointer { size: Some(size), scalar, .. } => Ok(Insn::PtrIndex {
                         dst,
                         base: base_reg,
                         index: index_reg,
                         count: *size as u32,
-                        stride: 1,
-                        len: 1,
+                        stride: component_words(*scalar),
+                    }),
+                    TypeInner::Vector { size, scalar } => Ok(Insn::Extract {
+                        dst,
+                        base: base_reg,
+                        index: index_reg,
+                        count: *size as u32,
+                        stride: component_words(*scalar),
+                        len: component_words(*scalar),
                     }),
                     TypeInner::Array { size: naga::ArraySize::Constant(n), stride, .. } => Ok(Insn::Extract {
                         dst,
@@ -330,6 +378,55 @@ impl Compiler<'_> {
                 self.reg(scope, pointer);
                 let dst = self.reg(scope, handle);
                 self.load(scope, pointer, dst, len);
+            }
+            Expression::Unary { op, expr } if is_wide(self.ty(scope, expr)) => {
+                let (src, n) = operand!(expr);
+                let dst = self.reg(scope, handle);
+                let apply: fn(u64) -> u64 = match op {
+                    naga::UnaryOperator::Negate => u64::wrapping_neg,
+                    naga::UnaryOperator::BitwiseNot => |x| !x,
+                    naga::UnaryOperator::LogicalNot => {
+                        self.fail("`!` on 64-bit integers".into(), line);
+                        return Ok(());
+                    }
+                };
+                self.push(Insn::Compute(Box::new(move |regs: &mut [u32]| {
+                    for i in (0..n as usize).step_by(2) {
+                        let x = wide::read(regs, src as usize + i);
+                        wide::write(regs, dst as usize + i, apply(x));
+                    }
+                })));
+            }
+            Expression::Binary { op, left, right } if is_wide(self.ty(scope, left)) => {
+                let (a, _) = operand!(left);
+                let (b, _) = operand!(right);
+                let dst = self.reg(scope, handle);
+                let (Some((scalar, ca)), Some((right_scalar, cb))) =
+                    (scalar_shape(self.ty(scope, left)), scalar_shape(self.ty(scope, right)))
+                else {
+                    self.fail(format!("{op:?} on 64-bit integers and composites"), line);
+                    return Ok(());
+                };
+                let signed = scalar.kind == ScalarKind::Sint;
+                if wide::binary(op, signed, 0, 1).is_none() {
+                    self.fail(format!("{op:?} on 64-bit integers"), line);
+                    return Ok(());
+                }
+                let n = ca.max(cb);
+                let (sa, sb) = (usize::from(ca != 1), usize::from(cb != 1));
+                // Shift amounts are u32: one word per component.
+                let wb = component_words(right_scalar) as usize;
+                let (a, b, dst) = (a as usize, b as usize, dst as usize);
+                self.push(Insn::Compute(Box::new(move |regs: &mut [u32]| {
+                    for i in 0..n {
+                        let x = wide::read(regs, a + 2 * i * sa);
+                        let y = if wb == 2 { wide::read(regs, b + 2 * i * sb) } else { u64::from(regs[b + i * sb]) };
+                        match wide::binary(op, signed, x, y).expect("probed") {
+                            wide::Out::Wide(v) => wide::write(regs, dst + 2 * i, v),
+                            wide::Out::Bool(v) => regs[dst + i] = u32::from(v),
+                        }
+                    }
+                })));
             }
             Expression::Unary { op, expr } => {
                 let (src, n) = operand!(expr);
@@ -391,7 +488,19 @@ impl Compiler<'_> {
                 let (accept, n) = operand!(accept);
                 let (reject, _) = operand!(reject);
                 let dst = self.reg(scope, handle);
-                self.push(Insn::Select { dst, cond, accept, reject, n: n as u8, sc: u8::from(lc != 1) });
+                if lc != 1 && n != lc {
+                    // Components of several words (64-bit) under a vector condition.
+                    let w = (n / lc) as usize;
+                    let (dst, cond, accept, reject) = (dst as usize, cond as usize, accept as usize, reject as usize);
+                    self.push(Insn::Compute(Box::new(move |regs: &mut [u32]| {
+                        for i in 0..lc as usize {
+                            let src = if regs[cond + i] != 0 { accept } else { reject };
+                            regs.copy_within(src + i * w..src + (i + 1) * w, dst + i * w);
+                        }
+                    })));
+                } else {
+                    self.push(Insn::Select { dst, cond, accept, reject, n: n as u8, sc: u8::from(lc != 1) });
+                }
             }
             Expression::Relational { fun, argument } => {
                 let v = operand!(argument);
@@ -415,6 +524,34 @@ impl Compiler<'_> {
             }
             Expression::Math { fun, arg, arg1, arg2, arg3 } => {
                 self.math(scope, handle, fun, [Some(arg), arg1, arg2, arg3])
+            }
+            Expression::As { expr, kind, convert: Some(width) }
+                if is_wide(self.ty(scope, expr)) || wide::is_wide(naga::Scalar { kind, width }) =>
+            {
+                let (src, _) = operand!(expr);
+                let dst = self.reg(scope, handle);
+                let Some((from, comps)) = scalar_shape(self.ty(scope, expr)) else {
+                    self.fail("conversion of a composite".into(), line);
+                    return Ok(());
+                };
+                let to = naga::Scalar { kind, width };
+                if wide::convert(0, from, to).is_none() {
+                    self.fail(format!("conversion from {from:?} to {to:?}"), line);
+                    return Ok(());
+                }
+                let (ws, wd) = (component_words(from) as usize, component_words(to) as usize);
+                let (src, dst) = (src as usize, dst as usize);
+                self.push(Insn::Compute(Box::new(move |regs: &mut [u32]| {
+                    for i in 0..comps {
+                        let x = if ws == 2 { wide::read(regs, src + 2 * i) } else { u64::from(regs[src + i]) };
+                        let v = wide::convert(x, from, to).expect("probed");
+                        if wd == 2 {
+                            wide::write(regs, dst + 2 * i, v);
+                        } else {
+                            regs[dst + i] = v as u32;
+                        }
+                    }
+                })));
             }
             Expression::As { expr, kind, convert } => {
                 let (src, n) = operand!(expr);
@@ -492,12 +629,12 @@ impl Compiler<'_> {
             TypeInner::Pointer { base: pointee, .. } => match module.types[*pointee].inner {
                 TypeInner::Array { stride, .. } => Ok((true, index * stride / 4)),
                 TypeInner::Struct { ref members, .. } => Ok((true, members[index as usize].offset / 4)),
-                TypeInner::Vector { .. } => Ok((true, index)),
+                TypeInner::Vector { scalar, .. } => Ok((true, index * component_words(scalar))),
                 TypeInner::Matrix { rows, .. } => Ok((true, index * column_words(rows) as u32)),
                 ref other => Err(format!("indexing through a pointer to {other:?}")),
             },
-            TypeInner::ValuePointer { size: Some(_), .. } => Ok((true, index)),
-            TypeInner::Vector { .. } => Ok((false, index)),
+            TypeInner::ValuePointer { size: Some(_), scalar, .. } => Ok((true, index * component_words(*scalar))),
+            TypeInner::Vector { scalar, .. } => Ok((false, index * component_words(*scalar))),
             TypeInner::Array { size: naga::ArraySize::Constant(_), stride, .. } => Ok((false, index * stride / 4)),
             TypeInner::Array { .. } => Err("indexing a runtime-sized array value".to_string()),
             TypeInner::Struct { members, .. } => Ok((false, members[index as usize].offset / 4)),
@@ -584,6 +721,22 @@ impl Compiler<'_> {
                 }
                 _ => Err(format!("{fun:?} of {arg_type:?}")),
             },
+            _ if is_wide(&arg_type) => {
+                let (scalar, comps) = scalar_shape(&arg_type).expect("a scalar or vector");
+                let signed = scalar.kind == ScalarKind::Sint;
+                if wide::math(fun, signed, 0, 0, 0).is_none() {
+                    Err(format!("math function {fun:?} on 64-bit integers"))
+                } else {
+                    let (b, c) = (operands[1], operands[2]);
+                    Ok(Box::new(move |regs: &mut [u32]| {
+                        for i in 0..comps {
+                            let at = |o: Option<(Reg, u32)>| o.map_or(0, |(r, _)| wide::read(regs, r as usize + 2 * i));
+                            let value = wide::math(fun, signed, wide::read(regs, a.0 as usize + 2 * i), at(b), at(c));
+                            wide::write(regs, dst as usize + 2 * i, value.expect("probed"));
+                        }
+                    }))
+                }
+            }
             _ if arith::pack(fun, &[0; 4]).is_some() => Ok(Box::new(move |regs: &mut [u32]| {
                 let value = arith::pack(fun, slice(regs, a)).expect("a pack function");
                 put(regs, dst, len, &[value]);

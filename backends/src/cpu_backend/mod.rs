@@ -18,7 +18,9 @@
 //! f32 without contraction. Out-of-bounds indices are clamped (naga's `Restrict` policy);
 //! out-of-bounds memory words read as 0 and are not written.
 //!
-//! Supported today: 32-bit scalars, bool, vectors, matrices as values, fixed and
+//! Supported today: 32-bit scalars, bool, 64-bit integers ([`wide`]: two words, low
+//! first, as the storage layout has them; arithmetic, comparisons, bit operations,
+//! shifts, conversions, `abs`/`min`/`max`/`clamp`/`sign`), vectors, matrices as values, fixed and
 //! runtime-sized arrays, structs, pointers, function calls, loops with `continuing` and
 //! `break if`, `switch`, atomics, barriers, `workgroupUniformLoad`, subgroup shuffles and
 //! broadcasts, the compute builtins, matrix arithmetic, and most math functions
@@ -36,6 +38,7 @@ mod insn;
 mod interp;
 mod matrix;
 mod memory;
+mod wide;
 
 use crate::backend::{Backend, Bind, BufferId};
 use crate::bindings_check::{check_binds, check_buffer_size, check_kernel_fits, check_workgroups, check_write};

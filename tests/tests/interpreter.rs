@@ -676,3 +676,179 @@ fn int64_semantics_agree_with_lavapipe_bit_for_bit() {
     let mut ash = AshBackend::new(options).expect("lavapipe through ash");
     assert_eq!(run_words(&mut ash, &kernel, &inputs, words, (pairs / 64) as u32), want, "ash and wgpu agree");
 }
+
+const F16_SEMANTICS: &str = r#"
+enable f16;
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+var<private> scale: f16 = 0.5h;
+
+fn half_at(i: u32) -> f16 {
+    return f16(bitcast<f32>(input[i]));
+}
+
+fn bits(x: f16) -> u32 {
+    return bitcast<u32>(f32(x));
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let x = half_at(2u * id.x);
+    let y = half_at(2u * id.x + 1u);
+    var acc = vec3<f16>(x, y, scale);
+    acc *= 2.0h;
+    let o = id.x * 20u;
+    output[o] = bits(x);
+    output[o + 1u] = bits(x + y);
+    output[o + 2u] = bits(x - y);
+    output[o + 3u] = bits(x * y);
+    output[o + 4u] = bits(x / y);
+    output[o + 5u] = bits(sqrt(abs(x)));
+    output[o + 6u] = bits(-x * scale + 1.0h);
+    output[o + 7u] = select(0u, 1u, x < y) | select(0u, 2u, x == y) | select(0u, 4u, x >= y)
+        | select(0u, 8u, x != y) | select(0u, 16u, x > y) | select(0u, 32u, x <= y);
+    output[o + 8u] = bitcast<u32>(i32(x));
+    output[o + 9u] = u32(y);
+    output[o + 10u] = bits(f16(bitcast<i32>(input[2u * id.x])));
+    output[o + 11u] = bits(f16(input[2u * id.x + 1u] >> 12u));
+    let v = vec3<f16>(x, y, scale) * vec3<f16>(y, x, x) + acc;
+    output[o + 12u] = bits(v.x);
+    output[o + 13u] = bits(v.y);
+    output[o + 14u] = bits(v.z);
+    output[o + 15u] = bits(dot(vec2<f16>(x, y), vec2<f16>(y, scale)));
+    output[o + 16u] = bits(floor(x)) ^ bits(ceil(y)) ^ bits(trunc(x * 3.0h)) ^ (bits(round(y * 0.25h)) >> 1u);
+    output[o + 17u] = bits(min(x, y)) ^ bits(max(x, -y)) ^ (bits(clamp(x, -1.0h, 1.0h)) >> 3u);
+    output[o + 18u] = bits(fract(x)) ^ bits(sign(y)) ^ u32(f32(x) == f32(y));
+    let w = select(vec2<f16>(y, x), vec2<f16>(x, y), vec2<bool>(x < y, y < x));
+    output[o + 19u] = bits(w.x - w.y) ^ bits(vec4<f16>(x, y, x, y)[id.x % 4u]);
+}
+"#;
+
+#[test]
+fn f16_arithmetic_and_conversions_agree_with_lavapipe_bit_for_bit() {
+    let kernel = Kernel::from_wgsl("f16_semantics.wgsl", F16_SEMANTICS.into(), "main", false).unwrap();
+    let mut inputs: Vec<u32> = Vec::new();
+    let edges: Vec<u32> = [
+        0.0f32,
+        -0.0,
+        1.0,
+        -1.0,
+        0.5,
+        65504.0,
+        -65504.0,
+        65520.0,
+        3.0,
+        -7.25,
+        1.0 + 1.0 / 2048.0,
+        1e-7,
+        6.0e-5,
+        100.5,
+        -0.75,
+    ]
+    .iter()
+    .map(|v| v.to_bits())
+    .chain([0x7fc0_0000, 0xff80_0000, 0x7f80_0000, 0x3380_0000, 0xb3c0_0000])
+    .collect();
+    for &a in &edges {
+        for &b in &edges {
+            inputs.extend([a, b]);
+        }
+    }
+    let mut state = 0x1357_9bdfu32;
+    while inputs.len() < 2 * 640 {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        // Floats within binary16's range and beyond, most in its normal range.
+        let exponent = 100 + (state >> 24) % 50;
+        inputs.push((state & 0x807f_ffff) | exponent << 23);
+    }
+    let pairs = inputs.len() / 2;
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &inputs, pairs * 20, (pairs / 64) as u32);
+    let at = |a: f32, b: f32, k: usize| {
+        let pair = (0..pairs).find(|&p| inputs[2 * p] == a.to_bits() && inputs[2 * p + 1] == b.to_bits()).unwrap();
+        got[pair * 20 + k]
+    };
+    assert_eq!(at(65520.0, 0.0, 0), f32::INFINITY.to_bits(), "f32 -> f16 overflows to infinity");
+    assert_eq!(at(1.0 + 1.0 / 2048.0, 0.0, 0), 1.0f32.to_bits(), "ties to even");
+    assert_eq!(at(65504.0, 65504.0, 1), f32::INFINITY.to_bits(), "f16 sums overflow");
+    assert_eq!(at(1.0, 1e-7, 1), 1.0f32.to_bits(), "f16 sums round");
+    assert_eq!(at(3.0, 1.0, 4), 3.0f32.to_bits(), "f16 division");
+    assert_eq!(at(1.0, 3.0, 4), 0.333_251_95f32.to_bits(), "1/3 rounded to binary16");
+    let Some(mut gpu) = strata_tests::vulkan_backend("f16_arithmetic_and_conversions_agree_with_lavapipe_bit_for_bit")
+    else {
+        return;
+    };
+    let want = run_words(&mut gpu, &kernel, &inputs, pairs * 20, (pairs / 64) as u32);
+    // Bit for bit, except where lavapipe is allowed to differ, each named:
+    // - an operand that is NaN or ±Inf as an f16: Vulkan (without float controls) and
+    //   WGSL's finite-math assumption leave the results of arithmetic on them open, and
+    //   lavapipe's optimiser uses that (`x != NaN` false, dot products giving Inf for
+    //   IEEE's NaN); NaN → integer is implementation-defined. Conversions are compared.
+    // - `a * b + c` and dot products: lavapipe keeps f16 products and sums in f32 until
+    //   the end (one rounding: contraction, excess precision, no intermediate overflow);
+    //   the interpreter rounds every operation. Within 2 binary16 ULPs, or the
+    //   interpreter's result overflowed where lavapipe's wider intermediate did not.
+    // - the sign of a zero from min/max/sums of zeros (lavapipe's algebraic rewrites
+    //   do not keep signed zeros).
+    let special = |w: u32| !f32::from_bits(w).is_finite() || f32::from_bits(w).abs() >= 65520.0;
+    let within_two_ulps = |x: u32, y: u32| {
+        let (x, y) = (f32::from_bits(x), f32::from_bits(y));
+        let ulp = (x.abs().max(y.abs()).max(6.103_515_6e-5) * (1.0 / 1024.0)).max(5.960_464_5e-8);
+        (x - y).abs() <= 2.0 * ulp
+    };
+    let zero_sign_only = |x: u32, y: u32| matches!(x ^ y, 0x8000_0000 | 0x4000_0000 | 0x1000_0000 | 0x9000_0000);
+    let excused = |i: usize| {
+        let (a, b) = (inputs[2 * (i / 20)], inputs[2 * (i / 20) + 1]);
+        let operand_special = special(a) || special(b);
+        let (g, w) = (got[i], want[i]);
+        match i % 20 {
+            0 | 10 | 11 => false,
+            8 | 9 => f32::from_bits(a).is_nan() || f32::from_bits(b).is_nan(),
+            12 | 13 | 15 => {
+                operand_special || within_two_ulps(g, w) || zero_sign_only(g, w) || !f32::from_bits(g).is_finite()
+            }
+            17 | 18 => operand_special || zero_sign_only(g, w),
+            _ => operand_special,
+        }
+    };
+    let differing = (0..want.len()).filter(|&i| got[i] != want[i]).count();
+    eprintln!("f16: {} words, {differing} differ, all excused by the rules above", want.len());
+    let mismatches: Vec<String> = (0..want.len())
+        .filter(|&i| got[i] != want[i] && !excused(i))
+        .map(|i| {
+            let (a, b) = (inputs[2 * (i / 20)], inputs[2 * (i / 20) + 1]);
+            format!("a {a:#010x} b {b:#010x} op {}: cpu {:#010x}, lavapipe {:#010x}", i % 20, got[i], want[i])
+        })
+        .collect();
+    assert!(mismatches.is_empty(), "{} mismatches:\n{}", mismatches.len(), mismatches.join("\n"));
+    // The ash backend enables shaderFloat16 for it.
+    let options = AshOptions { validation: true, source: SpirvSource::Naga, subgroups: false };
+    let mut ash = AshBackend::new(options).expect("lavapipe through ash");
+    assert_eq!(run_words(&mut ash, &kernel, &inputs, pairs * 20, (pairs / 64) as u32), want, "ash and wgpu agree");
+}
+
+#[test]
+fn f16_in_memory_the_interpreter_lays_out_by_words_is_refused_with_its_line() {
+    for (declaration, what) in [
+        ("@group(0) @binding(1) var<storage, read_write> output: array<f16>;", "f16 in Storage"),
+        ("var<workgroup> scratch: vec2<f16>;", "f16 in WorkGroup memory"),
+        ("var<private> pair: array<f16, 2>;", "arrays of f16"),
+    ] {
+        let source = format!(
+            "enable f16;\n@group(0) @binding(0) var<storage, read_write> input: array<u32>;\n{declaration}\n\
+             @compute @workgroup_size(1)\nfn main() {{\n    input[0] = 1u;\n    _ = &{name};\n}}\n",
+            name = declaration.split(':').next().unwrap().split(' ').next_back().unwrap()
+        );
+        let kernel = Kernel::from_wgsl("f16_memory.wgsl", source, "main", false).unwrap();
+        let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+        let mut binds = vec![Bind::new(0, cpu.create_buffer("input", 4).unwrap())];
+        if kernel.bindings.len() > 1 {
+            binds.push(Bind::new(1, cpu.create_buffer("output", 4).unwrap()));
+        }
+        let message = cpu.dispatch(&kernel, &binds, [1, 1, 1]).unwrap_err().to_string();
+        assert!(message.contains(&format!("unsupported: {what}")), "{message}");
+        assert!(message.contains("(WGSL line 3)"), "{message}");
+    }
+}

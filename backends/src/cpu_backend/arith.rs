@@ -203,6 +203,34 @@ pub(super) fn f16_to_f32(h: u32) -> u32 {
     half::f16::from_bits(h as u16).to_f32().to_bits()
 }
 
+/// Rounds an f32 to the nearest binary16 value, as an f32 (how registers hold f16).
+pub(super) fn round_f16(x: u32) -> u32 {
+    f16_to_f32(f32_to_f16(x))
+}
+
+/// Numeric conversion where the source or the target is an f16 (held as the f32 of
+/// equal value). Integers → f16 round once (through f64, which holds them exactly);
+/// f16 → integer truncates after clamping to the range both types hold (±Inf → ±65504
+/// as naga's clamp bounds for f16 make it), NaN → 0. `None`: unsupported.
+pub(super) fn convert_half(value: u32, from: naga::Scalar, to: naga::Scalar) -> Option<u32> {
+    use ScalarKind as K;
+    let half = |s: naga::Scalar| s.kind == K::Float && s.width == 2;
+    let plain = |s: naga::Scalar| s.width == 4 || s.kind == K::Bool || half(s);
+    if !plain(from) || !plain(to) {
+        return None;
+    }
+    let round64 = |v: f64| half::f16::from_f64(v).to_f32().to_bits();
+    Some(match (from.kind, to.kind) {
+        (K::Float, K::Float) if half(to) => round_f16(value),
+        (K::Float, K::Float) => value,
+        (K::Float, K::Sint) => convert(f(value).clamp(-65504.0, 65504.0).to_bits(), K::Float, K::Sint)?,
+        (K::Float, K::Uint) => convert(f(value).clamp(0.0, 65504.0).to_bits(), K::Float, K::Uint)?,
+        (K::Sint, K::Float) => round64(f64::from(value as i32)),
+        (K::Uint, K::Float) => round64(f64::from(value)),
+        _ => convert(value, from.kind, to.kind)?,
+    })
+}
+
 /// `modf(x)`: (fract, whole) with whole = trunc(x) and fract = x - whole, both with
 /// x's sign. Where WGSL leaves the sign of a zero or a NaN's bits open, the choices are
 /// lavapipe's (Mesa computes sign(x) · (|x| - floor|x|) and sign(x) · floor|x|): ±0 gives

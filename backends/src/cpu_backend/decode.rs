@@ -41,10 +41,19 @@ pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String
             size as u32 * scalar_words(scalar).ok_or_else(|| format!("{}-bit vectors", scalar.width * 8))?
         }
         TypeInner::Pointer { .. } | TypeInner::ValuePointer { .. } => 2,
+        TypeInner::Matrix { scalar, .. } if scalar.width == 2 => return Err("f16 matrices".into()),
         TypeInner::Matrix { columns, rows, .. } => {
             // Columns are padded like vec3 → 4 words in memory.
             let row_words = if rows == naga::VectorSize::Tri { 4 } else { rows as u32 };
             columns as u32 * row_words
+        }
+        TypeInner::Array { base, .. } if contains_f16(module, &module.types[base].inner) => {
+            return Err("arrays of f16".into());
+        }
+        TypeInner::Struct { ref members, .. }
+            if members.iter().any(|m| contains_f16(module, &module.types[m.ty].inner)) =>
+        {
+            return Err("f16 in structs".into());
         }
         TypeInner::Array { base, size, stride } => {
             // The element type must be supported too.
@@ -61,11 +70,33 @@ pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String
 
 /// Words of one scalar: 1 for bool and 32-bit scalars, 2 for 64-bit integers; `None`
 /// for scalars the interpreter does not support.
+///
+/// An f16 takes a word of its own in registers, holding the f32 of equal value (every
+/// operation producing an f16 rounds to binary16), so f16 exists only where the
+/// interpreter chooses the layout: values, function and private variables of scalar
+/// and vector type. Structs, arrays and matrices of f16 (whose layout naga fixes at
+/// two bytes per scalar) and f16 in storage, uniform or workgroup memory are refused.
 pub(super) fn scalar_words(scalar: naga::Scalar) -> Option<u32> {
     match (scalar.kind, scalar.width) {
-        (naga::ScalarKind::Bool, _) | (_, 4) => Some(1),
+        (naga::ScalarKind::Bool, _) | (_, 4) | (naga::ScalarKind::Float, 2) => Some(1),
         (naga::ScalarKind::Sint | naga::ScalarKind::Uint, 8) => Some(2),
         _ => None,
+    }
+}
+
+/// Whether a value of type `inner` holds an f16 anywhere.
+pub(super) fn contains_f16(module: &Module, inner: &TypeInner) -> bool {
+    match *inner {
+        TypeInner::Scalar(s) | TypeInner::Vector { scalar: s, .. } | TypeInner::Matrix { scalar: s, .. } => {
+            s.kind == naga::ScalarKind::Float && s.width == 2
+        }
+        TypeInner::Array { base, .. } | TypeInner::BindingArray { base, .. } => {
+            contains_f16(module, &module.types[base].inner)
+        }
+        TypeInner::Struct { ref members, .. } => {
+            members.iter().any(|m| contains_f16(module, &module.types[m.ty].inner))
+        }
+        _ => false,
     }
 }
 
@@ -291,9 +322,10 @@ impl Compiler<'_> {
             scope.lines.push(line);
             scope.lens.push(words_of(self.module, inner).map_err(|what| unsupported(&what, line))?);
         }
-        for (_, local) in function.local_variables.iter() {
+        for (handle, local) in function.local_variables.iter() {
+            let line = self.lines_of.line(function.local_variables.get_span(handle));
             let words =
-                words_of(self.module, &self.module.types[local.ty].inner).map_err(|what| unsupported(&what, 0))?;
+                words_of(self.module, &self.module.types[local.ty].inner).map_err(|what| unsupported(&what, line))?;
             let reg = self.alloc(words);
             scope.locals.push(reg);
         }
@@ -743,8 +775,16 @@ pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> 
     let mut globals = Vec::new();
     let (mut workgroup_words, mut private_words) = (0u32, 0u32);
     let mut private_init = Vec::new();
-    for (_, variable) in module.global_variables.iter() {
-        let words = words_of(module, &module.types[variable.ty].inner).unwrap_or(0);
+    for (handle, variable) in module.global_variables.iter() {
+        let inner = &module.types[variable.ty].inner;
+        if contains_f16(module, inner) {
+            let line = lines_of.line(module.global_variables.get_span(handle));
+            if variable.space != naga::AddressSpace::Private {
+                return Err(unsupported(&format!("f16 in {:?} memory", variable.space), line));
+            }
+            words_of(module, inner).map_err(|what| unsupported(&what, line))?;
+        }
+        let words = words_of(module, inner).unwrap_or(0);
         let entry = match variable.space {
             naga::AddressSpace::Uniform | naga::AddressSpace::Storage { .. } => {
                 let binding = variable.binding.as_ref().map_or(u32::MAX, |b| b.binding);

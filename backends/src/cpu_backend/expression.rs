@@ -59,6 +59,7 @@ fn literal(value: &naga::Literal) -> Option<Vec<u32>> {
         naga::Literal::Bool(v) => vec![u32::from(v)],
         naga::Literal::U64(v) => wide(v),
         naga::Literal::I64(v) => wide(v as u64),
+        naga::Literal::F16(v) => vec![v.to_f32().to_bits()],
         _ => return None,
     })
 }
@@ -75,6 +76,11 @@ pub(super) fn scalar_shape(inner: &TypeInner) -> Option<(naga::Scalar, usize)> {
 /// Whether `inner` is a 64-bit integer scalar or vector.
 fn is_wide(inner: &TypeInner) -> bool {
     scalar_shape(inner).is_some_and(|(s, _)| wide::is_wide(s))
+}
+
+/// Whether `inner` is an f16 scalar or vector.
+fn is_half(inner: &TypeInner) -> bool {
+    scalar_shape(inner).is_some_and(|(s, _)| s.kind == ScalarKind::Float && s.width == 2)
 }
 
 /// Words per component of a vector (or of a pointer to one) of scalar `scalar`.
@@ -482,6 +488,11 @@ impl Compiler<'_> {
                     let (sa, sb) = (u8::from(la != 1), u8::from(lb != 1));
                     self.push(Insn::BinV { op: resolved, dst, a, b, n: n as u8, sa, sb });
                 }
+                // f16 arithmetic: computed in f32 (exact or correctly rounded there, as
+                // f32 has more than 2 * 11 + 2 bits), then rounded to binary16.
+                if is_half(self.ty(scope, handle)) {
+                    self.round_half(dst, len);
+                }
             }
             Expression::Select { condition, accept, reject } => {
                 let (cond, lc) = operand!(condition);
@@ -550,6 +561,27 @@ impl Compiler<'_> {
                         } else {
                             regs[dst + i] = v as u32;
                         }
+                    }
+                })));
+            }
+            Expression::As { expr, kind, convert: Some(width) }
+                if is_half(self.ty(scope, expr)) || (kind == ScalarKind::Float && width == 2) =>
+            {
+                let (src, _) = operand!(expr);
+                let dst = self.reg(scope, handle);
+                let Some((from, comps)) = scalar_shape(self.ty(scope, expr)) else {
+                    self.fail("conversion of a composite".into(), line);
+                    return Ok(());
+                };
+                let to = naga::Scalar { kind, width };
+                if arith::convert_half(0, from, to).is_none() {
+                    self.fail(format!("conversion from {from:?} to {to:?}"), line);
+                    return Ok(());
+                }
+                let (src, dst) = (src as usize, dst as usize);
+                self.push(Insn::Compute(Box::new(move |regs: &mut [u32]| {
+                    for i in 0..comps {
+                        regs[dst + i] = arith::convert_half(regs[src + i], from, to).expect("probed");
                     }
                 })));
             }
@@ -787,8 +819,22 @@ impl Compiler<'_> {
         match compute {
             Ok(compute) => {
                 self.push(Insn::Compute(compute));
+                // f16 results: computed in f32, rounded to binary16 once.
+                if is_half(self.ty(scope, handle)) {
+                    self.round_half(dst, len);
+                }
             }
             Err(what) => self.fail(what, line),
         }
+    }
+
+    /// Rounds the `len` f16 values at `dst` (held as f32) to binary16.
+    fn round_half(&mut self, dst: Reg, len: u32) {
+        let (dst, len) = (dst as usize, len as usize);
+        self.push(Insn::Compute(Box::new(move |regs: &mut [u32]| {
+            for x in &mut regs[dst..dst + len] {
+                *x = arith::round_f16(*x);
+            }
+        })));
     }
 }

@@ -20,7 +20,10 @@
 //!
 //! Supported today: 32-bit scalars, bool, 64-bit integers ([`wide`]: two words, low
 //! first, as the storage layout has them; arithmetic, comparisons, bit operations,
-//! shifts, conversions, `abs`/`min`/`max`/`clamp`/`sign`), vectors, matrices as values, fixed and
+//! shifts, conversions, `abs`/`min`/`max`/`clamp`/`sign`), f16 scalars and vectors as
+//! values and in function and private variables (held as the f32 of equal value, every
+//! operation computed in f32 and rounded to binary16; f16 in buffers, workgroup memory,
+//! arrays, structs and matrices is refused by name), vectors, matrices as values, fixed and
 //! runtime-sized arrays, structs, pointers, function calls, loops with `continuing` and
 //! `break if`, `switch`, atomics, barriers, `workgroupUniformLoad`, subgroup shuffles and
 //! broadcasts, the compute builtins, matrix arithmetic, and most math functions

@@ -47,13 +47,18 @@ pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String
             let row_words = if rows == naga::VectorSize::Tri { 4 } else { rows as u32 };
             columns as u32 * row_words
         }
-        TypeInner::Array { base, .. } if contains_f16(module, &module.types[base].inner) => {
-            return Err("arrays of f16".into());
-        }
-        TypeInner::Struct { ref members, .. }
-            if members.iter().any(|m| contains_f16(module, &module.types[m.ty].inner)) =>
-        {
-            return Err("f16 in structs".into());
+        // Register layout of composites holding f16: a word per f16, members and
+        // elements one after the other (naga's 2-byte layout is used in buffers only).
+        TypeInner::Array { base, size, .. } if contains_f16(module, &module.types[base].inner) => match size {
+            naga::ArraySize::Constant(n) => n.get() * words_of(module, &module.types[base].inner)?,
+            _ => return Err("runtime-sized arrays as values".into()),
+        },
+        TypeInner::Struct { ref members, .. } if contains_f16(module, inner) => {
+            let mut words = 0;
+            for member in members {
+                words += words_of(module, &module.types[member.ty].inner)?;
+            }
+            words
         }
         TypeInner::Array { base, size, stride } => {
             // The element type must be supported too.
@@ -72,15 +77,98 @@ pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String
 /// for scalars the interpreter does not support.
 ///
 /// An f16 takes a word of its own in registers, holding the f32 of equal value (every
-/// operation producing an f16 rounds to binary16), so f16 exists only where the
-/// interpreter chooses the layout: values, function and private variables of scalar
-/// and vector type. Structs, arrays and matrices of f16 (whose layout naga fixes at
-/// two bytes per scalar) and f16 in storage, uniform or workgroup memory are refused.
+/// operation producing an f16 rounds to binary16). Registers, function, private and
+/// workgroup memory (which only the interpreter sees) use this register layout; bound
+/// buffers use naga's (two bytes per f16), and loads and stores of types holding f16
+/// convert between the two ([`load_plan`]). Pointers into buffers count bytes,
+/// pointers elsewhere count words. f16 matrices are refused.
 pub(super) fn scalar_words(scalar: naga::Scalar) -> Option<u32> {
     match (scalar.kind, scalar.width) {
         (naga::ScalarKind::Bool, _) | (_, 4) | (naga::ScalarKind::Float, 2) => Some(1),
         (naga::ScalarKind::Sint | naga::ScalarKind::Uint, 8) => Some(2),
         _ => None,
+    }
+}
+
+/// Whether pointers into `space` count bytes (bound buffers, laid out as naga says)
+/// rather than register words.
+pub(super) fn byte_addressed(space: naga::AddressSpace) -> bool {
+    matches!(space, naga::AddressSpace::Uniform | naga::AddressSpace::Storage { .. })
+}
+
+/// Offset of member `index` of struct `inner`: bytes (`bytes`), else register words.
+pub(super) fn member_step(module: &Module, inner: &TypeInner, index: u32, bytes: bool) -> u32 {
+    let TypeInner::Struct { ref members, .. } = *inner else { return 0 };
+    if bytes {
+        members[index as usize].offset
+    } else if !contains_f16(module, inner) {
+        members[index as usize].offset / 4
+    } else {
+        members[..index as usize].iter().map(|m| words_of(module, &module.types[m.ty].inner).unwrap_or(0)).sum()
+    }
+}
+
+/// Distance between elements of an array of `base` with naga stride `stride`: bytes
+/// (`bytes`), else register words.
+pub(super) fn element_step(module: &Module, base: Handle<naga::Type>, stride: u32, bytes: bool) -> u32 {
+    let inner = &module.types[base].inner;
+    if bytes {
+        stride
+    } else if !contains_f16(module, inner) {
+        stride / 4
+    } else {
+        words_of(module, inner).unwrap_or(0)
+    }
+}
+
+/// Distance between components of a vector of `scalar`: bytes (`bytes`), else words.
+pub(super) fn component_step(scalar: naga::Scalar, bytes: bool) -> u32 {
+    match (bytes, scalar.width) {
+        (true, 1) => 4, // bool
+        (true, width) => u32::from(width),
+        (false, 8) if scalar.kind != naga::ScalarKind::Float => 2,
+        (false, _) => 1,
+    }
+}
+
+/// One piece of a load or store between a buffer (naga's layout) and registers.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Piece {
+    /// `len` words at byte offset `memory` ↔ register word `reg`.
+    Words { memory: u32, reg: u32, len: u32 },
+    /// The binary16 at byte offset `memory` ↔ the f32 at register word `reg`.
+    Half { memory: u32, reg: u32 },
+}
+
+/// How a value of type `inner` holding f16 moves between a buffer at byte `memory` and
+/// registers at word `reg`.
+pub(super) fn load_plan(module: &Module, inner: &TypeInner, memory: u32, reg: u32, out: &mut Vec<Piece>) {
+    if !contains_f16(module, inner) {
+        let len = words_of(module, inner).unwrap_or(0);
+        match out.last_mut() {
+            Some(Piece::Words { memory: m, reg: r, len: l }) if *m + 4 * *l == memory && *r + *l == reg => *l += len,
+            _ => out.push(Piece::Words { memory, reg, len }),
+        }
+        return;
+    }
+    match *inner {
+        TypeInner::Scalar(_) => out.push(Piece::Half { memory, reg }),
+        TypeInner::Vector { size, .. } => {
+            out.extend((0..size as u32).map(|i| Piece::Half { memory: memory + 2 * i, reg: reg + i }))
+        }
+        TypeInner::Array { base, size: naga::ArraySize::Constant(n), stride } => {
+            let words = words_of(module, &module.types[base].inner).unwrap_or(0);
+            for i in 0..n.get() {
+                load_plan(module, &module.types[base].inner, memory + i * stride, reg + i * words, out);
+            }
+        }
+        TypeInner::Struct { ref members, .. } => {
+            for (i, member) in members.iter().enumerate() {
+                let step = member_step(module, inner, i as u32, false);
+                load_plan(module, &module.types[member.ty].inner, memory + member.offset, reg + step, out);
+            }
+        }
+        _ => {}
     }
 }
 
@@ -423,8 +511,40 @@ impl Compiler<'_> {
         scope.places[pointer.index()]
     }
 
+    /// How a load or store through `pointer` converts between a buffer's layout and
+    /// registers, if its type holds f16 and it points into a buffer.
+    fn mixed_plan(&self, scope: &Scope, pointer: Handle<Expression>) -> Option<Box<[Piece]>> {
+        let module = self.module;
+        let mut plan = Vec::new();
+        match *self.ty(scope, pointer) {
+            TypeInner::Pointer { base, space } if byte_addressed(space) => {
+                let inner = &module.types[base].inner;
+                if !contains_f16(module, inner) {
+                    return None;
+                }
+                load_plan(module, inner, 0, 0, &mut plan);
+            }
+            TypeInner::ValuePointer { size, scalar, space }
+                if byte_addressed(space) && scalar.kind == naga::ScalarKind::Float && scalar.width == 2 =>
+            {
+                let inner = match size {
+                    Some(size) => TypeInner::Vector { size, scalar },
+                    None => TypeInner::Scalar(scalar),
+                };
+                load_plan(module, &inner, 0, 0, &mut plan);
+            }
+            _ => return None,
+        }
+        Some(plan.into_boxed_slice())
+    }
+
     /// Stores `len` words of register `src` through pointer expression `pointer`.
     pub(super) fn store(&mut self, scope: &mut Scope, pointer: Handle<Expression>, src: Reg, len: u32) {
+        if let Some(plan) = self.mixed_plan(scope, pointer) {
+            let pointer = self.reg(scope, pointer);
+            self.push(Insn::StoreMixed { pointer, src, plan });
+            return;
+        }
         match self.place(scope, pointer) {
             Some(Place::Local(variable)) => self.copy(variable, src, len),
             Some(Place::Workgroup(address)) => {
@@ -433,8 +553,8 @@ impl Compiler<'_> {
             Some(Place::Private(address)) => {
                 self.push(Insn::StorePrivate { address, src, len });
             }
-            Some(Place::Buffer(buffer, address)) => {
-                self.push(Insn::StoreBuffer { buffer, address, src, len });
+            Some(Place::Buffer(buffer, bytes)) => {
+                self.push(Insn::StoreBuffer { buffer, address: bytes / 4, src, len });
             }
             None => {
                 let pointer = self.reg(scope, pointer);
@@ -445,6 +565,11 @@ impl Compiler<'_> {
 
     /// Loads `len` words through pointer expression `pointer` into register `dst`.
     pub(super) fn load(&mut self, scope: &mut Scope, pointer: Handle<Expression>, dst: Reg, len: u32) {
+        if let Some(plan) = self.mixed_plan(scope, pointer) {
+            let pointer = self.reg(scope, pointer);
+            self.push(Insn::LoadMixed { dst, pointer, plan });
+            return;
+        }
         match self.place(scope, pointer) {
             Some(Place::Local(variable)) => self.copy(dst, variable, len),
             Some(Place::Workgroup(address)) => {
@@ -453,8 +578,8 @@ impl Compiler<'_> {
             Some(Place::Private(address)) => {
                 self.push(Insn::LoadPrivate { dst, address, len });
             }
-            Some(Place::Buffer(buffer, address)) => {
-                self.push(Insn::LoadBuffer { dst, buffer, address, len });
+            Some(Place::Buffer(buffer, bytes)) => {
+                self.push(Insn::LoadBuffer { dst, buffer, address: bytes / 4, len });
             }
             None => {
                 let pointer = self.reg(scope, pointer);
@@ -777,11 +902,8 @@ pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> 
     let mut private_init = Vec::new();
     for (handle, variable) in module.global_variables.iter() {
         let inner = &module.types[variable.ty].inner;
-        if contains_f16(module, inner) {
+        if contains_f16(module, inner) && !byte_addressed(variable.space) {
             let line = lines_of.line(module.global_variables.get_span(handle));
-            if variable.space != naga::AddressSpace::Private {
-                return Err(unsupported(&format!("f16 in {:?} memory", variable.space), line));
-            }
             words_of(module, inner).map_err(|what| unsupported(&what, line))?;
         }
         let words = words_of(module, inner).unwrap_or(0);

@@ -5,7 +5,7 @@
 //! [`Insn::Fail`] naming the construct and its line, reported only if reached.
 
 use super::arith;
-use super::decode::{Compiler, Scope, words_of};
+use super::decode::{Compiler, Scope, byte_addressed, component_step, element_step, member_step, words_of};
 use super::insn::{BinOp, Insn, Reg, UnOp};
 use super::matrix::column_words;
 use super::wide;
@@ -25,7 +25,7 @@ pub(super) enum Place {
     Workgroup(u32),
     /// Private memory at this word.
     Private(u32),
-    /// Bound buffer (slot, word).
+    /// Bound buffer (slot, byte).
     Buffer(u32, u32),
 }
 
@@ -109,11 +109,14 @@ pub(super) fn global_value(
 }
 
 /// Word offset of each part of a value of type `inner` composed of parts of `lens` words.
-fn compose_offsets(inner: &TypeInner, lens: &[u32]) -> Result<Vec<u32>, String> {
+fn compose_offsets(module: &naga::Module, inner: &TypeInner, lens: &[u32]) -> Result<Vec<u32>, String> {
     Ok(match *inner {
         TypeInner::Vector { .. } => lens.iter().scan(0, |at, len| Some(std::mem::replace(at, *at + len))).collect(),
-        TypeInner::Struct { ref members, .. } => members.iter().take(lens.len()).map(|m| m.offset / 4).collect(),
-        TypeInner::Array { stride, .. } => (0..lens.len() as u32).map(|i| i * stride / 4).collect(),
+        TypeInner::Struct { .. } => (0..lens.len() as u32).map(|i| member_step(module, inner, i, false)).collect(),
+        TypeInner::Array { base, stride, .. } => {
+            let step = element_step(module, base, stride, false);
+            (0..lens.len() as u32).map(|i| i * step).collect()
+        }
         TypeInner::Matrix { rows, .. } => (0..lens.len()).map(|i| (i * column_words(rows)) as u32).collect(),
         _ => return Err(format!("composing {inner:?}")),
     })
@@ -123,7 +126,7 @@ fn compose_offsets(inner: &TypeInner, lens: &[u32]) -> Result<Vec<u32>, String> 
 pub(super) fn compose(module: &naga::Module, inner: &TypeInner, parts: &[&[u32]]) -> Result<Vec<u32>, String> {
     let mut out = vec![0u32; words_of(module, inner)? as usize];
     let lens: Vec<u32> = parts.iter().map(|p| p.len() as u32).collect();
-    let offsets = compose_offsets(inner, &lens)?;
+    let offsets = compose_offsets(module, inner, &lens)?;
     for (part, at) in parts.iter().zip(offsets) {
         let at = at as usize;
         let len = part.len().min(out.len().saturating_sub(at));
@@ -266,7 +269,7 @@ impl Compiler<'_> {
             Expression::Compose { ref components, .. } => {
                 let parts: Vec<(Reg, u32)> = components.iter().map(|c| operand!(*c)).collect();
                 let lens: Vec<u32> = parts.iter().map(|p| p.1).collect();
-                match compose_offsets(self.ty(scope, handle), &lens) {
+                match compose_offsets(module, self.ty(scope, handle), &lens) {
                     Ok(offsets) => {
                         let dst = self.reg(scope, handle);
                         for ((src, part), at) in parts.into_iter().zip(offsets) {
@@ -311,39 +314,48 @@ impl Compiler<'_> {
                 let (index_reg, _) = operand!(index_handle);
                 let dst = self.reg(scope, handle);
                 let insn = match self.ty(scope, base) {
-                    TypeInner::Pointer { base: pointee, .. } => match module.types[*pointee].inner {
-                        TypeInner::Array { size: naga::ArraySize::Constant(n), stride, .. } => Ok(Insn::PtrIndex {
-                            dst,
-                            base: base_reg,
-                            index: index_reg,
-                            count: n.get(),
-                            stride: stride / 4,
-                        }),
-                        TypeInner::Array { stride, .. } => {
-                            Ok(Insn::PtrIndexRt { dst, base: base_reg, index: index_reg, stride: stride / 4 })
+                    TypeInner::Pointer { base: pointee, space } => {
+                        // Pointers into buffers count bytes, others register words.
+                        let bytes = byte_addressed(*space);
+                        match module.types[*pointee].inner {
+                            TypeInner::Array { base: element, size: naga::ArraySize::Constant(n), stride } => {
+                                Ok(Insn::PtrIndex {
+                                    dst,
+                                    base: base_reg,
+                                    index: index_reg,
+                                    count: n.get(),
+                                    stride: element_step(module, element, stride, bytes),
+                                })
+                            }
+                            TypeInner::Array { base: element, stride, .. } => Ok(Insn::PtrIndexRt {
+                                dst,
+                                base: base_reg,
+                                index: index_reg,
+                                stride: element_step(module, element, stride, bytes),
+                            }),
+                            TypeInner::Vector { size, scalar } => Ok(Insn::PtrIndex {
+                                dst,
+                                base: base_reg,
+                                index: index_reg,
+                                count: size as u32,
+                                stride: component_step(scalar, bytes),
+                            }),
+                            TypeInner::Matrix { columns, rows, .. } => Ok(Insn::PtrIndex {
+                                dst,
+                                base: base_reg,
+                                index: index_reg,
+                                count: columns as u32,
+                                stride: column_words(rows) as u32 * if bytes { 4 } else { 1 },
+                            }),
+                            ref other => Err(format!("indexing through a pointer to {other:?}")),
                         }
-                        TypeInner::Vector { size, scalar } => Ok(Insn::PtrIndex {
-                            dst,
-                            base: base_reg,
-                            index: index_reg,
-                            count: size as u32,
-                            stride: component_words(scalar),
-                        }),
-                        TypeInner::Matrix { columns, rows, .. } => Ok(Insn::PtrIndex {
-                            dst,
-                            base: base_reg,
-                            index: index_reg,
-                            count: columns as u32,
-                            stride: column_words(rows) as u32,
-                        }),
-                        ref other => Err(format!("indexing through a pointer to {other:?}")),
-                    },
-                    TypeInner::ValuePointer { size: Some(size), scalar, .. } => Ok(Insn::PtrIndex {
+                    }
+                    TypeInner::ValuePointer { size: Some(size), scalar, space } => Ok(Insn::PtrIndex {
                         dst,
                         base: base_reg,
                         index: index_reg,
                         count: *size as u32,
-                        stride: component_words(*scalar),
+                        stride: component_step(*scalar, byte_addressed(*space)),
                     }),
                     TypeInner::Vector { size, scalar } => Ok(Insn::Extract {
                         dst,
@@ -353,14 +365,16 @@ impl Compiler<'_> {
                         stride: component_words(*scalar),
                         len: component_words(*scalar),
                     }),
-                    TypeInner::Array { size: naga::ArraySize::Constant(n), stride, .. } => Ok(Insn::Extract {
-                        dst,
-                        base: base_reg,
-                        index: index_reg,
-                        count: n.get(),
-                        stride: stride / 4,
-                        len,
-                    }),
+                    TypeInner::Array { base: element, size: naga::ArraySize::Constant(n), stride } => {
+                        Ok(Insn::Extract {
+                            dst,
+                            base: base_reg,
+                            index: index_reg,
+                            count: n.get(),
+                            stride: element_step(module, *element, *stride, false),
+                            len,
+                        })
+                    }
                     TypeInner::Array { .. } => Err("indexing a runtime-sized array value".to_string()),
                     TypeInner::Matrix { columns, rows, .. } => Ok(Insn::Extract {
                         dst,
@@ -618,7 +632,8 @@ impl Compiler<'_> {
                 let dst = self.reg(scope, handle);
                 let stride = match self.ty(scope, pointer) {
                     TypeInner::Pointer { base, .. } => match module.types[*base].inner {
-                        TypeInner::Array { stride, .. } => Ok(stride / 4),
+                        // Runtime-sized arrays live in buffers: bytes.
+                        TypeInner::Array { stride, .. } => Ok(stride),
                         _ => Err("arrayLength of a non-array"),
                     },
                     _ => Err("arrayLength of a non-pointer"),
@@ -658,18 +673,31 @@ impl Compiler<'_> {
         let line = self.line;
         let base_reg = self.reg(scope, base);
         let step = match self.ty(scope, base) {
-            TypeInner::Pointer { base: pointee, .. } => match module.types[*pointee].inner {
-                TypeInner::Array { stride, .. } => Ok((true, index * stride / 4)),
-                TypeInner::Struct { ref members, .. } => Ok((true, members[index as usize].offset / 4)),
-                TypeInner::Vector { scalar, .. } => Ok((true, index * component_words(scalar))),
-                TypeInner::Matrix { rows, .. } => Ok((true, index * column_words(rows) as u32)),
-                ref other => Err(format!("indexing through a pointer to {other:?}")),
-            },
-            TypeInner::ValuePointer { size: Some(_), scalar, .. } => Ok((true, index * component_words(*scalar))),
+            TypeInner::Pointer { base: pointee, space } => {
+                // Pointers into buffers count bytes, others register words.
+                let bytes = byte_addressed(*space);
+                let inner = &module.types[*pointee].inner;
+                match *inner {
+                    TypeInner::Array { base: element, stride, .. } => {
+                        Ok((true, index * element_step(module, element, stride, bytes)))
+                    }
+                    TypeInner::Struct { .. } => Ok((true, member_step(module, inner, index, bytes))),
+                    TypeInner::Vector { scalar, .. } => Ok((true, index * component_step(scalar, bytes))),
+                    TypeInner::Matrix { rows, .. } => {
+                        Ok((true, index * column_words(rows) as u32 * if bytes { 4 } else { 1 }))
+                    }
+                    ref other => Err(format!("indexing through a pointer to {other:?}")),
+                }
+            }
+            TypeInner::ValuePointer { size: Some(_), scalar, space } => {
+                Ok((true, index * component_step(*scalar, byte_addressed(*space))))
+            }
             TypeInner::Vector { scalar, .. } => Ok((false, index * component_words(*scalar))),
-            TypeInner::Array { size: naga::ArraySize::Constant(_), stride, .. } => Ok((false, index * stride / 4)),
+            TypeInner::Array { base: element, size: naga::ArraySize::Constant(_), stride } => {
+                Ok((false, index * element_step(module, *element, *stride, false)))
+            }
             TypeInner::Array { .. } => Err("indexing a runtime-sized array value".to_string()),
-            TypeInner::Struct { members, .. } => Ok((false, members[index as usize].offset / 4)),
+            inner @ TypeInner::Struct { .. } => Ok((false, member_step(module, inner, index, false))),
             TypeInner::Matrix { rows, .. } => Ok((false, index * column_words(*rows) as u32)),
             other => Err(format!("indexing {other:?}")),
         };
@@ -741,7 +769,7 @@ impl Compiler<'_> {
                 (Some((ScalarKind::Float, comps)), TypeInner::Struct { members, .. })
                     if members.len() == 2 && a.1 as usize == comps =>
                 {
-                    let second = dst + members[1].offset / 4;
+                    let second = dst + member_step(self.module, self.ty(scope, handle), 1, false);
                     Ok(Box::new(move |regs: &mut [u32]| {
                         for i in 0..comps {
                             let x = regs[a.0 as usize + i];

@@ -179,8 +179,9 @@ fn math(
     match fun {
         M::Dot if kind == ScalarKind::Float => {
             let b = b?;
-            // Sequential sum of products, no fused multiply-add.
-            let sum = (0..comps).fold(0.0f32, |acc, i| acc + f(a[i]) * f(b[i]));
+            // Sequential sum of products, no fused multiply-add; starting from the first
+            // product, not from +0, so that products that are all -0 sum to -0.
+            let sum = (1..comps).fold(f(a[0]) * f(b[0]), |acc, i| acc + f(a[i]) * f(b[i]));
             Some(smallvec![sum.to_bits()])
         }
         M::Dot => {

@@ -209,6 +209,11 @@ impl KernelFeatures {
     }
 }
 
+/// What the validator allows in external kernels ([`Kernel::from_wgsl`]) beyond the
+/// kernel's [`KernelFeatures`].
+const EXTERNAL_CAPABILITIES: Capabilities =
+    Capabilities::SHADER_FLOAT16_IN_FLOAT32.union(Capabilities::SHADER_INT64).union(Capabilities::SHADER_FLOAT16);
+
 /// A kernel as declared in the registry.
 #[derive(Clone, Debug)]
 pub struct KernelSpec {
@@ -332,7 +337,14 @@ impl Kernel {
                 message: format!("at {location}\n{}", error.emit_to_string(&source.text)),
             }
         })?;
-        let info = naga::valid::Validator::new(ValidationFlags::all(), spec.features.capabilities())
+        // External kernels may use what a backend supports beyond core WebGPU (the
+        // interpreter and Vulkan devices with the features: 64-bit integers, f16, the
+        // f16 packing builtins); a backend without them refuses the kernel itself.
+        let mut capabilities = spec.features.capabilities();
+        if matches!(id, KernelId::External(_)) {
+            capabilities |= EXTERNAL_CAPABILITIES;
+        }
+        let info = naga::valid::Validator::new(ValidationFlags::all(), capabilities)
             .subgroup_stages(ShaderStages::COMPUTE)
             .subgroup_operations(SubgroupOperationSet::all())
             .validate(&module)

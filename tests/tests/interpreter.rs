@@ -4,6 +4,7 @@
 
 use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
 use strata::synthetic::{CandidateMix, candidate_image};
+use strata_backends::ash_backend::{AshBackend, AshOptions, SpirvSource};
 use strata_backends::backend::{download, upload};
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_backends::{Backend, BackendError, Bind};
@@ -240,18 +241,19 @@ fn unsupported_constructs_are_named_with_their_line() {
 @group(0) @binding(1) var<storage, read_write> output: array<f32>;
 @compute @workgroup_size(1)
 fn main() {
-    output[0] = modf(f32(input[0]) * 0.5).fract;
+    let v = vec2<f32>(f32(input[0]), 1.0);
+    output[0] = reflect(v, vec2<f32>(0.0, 1.0)).x;
 }
 "#;
-    let kernel = Kernel::from_wgsl("pack.wgsl", source.into(), "main", false).unwrap();
+    let kernel = Kernel::from_wgsl("reflect.wgsl", source.into(), "main", false).unwrap();
     let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
     let input = upload(&mut cpu, "input", &[1u32]).unwrap();
     let output = cpu.create_buffer("output", 4).unwrap();
     let error = cpu.dispatch(&kernel, &[Bind::new(0, input), Bind::new(1, output)], [1, 1, 1]).unwrap_err();
     assert!(matches!(error, BackendError::Validation { .. }), "{error}");
     let message = error.to_string();
-    assert!(message.contains("unsupported: math function Modf"), "{message}");
-    assert!(message.contains("(WGSL line 6)"), "{message}");
+    assert!(message.contains("unsupported: math function Reflect on Float"), "{message}");
+    assert!(message.contains("(WGSL line 7)"), "{message}");
 }
 
 #[test]
@@ -378,4 +380,552 @@ fn float_math_and_matrices_agree_with_lavapipe_within_ulps() {
     let agreement = compare_outputs(&[Output { name: "output", words: got, compare: Compare::Exact }], &expected)
         .unwrap_or_else(|mismatch| panic!("{mismatch}"));
     eprintln!("float math: max {} ULP, {:.2}% beyond 64 ULP", agreement.max_ulp, agreement.outside_share() * 100.0);
+}
+
+const HALF_AND_SPLIT: &str = r#"
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let n = arrayLength(&input);
+    let a = input[id.x];
+    let b = input[(id.x * 7u + 3u) % n];
+    let x = bitcast<f32>(a);
+    let y = bitcast<f32>(b);
+    let m = modf(x);
+    let e = frexp(x);
+    let mv = modf(vec3<f32>(x, y, -x));
+    let ev = frexp(vec2<f32>(y, x));
+    let u = unpack2x16float(a);
+    let q = quantizeToF16(vec2<f32>(y, x));
+    let o = id.x * 20u;
+    output[o] = bitcast<u32>(m.fract);
+    output[o + 1u] = bitcast<u32>(m.whole);
+    output[o + 2u] = bitcast<u32>(e.fract);
+    output[o + 3u] = bitcast<u32>(e.exp);
+    output[o + 4u] = bitcast<u32>(quantizeToF16(x));
+    output[o + 5u] = pack2x16float(vec2<f32>(x, y));
+    output[o + 6u] = bitcast<u32>(u.x);
+    output[o + 7u] = bitcast<u32>(u.y);
+    output[o + 8u] = bitcast<u32>(mv.fract.x);
+    output[o + 9u] = bitcast<u32>(mv.fract.y);
+    output[o + 10u] = bitcast<u32>(mv.fract.z);
+    output[o + 11u] = bitcast<u32>(mv.whole.x);
+    output[o + 12u] = bitcast<u32>(mv.whole.y);
+    output[o + 13u] = bitcast<u32>(mv.whole.z);
+    output[o + 14u] = bitcast<u32>(ev.fract.x);
+    output[o + 15u] = bitcast<u32>(ev.fract.y);
+    output[o + 16u] = bitcast<u32>(ev.exp.x);
+    output[o + 17u] = bitcast<u32>(ev.exp.y);
+    output[o + 18u] = bitcast<u32>(q.x);
+    output[o + 19u] = bitcast<u32>(q.y);
+}
+"#;
+
+/// f32 bit patterns at the edges of f32 and of binary16.
+fn half_edge_inputs() -> Vec<u32> {
+    let mut inputs: Vec<u32> = vec![
+        0,
+        0x8000_0000,
+        1,
+        0x8000_0001,
+        0x007f_ffff,
+        0x0080_0000,
+        0x7fc0_0000,
+        0xffc0_0000,
+        0x7f80_0001,
+        0x7fc0_1234,
+        0x7f80_0000,
+        0xff80_0000,
+        0x7f7f_ffff,
+    ];
+    let floats = [
+        65504.0f32,
+        -65504.0,
+        65519.99,
+        65520.0,
+        -65520.0,
+        65536.0,
+        1e10,
+        -1e-10,
+        5.960_464_5e-8, // 2^-24, the smallest binary16 denormal
+        2.980_232_2e-8, // 2^-25: halfway to zero, ties to even (zero)
+        4.470_348_4e-8, // 3 * 2^-26: rounds up to 2^-24
+        8.940_697e-8,   // 3 * 2^-25: halfway between 2^-24 and 2^-23, ties to even
+        6.103_515_6e-5, // 2^-14, the smallest normal binary16
+        6.097_555e-5,   // just below: the largest denormal region
+        1.0 + 1.0 / 2048.0,
+        1.0 + 3.0 / 2048.0,
+        1.0 + 1.0 / 4096.0,
+        -2.5,
+        0.5,
+        1.5,
+        3.0,
+        -7.75,
+        0.999_999_94,
+        1e-30,
+        -123.456,
+        2049.0,
+        2051.0,
+        4097.0,
+    ];
+    inputs.extend(floats.iter().map(|v| v.to_bits()));
+    // Pairs of binary16 edges for unpack2x16float: ±0, denormals, NaNs, ±Inf, max.
+    inputs.extend([0x7c00_fc00u32, 0x7e01_7c01, 0x0001_0400, 0x83ff_8001, 0x7bff_fbff, 0x3c00_bc00, 0x8000_0000]);
+    let mut state = 0x9e37_79b9u32;
+    while inputs.len() < 256 {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        // Half of them random bits, half floats around binary16's range.
+        inputs.push(if inputs.len().is_multiple_of(2) {
+            state
+        } else {
+            let exponent = 100 + (state >> 24) % 48;
+            (state & 0x807f_ffff) | exponent << 23
+        });
+    }
+    inputs
+}
+
+#[test]
+fn modf_frexp_and_binary16_conversions_agree_with_lavapipe_bit_for_bit() {
+    let kernel = Kernel::from_wgsl("half_and_split.wgsl", HALF_AND_SPLIT.into(), "main", false).unwrap();
+    let inputs = half_edge_inputs();
+    let count = inputs.len();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &inputs, count * 20, (count / 64) as u32);
+    // Spot checks independent of any GPU.
+    let at = |value: f32, k: usize| got[inputs.iter().position(|&w| w == value.to_bits()).unwrap() * 20 + k];
+    assert_eq!(at(-7.75, 0), (-0.75f32).to_bits(), "modf fract");
+    assert_eq!(at(-7.75, 1), (-7.0f32).to_bits(), "modf whole");
+    assert_eq!((at(-7.75, 2), at(-7.75, 3)), ((-0.968_75f32).to_bits(), 3), "frexp");
+    assert_eq!(at(65520.0, 4), f32::INFINITY.to_bits(), "quantizeToF16 overflows to infinity");
+    assert_eq!(at(65519.99, 4), 65504.0f32.to_bits(), "below the rounding boundary: f16 max");
+    assert_eq!(at(2.980_232_2e-8, 4), 0, "ties to even: zero");
+    assert_eq!(at(4.470_348_4e-8, 4), 5.960_464_5e-8f32.to_bits(), "rounds up to the smallest denormal");
+    assert_eq!(at(1.0 + 1.0 / 2048.0, 4), 1.0f32.to_bits(), "tie to even, down");
+    assert_eq!(at(1.0 + 3.0 / 2048.0, 4), (1.0f32 + 2.0 / 1024.0).to_bits(), "tie to even, up");
+    let Some(mut gpu) =
+        strata_tests::vulkan_backend("modf_frexp_and_binary16_conversions_agree_with_lavapipe_bit_for_bit")
+    else {
+        return;
+    };
+    let want = run_words(&mut gpu, &kernel, &inputs, count * 20, (count / 64) as u32);
+    let denormal = |w: u32| w & 0x7f80_0000 == 0 && w & 0x007f_ffff != 0;
+    // Excused, each only where lavapipe's result is the stated one:
+    // - quantizeToF16 of a value in binary16's denormal range: the interpreter keeps the
+    //   denormal (WGSL: the same as unpack2x16float(pack2x16float(e)), and both of those
+    //   keep denormals on lavapipe too); lavapipe's OpQuantizeToF16 flushes it to +0,
+    //   which SPIR-V allows.
+    // - frexp of an f32 denormal: the interpreter normalises it; lavapipe returns the
+    //   raw mantissa with exponent -126 (fract outside [0.5, 1)).
+    let excused = |i: usize| {
+        let (x, y) = (inputs[i / 20], inputs[(i / 20 * 7 + 3) % count]);
+        let value = f32::from_bits(got[i]).abs();
+        match i % 20 {
+            4 | 18 | 19 => value > 0.0 && value < 6.103_515_6e-5 && want[i] == 0,
+            2 | 3 | 15 | 17 => denormal(x),
+            14 | 16 => denormal(y),
+            _ => false,
+        }
+    };
+    let mismatches: Vec<String> = (0..want.len())
+        .filter(|&i| got[i] != want[i] && !excused(i))
+        .map(|i| {
+            let (x, y) = (inputs[i / 20], inputs[(i / 20 * 7 + 3) % count]);
+            format!("x {x:#010x} y {y:#010x} op {}: cpu {:#010x}, lavapipe {:#010x}", i % 20, got[i], want[i])
+        })
+        .collect();
+    assert!(mismatches.is_empty(), "{} mismatches:\n{}", mismatches.len(), mismatches.join("\n"));
+    let excused_count = (0..want.len()).filter(|&i| got[i] != want[i]).count();
+    eprintln!("binary16/modf/frexp: {} words, {excused_count} excused differences", want.len());
+}
+
+const INT64_SEMANTICS: &str = r#"
+@group(0) @binding(0) var<storage, read> input: array<u64>;
+@group(0) @binding(1) var<storage, read_write> output: array<u64>;
+
+struct Tagged { tag: u32, value: i64, halves: vec2<u32> }
+var<workgroup> shared_values: array<Tagged, 64>;
+var<private> bias: i64 = -5000000000li;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let a = input[2u * id.x];
+    let b = input[2u * id.x + 1u];
+    let ia = bitcast<i64>(a);
+    let ib = bitcast<i64>(b);
+    let s = u32(b);
+    let fa = bitcast<f32>(u32(a));
+    shared_values[li] = Tagged(li, ia + bias, vec2<u32>(u32(b), u32(b >> 32u)));
+    workgroupBarrier();
+    let other = shared_values[63u - li];
+    let o = id.x * 24u;
+    output[o] = a + b;
+    output[o + 1u] = a - b;
+    output[o + 2u] = a * b;
+    output[o + 3u] = a / b;
+    output[o + 4u] = a % b;
+    output[o + 5u] = bitcast<u64>(ia / ib);
+    output[o + 6u] = bitcast<u64>(ia % ib);
+    output[o + 7u] = (a & b) ^ (a | ~b);
+    output[o + 8u] = a << s;
+    output[o + 9u] = a >> s;
+    output[o + 10u] = bitcast<u64>(ia >> s);
+    output[o + 11u] = bitcast<u64>(-ia);
+    output[o + 12u] = u64(select(0u, 1u, a < b)) | u64(select(0u, 2u, ia < ib)) | u64(select(0u, 4u, a == b))
+        | u64(select(0u, 8u, ia >= ib)) | u64(select(0u, 16u, a > b)) | u64(select(0u, 32u, ia <= ib))
+        | u64(select(0u, 64u, a != b)) | u64(select(0u, 128u, ia > ib)) | u64(select(0u, 256u, a <= b));
+    output[o + 13u] = u64(fa);
+    output[o + 14u] = bitcast<u64>(i64(fa));
+    output[o + 15u] = u64(bitcast<u32>(f32(ia))) | (u64(bitcast<u32>(f32(a))) << 32u);
+    output[o + 16u] = u64(i32(s)) ^ (bitcast<u64>(i64(u32(a))) << 1u);
+    output[o + 17u] = bitcast<u64>(i64(i32(s))) ^ u64(u32(a >> 32u)) ^ (u64(bitcast<u32>(i32(ib))) << 7u);
+    // naga 30 cannot express bitcast<vec2<u32>>(u64) (its `As` keeps the width): halves by shifts.
+    output[o + 18u] = (a << 32u) | (a >> 32u);
+    let va = vec2<i64>(ia, ib);
+    let vb = vec2<i64>(ib, 3li);
+    let vr = va * vb + select(va, vb, va < vb) - vec2<i64>(7li);
+    output[o + 19u] = bitcast<u64>(vr.x);
+    output[o + 20u] = bitcast<u64>(vr.y) ^ u64(all(va == vb)) ^ u64(i64(true));
+    output[o + 21u] = bitcast<u64>(abs(ia)) ^ min(a, b) ^ bitcast<u64>(max(ia, ib)) ^ max(a, 1000lu);
+    output[o + 22u] = bitcast<u64>(clamp(ia, -1000li, 1000li) + sign(ib) + other.value) ^ u64(other.tag)
+        ^ (u64(other.halves.x) << 3u) ^ (u64(other.halves.y) << 32u);
+    let vs = vec2<u64>(a, b) << vec2<u32>(s, 63u);
+    output[o + 23u] = vs.x ^ (vs.y >> 1u) ^ vec3<u64>(a, b, a ^ b)[s % 3u] ^ u64(f32(a) > 1e18);
+}
+"#;
+
+#[test]
+fn int64_semantics_agree_with_lavapipe_bit_for_bit() {
+    let kernel = Kernel::from_wgsl("int64_semantics.wgsl", INT64_SEMANTICS.into(), "main", false).unwrap();
+    let edges: [u64; 16] = [
+        0,
+        1,
+        2,
+        63,
+        64,
+        65,
+        i64::MAX as u64,
+        i64::MIN as u64,
+        u64::MAX,
+        u64::MAX - 1,
+        0xffff_ffff,
+        0x1_0000_0000,
+        0x5f00_0000,           // low word 2^63 as f32
+        0xffff_ffff_df00_0000, // low word -2^63 as f32
+        0x0000_0003_5f80_0000, // low word 2^64 as f32
+        0x8000_0000_4f80_0000, // low word 2^32 as f32
+    ];
+    let mut values = Vec::new();
+    for &a in &edges {
+        for &b in &edges {
+            values.extend([a, b]);
+        }
+    }
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    while values.len() < 2 * 320 {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        // Some small magnitudes too, where the operators' edge cases live.
+        values.push(if values.len() % 3 == 0 { state % 200 } else { state });
+    }
+    let inputs: Vec<u32> = values.iter().flat_map(|v| [*v as u32, (*v >> 32) as u32]).collect();
+    let pairs = values.len() / 2;
+    let words = pairs * 24 * 2;
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &inputs, words, (pairs / 64) as u32);
+    let wide = |w: &[u32], i: usize| u64::from(w[2 * i]) | u64::from(w[2 * i + 1]) << 32;
+    // Spot checks of WGSL's rules, independent of any GPU.
+    let at = |ai: usize, bi: usize, k: usize| wide(&got, (ai * edges.len() + bi) * 24 + k);
+    assert_eq!(at(7, 0, 5), i64::MIN as u64, "division by zero yields the dividend");
+    assert_eq!(at(7, 8, 5), i64::MIN as u64, "i64::MIN / -1 yields the dividend");
+    assert_eq!(at(7, 8, 6), 0, "i64::MIN % -1 yields 0");
+    assert_eq!(at(1, 5, 8), 2, "shift amounts are taken modulo 64");
+    assert_eq!(at(12, 0, 14), 9_223_371_487_098_961_920, "f32 to i64 clamps to the largest float below 2^63");
+    assert_eq!(at(1, 0, 18), 1 << 32, "halves swapped");
+    let Some(mut gpu) = strata_tests::vulkan_backend("int64_semantics_agree_with_lavapipe_bit_for_bit") else {
+        return;
+    };
+    let want = run_words(&mut gpu, &kernel, &inputs, words, (pairs / 64) as u32);
+    // NaN → integer is implementation-defined (see the 32-bit test): not compared.
+    let nan_conversion = |i: usize| matches!(i % 24, 13 | 14) && f32::from_bits(values[2 * (i / 24)] as u32).is_nan();
+    // Widening between signednesses (u64(i32), i64(u32)): the interpreter extends by
+    // the source's signedness, preserving the value, as naga's constant evaluator does
+    // (so folded and run-time conversions agree); naga's SPIR-V extends by the target's
+    // (UConvert / SConvert). Excused where both follow their rule exactly.
+    let mixed_widening = |i: usize| {
+        let (a, b) = (values[2 * (i / 24)] as u32, values[2 * (i / 24) + 1] as u32);
+        let (sext, zext) = (|x: u32| x as i32 as i64 as u64, |x: u32| u64::from(x));
+        i % 24 == 16 && wide(&got, i) == sext(b) ^ (zext(a) << 1) && wide(&want, i) == zext(b) ^ (sext(a) << 1)
+    };
+    let mismatches: Vec<String> = (0..words / 2)
+        .filter(|&i| wide(&got, i) != wide(&want, i) && !nan_conversion(i) && !mixed_widening(i))
+        .map(|i| {
+            let (a, b) = (values[2 * (i / 24)], values[2 * (i / 24) + 1]);
+            format!("a {a:#x} b {b:#x} op {}: cpu {:#x}, lavapipe {:#x}", i % 24, wide(&got, i), wide(&want, i))
+        })
+        .collect();
+    assert!(mismatches.is_empty(), "{} mismatches:\n{}", mismatches.len(), mismatches.join("\n"));
+    // The ash backend runs it too (it enables shaderInt64, which Vulkan requires for
+    // naga's Int64 capability; lavapipe's validation layer did not flag its absence).
+    let options = AshOptions { validation: true, source: SpirvSource::Naga, subgroups: false };
+    let mut ash = AshBackend::new(options).expect("lavapipe through ash");
+    assert_eq!(run_words(&mut ash, &kernel, &inputs, words, (pairs / 64) as u32), want, "ash and wgpu agree");
+}
+
+const F16_SEMANTICS: &str = r#"
+enable f16;
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+var<private> scale: f16 = 0.5h;
+
+fn half_at(i: u32) -> f16 {
+    return f16(bitcast<f32>(input[i]));
+}
+
+fn bits(x: f16) -> u32 {
+    return bitcast<u32>(f32(x));
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let x = half_at(2u * id.x);
+    let y = half_at(2u * id.x + 1u);
+    var acc = vec3<f16>(x, y, scale);
+    acc *= 2.0h;
+    let o = id.x * 22u;
+    output[o] = bits(x);
+    output[o + 1u] = bits(x + y);
+    output[o + 2u] = bits(x - y);
+    output[o + 3u] = bits(x * y);
+    output[o + 4u] = bits(x / y);
+    output[o + 5u] = bits(sqrt(abs(x)));
+    output[o + 6u] = bits(-x * scale + 1.0h);
+    output[o + 7u] = select(0u, 1u, x < y) | select(0u, 2u, x == y) | select(0u, 4u, x >= y)
+        | select(0u, 8u, x != y) | select(0u, 16u, x > y) | select(0u, 32u, x <= y);
+    output[o + 8u] = bitcast<u32>(i32(x));
+    output[o + 9u] = u32(y);
+    output[o + 10u] = bits(f16(bitcast<i32>(input[2u * id.x])));
+    output[o + 11u] = bits(f16(input[2u * id.x + 1u] >> 12u));
+    let v = vec3<f16>(x, y, scale) * vec3<f16>(y, x, x) + acc;
+    output[o + 12u] = bits(v.x);
+    output[o + 13u] = bits(v.y);
+    output[o + 14u] = bits(v.z);
+    output[o + 15u] = bits(dot(vec2<f16>(x, y), vec2<f16>(y, scale)));
+    output[o + 16u] = bits(floor(x)) ^ bits(ceil(y)) ^ bits(trunc(x * 3.0h)) ^ (bits(round(y * 0.25h)) >> 1u);
+    output[o + 17u] = bits(min(x, y)) ^ bits(max(x, -y)) ^ (bits(clamp(x, -1.0h, 1.0h)) >> 3u);
+    output[o + 18u] = bits(fract(x)) ^ bits(sign(y)) ^ u32(f32(x) == f32(y));
+    let w = select(vec2<f16>(y, x), vec2<f16>(x, y), vec2<bool>(x < y, y < x));
+    output[o + 19u] = bits(w.x - w.y) ^ bits(vec4<f16>(x, y, x, y)[id.x % 4u]);
+    let m = modf(vec2<f16>(x, y));
+    output[o + 20u] = bits(m.fract.x) ^ (bits(m.whole.y) >> 1u);
+    // (frexp of an f16 is not testable: naga 30 types its exponent i16, which needs
+    // SHADER_INT16.)
+    output[o + 21u] = bits(modf(y).whole);
+}
+"#;
+
+#[test]
+fn f16_arithmetic_and_conversions_agree_with_lavapipe_bit_for_bit() {
+    let kernel = Kernel::from_wgsl("f16_semantics.wgsl", F16_SEMANTICS.into(), "main", false).unwrap();
+    let mut inputs: Vec<u32> = Vec::new();
+    let edges: Vec<u32> = [
+        0.0f32,
+        -0.0,
+        1.0,
+        -1.0,
+        0.5,
+        65504.0,
+        -65504.0,
+        65520.0,
+        3.0,
+        -7.25,
+        1.0 + 1.0 / 2048.0,
+        1e-7,
+        6.0e-5,
+        100.5,
+        -0.75,
+    ]
+    .iter()
+    .map(|v| v.to_bits())
+    .chain([0x7fc0_0000, 0xff80_0000, 0x7f80_0000, 0x3380_0000, 0xb3c0_0000])
+    .collect();
+    for &a in &edges {
+        for &b in &edges {
+            inputs.extend([a, b]);
+        }
+    }
+    let mut state = 0x1357_9bdfu32;
+    while inputs.len() < 2 * 640 {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        // Floats within binary16's range and beyond, most in its normal range.
+        let exponent = 100 + (state >> 24) % 50;
+        inputs.push((state & 0x807f_ffff) | exponent << 23);
+    }
+    let pairs = inputs.len() / 2;
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &inputs, pairs * 22, (pairs / 64) as u32);
+    let at = |a: f32, b: f32, k: usize| {
+        let pair = (0..pairs).find(|&p| inputs[2 * p] == a.to_bits() && inputs[2 * p + 1] == b.to_bits()).unwrap();
+        got[pair * 22 + k]
+    };
+    assert_eq!(at(65520.0, 0.0, 0), f32::INFINITY.to_bits(), "f32 -> f16 overflows to infinity");
+    assert_eq!(at(1.0 + 1.0 / 2048.0, 0.0, 0), 1.0f32.to_bits(), "ties to even");
+    assert_eq!(at(65504.0, 65504.0, 1), f32::INFINITY.to_bits(), "f16 sums overflow");
+    assert_eq!(at(1.0, 1e-7, 1), 1.0f32.to_bits(), "f16 sums round");
+    assert_eq!(at(3.0, 1.0, 4), 3.0f32.to_bits(), "f16 division");
+    assert_eq!(at(1.0, 3.0, 4), 0.333_251_95f32.to_bits(), "1/3 rounded to binary16");
+    let Some(mut gpu) = strata_tests::vulkan_backend("f16_arithmetic_and_conversions_agree_with_lavapipe_bit_for_bit")
+    else {
+        return;
+    };
+    let want = run_words(&mut gpu, &kernel, &inputs, pairs * 22, (pairs / 64) as u32);
+    // Bit for bit, except where lavapipe is allowed to differ, each named:
+    // - an operand that is NaN or ±Inf as an f16: Vulkan (without float controls) and
+    //   WGSL's finite-math assumption leave the results of arithmetic on them open, and
+    //   lavapipe's optimiser uses that (`x != NaN` false, dot products giving Inf for
+    //   IEEE's NaN); NaN → integer is implementation-defined. Conversions are compared.
+    // - `a * b + c` and dot products: lavapipe keeps f16 products and sums in f32 until
+    //   the end (one rounding: contraction, excess precision, no intermediate overflow);
+    //   the interpreter rounds every operation. Within 2 binary16 ULPs, or the
+    //   interpreter's result overflowed where lavapipe's wider intermediate did not.
+    // - the sign of a zero from min/max/sums of zeros (lavapipe's algebraic rewrites
+    //   do not keep signed zeros).
+    let special = |w: u32| !f32::from_bits(w).is_finite() || f32::from_bits(w).abs() >= 65520.0;
+    let within_two_ulps = |x: u32, y: u32| {
+        let (x, y) = (f32::from_bits(x), f32::from_bits(y));
+        let ulp = (x.abs().max(y.abs()).max(6.103_515_6e-5) * (1.0 / 1024.0)).max(5.960_464_5e-8);
+        (x - y).abs() <= 2.0 * ulp
+    };
+    let zero_sign_only = |x: u32, y: u32| matches!(x ^ y, 0x8000_0000 | 0x4000_0000 | 0x1000_0000 | 0x9000_0000);
+    // Why a differing word is allowed to differ, if it is.
+    let excuse = |i: usize| -> Option<&'static str> {
+        let (a, b) = (inputs[2 * (i / 22)], inputs[2 * (i / 22) + 1]);
+        let (g, w) = (got[i], want[i]);
+        if matches!(i % 22, 0 | 10 | 11) {
+            return None;
+        }
+        if matches!(i % 22, 8 | 9) {
+            return (f32::from_bits(a).is_nan() || f32::from_bits(b).is_nan()).then_some("NaN -> integer");
+        }
+        if special(a) || special(b) {
+            return Some("NaN or Inf operand");
+        }
+        if zero_sign_only(g, w) && matches!(i % 22, 12 | 13 | 15 | 17 | 18) {
+            return Some("sign of a zero");
+        }
+        if matches!(i % 22, 12 | 13 | 15) {
+            if within_two_ulps(g, w) {
+                return Some("a * b + c within 2 ULPs");
+            }
+            if !f32::from_bits(g).is_finite() {
+                return Some("intermediate overflow");
+            }
+        }
+        None
+    };
+    let mut reasons = std::collections::BTreeMap::new();
+    for i in (0..want.len()).filter(|&i| got[i] != want[i]) {
+        *reasons.entry(excuse(i).unwrap_or("not excused")).or_insert(0) += 1;
+    }
+    eprintln!("f16: {} words; differing: {reasons:?}", want.len());
+    let mismatches: Vec<String> = (0..want.len())
+        .filter(|&i| got[i] != want[i] && excuse(i).is_none())
+        .map(|i| {
+            let (a, b) = (inputs[2 * (i / 22)], inputs[2 * (i / 22) + 1]);
+            format!("a {a:#010x} b {b:#010x} op {}: cpu {:#010x}, lavapipe {:#010x}", i % 22, got[i], want[i])
+        })
+        .collect();
+    assert!(mismatches.is_empty(), "{} mismatches:\n{}", mismatches.len(), mismatches.join("\n"));
+    // The ash backend enables shaderFloat16 for it.
+    let options = AshOptions { validation: true, source: SpirvSource::Naga, subgroups: false };
+    let mut ash = AshBackend::new(options).expect("lavapipe through ash");
+    assert_eq!(run_words(&mut ash, &kernel, &inputs, pairs * 22, (pairs / 64) as u32), want, "ash and wgpu agree");
+}
+
+const F16_MEMORY: &str = r#"
+enable f16;
+struct Mixed { a: f16, b: vec3<f16>, c: u32, d: vec2<f16>, e: array<f16, 3> }
+@group(0) @binding(0) var<storage, read> input: array<f16>;
+@group(0) @binding(1) var<storage, read_write> output: array<Mixed>;
+var<workgroup> tile: array<vec2<f16>, 64>;
+var<private> lut: array<f16, 4> = array<f16, 4>(1.0h, -2.0h, 0.5h, 65504.0h);
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let i = id.x;
+    let x = input[2u * i];
+    let y = input[2u * i + 1u];
+    tile[li] = vec2<f16>(x, y);
+    workgroupBarrier();
+    let t = tile[63u - li];
+    var m: Mixed;
+    m.a = x * y;
+    m.b = vec3<f16>(t, lut[i % 4u]);
+    m.c = (bitcast<u32>(f32(x + y)) ^ i) + (arrayLength(&input) << 20u);
+    m.d = t.yx - vec2<f16>(y);
+    m.e[i % 3u] = x;
+    m.e[2] = lut[(i + 1u) % 4u] * t.x;
+    output[i] = m;
+    output[i].b.y = y;
+    output[i].e[(i + 2u) % 3u] = output[i].e[i % 3u] + 1.0h;
+    let p = &output[i].d;
+    (*p)[i % 2u] = (*p).x * 2.0h;
+}
+"#;
+
+#[test]
+fn f16_in_buffers_workgroup_memory_and_structs_agrees_with_lavapipe_bit_for_bit() {
+    let kernel = Kernel::from_wgsl("f16_memory.wgsl", F16_MEMORY.into(), "main", false).unwrap();
+    // Two binary16 per word: ±0, denormals, the largest finite, then finite random ones.
+    let mut halves: Vec<u16> = vec![0, 0x8000, 0x0001, 0x83ff, 0x7bff, 0xfbff, 0x3c00, 0x3555, 0x0400, 0xc900];
+    let mut state = 0xace1u32;
+    while halves.len() < 2 * 256 {
+        state = state.wrapping_mul(1_103_515_245).wrapping_add(12345);
+        let h = (state >> 16) as u16;
+        // Keep them finite: exponent field below 31, mostly in a moderate range.
+        let exponent = 9 + (h >> 10) % 12;
+        halves.push((h & 0x83ff) | exponent << 10);
+    }
+    let inputs: Vec<u32> = halves.chunks(2).map(|p| u32::from(p[0]) | u32::from(p[1]) << 16).collect();
+    let count = inputs.len();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &inputs, count * 8, (count / 64) as u32);
+    // naga's layout: a@0, b@8 (6 bytes), c@16, d@20, e@24 (stride 2), 32 bytes each.
+    let half = |words: &[u32], byte: usize| (words[byte / 4] >> (8 * (byte % 4))) & 0xffff;
+    assert_eq!(half(&got, 10), u32::from(halves[1]), "output[0].b.y = y, stored through a pointer to a half");
+    assert_eq!(got[4] >> 20, 512, "arrayLength of an array<f16> counts halves");
+    let Some(mut gpu) =
+        strata_tests::vulkan_backend("f16_in_buffers_workgroup_memory_and_structs_agrees_with_lavapipe_bit_for_bit")
+    else {
+        return;
+    };
+    let want = run_words(&mut gpu, &kernel, &inputs, count * 8, (count / 64) as u32);
+    let mismatches: Vec<String> = (0..want.len())
+        .filter(|&i| got[i] != want[i])
+        .map(|i| format!("output[{}] word {}: cpu {:#010x}, lavapipe {:#010x}", i / 8, i % 8, got[i], want[i]))
+        .collect();
+    assert!(mismatches.is_empty(), "{} mismatches:\n{}", mismatches.len(), mismatches.join("\n"));
+    // Every member written (padding, bytes 6-7 and 30-31, stays zero on both).
+    let written = (0..count).filter(|&i| (0..8).all(|w| w == 1 || w == 7 || got[i * 8 + w] != 0)).count();
+    assert!(written > count * 9 / 10, "{written} of {count} structs have every member non-zero");
+    eprintln!("first struct: {:08x?}", &got[..8]);
+}
+
+#[test]
+fn f16_matrices_are_refused_with_their_line() {
+    let source = "enable f16;\n@group(0) @binding(0) var<storage, read_write> output: array<u32>;\n\
+                  var<private> m: mat2x2<f16>;\n@compute @workgroup_size(1)\nfn main() {\n    output[0] = 1u;\n    _ = &m;\n}\n";
+    let kernel = Kernel::from_wgsl("f16_matrix.wgsl", source.into(), "main", false).unwrap();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let output = cpu.create_buffer("output", 4).unwrap();
+    let message = cpu.dispatch(&kernel, &[Bind::new(0, output)], [1, 1, 1]).unwrap_err().to_string();
+    assert!(message.contains("unsupported: f16 matrices"), "{message}");
+    assert!(message.contains("(WGSL line 3)"), "{message}");
 }

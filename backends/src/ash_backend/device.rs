@@ -156,15 +156,40 @@ impl VulkanDevice {
             // SAFETY: Vulkan 1.1 core query; the 1.3 struct only on a 1.3 device.
             unsafe { instance_ref.get_physical_device_features2(physical, &mut features2) };
         }
+        // f16 in shaders and in storage buffers where the device has them (naga's SPIR-V
+        // for a kernel using f16 declares Float16 and, for f16 in buffers,
+        // StorageBuffer16BitAccess).
+        let (mut vulkan11, mut vulkan12) =
+            (vk::PhysicalDeviceVulkan11Features::default(), vk::PhysicalDeviceVulkan12Features::default());
+        if properties.api_version >= vk::API_VERSION_1_2 {
+            let mut features2 =
+                vk::PhysicalDeviceFeatures2::default().push_next(&mut vulkan11).push_next(&mut vulkan12);
+            // SAFETY: Vulkan 1.1 core query; the 1.2 structs only on a 1.2 device.
+            unsafe { instance_ref.get_physical_device_features2(physical, &mut features2) };
+        }
+        let float16 = vulkan12.shader_float16 == vk::TRUE;
+        let mut enable12 = vk::PhysicalDeviceVulkan12Features::default().shader_float16(true);
+        let mut enable11 = vk::PhysicalDeviceVulkan11Features::default()
+            .storage_buffer16_bit_access(vulkan11.storage_buffer16_bit_access == vk::TRUE)
+            .uniform_and_storage_buffer16_bit_access(vulkan11.uniform_and_storage_buffer16_bit_access == vk::TRUE);
         let native_zero_init = vulkan13.shader_zero_initialize_workgroup_memory == vk::TRUE;
         let mut enable13 =
             vk::PhysicalDeviceVulkan13Features::default().shader_zero_initialize_workgroup_memory(native_zero_init);
         let priorities = [1.0f32];
         let queue_info =
             [vk::DeviceQueueCreateInfo::default().queue_family_index(family).queue_priorities(&priorities)];
-        let mut device_info = vk::DeviceCreateInfo::default().queue_create_infos(&queue_info);
+        // 64-bit integers in shaders where the device has them (naga's SPIR-V for a
+        // kernel using `i64`/`u64` declares the Int64 capability).
+        // SAFETY: valid physical device.
+        let core_features = unsafe { instance_ref.get_physical_device_features(physical) };
+        let enabled = vk::PhysicalDeviceFeatures::default().shader_int64(core_features.shader_int64 == vk::TRUE);
+        let mut device_info =
+            vk::DeviceCreateInfo::default().queue_create_infos(&queue_info).enabled_features(&enabled);
         if native_zero_init {
             device_info = device_info.push_next(&mut enable13);
+        }
+        if float16 {
+            device_info = device_info.push_next(&mut enable12).push_next(&mut enable11);
         }
         // SAFETY: valid physical device and create info.
         let device = unsafe { instance_ref.create_device(physical, &device_info, None) }.map_err(|e| {

@@ -164,6 +164,8 @@ pub(super) fn math(fun: MathFunction, kind: ScalarKind, x: u32, y: u32, z: u32) 
         }
         // Fused: one rounding, as WGSL's fma allows and Rust's mul_add guarantees.
         (M::Fma, K::Float) => f(x).mul_add(f(y), f(z)).to_bits(),
+        // Through binary16 and back: round to nearest even, overflow to ±Inf.
+        (M::QuantizeToF16, K::Float) => f16_to_f32(f32_to_f16(x)),
         (M::CountTrailingZeros, K::Uint | K::Sint) => x.trailing_zeros(),
         (M::CountLeadingZeros, K::Uint | K::Sint) => x.leading_zeros(),
         (M::CountOneBits, K::Uint | K::Sint) => x.count_ones(),
@@ -188,6 +190,80 @@ pub(super) fn math(fun: MathFunction, kind: ScalarKind, x: u32, y: u32, z: u32) 
         }
         _ => return None,
     })
+}
+
+/// The binary16 nearest to f32 `x` (ties to even; too large: ±Inf; NaN stays NaN,
+/// quiet, with the sign and the top payload bits kept).
+pub(super) fn f32_to_f16(x: u32) -> u32 {
+    u32::from(half::f16::from_f32(f(x)).to_bits())
+}
+
+/// The f32 equal to binary16 `h` (the low 16 bits; exact, denormals included).
+pub(super) fn f16_to_f32(h: u32) -> u32 {
+    half::f16::from_bits(h as u16).to_f32().to_bits()
+}
+
+/// Rounds an f32 to the nearest binary16 value, as an f32 (how registers hold f16).
+pub(super) fn round_f16(x: u32) -> u32 {
+    f16_to_f32(f32_to_f16(x))
+}
+
+/// Numeric conversion where the source or the target is an f16 (held as the f32 of
+/// equal value). Integers → f16 round once (through f64, which holds them exactly);
+/// f16 → integer truncates after clamping to the range both types hold (±Inf → ±65504
+/// as naga's clamp bounds for f16 make it), NaN → 0. `None`: unsupported.
+pub(super) fn convert_half(value: u32, from: naga::Scalar, to: naga::Scalar) -> Option<u32> {
+    use ScalarKind as K;
+    let half = |s: naga::Scalar| s.kind == K::Float && s.width == 2;
+    let plain = |s: naga::Scalar| s.width == 4 || s.kind == K::Bool || half(s);
+    if !plain(from) || !plain(to) {
+        return None;
+    }
+    let round64 = |v: f64| half::f16::from_f64(v).to_f32().to_bits();
+    Some(match (from.kind, to.kind) {
+        (K::Float, K::Float) if half(to) => round_f16(value),
+        (K::Float, K::Float) => value,
+        (K::Float, K::Sint) => convert(f(value).clamp(-65504.0, 65504.0).to_bits(), K::Float, K::Sint)?,
+        (K::Float, K::Uint) => convert(f(value).clamp(0.0, 65504.0).to_bits(), K::Float, K::Uint)?,
+        (K::Sint, K::Float) => round64(f64::from(value as i32)),
+        (K::Uint, K::Float) => round64(f64::from(value)),
+        _ => convert(value, from.kind, to.kind)?,
+    })
+}
+
+/// `modf(x)`: (fract, whole) with whole = trunc(x) and fract = x - whole, both with
+/// x's sign. Where WGSL leaves the sign of a zero or a NaN's bits open, the choices are
+/// lavapipe's (Mesa computes sign(x) · (|x| - floor|x|) and sign(x) · floor|x|): ±0 gives
+/// (+0, +0), ±Inf gives (±0, ±Inf), a NaN gives its quiet, positive self twice.
+pub(super) fn modf(x: u32) -> (u32, u32) {
+    let v = f(x);
+    if v.is_nan() {
+        let nan = (x & 0x7fff_ffff) | 0x0040_0000;
+        return (nan, nan);
+    }
+    if v == 0.0 {
+        return (0, 0);
+    }
+    let whole = v.trunc();
+    let fract = if v.is_infinite() { 0.0f32.copysign(v) } else { (v - whole).copysign(v) };
+    (fract.to_bits(), whole.to_bits())
+}
+
+/// `frexp(x)`: (fract, exp) with x = fract · 2^exp and |fract| in [0.5, 1); a
+/// denormal is normalised first. ±0 gives (±0, 0); ±Inf and NaN (undefined in WGSL)
+/// give (x, 129), the exponent field less 126, as lavapipe does.
+pub(super) fn frexp(x: u32) -> (u32, u32) {
+    let v = f(x);
+    if v == 0.0 {
+        return (x, 0);
+    }
+    if !v.is_finite() {
+        return (x, 129);
+    }
+    // A denormal is scaled into the normal range first (exactly: by 2^32).
+    let (bits, bias) = if (x >> 23) & 0xff == 0 { ((v * 4_294_967_296.0).to_bits(), 32) } else { (x, 0) };
+    let exponent = ((bits >> 23) & 0xff) as i32 - 126 - bias;
+    ((bits & 0x807f_ffff) | (126 << 23), exponent as u32)
 }
 
 /// `extractBits(e, offset, count)` and `insertBits(e, newbits, offset, count)`.
@@ -229,6 +305,8 @@ pub(super) fn pack(fun: MathFunction, v: &[u32]) -> Option<u32> {
         M::Pack4x8snorm => (0..4).fold(0, |acc, i| acc | (snorm(v[i], 127.0) & 0xff) << (8 * i)),
         M::Pack2x16unorm => (0..2).fold(0, |acc, i| acc | (unorm(v[i], 65535.0) & 0xffff) << (16 * i)),
         M::Pack2x16snorm => (0..2).fold(0, |acc, i| acc | (snorm(v[i], 32767.0) & 0xffff) << (16 * i)),
+        // WGSL: the binary16 values of v[0] (low half) and v[1] (high half).
+        M::Pack2x16float => f32_to_f16(v[0]) | f32_to_f16(v[1]) << 16,
         M::Pack4xI8 => (0..4).fold(0, |acc, i| acc | (v[i] & 0xff) << (8 * i)),
         M::Pack4xU8 => (0..4).fold(0, |acc, i| acc | (v[i] & 0xff) << (8 * i)),
         M::Pack4xI8Clamp => (0..4).fold(0, |acc, i| acc | ((v[i] as i32).clamp(-128, 127) as u32 & 0xff) << (8 * i)),
@@ -247,6 +325,7 @@ pub(super) fn unpack(fun: MathFunction, x: u32) -> Option<Vec<u32>> {
         M::Unpack4x8snorm => (0..4).map(|i| ((byte(i) as u8 as i8 as f32 / 127.0).max(-1.0)).to_bits()).collect(),
         M::Unpack2x16unorm => (0..2).map(|i| (half(i) as f32 / 65535.0).to_bits()).collect(),
         M::Unpack2x16snorm => (0..2).map(|i| ((half(i) as u16 as i16 as f32 / 32767.0).max(-1.0)).to_bits()).collect(),
+        M::Unpack2x16float => (0..2).map(|i| f16_to_f32(half(i))).collect(),
         M::Unpack4xI8 => (0..4).map(|i| byte(i) as u8 as i8 as i32 as u32).collect(),
         M::Unpack4xU8 => (0..4).map(byte).collect(),
         _ => return None,

@@ -29,26 +29,36 @@ pub(super) const INLINE_DEPTH: u32 = 8;
 /// Marks an expression without a register yet.
 const NONE: Reg = Reg::MAX;
 
-/// Words of a value of type `inner` (bool and every 32-bit scalar: one word).
+/// Words of a value of type `inner` (bool and every 32-bit scalar: one word; 64-bit
+/// integers: two, the low word first).
 pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String> {
     Ok(match *inner {
+        TypeInner::Atomic(s) if s.width != 4 => return Err(format!("{}-bit atomics", s.width * 8)),
         TypeInner::Scalar(s) | TypeInner::Atomic(s) => {
-            if s.width != 4 && s.kind != naga::ScalarKind::Bool {
-                return Err(format!("{}-bit scalars", s.width * 8));
-            }
-            1
+            scalar_words(s).ok_or_else(|| format!("{}-bit scalars", s.width * 8))?
         }
         TypeInner::Vector { size, scalar } => {
-            if scalar.width != 4 && scalar.kind != naga::ScalarKind::Bool {
-                return Err(format!("{}-bit vectors", scalar.width * 8));
-            }
-            size as u32
+            size as u32 * scalar_words(scalar).ok_or_else(|| format!("{}-bit vectors", scalar.width * 8))?
         }
         TypeInner::Pointer { .. } | TypeInner::ValuePointer { .. } => 2,
+        TypeInner::Matrix { scalar, .. } if scalar.width == 2 => return Err("f16 matrices".into()),
         TypeInner::Matrix { columns, rows, .. } => {
             // Columns are padded like vec3 → 4 words in memory.
             let row_words = if rows == naga::VectorSize::Tri { 4 } else { rows as u32 };
             columns as u32 * row_words
+        }
+        // Register layout of composites holding f16: a word per f16, members and
+        // elements one after the other (naga's 2-byte layout is used in buffers only).
+        TypeInner::Array { base, size, .. } if contains_f16(module, &module.types[base].inner) => match size {
+            naga::ArraySize::Constant(n) => n.get() * words_of(module, &module.types[base].inner)?,
+            _ => return Err("runtime-sized arrays as values".into()),
+        },
+        TypeInner::Struct { ref members, .. } if contains_f16(module, inner) => {
+            let mut words = 0;
+            for member in members {
+                words += words_of(module, &module.types[member.ty].inner)?;
+            }
+            words
         }
         TypeInner::Array { base, size, stride } => {
             // The element type must be supported too.
@@ -61,6 +71,121 @@ pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String
         TypeInner::Struct { span, .. } => span / 4,
         _ => return Err(format!("type {inner:?}")),
     })
+}
+
+/// Words of one scalar: 1 for bool and 32-bit scalars, 2 for 64-bit integers; `None`
+/// for scalars the interpreter does not support.
+///
+/// An f16 takes a word of its own in registers, holding the f32 of equal value (every
+/// operation producing an f16 rounds to binary16). Registers, function, private and
+/// workgroup memory (which only the interpreter sees) use this register layout; bound
+/// buffers use naga's (two bytes per f16), and loads and stores of types holding f16
+/// convert between the two ([`load_plan`]). Pointers into buffers count bytes,
+/// pointers elsewhere count words. f16 matrices are refused.
+pub(super) fn scalar_words(scalar: naga::Scalar) -> Option<u32> {
+    match (scalar.kind, scalar.width) {
+        (naga::ScalarKind::Bool, _) | (_, 4) | (naga::ScalarKind::Float, 2) => Some(1),
+        (naga::ScalarKind::Sint | naga::ScalarKind::Uint, 8) => Some(2),
+        _ => None,
+    }
+}
+
+/// Whether pointers into `space` count bytes (bound buffers, laid out as naga says)
+/// rather than register words.
+pub(super) fn byte_addressed(space: naga::AddressSpace) -> bool {
+    matches!(space, naga::AddressSpace::Uniform | naga::AddressSpace::Storage { .. })
+}
+
+/// Offset of member `index` of struct `inner`: bytes (`bytes`), else register words.
+pub(super) fn member_step(module: &Module, inner: &TypeInner, index: u32, bytes: bool) -> u32 {
+    let TypeInner::Struct { ref members, .. } = *inner else { return 0 };
+    if bytes {
+        members[index as usize].offset
+    } else if !contains_f16(module, inner) {
+        members[index as usize].offset / 4
+    } else {
+        members[..index as usize].iter().map(|m| words_of(module, &module.types[m.ty].inner).unwrap_or(0)).sum()
+    }
+}
+
+/// Distance between elements of an array of `base` with naga stride `stride`: bytes
+/// (`bytes`), else register words.
+pub(super) fn element_step(module: &Module, base: Handle<naga::Type>, stride: u32, bytes: bool) -> u32 {
+    let inner = &module.types[base].inner;
+    if bytes {
+        stride
+    } else if !contains_f16(module, inner) {
+        stride / 4
+    } else {
+        words_of(module, inner).unwrap_or(0)
+    }
+}
+
+/// Distance between components of a vector of `scalar`: bytes (`bytes`), else words.
+pub(super) fn component_step(scalar: naga::Scalar, bytes: bool) -> u32 {
+    match (bytes, scalar.width) {
+        (true, 1) => 4, // bool
+        (true, width) => u32::from(width),
+        (false, 8) if scalar.kind != naga::ScalarKind::Float => 2,
+        (false, _) => 1,
+    }
+}
+
+/// One piece of a load or store between a buffer (naga's layout) and registers.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Piece {
+    /// `len` words at byte offset `memory` ↔ register word `reg`.
+    Words { memory: u32, reg: u32, len: u32 },
+    /// The binary16 at byte offset `memory` ↔ the f32 at register word `reg`.
+    Half { memory: u32, reg: u32 },
+}
+
+/// How a value of type `inner` holding f16 moves between a buffer at byte `memory` and
+/// registers at word `reg`.
+pub(super) fn load_plan(module: &Module, inner: &TypeInner, memory: u32, reg: u32, out: &mut Vec<Piece>) {
+    if !contains_f16(module, inner) {
+        let len = words_of(module, inner).unwrap_or(0);
+        match out.last_mut() {
+            Some(Piece::Words { memory: m, reg: r, len: l }) if *m + 4 * *l == memory && *r + *l == reg => *l += len,
+            _ => out.push(Piece::Words { memory, reg, len }),
+        }
+        return;
+    }
+    match *inner {
+        TypeInner::Scalar(_) => out.push(Piece::Half { memory, reg }),
+        TypeInner::Vector { size, .. } => {
+            out.extend((0..size as u32).map(|i| Piece::Half { memory: memory + 2 * i, reg: reg + i }))
+        }
+        TypeInner::Array { base, size: naga::ArraySize::Constant(n), stride } => {
+            let words = words_of(module, &module.types[base].inner).unwrap_or(0);
+            for i in 0..n.get() {
+                load_plan(module, &module.types[base].inner, memory + i * stride, reg + i * words, out);
+            }
+        }
+        TypeInner::Struct { ref members, .. } => {
+            for (i, member) in members.iter().enumerate() {
+                let step = member_step(module, inner, i as u32, false);
+                load_plan(module, &module.types[member.ty].inner, memory + member.offset, reg + step, out);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// Whether a value of type `inner` holds an f16 anywhere.
+pub(super) fn contains_f16(module: &Module, inner: &TypeInner) -> bool {
+    match *inner {
+        TypeInner::Scalar(s) | TypeInner::Vector { scalar: s, .. } | TypeInner::Matrix { scalar: s, .. } => {
+            s.kind == naga::ScalarKind::Float && s.width == 2
+        }
+        TypeInner::Array { base, .. } | TypeInner::BindingArray { base, .. } => {
+            contains_f16(module, &module.types[base].inner)
+        }
+        TypeInner::Struct { ref members, .. } => {
+            members.iter().any(|m| contains_f16(module, &module.types[m.ty].inner))
+        }
+        _ => false,
+    }
 }
 
 /// Byte offsets where source lines start, for span → line lookups.
@@ -285,9 +410,10 @@ impl Compiler<'_> {
             scope.lines.push(line);
             scope.lens.push(words_of(self.module, inner).map_err(|what| unsupported(&what, line))?);
         }
-        for (_, local) in function.local_variables.iter() {
+        for (handle, local) in function.local_variables.iter() {
+            let line = self.lines_of.line(function.local_variables.get_span(handle));
             let words =
-                words_of(self.module, &self.module.types[local.ty].inner).map_err(|what| unsupported(&what, 0))?;
+                words_of(self.module, &self.module.types[local.ty].inner).map_err(|what| unsupported(&what, line))?;
             let reg = self.alloc(words);
             scope.locals.push(reg);
         }
@@ -385,8 +511,40 @@ impl Compiler<'_> {
         scope.places[pointer.index()]
     }
 
+    /// How a load or store through `pointer` converts between a buffer's layout and
+    /// registers, if its type holds f16 and it points into a buffer.
+    fn mixed_plan(&self, scope: &Scope, pointer: Handle<Expression>) -> Option<Box<[Piece]>> {
+        let module = self.module;
+        let mut plan = Vec::new();
+        match *self.ty(scope, pointer) {
+            TypeInner::Pointer { base, space } if byte_addressed(space) => {
+                let inner = &module.types[base].inner;
+                if !contains_f16(module, inner) {
+                    return None;
+                }
+                load_plan(module, inner, 0, 0, &mut plan);
+            }
+            TypeInner::ValuePointer { size, scalar, space }
+                if byte_addressed(space) && scalar.kind == naga::ScalarKind::Float && scalar.width == 2 =>
+            {
+                let inner = match size {
+                    Some(size) => TypeInner::Vector { size, scalar },
+                    None => TypeInner::Scalar(scalar),
+                };
+                load_plan(module, &inner, 0, 0, &mut plan);
+            }
+            _ => return None,
+        }
+        Some(plan.into_boxed_slice())
+    }
+
     /// Stores `len` words of register `src` through pointer expression `pointer`.
     pub(super) fn store(&mut self, scope: &mut Scope, pointer: Handle<Expression>, src: Reg, len: u32) {
+        if let Some(plan) = self.mixed_plan(scope, pointer) {
+            let pointer = self.reg(scope, pointer);
+            self.push(Insn::StoreMixed { pointer, src, plan });
+            return;
+        }
         match self.place(scope, pointer) {
             Some(Place::Local(variable)) => self.copy(variable, src, len),
             Some(Place::Workgroup(address)) => {
@@ -395,8 +553,8 @@ impl Compiler<'_> {
             Some(Place::Private(address)) => {
                 self.push(Insn::StorePrivate { address, src, len });
             }
-            Some(Place::Buffer(buffer, address)) => {
-                self.push(Insn::StoreBuffer { buffer, address, src, len });
+            Some(Place::Buffer(buffer, bytes)) => {
+                self.push(Insn::StoreBuffer { buffer, address: bytes / 4, src, len });
             }
             None => {
                 let pointer = self.reg(scope, pointer);
@@ -407,6 +565,11 @@ impl Compiler<'_> {
 
     /// Loads `len` words through pointer expression `pointer` into register `dst`.
     pub(super) fn load(&mut self, scope: &mut Scope, pointer: Handle<Expression>, dst: Reg, len: u32) {
+        if let Some(plan) = self.mixed_plan(scope, pointer) {
+            let pointer = self.reg(scope, pointer);
+            self.push(Insn::LoadMixed { dst, pointer, plan });
+            return;
+        }
         match self.place(scope, pointer) {
             Some(Place::Local(variable)) => self.copy(dst, variable, len),
             Some(Place::Workgroup(address)) => {
@@ -415,8 +578,8 @@ impl Compiler<'_> {
             Some(Place::Private(address)) => {
                 self.push(Insn::LoadPrivate { dst, address, len });
             }
-            Some(Place::Buffer(buffer, address)) => {
-                self.push(Insn::LoadBuffer { dst, buffer, address, len });
+            Some(Place::Buffer(buffer, bytes)) => {
+                self.push(Insn::LoadBuffer { dst, buffer, address: bytes / 4, len });
             }
             None => {
                 let pointer = self.reg(scope, pointer);
@@ -737,8 +900,13 @@ pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> 
     let mut globals = Vec::new();
     let (mut workgroup_words, mut private_words) = (0u32, 0u32);
     let mut private_init = Vec::new();
-    for (_, variable) in module.global_variables.iter() {
-        let words = words_of(module, &module.types[variable.ty].inner).unwrap_or(0);
+    for (handle, variable) in module.global_variables.iter() {
+        let inner = &module.types[variable.ty].inner;
+        if contains_f16(module, inner) && !byte_addressed(variable.space) {
+            let line = lines_of.line(module.global_variables.get_span(handle));
+            words_of(module, inner).map_err(|what| unsupported(&what, line))?;
+        }
+        let words = words_of(module, inner).unwrap_or(0);
         let entry = match variable.space {
             naga::AddressSpace::Uniform | naga::AddressSpace::Storage { .. } => {
                 let binding = variable.binding.as_ref().map_or(u32::MAX, |b| b.binding);

@@ -5,9 +5,10 @@
 //! [`Insn::Fail`] naming the construct and its line, reported only if reached.
 
 use super::arith;
-use super::decode::{Compiler, Scope, words_of};
+use super::decode::{Compiler, Scope, byte_addressed, component_step, element_step, member_step, words_of};
 use super::insn::{BinOp, Insn, Reg, UnOp};
 use super::matrix::column_words;
+use super::wide;
 use crate::error::BackendError;
 use naga::{Expression, Handle, ScalarKind, TypeInner};
 use smallvec::{SmallVec, smallvec};
@@ -24,7 +25,7 @@ pub(super) enum Place {
     Workgroup(u32),
     /// Private memory at this word.
     Private(u32),
-    /// Bound buffer (slot, word).
+    /// Bound buffer (slot, byte).
     Buffer(u32, u32),
 }
 
@@ -48,14 +49,43 @@ pub(super) fn shape(inner: &TypeInner) -> Option<(ScalarKind, usize)> {
     }
 }
 
-fn literal(value: &naga::Literal) -> Option<u32> {
+/// A literal's words (64-bit integers: low word first).
+fn literal(value: &naga::Literal) -> Option<Vec<u32>> {
+    let wide = |v: u64| vec![v as u32, (v >> 32) as u32];
     Some(match *value {
-        naga::Literal::F32(v) => v.to_bits(),
-        naga::Literal::U32(v) => v,
-        naga::Literal::I32(v) => v as u32,
-        naga::Literal::Bool(v) => u32::from(v),
+        naga::Literal::F32(v) => vec![v.to_bits()],
+        naga::Literal::U32(v) => vec![v],
+        naga::Literal::I32(v) => vec![v as u32],
+        naga::Literal::Bool(v) => vec![u32::from(v)],
+        naga::Literal::U64(v) => wide(v),
+        naga::Literal::I64(v) => wide(v as u64),
+        naga::Literal::F16(v) => vec![v.to_f32().to_bits()],
         _ => return None,
     })
+}
+
+/// Scalar and component count of a scalar or vector type.
+pub(super) fn scalar_shape(inner: &TypeInner) -> Option<(naga::Scalar, usize)> {
+    match *inner {
+        TypeInner::Scalar(s) | TypeInner::Atomic(s) => Some((s, 1)),
+        TypeInner::Vector { size, scalar } => Some((scalar, size as usize)),
+        _ => None,
+    }
+}
+
+/// Whether `inner` is a 64-bit integer scalar or vector.
+fn is_wide(inner: &TypeInner) -> bool {
+    scalar_shape(inner).is_some_and(|(s, _)| wide::is_wide(s))
+}
+
+/// Whether `inner` is an f16 scalar or vector.
+fn is_half(inner: &TypeInner) -> bool {
+    scalar_shape(inner).is_some_and(|(s, _)| s.kind == ScalarKind::Float && s.width == 2)
+}
+
+/// Words per component of a vector (or of a pointer to one) of scalar `scalar`.
+fn component_words(scalar: naga::Scalar) -> u32 {
+    if wide::is_wide(scalar) { 2 } else { 1 }
 }
 
 /// Value of a constant expression of the module (`global_expressions`).
@@ -66,7 +96,7 @@ pub(super) fn global_value(
 ) -> Result<Vec<u32>, String> {
     let inner_of = |ty: Handle<naga::Type>| &module.types[ty].inner;
     Ok(match &module.global_expressions[handle] {
-        Expression::Literal(value) => vec![literal(value).ok_or_else(|| format!("literal {value:?}"))?],
+        Expression::Literal(value) => literal(value).ok_or_else(|| format!("literal {value:?}"))?,
         Expression::Constant(c) => values[module.constants[*c].init.index()].clone(),
         Expression::ZeroValue(ty) => vec![0; words_of(module, inner_of(*ty))? as usize],
         Expression::Splat { size, value } => values[value.index()].repeat(*size as usize),
@@ -79,11 +109,14 @@ pub(super) fn global_value(
 }
 
 /// Word offset of each part of a value of type `inner` composed of parts of `lens` words.
-fn compose_offsets(inner: &TypeInner, lens: &[u32]) -> Result<Vec<u32>, String> {
+fn compose_offsets(module: &naga::Module, inner: &TypeInner, lens: &[u32]) -> Result<Vec<u32>, String> {
     Ok(match *inner {
         TypeInner::Vector { .. } => lens.iter().scan(0, |at, len| Some(std::mem::replace(at, *at + len))).collect(),
-        TypeInner::Struct { ref members, .. } => members.iter().take(lens.len()).map(|m| m.offset / 4).collect(),
-        TypeInner::Array { stride, .. } => (0..lens.len() as u32).map(|i| i * stride / 4).collect(),
+        TypeInner::Struct { .. } => (0..lens.len() as u32).map(|i| member_step(module, inner, i, false)).collect(),
+        TypeInner::Array { base, stride, .. } => {
+            let step = element_step(module, base, stride, false);
+            (0..lens.len() as u32).map(|i| i * step).collect()
+        }
         TypeInner::Matrix { rows, .. } => (0..lens.len()).map(|i| (i * column_words(rows)) as u32).collect(),
         _ => return Err(format!("composing {inner:?}")),
     })
@@ -93,7 +126,7 @@ fn compose_offsets(inner: &TypeInner, lens: &[u32]) -> Result<Vec<u32>, String> 
 pub(super) fn compose(module: &naga::Module, inner: &TypeInner, parts: &[&[u32]]) -> Result<Vec<u32>, String> {
     let mut out = vec![0u32; words_of(module, inner)? as usize];
     let lens: Vec<u32> = parts.iter().map(|p| p.len() as u32).collect();
-    let offsets = compose_offsets(inner, &lens)?;
+    let offsets = compose_offsets(module, inner, &lens)?;
     for (part, at) in parts.iter().zip(offsets) {
         let at = at as usize;
         let len = part.len().min(out.len().saturating_sub(at));
@@ -116,7 +149,7 @@ pub(super) fn const_value(compiler: &Compiler, scope: &Scope, handle: Handle<Exp
     };
     let len = scope.lens[handle.index()] as usize;
     let value = match &scope.function.expressions[handle] {
-        Expression::Literal(value) => vec![literal(value)?],
+        Expression::Literal(value) => literal(value)?,
         Expression::Constant(c) => compiler.global_values[module.constants[*c].init.index()].clone(),
         Expression::ZeroValue(_) => vec![0; len],
         Expression::Splat { size, value } => value_of(*value)?.repeat(*size as usize),
@@ -146,8 +179,9 @@ fn math(
     match fun {
         M::Dot if kind == ScalarKind::Float => {
             let b = b?;
-            // Sequential sum of products, no fused multiply-add.
-            let sum = (0..comps).fold(0.0f32, |acc, i| acc + f(a[i]) * f(b[i]));
+            // Sequential sum of products, no fused multiply-add; starting from the first
+            // product, not from +0, so that products that are all -0 sum to -0.
+            let sum = (1..comps).fold(f(a[0]) * f(b[0]), |acc, i| acc + f(a[i]) * f(b[i]));
             Some(smallvec![sum.to_bits()])
         }
         M::Dot => {
@@ -216,7 +250,10 @@ impl Compiler<'_> {
             Expression::Literal(ref value) => {
                 let dst = self.reg(scope, handle);
                 match literal(value) {
-                    Some(v) => self.template[dst as usize] = v,
+                    Some(v) => {
+                        let n = v.len().min(len as usize);
+                        self.template[dst as usize..dst as usize + n].copy_from_slice(&v[..n]);
+                    }
                     None => self.fail(format!("literal {value:?}"), line),
                 }
             }
@@ -233,7 +270,7 @@ impl Compiler<'_> {
             Expression::Compose { ref components, .. } => {
                 let parts: Vec<(Reg, u32)> = components.iter().map(|c| operand!(*c)).collect();
                 let lens: Vec<u32> = parts.iter().map(|p| p.1).collect();
-                match compose_offsets(self.ty(scope, handle), &lens) {
+                match compose_offsets(module, self.ty(scope, handle), &lens) {
                     Ok(offsets) => {
                         let dst = self.reg(scope, handle);
                         for ((src, part), at) in parts.into_iter().zip(offsets) {
@@ -247,9 +284,22 @@ impl Compiler<'_> {
                 }
             }
             Expression::Splat { size, value } => {
-                let (src, _) = operand!(value);
+                let (src, w) = operand!(value);
                 let dst = self.reg(scope, handle);
-                self.push(Insn::Splat { dst, src, n: size as u8 });
+                if w == 1 {
+                    self.push(Insn::Splat { dst, src, n: size as u8 });
+                } else {
+                    for i in 0..size as u32 {
+                        self.copy(dst + i * w, src, w);
+                    }
+                }
+            }
+            Expression::Swizzle { size, vector, pattern } if is_wide(self.ty(scope, vector)) => {
+                let (src, _) = operand!(vector);
+                let dst = self.reg(scope, handle);
+                for (i, c) in pattern.iter().take(size as usize).enumerate() {
+                    self.copy(dst + 2 * i as u32, src + 2 * *c as u32, 2);
+                }
             }
             Expression::Swizzle { size, vector, pattern } => {
                 let (src, _) = operand!(vector);
@@ -265,48 +315,67 @@ impl Compiler<'_> {
                 let (index_reg, _) = operand!(index_handle);
                 let dst = self.reg(scope, handle);
                 let insn = match self.ty(scope, base) {
-                    TypeInner::Pointer { base: pointee, .. } => match module.types[*pointee].inner {
-                        TypeInner::Array { size: naga::ArraySize::Constant(n), stride, .. } => Ok(Insn::PtrIndex {
-                            dst,
-                            base: base_reg,
-                            index: index_reg,
-                            count: n.get(),
-                            stride: stride / 4,
-                        }),
-                        TypeInner::Array { stride, .. } => {
-                            Ok(Insn::PtrIndexRt { dst, base: base_reg, index: index_reg, stride: stride / 4 })
+                    TypeInner::Pointer { base: pointee, space } => {
+                        // Pointers into buffers count bytes, others register words.
+                        let bytes = byte_addressed(*space);
+                        match module.types[*pointee].inner {
+                            TypeInner::Array { base: element, size: naga::ArraySize::Constant(n), stride } => {
+                                Ok(Insn::PtrIndex {
+                                    dst,
+                                    base: base_reg,
+                                    index: index_reg,
+                                    count: n.get(),
+                                    stride: element_step(module, element, stride, bytes),
+                                })
+                            }
+                            TypeInner::Array { base: element, stride, .. } => Ok(Insn::PtrIndexRt {
+                                dst,
+                                base: base_reg,
+                                index: index_reg,
+                                stride: element_step(module, element, stride, bytes),
+                            }),
+                            TypeInner::Vector { size, scalar } => Ok(Insn::PtrIndex {
+                                dst,
+                                base: base_reg,
+                                index: index_reg,
+                                count: size as u32,
+                                stride: component_step(scalar, bytes),
+                            }),
+                            TypeInner::Matrix { columns, rows, .. } => Ok(Insn::PtrIndex {
+                                dst,
+                                base: base_reg,
+                                index: index_reg,
+                                count: columns as u32,
+                                stride: column_words(rows) as u32 * if bytes { 4 } else { 1 },
+                            }),
+                            ref other => Err(format!("indexing through a pointer to {other:?}")),
                         }
-                        TypeInner::Vector { size, .. } => {
-                            Ok(Insn::PtrIndex { dst, base: base_reg, index: index_reg, count: size as u32, stride: 1 })
-                        }
-                        TypeInner::Matrix { columns, rows, .. } => Ok(Insn::PtrIndex {
-                            dst,
-                            base: base_reg,
-                            index: index_reg,
-                            count: columns as u32,
-                            stride: column_words(rows) as u32,
-                        }),
-                        ref other => Err(format!("indexing through a pointer to {other:?}")),
-                    },
-                    TypeInner::ValuePointer { size: Some(size), .. } => {
-                        Ok(Insn::PtrIndex { dst, base: base_reg, index: index_reg, count: *size as u32, stride: 1 })
                     }
-                    TypeInner::Vector { size, .. } => Ok(Insn::Extract {
+                    TypeInner::ValuePointer { size: Some(size), scalar, space } => Ok(Insn::PtrIndex {
                         dst,
                         base: base_reg,
                         index: index_reg,
                         count: *size as u32,
-                        stride: 1,
-                        len: 1,
+                        stride: component_step(*scalar, byte_addressed(*space)),
                     }),
-                    TypeInner::Array { size: naga::ArraySize::Constant(n), stride, .. } => Ok(Insn::Extract {
+                    TypeInner::Vector { size, scalar } => Ok(Insn::Extract {
                         dst,
                         base: base_reg,
                         index: index_reg,
-                        count: n.get(),
-                        stride: stride / 4,
-                        len,
+                        count: *size as u32,
+                        stride: component_words(*scalar),
+                        len: component_words(*scalar),
                     }),
+                    TypeInner::Array { base: element, size: naga::ArraySize::Constant(n), stride } => {
+                        Ok(Insn::Extract {
+                            dst,
+                            base: base_reg,
+                            index: index_reg,
+                            count: n.get(),
+                            stride: element_step(module, *element, *stride, false),
+                            len,
+                        })
+                    }
                     TypeInner::Array { .. } => Err("indexing a runtime-sized array value".to_string()),
                     TypeInner::Matrix { columns, rows, .. } => Ok(Insn::Extract {
                         dst,
@@ -330,6 +399,55 @@ impl Compiler<'_> {
                 self.reg(scope, pointer);
                 let dst = self.reg(scope, handle);
                 self.load(scope, pointer, dst, len);
+            }
+            Expression::Unary { op, expr } if is_wide(self.ty(scope, expr)) => {
+                let (src, n) = operand!(expr);
+                let dst = self.reg(scope, handle);
+                let apply: fn(u64) -> u64 = match op {
+                    naga::UnaryOperator::Negate => u64::wrapping_neg,
+                    naga::UnaryOperator::BitwiseNot => |x| !x,
+                    naga::UnaryOperator::LogicalNot => {
+                        self.fail("`!` on 64-bit integers".into(), line);
+                        return Ok(());
+                    }
+                };
+                self.push(Insn::Compute(Box::new(move |regs: &mut [u32]| {
+                    for i in (0..n as usize).step_by(2) {
+                        let x = wide::read(regs, src as usize + i);
+                        wide::write(regs, dst as usize + i, apply(x));
+                    }
+                })));
+            }
+            Expression::Binary { op, left, right } if is_wide(self.ty(scope, left)) => {
+                let (a, _) = operand!(left);
+                let (b, _) = operand!(right);
+                let dst = self.reg(scope, handle);
+                let (Some((scalar, ca)), Some((right_scalar, cb))) =
+                    (scalar_shape(self.ty(scope, left)), scalar_shape(self.ty(scope, right)))
+                else {
+                    self.fail(format!("{op:?} on 64-bit integers and composites"), line);
+                    return Ok(());
+                };
+                let signed = scalar.kind == ScalarKind::Sint;
+                if wide::binary(op, signed, 0, 1).is_none() {
+                    self.fail(format!("{op:?} on 64-bit integers"), line);
+                    return Ok(());
+                }
+                let n = ca.max(cb);
+                let (sa, sb) = (usize::from(ca != 1), usize::from(cb != 1));
+                // Shift amounts are u32: one word per component.
+                let wb = component_words(right_scalar) as usize;
+                let (a, b, dst) = (a as usize, b as usize, dst as usize);
+                self.push(Insn::Compute(Box::new(move |regs: &mut [u32]| {
+                    for i in 0..n {
+                        let x = wide::read(regs, a + 2 * i * sa);
+                        let y = if wb == 2 { wide::read(regs, b + 2 * i * sb) } else { u64::from(regs[b + i * sb]) };
+                        match wide::binary(op, signed, x, y).expect("probed") {
+                            wide::Out::Wide(v) => wide::write(regs, dst + 2 * i, v),
+                            wide::Out::Bool(v) => regs[dst + i] = u32::from(v),
+                        }
+                    }
+                })));
             }
             Expression::Unary { op, expr } => {
                 let (src, n) = operand!(expr);
@@ -385,13 +503,30 @@ impl Compiler<'_> {
                     let (sa, sb) = (u8::from(la != 1), u8::from(lb != 1));
                     self.push(Insn::BinV { op: resolved, dst, a, b, n: n as u8, sa, sb });
                 }
+                // f16 arithmetic: computed in f32 (exact or correctly rounded there, as
+                // f32 has more than 2 * 11 + 2 bits), then rounded to binary16.
+                if is_half(self.ty(scope, handle)) {
+                    self.round_half(dst, len);
+                }
             }
             Expression::Select { condition, accept, reject } => {
                 let (cond, lc) = operand!(condition);
                 let (accept, n) = operand!(accept);
                 let (reject, _) = operand!(reject);
                 let dst = self.reg(scope, handle);
-                self.push(Insn::Select { dst, cond, accept, reject, n: n as u8, sc: u8::from(lc != 1) });
+                if lc != 1 && n != lc {
+                    // Components of several words (64-bit) under a vector condition.
+                    let w = (n / lc) as usize;
+                    let (dst, cond, accept, reject) = (dst as usize, cond as usize, accept as usize, reject as usize);
+                    self.push(Insn::Compute(Box::new(move |regs: &mut [u32]| {
+                        for i in 0..lc as usize {
+                            let src = if regs[cond + i] != 0 { accept } else { reject };
+                            regs.copy_within(src + i * w..src + (i + 1) * w, dst + i * w);
+                        }
+                    })));
+                } else {
+                    self.push(Insn::Select { dst, cond, accept, reject, n: n as u8, sc: u8::from(lc != 1) });
+                }
             }
             Expression::Relational { fun, argument } => {
                 let v = operand!(argument);
@@ -415,6 +550,55 @@ impl Compiler<'_> {
             }
             Expression::Math { fun, arg, arg1, arg2, arg3 } => {
                 self.math(scope, handle, fun, [Some(arg), arg1, arg2, arg3])
+            }
+            Expression::As { expr, kind, convert: Some(width) }
+                if is_wide(self.ty(scope, expr)) || wide::is_wide(naga::Scalar { kind, width }) =>
+            {
+                let (src, _) = operand!(expr);
+                let dst = self.reg(scope, handle);
+                let Some((from, comps)) = scalar_shape(self.ty(scope, expr)) else {
+                    self.fail("conversion of a composite".into(), line);
+                    return Ok(());
+                };
+                let to = naga::Scalar { kind, width };
+                if wide::convert(0, from, to).is_none() {
+                    self.fail(format!("conversion from {from:?} to {to:?}"), line);
+                    return Ok(());
+                }
+                let (ws, wd) = (component_words(from) as usize, component_words(to) as usize);
+                let (src, dst) = (src as usize, dst as usize);
+                self.push(Insn::Compute(Box::new(move |regs: &mut [u32]| {
+                    for i in 0..comps {
+                        let x = if ws == 2 { wide::read(regs, src + 2 * i) } else { u64::from(regs[src + i]) };
+                        let v = wide::convert(x, from, to).expect("probed");
+                        if wd == 2 {
+                            wide::write(regs, dst + 2 * i, v);
+                        } else {
+                            regs[dst + i] = v as u32;
+                        }
+                    }
+                })));
+            }
+            Expression::As { expr, kind, convert: Some(width) }
+                if is_half(self.ty(scope, expr)) || (kind == ScalarKind::Float && width == 2) =>
+            {
+                let (src, _) = operand!(expr);
+                let dst = self.reg(scope, handle);
+                let Some((from, comps)) = scalar_shape(self.ty(scope, expr)) else {
+                    self.fail("conversion of a composite".into(), line);
+                    return Ok(());
+                };
+                let to = naga::Scalar { kind, width };
+                if arith::convert_half(0, from, to).is_none() {
+                    self.fail(format!("conversion from {from:?} to {to:?}"), line);
+                    return Ok(());
+                }
+                let (src, dst) = (src as usize, dst as usize);
+                self.push(Insn::Compute(Box::new(move |regs: &mut [u32]| {
+                    for i in 0..comps {
+                        regs[dst + i] = arith::convert_half(regs[src + i], from, to).expect("probed");
+                    }
+                })));
             }
             Expression::As { expr, kind, convert } => {
                 let (src, n) = operand!(expr);
@@ -449,7 +633,8 @@ impl Compiler<'_> {
                 let dst = self.reg(scope, handle);
                 let stride = match self.ty(scope, pointer) {
                     TypeInner::Pointer { base, .. } => match module.types[*base].inner {
-                        TypeInner::Array { stride, .. } => Ok(stride / 4),
+                        // Runtime-sized arrays live in buffers: bytes.
+                        TypeInner::Array { stride, .. } => Ok(stride),
                         _ => Err("arrayLength of a non-array"),
                     },
                     _ => Err("arrayLength of a non-pointer"),
@@ -489,18 +674,31 @@ impl Compiler<'_> {
         let line = self.line;
         let base_reg = self.reg(scope, base);
         let step = match self.ty(scope, base) {
-            TypeInner::Pointer { base: pointee, .. } => match module.types[*pointee].inner {
-                TypeInner::Array { stride, .. } => Ok((true, index * stride / 4)),
-                TypeInner::Struct { ref members, .. } => Ok((true, members[index as usize].offset / 4)),
-                TypeInner::Vector { .. } => Ok((true, index)),
-                TypeInner::Matrix { rows, .. } => Ok((true, index * column_words(rows) as u32)),
-                ref other => Err(format!("indexing through a pointer to {other:?}")),
-            },
-            TypeInner::ValuePointer { size: Some(_), .. } => Ok((true, index)),
-            TypeInner::Vector { .. } => Ok((false, index)),
-            TypeInner::Array { size: naga::ArraySize::Constant(_), stride, .. } => Ok((false, index * stride / 4)),
+            TypeInner::Pointer { base: pointee, space } => {
+                // Pointers into buffers count bytes, others register words.
+                let bytes = byte_addressed(*space);
+                let inner = &module.types[*pointee].inner;
+                match *inner {
+                    TypeInner::Array { base: element, stride, .. } => {
+                        Ok((true, index * element_step(module, element, stride, bytes)))
+                    }
+                    TypeInner::Struct { .. } => Ok((true, member_step(module, inner, index, bytes))),
+                    TypeInner::Vector { scalar, .. } => Ok((true, index * component_step(scalar, bytes))),
+                    TypeInner::Matrix { rows, .. } => {
+                        Ok((true, index * column_words(rows) as u32 * if bytes { 4 } else { 1 }))
+                    }
+                    ref other => Err(format!("indexing through a pointer to {other:?}")),
+                }
+            }
+            TypeInner::ValuePointer { size: Some(_), scalar, space } => {
+                Ok((true, index * component_step(*scalar, byte_addressed(*space))))
+            }
+            TypeInner::Vector { scalar, .. } => Ok((false, index * component_words(*scalar))),
+            TypeInner::Array { base: element, size: naga::ArraySize::Constant(_), stride } => {
+                Ok((false, index * element_step(module, *element, *stride, false)))
+            }
             TypeInner::Array { .. } => Err("indexing a runtime-sized array value".to_string()),
-            TypeInner::Struct { members, .. } => Ok((false, members[index as usize].offset / 4)),
+            inner @ TypeInner::Struct { .. } => Ok((false, member_step(module, inner, index, false))),
             TypeInner::Matrix { rows, .. } => Ok((false, index * column_words(*rows) as u32)),
             other => Err(format!("indexing {other:?}")),
         };
@@ -567,6 +765,39 @@ impl Compiler<'_> {
                 })),
                 other => Err(format!("determinant of {other:?}")),
             },
+            // Results are naga's predeclared structs: (fract, whole) and (fract, exp).
+            M::Modf | M::Frexp => match (shape(&arg_type), self.ty(scope, handle)) {
+                (Some((ScalarKind::Float, comps)), TypeInner::Struct { members, .. })
+                    if members.len() == 2 && a.1 as usize == comps =>
+                {
+                    let second = dst + member_step(self.module, self.ty(scope, handle), 1, false);
+                    Ok(Box::new(move |regs: &mut [u32]| {
+                        for i in 0..comps {
+                            let x = regs[a.0 as usize + i];
+                            let (first, other) = if fun == M::Modf { arith::modf(x) } else { arith::frexp(x) };
+                            regs[dst as usize + i] = first;
+                            regs[second as usize + i] = other;
+                        }
+                    }))
+                }
+                _ => Err(format!("{fun:?} of {arg_type:?}")),
+            },
+            _ if is_wide(&arg_type) => {
+                let (scalar, comps) = scalar_shape(&arg_type).expect("a scalar or vector");
+                let signed = scalar.kind == ScalarKind::Sint;
+                if wide::math(fun, signed, 0, 0, 0).is_none() {
+                    Err(format!("math function {fun:?} on 64-bit integers"))
+                } else {
+                    let (b, c) = (operands[1], operands[2]);
+                    Ok(Box::new(move |regs: &mut [u32]| {
+                        for i in 0..comps {
+                            let at = |o: Option<(Reg, u32)>| o.map_or(0, |(r, _)| wide::read(regs, r as usize + 2 * i));
+                            let value = wide::math(fun, signed, wide::read(regs, a.0 as usize + 2 * i), at(b), at(c));
+                            wide::write(regs, dst as usize + 2 * i, value.expect("probed"));
+                        }
+                    }))
+                }
+            }
             _ if arith::pack(fun, &[0; 4]).is_some() => Ok(Box::new(move |regs: &mut [u32]| {
                 let value = arith::pack(fun, slice(regs, a)).expect("a pack function");
                 put(regs, dst, len, &[value]);
@@ -617,8 +848,22 @@ impl Compiler<'_> {
         match compute {
             Ok(compute) => {
                 self.push(Insn::Compute(compute));
+                // f16 results: computed in f32, rounded to binary16 once.
+                if is_half(self.ty(scope, handle)) {
+                    self.round_half(dst, len);
+                }
             }
             Err(what) => self.fail(what, line),
         }
+    }
+
+    /// Rounds the `len` f16 values at `dst` (held as f32) to binary16.
+    fn round_half(&mut self, dst: Reg, len: u32) {
+        let (dst, len) = (dst as usize, len as usize);
+        self.push(Insn::Compute(Box::new(move |regs: &mut [u32]| {
+            for x in &mut regs[dst..dst + len] {
+                *x = arith::round_f16(*x);
+            }
+        })));
     }
 }

@@ -8,6 +8,7 @@
 //! (literals, constants, pointers to globals) are filled into each code's register
 //! template once and never recomputed.
 
+use super::decode::Piece;
 use naga::ScalarKind;
 
 /// Word offset of a value in the frame's register file.
@@ -260,6 +261,11 @@ pub(super) enum Insn {
     Load { dst: Reg, pointer: Reg, len: u32 },
     /// Writes `len` words through a pointer register.
     Store { pointer: Reg, src: Reg, len: u32 },
+    /// Reads a value holding f16 through a pointer into a buffer: naga's layout there,
+    /// the register layout here.
+    LoadMixed { dst: Reg, pointer: Reg, plan: Box<[Piece]> },
+    /// Writes a value holding f16 through a pointer into a buffer.
+    StoreMixed { pointer: Reg, src: Reg, plan: Box<[Piece]> },
     /// Reads workgroup memory at a word address known when compiling.
     LoadWorkgroup { dst: Reg, address: u32, len: u32 },
     /// Writes workgroup memory at a known word address.
@@ -268,7 +274,8 @@ pub(super) enum Insn {
     LoadPrivate { dst: Reg, address: u32, len: u32 },
     /// Writes private memory at a known word address.
     StorePrivate { address: u32, src: Reg, len: u32 },
-    /// Reads bound buffer `buffer` at a known word address.
+    /// Reads bound buffer `buffer` at a known word address (pointers into buffers count
+    /// bytes; these static addresses are words).
     LoadBuffer { dst: Reg, buffer: u32, address: u32, len: u32 },
     /// Writes bound buffer `buffer` at a known word address.
     StoreBuffer { buffer: u32, address: u32, src: Reg, len: u32 },

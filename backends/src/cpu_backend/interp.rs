@@ -5,7 +5,7 @@
 use super::decode::Program;
 use super::error::{invalid, unsupported};
 use super::insn::{BinOp, Insn};
-use super::memory::{Frame, Memory, copy_regs, read_buffer, write_buffer};
+use super::memory::{BUFFER, Frame, Memory, TAG_MASK, copy_regs, read_buffer, read_mixed, write_buffer, write_mixed};
 use crate::error::BackendError;
 use std::sync::atomic::AtomicU32;
 
@@ -193,6 +193,21 @@ pub(super) fn run(
                         callers: &mut callers[..],
                     };
                     memory.store(regs, pointer, *src as usize, *len as usize);
+                }
+                Insn::LoadMixed { dst, pointer, plan } => {
+                    let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1]);
+                    // Only pointers into buffers get a plan.
+                    if tag & TAG_MASK == BUFFER {
+                        let buffer = &buffers[(tag & !TAG_MASK) as usize];
+                        read_mixed(buffer, offset as usize, regs, *dst as usize, plan);
+                    }
+                }
+                Insn::StoreMixed { pointer, src, plan } => {
+                    let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1]);
+                    if tag & TAG_MASK == BUFFER {
+                        let buffer = &buffers[(tag & !TAG_MASK) as usize];
+                        write_mixed(buffer, offset as usize, regs, *src as usize, plan);
+                    }
                 }
                 Insn::LoadWorkgroup { dst, address, len } => {
                     let (dst, address, len) = (*dst as usize, *address as usize, *len as usize);

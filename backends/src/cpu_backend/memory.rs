@@ -1,5 +1,6 @@
 //! The interpreter's memory model. A pointer is two words: a region tag (and the
-//! region's index) in the first, a word offset in the second. Regions: a bound buffer
+//! region's index) in the first, an offset in the second: bytes into a bound buffer
+//! (naga's layout, where an f16 takes two bytes), register words elsewhere. Regions: a bound buffer
 //! (shared between the workgroups running on other threads, so its words are atomics,
 //! read and written relaxed), the workgroup's memory, the invocation's private memory,
 //! and a frame's register file (function-space variables live among a frame's
@@ -7,6 +8,7 @@
 //!
 //! Out-of-bounds words read as 0 and are not written.
 
+use super::decode::Piece;
 use super::insn::Reg;
 use std::sync::atomic::{AtomicU32, Ordering};
 
@@ -118,7 +120,7 @@ impl Memory<'_> {
     pub(super) fn load(&mut self, regs: &mut [u32], (tag, offset): (u32, u32), dst: usize, len: usize) {
         let start = offset as usize;
         match tag & TAG_MASK {
-            BUFFER => read_buffer(&self.buffers[(tag & !TAG_MASK) as usize], start, &mut regs[dst..dst + len]),
+            BUFFER => read_buffer(&self.buffers[(tag & !TAG_MASK) as usize], start / 4, &mut regs[dst..dst + len]),
             WORKGROUP => read_plain(self.workgroup, start, &mut regs[dst..dst + len]),
             PRIVATE => read_plain(self.private, start, &mut regs[dst..dst + len]),
             _ => {
@@ -143,7 +145,7 @@ impl Memory<'_> {
     pub(super) fn store(&mut self, regs: &mut [u32], (tag, offset): (u32, u32), src: usize, len: usize) {
         let start = offset as usize;
         match tag & TAG_MASK {
-            BUFFER => write_buffer(&self.buffers[(tag & !TAG_MASK) as usize], start, &regs[src..src + len]),
+            BUFFER => write_buffer(&self.buffers[(tag & !TAG_MASK) as usize], start / 4, &regs[src..src + len]),
             WORKGROUP => write_plain(self.workgroup, start, &regs[src..src + len]),
             PRIVATE => write_plain(self.private, start, &regs[src..src + len]),
             _ => {
@@ -165,10 +167,11 @@ impl Memory<'_> {
         }
     }
 
-    /// Words in the region of pointer tag `tag` (`regs`: the running frame's registers).
+    /// Size of the region of pointer tag `tag` in the pointer's units: bytes for a
+    /// buffer, words elsewhere (`regs`: the running frame's registers).
     pub(super) fn words(&self, regs: &[u32], tag: u32) -> usize {
         match tag & TAG_MASK {
-            BUFFER => self.buffers[(tag & !TAG_MASK) as usize].len(),
+            BUFFER => self.buffers[(tag & !TAG_MASK) as usize].len() * 4,
             WORKGROUP => self.workgroup.len(),
             PRIVATE => self.private.len(),
             _ => {
@@ -182,7 +185,7 @@ impl Memory<'_> {
     /// atomic in buffers, a plain read and write elsewhere (one thread runs a workgroup).
     pub(super) fn atomic(&mut self, regs: &mut [u32], (tag, offset): (u32, u32), apply: impl Fn(u32) -> u32) -> u32 {
         if tag & TAG_MASK == BUFFER {
-            match self.buffers[(tag & !TAG_MASK) as usize].get(offset as usize) {
+            match self.buffers[(tag & !TAG_MASK) as usize].get(offset as usize / 4) {
                 Some(word) => {
                     word.fetch_update(Ordering::Relaxed, Ordering::Relaxed, |old| Some(apply(old))).unwrap_or(0)
                 }
@@ -217,6 +220,47 @@ impl Memory<'_> {
                 }
             }
             old[0]
+        }
+    }
+}
+
+/// Reads a value holding f16 from buffer `memory` at byte `start` into `regs[dst..]`,
+/// piece by piece (binary16 → the f32 of equal value); missing words read as 0.
+pub(super) fn read_mixed(memory: &[AtomicU32], start: usize, regs: &mut [u32], dst: usize, plan: &[Piece]) {
+    for piece in plan {
+        match *piece {
+            Piece::Words { memory: at, reg, len } => {
+                let reg = dst + reg as usize;
+                read_buffer(memory, (start + at as usize) / 4, &mut regs[reg..reg + len as usize]);
+            }
+            Piece::Half { memory: at, reg } => {
+                let byte = start + at as usize;
+                let word = memory.get(byte / 4).map_or(0, |w| w.load(Ordering::Relaxed));
+                regs[dst + reg as usize] = super::arith::f16_to_f32((word >> (8 * (byte & 2))) & 0xffff);
+            }
+        }
+    }
+}
+
+/// Writes a value holding f16 from `regs[src..]` into buffer `memory` at byte `start`;
+/// a binary16 replaces its half of a word atomically (the other half may belong to
+/// another invocation); missing words are skipped.
+pub(super) fn write_mixed(memory: &[AtomicU32], start: usize, regs: &[u32], src: usize, plan: &[Piece]) {
+    for piece in plan {
+        match *piece {
+            Piece::Words { memory: at, reg, len } => {
+                let reg = src + reg as usize;
+                write_buffer(memory, (start + at as usize) / 4, &regs[reg..reg + len as usize]);
+            }
+            Piece::Half { memory: at, reg } => {
+                let byte = start + at as usize;
+                let shift = 8 * (byte & 2);
+                let half = super::arith::f32_to_f16(regs[src + reg as usize]) << shift;
+                if let Some(word) = memory.get(byte / 4) {
+                    let mask = 0xffff << shift;
+                    let _ = word.fetch_update(Ordering::Relaxed, Ordering::Relaxed, |old| Some((old & !mask) | half));
+                }
+            }
         }
     }
 }

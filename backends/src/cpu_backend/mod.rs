@@ -6,7 +6,8 @@
 //! [`decode`] and [`expression`]): instructions whose operands are word offsets in the
 //! frame's register file, small callees inlined, fields and bitcasts aliasing their
 //! source's registers, compile-time values in a register template. [`interp`] runs it;
-//! [`memory`] is the pointer model. Workgroups run in parallel on the machine's cores;
+//! [`memory`] is the pointer model (offsets in bytes into bound buffers, in register
+//! words elsewhere). Workgroups run in parallel on the machine's cores;
 //! the invocations of a workgroup run round-robin from barrier to barrier ([`exec`]), each
 //! a resumable stack of frames, so every invocation reaches a barrier before any passes
 //! it. A barrier or subgroup operation reached in non-uniform control flow is an error
@@ -18,11 +19,19 @@
 //! f32 without contraction. Out-of-bounds indices are clamped (naga's `Restrict` policy);
 //! out-of-bounds memory words read as 0 and are not written.
 //!
-//! Supported today: 32-bit scalars, bool, vectors, matrices as values, fixed and
+//! Supported today: 32-bit scalars, bool, 64-bit integers ([`wide`]: two words, low
+//! first, as the storage layout has them; arithmetic, comparisons, bit operations,
+//! shifts, conversions, `abs`/`min`/`max`/`clamp`/`sign`), f16 (held in a register
+//! word as the f32 of equal value, every operation computed in f32 and rounded to
+//! binary16; in buffers at naga's two bytes each, converted on load and store; f16
+//! matrices are refused by name), vectors, matrices as values, fixed and
 //! runtime-sized arrays, structs, pointers, function calls, loops with `continuing` and
 //! `break if`, `switch`, atomics, barriers, `workgroupUniformLoad`, subgroup shuffles and
-//! broadcasts, the compute builtins, matrix arithmetic, and most math functions. Anything else is an error
-//! naming the construct and its WGSL line, never a panic.
+//! broadcasts, the compute builtins, matrix arithmetic, and most math functions
+//! (`modf` and `frexp` with their result structs; `pack2x16float`, `unpack2x16float`
+//! and `quantizeToF16` through IEEE binary16, rounding to nearest even, keeping
+//! denormals). Anything else is an error naming the construct and its WGSL line, never
+//! a panic.
 
 mod arith;
 mod decode;
@@ -33,6 +42,7 @@ mod insn;
 mod interp;
 mod matrix;
 mod memory;
+mod wide;
 
 use crate::backend::{Backend, Bind, BufferId};
 use crate::bindings_check::{check_binds, check_buffer_size, check_kernel_fits, check_workgroups, check_write};

@@ -82,6 +82,9 @@ impl WgpuBackend {
         if subgroups {
             features |= wgpu::Features::SUBGROUP;
         }
+        // 64-bit integers and f16 in shaders where the adapter has them (lavapipe
+        // does), so that external kernels using `i64`/`u64`/`f16` run.
+        features |= adapter_features & (wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_F16);
         let timestamps = adapter_features.contains(wgpu::Features::TIMESTAMP_QUERY);
         if timestamps {
             features |= wgpu::Features::TIMESTAMP_QUERY;

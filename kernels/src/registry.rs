@@ -84,11 +84,13 @@ impl KernelId {
                 fragment!("render/path.wgsl"),
             ]
         };
-        let restir = |name: &'static str, entry: Fragment| KernelSpec {
+        // A ReSTIR pass: the renderer, the shared records, then `pass` (its entry point last).
+        let restir = |name: &'static str, pass: &[Fragment]| KernelSpec {
             name: name.into(),
             fragments: [
                 renderer(),
-                vec![fragment!("common/candidate.wgsl"), fragment!("restir/reservoir.wgsl"), entry],
+                vec![fragment!("common/candidate.wgsl"), fragment!("restir/reservoir.wgsl")],
+                pass.to_vec(),
             ]
             .concat(),
             entry_point: name.into(),
@@ -154,13 +156,18 @@ impl KernelId {
                 // functions by ~2100 ULP in environment-lit pixels.
                 float_ulp_bound: Some(4096),
             },
-            KernelId::RestirCandidates => restir("restir_candidates", fragment!("restir/entry_candidates.wgsl")),
-            KernelId::RestirSelect => restir("restir_select", fragment!("restir/entry_select.wgsl")),
-            KernelId::RestirTemporalKeys => {
-                restir("restir_temporal_keys", fragment!("restir/entry_temporal_keys.wgsl"))
+            KernelId::RestirCandidates => restir("restir_candidates", &[fragment!("restir/entry_candidates.wgsl")]),
+            KernelId::RestirSelect => {
+                restir("restir_select", &[fragment!("restir/reuse_slot.wgsl"), fragment!("restir/entry_select.wgsl")])
             }
-            KernelId::RestirTemporal => restir("restir_temporal", fragment!("restir/entry_temporal.wgsl")),
-            KernelId::RestirShade => restir("restir_shade", fragment!("restir/entry_shade.wgsl")),
+            KernelId::RestirTemporalKeys => {
+                restir("restir_temporal_keys", &[fragment!("restir/entry_temporal_keys.wgsl")])
+            }
+            KernelId::RestirTemporal => restir(
+                "restir_temporal",
+                &[fragment!("restir/reuse_slot.wgsl"), fragment!("restir/entry_temporal.wgsl")],
+            ),
+            KernelId::RestirShade => restir("restir_shade", &[fragment!("restir/entry_shade.wgsl")]),
             KernelId::StrataSelect => KernelSpec {
                 name: "strata_select".into(),
                 fragments: vec![

@@ -57,34 +57,16 @@ fn empty_reservoir() -> Reservoir {
     return Reservoir(PathCandidate(vec3<f32>(0.0), KIND_NONE, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), 0.0), 0.0, 0.0, 0.0, 0u);
 }
 
-// The pixel that selection slot `slot` of pixel (x, y) takes, or 0xffffffff for none.
+// The pixel that selection slot `slot` of pixel (x, y) takes, or NO_PIXEL for none
+// (restir/reuse_slot.wgsl).
 fn selected_pixel(x: u32, y: u32, pixel: u32, p: Primary, slot: u32, positions: vec4<f32>) -> u32 {
     if restir.method == METHOD_RESTIR_DISC {
-        let r = restir.disc_radius * sqrt(random());
-        let phi = 2.0 * PI * random();
-        let qx = i32(floor(f32(x) + 0.5 + r * cos(phi)));
-        let qy = i32(floor(f32(y) + 0.5 + r * sin(phi)));
-        if qx < 0 || qy < 0 || qx >= i32(params.width) || qy >= i32(params.height) {
-            return 0xffffffffu;
-        }
-        let q = u32(qy) * params.width + u32(qx);
-        let n = primaries[q];
-        if (n.flags & PRIMARY_RESAMPLE) == 0u || dot(n.normal, p.normal) < 0.906
-            || abs(n.depth - p.depth) > 0.1 * p.depth {
-            return 0xffffffffu;
-        }
-        return q;
+        return disc_neighbour(x, y, p);
     }
-    let span = spans[pixel];
-    let n = span.length;
-    if n == 0u {
-        return 0xffffffffu;
+    let index = run_index(spans[pixel], positions[slot]);
+    if index == NO_PIXEL {
+        return NO_PIXEL;
     }
-    var position = positions[slot];
-    if restir.method == METHOD_RESTIR {
-        position = random();
-    }
-    let index = span.offset + min(u32(floor(position * f32(n))), n - 1u);
     return sorted_pixels[index];
 }
 
@@ -114,7 +96,7 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
     var sources = vec4<u32>(pixel);
     for (var slot = 0u; slot < k; slot++) {
         let q = selected_pixel(id.x, id.y, pixel, p, slot, positions);
-        if q == 0xffffffffu {
+        if q == NO_PIXEL {
             // No candidate in this slot: the canonical sample alone covers its share.
             weight_c += target_c * c.weight / f32(k);
             continue;

@@ -67,34 +67,21 @@ fn target_at(p: Primary, y: PathCandidate, lane: u32) -> f32 {
 }
 
 // The previous frame's pixel whose reservoir drawn temporal slot `slot` of pixel (x, y)
-// merges, or NO_SOURCE for an empty slot.
+// merges, or NO_SOURCE for an empty slot (restir/reuse_slot.wgsl draws it like a
+// spatial candidate).
 fn drawn_source(x: u32, y: u32, pixel: u32, p: Primary, slot: u32, positions: vec4<f32>) -> u32 {
     if restir.method == METHOD_RESTIR_DISC {
-        let r = restir.disc_radius * sqrt(random());
-        let phi = 2.0 * PI * random();
-        let qx = i32(floor(f32(x) + 0.5 + r * cos(phi)));
-        let qy = i32(floor(f32(y) + 0.5 + r * sin(phi)));
-        if qx < 0 || qy < 0 || qx >= i32(params.width) || qy >= i32(params.height) {
-            return NO_SOURCE;
-        }
-        let q = u32(qy) * params.width + u32(qx);
-        let n = primaries[q];
-        if (n.flags & PRIMARY_RESAMPLE) == 0u || dot(n.normal, p.normal) < 0.906
-            || abs(n.depth - p.depth) > 0.1 * p.depth {
+        let q = disc_neighbour(x, y, p);
+        if q == NO_PIXEL {
             return NO_SOURCE;
         }
         return temporal_sources[q];
     }
-    let span = temporal_spans[pixel];
-    let n = span.length;
-    if n == 0u {
+    let index = run_index(temporal_spans[pixel], positions[slot]);
+    if index == NO_PIXEL {
         return NO_SOURCE;
     }
-    var position = positions[slot];
-    if restir.method == METHOD_RESTIR {
-        position = random();
-    }
-    return temporal_sources[temporal_sorted_pixels[span.offset + min(u32(floor(position * f32(n))), n - 1u)]];
+    return temporal_sources[temporal_sorted_pixels[index]];
 }
 
 // One pair (current c, previous reservoir of source s) of the merge, each pair sharing

@@ -241,18 +241,18 @@ fn unsupported_constructs_are_named_with_their_line() {
 @group(0) @binding(1) var<storage, read_write> output: array<f32>;
 @compute @workgroup_size(1)
 fn main() {
-    let v = vec2<f32>(f32(input[0]), 1.0);
-    output[0] = reflect(v, vec2<f32>(0.0, 1.0)).x;
+    let wide = u64(input[0]) << 40u;
+    output[0] = f32(countOneBits(wide));
 }
 "#;
-    let kernel = Kernel::from_wgsl("reflect.wgsl", source.into(), "main", false).unwrap();
+    let kernel = Kernel::from_wgsl("count64.wgsl", source.into(), "main", false).unwrap();
     let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
     let input = upload(&mut cpu, "input", &[1u32]).unwrap();
     let output = cpu.create_buffer("output", 4).unwrap();
     let error = cpu.dispatch(&kernel, &[Bind::new(0, input), Bind::new(1, output)], [1, 1, 1]).unwrap_err();
     assert!(matches!(error, BackendError::Validation { .. }), "{error}");
     let message = error.to_string();
-    assert!(message.contains("unsupported: math function Reflect on Float"), "{message}");
+    assert!(message.contains("unsupported: math function CountOneBits on 64-bit integers"), "{message}");
     assert!(message.contains("(WGSL line 7)"), "{message}");
 }
 
@@ -380,6 +380,167 @@ fn float_math_and_matrices_agree_with_lavapipe_within_ulps() {
     let agreement = compare_outputs(&[Output { name: "output", words: got, compare: Compare::Exact }], &expected)
         .unwrap_or_else(|mismatch| panic!("{mismatch}"));
     eprintln!("float math: max {} ULP, {:.2}% beyond 64 ULP", agreement.max_ulp, agreement.outside_share() * 100.0);
+}
+
+const MORE_MATH: &str = r#"
+@group(0) @binding(0) var<storage, read> input: array<f32>;
+@group(0) @binding(1) var<storage, read_write> output: array<f32>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let x = input[2u * id.x];
+    let y = input[2u * id.x + 1u];
+    let i = normalize(vec3<f32>(x, -1.0, y));
+    let n = normalize(vec3<f32>(0.25 * y, 1.0, 0.5));
+    let r = reflect(i, n);
+    let glass = refract(i, n, 1.0 / 1.5);
+    // eta 1.5 from inside: total internal reflection (k < 0) for grazing directions.
+    let inside = refract(i, n, 1.5);
+    let f = faceForward(n, i, vec3<f32>(x, y, 1.0));
+    let o = id.x * 16u;
+    output[o] = r.x + r.y + r.z;
+    output[o + 1u] = glass.x - glass.y + glass.z;
+    output[o + 2u] = inside.x + inside.y - inside.z;
+    output[o + 3u] = f.x + f.y + f.z;
+    output[o + 4u] = asinh(x);
+    output[o + 5u] = acosh(abs(y) + 1.0);
+    output[o + 6u] = atanh(clamp(0.2 * x, -0.9, 0.9));
+    output[o + 7u] = radians(x * 45.0);
+    output[o + 8u] = degrees(y);
+    output[o + 9u] = ldexp(x, i32(y * 32.0));
+    output[o + 10u] = ldexp(vec2<f32>(y, x), vec2<i32>(-140, 127)).x + ldexp(x, 200);
+    output[o + 11u] = ldexp(y, -200);
+    let a = bitcast<u32>(x);
+    let b = bitcast<u32>(y) ^ 0x80ff7f01u;
+    output[o + 12u] = bitcast<f32>(dot4I8Packed(a, b));
+    output[o + 13u] = bitcast<f32>(dot4U8Packed(a, b));
+    output[o + 14u] = bitcast<f32>(dot4I8Packed(b, 0x80808080u));
+    output[o + 15u] = bitcast<f32>(dot4U8Packed(0xffffffffu, b));
+}
+"#;
+
+#[test]
+fn reflect_refract_hyperbolic_ldexp_and_packed_dots_agree_with_lavapipe() {
+    use strata::check::{Compare, Output, compare_outputs};
+    let kernel = Kernel::from_wgsl("more_math.wgsl", MORE_MATH.into(), "main", false).unwrap();
+    let mut state = 777u32;
+    let inputs: Vec<u32> = (0..2 * 128)
+        .map(|_| {
+            state = state.wrapping_mul(1_103_515_245).wrapping_add(12345);
+            ((state >> 8) as f32 / (1 << 24) as f32 * 8.0 - 4.0).to_bits()
+        })
+        .collect();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &inputs, 128 * 16, 2);
+    // Known values on the interpreter: total internal reflection gives the zero vector,
+    // ldexp saturates and flushes exactly.
+    let f = f32::from_bits;
+    for p in 0..128 {
+        let (x, y) = (f(inputs[2 * p]), f(inputs[2 * p + 1]));
+        let at = |k: usize| f(got[16 * p + k]);
+        assert_eq!(at(9), x * 2f32.powi((y * 32.0) as i32), "ldexp({x}, {y} * 32)");
+        assert_eq!(at(11), y * 2f32.powi(-100) * 2f32.powi(-100), "ldexp({y}, -200)");
+        if x != 0.0 {
+            assert!(at(10).is_infinite(), "ldexp({x}, 200) overflows");
+        }
+        assert_eq!(at(7).to_bits(), (x * 45.0 * (std::f32::consts::PI / 180.0)).to_bits());
+    }
+    let Some(mut gpu) =
+        strata_tests::vulkan_backend("reflect_refract_hyperbolic_ldexp_and_packed_dots_agree_with_lavapipe")
+    else {
+        return;
+    };
+    let want = run_words(&mut gpu, &kernel, &inputs, 128 * 16, 2);
+    // The packed dot products are integers: bit for bit.
+    let integer = |i: usize| i % 16 >= 12;
+    if let Some(i) = (0..want.len()).find(|&i| integer(i) && got[i] != want[i]) {
+        panic!("output[{i}] (packed dot {}): cpu {:#x}, lavapipe {:#x}", i % 16 - 12, got[i], want[i]);
+    }
+    let floats = |words: &[u32]| (0..words.len()).filter(|&i| !integer(i)).map(|i| words[i]).collect::<Vec<_>>();
+    let expected =
+        [Output { name: "output", words: floats(&want), compare: Compare::Float { ulp: 64, max_outside: 0.005 } }];
+    let agreement =
+        compare_outputs(&[Output { name: "output", words: floats(&got), compare: Compare::Exact }], &expected)
+            .unwrap_or_else(|mismatch| panic!("{mismatch}"));
+    eprintln!("more math: max {} ULP, {:.2}% beyond 64 ULP", agreement.max_ulp, agreement.outside_share() * 100.0);
+}
+
+/// Subgroup ballots, reductions and scans, per invocation 24 outputs; `WG` is replaced by
+/// the workgroup size (a multiple of the subgroup size, or not: a partial last subgroup).
+const SUBGROUP_COLLECTIVES: &str = r#"
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+
+@compute @workgroup_size(WG)
+fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(subgroup_size) size: u32) {
+    let x = input[id.x];
+    let s = bitcast<i32>(x);
+    let small = f32(x & 255u);
+    let o = id.x * 24u;
+    output[o] = size;
+    output[o + 1u] = subgroupAdd(x);
+    output[o + 2u] = bitcast<u32>(subgroupMul(s | 1));
+    output[o + 3u] = bitcast<u32>(subgroupMin(s));
+    output[o + 4u] = subgroupMax(x);
+    output[o + 5u] = subgroupAnd(x);
+    output[o + 6u] = subgroupOr(x);
+    output[o + 7u] = subgroupXor(x);
+    output[o + 8u] = u32(subgroupAll((x & 3u) != 0u));
+    output[o + 9u] = u32(subgroupAny((x & 63u) == 5u));
+    output[o + 10u] = subgroupInclusiveAdd(x);
+    output[o + 11u] = subgroupExclusiveAdd(x);
+    output[o + 12u] = subgroupInclusiveMul(x | 1u);
+    output[o + 13u] = bitcast<u32>(subgroupExclusiveMul(s));
+    let ballot = subgroupBallot((x & 1u) == 1u);
+    output[o + 14u] = ballot.x;
+    output[o + 15u] = ballot.y;
+    output[o + 16u] = ballot.z;
+    output[o + 17u] = ballot.w;
+    // Small integers as floats: every sum is exact, whatever the order.
+    output[o + 18u] = bitcast<u32>(subgroupAdd(small));
+    output[o + 19u] = bitcast<u32>(subgroupMin(small - 100.0));
+    output[o + 20u] = bitcast<u32>(subgroupMax(vec2<f32>(small, -small)).y);
+    output[o + 21u] = subgroupExclusiveAdd(vec3<u32>(x, 1u, x >> 3u)).z;
+    output[o + 22u] = subgroupBallot().x;
+    output[o + 23u] = bitcast<u32>(subgroupMax(s));
+}
+"#;
+
+#[test]
+fn subgroup_ballots_reductions_and_scans_agree_with_lavapipe_bit_for_bit() {
+    let Some(mut gpu) =
+        strata_tests::vulkan_backend("subgroup_ballots_reductions_and_scans_agree_with_lavapipe_bit_for_bit")
+    else {
+        return;
+    };
+    let mut state = 4242u32;
+    let inputs: Vec<u32> = (0..240)
+        .map(|i| {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            if i % 7 == 0 { state | 3 } else { state }
+        })
+        .collect();
+    for workgroup_size in [64u32, 20] {
+        let source = SUBGROUP_COLLECTIVES.replace("WG", &workgroup_size.to_string());
+        let kernel = Kernel::from_wgsl("subgroup_collectives.wgsl", source, "main", true).unwrap();
+        let workgroups = inputs.len() as u32 / workgroup_size;
+        let want = run_words(&mut gpu, &kernel, &inputs, inputs.len() * 24, workgroups);
+        // The interpreter runs with lavapipe's subgroup size.
+        let mut cpu = CpuBackend::new(CpuOptions { subgroup_size: Some(want[0]) }).unwrap();
+        let got = run_words(&mut cpu, &kernel, &inputs, inputs.len() * 24, workgroups);
+        if let Some(i) = (0..want.len()).find(|&i| got[i] != want[i]) {
+            panic!(
+                "workgroup size {workgroup_size}, subgroup size {}: output[{i}] (invocation {}, output {}): cpu {:#x}, lavapipe {:#x}",
+                want[0],
+                i / 24,
+                i % 24,
+                got[i],
+                want[i]
+            );
+        }
+    }
 }
 
 const HALF_AND_SPLIT: &str = r#"

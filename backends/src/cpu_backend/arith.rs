@@ -141,6 +141,14 @@ pub(super) fn math(fun: MathFunction, kind: ScalarKind, x: u32, y: u32, z: u32) 
         (M::Acos, K::Float) => f(x).acos().to_bits(),
         (M::Atan, K::Float) => f(x).atan().to_bits(),
         (M::Atan2, K::Float) => f(x).atan2(f(y)).to_bits(),
+        (M::Asinh, K::Float) => f(x).asinh().to_bits(),
+        (M::Acosh, K::Float) => f(x).acosh().to_bits(),
+        (M::Atanh, K::Float) => f(x).atanh().to_bits(),
+        (M::Radians, K::Float) => (f(x) * (std::f32::consts::PI / 180.0)).to_bits(),
+        (M::Degrees, K::Float) => (f(x) * (180.0 / std::f32::consts::PI)).to_bits(),
+        // x · 2^e, exact until the single rounding to f32 (f64 holds every f32 times any
+        // power of two in ±400 exactly; beyond that the result saturates anyway).
+        (M::Ldexp, K::Float) => ((f64::from(f(x)) * 2f64.powi(iy.clamp(-400, 400))) as f32).to_bits(),
         (M::Sinh, K::Float) => f(x).sinh().to_bits(),
         (M::Cosh, K::Float) => f(x).cosh().to_bits(),
         (M::Tanh, K::Float) => f(x).tanh().to_bits(),

@@ -16,7 +16,7 @@
 
 use super::error::unsupported;
 use super::expression::{Place, const_value, global_value};
-use super::insn::{CallInsn, GatherInsn, Insn, Reg};
+use super::insn::{CallInsn, CollectiveFun, CollectiveInsn, GatherInsn, Insn, Reg};
 use super::memory;
 use crate::error::BackendError;
 use naga::{Expression, Handle, Module, Statement, TypeInner};
@@ -778,6 +778,31 @@ impl Compiler<'_> {
                 };
                 self.line = line;
                 self.push(Insn::Gather(Box::new(gather)));
+            }
+            Statement::SubgroupBallot { result, predicate } => {
+                let collective = CollectiveInsn {
+                    fun: CollectiveFun::Ballot { predicate: predicate.map(|p| self.reg(scope, p)) },
+                    argument: 0,
+                    len: 4,
+                    result: self.reg(scope, *result),
+                };
+                self.line = line;
+                self.push(Insn::Collective(Box::new(collective)));
+            }
+            Statement::SubgroupCollectiveOperation { op, collective_op, argument, result } => {
+                let ty = self.ty(scope, *argument);
+                let kind = match super::expression::shape(ty) {
+                    Some((kind, _)) if !super::expression::is_wide(ty) && !super::expression::is_half(ty) => kind,
+                    _ => return Err(unsupported(&format!("subgroup {op:?} {collective_op:?} on {ty:?}"), line)),
+                };
+                let collective = CollectiveInsn {
+                    fun: CollectiveFun::Operation { op: *op, collective: *collective_op, kind },
+                    argument: self.reg(scope, *argument),
+                    len: scope.lens[argument.index()],
+                    result: self.reg(scope, *result),
+                };
+                self.line = line;
+                self.push(Insn::Collective(Box::new(collective)));
             }
             other => {
                 let name = format!("{other:?}");

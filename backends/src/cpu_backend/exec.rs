@@ -182,8 +182,10 @@ fn run_workgroup(
         // Everyone waits at the same instruction: a barrier needs nothing more; a
         // subgroup gather is computed for all invocations now.
         let Stop::Sync(code, pc) = first else { unreachable!() };
-        if let Insn::Gather(gather) = &program.codes[code as usize].insns[pc as usize] {
-            self::gather(&mut invocations, gather);
+        match &program.codes[code as usize].insns[pc as usize] {
+            Insn::Gather(gather) => self::gather(&mut invocations, gather),
+            Insn::Collective(collective) => self::collective(&mut invocations, collective),
+            _ => {}
         }
         for invocation in &mut invocations {
             invocation.frame.as_mut().expect("waiting invocations have frames").pc += 1;
@@ -229,5 +231,92 @@ fn gather(invocations: &mut [Invocation], gather: &super::insn::GatherInsn) {
     for (i, invocation) in invocations.iter_mut().enumerate() {
         let frame = invocation.frame.as_mut().expect("waiting");
         frame.regs[result..result + len].copy_from_slice(&results[i * len..i * len + len]);
+    }
+}
+
+/// Computes a subgroup ballot, reduction or scan for every invocation of the workgroup:
+/// the lanes of a subgroup are the invocations `subgroup_id * size ..` in local-index
+/// order, combined lane by lane in that order (float sums and products therefore
+/// associate left to right; GPUs may use another order, a few ULPs apart).
+fn collective(invocations: &mut [Invocation], collective: &super::insn::CollectiveInsn) {
+    use super::insn::CollectiveFun;
+    use naga::CollectiveOperation as C;
+    fn regs(inv: &Invocation) -> &[u32] {
+        &inv.frame.as_ref().expect("waiting").regs
+    }
+    let len = collective.len as usize;
+    let mut results = vec![0u32; invocations.len() * len];
+    for (i, invocation) in invocations.iter().enumerate() {
+        let size = invocation.subgroup_size as usize;
+        let base = invocation.subgroup_id as usize * size;
+        let members = &invocations[base..(base + size).min(invocations.len())];
+        let lane = invocation.lane as usize;
+        let out = &mut results[i * len..i * len + len];
+        match collective.fun {
+            CollectiveFun::Ballot { predicate } => {
+                for (l, member) in members.iter().enumerate() {
+                    if predicate.is_none_or(|p| regs(member)[p as usize] != 0) {
+                        out[l / 32] |= 1 << (l % 32);
+                    }
+                }
+            }
+            CollectiveFun::Operation { op, collective: mode, kind } => {
+                let lanes = match mode {
+                    C::Reduce => members,
+                    C::InclusiveScan => &members[..=lane],
+                    C::ExclusiveScan => &members[..lane],
+                };
+                let argument = collective.argument as usize;
+                for (c, word) in out.iter_mut().enumerate() {
+                    *word = lanes
+                        .iter()
+                        .fold(identity(op, kind), |acc, member| combine(op, kind, acc, regs(member)[argument + c]));
+                }
+            }
+        }
+    }
+    let result = collective.result as usize;
+    for (i, invocation) in invocations.iter_mut().enumerate() {
+        let frame = invocation.frame.as_mut().expect("waiting");
+        frame.regs[result..result + len].copy_from_slice(&results[i * len..i * len + len]);
+    }
+}
+
+/// The value an empty subgroup operation gives (exclusive scans' first lane).
+fn identity(op: naga::SubgroupOperation, kind: naga::ScalarKind) -> u32 {
+    use naga::ScalarKind as K;
+    use naga::SubgroupOperation as O;
+    match (op, kind) {
+        (O::All, _) => 1,
+        (O::Any | O::Add | O::Or | O::Xor, K::Float) => 0.0f32.to_bits(),
+        (O::Any | O::Add | O::Or | O::Xor, _) => 0,
+        (O::Mul, K::Float) => 1.0f32.to_bits(),
+        (O::Mul, _) => 1,
+        (O::And, K::Bool) => 1,
+        (O::And, _) => u32::MAX,
+        (O::Min, K::Float) => f32::INFINITY.to_bits(),
+        (O::Min, K::Sint) => i32::MAX as u32,
+        (O::Min, _) => u32::MAX,
+        (O::Max, K::Float) => f32::NEG_INFINITY.to_bits(),
+        (O::Max, K::Sint) => i32::MIN as u32,
+        (O::Max, _) => 0,
+    }
+}
+
+/// One step of a subgroup operation, with WGSL's scalar semantics.
+fn combine(op: naga::SubgroupOperation, kind: naga::ScalarKind, acc: u32, x: u32) -> u32 {
+    use super::insn::BinOp;
+    use naga::ScalarKind as K;
+    use naga::SubgroupOperation as O;
+    match (op, kind) {
+        (O::All | O::And, _) => acc & x,
+        (O::Any | O::Or, _) => acc | x,
+        (O::Xor, _) => acc ^ x,
+        (O::Add, K::Float) => BinOp::AddF.apply(acc, x),
+        (O::Add, _) => BinOp::AddI.apply(acc, x),
+        (O::Mul, K::Float) => BinOp::MulF.apply(acc, x),
+        (O::Mul, _) => BinOp::MulI.apply(acc, x),
+        (O::Min, _) => super::arith::math(naga::MathFunction::Min, kind, acc, x, 0).unwrap_or(acc),
+        (O::Max, _) => super::arith::math(naga::MathFunction::Max, kind, acc, x, 0).unwrap_or(acc),
     }
 }

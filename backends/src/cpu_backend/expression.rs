@@ -74,12 +74,12 @@ pub(super) fn scalar_shape(inner: &TypeInner) -> Option<(naga::Scalar, usize)> {
 }
 
 /// Whether `inner` is a 64-bit integer scalar or vector.
-fn is_wide(inner: &TypeInner) -> bool {
+pub(super) fn is_wide(inner: &TypeInner) -> bool {
     scalar_shape(inner).is_some_and(|(s, _)| wide::is_wide(s))
 }
 
 /// Whether `inner` is an f16 scalar or vector.
-fn is_half(inner: &TypeInner) -> bool {
+pub(super) fn is_half(inner: &TypeInner) -> bool {
     scalar_shape(inner).is_some_and(|(s, _)| s.kind == ScalarKind::Float && s.width == 2)
 }
 
@@ -162,6 +162,14 @@ pub(super) fn const_value(compiler: &Compiler, scope: &Scope, handle: Handle<Exp
     (value.len() == len).then_some(value)
 }
 
+/// The f32 dot product of two vectors of f32 words: a sequential sum of products, no fused
+/// multiply-add, starting from the first product rather than +0 so that products that are
+/// all -0 sum to -0.
+fn dot(a: &[u32], b: &[u32]) -> f32 {
+    let f = f32::from_bits;
+    (1..a.len()).fold(f(a[0]) * f(b[0]), |acc, i| acc + f(a[i]) * f(b[i]))
+}
+
 /// Math functions on vectors and scalars (the reference implementation, value by value).
 #[allow(clippy::too_many_arguments)]
 fn math(
@@ -177,13 +185,7 @@ fn math(
     let f = f32::from_bits;
     let pick = |v: Option<&[u32]>, i: usize| v.map_or(0, |v| v[if v.len() == 1 { 0 } else { i }]);
     match fun {
-        M::Dot if kind == ScalarKind::Float => {
-            let b = b?;
-            // Sequential sum of products, no fused multiply-add; starting from the first
-            // product, not from +0, so that products that are all -0 sum to -0.
-            let sum = (1..comps).fold(f(a[0]) * f(b[0]), |acc, i| acc + f(a[i]) * f(b[i]));
-            Some(smallvec![sum.to_bits()])
-        }
+        M::Dot if kind == ScalarKind::Float => Some(smallvec![dot(&a[..comps], &b?[..comps]).to_bits()]),
         M::Dot => {
             let b = b?;
             Some(smallvec![(0..comps).fold(0u32, |acc, i| acc.wrapping_add(a[i].wrapping_mul(b[i])))])
@@ -209,6 +211,39 @@ fn math(
                 (x(2) * y(0) - x(0) * y(2)).to_bits(),
                 (x(0) * y(1) - x(1) * y(0)).to_bits(),
             ])
+        }
+        M::Reflect => {
+            // e1 - 2 dot(e2, e1) e2
+            let b = b?;
+            let d = dot(&b[..comps], &a[..comps]);
+            Some((0..comps).map(|i| (f(a[i]) - 2.0 * d * f(b[i])).to_bits()).collect())
+        }
+        M::Refract => {
+            // k = 1 - η² (1 - dot(e2, e1)²); k < 0: the zero vector; else
+            // η e1 - (η dot(e2, e1) + sqrt(k)) e2.
+            let (b, eta) = (b?, f(c?[0]));
+            let d = dot(&b[..comps], &a[..comps]);
+            let k = 1.0 - eta * eta * (1.0 - d * d);
+            if k < 0.0 {
+                return Some((0..comps).map(|_| 0.0f32.to_bits()).collect());
+            }
+            let scale = eta * d + k.sqrt();
+            Some((0..comps).map(|i| (eta * f(a[i]) - scale * f(b[i])).to_bits()).collect())
+        }
+        M::FaceForward => {
+            // e1 if dot(e2, e3) < 0, else -e1.
+            let (b, c) = (b?, c?);
+            let keep = dot(&b[..comps], &c[..comps]) < 0.0;
+            Some(a[..comps].iter().map(|&x| if keep { x } else { (-f(x)).to_bits() }).collect())
+        }
+        M::Dot4I8Packed | M::Dot4U8Packed => {
+            let b = b?;
+            let signed = fun == M::Dot4I8Packed;
+            let byte = |word: u32, i: u32| {
+                let byte = (word >> (8 * i)) & 0xff;
+                if signed { byte as u8 as i8 as i32 as u32 } else { byte }
+            };
+            Some(smallvec![(0..4).fold(0u32, |acc, i| acc.wrapping_add(byte(a[0], i).wrapping_mul(byte(b[0], i))))])
         }
         M::ExtractBits | M::InsertBits => {
             (0..comps).map(|i| arith::bits(fun, kind, a[i], pick(b, i), pick(c, i), pick(d, i))).collect()
@@ -650,7 +685,8 @@ impl Compiler<'_> {
             Expression::CallResult(_)
             | Expression::AtomicResult { .. }
             | Expression::WorkGroupUniformLoadResult { .. }
-            | Expression::SubgroupOperationResult { .. } => {
+            | Expression::SubgroupOperationResult { .. }
+            | Expression::SubgroupBallotResult => {
                 self.reg(scope, handle);
             }
             // Pre-emitted when the scope opens.

@@ -218,6 +218,27 @@ pub(super) struct GatherInsn {
     pub result: Reg,
 }
 
+/// What a subgroup collective computes over the lanes of a subgroup.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum CollectiveFun {
+    /// `subgroupBallot`: bit `lane` of a `vec4<u32>` set where the predicate holds
+    /// (every lane when there is no predicate).
+    Ballot { predicate: Option<Reg> },
+    /// `subgroupAll`, `subgroupAdd`, `subgroupInclusiveMul`, ...: the operator over the
+    /// subgroup (reduce) or over the lanes up to this one (inclusive or exclusive scan),
+    /// component-wise, lane by lane in order.
+    Operation { op: naga::SubgroupOperation, collective: naga::CollectiveOperation, kind: naga::ScalarKind },
+}
+
+/// A subgroup collective operation: every invocation of the workgroup stops here and
+/// each receives the result over its subgroup.
+pub(super) struct CollectiveInsn {
+    pub fun: CollectiveFun,
+    pub argument: Reg,
+    pub len: u32,
+    pub result: Reg,
+}
+
 /// One bytecode instruction. Unless said otherwise operands are registers, `n` counts
 /// components, and a `s*` stride is 1 for a vector operand and 0 for a scalar one
 /// broadcast over the components.
@@ -299,6 +320,8 @@ pub(super) enum Insn {
     Atomic(Box<AtomicInsn>),
     /// Subgroup gather.
     Gather(Box<GatherInsn>),
+    /// Subgroup ballot, reduction or scan.
+    Collective(Box<CollectiveInsn>),
     /// An unsupported construct reached at run time: (what, WGSL line).
     Fail(Box<(String, u32)>),
 }

@@ -298,7 +298,7 @@ pub(super) fn run(
                         }
                     }
                 }
-                Insn::Barrier | Insn::Gather(_) => {
+                Insn::Barrier | Insn::Gather(_) | Insn::Collective(_) => {
                     frame.pc = pc as u32 - 1;
                     break 'frames Ok(Stop::Sync(code_index, pc as u32 - 1));
                 }

@@ -26,12 +26,14 @@
 //! binary16; in buffers at naga's two bytes each, converted on load and store; f16
 //! matrices are refused by name), vectors, matrices as values, fixed and
 //! runtime-sized arrays, structs, pointers, function calls, loops with `continuing` and
-//! `break if`, `switch`, atomics, barriers, `workgroupUniformLoad`, subgroup shuffles and
-//! broadcasts, the compute builtins, matrix arithmetic, and most math functions
-//! (`modf` and `frexp` with their result structs; `pack2x16float`, `unpack2x16float`
-//! and `quantizeToF16` through IEEE binary16, rounding to nearest even, keeping
-//! denormals). Anything else is an error naming the construct and its WGSL line, never
-//! a panic.
+//! `break if`, `switch`, atomics, barriers, `workgroupUniformLoad`, subgroup shuffles,
+//! broadcasts, ballots, reductions and inclusive/exclusive scans (32-bit and bool
+//! operands; lanes combined in lane order), the compute builtins, matrix arithmetic, and
+//! every WGSL math builtin on f32 (`modf` and `frexp` with their result structs;
+//! `pack2x16float`, `unpack2x16float` and `quantizeToF16` through IEEE binary16,
+//! rounding to nearest even, keeping denormals; `ldexp` exact up to one rounding;
+//! `reflect`, `refract`, `faceForward`, `dot4I8Packed`/`dot4U8Packed`). Anything else is
+//! an error naming the construct and its WGSL line, never a panic.
 
 mod arith;
 mod decode;

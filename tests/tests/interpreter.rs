@@ -543,6 +543,52 @@ fn subgroup_ballots_reductions_and_scans_agree_with_lavapipe_bit_for_bit() {
     }
 }
 
+const STRUCT_ARGUMENTS: &str = r#"
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+
+struct Ids {
+    @builtin(local_invocation_index) index: u32,
+    @builtin(global_invocation_id) global: vec3<u32>,
+    @builtin(workgroup_id) group: vec3<u32>,
+}
+struct Counts { @builtin(num_workgroups) groups: vec3<u32> }
+
+@compute @workgroup_size(4, 2, 1)
+fn main(ids: Ids, @builtin(local_invocation_id) local: vec3<u32>, counts: Counts) {
+    let flat = ids.global.x + ids.global.y * 4u * counts.groups.x;
+    let o = flat * 8u;
+    output[o] = ids.index;
+    output[o + 1u] = ids.global.x;
+    output[o + 2u] = ids.global.y;
+    output[o + 3u] = ids.group.x * 100u + ids.group.y;
+    output[o + 4u] = local.x + 10u * local.y;
+    output[o + 5u] = counts.groups.x * 10u + counts.groups.y;
+    output[o + 6u] = input[flat % arrayLength(&input)];
+    output[o + 7u] = ids.group.z + counts.groups.z;
+}
+"#;
+
+#[test]
+fn struct_entry_point_arguments_agree_with_lavapipe() {
+    let kernel = Kernel::from_wgsl("struct_arguments.wgsl", STRUCT_ARGUMENTS.into(), "main", false).unwrap();
+    let inputs: Vec<u32> = (0..16).map(|i| i * 7 + 1).collect();
+    let run = |backend: &mut dyn Backend| -> Vec<u32> {
+        let input = upload(backend, "input", &inputs).unwrap();
+        let output = backend.create_buffer("output", 3 * 4 * 2 * 2 * 8 * 4).unwrap();
+        backend.dispatch(&kernel, &[Bind::new(0, input), Bind::new(1, output)], [3, 2, 1]).unwrap();
+        download(backend, output).unwrap()
+    };
+    let got = run(&mut CpuBackend::new(CpuOptions::default()).unwrap());
+    // Invocation (global x 5, y 3): workgroup (1, 1), local (1, 1), index 5.
+    let o = (5 + 3 * 12) * 8;
+    assert_eq!(&got[o..o + 6], &[5, 5, 3, 101, 11, 32]);
+    let Some(mut gpu) = strata_tests::vulkan_backend("struct_entry_point_arguments_agree_with_lavapipe") else {
+        return;
+    };
+    assert_eq!(got, run(&mut gpu));
+}
+
 const HALF_AND_SPLIT: &str = r#"
 @group(0) @binding(0) var<storage, read> input: array<u32>;
 @group(0) @binding(1) var<storage, read_write> output: array<u32>;

@@ -230,8 +230,9 @@ pub(super) struct Program {
     pub entry: u32,
     /// Function names, for messages.
     pub names: Vec<String>,
-    /// Per entry-point argument: its builtin.
-    pub entry_arguments: Vec<naga::BuiltIn>,
+    /// Per entry-point argument: its builtins and their register offsets in it (one at
+    /// offset 0 for a builtin argument, one per member for a struct of builtins).
+    pub entry_arguments: Vec<Vec<(naga::BuiltIn, u32)>>,
     /// `@workgroup_size`.
     pub workgroup_size: [u32; 3],
     /// Words of workgroup memory.
@@ -913,12 +914,21 @@ pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> 
     }
     let entry_index = kernel.entry_index();
     let entry_point = &module.entry_points[entry_index];
+    // Each argument is a builtin or a struct of builtins (its members' register offsets).
     let entry_arguments = entry_point
         .function
         .arguments
         .iter()
-        .map(|argument| match argument.binding {
-            Some(naga::Binding::BuiltIn(builtin)) => Ok(builtin),
+        .map(|argument| match (&argument.binding, &module.types[argument.ty].inner) {
+            (Some(naga::Binding::BuiltIn(builtin)), _) => Ok(vec![(*builtin, 0)]),
+            (None, inner @ TypeInner::Struct { members, .. }) => members
+                .iter()
+                .enumerate()
+                .map(|(i, member)| match member.binding {
+                    Some(naga::Binding::BuiltIn(builtin)) => Ok((builtin, member_step(module, inner, i as u32, false))),
+                    _ => Err(unsupported("entry point struct members other than builtins", 0)),
+                })
+                .collect(),
             _ => Err(unsupported("entry point arguments other than builtins", 0)),
         })
         .collect::<Result<_, _>>()?;

@@ -100,9 +100,12 @@ fn entry_frame(program: &Program, b: &Builtins) -> Result<Frame, BackendError> {
     let code = &program.codes[program.entry as usize];
     let mut regs = code.template.clone();
     for &(argument, reg, len) in &code.arguments {
-        let value = builtin_value(program.entry_arguments[argument as usize], b)?;
-        let n = (len as usize).min(value.len());
-        regs[reg as usize..reg as usize + n].copy_from_slice(&value[..n]);
+        for &(builtin, offset) in &program.entry_arguments[argument as usize] {
+            let value = builtin_value(builtin, b)?;
+            let at = (reg + offset) as usize;
+            let n = (len.saturating_sub(offset) as usize).min(value.len());
+            regs[at..at + n].copy_from_slice(&value[..n]);
+        }
     }
     for &(reg, offset) in &code.local_pointers {
         regs[reg as usize] = FUNCTION;

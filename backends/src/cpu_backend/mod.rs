@@ -28,7 +28,8 @@
 //! runtime-sized arrays, structs, pointers, function calls, loops with `continuing` and
 //! `break if`, `switch`, atomics, barriers, `workgroupUniformLoad`, subgroup shuffles,
 //! broadcasts, ballots, reductions and inclusive/exclusive scans (32-bit and bool
-//! operands; lanes combined in lane order), the compute builtins, matrix arithmetic, and
+//! operands; lanes combined in lane order), the compute builtins (as arguments or as
+//! members of struct arguments), matrix arithmetic, and
 //! every WGSL math builtin on f32 (`modf` and `frexp` with their result structs;
 //! `pack2x16float`, `unpack2x16float` and `quantizeToF16` through IEEE binary16,
 //! rounding to nearest even, keeping denormals; `ldexp` exact up to one rounding;

@@ -18,5 +18,6 @@ pub mod sampler;
 pub mod scene;
 pub mod synthetic;
 pub mod trace_pass;
+pub mod variance;
 
 pub use histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};

@@ -339,9 +339,15 @@ fn run_and_report(
     let bar = indicatif::ProgressBar::new(total);
     let started = Instant::now();
     let mut write_error: Option<anyhow::Error> = None;
+    let shown: Vec<u32> = (0..args.frames).filter(|f| (f + 1).is_power_of_two() || f + 1 == args.frames).collect();
+    // Every seed's image of the shown frames, for the variance over seeds.
+    let mut seed_images: std::collections::HashMap<(Method, u32), Vec<RgbImage>> = Default::default();
     let errors =
         run_comparison(backend, gpu_scene, render, extent, comparison, references, |method, seed, frame, image| {
             bar.inc(1);
+            if args.seeds >= 3 && shown.contains(&frame) {
+                seed_images.entry((method, frame)).or_default().push(image.clone());
+            }
             // Images of the first seed: the first frame and every power of two.
             if seed == 1 && ((frame + 1).is_power_of_two() || frame + 1 == args.frames) {
                 let stem = args.out.join(format!("{}_frame{:03}", method.name(), frame + 1));
@@ -390,7 +396,6 @@ fn run_and_report(
         args.methods.len(),
         started.elapsed().as_secs_f64()
     );
-    let shown: Vec<u32> = (0..args.frames).filter(|f| (f + 1).is_power_of_two() || f + 1 == args.frames).collect();
     print!("{:<12}", "method");
     for f in &shown {
         print!(" | {:>20}", format!("frame {}", f + 1));
@@ -417,7 +422,65 @@ fn run_and_report(
             println!();
         }
     }
-    println!("wrote {}, {} and images in {}", csv.display(), plot.display(), args.out.display());
+    let mut wrote = format!("{}, {}", csv.display(), plot.display());
+    if args.seeds >= 3 {
+        let path = args.out.join("variance.csv");
+        print_variance(&args.methods, &shown, &seed_images, references, &path)?;
+        wrote += &format!(", {}", path.display());
+    }
+    println!("wrote {wrote} and images in {}", args.out.display());
+    Ok(())
+}
+
+/// The reference-free summary (`strata::variance`): each method's relative variance over
+/// seeds at the shown frames, strata's ratio to each baseline with its jackknife
+/// interval, and `variance.csv` (method, frame, relvar, and vs_restir / vs_restir_disc
+/// ratio ± half-width for strata).
+fn print_variance(
+    methods: &[Method],
+    shown: &[u32],
+    seed_images: &std::collections::HashMap<(Method, u32), Vec<RgbImage>>,
+    references: &[RgbImage],
+    path: &std::path::Path,
+) -> Result<()> {
+    use strata::variance::{relative_variance, variance_ratio};
+    let reference = |frame: u32| references.get(frame as usize).unwrap_or(&references[0]);
+    let images = |method: Method, frame: u32| seed_images.get(&(method, frame)).map_or(&[][..], |v| &v[..]);
+    println!("relative variance over seeds (reference-free RelMSE; ratio ± 95% jackknife interval):");
+    let mut csv =
+        String::from("method,frame,relvar,vs_restir,vs_restir_half_width,vs_restir_disc,vs_restir_disc_half_width\n");
+    for &method in methods {
+        print!("{:<12}", method.name());
+        for &f in shown {
+            let value = relative_variance(images(method, f), reference(f))?;
+            print!(" | {:>20}", format!("{value:.4e}"));
+            let mut ratios = String::new();
+            for baseline in [Method::Restir, Method::RestirDisc] {
+                if method == Method::Strata && methods.contains(&baseline) {
+                    let r = variance_ratio(images(method, f), images(baseline, f), reference(f))?;
+                    ratios += &format!(",{:.4},{:.4}", r.mean, r.half_width);
+                } else {
+                    ratios += ",,";
+                }
+            }
+            csv += &format!("{},{},{value:.6e}{ratios}\n", method.name(), f + 1);
+        }
+        println!();
+    }
+    if methods.contains(&Method::Strata) {
+        for baseline in [Method::Restir, Method::RestirDisc] {
+            if !methods.contains(&baseline) {
+                continue;
+            }
+            print!("{:<12}", format!("÷ {}", baseline.name()));
+            for &f in shown {
+                let r = variance_ratio(images(Method::Strata, f), images(baseline, f), reference(f))?;
+                print!(" | {:>20}", format!("{:.3} ± {:.3}", r.mean, r.half_width));
+            }
+            println!();
+        }
+    }
+    std::fs::write(path, csv).with_context(|| format!("{}: cannot write", path.display()))?;
     Ok(())
 }
 

@@ -56,9 +56,16 @@ pub enum MetricError {
         /// Row.
         y: u32,
     },
+    /// A variance over seeds needs at least three of them.
+    #[error("a variance over seeds needs at least 3 seeds, got {0}")]
+    TooFewSeeds(usize),
+    /// Two methods' seed counts differ.
+    #[error("{0} seeds against {1}: the methods must run from the same seeds")]
+    SeedCounts(usize, usize),
 }
 
-fn check(image: &RgbImage, reference: &RgbImage) -> Result<(), MetricError> {
+/// Both images have the same, non-zero size and only finite values.
+pub(crate) fn check(image: &RgbImage, reference: &RgbImage) -> Result<(), MetricError> {
     if (image.width, image.height) != (reference.width, reference.height) {
         return Err(MetricError::Size(image.width, image.height, reference.width, reference.height));
     }

@@ -454,3 +454,137 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
 "
     )
 }
+
+/// Workgroup sizes [`barrier_program`] picks from.
+const BARRIER_SIZES: [u32; 9] = [1, 2, 7, 32, 63, 64, 100, 128, 256];
+
+/// The operation each element of a barrier program's `totals` gets, whichever workgroup
+/// or phase applies it (so that the order between workgroups does not matter), and the
+/// element's initial value.
+pub const TOTALS: [(&str, u32); 8] = [
+    ("atomicAdd", 0),
+    ("atomicAdd", 0),
+    ("atomicXor", 0),
+    ("atomicOr", 0),
+    ("atomicMax", 0),
+    ("atomicMin", u32::MAX),
+    ("atomicAnd", u32::MAX),
+    ("atomicSub", 0),
+];
+
+/// A random integer compute program exchanging data between invocations through
+/// `var<workgroup>` memory and storage memory across `workgroupBarrier`,
+/// `storageBarrier` and `workgroupUniformLoad`, with atomics on workgroup and storage
+/// memory (including a `atomicCompareExchangeWeak` loop), all in uniform control flow
+/// and schedule-independent: every read of shared memory comes after a barrier that
+/// follows the writes it sees, every atomic is used commutatively and its result read
+/// only after a barrier. Returns the source and its workgroup size S; the program runs
+/// on any number W of workgroups with bindings 0: `input`, W·S words; 1: `output`,
+/// 2·W·S words (the second half is scratch); 2: `totals`, 8 atomics initialised as
+/// [`TOTALS`] says.
+pub fn barrier_program(seed: u64) -> (String, u32) {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let size = BARRIER_SIZES[rng.random_range(0..BARRIER_SIZES.len())];
+    let pow2 = size.next_power_of_two();
+    let mut body = String::new();
+    let ops = ["+", "^", "|", "*"];
+    for _ in 0..rng.random_range(3..9) {
+        let op = ops[rng.random_range(0..ops.len())];
+        match rng.random_range(0..8) {
+            0 => {
+                let (p, r) = (rng.random_range(1..300u32), rng.random_range(0..300u32));
+                body.push_str(&format!(
+                    "    a[l] = x;\n    workgroupBarrier();\n    x = x {op} a[(l * {p}u + {r}u) % S];\n    workgroupBarrier();\n"
+                ));
+            }
+            1 => body.push_str(&format!(
+                "    a[l] = x;
+    workgroupBarrier();
+    for (var s = {half}u; s > 0u; s >>= 1u) {{
+        if l < s && l + s < S {{
+            a[l] = a[l] {op} a[l + s];
+        }}
+        workgroupBarrier();
+    }}
+    x = (x ^ a[0]) + l;
+    workgroupBarrier();
+",
+                half = pow2 / 2
+            )),
+            2 => {
+                let f = ["atomicAdd", "atomicMax", "atomicMin", "atomicXor", "atomicOr", "atomicAnd", "atomicSub"];
+                let f = f[rng.random_range(0..f.len())];
+                let k = rng.random_range(0..4);
+                body.push_str(&format!(
+                    "    {f}(&counters[{k}], x);\n    workgroupBarrier();\n    x = x * 3u + atomicLoad(&counters[{k}]);\n    workgroupBarrier();\n"
+                ));
+            }
+            3 => {
+                let k = rng.random_range(0..4);
+                body.push_str(&format!(
+                    "    {{
+        var old = atomicLoad(&counters[{k}]);
+        for (var t = 0u; t < 1000000u; t++) {{
+            let r = atomicCompareExchangeWeak(&counters[{k}], old, old + (x & 1023u));
+            if r.exchanged {{ break; }}
+            old = r.old_value;
+        }}
+    }}
+    workgroupBarrier();
+    x ^= atomicLoad(&counters[{k}]);
+    workgroupBarrier();
+"
+                ));
+            }
+            4 => body.push_str(&format!(
+                "    if l == {leader}u {{ shared_value = x % 4u + 1u; }}
+    let u{seed_step} = workgroupUniformLoad(&shared_value);
+    for (var i = 0u; i < u{seed_step}; i++) {{
+        a[l] = x;
+        workgroupBarrier();
+        x = x {op} a[(l + i + 1u) % S];
+        workgroupBarrier();
+    }}
+    workgroupBarrier();
+",
+                leader = rng.random_range(0..size),
+                seed_step = body.len()
+            )),
+            5 => body.push_str(&format!(
+                "    output[n + gid.x] = x;\n    storageBarrier();\n    x = x {op} output[n + wg.x * S + (l + {r}u) % S];\n    storageBarrier();\n",
+                r = rng.random_range(0..size)
+            )),
+            6 => {
+                let k = rng.random_range(0..TOTALS.len());
+                body.push_str(&format!("    {}(&totals[{k}], x);\n", TOTALS[k].0));
+            }
+            _ => body.push_str("    if x % 3u == 0u { x = x * 2654435761u; } else { x = (x >> 3u) ^ l; }\n"),
+        }
+    }
+    let source = format!(
+        "const S: u32 = {size}u;
+
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+@group(0) @binding(2) var<storage, read_write> totals: array<atomic<u32>, 8>;
+
+var<workgroup> a: array<u32, S>;
+var<workgroup> counters: array<atomic<u32>, 4>;
+var<workgroup> shared_value: u32;
+
+@compute @workgroup_size(S)
+fn main(@builtin(local_invocation_index) l: u32, @builtin(global_invocation_id) gid: vec3<u32>,
+        @builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {{
+    let n = groups.x * S;
+    var x = input[gid.x];
+    if l == 0u {{
+        for (var k = 0u; k < 4u; k++) {{ atomicStore(&counters[k], k * 77u); }}
+    }}
+    workgroupBarrier();
+{body}    atomicAdd(&totals[0], x);
+    output[gid.x] = x;
+}}
+"
+    );
+    (source, size)
+}

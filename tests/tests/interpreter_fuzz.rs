@@ -6,7 +6,7 @@ use strata_backends::backend::{download, upload};
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_backends::{Backend, Bind};
 use strata_kernels::Kernel;
-use strata_tests::wgsl_fuzz::{FloatMode, float_program, integer_program};
+use strata_tests::wgsl_fuzz::{FloatMode, TOTALS, barrier_program, float_program, integer_program};
 
 fn run(backend: &mut dyn Backend, kernel: &Kernel, inputs: &[u32]) -> Vec<u32> {
     run_sized(backend, kernel, inputs, inputs.len())
@@ -232,6 +232,56 @@ fn generated_general_float_programs_never_crash_the_interpreter() {
     }
 }
 
+/// Runs a [`barrier_program`] on `groups` workgroups of `size`: (output, totals).
+fn run_barrier(backend: &mut dyn Backend, kernel: &Kernel, size: u32, groups: u32) -> (Vec<u32>, Vec<u32>) {
+    let n = (size * groups) as usize;
+    let mut state = 0x1234_5678_u32 ^ size;
+    let inputs: Vec<u32> = (0..n)
+        .map(|_| {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            state
+        })
+        .collect();
+    let initial: Vec<u32> = TOTALS.iter().map(|&(_, value)| value).collect();
+    let input = upload(backend, "input", &inputs).unwrap();
+    let output = backend.create_buffer("output", (n * 8) as u64).unwrap();
+    let totals = upload(backend, "totals", &initial).unwrap();
+    backend
+        .dispatch(kernel, &[Bind::new(0, input), Bind::new(1, output), Bind::new(2, totals)], [groups, 1, 1])
+        .unwrap();
+    let result = (download(backend, output).unwrap(), download(backend, totals).unwrap());
+    for buffer in [input, output, totals] {
+        backend.destroy_buffer(buffer).unwrap();
+    }
+    result
+}
+
+#[test]
+fn generated_barrier_programs_agree_with_lavapipe() {
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let mut gpu = strata_tests::vulkan_backend("generated_barrier_programs_agree_with_lavapipe");
+    for seed in 0..program_count(40) {
+        let (source, size) = barrier_program(seed);
+        let groups = 1 + (seed % 4) as u32;
+        let kernel = Kernel::from_wgsl(&format!("barrier-{seed}.wgsl"), source.clone(), "main", false)
+            .unwrap_or_else(|e| panic!("barrier program {seed} is invalid WGSL: {e}\n{source}"));
+        let got = run_barrier(&mut cpu, &kernel, size, groups);
+        if let Some(gpu) = gpu.as_mut() {
+            let want = run_barrier(gpu, &kernel, size, groups);
+            if let Some(i) = (0..want.0.len()).find(|&i| got.0[i] != want.0[i]) {
+                panic!(
+                    "barrier program {seed} (S = {size}, {groups} groups): output[{i}] = {:#x} on the interpreter, \
+                     {:#x} on lavapipe\n{source}",
+                    got.0[i], want.0[i]
+                );
+            }
+            assert_eq!(got.1, want.1, "barrier program {seed} (S = {size}, {groups} groups): totals\n{source}");
+        }
+    }
+}
+
 #[test]
 fn generated_programs_use_every_construct() {
     let programs: String = (0..40).map(integer_program).collect();
@@ -268,6 +318,27 @@ fn generated_programs_use_every_construct() {
     }
     for construct in ["exp(", "log(", "sin(", "cos(", "pow(", "atan2("] {
         assert!(!exact.contains(construct), "`{construct}` in an exact float program");
+    }
+    let barrier: String = (0..40).map(|seed| barrier_program(seed).0).collect();
+    for construct in [
+        "workgroupBarrier()",
+        "storageBarrier()",
+        "workgroupUniformLoad(",
+        "atomicCompareExchangeWeak(",
+        "atomicAdd(&counters",
+        "atomicMax(&counters",
+        "atomicMin(&counters",
+        "atomicXor(&counters",
+        "atomicAdd(&totals",
+        "atomicMax(&totals",
+        "atomicMin(&totals",
+        "atomicXor(&totals",
+        "for (var s = ",
+        "@workgroup_size(S)",
+        "const S: u32 = 1u;",
+        "const S: u32 = 256u;",
+    ] {
+        assert!(barrier.contains(construct), "no `{construct}` in 40 barrier programs");
     }
     let general: String = (0..200).map(|seed| float_program(seed, FloatMode::General)).collect();
     for construct in [

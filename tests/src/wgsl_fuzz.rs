@@ -317,6 +317,11 @@ impl FloatGenerator {
                     "abs",
                     "sign",
                     "saturate",
+                    "radians",
+                    "degrees",
+                    "asinh",
+                    "acosh",
+                    "atanh",
                 ]);
                 format!("{f}({a})")
             }
@@ -330,6 +335,10 @@ impl FloatGenerator {
                     "normalize(w).y",
                     "dot(w, w)",
                     "distance(w, vec3<f32>(1.0f, 2.0f, 3.0f))",
+                    "reflect(w, vec3<f32>(0.0f, 1.0f, 0.0f)).x",
+                    "refract(normalize(w), vec3<f32>(0.0f, 1.0f, 0.0f), 0.7f).y",
+                    "faceForward(w, w, vec3<f32>(1.0f, 0.0f, 0.0f)).z",
+                    "ldexp(w.x, i32(w.y) % 64)",
                 ]);
                 format!("({a} + {f})")
             }

@@ -457,7 +457,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
 }
 
 #[test]
-#[ignore = "the interpreter rejects asinh, acosh, atanh, degrees, radians, ldexp, reflect, faceForward, refract: left to the cpu_backend owners"]
 fn every_float_math_builtin_runs_on_the_interpreter() {
     let unsupported = unsupported_float_builtins();
     assert!(unsupported.is_empty(), "the interpreter rejects:\n{}", unsupported.join("\n"));

@@ -4,8 +4,9 @@
 //! For an unbiased method the expected RelMSE against a reference r is
 //! `mean over pixels of (Var f + (E f − r)²) / (r + 1e-4)`: the method's variance plus
 //! the reference's own error, which is the same for every method. Where the reference
-//! is grainy (veach-ajar's 8192-spp Mitsuba image has fireflies) that shared term
-//! dominates and pulls every RelMSE ratio towards 1. The relative variance measured
+//! is grainy that shared term can dominate and pull every RelMSE ratio towards 1 (on
+//! veach-ajar it turned out not to: its RelMSE is the methods' own variance). The
+//! relative variance measured
 //! across seeds, `mean of s² / (r + 1e-4)` with `s²` the unbiased sample variance of
 //! the seeds' images per pixel and channel, leaves it out; the reference only scales
 //! each pixel, exactly as in RelMSE.

@@ -1,0 +1,497 @@
+//! Realistic compute workloads of the kinds engines and public samples run — a tiled
+//! matrix multiply, a two-level prefix sum, a histogram with reductions, a separable
+//! blur, an n-body step, Collatz step counts and a Mandelbrot set — each run on the CPU
+//! interpreter, on wgpu (lavapipe) and on ash. The interpreter must give exactly what a
+//! small Rust reference computes in the same order; the Vulkan backends must agree with
+//! the interpreter bit for bit on integer outputs and within a stated ULP bound on float
+//! outputs (a GPU may contract a multiply and an add into a fused multiply-add). Wall
+//! times per backend are printed (not asserted).
+
+use std::time::Instant;
+
+use strata::check::{Agreement, Compare, Output, compare_outputs};
+use strata_backends::ash_backend::{AshBackend, AshOptions, SpirvSource};
+use strata_backends::backend::{download, upload};
+use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
+use strata_backends::{Backend, BackendError, Bind, BufferId, gpu_required};
+use strata_kernels::Kernel;
+
+fn kernel(path: &str, source: &str) -> Kernel {
+    Kernel::from_wgsl(path, source.into(), "main", false).unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
+fn open_ash(test: &str) -> Option<AshBackend> {
+    match AshBackend::new(AshOptions { validation: true, source: SpirvSource::Naga, subgroups: false }) {
+        Ok(backend) => Some(backend),
+        Err(error @ BackendError::NoAdapter { .. }) if !gpu_required() => {
+            eprintln!("SKIPPED {test} on ash: {error} (set STRATA_REQUIRE_GPU=1 to make this a failure)");
+            None
+        }
+        Err(error) => panic!("{test}: ash backend: {error}"),
+    }
+}
+
+/// Runs `run` on the interpreter, then on wgpu and ash when there is a Vulkan device;
+/// returns (backend, output words) with the interpreter first, and prints wall times
+/// (wgpu twice: the first run includes pipeline creation).
+fn run_everywhere(test: &str, run: impl Fn(&mut dyn Backend) -> Vec<u32>) -> Vec<(&'static str, Vec<u32>)> {
+    let mut results = Vec::new();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let start = Instant::now();
+    results.push(("interpreter", run(&mut cpu)));
+    let interpreter = start.elapsed();
+    let Some(mut wgpu) = strata_tests::vulkan_backend(test) else {
+        eprintln!("{test}: interpreter {:.1} ms", interpreter.as_secs_f64() * 1e3);
+        return results;
+    };
+    let start = Instant::now();
+    results.push(("wgpu", run(&mut wgpu)));
+    let wgpu_first = start.elapsed();
+    let start = Instant::now();
+    let again = run(&mut wgpu);
+    let wgpu_second = start.elapsed();
+    assert_eq!(again, results[1].1, "{test}: wgpu gives the same output twice");
+    if let Some(mut ash) = open_ash(test) {
+        let start = Instant::now();
+        results.push(("ash", run(&mut ash)));
+        let ash_time = start.elapsed();
+        let messages = ash.validation_messages();
+        assert!(messages.is_empty(), "{test}: validation layer:\n{}", messages.join("\n"));
+        eprintln!("{test}: ash (lavapipe) {:.1} ms", ash_time.as_secs_f64() * 1e3);
+    }
+    eprintln!(
+        "{test}: interpreter {:.1} ms, wgpu (lavapipe) {:.1} ms first / {:.1} ms second run",
+        interpreter.as_secs_f64() * 1e3,
+        wgpu_first.as_secs_f64() * 1e3,
+        wgpu_second.as_secs_f64() * 1e3
+    );
+    results
+}
+
+/// Compares the interpreter's words with another backend's under `compare`.
+fn agree(test: &str, backend: &str, interpreter: &[u32], other: &[u32], compare: Compare) -> Agreement {
+    let got = [Output { name: "out", words: interpreter.to_vec(), compare: Compare::Exact }];
+    let want = [Output { name: "out", words: other.to_vec(), compare }];
+    let agreement =
+        compare_outputs(&got, &want).unwrap_or_else(|mismatch| panic!("{test}: interpreter vs {backend}: {mismatch}"));
+    eprintln!(
+        "{test}: interpreter vs {backend}: max {} ULP, {} of {} floats beyond the bound",
+        agreement.max_ulp, agreement.outside, agreement.floats
+    );
+    agreement
+}
+
+/// Checks the interpreter (first result) against the reference bit for bit, then every
+/// other backend against the interpreter under `compare`.
+fn check(test: &str, results: &[(&'static str, Vec<u32>)], reference: &[u32], compare: Compare) {
+    let (_, interpreter) = &results[0];
+    assert_eq!(interpreter.len(), reference.len(), "{test}: output length");
+    let differing: Vec<usize> = (0..reference.len()).filter(|&i| interpreter[i] != reference[i]).collect();
+    assert!(
+        differing.is_empty(),
+        "{test}: the interpreter differs from the Rust reference at {} of {} words, first at {}: {:#x} vs {:#x}",
+        differing.len(),
+        reference.len(),
+        differing[0],
+        interpreter[differing[0]],
+        reference[differing[0]]
+    );
+    for (backend, words) in &results[1..] {
+        agree(test, backend, interpreter, words, compare);
+    }
+}
+
+fn bits(values: &[f32]) -> Vec<u32> {
+    values.iter().map(|v| v.to_bits()).collect()
+}
+
+/// A small deterministic generator (PCG-like LCG, high bits).
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u32 {
+        self.0 = self.0.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+        (self.0 >> 32) as u32
+    }
+
+    fn unit(&mut self) -> f32 {
+        (self.next() >> 8) as f32 / (1u32 << 24) as f32
+    }
+
+    fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.unit()
+    }
+}
+
+fn dispatch(backend: &mut dyn Backend, kernel: &Kernel, buffers: &[BufferId], workgroups: [u32; 3]) {
+    let binds: Vec<Bind> = buffers.iter().enumerate().map(|(i, &b)| Bind::new(i as u32, b)).collect();
+    backend.dispatch(kernel, &binds, workgroups).unwrap();
+}
+
+fn destroy(backend: &mut dyn Backend, buffers: &[BufferId]) {
+    for &buffer in buffers {
+        backend.destroy_buffer(buffer).unwrap();
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// 1. Tiled matrix multiply.
+
+const MATMUL: &str = include_str!("../data/workloads/matmul.wgsl");
+
+/// C = A * B summed as the kernel does: k in order, padded with zero products up to a
+/// multiple of 16.
+fn matmul_reference(m: usize, k: usize, n: usize, a: &[f32], b: &[f32]) -> Vec<f32> {
+    let mut c = vec![0.0f32; m * n];
+    for row in 0..m {
+        for col in 0..n {
+            let mut acc = 0.0f32;
+            for kk in 0..k.div_ceil(16) * 16 {
+                let (va, vb) = if kk < k { (a[row * k + kk], b[kk * n + col]) } else { (0.0, 0.0) };
+                acc += va * vb;
+            }
+            c[row * n + col] = acc;
+        }
+    }
+    c
+}
+
+#[test]
+fn tiled_matrix_multiply_agrees_with_the_reference_and_lavapipe() {
+    let kernel = kernel("matmul.wgsl", MATMUL);
+    for (m, k, n) in [(64usize, 48usize, 80usize), (61, 45, 77)] {
+        let test = format!("matmul {m}x{k} * {k}x{n}");
+        let mut rng = Rng((m * k * n) as u64);
+        // Positive inputs: no cancellation, so a fused multiply-add on the GPU moves a
+        // sum by a few ULPs at most.
+        let a: Vec<f32> = (0..m * k).map(|_| rng.range(0.0, 1.0)).collect();
+        let b: Vec<f32> = (0..k * n).map(|_| rng.range(0.0, 2.0)).collect();
+        let reference = bits(&matmul_reference(m, k, n, &a, &b));
+        let results = run_everywhere(&test, |backend| {
+            let dims = upload(backend, "dims", &[m as u32, k as u32, n as u32, 0]).unwrap();
+            let a = upload(backend, "a", &a).unwrap();
+            let b = upload(backend, "b", &b).unwrap();
+            let c = backend.create_buffer("c", (m * n * 4) as u64).unwrap();
+            dispatch(backend, &kernel, &[dims, a, b, c], [n.div_ceil(16) as u32, m.div_ceil(16) as u32, 1]);
+            let words = download(backend, c).unwrap();
+            destroy(backend, &[dims, a, b, c]);
+            words
+        });
+        // 48 products per output; contraction skips one rounding per step, a relative
+        // error of about 2^-24 each: 8 ULP is ample.
+        check(&test, &results, &reference, Compare::Float { ulp: 8, max_outside: 0.0 });
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// 2. Two-level prefix sum.
+
+const SCAN_BLOCKS: &str = include_str!("../data/workloads/scan_blocks.wgsl");
+const ADD_OFFSETS: &str = include_str!("../data/workloads/add_offsets.wgsl");
+
+#[test]
+fn two_level_prefix_sum_is_exact_on_every_backend() {
+    let scan = kernel("scan_blocks.wgsl", SCAN_BLOCKS);
+    let add = kernel("add_offsets.wgsl", ADD_OFFSETS);
+    let count = 256usize * 37 + 100;
+    let blocks = count.div_ceil(256);
+    let mut rng = Rng(7);
+    // 20-bit values: the running sum wraps around u32 several times.
+    let input: Vec<u32> = (0..count).map(|_| rng.next() >> 12).collect();
+    let reference: Vec<u32> = input
+        .iter()
+        .scan(0u32, |sum, &v| {
+            *sum = sum.wrapping_add(v);
+            Some(*sum)
+        })
+        .collect();
+    let results = run_everywhere("prefix sum", |backend| {
+        let params = upload(backend, "params", &[count as u32, 0, 0, 0]).unwrap();
+        let block_params = upload(backend, "block params", &[blocks as u32, 0, 0, 0]).unwrap();
+        let input = upload(backend, "input", &input).unwrap();
+        let out = backend.create_buffer("out", (count * 4) as u64).unwrap();
+        let sums = backend.create_buffer("block sums", (blocks * 4) as u64).unwrap();
+        let scanned = backend.create_buffer("scanned sums", (blocks * 4) as u64).unwrap();
+        let total = backend.create_buffer("total", 4).unwrap();
+        dispatch(backend, &scan, &[params, input, out, sums], [blocks as u32, 1, 1]);
+        dispatch(backend, &scan, &[block_params, sums, scanned, total], [1, 1, 1]);
+        dispatch(backend, &add, &[params, scanned, out], [blocks as u32, 1, 1]);
+        let mut words = download(backend, out).unwrap();
+        words.extend(download::<u32>(backend, total).unwrap());
+        destroy(backend, &[params, block_params, input, out, sums, scanned, total]);
+        words
+    });
+    let mut want = reference.clone();
+    want.push(*reference.last().unwrap());
+    check("prefix sum", &results, &want, Compare::Exact);
+}
+
+// ---------------------------------------------------------------------------------------
+// 3. Histogram and reductions.
+
+const HISTOGRAM: &str = include_str!("../data/workloads/histogram.wgsl");
+
+#[test]
+fn histogram_and_reductions_are_exact_on_every_backend() {
+    let kernel = kernel("histogram.wgsl", HISTOGRAM);
+    let count = 40_000usize;
+    let mut rng = Rng(99);
+    // Skewed: low bins are much fuller than high ones, so workgroup atomics contend.
+    let values: Vec<u32> = (0..count)
+        .map(|_| {
+            let x = rng.next();
+            x >> (x & 15)
+        })
+        .collect();
+    let mut want = vec![0u32; 256];
+    for v in &values {
+        want[((v >> 8) & 255) as usize] += 1;
+    }
+    want.push(*values.iter().max().unwrap());
+    want.push(*values.iter().min().unwrap());
+    want.push(values.iter().fold(0u32, |s, v| s.wrapping_add(*v)));
+    want.push(0);
+    let results = run_everywhere("histogram", |backend| {
+        let params = upload(backend, "params", &[count as u32, 0, 0, 0]).unwrap();
+        let input = upload(backend, "values", &values).unwrap();
+        let bins = backend.create_buffer("bins", 256 * 4).unwrap();
+        let stats = upload(backend, "stats", &[0, u32::MAX, 0, 0]).unwrap();
+        dispatch(backend, &kernel, &[params, input, bins, stats], [16, 1, 1]);
+        let mut words = download(backend, bins).unwrap();
+        words.extend(download::<u32>(backend, stats).unwrap());
+        destroy(backend, &[params, input, bins, stats]);
+        words
+    });
+    check("histogram", &results, &want, Compare::Exact);
+}
+
+// ---------------------------------------------------------------------------------------
+// 4. Separable Gaussian blur.
+
+const BLUR: &str = include_str!("../data/workloads/blur.wgsl");
+const BLUR_WEIGHTS: [f32; 9] =
+    [0.00390625, 0.03125, 0.109375, 0.21875, 0.2734375, 0.21875, 0.109375, 0.03125, 0.00390625];
+
+fn blur_pass(src: &[f32], width: usize, height: usize, direction: u32) -> Vec<f32> {
+    let (length, across_count) = if direction == 0 { (width, height) } else { (height, width) };
+    let pixel =
+        |along: usize, across: usize| if direction == 0 { across * width + along } else { along * width + across };
+    let mut dst = vec![0.0f32; width * height];
+    for across in 0..across_count {
+        for along in 0..length {
+            let mut sum = 0.0f32;
+            for (j, weight) in BLUR_WEIGHTS.iter().enumerate() {
+                let a = (along as i64 + j as i64 - 4).clamp(0, length as i64 - 1) as usize;
+                sum += weight * src[pixel(a, across)];
+            }
+            dst[pixel(along, across)] = sum;
+        }
+    }
+    dst
+}
+
+#[test]
+fn separable_blur_agrees_with_the_reference_and_lavapipe() {
+    let kernel = kernel("blur.wgsl", BLUR);
+    let (width, height) = (157usize, 75usize);
+    let mut rng = Rng(3);
+    // A smooth gradient with noise and a bright square: edges exercise clamp-to-edge.
+    let image: Vec<f32> = (0..width * height)
+        .map(|i| {
+            let (x, y) = (i % width, i / width);
+            let square = if (40..70).contains(&x) && (20..50).contains(&y) { 4.0 } else { 0.0 };
+            x as f32 / width as f32 + y as f32 / height as f32 + square + rng.range(0.0, 0.5)
+        })
+        .collect();
+    let reference = bits(&blur_pass(&blur_pass(&image, width, height, 0), width, height, 1));
+    let results = run_everywhere("blur", |backend| {
+        let horizontal = upload(backend, "horizontal", &[width as u32, height as u32, 0, 0]).unwrap();
+        let vertical = upload(backend, "vertical", &[width as u32, height as u32, 1, 0]).unwrap();
+        let src = upload(backend, "image", &image).unwrap();
+        let temp = backend.create_buffer("temp", (width * height * 4) as u64).unwrap();
+        let dst = backend.create_buffer("blurred", (width * height * 4) as u64).unwrap();
+        dispatch(backend, &kernel, &[horizontal, src, temp], [width.div_ceil(64) as u32, height as u32, 1]);
+        dispatch(backend, &kernel, &[vertical, temp, dst], [height.div_ceil(64) as u32, width as u32, 1]);
+        let words = download(backend, dst).unwrap();
+        destroy(backend, &[horizontal, vertical, src, temp, dst]);
+        words
+    });
+    // Nine positive products per pass, two passes: 4 ULP covers contraction.
+    check("blur", &results, &reference, Compare::Float { ulp: 4, max_outside: 0.0 });
+}
+
+// ---------------------------------------------------------------------------------------
+// 5. N-body step.
+
+const NBODY: &str = include_str!("../data/workloads/nbody.wgsl");
+const NBODY_STEPS: usize = 4;
+
+/// One step as the kernel computes it; a body is [px, py, pz, mass, vx, vy, vz, w].
+fn nbody_step(bodies: &[[f32; 8]], dt: f32, softening: f32) -> Vec<[f32; 8]> {
+    bodies
+        .iter()
+        .map(|me| {
+            let mut acc = [0.0f32; 3];
+            for other in bodies {
+                let d = [other[0] - me[0], other[1] - me[1], other[2] - me[2]];
+                let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + softening;
+                let s = other[3] / (r2 * r2.sqrt());
+                for c in 0..3 {
+                    acc[c] += d[c] * s;
+                }
+            }
+            let mut next = *me;
+            for c in 0..3 {
+                next[4 + c] = me[4 + c] + acc[c] * dt;
+                next[c] = me[c] + next[4 + c] * dt;
+            }
+            next
+        })
+        .collect()
+}
+
+#[test]
+fn nbody_steps_agree_with_the_reference_and_lavapipe() {
+    let kernel = kernel("nbody.wgsl", NBODY);
+    let count = 200usize;
+    let (dt, softening) = (0.01f32, 0.05f32);
+    let mut rng = Rng(2024);
+    let bodies: Vec<[f32; 8]> = (0..count)
+        .map(|_| {
+            let mut b = [0.0f32; 8];
+            for v in &mut b[..3] {
+                *v = rng.range(-1.0, 1.0);
+            }
+            b[3] = rng.range(0.001, 0.01);
+            for v in &mut b[4..7] {
+                *v = rng.range(-0.1, 0.1);
+            }
+            b[7] = rng.unit();
+            b
+        })
+        .collect();
+    let mut reference = bodies.clone();
+    for _ in 0..NBODY_STEPS {
+        reference = nbody_step(&reference, dt, softening);
+    }
+    let reference: Vec<f32> = reference.concat();
+    let flat: Vec<f32> = bodies.concat();
+    let results = run_everywhere("nbody", |backend| {
+        let params = upload(backend, "params", &[count as u32, dt.to_bits(), softening.to_bits(), 0]).unwrap();
+        let mut a = upload(backend, "bodies a", &flat).unwrap();
+        let mut b = backend.create_buffer("bodies b", (flat.len() * 4) as u64).unwrap();
+        for _ in 0..NBODY_STEPS {
+            dispatch(backend, &kernel, &[params, a, b], [count.div_ceil(64) as u32, 1, 1]);
+            std::mem::swap(&mut a, &mut b);
+        }
+        let words = download(backend, a).unwrap();
+        destroy(backend, &[params, a, b]);
+        words
+    });
+    // 200 softened interactions per step, four steps; contraction and a GPU's division
+    // and square root may each move the last bits, and positions that nearly cancel
+    // (a coordinate near 0) show small absolute errors as many ULPs: a share may exceed.
+    check("nbody", &results, &bits(&reference), Compare::Float { ulp: 64, max_outside: 0.02 });
+}
+
+// ---------------------------------------------------------------------------------------
+// 6. Collatz and Mandelbrot.
+
+const COLLATZ: &str = include_str!("../data/workloads/collatz.wgsl");
+const MANDELBROT: &str = include_str!("../data/workloads/mandelbrot.wgsl");
+
+fn collatz_steps(start: u32) -> u32 {
+    let (mut n, mut steps) = (start, 0);
+    while n > 1 && steps < 256 {
+        n = if n & 1 == 0 { n >> 1 } else { n.wrapping_mul(3).wrapping_add(1) };
+        steps += 1;
+    }
+    steps
+}
+
+#[test]
+fn collatz_step_counts_are_exact_on_every_backend() {
+    let kernel = kernel("collatz.wgsl", COLLATZ);
+    let mut rng = Rng(11);
+    // Small starts, random ones below a million, and large ones whose 3n + 1 wraps.
+    let mut input: Vec<u32> = (0..1024).collect();
+    input.extend((0..2048).map(|_| rng.next() % 1_000_000));
+    input.extend((0..1000).map(|_| rng.next() | 0x8000_0001));
+    let reference: Vec<u32> = input.iter().map(|&n| collatz_steps(n)).collect();
+    assert!(reference.contains(&256), "some start runs into the step bound");
+    let results = run_everywhere("collatz", |backend| {
+        let buffer = upload(backend, "input", &input).unwrap();
+        let out = backend.create_buffer("out", (input.len() * 4) as u64).unwrap();
+        dispatch(backend, &kernel, &[buffer, out], [input.len().div_ceil(64) as u32, 1, 1]);
+        let words = download(backend, out).unwrap();
+        destroy(backend, &[buffer, out]);
+        words
+    });
+    check("collatz", &results, &reference, Compare::Exact);
+}
+
+struct Mandelbrot {
+    width: u32,
+    height: u32,
+    max_iter: u32,
+    x0: f32,
+    y0: f32,
+    scale: f32,
+}
+
+impl Mandelbrot {
+    fn params(&self) -> [u32; 8] {
+        [self.width, self.height, self.max_iter, 0, self.x0.to_bits(), self.y0.to_bits(), self.scale.to_bits(), 0]
+    }
+
+    fn reference(&self) -> Vec<u32> {
+        let mut out = Vec::with_capacity((self.width * self.height) as usize);
+        for y in 0..self.height {
+            for x in 0..self.width {
+                let cx = self.x0 + (x as f32 + 0.5) * self.scale;
+                let cy = self.y0 + (y as f32 + 0.5) * self.scale;
+                let (mut zx, mut zy, mut i) = (0.0f32, 0.0f32, 0);
+                while i < self.max_iter && zx * zx + zy * zy <= 4.0 {
+                    let xt = zx * zx - zy * zy + cx;
+                    zy = 2.0 * zx * zy + cy;
+                    zx = xt;
+                    i += 1;
+                }
+                out.push(i);
+            }
+        }
+        out
+    }
+}
+
+#[test]
+fn mandelbrot_escape_counts_agree_with_the_reference_and_mostly_with_lavapipe() {
+    let kernel = kernel("mandelbrot.wgsl", MANDELBROT);
+    let set = Mandelbrot { width: 160, height: 120, max_iter: 200, x0: -2.2, y0: -1.2, scale: 0.02 };
+    let reference = set.reference();
+    let results = run_everywhere("mandelbrot", |backend| {
+        let params = upload(backend, "params", &set.params()).unwrap();
+        let out = backend.create_buffer("out", u64::from(set.width * set.height * 4)).unwrap();
+        dispatch(backend, &kernel, &[params, out], [set.width.div_ceil(8), set.height.div_ceil(8), 1]);
+        let words = download(backend, out).unwrap();
+        destroy(backend, &[params, out]);
+        words
+    });
+    let (_, interpreter) = &results[0];
+    assert_eq!(interpreter, &reference, "the interpreter gives the reference's counts");
+    for (backend, words) in &results[1..] {
+        let differing: Vec<u32> =
+            interpreter.iter().zip(words).filter(|(a, b)| a != b).map(|(a, b)| a.abs_diff(*b)).collect();
+        let share = differing.len() as f64 / interpreter.len() as f64;
+        eprintln!(
+            "mandelbrot: interpreter vs {backend}: {} of {} pixels ({:.3}%) differ, by at most {} iterations",
+            differing.len(),
+            interpreter.len(),
+            share * 100.0,
+            differing.iter().max().unwrap_or(&0)
+        );
+        // Iterates near the set's boundary are chaotic: a contracted multiply-add there
+        // changes the escape count, so a small share of pixels may differ.
+        assert!(share <= 0.02, "mandelbrot: {:.3}% of pixels differ on {backend}", share * 100.0);
+    }
+}

@@ -1,7 +1,7 @@
 //! Realistic compute workloads of the kinds engines and public samples run — a tiled
 //! matrix multiply, a two-level prefix sum, a histogram with reductions, a separable
-//! blur, an n-body step, Collatz step counts, a Mandelbrot set and a bitonic sort — each
-//! run on the CPU interpreter, on wgpu (lavapipe) and on ash. The interpreter must give
+//! blur, n-body and boids steps, Collatz step counts, a Mandelbrot set, a bitonic sort
+//! and an f32 tree reduction — each run on the CPU interpreter, on wgpu (lavapipe) and on ash. The interpreter must give
 //! exactly what a small Rust reference computes in the same order; the Vulkan backends
 //! must agree with the interpreter bit for bit on integer outputs and within a stated
 //! ULP bound on float outputs (a GPU may contract a multiply and an add into a fused
@@ -548,4 +548,201 @@ fn bitonic_sort_is_exact_on_every_backend() {
         words
     });
     check("bitonic sort", &results, &reference, Compare::Exact);
+}
+
+// ---------------------------------------------------------------------------------------
+// 8. Tree reduction of f32 values.
+
+const REDUCE: &str = include_str!("../data/workloads/reduce.wgsl");
+
+/// One pass of the reduction kernel: a (sum, min, max, sum of squares) per 256 loaded
+/// values, combined in the kernel's tree order.
+fn reduce_pass(items: &[[f32; 4]]) -> Vec<[f32; 4]> {
+    let identity = [0.0, 3.0e38, -3.0e38, 0.0];
+    items
+        .chunks(256)
+        .map(|chunk| {
+            let mut tile = [identity; 256];
+            tile[..chunk.len()].copy_from_slice(chunk);
+            let mut s = 128;
+            while s > 0 {
+                for li in 0..s {
+                    let (a, b) = (tile[li], tile[li + s]);
+                    tile[li] = [a[0] + b[0], a[1].min(b[1]), a[2].max(b[2]), a[3] + b[3]];
+                }
+                s /= 2;
+            }
+            tile[0]
+        })
+        .collect()
+}
+
+#[test]
+fn tree_reduction_agrees_with_the_reference_and_lavapipe() {
+    let kernel = kernel("reduce.wgsl", REDUCE);
+    let count = 256usize * 40 + 77;
+    let blocks = count.div_ceil(256);
+    let mut rng = Rng(31);
+    let values: Vec<f32> = (0..count).map(|_| rng.range(-100.0, 100.0)).collect();
+    let items: Vec<[f32; 4]> = values.iter().map(|&v| [v, v, v, v * v]).collect();
+    let partials = reduce_pass(&items);
+    let total = reduce_pass(&partials);
+    let reference = bits(&[partials.concat(), total.concat()].concat());
+    let results = run_everywhere("reduction", |backend| {
+        let first = upload(backend, "params", &[count as u32, 0, 0, 0]).unwrap();
+        let second = upload(backend, "params", &[blocks as u32, 1, 0, 0]).unwrap();
+        let input = upload(backend, "values", &values).unwrap();
+        let partials = backend.create_buffer("partials", (blocks * 16) as u64).unwrap();
+        let total = backend.create_buffer("total", 16).unwrap();
+        dispatch(backend, &kernel, &[first, input, partials], [blocks as u32, 1, 1]);
+        dispatch(backend, &kernel, &[second, partials, total], [1, 1, 1]);
+        let mut words = download(backend, partials).unwrap();
+        words.extend(download::<u32>(backend, total).unwrap());
+        destroy(backend, &[first, second, input, partials, total]);
+        words
+    });
+    // Additions only (the squares are rounded before they reach workgroup memory): a
+    // GPU has nothing to contract; 4 ULP leaves room for a different rounding of sums
+    // that cancel.
+    check("reduction", &results, &reference, Compare::Float { ulp: 4, max_outside: 0.0 });
+}
+
+// ---------------------------------------------------------------------------------------
+// 9. Boids.
+
+const BOIDS: &str = include_str!("../data/workloads/boids.wgsl");
+const BOIDS_STEPS: usize = 3;
+
+#[derive(Clone, Copy)]
+struct Flock {
+    dt: f32,
+    radius: f32,
+    separation: f32,
+    cohesion: f32,
+    alignment: f32,
+    repulsion: f32,
+    max_speed: f32,
+}
+
+impl Flock {
+    fn params(&self, count: u32) -> [u32; 8] {
+        let f = [self.dt, self.radius, self.separation, self.cohesion, self.alignment, self.repulsion, self.max_speed];
+        let mut words = [count; 8];
+        for (w, v) in words[1..].iter_mut().zip(f) {
+            *w = v.to_bits();
+        }
+        words
+    }
+
+    /// One step as the kernel computes it (WGSL `length` is sqrt(x*x + y*y + z*z) and
+    /// `normalize(d)` is d / length(d) on the interpreter); a boid is
+    /// [px, py, pz, pw, vx, vy, vz, vw].
+    fn step(&self, boids: &[[f32; 8]]) -> Vec<[f32; 8]> {
+        let length = |v: [f32; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        boids
+            .iter()
+            .enumerate()
+            .map(|(i, me)| {
+                let pos = [me[0], me[1], me[2]];
+                let mut vel = [me[4], me[5], me[6]];
+                let (mut center, mut heading, mut push, mut n) = ([0.0f32; 3], [0.0f32; 3], [0.0f32; 3], 0u32);
+                for (j, other) in boids.iter().enumerate() {
+                    if j == i {
+                        continue;
+                    }
+                    let d = [other[0] - pos[0], other[1] - pos[1], other[2] - pos[2]];
+                    let dist = length(d);
+                    if dist < self.radius {
+                        for c in 0..3 {
+                            center[c] += other[c];
+                            heading[c] += other[4 + c];
+                        }
+                        n += 1;
+                        if dist < self.separation && dist > 0.0 {
+                            for c in 0..3 {
+                                push[c] -= d[c] / dist / dist;
+                            }
+                        }
+                    }
+                }
+                if n > 0 {
+                    let inv = 1.0 / n as f32;
+                    for c in 0..3 {
+                        vel[c] += ((center[c] * inv - pos[c]) * self.cohesion
+                            + (heading[c] * inv - vel[c]) * self.alignment)
+                            * self.dt;
+                    }
+                }
+                let scale = self.repulsion * self.dt;
+                for c in 0..3 {
+                    vel[c] += push[c] * scale;
+                }
+                let speed = length(vel);
+                if speed > self.max_speed {
+                    let s = self.max_speed / speed;
+                    for v in &mut vel {
+                        *v *= s;
+                    }
+                }
+                let mut next = *me;
+                for c in 0..3 {
+                    let p = pos[c] + vel[c] * self.dt;
+                    next[c] = p - 2.0 * ((p + 1.0) * 0.5).floor();
+                    next[4 + c] = vel[c];
+                }
+                next
+            })
+            .collect()
+    }
+}
+
+#[test]
+fn boids_steps_agree_with_the_reference_and_lavapipe() {
+    let kernel = kernel("boids.wgsl", BOIDS);
+    let count = 300usize;
+    let flock = Flock {
+        dt: 0.02,
+        radius: 0.3,
+        separation: 0.08,
+        cohesion: 0.5,
+        alignment: 0.8,
+        repulsion: 0.002,
+        max_speed: 0.5,
+    };
+    let mut rng = Rng(77);
+    let boids: Vec<[f32; 8]> = (0..count)
+        .map(|_| {
+            let mut b = [0.0f32; 8];
+            for v in &mut b[..3] {
+                *v = rng.range(-1.0, 1.0);
+            }
+            for v in &mut b[4..7] {
+                *v = rng.range(-0.3, 0.3);
+            }
+            b[3] = rng.unit();
+            b[7] = rng.unit();
+            b
+        })
+        .collect();
+    let mut reference = boids.clone();
+    for _ in 0..BOIDS_STEPS {
+        reference = flock.step(&reference);
+    }
+    let flat: Vec<f32> = boids.concat();
+    let results = run_everywhere("boids", |backend| {
+        let params = upload(backend, "params", &flock.params(count as u32)).unwrap();
+        let mut a = upload(backend, "boids a", &flat).unwrap();
+        let mut b = backend.create_buffer("boids b", (flat.len() * 4) as u64).unwrap();
+        for _ in 0..BOIDS_STEPS {
+            dispatch(backend, &kernel, &[params, a, b], [count.div_ceil(64) as u32, 1, 1]);
+            std::mem::swap(&mut a, &mut b);
+        }
+        let words = download(backend, a).unwrap();
+        destroy(backend, &[params, a, b]);
+        words
+    });
+    // A GPU may compute normalize with an inverse square root and contract the steering
+    // sums; a neighbour right at the radius may then count on one side and not the
+    // other, so a share of values may exceed the bound.
+    check("boids", &results, &bits(&reference.concat()), Compare::Float { ulp: 64, max_outside: 0.02 });
 }

@@ -1044,11 +1044,10 @@ fn main() {
 }
 "#;
 
-/// Every product of `m = (-1)` and `v = (0, 0)` is -0.0, and so is their IEEE sum; the
-/// interpreter starts matrix-vector, vector-matrix and matrix-matrix sums at +0.0 and
-/// returns +0.0 (lavapipe gives -0.0, as does `dot`, which starts at the first product).
+/// Every product of `m = (-1)` and `v = (0, 0)` is -0.0, and so is their IEEE sum
+/// (lavapipe gives -0.0). A regression test: the interpreter once started matrix-vector,
+/// vector-matrix and matrix-matrix sums at +0.0 and returned +0.0.
 #[test]
-#[ignore = "interpreter bug: matrix products sum from +0.0, so a sum of -0.0 products is +0.0 (cpu_backend/matrix.rs)"]
 fn matrix_products_of_negative_zeros_are_negative_zero() {
     let kernel = kernel("negative_zero_products.wgsl", NEGATIVE_ZERO_PRODUCTS);
     let input = [-1.0f32, -1.0, -1.0, -1.0, 0.0, 0.0];

@@ -1,6 +1,7 @@
 //! Matrix arithmetic on matrices laid out as in memory: `columns` columns of `rows`
 //! f32 values, each column padded to 4 words when `rows` is 3. Products sum in order
-//! without fused multiply-add.
+//! without fused multiply-add, starting from the first product rather than +0 (so that
+//! products that are all -0 sum to -0, as on GPUs).
 
 use naga::{BinaryOperator, TypeInner, VectorSize};
 
@@ -16,14 +17,17 @@ pub(super) fn column_words(rows: VectorSize) -> usize {
 fn matrix_vector(m: &[u32], columns: usize, rows: VectorSize, v: &[u32]) -> Vec<u32> {
     let stride = column_words(rows);
     (0..rows as usize)
-        .map(|i| (0..columns).fold(0.0f32, |acc, k| acc + f(m[k * stride + i]) * f(v[k])).to_bits())
+        .map(|i| (1..columns).fold(f(m[i]) * f(v[0]), |acc, k| acc + f(m[k * stride + i]) * f(v[k])).to_bits())
         .collect()
 }
 
 fn vector_matrix(v: &[u32], m: &[u32], columns: usize, rows: VectorSize) -> Vec<u32> {
     let stride = column_words(rows);
     (0..columns)
-        .map(|j| (0..rows as usize).fold(0.0f32, |acc, i| acc + f(v[i]) * f(m[j * stride + i])).to_bits())
+        .map(|j| {
+            let column = j * stride;
+            (1..rows as usize).fold(f(v[0]) * f(m[column]), |acc, i| acc + f(v[i]) * f(m[column + i])).to_bits()
+        })
         .collect()
 }
 
@@ -88,17 +92,16 @@ pub(super) fn determinant(m: &[u32], size: VectorSize) -> u32 {
         if n == 2 {
             return values[0] * values[3] - values[2] * values[1];
         }
-        let mut total = 0.0f32;
-        for column in 0..n {
+        let term = |column: usize| {
             let minor: Vec<f32> = (0..n)
                 .filter(|&c| c != column)
                 .flat_map(|c| (1..n).map(move |r| (c, r)))
                 .map(|(c, r)| values[c * n + r])
                 .collect();
             let sign = if column % 2 == 0 { 1.0 } else { -1.0 };
-            total += sign * values[column * n] * det(&minor, n - 1);
-        }
-        total
+            sign * values[column * n] * det(&minor, n - 1)
+        };
+        (1..n).fold(term(0), |total, column| total + term(column))
     }
     let values: Vec<f32> = (0..n).flat_map(|c| (0..n).map(move |r| (c, r))).map(|(c, r)| at(c, r)).collect();
     det(&values, n).to_bits()

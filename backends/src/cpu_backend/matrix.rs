@@ -98,7 +98,7 @@ pub(super) fn determinant(m: &[u32], size: VectorSize) -> u32 {
                 .flat_map(|c| (1..n).map(move |r| (c, r)))
                 .map(|(c, r)| values[c * n + r])
                 .collect();
-            let sign = if column % 2 == 0 { 1.0 } else { -1.0 };
+            let sign = if column.is_multiple_of(2) { 1.0 } else { -1.0 };
             sign * values[column * n] * det(&minor, n - 1)
         };
         (1..n).fold(term(0), |total, column| total + term(column))

@@ -49,6 +49,29 @@ fn run_words(backend: &mut dyn Backend, kernel: &Kernel, inputs: &[u32], outputs
     words
 }
 
+/// `count` f32 bit patterns uniform in [-4, 4) from an LCG seeded with `seed`.
+fn uniform_floats(seed: u32, count: usize) -> Vec<u32> {
+    let mut state = seed;
+    (0..count)
+        .map(|_| {
+            state = state.wrapping_mul(1_103_515_245).wrapping_add(12345);
+            ((state >> 8) as f32 / (1 << 24) as f32 * 8.0 - 4.0).to_bits()
+        })
+        .collect()
+}
+
+/// The interpreter's f32 words `got` against lavapipe's `want`: sums of products may
+/// contract to fused multiply-adds on the GPU and transcendentals differ between
+/// implementations, a few ULPs; values that cancel to near zero turn a small absolute
+/// error into many ULPs, so 0.5 % of outliers beyond 64 ULP are allowed.
+fn assert_close_to_lavapipe(what: &str, got: Vec<u32>, want: Vec<u32>) {
+    use strata::check::{Compare, Output, compare_outputs};
+    let expected = [Output { name: "output", words: want, compare: Compare::Float { ulp: 64, max_outside: 0.005 } }];
+    let agreement = compare_outputs(&[Output { name: "output", words: got, compare: Compare::Exact }], &expected)
+        .unwrap_or_else(|mismatch| panic!("{what}: {mismatch}"));
+    eprintln!("{what}: max {} ULP, {:.2}% beyond 64 ULP", agreement.max_ulp, agreement.outside_share() * 100.0);
+}
+
 const CONTROL_FLOW: &str = r#"
 @group(0) @binding(0) var<storage, read> input: array<u32>;
 @group(0) @binding(1) var<storage, read_write> output: array<u32>;
@@ -356,15 +379,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
 
 #[test]
 fn float_math_and_matrices_agree_with_lavapipe_within_ulps() {
-    use strata::check::{Compare, Output, compare_outputs};
     let kernel = Kernel::from_wgsl("float_math.wgsl", FLOAT_MATH.into(), "main", false).unwrap();
-    let mut state = 12345u32;
-    let inputs: Vec<u32> = (0..2 * 128)
-        .map(|_| {
-            state = state.wrapping_mul(1_103_515_245).wrapping_add(12345);
-            ((state >> 8) as f32 / (1 << 24) as f32 * 8.0 - 4.0).to_bits()
-        })
-        .collect();
+    let inputs = uniform_floats(12345, 2 * 128);
     let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
     let got = run_words(&mut cpu, &kernel, &inputs, 128 * 18, 2);
     assert!(got.iter().all(|w| f32::from_bits(*w).is_finite()), "every result is finite");
@@ -372,14 +388,7 @@ fn float_math_and_matrices_agree_with_lavapipe_within_ulps() {
         return;
     };
     let want = run_words(&mut gpu, &kernel, &inputs, 128 * 18, 2);
-    // Sums of products may contract to fused multiply-adds on the GPU and
-    // transcendentals differ between implementations: a few ULPs, and for values that
-    // cancel to near zero a small absolute error shows up as many ULPs, so a share of
-    // outliers is allowed too.
-    let expected = [Output { name: "output", words: want, compare: Compare::Float { ulp: 64, max_outside: 0.005 } }];
-    let agreement = compare_outputs(&[Output { name: "output", words: got, compare: Compare::Exact }], &expected)
-        .unwrap_or_else(|mismatch| panic!("{mismatch}"));
-    eprintln!("float math: max {} ULP, {:.2}% beyond 64 ULP", agreement.max_ulp, agreement.outside_share() * 100.0);
+    assert_close_to_lavapipe("float math", got, want);
 }
 
 const MORE_MATH: &str = r#"
@@ -421,15 +430,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
 
 #[test]
 fn reflect_refract_hyperbolic_ldexp_and_packed_dots_agree_with_lavapipe() {
-    use strata::check::{Compare, Output, compare_outputs};
     let kernel = Kernel::from_wgsl("more_math.wgsl", MORE_MATH.into(), "main", false).unwrap();
-    let mut state = 777u32;
-    let inputs: Vec<u32> = (0..2 * 128)
-        .map(|_| {
-            state = state.wrapping_mul(1_103_515_245).wrapping_add(12345);
-            ((state >> 8) as f32 / (1 << 24) as f32 * 8.0 - 4.0).to_bits()
-        })
-        .collect();
+    let inputs = uniform_floats(777, 2 * 128);
     let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
     let got = run_words(&mut cpu, &kernel, &inputs, 128 * 16, 2);
     // Known values on the interpreter: total internal reflection gives the zero vector,
@@ -457,12 +459,7 @@ fn reflect_refract_hyperbolic_ldexp_and_packed_dots_agree_with_lavapipe() {
         panic!("output[{i}] (packed dot {}): cpu {:#x}, lavapipe {:#x}", i % 16 - 12, got[i], want[i]);
     }
     let floats = |words: &[u32]| (0..words.len()).filter(|&i| !integer(i)).map(|i| words[i]).collect::<Vec<_>>();
-    let expected =
-        [Output { name: "output", words: floats(&want), compare: Compare::Float { ulp: 64, max_outside: 0.005 } }];
-    let agreement =
-        compare_outputs(&[Output { name: "output", words: floats(&got), compare: Compare::Exact }], &expected)
-            .unwrap_or_else(|mismatch| panic!("{mismatch}"));
-    eprintln!("more math: max {} ULP, {:.2}% beyond 64 ULP", agreement.max_ulp, agreement.outside_share() * 100.0);
+    assert_close_to_lavapipe("more math", floats(&got), floats(&want));
 }
 
 /// Subgroup ballots, reductions and scans, per invocation 24 outputs; `WG` is replaced by

@@ -25,6 +25,9 @@ pub struct FrameError {
     pub prelmse: f64,
     /// Mean squared error.
     pub mse: f64,
+    /// The paper's RelMSE of luminance ([`metrics::relmse_luminance`]): the part of the
+    /// error that is not colour noise. `None` when read from a CSV written before it.
+    pub relmse_luminance: Option<f64>,
 }
 
 /// What to compare.
@@ -106,6 +109,7 @@ pub fn run_comparison(
                         relmse: measure(metrics::relmse(&shown, reference))?,
                         prelmse: measure(metrics::prelmse(&shown, reference))?,
                         mse: measure(metrics::mse(&shown, reference))?,
+                        relmse_luminance: Some(measure(metrics::relmse_luminance(&shown, reference))?),
                     });
                     on_frame(method, seed, frame, &shown);
                 }
@@ -118,12 +122,19 @@ pub fn run_comparison(
     Ok(errors)
 }
 
-/// The CSV of `errors`: method, frame, seed, relmse, prelmse, mse (frames 1-based).
+/// The CSV header [`errors_csv`] writes.
+const CSV_HEADER: &str = "method,frame,seed,relmse,prelmse,mse,relmse_luminance";
+/// The header of CSVs written before the luminance column (still read).
+const CSV_HEADER_WITHOUT_LUMINANCE: &str = "method,frame,seed,relmse,prelmse,mse";
+
+/// The CSV of `errors`: method, frame, seed, relmse, prelmse, mse, relmse_luminance
+/// (frames 1-based; an unknown luminance RelMSE is an empty field).
 pub fn errors_csv(errors: &[FrameError]) -> String {
-    let mut csv = String::from("method,frame,seed,relmse,prelmse,mse\n");
+    let mut csv = format!("{CSV_HEADER}\n");
     for e in errors {
+        let luminance = e.relmse_luminance.map(|v| format!("{v:.6e}")).unwrap_or_default();
         csv.push_str(&format!(
-            "{},{},{},{:.6e},{:.6e},{:.6e}\n",
+            "{},{},{},{:.6e},{:.6e},{:.6e},{luminance}\n",
             e.method.name(),
             e.frame + 1,
             e.seed,
@@ -144,8 +155,29 @@ pub fn relmse_over_seeds(errors: &[FrameError], method: Method, frame: u32) -> M
 /// Per seed, the ratio of `method`'s RelMSE to `baseline`'s at `frame`, with its mean and
 /// interval over seeds (paired: both rendered from the same seed).
 pub fn relmse_ratio(errors: &[FrameError], method: Method, baseline: Method, frame: u32) -> Option<MeanInterval> {
+    ratio_of(errors, method, baseline, frame, |e| Some(e.relmse))
+}
+
+/// [`relmse_ratio`] of the luminance RelMSE; `None` also when a frame lacks it.
+pub fn luminance_relmse_ratio(
+    errors: &[FrameError],
+    method: Method,
+    baseline: Method,
+    frame: u32,
+) -> Option<MeanInterval> {
+    ratio_of(errors, method, baseline, frame, |e| e.relmse_luminance)
+}
+
+/// Per seed, `value(method) / value(baseline)` at `frame`, with mean and interval.
+fn ratio_of(
+    errors: &[FrameError],
+    method: Method,
+    baseline: Method,
+    frame: u32,
+    value: impl Fn(&FrameError) -> Option<f64>,
+) -> Option<MeanInterval> {
     let of = |m: Method| -> Vec<(u32, f64)> {
-        errors.iter().filter(|e| e.method == m && e.frame == frame).map(|e| (e.seed, e.relmse)).collect()
+        errors.iter().filter(|e| e.method == m && e.frame == frame).filter_map(|e| Some((e.seed, value(e)?))).collect()
     };
     let (ours, theirs) = (of(method), of(baseline));
     let ratios: Vec<f64> =
@@ -156,15 +188,17 @@ pub fn relmse_ratio(errors: &[FrameError], method: Method, baseline: Method, fra
 /// Reads the CSV [`errors_csv`] writes; an error names the line and what is wrong.
 pub fn parse_errors_csv(text: &str) -> Result<Vec<FrameError>, String> {
     let mut lines = text.lines();
-    if lines.next().map(str::trim) != Some("method,frame,seed,relmse,prelmse,mse") {
-        return Err("line 1: expected the header `method,frame,seed,relmse,prelmse,mse`".into());
-    }
+    let columns = match lines.next().map(str::trim) {
+        Some(CSV_HEADER) => 7,
+        Some(CSV_HEADER_WITHOUT_LUMINANCE) => 6,
+        _ => return Err(format!("line 1: expected the header `{CSV_HEADER}`")),
+    };
     let mut errors = Vec::new();
     for (index, line) in lines.enumerate().filter(|(_, l)| !l.trim().is_empty()) {
         let number = index + 2;
         let fields: Vec<&str> = line.split(',').collect();
-        if fields.len() != 6 {
-            return Err(format!("line {number}: expected 6 fields, found {}", fields.len()));
+        if fields.len() != columns {
+            return Err(format!("line {number}: expected {columns} fields, found {}", fields.len()));
         }
         let method = <Method as clap::ValueEnum>::from_str(fields[0], false)
             .map_err(|_| format!("line {number}: unknown method `{}`", fields[0]))?;
@@ -181,6 +215,10 @@ pub fn parse_errors_csv(text: &str) -> Result<Vec<FrameError>, String> {
             relmse: float(3)?,
             prelmse: float(4)?,
             mse: float(5)?,
+            relmse_luminance: match fields.get(6) {
+                None | Some(&"") => None,
+                Some(_) => Some(float(6)?),
+            },
         });
     }
     Ok(errors)
@@ -192,9 +230,22 @@ mod tests {
 
     #[test]
     fn the_csv_reads_back_and_bad_lines_are_named() {
-        let errors =
-            vec![FrameError { method: Method::RestirDisc, frame: 2, seed: 7, relmse: 0.5, prelmse: 0.25, mse: 1e-3 }];
+        let error = |seed, relmse_luminance| FrameError {
+            method: Method::RestirDisc,
+            frame: 2,
+            seed,
+            relmse: 0.5,
+            prelmse: 0.25,
+            mse: 1e-3,
+            relmse_luminance,
+        };
+        let errors = vec![error(7, Some(0.125)), error(8, None)];
         assert_eq!(parse_errors_csv(&errors_csv(&errors)).unwrap(), errors);
+        // CSVs written before the luminance column still read.
+        let old = "method,frame,seed,relmse,prelmse,mse\nrestir-disc,3,8,0.5,0.25,1e-3\n";
+        assert_eq!(parse_errors_csv(old).unwrap(), vec![error(8, None)]);
+        let bad_luminance = "method,frame,seed,relmse,prelmse,mse,relmse_luminance\nstrata,1,1,0.1,0.1,0.1,x\n";
+        assert!(parse_errors_csv(bad_luminance).unwrap_err().contains("field 7"));
         let bad = "method,frame,seed,relmse,prelmse,mse\nstrata,1,1,0.1,0.1\n";
         assert!(parse_errors_csv(bad).unwrap_err().contains("line 2"));
         let unknown = "method,frame,seed,relmse,prelmse,mse\nfoo,1,1,0.1,0.1,0.1\n";

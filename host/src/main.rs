@@ -5,9 +5,11 @@ use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::time::Instant;
 use strata::backend_choice::{BackendChoice, open_backend};
-use strata::compare::{Comparison, errors_csv, relmse_over_seeds, relmse_ratio, run_comparison};
+use strata::compare::{
+    Comparison, FrameError, errors_csv, luminance_relmse_ratio, relmse_over_seeds, relmse_ratio, run_comparison,
+};
 use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
-use strata::metrics::{self, Metric};
+use strata::metrics::{self, MeanInterval, Metric};
 use strata::render::{GpuScene, LightSampling, RenderSettings};
 use strata::restir::{Method, RestirSettings};
 use strata::rgb_image::RgbImage;
@@ -16,6 +18,9 @@ use strata::scene::{Scene, default_scene, load_scene_file, parse_camera_path};
 use strata::synthetic::{CandidateMix, candidate_image};
 use strata_kernels::BlockGrid;
 use strata_kernels::reference::block_histogram::block_histogram;
+
+/// A paired ratio of one error column between two methods at one frame.
+type RatioOf = fn(&[FrameError], Method, Method, u32) -> Option<MeanInterval>;
 
 /// strata: histogram-stratified ReSTIR.
 #[derive(Parser)]
@@ -396,13 +401,13 @@ fn run_and_report(
         args.methods.len(),
         started.elapsed().as_secs_f64()
     );
-    print!("{:<12}", "method");
+    print!("{:<18}", "method");
     for f in &shown {
         print!(" | {:>20}", format!("frame {}", f + 1));
     }
     println!();
     for &method in &args.methods {
-        print!("{:<12}", method.name());
+        print!("{:<18}", method.name());
         for &f in &shown {
             print!(" | {:>20}", relmse_over_seeds(&errors, method, f).to_string());
         }
@@ -413,13 +418,15 @@ fn run_and_report(
             if !args.methods.contains(&baseline) {
                 continue;
             }
-            print!("{:<12}", format!("÷ {}", baseline.name()));
-            for &f in &shown {
-                let ratio = relmse_ratio(&errors, Method::Strata, baseline, f);
-                let text = ratio.map(|r| format!("{:.3} ± {:.3}", r.mean, r.half_width)).unwrap_or_default();
-                print!(" | {text:>20}");
+            for (suffix, ratio_of) in [("", relmse_ratio as RatioOf), (" luma", luminance_relmse_ratio)] {
+                print!("{:<18}", format!("÷ {}{suffix}", baseline.name()));
+                for &f in &shown {
+                    let ratio = ratio_of(&errors, Method::Strata, baseline, f);
+                    let text = ratio.map(|r| format!("{:.3} ± {:.3}", r.mean, r.half_width)).unwrap_or_default();
+                    print!(" | {text:>20}");
+                }
+                println!();
             }
-            println!();
         }
     }
     let mut wrote = format!("{}, {}", csv.display(), plot.display());
@@ -450,7 +457,7 @@ fn print_variance(
     let mut csv =
         String::from("method,frame,relvar,vs_restir,vs_restir_half_width,vs_restir_disc,vs_restir_disc_half_width\n");
     for &method in methods {
-        print!("{:<12}", method.name());
+        print!("{:<18}", method.name());
         for &f in shown {
             let value = relative_variance(images(method, f), reference(f))?;
             print!(" | {:>20}", format!("{value:.4e}"));
@@ -472,7 +479,7 @@ fn print_variance(
             if !methods.contains(&baseline) {
                 continue;
             }
-            print!("{:<12}", format!("÷ {}", baseline.name()));
+            print!("{:<18}", format!("÷ {}", baseline.name()));
             for &f in shown {
                 let r = variance_ratio(images(Method::Strata, f), images(baseline, f), reference(f))?;
                 print!(" | {:>20}", format!("{:.3} ± {:.3}", r.mean, r.half_width));
@@ -509,6 +516,7 @@ fn metrics(args: MetricsArgs) -> Result<()> {
     println!("relmse         {:.6e}", metrics::relmse(&image, &reference).with_context(context)?);
     println!("relmse-common  {:.6e}", metrics::relmse_common(&image, &reference).with_context(context)?);
     println!("prelmse        {:.6e}", metrics::prelmse(&image, &reference).with_context(context)?);
+    println!("relmse-luma    {:.6e}", metrics::relmse_luminance(&image, &reference).with_context(context)?);
     let (m, r) = (image.mean(), reference.mean());
     println!("mean image     ({:.5}, {:.5}, {:.5})", m[0], m[1], m[2]);
     println!("mean reference ({:.5}, {:.5}, {:.5})", r[0], r[1], r[2]);

@@ -5,7 +5,11 @@
 //! - [`relmse`]: the paper's form, (f − ref)² / (ref + 1e-4) (its Table 2 numbers);
 //! - [`relmse_common`]: the form most renderers print, (f − ref)² / (ref² + 1e-2);
 //! - [`prelmse`]: [`relmse`] after blurring both images with a Gaussian of σ = 1 px
-//!   (perceptual RelMSE: blue-noise error distributions score lower than white noise).
+//!   (perceptual RelMSE: blue-noise error distributions score lower than white noise);
+//! - [`relmse_luminance`]: the paper's form on Rec. 709 luminance instead of per channel.
+//!   It leaves out colour noise (errors that keep luminance), which ReSTIR's target p̂ =
+//!   luminance cannot resample away, so it shows how much of [`relmse`] the selection
+//!   of candidates can act on.
 //!
 //! [`error_map`] gives the per-pixel value of a metric (channel-averaged) for error
 //! images. [`MeanInterval`] reports a mean with its 95 % confidence interval over
@@ -111,6 +115,20 @@ pub fn relmse(image: &RgbImage, reference: &RgbImage) -> Result<f64, MetricError
 /// The common RelMSE: mean of (f − ref)² / (ref² + 1e-2).
 pub fn relmse_common(image: &RgbImage, reference: &RgbImage) -> Result<f64, MetricError> {
     mean_error(image, reference, Metric::RelmseCommon)
+}
+
+/// The paper's RelMSE of luminance: mean of (Y_f − Y_ref)² / (Y_ref + 1e-4), with Y the
+/// Rec. 709 luminance of each pixel.
+pub fn relmse_luminance(image: &RgbImage, reference: &RgbImage) -> Result<f64, MetricError> {
+    check(image, reference)?;
+    let total: f64 =
+        image.pixels.iter().zip(&reference.pixels).map(|(f, r)| Metric::Relmse.of(luminance(*f), luminance(*r))).sum();
+    Ok(total / image.pixels.len() as f64)
+}
+
+/// Rec. 709 luminance of a linear RGB value.
+fn luminance(c: [f32; 3]) -> f32 {
+    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
 }
 
 /// Perceptual RelMSE: [`relmse`] of both images blurred by a Gaussian of σ = 1 px.
@@ -237,6 +255,22 @@ mod tests {
         let common = (0.25 / 1.01 + 0.01 / 1e-2) / 3.0;
         assert!((relmse_common(&f, &reference).unwrap() - common).abs() < 1e-6);
         assert_eq!(relmse(&reference, &reference).unwrap(), 0.0);
+    }
+
+    #[test]
+    fn luminance_relmse_ignores_colour_shifts_of_equal_luminance() {
+        let reference = image(3, 2, |_, _| [0.5, 0.5, 0.5]);
+        // Red up, green down by the amount that keeps 0.2126 r + 0.7152 g + 0.0722 b.
+        let shifted = image(3, 2, |_, _| [0.5 + 0.7152 * 0.1, 0.5 - 0.2126 * 0.1, 0.5]);
+        assert!(relmse_luminance(&shifted, &reference).unwrap() < 1e-12);
+        assert!(relmse(&shifted, &reference).unwrap() > 1e-3);
+        // A uniform grey error is the same per channel and in luminance.
+        let brighter = image(3, 2, |_, _| [0.75, 0.75, 0.75]);
+        let expected = 0.0625 / (0.5 + 1e-4);
+        assert!((relmse_luminance(&brighter, &reference).unwrap() - expected).abs() < 1e-6);
+        assert!((relmse(&brighter, &reference).unwrap() - expected).abs() < 1e-6);
+        let nan = image(3, 2, |x, _| if x == 2 { [f32::NAN; 3] } else { [0.5; 3] });
+        assert!(matches!(relmse_luminance(&nan, &reference), Err(MetricError::NonFinite { x: 2, .. })));
     }
 
     #[test]

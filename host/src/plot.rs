@@ -123,6 +123,7 @@ mod tests {
                         relmse: 0.1 / f64::from(frame + seed),
                         prelmse: 0.0,
                         mse: 0.0,
+                        relmse_luminance: None,
                     })
                 })
             })

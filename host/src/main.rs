@@ -11,7 +11,7 @@ use strata::compare::{
 use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
 use strata::metrics::{self, MeanInterval, Metric};
 use strata::render::{GpuScene, LightSampling, RenderSettings};
-use strata::restir::{Method, RestirSettings};
+use strata::restir::{Method, RestirSettings, ShadedParts};
 use strata::rgb_image::RgbImage;
 use strata::sampler::SamplerVariant;
 use strata::scene::{Scene, default_scene, load_scene_file, parse_camera_path};
@@ -93,6 +93,11 @@ struct CompareArgs {
     /// Shift the block grid by a different offset every frame.
     #[arg(long)]
     block_shift: bool,
+    /// Which parts of each pixel's estimate the frames show (a diagnostic: `base` is what
+    /// no selection touches, `resampled` the reservoir's sample; read their variance over
+    /// seeds, since each part alone is biased against the reference).
+    #[arg(long, value_enum, default_value_t = ShadedParts::All)]
+    shaded_parts: ShadedParts,
     /// No object-id masking: one histogram cluster per block.
     #[arg(long)]
     no_masking: bool,
@@ -296,6 +301,7 @@ fn compare(args: CompareArgs) -> Result<()> {
             masking: !args.no_masking,
             block_shift: args.block_shift,
             temporal_candidates: args.temporal_candidates,
+            shaded_parts: args.shaded_parts,
             ..RestirSettings::default()
         },
         accumulate: args.accumulate,

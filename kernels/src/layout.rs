@@ -156,7 +156,7 @@ shader_struct!(
         previous_right,
         temporal_candidates,
         previous_up,
-        _pad1,
+        shaded_parts,
     ]
 );
 shader_struct!(Primary, "Primary", [position, object_id, normal, material, wo, flags, albedo, depth]);

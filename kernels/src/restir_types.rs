@@ -58,8 +58,9 @@ pub struct RestirParams {
     pub temporal_candidates: u32,
     /// Previous frame's up vector.
     pub previous_up: [f32; 3],
-    /// Padding.
-    pub _pad1: u32,
+    /// What restir_shade writes: bit 0 the pixel's own estimate, bit 1 the reservoir's
+    /// sample (3: the image; 1 or 2: a diagnostic of one part).
+    pub shaded_parts: u32,
 }
 
 /// One pixel's primary hit (WGSL `Primary`).

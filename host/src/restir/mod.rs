@@ -16,4 +16,4 @@ mod settings;
 
 pub use pipeline::{FrameBuffers, FrameStats, RestirRenderer};
 pub use selection_numbers::selection_numbers;
-pub use settings::{Method, RestirSettings};
+pub use settings::{Method, RestirSettings, ShadedParts};

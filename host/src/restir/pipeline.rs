@@ -221,7 +221,7 @@ impl RestirRenderer {
             previous_right: previous.right.into(),
             temporal_candidates: self.settings.temporal_candidates,
             previous_up: previous.up.into(),
-            _pad1: 0,
+            shaded_parts: self.settings.shaded_parts.bits(),
         };
         backend.write_buffer(self.restir_params, 0, bytemuck::bytes_of(&restir))?;
         let (width, height) = (camera.width, camera.height);

@@ -35,6 +35,33 @@ impl Method {
     }
 }
 
+/// Which parts of a pixel's estimate the shading pass writes: a diagnostic that splits
+/// the error into what resampling acts on and what it does not.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
+pub enum ShadedParts {
+    /// Everything: the image (default).
+    #[default]
+    All,
+    /// Only what the pixel estimates on its own and no candidate selection touches:
+    /// emission at the primary hit, next-event estimation there, and the whole path of
+    /// pixels that do not resample. Biased by design (the resampled light is missing);
+    /// measure it by its variance over seeds, not against a reference.
+    Base,
+    /// Only the reservoir's sample, f(Y) V W: the part the selection acts on.
+    Resampled,
+}
+
+impl ShadedParts {
+    /// The bits of `RestirParams.shaded_parts`: 1 the base, 2 the resampled part.
+    pub fn bits(self) -> u32 {
+        match self {
+            ShadedParts::All => 3,
+            ShadedParts::Base => 1,
+            ShadedParts::Resampled => 2,
+        }
+    }
+}
+
 /// Settings of a ReSTIR render; the defaults are the paper's (§5.1).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RestirSettings {
@@ -81,6 +108,8 @@ pub struct RestirSettings {
     /// (the geometry term is singular there). Default: 1e-3 of the scene's extent, set by
     /// the renderer when 0.
     pub min_distance: f32,
+    /// Which parts of the estimate the frame shows (a diagnostic). Default: all.
+    pub shaded_parts: ShadedParts,
 }
 
 impl Default for RestirSettings {
@@ -98,6 +127,7 @@ impl Default for RestirSettings {
             sampler: SamplerVariant::Antithetic,
             min_roughness: 0.2,
             min_distance: 0.0,
+            shaded_parts: ShadedParts::All,
         }
     }
 }

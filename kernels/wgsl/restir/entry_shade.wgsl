@@ -2,7 +2,8 @@
 // (emission at y1, next-event estimation there, or its whole path when it does not
 // resample) plus its reservoir's sample: f(Y) V(y1, Y) W, with one shadow ray. A sample
 // of kind PRIVATE can only be the pixel's own (nobody else can reconnect to it) and was
-// found along an unoccluded ray: it needs no shadow ray.
+// found along an unoccluded ray: it needs no shadow ray. RestirParams.shaded_parts can
+// leave out either part, to measure the other's variance (a diagnostic).
 //
 // Bindings (group 0): 0-7 the scene, 8 RestirParams, and
 //   9  storage, read     array<Primary>     G-buffer
@@ -26,8 +27,11 @@ fn restir_shade(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_inv
     let p = primaries[pixel];
     let base = base_in[pixel];
     var radiance = base.xyz;
+    if (restir.shaded_parts & 1u) == 0u {
+        radiance = vec3<f32>(0.0);
+    }
     let reservoir = reservoirs[pixel];
-    if (p.flags & PRIMARY_RESAMPLE) != 0u && reservoir.weight > 0.0 {
+    if (restir.shaded_parts & 2u) != 0u && (p.flags & PRIMARY_RESAMPLE) != 0u && reservoir.weight > 0.0 {
         let y = reservoir.sample;
         var seen = y.kind == KIND_PRIVATE;
         if !seen {

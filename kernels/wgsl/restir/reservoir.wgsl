@@ -55,7 +55,9 @@ struct RestirParams {
     // reservoirs (Fig. 11), 0 to 4, merged besides the pixel's own reprojected one.
     temporal_candidates: u32,
     previous_up: vec3<f32>,
-    _pad1: u32,
+    // What restir_shade writes: bit 0 the pixel's own estimate (base), bit 1 the
+    // reservoir's sample; 3 for the image, 1 or 2 to measure one part's variance.
+    shaded_parts: u32,
 }
 
 // The G-buffer: what the camera ray of a pixel hit.

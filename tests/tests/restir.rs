@@ -11,7 +11,7 @@
 //! Needs Vulkan (skips without it unless `STRATA_REQUIRE_GPU=1`).
 
 use strata::render::{GpuScene, PathTracer, RenderSettings};
-use strata::restir::{Method, RestirRenderer, RestirSettings};
+use strata::restir::{Method, RestirRenderer, RestirSettings, ShadedParts};
 use strata::rgb_image::RgbImage;
 use strata::scene::{Camera, CameraPath, Scene, default_scene};
 use strata_backends::{Backend, gpu_required};
@@ -201,6 +201,45 @@ fn temporal_reuse_stays_unbiased() {
         let ours = restir_frames(&mut backend, &scene, restir, 1..renders + 1, 6);
         let what = format!("{} with own + {temporal_candidates} drawn temporal reservoirs, frame 6", method.name());
         assert_unbiased(&what, &z_scores(&ours, &reference));
+    }
+}
+
+/// The `--shaded-parts` diagnostic: the base and the resampled part add up to the
+/// image, pixel by pixel, and the base does not depend on the selection method.
+#[test]
+fn shaded_parts_add_up_to_the_image() {
+    let Some(mut backend) = strata_tests::vulkan_backend("shaded_parts_add_up_to_the_image") else {
+        assert!(!gpu_required());
+        return;
+    };
+    let scene = default_scene();
+    let gpu_scene = GpuScene::build(&scene).unwrap();
+    let mut frame_3 = |method, shaded_parts| {
+        let restir = RestirSettings { method, block_size: 8, shaded_parts, ..RestirSettings::default() };
+        let mut renderer =
+            RestirRenderer::new(&mut backend, &gpu_scene, &settings(&scene, 7), restir, scene.extent()).unwrap();
+        let mut image = None;
+        for _ in 0..3 {
+            image = Some(renderer.render_frame(&mut backend, None).unwrap().0);
+        }
+        renderer.destroy(&mut backend).unwrap();
+        image.unwrap()
+    };
+    let strata_base = frame_3(Method::Strata, ShadedParts::Base);
+    let restir_base = frame_3(Method::Restir, ShadedParts::Base);
+    assert_eq!(strata_base.pixels, restir_base.pixels, "the base must not depend on the selection");
+    for method in [Method::Strata, Method::Restir] {
+        let all = frame_3(method, ShadedParts::All);
+        let resampled = frame_3(method, ShadedParts::Resampled);
+        let mut lit = 0;
+        for ((a, b), r) in all.pixels.iter().zip(&strata_base.pixels).zip(&resampled.pixels) {
+            for c in 0..3 {
+                assert!((a[c] - (b[c] + r[c])).abs() <= 1e-5 * (1.0 + a[c].abs()), "{a:?} != {b:?} + {r:?}");
+            }
+            lit += usize::from(r.iter().any(|&v| v > 0.0));
+        }
+        // Most pixels of the default scene resample some indirect light.
+        assert!(lit > all.pixels.len() / 2, "{}: only {lit} pixels have a resampled part", method.name());
     }
 }
 

@@ -93,6 +93,11 @@ struct CompareArgs {
     /// Shift the block grid by a different offset every frame.
     #[arg(long)]
     block_shift: bool,
+    /// Camera rays through pixel centres, no film jitter, for the methods and the
+    /// rendered reference alike (a diagnostic: without jitter a pixel's history sees the
+    /// same primary hit every frame).
+    #[arg(long)]
+    pixel_centres: bool,
     /// Which parts of each pixel's estimate the frames show (a diagnostic: `base` is what
     /// no selection touches, `resampled` the reservoir's sample; read their variance over
     /// seeds, since each part alone is biased against the reference).
@@ -244,6 +249,7 @@ fn scene_and_settings(
 
 fn compare(args: CompareArgs) -> Result<()> {
     let (scene, render) = scene_and_settings(&args.scene, args.width, args.height)?;
+    let render = RenderSettings { pixel_centres: args.pixel_centres, ..render };
     if args.frames == 0 || args.seeds == 0 {
         bail!("--frames and --seeds must be at least 1");
     }
@@ -460,8 +466,12 @@ fn print_variance(
     let reference = |frame: u32| references.get(frame as usize).unwrap_or(&references[0]);
     let images = |method: Method, frame: u32| seed_images.get(&(method, frame)).map_or(&[][..], |v| &v[..]);
     println!("relative variance over seeds (reference-free RelMSE; ratio ± 95% jackknife interval):");
-    let mut csv =
-        String::from("method,frame,relvar,vs_restir,vs_restir_half_width,vs_restir_disc,vs_restir_disc_half_width\n");
+    let grey = |method: Method, frame: u32| -> Vec<RgbImage> {
+        images(method, frame).iter().map(metrics::luminance_image).collect()
+    };
+    let mut csv = String::from(
+        "method,frame,relvar,vs_restir,vs_restir_half_width,vs_restir_disc,vs_restir_disc_half_width,relvar_luminance\n",
+    );
     for &method in methods {
         print!("{:<18}", method.name());
         for &f in shown {
@@ -476,7 +486,8 @@ fn print_variance(
                     ratios += ",,";
                 }
             }
-            csv += &format!("{},{},{value:.6e}{ratios}\n", method.name(), f + 1);
+            let luminance = relative_variance(&grey(method, f), &metrics::luminance_image(reference(f)))?;
+            csv += &format!("{},{},{value:.6e}{ratios},{luminance:.6e}\n", method.name(), f + 1);
         }
         println!();
     }
@@ -488,6 +499,29 @@ fn print_variance(
             print!("{:<18}", format!("÷ {}", baseline.name()));
             for &f in shown {
                 let r = variance_ratio(images(Method::Strata, f), images(baseline, f), reference(f))?;
+                print!(" | {:>20}", format!("{:.3} ± {:.3}", r.mean, r.half_width));
+            }
+            println!();
+        }
+    }
+    println!("the same of luminance (the error without colour noise):");
+    for &method in methods {
+        print!("{:<18}", format!("{} luma", method.name()));
+        for &f in shown {
+            let value = relative_variance(&grey(method, f), &metrics::luminance_image(reference(f)))?;
+            print!(" | {:>20}", format!("{value:.4e}"));
+        }
+        println!();
+    }
+    if methods.contains(&Method::Strata) {
+        for baseline in [Method::Restir, Method::RestirDisc] {
+            if !methods.contains(&baseline) {
+                continue;
+            }
+            print!("{:<18}", format!("÷ {} luma", baseline.name()));
+            for &f in shown {
+                let grey_reference = metrics::luminance_image(reference(f));
+                let r = variance_ratio(&grey(Method::Strata, f), &grey(baseline, f), &grey_reference)?;
                 print!(" | {:>20}", format!("{:.3} ± {:.3}", r.mean, r.half_width));
             }
             println!();

@@ -121,14 +121,14 @@ pub fn relmse_common(image: &RgbImage, reference: &RgbImage) -> Result<f64, Metr
 /// Rec. 709 luminance of each pixel.
 pub fn relmse_luminance(image: &RgbImage, reference: &RgbImage) -> Result<f64, MetricError> {
     check(image, reference)?;
-    let total: f64 =
-        image.pixels.iter().zip(&reference.pixels).map(|(f, r)| Metric::Relmse.of(luminance(*f), luminance(*r))).sum();
-    Ok(total / image.pixels.len() as f64)
+    relmse(&luminance_image(image), &luminance_image(reference))
 }
 
-/// Rec. 709 luminance of a linear RGB value.
-fn luminance(c: [f32; 3]) -> f32 {
-    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+/// The grey image (Y, Y, Y) of each pixel's Rec. 709 luminance Y: any per-channel
+/// metric of it is that metric of luminance.
+pub fn luminance_image(image: &RgbImage) -> RgbImage {
+    let grey = |c: &[f32; 3]| [0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; 3];
+    RgbImage { pixels: image.pixels.iter().map(grey).collect(), ..*image }
 }
 
 /// Perceptual RelMSE: [`relmse`] of both images blurred by a Gaussian of σ = 1 px.

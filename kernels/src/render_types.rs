@@ -9,6 +9,9 @@ pub const FLAG_SAMPLE_LIGHTS: u32 = 1;
 pub const FLAG_HIT_LIGHTS: u32 = 2;
 /// `RenderParams.flags`: Russian roulette from `rr_depth`.
 pub const FLAG_RUSSIAN_ROULETTE: u32 = 4;
+/// `RenderParams.flags`: camera rays through pixel centres instead of a random point of
+/// each pixel (no film jitter; a diagnostic: the image is then a point-sampled one).
+pub const FLAG_PIXEL_CENTRES: u32 = 8;
 
 /// `Material.kind`: Lambertian diffuse.
 pub const MATERIAL_DIFFUSE: u32 = 0;

@@ -155,6 +155,7 @@ fn settings_for(scene: &Scene, width: u32, height: u32, light_sampling: LightSam
         rr_depth: scene.rr_depth,
         light_sampling,
         russian_roulette: rr,
+        pixel_centres: false,
     }
 }
 

@@ -7,7 +7,9 @@ use crate::rgb_image::RgbImage;
 use crate::scene::{Camera, CameraFrame};
 use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, BackendError, Bind, BufferId};
-use strata_kernels::render_types::{FLAG_HIT_LIGHTS, FLAG_RUSSIAN_ROULETTE, FLAG_SAMPLE_LIGHTS, RenderParams};
+use strata_kernels::render_types::{
+    FLAG_HIT_LIGHTS, FLAG_PIXEL_CENTRES, FLAG_RUSSIAN_ROULETTE, FLAG_SAMPLE_LIGHTS, RenderParams,
+};
 use strata_kernels::{Kernel, KernelId, Registry};
 
 /// How light is found (all three estimate the same image).
@@ -38,6 +40,10 @@ pub struct RenderSettings {
     pub light_sampling: LightSampling,
     /// Russian roulette on (unbiased either way).
     pub russian_roulette: bool,
+    /// Camera rays through pixel centres, no film jitter (a diagnostic: the image is the
+    /// point-sampled one, so compare it with a reference rendered the same way). Default
+    /// off: each sample takes a uniform point of its pixel.
+    pub pixel_centres: bool,
 }
 
 impl RenderSettings {
@@ -51,6 +57,7 @@ impl RenderSettings {
             rr_depth: scene.rr_depth,
             light_sampling: LightSampling::Mis,
             russian_roulette: true,
+            pixel_centres: false,
         }
     }
 
@@ -81,7 +88,8 @@ impl RenderSettings {
             LightSampling::Mis => FLAG_SAMPLE_LIGHTS | FLAG_HIT_LIGHTS,
             LightSampling::Nee => FLAG_SAMPLE_LIGHTS,
             LightSampling::Bsdf => FLAG_HIT_LIGHTS,
-        } | if self.russian_roulette { FLAG_RUSSIAN_ROULETTE } else { 0 };
+        } | if self.russian_roulette { FLAG_RUSSIAN_ROULETTE } else { 0 }
+            | if self.pixel_centres { FLAG_PIXEL_CENTRES } else { 0 };
         Ok(RenderParams {
             width: camera.width,
             height: camera.height,

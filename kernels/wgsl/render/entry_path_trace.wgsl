@@ -23,7 +23,7 @@ fn path_trace(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invoc
     }
     let pixel = id.y * params.width + id.x;
     rng_seed(pixel, params.sample_index, params.seed);
-    let film = vec2<f32>(f32(id.x), f32(id.y)) + random2();
+    let film = film_position(id.xy, random2());
     let sample = trace_path(camera_ray(film), lane);
     var total = accumulation[pixel];
     if sample.invalid || !is_finite(sample.radiance) {

@@ -17,6 +17,16 @@
 const FLAG_SAMPLE_LIGHTS: u32 = 1u;      // next-event estimation
 const FLAG_HIT_LIGHTS: u32 = 2u;         // emission found by BSDF sampling counts
 const FLAG_RUSSIAN_ROULETTE: u32 = 4u;   // from depth rr_depth
+const FLAG_PIXEL_CENTRES: u32 = 8u;      // camera rays through pixel centres (no film jitter)
+
+// The film position of pixel `pixel`'s camera ray: a uniform point of the pixel from
+// `u` in [0, 1)², or its centre with FLAG_PIXEL_CENTRES.
+fn film_position(pixel: vec2<u32>, u: vec2<f32>) -> vec2<f32> {
+    if (params.flags & FLAG_PIXEL_CENTRES) != 0u {
+        return vec2<f32>(pixel) + vec2<f32>(0.5);
+    }
+    return vec2<f32>(pixel) + u;
+}
 
 // Material.kind
 const MATERIAL_DIFFUSE: u32 = 0u;

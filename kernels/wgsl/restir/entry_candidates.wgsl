@@ -74,7 +74,7 @@ fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
     }
     let pixel = id.y * params.width + id.x;
     rng_seed(pixel, params.sample_index, params.seed);
-    let ray = camera_ray(vec2<f32>(f32(id.x), f32(id.y)) + random2());
+    let ray = camera_ray(film_position(id.xy, random2()));
     var primary = Primary(vec3<f32>(0.0), OBJECT_ID_NONE, vec3<f32>(0.0, 0.0, 1.0), 0u, -ray.direction, 0u, vec3<f32>(0.0), 0.0);
     var candidate = no_candidate();
     var base = vec3<f32>(0.0);

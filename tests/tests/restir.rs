@@ -243,6 +243,42 @@ fn shaded_parts_add_up_to_the_image() {
     }
 }
 
+/// `pixel_centres` reaches the ReSTIR frames: the primary hits are then the same for
+/// every seed and frame (and differ with film jitter); the path tracer, which renders
+/// the references, does the same.
+#[test]
+fn pixel_centres_remove_the_film_jitter() {
+    let Some(mut backend) = strata_tests::vulkan_backend("pixel_centres_remove_the_film_jitter") else {
+        assert!(!gpu_required());
+        return;
+    };
+    let scene = default_scene();
+    let gpu_scene = GpuScene::build(&scene).unwrap();
+    let mut primaries = |seed: u32, pixel_centres: bool| {
+        let render = RenderSettings { pixel_centres, ..settings(&scene, seed) };
+        let mut renderer =
+            RestirRenderer::new(&mut backend, &gpu_scene, &render, RestirSettings::default(), scene.extent()).unwrap();
+        renderer.render_frame(&mut backend, None).unwrap();
+        renderer.render_frame(&mut backend, None).unwrap();
+        let buffers = renderer.frame_buffers(&mut backend).unwrap();
+        renderer.destroy(&mut backend).unwrap();
+        buffers.primaries.iter().map(|p| p.position).collect::<Vec<_>>()
+    };
+    assert_eq!(primaries(1, true), primaries(2, true));
+    assert_ne!(primaries(1, false), primaries(2, false));
+    // The path tracer (references): with only the camera segment (max depth 1) the image
+    // is the emission seen directly, the same for every seed at pixel centres, and
+    // different at the light's edges with jitter.
+    let mut emission = |seed: u32, pixel_centres: bool| {
+        let render = RenderSettings { pixel_centres, max_depth: 1, ..settings(&scene, seed) };
+        strata::render::render(&mut backend, &gpu_scene, &render, 1, |_| {}).unwrap().pixels
+    };
+    let centres = emission(3, true);
+    assert!(centres.iter().any(|p| p[0] > 0.0), "the light is in view");
+    assert_eq!(centres, emission(4, true));
+    assert_ne!(emission(3, false), emission(4, false));
+}
+
 #[test]
 fn bad_restir_settings_are_errors_naming_the_value() {
     let mut backend = strata_backends::cpu_backend::CpuBackend::new(Default::default()).unwrap();

@@ -11,7 +11,9 @@ use crate::scene::{Camera, CameraFrame};
 use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, BackendError, Bind, BufferId};
 use strata_kernels::block_grid::frame_shift;
-use strata_kernels::render_types::{FLAG_HIT_LIGHTS, FLAG_RUSSIAN_ROULETTE, FLAG_SAMPLE_LIGHTS, RenderParams};
+use strata_kernels::render_types::{
+    FLAG_HIT_LIGHTS, FLAG_PIXEL_CENTRES, FLAG_RUSSIAN_ROULETTE, FLAG_SAMPLE_LIGHTS, RenderParams,
+};
 use strata_kernels::restir_types::{
     METHOD_RESTIR, METHOD_RESTIR_DISC, METHOD_STRATA, PathCandidate, Primary, Reservoir, RestirParams,
 };
@@ -124,8 +126,12 @@ impl RestirRenderer {
         let pixels = u64::from(camera.width) * u64::from(camera.height);
         let scene_buffers = SceneBuffers::upload(backend, scene)?;
         let mut params = render.params(&scene.params)?;
-        params.flags =
-            FLAG_SAMPLE_LIGHTS | FLAG_HIT_LIGHTS | if render.russian_roulette { FLAG_RUSSIAN_ROULETTE } else { 0 };
+        // ReSTIR always combines light sampling and BSDF hits (its candidates' RIS needs
+        // both); the rest follows the render settings.
+        params.flags = FLAG_SAMPLE_LIGHTS
+            | FLAG_HIT_LIGHTS
+            | if render.russian_roulette { FLAG_RUSSIAN_ROULETTE } else { 0 }
+            | if render.pixel_centres { FLAG_PIXEL_CENTRES } else { 0 };
         let buffer = |backend: &mut dyn Backend, name: &str, bytes: u64| backend.create_buffer(name, bytes);
         let primary_size = pixels * size_of::<Primary>() as u64;
         let reservoir_size = pixels * size_of::<Reservoir>() as u64;

@@ -11,9 +11,7 @@ use crate::scene::{Camera, CameraFrame};
 use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, BackendError, Bind, BufferId};
 use strata_kernels::block_grid::frame_shift;
-use strata_kernels::render_types::{
-    FLAG_HIT_LIGHTS, FLAG_PIXEL_CENTRES, FLAG_RUSSIAN_ROULETTE, FLAG_SAMPLE_LIGHTS, RenderParams,
-};
+use strata_kernels::render_types::{FLAG_HIT_LIGHTS, FLAG_SAMPLE_LIGHTS, RenderParams};
 use strata_kernels::restir_types::{
     METHOD_RESTIR, METHOD_RESTIR_DISC, METHOD_STRATA, PathCandidate, Primary, Reservoir, RestirParams,
 };
@@ -127,11 +125,8 @@ impl RestirRenderer {
         let scene_buffers = SceneBuffers::upload(backend, scene)?;
         let mut params = render.params(&scene.params)?;
         // ReSTIR always combines light sampling and BSDF hits (its candidates' RIS needs
-        // both); the rest follows the render settings.
-        params.flags = FLAG_SAMPLE_LIGHTS
-            | FLAG_HIT_LIGHTS
-            | if render.russian_roulette { FLAG_RUSSIAN_ROULETTE } else { 0 }
-            | if render.pixel_centres { FLAG_PIXEL_CENTRES } else { 0 };
+        // both); every other flag is the render settings' own.
+        params.flags |= FLAG_SAMPLE_LIGHTS | FLAG_HIT_LIGHTS;
         let buffer = |backend: &mut dyn Backend, name: &str, bytes: u64| backend.create_buffer(name, bytes);
         let primary_size = pixels * size_of::<Primary>() as u64;
         let reservoir_size = pixels * size_of::<Reservoir>() as u64;

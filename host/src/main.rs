@@ -106,6 +106,14 @@ struct CompareArgs {
     /// No object-id masking: one histogram cluster per block.
     #[arg(long)]
     no_masking: bool,
+    /// A conductor at the primary hit resamples only from this GGX alpha up; smoother
+    /// ones path-trace on their own (1 sample per frame, no reuse).
+    #[arg(long, default_value_t = RestirSettings::default().min_roughness)]
+    min_roughness: f32,
+    /// No reconnection to a vertex closer than this (scene units) to a primary hit;
+    /// 0: 1e-3 of the scene's extent.
+    #[arg(long, default_value_t = 0.0)]
+    min_distance: f32,
     /// Camera motion: `static`, `orbit:DEGREES_PER_FRAME`, `dolly:DISTANCE_PER_FRAME` or
     /// a keyframe JSON file. A moving camera needs a reference per frame: they are
     /// path-traced (`--reference-spp` each) and `--reference` is refused.
@@ -308,6 +316,8 @@ fn compare(args: CompareArgs) -> Result<()> {
             block_shift: args.block_shift,
             temporal_candidates: args.temporal_candidates,
             shaded_parts: args.shaded_parts,
+            min_roughness: args.min_roughness,
+            min_distance: args.min_distance,
             ..RestirSettings::default()
         },
         accumulate: args.accumulate,

@@ -285,8 +285,10 @@ fn bad_restir_settings_are_errors_naming_the_value() {
     let scene = default_scene();
     let gpu_scene = GpuScene::build(&scene).unwrap();
     let render = settings(&scene, 1);
-    let cases: [(RestirSettings, &str); 4] = [
+    let cases: [(RestirSettings, &str); 6] = [
         (RestirSettings { block_size: 12, ..Default::default() }, "block size 12"),
+        (RestirSettings { min_roughness: f32::NAN, ..Default::default() }, "min roughness NaN"),
+        (RestirSettings { min_distance: -1.0, ..Default::default() }, "min distance -1"),
         (RestirSettings { candidates: 5, ..Default::default() }, "candidates 5"),
         (RestirSettings { temporal_cap: 0.5, ..Default::default() }, "temporal cap 0.5"),
         (

@@ -153,6 +153,18 @@ impl RestirSettings {
         if !(self.disc_radius > 0.0 && self.disc_radius.is_finite()) {
             return Err(PassError::Input(format!("disc radius {}: must be positive", self.disc_radius)));
         }
+        if !(self.min_distance >= 0.0 && self.min_distance.is_finite()) {
+            return Err(PassError::Input(format!(
+                "min distance {}: must be 0 (automatic) or a positive length",
+                self.min_distance
+            )));
+        }
+        if !(self.min_roughness >= 0.0 && self.min_roughness.is_finite()) {
+            return Err(PassError::Input(format!(
+                "min roughness {}: must be a GGX alpha of 0 or more",
+                self.min_roughness
+            )));
+        }
         if self.method == Method::Strata
             && self.candidates != 4
             && matches!(self.sampler, SamplerVariant::Antithetic | SamplerVariant::Heitz)

@@ -40,5 +40,5 @@
 mod patterns;
 mod ris_1d;
 
-pub use patterns::{K, SelectionPattern, expected_counts, select};
+pub use patterns::{K, SelectionPattern, expected_counts, select, variance_of_selected_mean};
 pub use ris_1d::{Estimate, OneDimensionalProblem, run_estimates};

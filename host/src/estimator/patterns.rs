@@ -72,6 +72,52 @@ pub fn expected_counts(pattern: SelectionPattern, n: usize) -> Vec<f64> {
     counts
 }
 
+/// Exact variance of the mean of the K values a pattern selects from `sorted_values`
+/// (ascending, as the histogram sorts them). Uniform random picks are independent, so
+/// it is the pool's variance over K; for the stratified patterns every position is
+/// affine in the one number u ∈ [0, 1/K), so the selected values are constant between
+/// the u at which some position crosses a cell boundary, and the variance is integrated
+/// exactly piece by piece. This is the selection's share of a pixel's variance, the only
+/// part a pattern can change.
+pub fn variance_of_selected_mean(pattern: SelectionPattern, sorted_values: &[f64]) -> f64 {
+    let n = sorted_values.len();
+    assert!(n > 0, "an empty pool has no selection");
+    if pattern == SelectionPattern::UniformRandom {
+        let mean = sorted_values.iter().sum::<f64>() / n as f64;
+        let pool_variance = sorted_values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
+        return pool_variance / K as f64;
+    }
+    // Breakpoints of u ∈ [0, 1) (the pattern scales it to [0, 1/K)) where a position
+    // crosses a cell boundary i/n.
+    let mut breaks = vec![0.0, 1.0];
+    for i in 0..=n {
+        let boundary = i as f64 / n as f64;
+        for j in 0..K {
+            // The u at which a position (j + u)/K or (j + 1 − u)/K meets the boundary.
+            let offset = boundary * K as f64 - j as f64;
+            for t in [offset, 1.0 - offset] {
+                if t > 0.0 && t < 1.0 {
+                    breaks.push(t);
+                }
+            }
+        }
+    }
+    breaks.sort_by(f64::total_cmp);
+    breaks.dedup();
+    // Stratified patterns draw nothing from the generator.
+    let mut rng = rand_pcg::Pcg64Mcg::new(0);
+    let (mut first, mut second) = (0.0, 0.0);
+    for pair in breaks.windows(2) {
+        let share = pair[1] - pair[0];
+        let u = 0.5 * (pair[0] + pair[1]);
+        let selected = pattern.positions(u, &mut rng).map(|pos| sorted_values[index_of(pos, n)]);
+        let mean = selected.iter().sum::<f64>() / K as f64;
+        first += share * mean;
+        second += share * mean * mean;
+    }
+    second - first * first
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -110,6 +156,53 @@ mod tests {
                     "{pattern:?} {i}: {mean}"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn stratification_gains_little_when_bright_candidates_are_rare() {
+        // A pool of n with m bright candidates (1) among dark ones (0), sorted: for
+        // m/n = q ≤ 1/4 only the antithetic position 1 − u reaches the bright ones, with
+        // probability 4q, so antithetic ÷ uniform = (1 − 4q) / (1 − q): about 1 − 3q.
+        let n = 256;
+        for m in [1, 4, 16, 64] {
+            let pool: Vec<f64> = (0..n).map(|i| if i >= n - m { 1.0 } else { 0.0 }).collect();
+            let q = m as f64 / n as f64;
+            let uniform = variance_of_selected_mean(SelectionPattern::UniformRandom, &pool);
+            let antithetic = variance_of_selected_mean(SelectionPattern::Antithetic, &pool);
+            assert!((uniform - q * (1.0 - q) / K as f64).abs() < 1e-12);
+            let ratio = antithetic / uniform;
+            let want = (1.0 - 4.0 * q) / (1.0 - q);
+            assert!((ratio - want).abs() < 1e-9, "m = {m}: {ratio} != {want}");
+        }
+        // Smooth pools, by contrast, lose most of their selection variance: the mirrored
+        // pairs integrate a linear ramp exactly, and a quadratic one nearly.
+        let ratio = |power: i32| {
+            let pool: Vec<f64> = (0..n).map(|i| (i as f64 / n as f64).powi(power)).collect();
+            variance_of_selected_mean(SelectionPattern::Antithetic, &pool)
+                / variance_of_selected_mean(SelectionPattern::UniformRandom, &pool)
+        };
+        assert!(ratio(1) < 1e-12, "{}", ratio(1));
+        assert!(ratio(2) < 0.05, "{}", ratio(2));
+    }
+
+    #[test]
+    fn exact_selection_variance_agrees_with_sampling() {
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(11);
+        let pool: Vec<f64> = (0..13).map(|i| f64::from(i * i % 7) + 0.25 * f64::from(i)).collect();
+        let mut sorted = pool.clone();
+        sorted.sort_by(f64::total_cmp);
+        for pattern in SelectionPattern::ALL {
+            let exact = variance_of_selected_mean(pattern, &sorted);
+            let trials = 400_000;
+            let (mut s1, mut s2) = (0.0, 0.0);
+            for _ in 0..trials {
+                let mean = select(pattern, sorted.len(), &mut rng).map(|i| sorted[i]).iter().sum::<f64>() / K as f64;
+                s1 += mean;
+                s2 += mean * mean;
+            }
+            let sampled = s2 / trials as f64 - (s1 / trials as f64).powi(2);
+            assert!((sampled - exact).abs() < 0.02 * exact, "{pattern:?}: sampled {sampled}, exact {exact}");
         }
     }
 

@@ -243,6 +243,40 @@ fn shaded_parts_add_up_to_the_image() {
     }
 }
 
+/// `min_roughness` decides which conductors resample: with the default scene's white
+/// surfaces (floor, ceiling, back wall, boxes) made a GGX conductor of alpha 0.1, they have no
+/// resampled part at the default threshold of 0.2 and have one at 0.05.
+#[test]
+fn min_roughness_decides_which_conductors_resample() {
+    let Some(mut backend) = strata_tests::vulkan_backend("min_roughness_decides_which_conductors_resample") else {
+        assert!(!gpu_required());
+        return;
+    };
+    let mut scene = default_scene();
+    scene.materials[0] = strata::scene::Material::RoughConductor {
+        alpha: 0.1,
+        eta: [0.2, 0.9, 1.1],
+        k: [3.9, 2.4, 2.2],
+        two_sided: true,
+    };
+    let gpu_scene = GpuScene::build(&scene).unwrap();
+    let mut lit_pixels = |min_roughness: f32| {
+        let restir =
+            RestirSettings { min_roughness, shaded_parts: ShadedParts::Resampled, ..RestirSettings::default() };
+        let mut renderer =
+            RestirRenderer::new(&mut backend, &gpu_scene, &settings(&scene, 5), restir, scene.extent()).unwrap();
+        let image = renderer.render_frame(&mut backend, None).unwrap().0;
+        renderer.destroy(&mut backend).unwrap();
+        image.pixels.iter().filter(|p| p.iter().any(|&v| v > 0.0)).count()
+    };
+    let (strict, loose) = (lit_pixels(0.2), lit_pixels(0.05));
+    let total = (SIZE * SIZE) as usize;
+    // Only the red and green walls resample at 0.2; the conductor (floor, ceiling, back
+    // wall and both boxes) covers well over a fifth of the image.
+    assert!(strict < total / 2, "{strict} of {total} pixels resample at 0.2");
+    assert!(loose > strict + total / 5, "{loose} pixels resample at 0.05, {strict} at 0.2");
+}
+
 /// `pixel_centres` reaches the ReSTIR frames: the primary hits are then the same for
 /// every seed and frame (and differ with film jitter); the path tracer, which renders
 /// the references, does the same.

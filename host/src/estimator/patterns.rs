@@ -78,7 +78,7 @@ pub fn expected_counts(pattern: SelectionPattern, n: usize) -> Vec<f64> {
 /// affine in the one number u ∈ [0, 1/K), so the selected values are constant between
 /// the u at which some position crosses a cell boundary, and the variance is integrated
 /// exactly piece by piece. This is the selection's share of a pixel's variance, the only
-/// part a pattern can change.
+/// part a pattern can change. Panics on an empty pool.
 pub fn variance_of_selected_mean(pattern: SelectionPattern, sorted_values: &[f64]) -> f64 {
     let n = sorted_values.len();
     assert!(n > 0, "an empty pool has no selection");

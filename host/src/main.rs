@@ -112,7 +112,7 @@ struct CompareArgs {
     min_roughness: f32,
     /// No reconnection to a vertex closer than this (scene units) to a primary hit;
     /// 0: 1e-3 of the scene's extent.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = RestirSettings::default().min_distance)]
     min_distance: f32,
     /// Camera motion: `static`, `orbit:DEGREES_PER_FRAME`, `dolly:DISTANCE_PER_FRAME` or
     /// a keyframe JSON file. A moving camera needs a reference per frame: they are
@@ -261,6 +261,20 @@ fn compare(args: CompareArgs) -> Result<()> {
     if args.frames == 0 || args.seeds == 0 {
         bail!("--frames and --seeds must be at least 1");
     }
+    let restir = RestirSettings {
+        block_size: args.block_size,
+        sampler: args.sampler,
+        temporal: !args.accumulate,
+        masking: !args.no_masking,
+        block_shift: args.block_shift,
+        temporal_candidates: args.temporal_candidates,
+        shaded_parts: args.shaded_parts,
+        min_roughness: args.min_roughness,
+        min_distance: args.min_distance,
+        ..RestirSettings::default()
+    };
+    // Refused settings are said before the reference takes its minutes.
+    restir.check()?;
     let gpu_scene = GpuScene::build(&scene)?;
     let mut backend = open_backend(args.backend)?;
     println!("backend: {}", backend.info().summary());
@@ -308,18 +322,7 @@ fn compare(args: CompareArgs) -> Result<()> {
         methods: args.methods.clone(),
         frames: args.frames,
         seeds: (1..=args.seeds).collect(),
-        restir: RestirSettings {
-            block_size: args.block_size,
-            sampler: args.sampler,
-            temporal: !args.accumulate,
-            masking: !args.no_masking,
-            block_shift: args.block_shift,
-            temporal_candidates: args.temporal_candidates,
-            shaded_parts: args.shaded_parts,
-            min_roughness: args.min_roughness,
-            min_distance: args.min_distance,
-            ..RestirSettings::default()
-        },
+        restir,
         accumulate: args.accumulate,
         cameras,
     };

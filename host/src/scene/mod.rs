@@ -41,8 +41,9 @@ use thiserror::Error;
 /// A scene file or mesh that cannot be loaded.
 #[derive(Debug, Error)]
 pub enum SceneError {
-    /// A file could not be read.
-    #[error("{path}: {source}")]
+    /// A file could not be read (the OS error is the source, so an error chain names it
+    /// once).
+    #[error("{path}: cannot read the file")]
     Io {
         /// The file.
         path: PathBuf,

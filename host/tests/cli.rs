@@ -1,0 +1,172 @@
+//! The `strata` command line as a user runs it: the README's compare command at a tiny
+//! size, its fall-back to the CPU interpreter when no Vulkan device exists, and the
+//! errors that bad arguments and missing files give (a message naming the value or the
+//! file, exit status 1, no panic, nothing rendered first).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// A fresh, empty folder for one test.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("strata-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("a scratch folder");
+    dir
+}
+
+/// `strata ARGS` with every Vulkan driver hidden from the loader, so the command line
+/// must fall back to the CPU interpreter (and does so on any machine).
+fn strata_without_vulkan(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_strata"))
+        .args(args)
+        .env("VK_ICD_FILENAMES", "/nonexistent/strata-no-driver.json")
+        .env("VK_DRIVER_FILES", "/nonexistent/strata-no-driver.json")
+        .env("RUST_BACKTRACE", "0")
+        .env("RUST_LIB_BACKTRACE", "0")
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .expect("the strata binary runs")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// Asserts that `output` is a refusal (exit status 1, no panic) whose message contains
+/// every one of `names`.
+fn assert_refused(output: &Output, names: &[&str]) {
+    let stderr = text(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "expected a refusal; stderr:\n{stderr}");
+    assert!(!stderr.contains("panicked"), "a panic instead of an error:\n{stderr}");
+    for name in names {
+        assert!(stderr.contains(name), "the error does not name `{name}`:\n{stderr}");
+    }
+}
+
+#[test]
+fn compare_without_a_vulkan_device_runs_on_the_interpreter_and_says_so() {
+    let out = scratch("compare");
+    let out_arg = out.to_str().unwrap();
+    let args = ["compare", "--width", "16", "--height", "16", "--frames", "2", "--seeds", "3", "--reference-spp", "4"];
+    let output = strata_without_vulkan(&[&args[..], &["--out", out_arg]].concat());
+    let (stdout, stderr) = (text(&output.stdout), text(&output.stderr));
+    assert!(output.status.success(), "compare failed:\n{stdout}\n{stderr}");
+    assert!(stderr.contains("no GPU adapter found") && stderr.contains("CPU interpreter"), "no notice:\n{stderr}");
+    assert!(stdout.contains("backend: cpu"), "{stdout}");
+    // The summary table: every method and the ratios against both baselines.
+    for row in ["restir ", "restir-disc ", "strata ", "÷ restir ", "÷ restir-disc "] {
+        assert!(stdout.contains(row), "no `{row}` row in the summary:\n{stdout}");
+    }
+    for file in [
+        "reference.exr",
+        "reference.png",
+        "relmse.svg",
+        "variance.csv",
+        "strata_frame001.exr",
+        "strata_frame002.png",
+        "restir_frame002_relmse.exr",
+        "restir-disc_frame001_relmse.png",
+    ] {
+        assert!(out.join(file).is_file(), "{file} was not written");
+    }
+    // errors.csv: one row per method, frame and seed, with finite positive errors.
+    let csv = std::fs::read_to_string(out.join("errors.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    for column in ["method", "frame", "seed", "relmse", "prelmse", "mse"] {
+        assert!(header.contains(&column), "errors.csv lacks column {column}: {header:?}");
+    }
+    let rows: Vec<Vec<&str>> = lines.map(|line| line.split(',').collect()).collect();
+    assert_eq!(rows.len(), 3 * 2 * 3, "3 methods x 2 frames x 3 seeds");
+    let relmse = header.iter().position(|c| *c == "relmse").unwrap();
+    for row in &rows {
+        let value: f64 = row[relmse].parse().unwrap();
+        assert!(value.is_finite() && value > 0.0, "relmse {value} in {row:?}");
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn bad_compare_arguments_are_refused_before_anything_renders() {
+    let out = scratch("refused");
+    let out_arg = out.to_str().unwrap();
+    let cases: [(&[&str], &[&str]); 6] = [
+        (&["--block-size", "12"], &["block size 12"]),
+        (&["--width", "0"], &["--width 0"]),
+        (&["--min-roughness", "NaN"], &["min roughness NaN"]),
+        (&["--min-distance=-1"], &["min distance -1"]),
+        (&["--temporal-candidates", "9"], &["temporal candidates 9"]),
+        (&["--frames", "0"], &["--frames"]),
+    ];
+    for (arguments, names) in cases {
+        let output = strata_without_vulkan(&[&["compare", "--out", out_arg][..], arguments].concat());
+        assert_refused(&output, names);
+        assert!(!text(&output.stdout).contains("rendering the reference"), "{arguments:?} rendered first");
+        assert!(!out.join("reference.exr").exists(), "{arguments:?} rendered a reference");
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn missing_and_unreadable_files_are_named() {
+    let out = scratch("files");
+    let missing_scene = out.join("no-such-scene.json");
+    let output = strata_without_vulkan(&["compare", missing_scene.to_str().unwrap()]);
+    assert_refused(&output, &["no-such-scene.json", "cannot read"]);
+    // The OS reason is said once, not twice.
+    assert_eq!(text(&output.stderr).matches("No such file").count(), 1, "{}", text(&output.stderr));
+
+    let xml = out.join("scene.xml");
+    std::fs::write(&xml, "<scene/>").unwrap();
+    assert_refused(&strata_without_vulkan(&["render", xml.to_str().unwrap()]), &["scene.xml", "xml"]);
+
+    let missing_exr = out.join("missing.exr");
+    let output = strata_without_vulkan(&["metrics", missing_exr.to_str().unwrap(), missing_exr.to_str().unwrap()]);
+    assert_refused(&output, &["missing.exr"]);
+
+    let not_an_exr = out.join("text.exr");
+    std::fs::write(&not_an_exr, "not an image").unwrap();
+    let output =
+        strata_without_vulkan(&["compare", "--reference", not_an_exr.to_str().unwrap(), "--out", out_str(&out)]);
+    assert_refused(&output, &["text.exr"]);
+
+    let missing_csv = out.join("missing.csv");
+    assert_refused(&strata_without_vulkan(&["plot", missing_csv.to_str().unwrap()]), &["missing.csv"]);
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn a_reference_of_another_size_is_refused_naming_both_sizes() {
+    let out = scratch("reference-size");
+    let reference = out.join("reference.exr");
+    let output =
+        strata_without_vulkan(&["render", "--width", "8", "--height", "6", "--spp", "1", "--out", out_str(&out)]);
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    let rendered = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|entry| entry.unwrap().path())
+        .find(|path| path.extension().is_some_and(|e| e == "exr"))
+        .expect("render wrote an EXR");
+    std::fs::rename(rendered, &reference).unwrap();
+    let output = strata_without_vulkan(&[
+        "compare",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--frames",
+        "1",
+        "--seeds",
+        "1",
+        "--reference",
+        reference.to_str().unwrap(),
+        "--out",
+        out_str(&out),
+    ]);
+    assert_refused(&output, &["8x6", "16x16"]);
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+fn out_str(path: &Path) -> &str {
+    path.to_str().expect("a UTF-8 temporary path")
+}

@@ -185,6 +185,22 @@ fn ratio_of(
     (!ratios.is_empty()).then(|| MeanInterval::of(&ratios))
 }
 
+/// Per seed, `method`'s RelMSE summed over every frame divided by `baseline`'s, with its
+/// mean and interval over seeds: one paired ratio for a whole run. The frames of one seed
+/// are correlated (a reservoir lives on), so frames are pooled within a seed, never
+/// counted as independent samples. Seeds missing a frame of either method are left out.
+pub fn relmse_ratio_over_frames(errors: &[FrameError], method: Method, baseline: Method) -> Option<MeanInterval> {
+    let frames: std::collections::BTreeSet<u32> = errors.iter().map(|e| e.frame).collect();
+    let seeds: std::collections::BTreeSet<u32> = errors.iter().map(|e| e.seed).collect();
+    let summed = |m: Method, seed: u32| -> Option<f64> {
+        let values: Vec<f64> = errors.iter().filter(|e| e.method == m && e.seed == seed).map(|e| e.relmse).collect();
+        (values.len() == frames.len()).then(|| values.iter().sum())
+    };
+    let ratios: Vec<f64> =
+        seeds.iter().filter_map(|&seed| Some(summed(method, seed)? / summed(baseline, seed)?)).collect();
+    (!ratios.is_empty()).then(|| MeanInterval::of(&ratios))
+}
+
 /// Reads the CSV [`errors_csv`] writes; an error names the line and what is wrong.
 pub fn parse_errors_csv(text: &str) -> Result<Vec<FrameError>, String> {
     let mut lines = text.lines();
@@ -250,5 +266,34 @@ mod tests {
         assert!(parse_errors_csv(bad).unwrap_err().contains("line 2"));
         let unknown = "method,frame,seed,relmse,prelmse,mse\nfoo,1,1,0.1,0.1,0.1\n";
         assert!(parse_errors_csv(unknown).unwrap_err().contains("`foo`"));
+    }
+
+    #[test]
+    fn the_ratio_over_frames_pools_frames_within_a_seed() {
+        let error = |method, frame, seed, relmse| FrameError {
+            method,
+            frame,
+            seed,
+            relmse,
+            prelmse: relmse,
+            mse: relmse,
+            relmse_luminance: None,
+        };
+        // Seed s: restir has RelMSE 3 and 1 at frames 0 and 1; strata 1 and 1, so the
+        // pooled ratio is 2/4 for every seed, while the per-frame ratios are 1/3 and 1.
+        let mut errors = Vec::new();
+        for seed in 1..=3 {
+            errors.extend([error(Method::Restir, 0, seed, 3.0), error(Method::Restir, 1, seed, 1.0)]);
+            errors.extend([error(Method::Strata, 0, seed, 1.0), error(Method::Strata, 1, seed, 1.0)]);
+        }
+        let pooled = relmse_ratio_over_frames(&errors, Method::Strata, Method::Restir).unwrap();
+        assert!((pooled.mean - 0.5).abs() < 1e-12 && pooled.half_width < 1e-12 && pooled.count == 3, "{pooled:?}");
+        // A seed that lacks a frame is left out, not pooled over fewer frames.
+        errors.push(error(Method::Strata, 0, 4, 100.0));
+        errors.push(error(Method::Restir, 0, 4, 1.0));
+        errors.push(error(Method::Restir, 1, 4, 1.0));
+        let pooled = relmse_ratio_over_frames(&errors, Method::Strata, Method::Restir).unwrap();
+        assert_eq!(pooled.count, 3);
+        assert!(relmse_ratio_over_frames(&errors, Method::Strata, Method::RestirDisc).is_none());
     }
 }

@@ -6,7 +6,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 use strata::backend_choice::{BackendChoice, open_backend};
 use strata::compare::{
-    Comparison, FrameError, errors_csv, luminance_relmse_ratio, relmse_over_seeds, relmse_ratio, run_comparison,
+    Comparison, FrameError, errors_csv, luminance_relmse_ratio, relmse_over_seeds, relmse_ratio,
+    relmse_ratio_over_frames, run_comparison,
 };
 use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
 use strata::metrics::{self, MeanInterval, Metric};
@@ -455,6 +456,23 @@ fn run_and_report(
                     print!(" | {text:>20}");
                 }
                 println!();
+            }
+        }
+        // One paired ratio for the whole run: per seed, RelMSE summed over all frames.
+        for baseline in [Method::Restir, Method::RestirDisc] {
+            if let Some(r) = args
+                .methods
+                .contains(&baseline)
+                .then(|| relmse_ratio_over_frames(&errors, Method::Strata, baseline))
+                .flatten()
+            {
+                println!(
+                    "strata ÷ {} over frames 1-{} (per seed, RelMSE summed over the frames): {:.4} ± {:.4}",
+                    baseline.name(),
+                    args.frames,
+                    r.mean,
+                    r.half_width
+                );
             }
         }
     }

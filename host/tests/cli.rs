@@ -54,7 +54,15 @@ fn compare_without_a_vulkan_device_runs_on_the_interpreter_and_says_so() {
     assert!(stderr.contains("no GPU adapter found") && stderr.contains("CPU interpreter"), "no notice:\n{stderr}");
     assert!(stdout.contains("backend: cpu"), "{stdout}");
     // The summary table: every method and the ratios against both baselines.
-    for row in ["restir ", "restir-disc ", "strata ", "÷ restir ", "÷ restir-disc "] {
+    for row in [
+        "restir ",
+        "restir-disc ",
+        "strata ",
+        "÷ restir ",
+        "÷ restir-disc ",
+        "strata ÷ restir over frames 1-2",
+        "strata ÷ restir-disc over frames 1-2",
+    ] {
         assert!(stdout.contains(row), "no `{row}` row in the summary:\n{stdout}");
     }
     for file in [

@@ -458,23 +458,7 @@ fn run_and_report(
                 println!();
             }
         }
-        // One paired ratio for the whole run: per seed, RelMSE summed over all frames.
-        for baseline in [Method::Restir, Method::RestirDisc] {
-            if let Some(r) = args
-                .methods
-                .contains(&baseline)
-                .then(|| relmse_ratio_over_frames(&errors, Method::Strata, baseline))
-                .flatten()
-            {
-                println!(
-                    "strata ÷ {} over frames 1-{} (per seed, RelMSE summed over the frames): {:.4} ± {:.4}",
-                    baseline.name(),
-                    args.frames,
-                    r.mean,
-                    r.half_width
-                );
-            }
-        }
+        print_ratio_over_frames(&errors, args.frames);
     }
     let mut wrote = format!("{}, {}", csv.display(), plot.display());
     if args.seeds >= 3 {
@@ -484,6 +468,22 @@ fn run_and_report(
     }
     println!("wrote {wrote} and images in {}", args.out.display());
     Ok(())
+}
+
+/// strata ÷ each baseline over the whole run, one paired ratio per baseline the errors
+/// hold ([`relmse_ratio_over_frames`]).
+fn print_ratio_over_frames(errors: &[FrameError], frames: u32) {
+    for baseline in [Method::Restir, Method::RestirDisc] {
+        if let Some(r) = relmse_ratio_over_frames(errors, Method::Strata, baseline) {
+            println!(
+                "strata ÷ {} over frames 1-{frames} (per seed, RelMSE summed over the frames): {:.4} ± {:.4} ({} seeds)",
+                baseline.name(),
+                r.mean,
+                r.half_width,
+                r.count
+            );
+        }
+    }
 }
 
 /// The reference-free summary (`strata::variance`), of the images and of their
@@ -577,6 +577,7 @@ fn plot(args: PlotArgs) -> Result<()> {
     std::fs::write(&args.out, strata::plot::relmse_svg(&errors, &methods, frames, &args.title))
         .with_context(|| format!("{}: cannot write", args.out.display()))?;
     println!("wrote {}", args.out.display());
+    print_ratio_over_frames(&errors, frames);
     Ok(())
 }
 

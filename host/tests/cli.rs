@@ -91,6 +91,15 @@ fn compare_without_a_vulkan_device_runs_on_the_interpreter_and_says_so() {
         let value: f64 = row[relmse].parse().unwrap();
         assert!(value.is_finite() && value > 0.0, "relmse {value} in {row:?}");
     }
+    // `strata plot` redraws the plot from the CSV and says the same whole-run ratios.
+    let svg = out.join("again.svg");
+    let plot = strata_without_vulkan(&["plot", out.join("errors.csv").to_str().unwrap(), "--out", out_str(&svg)]);
+    assert!(plot.status.success(), "{}", text(&plot.stderr));
+    assert!(std::fs::read_to_string(&svg).unwrap().starts_with("<svg"));
+    let said =
+        |stdout: &str| stdout.lines().filter(|l| l.contains(" over frames 1-2 ")).map(String::from).collect::<Vec<_>>();
+    assert_eq!(said(&text(&plot.stdout)), said(&stdout));
+    assert_eq!(said(&stdout).len(), 2, "{stdout}");
     let _ = std::fs::remove_dir_all(&out);
 }
 

@@ -188,14 +188,28 @@ fn ratio_of(
 /// Per seed, `method`'s RelMSE summed over every frame divided by `baseline`'s, with its
 /// mean and interval over seeds: one paired ratio for a whole run. The frames of one seed
 /// are correlated (a reservoir lives on), so frames are pooled within a seed, never
-/// counted as independent samples. Seeds missing a frame of either method are left out.
+/// counted as independent samples. The frames are those either method has; a seed that
+/// lacks one of them, or has one twice, for either method is left out. The ratio of sums
+/// is the per-frame ratios weighted by the baseline's error at each frame.
 pub fn relmse_ratio_over_frames(errors: &[FrameError], method: Method, baseline: Method) -> Option<MeanInterval> {
-    let frames: std::collections::BTreeSet<u32> = errors.iter().map(|e| e.frame).collect();
-    let seeds: std::collections::BTreeSet<u32> = errors.iter().map(|e| e.seed).collect();
+    use std::collections::{BTreeMap, BTreeSet};
+    let frames: BTreeSet<u32> =
+        errors.iter().filter(|e| e.method == method || e.method == baseline).map(|e| e.frame).collect();
+    // Per (is `method`, seed): frame -> RelMSE; a frame measured twice spoils the seed.
+    let mut runs: BTreeMap<(bool, u32), Option<BTreeMap<u32, f64>>> = BTreeMap::new();
+    for e in errors.iter().filter(|e| e.method == method || e.method == baseline) {
+        let run = runs.entry((e.method == method, e.seed)).or_insert_with(|| Some(BTreeMap::new()));
+        if let Some(values) = run
+            && values.insert(e.frame, e.relmse).is_some()
+        {
+            *run = None;
+        }
+    }
     let summed = |m: Method, seed: u32| -> Option<f64> {
-        let values: Vec<f64> = errors.iter().filter(|e| e.method == m && e.seed == seed).map(|e| e.relmse).collect();
-        (values.len() == frames.len()).then(|| values.iter().sum())
+        let values = runs.get(&(m == method, seed))?.as_ref()?;
+        values.keys().copied().eq(frames.iter().copied()).then(|| values.values().sum())
     };
+    let seeds: BTreeSet<u32> = errors.iter().map(|e| e.seed).collect();
     let ratios: Vec<f64> =
         seeds.iter().filter_map(|&seed| Some(summed(method, seed)? / summed(baseline, seed)?)).collect();
     (!ratios.is_empty()).then(|| MeanInterval::of(&ratios))
@@ -294,6 +308,13 @@ mod tests {
         errors.push(error(Method::Restir, 1, 4, 1.0));
         let pooled = relmse_ratio_over_frames(&errors, Method::Strata, Method::Restir).unwrap();
         assert_eq!(pooled.count, 3);
+        // So is a seed with a frame measured twice, even when the count of rows is right.
+        errors.push(error(Method::Strata, 0, 4, 1.0));
+        let pooled = relmse_ratio_over_frames(&errors, Method::Strata, Method::Restir).unwrap();
+        assert_eq!(pooled.count, 3);
+        // A third method with more frames does not change the pair's frames.
+        errors.push(error(Method::RestirDisc, 7, 1, 1.0));
+        assert_eq!(relmse_ratio_over_frames(&errors, Method::Strata, Method::Restir).unwrap().count, 3);
         assert!(relmse_ratio_over_frames(&errors, Method::Strata, Method::RestirDisc).is_none());
     }
 }

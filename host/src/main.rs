@@ -253,8 +253,10 @@ fn scene_and_settings(
     let width = width.unwrap_or(scene.camera.width);
     let height = height.unwrap_or(scene.camera.height);
     // Said before a backend opens or a reference starts rendering.
-    if width == 0 || height == 0 {
-        bail!("--width {width} --height {height}: the image must be at least 1x1 pixels");
+    for (flag, value) in [("--width", width), ("--height", height)] {
+        if value == 0 {
+            bail!("{flag} 0: the image must be at least 1x1 pixels");
+        }
     }
     let settings = RenderSettings::for_scene(&scene, width, height, 1);
     Ok((scene, settings))

@@ -192,22 +192,15 @@ fn ratio_of(
 /// lacks one of them, or has one twice, for either method is left out. The ratio of sums
 /// is the per-frame ratios weighted by the baseline's error at each frame.
 pub fn relmse_ratio_over_frames(errors: &[FrameError], method: Method, baseline: Method) -> Option<MeanInterval> {
-    use std::collections::{BTreeMap, BTreeSet};
+    use std::collections::BTreeSet;
     let frames: BTreeSet<u32> =
         errors.iter().filter(|e| e.method == method || e.method == baseline).map(|e| e.frame).collect();
-    // Per (is `method`, seed): frame -> RelMSE; a frame measured twice spoils the seed.
-    let mut runs: BTreeMap<(bool, u32), Option<BTreeMap<u32, f64>>> = BTreeMap::new();
-    for e in errors.iter().filter(|e| e.method == method || e.method == baseline) {
-        let run = runs.entry((e.method == method, e.seed)).or_insert_with(|| Some(BTreeMap::new()));
-        if let Some(values) = run
-            && values.insert(e.frame, e.relmse).is_some()
-        {
-            *run = None;
-        }
-    }
+    // One run's RelMSE summed over the frames, if it has each of them exactly once.
     let summed = |m: Method, seed: u32| -> Option<f64> {
-        let values = runs.get(&(m == method, seed))?.as_ref()?;
-        values.keys().copied().eq(frames.iter().copied()).then(|| values.values().sum())
+        let mut run: Vec<(u32, f64)> =
+            errors.iter().filter(|e| e.method == m && e.seed == seed).map(|e| (e.frame, e.relmse)).collect();
+        run.sort_by_key(|&(frame, _)| frame);
+        run.iter().map(|&(frame, _)| frame).eq(frames.iter().copied()).then(|| run.iter().map(|&(_, v)| v).sum())
     };
     let seeds: BTreeSet<u32> = errors.iter().map(|e| e.seed).collect();
     let ratios: Vec<f64> =

@@ -48,9 +48,8 @@ fn assert_refused(output: &Output, names: &[&str]) {
 #[test]
 fn compare_without_a_vulkan_device_runs_on_the_interpreter_and_says_so() {
     let out = scratch("compare");
-    let out_arg = out.to_str().unwrap();
     let args = ["compare", "--width", "16", "--height", "16", "--frames", "2", "--seeds", "3", "--reference-spp", "4"];
-    let output = strata_without_vulkan(&[&args[..], &["--out", out_arg]].concat());
+    let output = strata_without_vulkan(&[&args[..], &["--out", out_str(&out)]].concat());
     let (stdout, stderr) = (text(&output.stdout), text(&output.stderr));
     assert!(output.status.success(), "compare failed:\n{stdout}\n{stderr}");
     assert!(stderr.contains("no GPU adapter found") && stderr.contains("CPU interpreter"), "no notice:\n{stderr}");
@@ -115,7 +114,6 @@ fn compare_without_a_vulkan_device_runs_on_the_interpreter_and_says_so() {
 #[test]
 fn bad_compare_arguments_are_refused_before_anything_renders() {
     let out = scratch("refused");
-    let out_arg = out.to_str().unwrap();
     let cases: [(&[&str], &[&str]); 6] = [
         (&["--block-size", "12"], &["block size 12"]),
         (&["--width", "0"], &["--width 0"]),
@@ -125,7 +123,7 @@ fn bad_compare_arguments_are_refused_before_anything_renders() {
         (&["--frames", "0"], &["--frames"]),
     ];
     for (arguments, names) in cases {
-        let output = strata_without_vulkan(&[&["compare", "--out", out_arg][..], arguments].concat());
+        let output = strata_without_vulkan(&[&["compare", "--out", out_str(&out)][..], arguments].concat());
         assert_refused(&output, names);
         assert!(!text(&output.stdout).contains("rendering the reference"), "{arguments:?} rendered first");
         assert!(!out.join("reference.exr").exists(), "{arguments:?} rendered a reference");

@@ -19,6 +19,7 @@ use strata::scene::{Scene, default_scene};
 use strata_backends::Backend;
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_backends::wgpu_backend::{WgpuBackend, WgpuOptions};
+use strata_kernels::selection::SelectionSettings;
 
 fn settings(scene: &Scene, size: u32) -> RenderSettings {
     RenderSettings::for_scene(scene, size, size, 1)
@@ -60,7 +61,8 @@ fn restir_frames(c: &mut Criterion, backend: &mut dyn Backend) {
     let mut group = c.benchmark_group("histogram_share_256");
     group.sample_size(10).measurement_time(Duration::from_secs(10));
     for block_size in [4, 8, 16, 32] {
-        let restir = RestirSettings { block_size, ..RestirSettings::default() };
+        let selection = SelectionSettings { block_size, ..SelectionSettings::default() };
+        let restir = RestirSettings { selection, ..RestirSettings::default() };
         let mut renderer = RestirRenderer::new(backend, &gpu_scene, &render, restir, scene.extent()).expect("renderer");
         renderer.set_timed(true);
         let mut passes = [Duration::ZERO; 5];

@@ -2,17 +2,17 @@
 //! SPIR-V of the same WGSL kernels, recording into the engine's command buffer with the
 //! engine's buffers.
 
-use crate::binding_plan::{EngineBuffers, OwnBuffers, ResampleBuffers, Resource};
+use crate::binding_plan::{BindingPlan, EngineBuffers, OwnBuffers, ResampleBuffers, Resource};
 use crate::contract::check_size;
 use crate::error::EmbedError;
-use crate::frame::{FrameParams, frame_params, max_blocks};
+use crate::frame::{FrameId, FrameParams, frame_params, max_blocks};
 use crate::limits::{DeviceLimits, VULKAN_NAMES, check_limits};
-use crate::settings::SelectionSettings;
 use crate::wgsl::{ModuleId, WgslModule, module};
 use ash::vk;
 use strata_kernels::Registry;
 use strata_kernels::blue_noise::BlueNoiseTables;
 use strata_kernels::embed_types::SelectionParams;
+use strata_kernels::selection::SelectionSettings;
 use strata_kernels::translate::{TranslateOptions, spirv};
 use strata_kernels::types::HistogramParams;
 
@@ -61,7 +61,7 @@ struct Pipeline {
     pipeline: vk::Pipeline,
     layout: vk::PipelineLayout,
     set_layout: vk::DescriptorSetLayout,
-    bindings: Vec<vk::DescriptorType>,
+    module: WgslModule,
 }
 
 struct OwnBuffer {
@@ -81,6 +81,7 @@ struct OwnBuffer {
 pub struct AshSelection {
     device: ash::Device,
     settings: SelectionSettings,
+    seed: u32,
     width: u32,
     height: u32,
     max_workgroups: u32,
@@ -110,9 +111,9 @@ impl AshSelection {
     /// Builds the pipelines (naga's SPIR-V) and the pass's own buffers for a `width` ×
     /// `height` image; fails, naming the setting or the device limit, when the settings
     /// are out of range or the device cannot run the pass at this size. Uses the subgroup
-    /// histogram where compute shaders have subgroup shuffles.
+    /// histogram where compute shaders have subgroup shuffles. Frames belong to the
+    /// render of seed 0 until [`Self::set_seed`].
     pub fn new(vulkan: AshDevice, settings: SelectionSettings, width: u32, height: u32) -> Result<Self, EmbedError> {
-        settings.validate()?;
         crate::frame::grid(&settings, width, height)?;
         // SAFETY: valid handles from the engine.
         let properties = unsafe { vulkan.instance.get_physical_device_properties(vulkan.physical_device) };
@@ -148,18 +149,17 @@ impl AshSelection {
         let sorted_pixels = created.buffer(&memory, pixels * 4, storage, local, None)?;
         let spans = created.buffer(&memory, pixels * 12, storage, local, None)?;
         let block_stats = created.buffer(&memory, blocks * 12, storage, local, None)?;
-        let tables = BlueNoiseTables::new();
         let host = vk::MemoryPropertyFlags::HOST_VISIBLE | vk::MemoryPropertyFlags::HOST_COHERENT;
-        let mut table = |words: &[u32]| {
-            let bytes: &[u8] = bytemuck::cast_slice(words);
-            created.buffer(&memory, bytes.len() as u64, vk::BufferUsageFlags::STORAGE_BUFFER, host, Some(bytes))
-        };
-        let tables = [table(&tables.sobol)?, table(&tables.scrambling)?, table(&tables.ranking)?];
+        let packed = BlueNoiseTables::new().packed();
+        let bytes: &[u8] = bytemuck::cast_slice(&packed);
+        let blue_noise =
+            created.buffer(&memory, bytes.len() as u64, vk::BufferUsageFlags::STORAGE_BUFFER, host, Some(bytes))?;
         let unused_payloads = created.buffer(&memory, 4, vk::BufferUsageFlags::STORAGE_BUFFER, local, None)?;
         created.keep();
         Ok(Self {
             device,
             settings,
+            seed: 0,
             width,
             height,
             max_workgroups: limits.max_compute_work_group_count.iter().copied().min().unwrap_or(1),
@@ -173,7 +173,7 @@ impl AshSelection {
                 sorted_pixels,
                 spans,
                 block_stats,
-                tables,
+                blue_noise,
                 unused_payloads,
             },
         })
@@ -187,12 +187,18 @@ impl AshSelection {
     /// Starts an independent render: a new seed for the frames recorded from now on
     /// (for example per run of an unbiasedness test); costs nothing.
     pub fn set_seed(&mut self, seed: u32) {
-        self.settings.seed = seed;
+        self.seed = seed;
+    }
+
+    /// The seed of the frames recorded from now on.
+    pub fn seed(&self) -> u32 {
+        self.seed
     }
 
     /// The parameters frame `frame` runs with.
     pub fn frame_params(&self, frame: u32, identity_payload: bool) -> Result<FrameParams, EmbedError> {
-        frame_params(&self.settings, self.width, self.height, frame, identity_payload, self.max_workgroups)
+        let id = FrameId { frame, seed: self.seed, identity_payload };
+        frame_params(&self.settings, self.width, self.height, id, self.max_workgroups)
     }
 
     /// Checks the engine's buffers against the contract and writes their descriptor sets.
@@ -235,9 +241,10 @@ impl AshSelection {
             writes.push((allocated[2], &self.resample, resources));
         }
         for (set, pipeline, resources) in &writes {
-            let infos: Vec<[vk::DescriptorBufferInfo; 1]> = resources
+            let numbered = BindingPlan::numbered(&pipeline.module, resources);
+            let infos: Vec<[vk::DescriptorBufferInfo; 1]> = numbered
                 .iter()
-                .map(|resource| {
+                .map(|(_, resource)| {
                     [match *resource {
                         Resource::Own(own) => {
                             vk::DescriptorBufferInfo { buffer: own.buffer, offset: 0, range: own.size }
@@ -250,12 +257,12 @@ impl AshSelection {
                 .collect();
             let descriptor_writes: Vec<_> = infos
                 .iter()
-                .enumerate()
-                .map(|(binding, info)| {
+                .zip(&numbered)
+                .map(|(info, (binding, _))| {
                     vk::WriteDescriptorSet::default()
                         .dst_set(*set)
-                        .dst_binding(binding as u32)
-                        .descriptor_type(pipeline.bindings[binding])
+                        .dst_binding(*binding)
+                        .descriptor_type(descriptor_type(&pipeline.module, *binding))
                         .buffer_info(info)
                 })
                 .collect();
@@ -377,7 +384,8 @@ impl AshSelection {
         let set = bindings.resample.ok_or(EmbedError::NoResampleBuffers)?;
         let writes = vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE;
         self.barrier(command_buffer, vk::PipelineStageFlags::ALL_COMMANDS, writes);
-        self.dispatch(command_buffer, &self.resample, set, [self.width.div_ceil(8), self.height.div_ceil(8), 1]);
+        let workgroups = crate::frame::pixel_workgroups(self.width, self.height)?;
+        self.dispatch(command_buffer, &self.resample, set, workgroups);
         Ok(())
     }
 
@@ -397,6 +405,14 @@ impl AshSelection {
                 destroy_pipeline(&self.device, pipeline);
             }
         }
+    }
+}
+
+/// The descriptor type of binding `binding` of `module`.
+fn descriptor_type(module: &WgslModule, binding: u32) -> vk::DescriptorType {
+    match module.bindings.iter().find(|b| b.binding == binding) {
+        Some(b) if b.uniform => vk::DescriptorType::UNIFORM_BUFFER,
+        _ => vk::DescriptorType::STORAGE_BUFFER,
     }
 }
 
@@ -422,18 +438,13 @@ impl Created<'_> {
     fn pipeline(&mut self, module: &WgslModule) -> Result<Pipeline, EmbedError> {
         let kernel = Registry::shared()?.get(module.id.kernel());
         let code = spirv(kernel, TranslateOptions::default())?;
-        let bindings: Vec<vk::DescriptorType> = module
+        let layout_bindings: Vec<_> = module
             .bindings
             .iter()
-            .map(|b| if b.uniform { vk::DescriptorType::UNIFORM_BUFFER } else { vk::DescriptorType::STORAGE_BUFFER })
-            .collect();
-        let layout_bindings: Vec<_> = bindings
-            .iter()
-            .enumerate()
-            .map(|(binding, &ty)| {
+            .map(|b| {
                 vk::DescriptorSetLayoutBinding::default()
-                    .binding(binding as u32)
-                    .descriptor_type(ty)
+                    .binding(b.binding)
+                    .descriptor_type(descriptor_type(module, b.binding))
                     .descriptor_count(1)
                     .stage_flags(vk::ShaderStageFlags::COMPUTE)
             })
@@ -473,7 +484,7 @@ impl Created<'_> {
             device.destroy_shader_module(shader, None);
             let pipeline = result.map_err(|(_, e)| vk_error(&operation, e))?[0];
             self.pipelines.last_mut().expect("pushed above").0 = pipeline;
-            Ok(Pipeline { pipeline, layout, set_layout, bindings })
+            Ok(Pipeline { pipeline, layout, set_layout, module: module.clone() })
         }
     }
 

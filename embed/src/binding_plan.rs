@@ -3,6 +3,7 @@
 //! pass's own buffers (generic over an API's buffer type).
 
 use crate::contract::BufferRole;
+use crate::wgsl::WgslModule;
 
 /// The engine's buffers of the contract ([`crate::contract`]); `S` is the API's buffer
 /// range ([`crate::WgpuBufferSlice`], [`crate::AshBufferSlice`]).
@@ -34,24 +35,22 @@ pub(crate) struct OwnBuffers<B> {
     pub sorted_pixels: B,
     pub spans: B,
     pub block_stats: B,
-    /// Blue-noise sobol, scrambling, ranking.
-    pub tables: [B; 3],
+    /// The blue-noise tables, packed (`BlueNoiseTables::packed`).
+    pub blue_noise: B,
     /// Bound as `payloads` when the engine has none (never read then).
     pub unused_payloads: B,
 }
 
 impl<B> OwnBuffers<B> {
     /// Every buffer, for destruction.
-    pub fn all(&self) -> [&B; 9] {
+    pub fn all(&self) -> [&B; 7] {
         [
             &self.histogram_params,
             &self.selection_params,
             &self.sorted_pixels,
             &self.spans,
             &self.block_stats,
-            &self.tables[0],
-            &self.tables[1],
-            &self.tables[2],
+            &self.blue_noise,
             &self.unused_payloads,
         ]
     }
@@ -65,11 +64,47 @@ pub(crate) enum Resource<'a, B, S> {
     Engine(S),
 }
 
-/// Resources of the three kernels' bindings, in binding order.
+impl<B, S: Copy> Clone for Resource<'_, B, S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<B, S: Copy> Copy for Resource<'_, B, S> {}
+
+/// Resources of the three kernels' bindings, each under its WGSL variable's name (the
+/// binding numbers come from the registry, [`BindingPlan::numbered`]).
 pub(crate) struct BindingPlan<'a, B, S> {
-    pub histogram: Vec<Resource<'a, B, S>>,
-    pub select: Vec<Resource<'a, B, S>>,
-    pub resample: Option<Vec<Resource<'a, B, S>>>,
+    pub histogram: Vec<(&'static str, Resource<'a, B, S>)>,
+    pub select: Vec<(&'static str, Resource<'a, B, S>)>,
+    pub resample: Option<Vec<(&'static str, Resource<'a, B, S>)>>,
+}
+
+impl<'a, B, S: Copy> BindingPlan<'a, B, S> {
+    /// `resources` with the binding number `module` declares for each name, in binding
+    /// order; every binding of the module must be given.
+    pub fn numbered(
+        module: &WgslModule,
+        resources: &[(&'static str, Resource<'a, B, S>)],
+    ) -> Vec<(u32, Resource<'a, B, S>)> {
+        let mut numbered: Vec<(u32, Resource<'a, B, S>)> = resources
+            .iter()
+            .map(|(name, resource)| {
+                let binding = module.bindings.iter().find(|b| b.name == *name).unwrap_or_else(|| {
+                    panic!("{}: no binding named `{name}` (the plan and the WGSL disagree)", module.entry_point)
+                });
+                (binding.binding, *resource)
+            })
+            .collect();
+        numbered.sort_by_key(|(binding, _)| *binding);
+        assert_eq!(
+            numbered.len(),
+            module.bindings.len(),
+            "{}: the plan must bind every binding of the module",
+            module.entry_point
+        );
+        numbered
+    }
 }
 
 impl<S: Copy> EngineBuffers<S> {
@@ -86,35 +121,34 @@ impl<S: Copy> EngineBuffers<S> {
     }
 
     /// What each binding of `block_histogram`, `strata_select` and `strata_resample`
-    /// gets (their WGSL declarations: `kernels/wgsl/embed/entry_*.wgsl`).
+    /// gets, by the WGSL variable's name (`kernels/wgsl/strata/histogram.wgsl`,
+    /// `kernels/wgsl/embed/entry_*.wgsl`).
     pub(crate) fn plan<'a, B>(&self, own: &'a OwnBuffers<B>) -> BindingPlan<'a, B, S> {
         use Resource::{Engine, Own};
         let payloads = self.payloads.map_or(Own(&own.unused_payloads), Engine);
         BindingPlan {
             histogram: vec![
-                Own(&own.histogram_params),
-                Engine(self.candidates),
-                Own(&own.sorted_pixels),
-                Own(&own.spans),
-                Own(&own.block_stats),
+                ("params", Own(&own.histogram_params)),
+                ("candidates", Engine(self.candidates)),
+                ("sorted_pixels", Own(&own.sorted_pixels)),
+                ("spans", Own(&own.spans)),
+                ("block_stats", Own(&own.block_stats)),
             ],
             select: vec![
-                Own(&own.selection_params),
-                Engine(self.candidates),
-                payloads,
-                Own(&own.sorted_pixels),
-                Own(&own.spans),
-                Own(&own.tables[0]),
-                Own(&own.tables[1]),
-                Own(&own.tables[2]),
-                Engine(self.selections),
+                ("params", Own(&own.selection_params)),
+                ("candidates", Engine(self.candidates)),
+                ("payloads", payloads),
+                ("sorted_pixels", Own(&own.sorted_pixels)),
+                ("spans", Own(&own.spans)),
+                ("blue_noise", Own(&own.blue_noise)),
+                ("selections", Engine(self.selections)),
             ],
             resample: self.resample.map(|resample| {
                 vec![
-                    Own(&own.selection_params),
-                    Engine(self.selections),
-                    Engine(resample.inputs),
-                    Engine(resample.outputs),
+                    ("params", Own(&own.selection_params)),
+                    ("selections", Engine(self.selections)),
+                    ("resample_inputs", Engine(resample.inputs)),
+                    ("resampled", Engine(resample.outputs)),
                 ]
             }),
         }

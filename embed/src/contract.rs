@@ -152,11 +152,11 @@ mod tests {
     #[test]
     fn block_shift_varies_per_frame() {
         let settings = crate::SelectionSettings { block_shift: true, ..Default::default() };
-        let shifts: Vec<_> = (0..64).map(|frame| crate::frame::grid_shift(&settings, frame)).collect();
+        let shifts: Vec<_> = (0..64).map(|frame| crate::frame::grid_shift(&settings, frame, 0)).collect();
         assert!(shifts.iter().all(|&(x, y)| x < 16 && y < 16));
         let distinct: std::collections::HashSet<_> = shifts.iter().collect();
         assert!(distinct.len() > 40, "{} distinct shifts", distinct.len());
         let off = crate::SelectionSettings::default();
-        assert!((0..64).all(|frame| crate::frame::grid_shift(&off, frame) == (0, 0)));
+        assert!((0..64).all(|frame| crate::frame::grid_shift(&off, frame, 0) == (0, 0)));
     }
 }

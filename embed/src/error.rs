@@ -7,15 +7,8 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 pub enum EmbedError {
     /// A [`crate::SelectionSettings`] field is out of range.
-    #[error("SelectionSettings.{field} = {value}: must be {expected}")]
-    Setting {
-        /// The field.
-        field: &'static str,
-        /// Its value.
-        value: String,
-        /// What it may be.
-        expected: &'static str,
-    },
+    #[error("SelectionSettings.{0}")]
+    Setting(#[from] strata_kernels::selection::SettingError),
     /// Zero or too many pixels.
     #[error("image size {width}x{height}: {why}")]
     ImageSize {

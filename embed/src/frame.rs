@@ -2,10 +2,10 @@
 //! the selection's uniform, and the dispatch sizes of the three kernels.
 
 use crate::error::EmbedError;
-use crate::settings::SelectionSettings;
-use strata_kernels::embed_types::{SelectionParams, sampler_id};
+use strata_kernels::embed_types::SelectionParams;
+use strata_kernels::selection::SelectionSettings;
 use strata_kernels::types::{HISTOGRAM_SLOTS_PER_WORKGROUP, HistogramParams};
-use strata_kernels::{BlockGrid, GridError};
+use strata_kernels::{BlockGrid, KernelId, Registry};
 
 /// Everything one frame's dispatches need.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -16,29 +16,27 @@ pub struct FrameParams {
     pub selection: SelectionParams,
     /// Workgroups of the histogram dispatch.
     pub histogram_workgroups: [u32; 3],
-    /// Workgroups of the per-pixel dispatches (8 × 8 pixels each).
+    /// Workgroups of the per-pixel dispatches (`strata_select`, `strata_resample`).
     pub pixel_workgroups: [u32; 3],
 }
 
-/// The image's grid, checked.
+/// The image's grid, checked (the settings are validated first).
 pub(crate) fn grid(settings: &SelectionSettings, width: u32, height: u32) -> Result<BlockGrid, EmbedError> {
-    BlockGrid::new(width, height, settings.block_size).map_err(|error| match error {
-        GridError::BlockSize(_) => EmbedError::Setting {
-            field: "block_size",
-            value: settings.block_size.to_string(),
-            expected: "a power of two from 4 to 32 (4, 8, 16 or 32)",
-        },
-        other => EmbedError::ImageSize { width, height, why: other.to_string() },
+    settings.validate()?;
+    BlockGrid::new(width, height, settings.block_size).map_err(|error| EmbedError::ImageSize {
+        width,
+        height,
+        why: error.to_string(),
     })
 }
 
-/// Block-grid shift of a frame: (0, 0) without block shifting, else a hash of the frame
-/// and seed in 0..B per axis.
-pub fn grid_shift(settings: &SelectionSettings, frame: u32) -> (u32, u32) {
+/// Block-grid shift of frame `frame` of the render `seed`: (0, 0) without block shifting,
+/// else a hash of the frame and seed in 0..B per axis.
+pub fn grid_shift(settings: &SelectionSettings, frame: u32, seed: u32) -> (u32, u32) {
     if !settings.block_shift {
         return (0, 0);
     }
-    strata_kernels::block_grid::frame_shift(settings.block_size, frame, settings.seed)
+    strata_kernels::block_grid::frame_shift(settings.block_size, frame, seed)
 }
 
 /// Most blocks any frame's grid has (a shifted grid has up to one more row and column).
@@ -50,16 +48,36 @@ pub(crate) fn max_blocks(settings: &SelectionSettings, width: u32, height: u32) 
     }
 }
 
-/// The parameters of frame `frame`; `max_workgroups` is the device's per-dimension limit.
+/// Workgroups of `strata_select` and `strata_resample` over a `width` × `height` image,
+/// from the kernels' own `@workgroup_size`.
+pub(crate) fn pixel_workgroups(width: u32, height: u32) -> Result<[u32; 3], EmbedError> {
+    let registry = Registry::shared()?;
+    let [x, y, _] = registry.get(KernelId::StrataSelect).workgroup_size;
+    debug_assert_eq!(registry.get(KernelId::StrataResample).workgroup_size, [x, y, 1]);
+    Ok([width.div_ceil(x), height.div_ceil(y), 1])
+}
+
+/// Which frame of which render, and how the engine hands out payloads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FrameId {
+    /// Frame index (the blue-noise sample index is frame mod 256).
+    pub frame: u32,
+    /// Seed of the render: independent renders need different seeds.
+    pub seed: u32,
+    /// A pixel's payload is its index (the engine binds no payloads buffer).
+    pub identity_payload: bool,
+}
+
+/// The parameters of one frame; `max_workgroups` is the device's per-dimension limit.
 pub fn frame_params(
     settings: &SelectionSettings,
     width: u32,
     height: u32,
-    frame: u32,
-    identity_payload: bool,
+    id: FrameId,
     max_workgroups: u32,
 ) -> Result<FrameParams, EmbedError> {
-    let (sx, sy) = grid_shift(settings, frame);
+    let FrameId { frame, seed, identity_payload } = id;
+    let (sx, sy) = grid_shift(settings, frame, seed);
     let grid = grid(settings, width, height)?.with_shift(sx, sy).map_err(|e| EmbedError::ImageSize {
         width,
         height,
@@ -73,9 +91,9 @@ pub fn frame_params(
         width,
         height,
         frame,
-        seed: settings.seed,
+        seed,
         candidates: settings.candidates,
-        sampler: sampler_id(settings.sampler),
+        sampler: settings.sampler.id(),
         identity_payload: u32::from(identity_payload),
         _pad: 0,
     };
@@ -83,6 +101,6 @@ pub fn frame_params(
         histogram: grid.histogram_params(x, settings.masking),
         selection,
         histogram_workgroups,
-        pixel_workgroups: [width.div_ceil(8), height.div_ceil(8), 1],
+        pixel_workgroups: pixel_workgroups(width, height)?,
     })
 }

@@ -29,7 +29,6 @@ pub mod contract;
 mod error;
 pub mod frame;
 mod limits;
-mod settings;
 pub mod wgsl;
 
 #[cfg(feature = "ash")]
@@ -41,6 +40,8 @@ mod wgpu_selection;
 pub use ash_selection::{AshBindings, AshBufferSlice, AshBuffers, AshDevice, AshResampleBuffers, AshSelection};
 pub use binding_plan::{EngineBuffers, ResampleBuffers};
 pub use error::EmbedError;
-pub use settings::{SamplerVariant, SelectionSettings};
+/// The selection's settings and sampler variants: the paper's one settings struct, shared
+/// with strata's renderer and command line.
+pub use strata_kernels::selection::{SamplerVariant, SelectionSettings};
 #[cfg(feature = "wgpu")]
 pub use wgpu_selection::{WgpuBindings, WgpuBufferSlice, WgpuBuffers, WgpuResampleBuffers, WgpuSelection};

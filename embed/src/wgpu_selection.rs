@@ -1,15 +1,15 @@
 //! [`WgpuSelection`]: the pass on an engine's own `wgpu::Device`, recording into the
 //! engine's command encoder with the engine's buffers.
 
-use crate::binding_plan::{EngineBuffers, OwnBuffers, ResampleBuffers, Resource};
+use crate::binding_plan::{BindingPlan, EngineBuffers, OwnBuffers, ResampleBuffers, Resource};
 use crate::contract::{BufferRole, check_size};
 use crate::error::EmbedError;
-use crate::frame::{FrameParams, frame_params, max_blocks};
+use crate::frame::{FrameId, FrameParams, frame_params, max_blocks};
 use crate::limits::{DeviceLimits, WGPU_NAMES, check_limits};
-use crate::settings::SelectionSettings;
 use crate::wgsl::{ModuleId, WgslModule, module};
 use strata_kernels::blue_noise::BlueNoiseTables;
 use strata_kernels::embed_types::SelectionParams;
+use strata_kernels::selection::SelectionSettings;
 use strata_kernels::types::HistogramParams;
 use wgpu::util::DeviceExt;
 
@@ -47,6 +47,7 @@ pub struct WgpuBindings {
 struct Pipeline {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
+    module: WgslModule,
 }
 
 /// The stratified selection on an engine's wgpu device: the histogram pass, the
@@ -58,6 +59,7 @@ struct Pipeline {
 /// and calls [`Self::encode_resampling`] if it resamples with the pass.
 pub struct WgpuSelection {
     settings: SelectionSettings,
+    seed: u32,
     width: u32,
     height: u32,
     max_workgroups: u32,
@@ -107,7 +109,7 @@ fn pipeline(device: &wgpu::Device, module: &WgslModule) -> Pipeline {
         compilation_options: wgpu::PipelineCompilationOptions::default(),
         cache: None,
     });
-    Pipeline { pipeline, layout }
+    Pipeline { pipeline, layout, module: module.clone() }
 }
 
 fn check_usage(role: BufferRole, slice: WgpuBufferSlice, alignment: u64) -> Result<(), EmbedError> {
@@ -126,13 +128,13 @@ impl WgpuSelection {
     /// `width` × `height` image. Fails, naming the setting or the device limit, when the
     /// settings are out of range or the device cannot run the pass at this size. Uses
     /// the subgroup histogram when the device was created with `Features::SUBGROUP`.
+    /// Frames belong to the render of seed 0 until [`Self::set_seed`].
     pub fn new(
         device: &wgpu::Device,
         settings: SelectionSettings,
         width: u32,
         height: u32,
     ) -> Result<Self, EmbedError> {
-        settings.validate()?;
         crate::frame::grid(&settings, width, height)?;
         let histogram_module = if device.features().contains(wgpu::Features::SUBGROUP) {
             ModuleId::HistogramSubgroup
@@ -157,15 +159,9 @@ impl WgpuSelection {
             };
             let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
             let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
-            let table = |label: &str, words: &[u32]| {
-                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents: bytemuck::cast_slice(words),
-                    usage: wgpu::BufferUsages::STORAGE,
-                })
-            };
             Self {
                 settings,
+                seed: 0,
                 width,
                 height,
                 max_workgroups: limits.max_compute_workgroups_per_dimension,
@@ -179,11 +175,11 @@ impl WgpuSelection {
                     sorted_pixels: buffer("strata sorted pixels", pixels * 4, storage),
                     spans: buffer("strata cluster spans", pixels * 12, storage),
                     block_stats: buffer("strata block stats", blocks * 12, storage),
-                    tables: [
-                        table("blue_noise_sobol", &tables.sobol),
-                        table("blue_noise_scrambling", &tables.scrambling),
-                        table("blue_noise_ranking", &tables.ranking),
-                    ],
+                    blue_noise: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("strata blue noise"),
+                        contents: bytemuck::cast_slice(&tables.packed()),
+                        usage: wgpu::BufferUsages::STORAGE,
+                    }),
                     unused_payloads: buffer("strata unused payloads", 4, wgpu::BufferUsages::STORAGE),
                 },
             }
@@ -198,7 +194,12 @@ impl WgpuSelection {
     /// Starts an independent render: a new seed for the frames recorded from now on
     /// (for example per run of an unbiasedness test); costs nothing.
     pub fn set_seed(&mut self, seed: u32) {
-        self.settings.seed = seed;
+        self.seed = seed;
+    }
+
+    /// The seed of the frames recorded from now on.
+    pub fn seed(&self) -> u32 {
+        self.seed
     }
 
     /// The image size.
@@ -215,7 +216,8 @@ impl WgpuSelection {
 
     /// The parameters frame `frame` runs with.
     pub fn frame_params(&self, frame: u32, identity_payload: bool) -> Result<FrameParams, EmbedError> {
-        frame_params(&self.settings, self.width, self.height, frame, identity_payload, self.max_workgroups)
+        let id = FrameId { frame, seed: self.seed, identity_payload };
+        frame_params(&self.settings, self.width, self.height, id, self.max_workgroups)
     }
 
     /// Checks the engine's buffers against the contract and makes their bind groups.
@@ -234,11 +236,10 @@ impl WgpuSelection {
                 }),
             }
         }
-        let group = |pipeline: &Pipeline, resources: &[Resource<'_, wgpu::Buffer, WgpuBufferSlice>]| {
-            let entries: Vec<_> = resources
+        let group = |pipeline: &Pipeline, resources: &[(&'static str, Resource<'_, wgpu::Buffer, WgpuBufferSlice>)]| {
+            let entries: Vec<_> = BindingPlan::numbered(&pipeline.module, resources)
                 .iter()
-                .enumerate()
-                .map(|(binding, r)| wgpu::BindGroupEntry { binding: binding as u32, resource: resource(r) })
+                .map(|(binding, r)| wgpu::BindGroupEntry { binding: *binding, resource: resource(r) })
                 .collect();
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("strata selection"),
@@ -296,7 +297,8 @@ impl WgpuSelection {
         });
         pass.set_pipeline(&self.resample.pipeline);
         pass.set_bind_group(0, group, &[]);
-        pass.dispatch_workgroups(self.width.div_ceil(8), self.height.div_ceil(8), 1);
+        let [x, y, z] = crate::frame::pixel_workgroups(self.width, self.height)?;
+        pass.dispatch_workgroups(x, y, z);
         Ok(())
     }
 }

@@ -14,7 +14,6 @@ pub mod render;
 pub mod restir;
 pub mod rgb_image;
 pub mod run_kernel;
-pub mod sampler;
 pub mod scene;
 pub mod synthetic;
 pub mod trace_pass;

@@ -14,11 +14,11 @@ use strata::metrics::{self, MeanInterval, Metric};
 use strata::render::{GpuScene, LightSampling, RenderSettings};
 use strata::restir::{Method, RestirSettings, ShadedParts};
 use strata::rgb_image::RgbImage;
-use strata::sampler::SamplerVariant;
 use strata::scene::{Scene, default_scene, load_scene_file, parse_camera_path};
 use strata::synthetic::{CandidateMix, candidate_image};
 use strata_kernels::BlockGrid;
 use strata_kernels::reference::block_histogram::block_histogram;
+use strata_kernels::selection::SelectionSettings;
 
 /// A paired ratio of one error column between two methods at one frame.
 type RatioOf = fn(&[FrameError], Method, Method, u32) -> Option<MeanInterval>;
@@ -78,12 +78,10 @@ struct CompareArgs {
     /// Image height (default: the scene camera's).
     #[arg(long)]
     height: Option<u32>,
-    /// Histogram block size (4, 8, 16, 32).
-    #[arg(long, default_value_t = 16)]
-    block_size: u32,
-    /// Sampler variant of the selection (the paper's Table 2).
-    #[arg(long, value_enum, default_value_t = SamplerVariant::Antithetic)]
-    sampler: SamplerVariant,
+    /// The histogram and the selection (§4.1-4.3), shared by every method except where
+    /// a field says otherwise.
+    #[command(flatten)]
+    selection: SelectionSettings,
     /// No temporal reuse: frames are accumulated instead (Fig. 5 / 10).
     #[arg(long)]
     accumulate: bool,
@@ -91,9 +89,6 @@ struct CompareArgs {
     /// 0 to 4, merged besides the pixel's own reprojected one.
     #[arg(long, default_value_t = 0)]
     temporal_candidates: u32,
-    /// Shift the block grid by a different offset every frame.
-    #[arg(long)]
-    block_shift: bool,
     /// Camera rays through pixel centres, no film jitter, for the methods and the
     /// rendered reference alike (a diagnostic: without jitter a pixel's history sees the
     /// same primary hit every frame).
@@ -104,9 +99,6 @@ struct CompareArgs {
     /// seeds, since each part alone is biased against the reference).
     #[arg(long, value_enum, default_value_t = ShadedParts::All)]
     shaded_parts: ShadedParts,
-    /// No object-id masking: one histogram cluster per block.
-    #[arg(long)]
-    no_masking: bool,
     /// A conductor at the primary hit resamples only from this GGX alpha up; smoother
     /// ones path-trace on their own (1 sample per frame, no reuse).
     #[arg(long, default_value_t = RestirSettings::default().min_roughness)]
@@ -269,11 +261,8 @@ fn compare(args: CompareArgs) -> Result<()> {
         bail!("--frames and --seeds must be at least 1");
     }
     let restir = RestirSettings {
-        block_size: args.block_size,
-        sampler: args.sampler,
+        selection: args.selection,
         temporal: !args.accumulate,
-        masking: !args.no_masking,
-        block_shift: args.block_shift,
         temporal_candidates: args.temporal_candidates,
         shaded_parts: args.shaded_parts,
         min_roughness: args.min_roughness,

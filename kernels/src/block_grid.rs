@@ -95,13 +95,17 @@ impl BlockGrid {
         if width == 0 || height == 0 {
             return Err(GridError::EmptyImage { width, height });
         }
-        if !BLOCK_SIZES.contains(&block_size) {
-            return Err(GridError::BlockSize(block_size));
-        }
+        Self::check_block_size(block_size)?;
         if u64::from(width) * u64::from(height) > u64::from(u32::MAX) {
             return Err(GridError::TooLarge { width, height });
         }
         Ok(Self { width, height, block_size, shift_x: 0, shift_y: 0 })
+    }
+
+    /// Whether the histogram pass can take blocks of `block_size` × `block_size`: one of
+    /// [`BLOCK_SIZES`] (the one check of a block size, wherever it comes from).
+    pub fn check_block_size(block_size: u32) -> Result<(), GridError> {
+        if BLOCK_SIZES.contains(&block_size) { Ok(()) } else { Err(GridError::BlockSize(block_size)) }
     }
 
     /// The same grid shifted by (sx, sy), each in 0..B.

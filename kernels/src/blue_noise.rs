@@ -3,13 +3,15 @@
 //! Owen-scrambled Sobol sequence per pixel across frames, decorrelated between pixels by
 //! an optimised XOR scrambling and ranking over a 128² tile. The tables come from the
 //! `blue-noise-sampler` crate (MIT, the 256-spp variant); the GPU twin of
-//! [`BlueNoiseTables::sample`] is `blue_noise_sample` in `kernels/wgsl/restir/sampler.wgsl`.
+//! [`BlueNoiseTables::stratum`] is `blue_noise_stratum` in `kernels/wgsl/strata/blue_noise.wgsl`,
+//! which reads the three tables from one buffer ([`BlueNoiseTables::packed`]).
 //!
 //! Only dimensions 0–7 are optimised, as the 2-D pairs (0, 1), (2, 3), (4, 5), (6, 7)
 //! ("OptimizedFor_2d2d2d2d"): the ranking tile is shared within a pair, so a pair at one
 //! pixel is the first 256 points of a 2-D Sobol net, and the scrambling is chosen so that
 //! at a fixed sample index the error is distributed as blue noise over the tile.
-//! ReSTIR's selection uses the pair (0, 1) with sample index = frame mod 256.
+//! The selection (Table 2's temporal blue noise) uses the pair (0, 1) for its spatial
+//! slots and (2, 3) for its temporal ones, with sample index = frame mod 256.
 
 /// Side of the square pixel tile the tables cover (pixels wrap modulo it).
 pub const TILE_SIZE: u32 = 128;
@@ -20,9 +22,16 @@ pub const DIMENSIONS: u32 = 256;
 /// Dimensions with an optimised scrambling and ranking (the pairs (0, 1) … (6, 7)).
 pub const OPTIMISED_DIMENSIONS: u32 = 8;
 
-/// Names of the storage arrays `sampler.wgsl` expects, in the order of
-/// [`BlueNoiseTables::buffers`].
-pub const WGSL_BUFFER_NAMES: [&str; 3] = ["blue_noise_sobol", "blue_noise_scrambling", "blue_noise_ranking"];
+/// Word offset of the Sobol table in [`BlueNoiseTables::packed`] (WGSL `BLUE_NOISE_SOBOL`).
+pub const PACKED_SOBOL: u32 = 0;
+/// Word offset of the scrambling table (WGSL `BLUE_NOISE_SCRAMBLING`).
+pub const PACKED_SCRAMBLING: u32 = SAMPLES * DIMENSIONS;
+/// Word offset of the ranking table (WGSL `BLUE_NOISE_RANKING`).
+pub const PACKED_RANKING: u32 = PACKED_SCRAMBLING + TILE_SIZE * TILE_SIZE * OPTIMISED_DIMENSIONS;
+/// Words of [`BlueNoiseTables::packed`].
+pub const PACKED_WORDS: u32 = PACKED_RANKING + TILE_SIZE * TILE_SIZE * OPTIMISED_DIMENSIONS;
+/// Name of the storage array `blue_noise.wgsl` reads the packed tables from.
+pub const WGSL_BUFFER_NAME: &str = "blue_noise";
 
 /// Heitz et al. 2019's three 256-spp tables, widened to `u32` so that they upload as
 /// `array<u32>` as they are. Every entry is in 0..=255.
@@ -62,13 +71,11 @@ impl BlueNoiseTables {
         tables
     }
 
-    /// The three tables with the names `sampler.wgsl` gives their storage arrays.
-    pub fn buffers(&self) -> [(&'static str, &[u32]); 3] {
-        [
-            (WGSL_BUFFER_NAMES[0], &self.sobol),
-            (WGSL_BUFFER_NAMES[1], &self.scrambling),
-            (WGSL_BUFFER_NAMES[2], &self.ranking),
-        ]
+    /// The three tables in one buffer, as `blue_noise.wgsl` reads them: Sobol at
+    /// [`PACKED_SOBOL`], scrambling at [`PACKED_SCRAMBLING`], ranking at
+    /// [`PACKED_RANKING`] ([`PACKED_WORDS`] words, 1.25 MiB).
+    pub fn packed(&self) -> Vec<u32> {
+        [self.sobol.as_slice(), &self.scrambling, &self.ranking].concat()
     }
 
     /// The stratum k ∈ 0..=255 of a sample, the sample being (k + 0.5) / 256: the
@@ -99,38 +106,6 @@ impl BlueNoiseTables {
     }
 }
 
-/// How ReSTIR's selection draws its random numbers and places its K = 4 candidates: the
-/// variants of the paper's Table 2 (ablation of histogram sampling strategies). The
-/// selection kernel reads this; "temporal blue noise" means one sample of
-/// [`BlueNoiseTables`] per pixel and frame, sample index = frame mod 256, dimension 0 for
-/// the candidates and dimension 1 for resampling.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
-pub enum SamplerVariant {
-    /// Uncorrelated candidates (Table 2's "ReSTIR"): K independent uniform positions from
-    /// a per-pixel, per-frame PCG stream, and a PCG number for resampling; white noise,
-    /// no stratification within or across frames.
-    Random,
-    /// Heitz et al. 2019 with 4 samples per frame: candidate j ∈ 0..4 takes its position
-    /// from dimension 0 at sample index (4·frame + j) mod 256, so a frame's 4 candidates
-    /// are 4 consecutive points of the pixel's Sobol sequence (the 256-sample sequence
-    /// lasts 64 frames); resampling uses dimension 1 at sample index (4·frame) mod 256.
-    Heitz,
-    /// Random-offset stratification with white noise: one PCG number u per pixel and
-    /// frame, positions (u + j) / 4; resampling from PCG. Stratified within a frame,
-    /// uncorrelated across frames.
-    RandomOffset,
-    /// Random offset + temporal blue noise: positions (u + j) / 4 with u from dimension 0
-    /// of the blue-noise sampler at sample index frame mod 256, resampling from
-    /// dimension 1.
-    RandomOffsetBlueNoise,
-    /// Antithetic + temporal blue noise (the paper's method, the default): u from
-    /// dimension 0 at sample index frame mod 256 scaled into [0, ¼), positions
-    /// {u, ½ − u, ½ + u, 1 − u} (Fig. 3); resampling from dimension 1.
-    #[default]
-    Antithetic,
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -141,9 +116,11 @@ mod tests {
         assert_eq!(tables.sobol.len(), 256 * 256);
         assert_eq!(tables.scrambling.len(), 128 * 128 * 8);
         assert_eq!(tables.ranking.len(), 128 * 128 * 8);
-        for (_, table) in tables.buffers() {
-            assert!(table.iter().all(|&v| v < 256));
-        }
+        let packed = tables.packed();
+        assert_eq!(packed.len(), PACKED_WORDS as usize);
+        assert!(packed.iter().all(|&v| v < 256));
+        assert_eq!(packed[PACKED_SCRAMBLING as usize..PACKED_RANKING as usize], tables.scrambling[..]);
+        assert_eq!(packed[PACKED_RANKING as usize..], tables.ranking[..]);
         // The ranking is shared within each optimised pair.
         assert!(tables.ranking.chunks_exact(2).all(|pair| pair[0] == pair[1]));
     }

@@ -1,8 +1,7 @@
-//! Host twins of the embeddable selection's records (`wgsl/embed/selection.wgsl`),
+//! Host twins of the embeddable selection's records (`wgsl/embed/contract.wgsl`),
 //! checked against naga's layout by [`crate::layout::check_struct`]. These are the buffer
 //! contract between an engine and the `strata_select` / `strata_resample` kernels.
 
-use crate::blue_noise::SamplerVariant;
 use bytemuck::{Pod, Zeroable};
 
 /// A slot without a candidate, or a pixel without a selection.
@@ -14,19 +13,7 @@ pub const NO_SLOT: u32 = 0xffff_ffff;
 /// [`ResampleOutput::slot`]: a weight or target was NaN, infinite or negative, or a
 /// positive weight came with a zero target; nothing chosen.
 pub const INVALID_SLOT: u32 = 0xffff_fffe;
-/// Most candidates selected per pixel.
-pub const MAX_SELECTED: u32 = 4;
-
-/// The WGSL `SAMPLER_*` constant of a sampler variant.
-pub fn sampler_id(variant: SamplerVariant) -> u32 {
-    match variant {
-        SamplerVariant::Random => 0,
-        SamplerVariant::Heitz => 1,
-        SamplerVariant::RandomOffset => 2,
-        SamplerVariant::RandomOffsetBlueNoise => 3,
-        SamplerVariant::Antithetic => 4,
-    }
-}
+pub use crate::selection::MAX_SELECTED;
 
 /// Per-frame settings of `strata_select` and `strata_resample` (WGSL `SelectionParams`,
 /// a uniform).
@@ -43,7 +30,7 @@ pub struct SelectionParams {
     pub seed: u32,
     /// K in 1..=4.
     pub candidates: u32,
-    /// [`sampler_id`] of the sampler variant.
+    /// The sampler variant's [`crate::selection::SamplerVariant::id`].
     pub sampler: u32,
     /// 1: the payload of a pixel is its index (the payloads buffer is not read).
     pub identity_payload: u32,
@@ -107,8 +94,8 @@ pub struct ResampleOutput {
 /// selections and write the resampling inputs: prepend it to the shader source.
 pub fn contract_wgsl() -> String {
     crate::source::ComposedSource::compose(&[
-        crate::fragment!("common/candidate.wgsl"),
-        crate::fragment!("embed/selection.wgsl"),
+        crate::fragment!("strata/candidate.wgsl"),
+        crate::fragment!("embed/contract.wgsl"),
     ])
     .text
 }

@@ -143,7 +143,7 @@ shader_struct!(
     [
         method,
         candidates,
-        masking,
+        sampler,
         temporal,
         temporal_cap,
         disc_radius,

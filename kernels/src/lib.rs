@@ -8,6 +8,12 @@
 //!   backend of the project uses.
 //! * [`reference`]: plain-Rust statements of what each kernel computes, the oracle of
 //!   the tests.
+//! * [`selection`]: the paper's stratified selection on the host (§4.2): the settings
+//!   struct every user shares, the sampler variants and the table of position patterns.
+//!
+//! Where the paper lives in WGSL (`kernels/wgsl/strata/`): §4.1 `histogram.wgsl` (with
+//! its records in `candidate.wgsl`), §4.2 `selection.wgsl` (and its last step,
+//! `resampling.wgsl`), §4.3 `masking.wgsl`.
 
 pub mod binding;
 pub mod block_grid;
@@ -20,6 +26,7 @@ pub mod reference;
 pub mod registry;
 pub mod render_types;
 pub mod restir_types;
+pub mod selection;
 pub mod source;
 pub mod trace_types;
 pub mod translate;

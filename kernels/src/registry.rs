@@ -67,7 +67,19 @@ impl KernelId {
 
     /// What the registry knows of this kernel before parsing it.
     pub fn spec(self) -> Option<KernelSpec> {
-        let histogram = || [fragment!("common/candidate.wgsl"), fragment!("histogram/block_sort.wgsl")];
+        // The paper's histogram (§4.1) with object masking (§4.3).
+        let histogram = || {
+            [fragment!("strata/candidate.wgsl"), fragment!("strata/masking.wgsl"), fragment!("strata/histogram.wgsl")]
+        };
+        // The paper's selection (§4.2): positions from the blue-noise sampler, then the
+        // inverse-CDF resampling.
+        let selection = || {
+            vec![
+                fragment!("strata/blue_noise.wgsl"),
+                fragment!("strata/selection.wgsl"),
+                fragment!("strata/resampling.wgsl"),
+            ]
+        };
         // Every ReSTIR pass: the scene and the path tracer's functions, the candidate
         // records of the histogram, then its own entry point.
         // The path tracer's functions, shared by path_trace and the ReSTIR passes.
@@ -89,7 +101,7 @@ impl KernelId {
             name: name.into(),
             fragments: [
                 renderer(),
-                vec![fragment!("common/candidate.wgsl"), fragment!("restir/reservoir.wgsl")],
+                vec![fragment!("strata/candidate.wgsl"), fragment!("restir/reservoir.wgsl")],
                 pass.to_vec(),
             ]
             .concat(),
@@ -102,14 +114,14 @@ impl KernelId {
         Some(match self {
             KernelId::BlockHistogram => KernelSpec {
                 name: "block_histogram".into(),
-                fragments: [histogram().to_vec(), vec![fragment!("histogram/entry_portable.wgsl")]].concat(),
+                fragments: [histogram().to_vec(), vec![fragment!("strata/entry_histogram.wgsl")]].concat(),
                 entry_point: "block_histogram".into(),
                 features: KernelFeatures::empty(),
                 float_ulp_bound: None,
             },
             KernelId::BlockHistogramSubgroup => KernelSpec {
                 name: "block_histogram_subgroup".into(),
-                fragments: [histogram().to_vec(), vec![fragment!("histogram/entry_subgroup.wgsl")]].concat(),
+                fragments: [histogram().to_vec(), vec![fragment!("strata/entry_histogram_subgroup.wgsl")]].concat(),
                 entry_point: "block_histogram_subgroup".into(),
                 features: KernelFeatures::SUBGROUP,
                 float_ulp_bound: None,
@@ -157,26 +169,28 @@ impl KernelId {
                 float_ulp_bound: Some(4096),
             },
             KernelId::RestirCandidates => restir("restir_candidates", &[fragment!("restir/entry_candidates.wgsl")]),
-            KernelId::RestirSelect => {
-                restir("restir_select", &[fragment!("restir/reuse_slot.wgsl"), fragment!("restir/entry_select.wgsl")])
-            }
+            KernelId::RestirSelect => restir(
+                "restir_select",
+                &[selection(), vec![fragment!("restir/reuse_slot.wgsl"), fragment!("restir/entry_select.wgsl")]]
+                    .concat(),
+            ),
             KernelId::RestirTemporalKeys => {
                 restir("restir_temporal_keys", &[fragment!("restir/entry_temporal_keys.wgsl")])
             }
             KernelId::RestirTemporal => restir(
                 "restir_temporal",
-                &[fragment!("restir/reuse_slot.wgsl"), fragment!("restir/entry_temporal.wgsl")],
+                &[selection(), vec![fragment!("restir/reuse_slot.wgsl"), fragment!("restir/entry_temporal.wgsl")]]
+                    .concat(),
             ),
             KernelId::RestirShade => restir("restir_shade", &[fragment!("restir/entry_shade.wgsl")]),
             KernelId::StrataSelect => KernelSpec {
                 name: "strata_select".into(),
-                fragments: vec![
-                    fragment!("common/candidate.wgsl"),
-                    fragment!("restir/sampler.wgsl"),
-                    fragment!("embed/selection.wgsl"),
-                    fragment!("embed/selection_numbers.wgsl"),
-                    fragment!("embed/entry_select.wgsl"),
-                ],
+                fragments: [
+                    vec![fragment!("strata/candidate.wgsl")],
+                    selection(),
+                    vec![fragment!("embed/contract.wgsl"), fragment!("embed/entry_select.wgsl")],
+                ]
+                .concat(),
                 entry_point: "strata_select".into(),
                 features: KernelFeatures::empty(),
                 // Payload indices are integers; the resampling number is the one float
@@ -185,7 +199,11 @@ impl KernelId {
             },
             KernelId::StrataResample => KernelSpec {
                 name: "strata_resample".into(),
-                fragments: vec![fragment!("embed/selection.wgsl"), fragment!("embed/entry_resample.wgsl")],
+                fragments: vec![
+                    fragment!("strata/resampling.wgsl"),
+                    fragment!("embed/contract.wgsl"),
+                    fragment!("embed/entry_resample.wgsl"),
+                ],
                 entry_point: "strata_resample".into(),
                 features: KernelFeatures::empty(),
                 // W = sum / target: one division after K + 1 additions.
@@ -581,7 +599,7 @@ mod tests {
     #[test]
     fn the_portable_kernel_is_validated_without_subgroups() {
         let mut spec = KernelId::BlockHistogram.spec().unwrap();
-        spec.fragments[2] = fragment!("histogram/entry_subgroup.wgsl");
+        *spec.fragments.last_mut().unwrap() = fragment!("strata/entry_histogram_subgroup.wgsl");
         let source = ComposedSource::compose(&spec.fragments);
         let module = naga::front::wgsl::parse_str(&source.text).unwrap();
         let result =

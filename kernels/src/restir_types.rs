@@ -32,8 +32,9 @@ pub struct RestirParams {
     pub method: u32,
     /// K, candidates selected per pixel.
     pub candidates: u32,
-    /// 1: clusters by object id; 0: one cluster per block.
-    pub masking: u32,
+    /// strata's sampler variant (`SAMPLER_*` of [`crate::selection`], Table 2). Object
+    /// masking (§4.3) is the histogram's own setting (`HistogramParams.masking`).
+    pub sampler: u32,
     /// 1: temporal reuse on.
     pub temporal: u32,
     /// Cap of the previous reservoir's M before a merge.

@@ -131,13 +131,7 @@ fn pass_matches_the_reference() {
         return;
     };
     let tables = BlueNoiseTables::new();
-    let samplers = [
-        SamplerVariant::Antithetic,
-        SamplerVariant::Random,
-        SamplerVariant::Heitz,
-        SamplerVariant::RandomOffset,
-        SamplerVariant::RandomOffsetBlueNoise,
-    ];
+    let samplers = SamplerVariant::ALL;
     let cases = [(1, 1, 4), (37, 21, 8), (64, 48, 16), (70, 33, 32), (16, 16, 16)];
     for (index, &(width, height, block_size)) in cases.iter().enumerate() {
         let settings = SelectionSettings {
@@ -146,7 +140,6 @@ fn pass_matches_the_reference() {
             masking: index % 2 == 0,
             block_shift: index % 3 != 0,
             sampler: samplers[index % samplers.len()],
-            seed: 17 * index as u32,
         };
         let context = format!("{width}x{height} {settings:?}");
         let candidates = candidates(width, height, 3, index as u32);
@@ -154,7 +147,9 @@ fn pass_matches_the_reference() {
         let payloads: Vec<u32> = (0..pixels as u32).map(|p| p * 3 + 7).collect();
         let inputs = resample_inputs(pixels, index as u32, true);
         let buffers = EngineBuffers::new(&device, &candidates, &payloads, &inputs);
-        let pass = WgpuSelection::new(&device, settings, width, height).unwrap_or_else(|e| panic!("{context}: {e}"));
+        let mut pass =
+            WgpuSelection::new(&device, settings, width, height).unwrap_or_else(|e| panic!("{context}: {e}"));
+        pass.set_seed(17 * index as u32);
         for frame in 0..3 {
             let with_payloads = frame != 1;
             let (selections, resampled) = run_frame(&device, &queue, &pass, &buffers, with_payloads, frame);
@@ -194,13 +189,14 @@ fn exported_wgsl_modules_give_the_same_outputs() {
         return;
     };
     let (width, height) = (45, 30);
-    let settings = SelectionSettings { block_shift: true, seed: 5, ..Default::default() };
+    let settings = SelectionSettings { block_shift: true, ..Default::default() };
     let candidates = candidates(width, height, 4, 99);
     let pixels = candidates.len();
     let payloads: Vec<u32> = (0..pixels as u32).rev().collect();
     let inputs = resample_inputs(pixels, 3, true);
     let buffers = EngineBuffers::new(&device, &candidates, &payloads, &inputs);
-    let pass = WgpuSelection::new(&device, settings, width, height).unwrap();
+    let mut pass = WgpuSelection::new(&device, settings, width, height).unwrap();
+    pass.set_seed(5);
     let frame = 11;
     let (want_selections, want_resampled) = run_frame(&device, &queue, &pass, &buffers, true, frame);
 
@@ -224,9 +220,7 @@ fn exported_wgsl_modules_give_the_same_outputs() {
     let sorted = storage(&vec![0; pixels * 4]);
     let spans = storage(&vec![0; pixels * 12]);
     let stats = storage(&vec![0; blocks * 12]);
-    let sobol = storage(bytemuck::cast_slice(&tables.sobol));
-    let scrambling = storage(bytemuck::cast_slice(&tables.scrambling));
-    let ranking = storage(bytemuck::cast_slice(&tables.ranking));
+    let blue_noise = storage(bytemuck::cast_slice(&tables.packed()));
     let payload_buffer = storage(bytemuck::cast_slice(&payloads));
     let selections = storage(&vec![0; pixels * size_of::<SelectedCandidates>()]);
     let input_buffer = storage(bytemuck::cast_slice(&inputs));
@@ -244,17 +238,7 @@ fn exported_wgsl_modules_give_the_same_outputs() {
         ),
         (
             ModuleId::Select,
-            vec![
-                &selection_params,
-                &candidate_buffer,
-                &payload_buffer,
-                &sorted,
-                &spans,
-                &sobol,
-                &scrambling,
-                &ranking,
-                &selections,
-            ],
+            vec![&selection_params, &candidate_buffer, &payload_buffer, &sorted, &spans, &blue_noise, &selections],
             params.pixel_workgroups,
         ),
         (ModuleId::Resample, vec![&selection_params, &selections, &input_buffer, &resampled], params.pixel_workgroups),
@@ -318,16 +302,17 @@ enum Renders {
 }
 
 /// Counts, per pixel and run position, how often the pass selects each member of the
-/// pixel's run over `renders` repetitions.
+/// pixel's run over `renders` repetitions with K = `k`.
 fn selection_counts(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     sampler: SamplerVariant,
+    k: u32,
     renders: u32,
     mode: Renders,
-) -> (Vec<Vec<u32>>, u32) {
+) -> Vec<Vec<u32>> {
     let (width, height) = (16, 16);
-    // Two objects with runs of 12 to 140 pixels; distinct keys.
+    // Two objects with runs of 48 and 208 pixels; distinct keys.
     let candidates: Vec<Candidate> = (0..width * height)
         .map(|p| Candidate { key: (p * 37 % 256) as f32, object_id: u32::from((p % 16) < 3) })
         .collect();
@@ -336,9 +321,9 @@ fn selection_counts(
     let buffers = EngineBuffers::new(device, &candidates, &payloads, &inputs);
     let histogram = block_histogram(BlockGrid::new(width, height, 16).unwrap(), &candidates);
     let mut counts: Vec<Vec<u32>> = histogram.spans.iter().map(|span| vec![0; span.length as usize]).collect();
-    let k = 4;
-    let settings = SelectionSettings { sampler, seed: 1, ..Default::default() };
+    let settings = SelectionSettings { sampler, candidates: k, ..Default::default() };
     let mut pass = WgpuSelection::new(device, settings, width, height).unwrap();
+    pass.set_seed(1);
     for render in 0..renders {
         let frame = match mode {
             Renders::Independent => {
@@ -351,7 +336,8 @@ fn selection_counts(
         let (selections, _) = run_frame(device, queue, &pass, &buffers, false, frame);
         for (pixel, selection) in selections.iter().enumerate() {
             let span = histogram.spans[pixel];
-            for &payload in &selection.payloads[..k] {
+            assert_eq!(selection.selected, k, "pixel {pixel}: slots filled");
+            for &payload in &selection.payloads[..k as usize] {
                 let position = (span.offset..span.offset + span.length)
                     .position(|i| histogram.sorted_pixels[i as usize] == payload)
                     .expect("selected from the pixel's own run");
@@ -359,40 +345,90 @@ fn selection_counts(
             }
         }
     }
-    (counts, k as u32)
+    counts
 }
 
 /// Over independent renders every member of a pixel's run is selected K/n times per
-/// render in expectation (what keeps the fixed 1/K normalisation unbiased): each count
-/// within 5 binomial standard deviations (an upper bound for the stratified patterns).
+/// render in expectation (what keeps the fixed 1/K normalisation unbiased), for every
+/// K from 1 to 4 and every sampler variant. The same statistics fail on the same render
+/// repeated and on the positions `strata-embed` once used for K < 4 (the first K slots
+/// of the four-slot antithetic pattern, which never reach the top of a run).
 #[test]
 fn every_run_member_is_selected_k_over_n_times() {
     let Some((device, queue)) = engine_device("every_run_member_is_selected_k_over_n_times", None) else {
         return;
     };
-    let renders = 192;
-    let (counts, k) = selection_counts(&device, &queue, SamplerVariant::Antithetic, renders, Renders::Independent);
-    if let Err(message) = k_over_n(&counts, renders, k) {
-        panic!("{message}");
-    }
-    // The check can fail: the same render repeated selects the same members every time.
-    let (counts, k) = selection_counts(&device, &queue, SamplerVariant::Antithetic, 64, Renders::SameSeed);
-    assert!(k_over_n(&counts, 64, k).is_err(), "a deterministic selection passed the K/n check");
-}
-
-/// Each member's count within 5 binomial standard deviations of renders·K/n.
-fn k_over_n(counts: &[Vec<u32>], renders: u32, k: u32) -> Result<(), String> {
-    for (pixel, members) in counts.iter().enumerate() {
-        let n = members.len() as f64;
-        let draws = f64::from(renders * k);
-        let p = 1.0 / n;
-        let expected = draws * p;
-        let sigma = (draws * p * (1.0 - p)).sqrt().max(1.0);
-        for (position, &count) in members.iter().enumerate() {
-            if (f64::from(count) - expected).abs() > 5.0 * sigma {
-                return Err(format!("pixel {pixel} member {position}/{n}: {count} selections, {expected:.1} expected"));
+    let renders = 96;
+    for sampler in SamplerVariant::ALL {
+        for k in 1..=4 {
+            let counts = selection_counts(&device, &queue, sampler, k, renders, Renders::Independent);
+            if let Err(message) = k_over_n(&counts, renders, k) {
+                panic!("{sampler:?} K = {k}: {message}");
             }
         }
+    }
+    // The check can fail: the same render repeated selects the same members every time.
+    let counts = selection_counts(&device, &queue, SamplerVariant::Antithetic, 4, 64, Renders::SameSeed);
+    assert!(k_over_n(&counts, 64, 4).is_err(), "a deterministic selection passed the K/n check");
+    // ... and on the old biased positions, drawn here with the same run lengths.
+    for k in 1..4 {
+        let counts = biased_counts(k, renders);
+        let verdict = k_over_n(&counts, renders, k);
+        assert!(verdict.is_err(), "K = {k}: the first K antithetic slots passed the K/n check");
+    }
+}
+
+/// Counts of the positions `strata-embed` used before the selection had one home: the
+/// first K of {b, 1/2 - b, 1/2 + b, 1 - b} / ... (the four-slot antithetic pattern) with
+/// b uniform, for runs of 48 and 208 members as in [`selection_counts`].
+fn biased_counts(k: u32, renders: u32) -> Vec<Vec<u32>> {
+    let pattern = strata_kernels::selection::StratifiedPattern::antithetic(4);
+    let mut state = 0x1234_5678u32;
+    let mut counts: Vec<Vec<u32>> = (0..256).map(|p| vec![0; if p % 16 < 3 { 48 } else { 208 }]).collect();
+    for _ in 0..renders {
+        for members in &mut counts {
+            state = strata_kernels::reference::stratified_selection::selection_hash(state);
+            let b = (state >> 8) as f32 / 16_777_216.0;
+            let n = members.len();
+            for position in &pattern.positions(b)[..k as usize] {
+                members[((position * n as f32) as usize).min(n - 1)] += 1;
+            }
+        }
+    }
+    counts
+}
+
+/// Whether per-pixel counts of selected run members are consistent with every member
+/// being selected renders·K/n times in expectation. Two Pearson statistics, each against
+/// independent uniform draws (the stratified patterns disperse less, so both are upper
+/// bounds for them): the sum over pixels of each pixel's chi-square across its members
+/// (any member over- or under-selected; z-score of the summed chi-square under 6), and
+/// one chi-square of all selections by relative run position in 8 bins (a part of every
+/// run never reached; under 60 at 7 degrees of freedom, p ≈ 1e-10).
+fn k_over_n(counts: &[Vec<u32>], renders: u32, k: u32) -> Result<(), String> {
+    let draws = f64::from(renders * k);
+    let (mut statistic, mut freedom) = (0.0, 0.0);
+    let (mut observed, mut expected) = ([0.0f64; 8], [0.0f64; 8]);
+    for members in counts {
+        let n = members.len();
+        let mean = draws / n as f64;
+        for (position, &count) in members.iter().enumerate() {
+            statistic += (f64::from(count) - mean).powi(2) / mean;
+            let bin = position * 8 / n;
+            observed[bin] += f64::from(count);
+            expected[bin] += mean;
+        }
+        freedom += (n - 1) as f64;
+    }
+    let z = (statistic - freedom) / (2.0 * freedom).sqrt();
+    if z > 6.0 {
+        return Err(format!("members' chi-square {statistic:.0} on {freedom} degrees of freedom (z = {z:.1})"));
+    }
+    let by_position: f64 = observed.iter().zip(&expected).map(|(o, e)| (o - e).powi(2) / e).sum();
+    if by_position > 60.0 {
+        return Err(format!(
+            "selections by relative run position {observed:?}, {expected:.0?} expected (chi-square {by_position:.0})"
+        ));
     }
     Ok(())
 }
@@ -406,7 +442,8 @@ fn blue_noise_stratifies_selection_over_frames() {
         return;
     };
     let spread = |sampler| {
-        let (counts, k) = selection_counts(&device, &queue, sampler, 256, Renders::Frames);
+        let k = 4;
+        let counts = selection_counts(&device, &queue, sampler, k, 256, Renders::Frames);
         let mut squared = 0.0;
         let mut cells = 0.0;
         for members in &counts {
@@ -546,7 +583,7 @@ fn bad_configurations_are_named_errors() {
         (
             wgpu::Limits { max_storage_buffers_per_shader_stage: 4, ..wgpu::Limits::downlevel_defaults() },
             16,
-            &["max_storage_buffers_per_shader_stage", "is 4", "needs 8", "strata_select"][..],
+            &["max_storage_buffers_per_shader_stage", "is 4", "needs 6", "strata_select"][..],
         ),
         (
             wgpu::Limits { max_compute_workgroup_storage_size: 4096, ..wgpu::Limits::default() },

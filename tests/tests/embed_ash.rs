@@ -33,7 +33,7 @@ fn inputs() -> (Vec<Candidate>, Vec<u32>, Vec<ResampleInput>) {
 }
 
 fn settings() -> SelectionSettings {
-    SelectionSettings { block_size: 8, candidates: 3, block_shift: true, seed: 9, ..Default::default() }
+    SelectionSettings { block_size: 8, candidates: 3, block_shift: true, ..Default::default() }
 }
 
 /// Frames 0-3 on the wgpu flavour.
@@ -49,7 +49,8 @@ fn wgpu_frames() -> Option<Vec<(Vec<SelectedCandidates>, Vec<ResampleOutput>)>> 
     let selections = init(&vec![0; pixels * size_of::<SelectedCandidates>()]);
     let weights = init(bytemuck::cast_slice(&resample));
     let outputs = init(&vec![0; pixels * size_of::<ResampleOutput>()]);
-    let pass = WgpuSelection::new(&device, settings(), WIDTH, HEIGHT).unwrap();
+    let mut pass = WgpuSelection::new(&device, settings(), WIDTH, HEIGHT).unwrap();
+    pass.set_seed(9);
     let bindings = pass
         .bind(
             &device,
@@ -95,7 +96,8 @@ fn ash_flavour_matches_wgpu_flavour() {
     let slice = |i: usize| AshBufferSlice { buffer: buffers[i].0, offset: 0, size: sizes[i] };
     let vulkan =
         AshDevice { instance: &engine.instance, physical_device: engine.physical_device, device: &engine.device };
-    let pass = AshSelection::new(vulkan, settings(), WIDTH, HEIGHT).unwrap();
+    let mut pass = AshSelection::new(vulkan, settings(), WIDTH, HEIGHT).unwrap();
+    pass.set_seed(9);
     let good = AshBuffers {
         candidates: slice(0),
         payloads: Some(slice(1)),

@@ -15,6 +15,7 @@ use strata::restir::{Method, RestirRenderer, RestirSettings, ShadedParts};
 use strata::rgb_image::RgbImage;
 use strata::scene::{Camera, CameraPath, Scene, default_scene};
 use strata_backends::{Backend, gpu_required};
+use strata_kernels::selection::SelectionSettings;
 
 const SIZE: u32 = 32;
 const REGION: u32 = 8;
@@ -61,6 +62,11 @@ impl RegionStats {
         let m = self.mean(i);
         (self.squares[i] / self.count - m * m) * self.count / (self.count - 1.0) / self.count
     }
+}
+
+/// The selection at 8 x 8 blocks (the 32 x 32 test image holds 16 of them).
+fn blocks_of_8() -> SelectionSettings {
+    SelectionSettings { block_size: 8, ..Default::default() }
 }
 
 fn settings(scene: &Scene, seed: u32) -> RenderSettings {
@@ -162,7 +168,7 @@ fn every_method_converges_to_the_path_traced_reference() {
     let scene = default_scene();
     let reference = reference(&mut backend, &scene, 2048);
     for method in [Method::Strata, Method::Restir, Method::RestirDisc] {
-        let restir = RestirSettings { method, temporal: false, block_size: 8, ..RestirSettings::default() };
+        let restir = RestirSettings { method, temporal: false, selection: blocks_of_8(), ..RestirSettings::default() };
         let ours = restir_frames(&mut backend, &scene, restir, 1..9, 64);
         assert_unbiased(&format!("{} without temporal reuse", method.name()), &z_scores(&ours, &reference));
         // The test can fail: the same frames 3 % too bright are caught.
@@ -197,7 +203,8 @@ fn temporal_reuse_stays_unbiased() {
         (Method::RestirDisc, 4, 512),
     ];
     for (method, temporal_candidates, renders) in configurations {
-        let restir = RestirSettings { method, block_size: 8, temporal_candidates, ..RestirSettings::default() };
+        let restir =
+            RestirSettings { method, selection: blocks_of_8(), temporal_candidates, ..RestirSettings::default() };
         let ours = restir_frames(&mut backend, &scene, restir, 1..renders + 1, 6);
         let what = format!("{} with own + {temporal_candidates} drawn temporal reservoirs, frame 6", method.name());
         assert_unbiased(&what, &z_scores(&ours, &reference));
@@ -215,7 +222,7 @@ fn shaded_parts_add_up_to_the_image() {
     let scene = default_scene();
     let gpu_scene = GpuScene::build(&scene).unwrap();
     let mut frame_3 = |method, shaded_parts| {
-        let restir = RestirSettings { method, block_size: 8, shaded_parts, ..RestirSettings::default() };
+        let restir = RestirSettings { method, selection: blocks_of_8(), shaded_parts, ..RestirSettings::default() };
         let mut renderer =
             RestirRenderer::new(&mut backend, &gpu_scene, &settings(&scene, 7), restir, scene.extent()).unwrap();
         let mut image = None;
@@ -320,19 +327,24 @@ fn bad_restir_settings_are_errors_naming_the_value() {
     let gpu_scene = GpuScene::build(&scene).unwrap();
     let render = settings(&scene, 1);
     let cases: [(RestirSettings, &str); 6] = [
-        (RestirSettings { block_size: 12, ..Default::default() }, "block size 12"),
-        (RestirSettings { min_roughness: f32::NAN, ..Default::default() }, "min roughness NaN"),
-        (RestirSettings { min_distance: -1.0, ..Default::default() }, "min distance -1"),
-        (RestirSettings { candidates: 5, ..Default::default() }, "candidates 5"),
-        (RestirSettings { temporal_cap: 0.5, ..Default::default() }, "temporal cap 0.5"),
         (
             RestirSettings {
-                candidates: 3,
-                sampler: strata::sampler::SamplerVariant::Antithetic,
+                selection: SelectionSettings { block_size: 12, ..Default::default() },
                 ..Default::default()
             },
-            "exactly 4",
+            "block_size = 12",
         ),
+        (RestirSettings { min_roughness: f32::NAN, ..Default::default() }, "min roughness NaN"),
+        (RestirSettings { min_distance: -1.0, ..Default::default() }, "min distance -1"),
+        (
+            RestirSettings {
+                selection: SelectionSettings { candidates: 5, ..Default::default() },
+                ..Default::default()
+            },
+            "candidates = 5",
+        ),
+        (RestirSettings { temporal_cap: 0.5, ..Default::default() }, "temporal cap 0.5"),
+        (RestirSettings { temporal_candidates: 5, ..Default::default() }, "temporal candidates 5"),
     ];
     for (restir, expected) in cases {
         let error = RestirRenderer::new(&mut backend, &gpu_scene, &render, restir, 1.0).err().unwrap().to_string();
@@ -360,7 +372,10 @@ fn temporal_reuse_with_a_moving_camera_stays_unbiased() {
     let base = settings(&scene, 0).camera;
     let path = CameraPath::orbit(&base, 1.5);
     let reference = reference_from(&mut backend, &scene, 2048, &path.camera_at(&base, 5));
-    let restir = RestirSettings { block_size: 8, block_shift: true, ..RestirSettings::default() };
+    let restir = RestirSettings {
+        selection: SelectionSettings { block_shift: true, ..blocks_of_8() },
+        ..RestirSettings::default()
+    };
     let ours = restir_frames_moving(&mut backend, &scene, restir, 1..129, 6, &path);
     assert_unbiased(
         "strata with temporal reuse, orbiting camera, shifting grid, frame 6",

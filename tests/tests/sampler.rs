@@ -4,11 +4,11 @@
 
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
-use strata::sampler::{BlueNoiseTables, SAMPLES, TILE_SIZE};
 use strata_backends::backend::{download, upload};
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_backends::{Backend, Bind, gpu_required};
 use strata_kernels::Kernel;
+use strata_kernels::blue_noise::{BlueNoiseTables, SAMPLES, TILE_SIZE, WGSL_BUFFER_NAME};
 
 /// [x, y, sample, dimension]; where the reference reads [ranking, sobol, scrambling]; what
 /// it reads there and the ranked index [ranking, ranked, sobol, scrambling]; the stratum.
@@ -180,12 +180,10 @@ fn a_frame_over_the_tile_is_blue_noise() {
 }
 
 const TEST_ENTRY: &str = r#"
-@group(0) @binding(0) var<storage, read> blue_noise_sobol: array<u32>;
-@group(0) @binding(1) var<storage, read> blue_noise_scrambling: array<u32>;
-@group(0) @binding(2) var<storage, read> blue_noise_ranking: array<u32>;
+@group(0) @binding(0) var<storage, read> blue_noise: array<u32>;
 // (pixel x, pixel y, sample index, dimension) per invocation.
-@group(0) @binding(3) var<storage, read> queries: array<vec4<u32>>;
-@group(0) @binding(4) var<storage, read_write> samples: array<u32>;
+@group(0) @binding(1) var<storage, read> queries: array<vec4<u32>>;
+@group(0) @binding(2) var<storage, read_write> samples: array<u32>;
 
 @compute @workgroup_size(64)
 fn sampler_test(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -212,18 +210,15 @@ fn queries() -> Vec<[u32; 4]> {
     queries
 }
 
-/// Runs `sampler.wgsl` (after the host) on `backend` and compares the bits.
+/// Runs `strata/blue_noise.wgsl` (after the host) on `backend` and compares the bits.
 fn wgsl_matches_host(backend: &mut dyn Backend) {
-    let include = include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/../kernels/wgsl/restir/sampler.wgsl"));
+    let include = include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/../kernels/wgsl/strata/blue_noise.wgsl"));
     let kernel = Kernel::from_wgsl("sampler_test.wgsl", format!("{include}\n{TEST_ENTRY}"), "sampler_test", false)
         .unwrap_or_else(|e| panic!("{e}"));
     let tables = BlueNoiseTables::new();
     let queries = queries();
-    let mut bound = Vec::new();
-    for (binding, (name, table)) in tables.buffers().into_iter().enumerate() {
-        assert_eq!(kernel.binding(0, binding as u32).map(|b| b.name.as_str()), Some(name));
-        bound.push(upload(backend, name, table).unwrap());
-    }
+    assert_eq!(kernel.binding(0, 0).map(|b| b.name.as_str()), Some(WGSL_BUFFER_NAME));
+    let mut bound = vec![upload(backend, WGSL_BUFFER_NAME, &tables.packed()).unwrap()];
     bound.push(upload(backend, "queries", &queries).unwrap());
     let output = upload(backend, "samples", &vec![strata_tests::POISON; queries.len()]).unwrap();
     bound.push(output);

@@ -16,6 +16,7 @@ use crate::render::{GpuScene, RenderSettings};
 use crate::restir::{FrameBuffers, Method, RestirRenderer, RestirSettings};
 use strata_backends::Backend;
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
+use strata_kernels::selection::{SamplerVariant, SelectionSettings};
 use strata_kernels::{KernelId, Registry};
 
 /// Checks one of the ReSTIR kernels ([`KernelId::RestirCandidates`] and the four after it).
@@ -32,7 +33,14 @@ fn frame(backend: &mut dyn Backend, case: &Case) -> Result<FrameBuffers, PassErr
     let temporal_candidates = [4, 0, 2][(case.seed % 3) as usize];
     let settings = RestirSettings {
         method,
-        block_size: case.block_size,
+        // Every sampler variant and K in turn (the seed's remaining digits), so the
+        // in-kernel selection numbers (§4.2) are compared for each.
+        selection: SelectionSettings {
+            block_size: case.block_size,
+            candidates: 1 + (case.seed / 3 % 4) as u32,
+            sampler: SamplerVariant::ALL[(case.seed / 3 % 5) as usize],
+            ..SelectionSettings::default()
+        },
         disc_radius: 4.0,
         temporal_candidates,
         ..RestirSettings::default()

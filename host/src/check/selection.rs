@@ -12,23 +12,19 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg32;
 use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, Bind};
-use strata_kernels::blue_noise::{BlueNoiseTables, SamplerVariant};
-use strata_kernels::embed_types::{ResampleInput, ResampleOutput, SelectedCandidates, SelectionParams, sampler_id};
+use strata_kernels::blue_noise::BlueNoiseTables;
+use strata_kernels::embed_types::{ResampleInput, ResampleOutput, SelectedCandidates, SelectionParams};
 use strata_kernels::reference::block_histogram::{HistogramOutput, block_histogram};
 use strata_kernels::reference::stratified_selection::{resample, select};
+use strata_kernels::selection::SamplerVariant;
 use strata_kernels::types::Candidate;
 use strata_kernels::{BlockGrid, KernelId, Registry};
 
 /// Checks [`KernelId::StrataSelect`] or [`KernelId::StrataResample`].
 pub struct SelectionCheck(pub KernelId);
 
-const SAMPLERS: [SamplerVariant; 5] = [
-    SamplerVariant::Antithetic,
-    SamplerVariant::Random,
-    SamplerVariant::Heitz,
-    SamplerVariant::RandomOffset,
-    SamplerVariant::RandomOffsetBlueNoise,
-];
+/// Every sampler variant of Table 2, one per case family.
+const SAMPLERS: [SamplerVariant; 5] = SamplerVariant::ALL;
 
 /// The generated inputs of one case.
 struct Inputs {
@@ -57,7 +53,7 @@ fn inputs(case: &Case) -> Inputs {
         frame: (case.seed * 37 % 1000) as u32,
         seed: case.seed as u32,
         candidates: 1 + (case.seed % 4) as u32,
-        sampler: sampler_id(SAMPLERS[case.family as usize % SAMPLERS.len()]),
+        sampler: SAMPLERS[case.family as usize % SAMPLERS.len()].id(),
         identity_payload: (case.seed % 2) as u32,
         _pad: 0,
     };
@@ -164,30 +160,36 @@ impl KernelCheck for SelectionCheck {
         let kernel = registry.get(self.0);
         let inputs = inputs(case);
         let pixels = inputs.candidates.len() as u64;
-        let workgroups = [case.width.div_ceil(8), case.height.div_ceil(8), 1];
+        let [group_x, group_y, _] = kernel.workgroup_size;
+        let workgroups = [case.width.div_ceil(group_x), case.height.div_ceil(group_y), 1];
         let params = upload(backend, "selection params", &[inputs.params])?;
         let mut buffers = vec![params];
         let result = if self.0 == KernelId::StrataSelect {
             let tables = BlueNoiseTables::new();
-            let mut binds = vec![Bind::new(0, params)];
-            let inputs_words: [(u32, &[u32]); 7] = [
-                (1, bytemuck::cast_slice(&inputs.candidates)),
-                (2, &inputs.payloads),
-                (3, &inputs.histogram.sorted_pixels),
-                (4, bytemuck::cast_slice(&inputs.histogram.spans)),
-                (5, &tables.sobol),
-                (6, &tables.scrambling),
-                (7, &tables.ranking),
+            let binding = |name: &str| {
+                kernel
+                    .binding_named(name)
+                    .map(|b| b.binding)
+                    .ok_or_else(|| PassError::Input(format!("kernel {}: no binding named {name}", kernel.name())))
+            };
+            let mut binds = vec![Bind::new(binding("params")?, params)];
+            let packed = tables.packed();
+            let inputs_words: [(&str, &[u32]); 5] = [
+                ("candidates", bytemuck::cast_slice(&inputs.candidates)),
+                ("payloads", &inputs.payloads),
+                ("sorted_pixels", &inputs.histogram.sorted_pixels),
+                ("spans", bytemuck::cast_slice(&inputs.histogram.spans)),
+                ("blue_noise", &packed),
             ];
-            for (binding, words) in inputs_words {
+            for (name, words) in inputs_words {
                 let buffer = upload(backend, "selection input", words)?;
                 buffers.push(buffer);
-                binds.push(Bind::new(binding, buffer));
+                binds.push(Bind::new(binding(name)?, buffer));
             }
             let out = backend.create_buffer("selections", pixels * size_of::<SelectedCandidates>() as u64)?;
             buffers.push(out);
             backend.write_buffer(out, 0, &vec![0xa5; (pixels as usize) * size_of::<SelectedCandidates>()])?;
-            binds.push(Bind::new(8, out));
+            binds.push(Bind::new(binding("selections")?, out));
             backend.dispatch(kernel, &binds, workgroups)?;
             download::<SelectedCandidates>(backend, out).map(|s| selection_outputs(&s))
         } else {

@@ -7,13 +7,11 @@
 //! One frame is five kernels (`kernels/wgsl/restir/`): candidates (G-buffer, each pixel's
 //! own estimate, one path candidate per pixel), the block histogram (strata and restir
 //! only), selection + resampling with the pixel's canonical candidate, temporal reuse
-//! and shading. See [`RestirRenderer`] for the buffers and [`selection_numbers`] for the
-//! sampler variants of the paper's Table 2.
+//! and shading. See [`RestirRenderer`] for the buffers; the selection itself (§4.1-4.3)
+//! lives in the kernels' `strata/` folder and [`strata_kernels::selection`].
 
 mod pipeline;
-mod selection_numbers;
 mod settings;
 
 pub use pipeline::{FrameBuffers, FrameStats, RestirRenderer};
-pub use selection_numbers::selection_numbers;
 pub use settings::{Method, RestirSettings, ShadedParts};

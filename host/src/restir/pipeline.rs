@@ -2,15 +2,15 @@
 //! buffers (two G-buffers and two reservoir buffers alternate for temporal reuse), and
 //! the five passes dispatched in order.
 
-use super::{Method, RestirSettings, selection_numbers};
+use super::{Method, RestirSettings};
 use crate::histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};
 use crate::render::{GpuScene, RenderSettings, SceneBuffers};
 use crate::rgb_image::RgbImage;
-use crate::sampler::BlueNoiseTables;
 use crate::scene::{Camera, CameraFrame};
 use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, BackendError, Bind, BufferId};
 use strata_kernels::block_grid::frame_shift;
+use strata_kernels::blue_noise::BlueNoiseTables;
 use strata_kernels::render_types::{FLAG_HIT_LIGHTS, FLAG_SAMPLE_LIGHTS, RenderParams};
 use strata_kernels::restir_types::{
     METHOD_RESTIR, METHOD_RESTIR_DISC, METHOD_STRATA, PathCandidate, Primary, Reservoir, RestirParams,
@@ -67,7 +67,9 @@ pub struct RestirRenderer {
     temporal_sources: BufferId,
     /// The temporal keys when there is no temporal histogram to hold them (T = 0).
     temporal_keys: BufferId,
-    tables: BlueNoiseTables,
+    /// Heitz et al.'s tables packed in one buffer (`strata/blue_noise.wgsl`), from which
+    /// the selection kernels draw their numbers (§4.2).
+    blue_noise: BufferId,
     render_params: BufferId,
     restir_params: BufferId,
     primaries: [BufferId; 2],
@@ -75,7 +77,6 @@ pub struct RestirRenderer {
     base_radiance: BufferId,
     selected: BufferId,
     reservoirs: [BufferId; 2],
-    numbers: BufferId,
     frame_out: BufferId,
     /// Frames rendered; the next frame's index.
     frame: u32,
@@ -114,10 +115,11 @@ impl RestirRenderer {
                 camera.width, camera.height
             )));
         }
-        let grid = BlockGrid::new(camera.width, camera.height, settings.block_size)?;
-        let histogram = BlockHistogramPass::new(backend, HistogramVariant::Auto, grid)?;
+        let selection = settings.selection;
+        let grid = BlockGrid::new(camera.width, camera.height, selection.block_size)?;
+        let histogram = BlockHistogramPass::with_masking(backend, HistogramVariant::Auto, grid, selection.masking)?;
         let temporal_histogram = if settings.temporal_candidates > 0 && settings.method.uses_histogram() {
-            Some(BlockHistogramPass::new(backend, HistogramVariant::Auto, grid)?)
+            Some(BlockHistogramPass::with_masking(backend, HistogramVariant::Auto, grid, selection.masking)?)
         } else {
             None
         };
@@ -140,7 +142,7 @@ impl RestirRenderer {
             temporal_histogram,
             temporal_sources: buffer(backend, "temporal sources", pixels * 4)?,
             temporal_keys: buffer(backend, "temporal keys", pixels * size_of::<Candidate>() as u64)?,
-            tables: BlueNoiseTables::new(),
+            blue_noise: upload(backend, "blue noise", &BlueNoiseTables::new().packed())?,
             render_params: upload(backend, "render params", &[params])?,
             restir_params: upload(backend, "restir params", &[RestirParams::default()])?,
             primaries: [
@@ -154,7 +156,6 @@ impl RestirRenderer {
                 buffer(backend, "reservoirs A", reservoir_size)?,
                 buffer(backend, "reservoirs B", reservoir_size)?,
             ],
-            numbers: buffer(backend, "selection numbers", pixels * 48)?,
             frame_out: buffer(backend, "frame", pixels * 16)?,
             frame: 0,
             previous_camera: None,
@@ -191,8 +192,9 @@ impl RestirRenderer {
         let render = RenderSettings { camera: camera.clone(), ..self.render.clone() };
         let frame_camera = CameraFrame::new(&camera)
             .ok_or_else(|| PassError::Input("camera: invalid frame (fov axis or up vector)".into()))?;
-        if self.settings.block_shift && self.settings.method.uses_histogram() {
-            let (sx, sy) = frame_shift(self.settings.block_size, self.frame, self.render.seed);
+        let selection = self.settings.selection;
+        if selection.block_shift && self.settings.method.uses_histogram() {
+            let (sx, sy) = frame_shift(selection.block_size, self.frame, self.render.seed);
             self.histogram.set_grid_shift(backend, sx, sy)?;
             if let Some(temporal) = &mut self.temporal_histogram {
                 temporal.set_grid_shift(backend, sx, sy)?;
@@ -208,8 +210,8 @@ impl RestirRenderer {
                 Method::Restir => METHOD_RESTIR,
                 Method::RestirDisc => METHOD_RESTIR_DISC,
             },
-            candidates: self.settings.candidates,
-            masking: u32::from(self.settings.masking),
+            candidates: selection.candidates,
+            sampler: selection.sampler.id(),
             temporal: u32::from(self.settings.temporal && self.frame > 0),
             temporal_cap: self.settings.temporal_cap,
             disc_radius: self.settings.disc_radius,
@@ -226,26 +228,31 @@ impl RestirRenderer {
         };
         backend.write_buffer(self.restir_params, 0, bytemuck::bytes_of(&restir))?;
         let (width, height) = (camera.width, camera.height);
-        let numbers = selection_numbers(&self.tables, &self.settings, width, height, self.frame, self.render.seed);
-        backend.write_buffer(self.numbers, 0, bytemuck::cast_slice(&numbers))?;
 
         let current = (self.frame % 2) as usize;
         let previous_index = 1 - current;
-        let groups = [width.div_ceil(8), height.div_ceil(8), 1];
-        // The scene, the settings and `extra`, restricted to what `kernel` declares (naga
-        // drops bindings an entry point never reaches).
-        let with = |kernel: &Kernel, extra: &[(u32, BufferId)]| -> Vec<Bind> {
+        // The scene, the settings and the pass's own buffers by their WGSL names, restricted
+        // to what `kernel` uses (naga drops bindings an entry point never reaches).
+        let with = |kernel: &Kernel, extra: &[(&str, BufferId)]| -> Result<Vec<Bind>, PassError> {
             let mut binds = self.scene.binds(self.render_params);
             binds.push(Bind::new(8, self.restir_params));
-            binds.extend(extra.iter().map(|&(slot, buffer)| Bind::new(slot, buffer)));
             binds.retain(|bind| kernel.bindings.iter().any(|b| b.binding == bind.binding));
-            binds
+            for &(name, buffer) in extra {
+                if let Some(info) = kernel.binding_named(name) {
+                    binds.push(Bind::new(info.binding, buffer));
+                } else if !declares(kernel, name) {
+                    return Err(PassError::Input(format!("kernel {}: no binding named {name}", kernel.name())));
+                }
+            }
+            Ok(binds)
         };
         let [candidates_kernel, select_kernel, keys_kernel, temporal_kernel, shade_kernel] = self.kernels;
         let timed = self.timed && backend.info().timestamps;
         let mut pass_times = [std::time::Duration::ZERO; 5];
         let run =
             |backend: &mut dyn Backend, kernel: &Kernel, binds: &[Bind]| -> Result<std::time::Duration, PassError> {
+                let [group_x, group_y, _] = kernel.workgroup_size;
+                let groups = [width.div_ceil(group_x), height.div_ceil(group_y), 1];
                 if timed {
                     return Ok(backend.dispatch_timed(kernel, binds, groups)?);
                 }
@@ -258,12 +265,12 @@ impl RestirRenderer {
             &with(
                 candidates_kernel,
                 &[
-                    (9, self.primaries[current]),
-                    (10, self.candidates),
-                    (11, self.histogram.candidates),
-                    (12, self.base_radiance),
+                    ("primary_out", self.primaries[current]),
+                    ("candidates_out", self.candidates),
+                    ("histogram_in", self.histogram.candidates),
+                    ("base_radiance", self.base_radiance),
                 ],
-            ),
+            )?,
         )?;
         if self.settings.method.uses_histogram() {
             if timed {
@@ -278,14 +285,14 @@ impl RestirRenderer {
             &with(
                 select_kernel,
                 &[
-                    (9, self.primaries[current]),
-                    (10, self.candidates),
-                    (11, self.histogram.sorted_pixels),
-                    (12, self.histogram.spans),
-                    (13, self.selected),
-                    (14, self.numbers),
+                    ("primaries", self.primaries[current]),
+                    ("path_candidates", self.candidates),
+                    ("sorted_pixels", self.histogram.sorted_pixels),
+                    ("spans", self.histogram.spans),
+                    ("reservoirs_out", self.selected),
+                    ("blue_noise", self.blue_noise),
                 ],
-            ),
+            )?,
         )?;
         // Temporal sources, and with T > 0 their histogram (the spatial histogram's runs
         // stand in for it when unused: the merge reads them only with T > 0).
@@ -297,13 +304,13 @@ impl RestirRenderer {
                 &with(
                     keys_kernel,
                     &[
-                        (9, self.primaries[current]),
-                        (10, self.primaries[previous_index]),
-                        (11, self.reservoirs[previous_index]),
-                        (12, self.temporal_keys_buffer()),
-                        (13, self.temporal_sources),
+                        ("primaries", self.primaries[current]),
+                        ("previous_primaries", self.primaries[previous_index]),
+                        ("previous_reservoirs", self.reservoirs[previous_index]),
+                        ("temporal_keys", self.temporal_keys_buffer()),
+                        ("temporal_sources", self.temporal_sources),
                     ],
-                ),
+                )?,
             )?;
             if let Some(temporal) = &self.temporal_histogram {
                 pass_times[3] += if timed {
@@ -321,17 +328,17 @@ impl RestirRenderer {
             &with(
                 temporal_kernel,
                 &[
-                    (9, self.primaries[current]),
-                    (10, self.primaries[previous_index]),
-                    (11, self.selected),
-                    (12, self.reservoirs[previous_index]),
-                    (13, self.reservoirs[current]),
-                    (14, temporal_runs.sorted_pixels),
-                    (15, temporal_runs.spans),
-                    (16, self.temporal_sources),
-                    (17, self.numbers),
+                    ("primaries", self.primaries[current]),
+                    ("previous_primaries", self.primaries[previous_index]),
+                    ("current_reservoirs", self.selected),
+                    ("previous_reservoirs", self.reservoirs[previous_index]),
+                    ("merged_reservoirs", self.reservoirs[current]),
+                    ("temporal_sorted_pixels", temporal_runs.sorted_pixels),
+                    ("temporal_spans", temporal_runs.spans),
+                    ("temporal_sources", self.temporal_sources),
+                    ("blue_noise", self.blue_noise),
                 ],
-            ),
+            )?,
         )?;
         pass_times[4] = run(
             backend,
@@ -339,12 +346,12 @@ impl RestirRenderer {
             &with(
                 shade_kernel,
                 &[
-                    (9, self.primaries[current]),
-                    (10, self.reservoirs[current]),
-                    (11, self.base_radiance),
-                    (12, self.frame_out),
+                    ("primaries", self.primaries[current]),
+                    ("reservoirs", self.reservoirs[current]),
+                    ("base_in", self.base_radiance),
+                    ("frame_out", self.frame_out),
                 ],
-            ),
+            )?,
         )?;
         let pixels: Vec<[f32; 4]> = download(backend, self.frame_out)?;
         self.frame += 1;
@@ -407,9 +414,15 @@ impl RestirRenderer {
             self.selected,
             self.reservoirs[0],
             self.reservoirs[1],
-            self.numbers,
+            self.blue_noise,
             self.frame_out,
         ];
         buffers.into_iter().try_for_each(|b| backend.destroy_buffer(b)).map_err(|e: BackendError| e.into())
     }
+}
+
+/// Whether `kernel`'s WGSL declares a global variable `name` (naga keeps every declared
+/// global in the module, also those its entry point never reaches).
+fn declares(kernel: &Kernel, name: &str) -> bool {
+    kernel.module.global_variables.iter().any(|(_, variable)| variable.name.as_deref() == Some(name))
 }

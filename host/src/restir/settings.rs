@@ -1,7 +1,7 @@
 //! What a ReSTIR render does, one documented setting per field.
 
 use crate::histogram_pass::PassError;
-use crate::sampler::SamplerVariant;
+use strata_kernels::selection::SelectionSettings;
 
 /// How each pixel chooses the K candidates it resamples.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
@@ -67,22 +67,11 @@ impl ShadedParts {
 pub struct RestirSettings {
     /// Candidate selection. Default: strata.
     pub method: Method,
-    /// K, candidates resampled per pixel besides its own (1 to 4). More candidates lower
-    /// the variance and cost 2 shadow rays each. Default 4 (the paper's antithetic
-    /// pattern is defined for 4).
-    pub candidates: u32,
-    /// Block size B of the histogram (4, 8, 16 or 32; blocks are B x B pixels). Larger
-    /// blocks give a finer histogram and more candidates to choose from, at a higher
-    /// sorting cost and with candidates from farther away. Default 16.
-    pub block_size: u32,
-    /// Cluster the histogram by object id (§4.3 masking): only candidates whose primary
-    /// hit is on the same object are shared. Off: one cluster per block. Default on.
-    pub masking: bool,
-    /// Shift the block grid by a different offset every frame (the paper's limitations
-    /// section: block-shaped error patterns average out over time), at no cost; pixels
-    /// then share histograms with different neighbours each frame. Default off, as in
-    /// the paper's measurements.
-    pub block_shift: bool,
+    /// The histogram and the selection (§4.1-4.3): block size, K (the candidates every
+    /// method resamples per pixel besides its own), object masking, block shifting and
+    /// strata's sampler variant. The baselines use K, and restir the histogram; the
+    /// sampler variant is strata's alone. Default: the paper's.
+    pub selection: SelectionSettings,
     /// Merge each frame's reservoir with the previous frame's (temporal reuse). Off: each
     /// frame stands alone (the accumulation mode of Fig. 5 / 10). Default on.
     pub temporal: bool,
@@ -98,9 +87,6 @@ pub struct RestirSettings {
     pub temporal_cap: f32,
     /// Neighbourhood radius in pixels of `restir-disc`. Default 30.
     pub disc_radius: f32,
-    /// Where the selection and resampling numbers come from (Table 2). Default: the
-    /// antithetic pattern with temporal blue noise (ours).
-    pub sampler: SamplerVariant,
     /// A conductor at the primary hit resamples only from this GGX alpha up (smoother ones
     /// path-trace on their own: reconnecting through them is noisy). Default 0.2.
     pub min_roughness: f32,
@@ -116,15 +102,11 @@ impl Default for RestirSettings {
     fn default() -> Self {
         RestirSettings {
             method: Method::Strata,
-            candidates: 4,
-            block_size: 16,
-            masking: true,
-            block_shift: false,
+            selection: SelectionSettings::default(),
             temporal_candidates: 0,
             temporal: true,
             temporal_cap: 20.0,
             disc_radius: 30.0,
-            sampler: SamplerVariant::Antithetic,
             min_roughness: 0.2,
             min_distance: 0.0,
             shaded_parts: ShadedParts::All,
@@ -135,15 +117,7 @@ impl Default for RestirSettings {
 impl RestirSettings {
     /// Refuses settings the kernels cannot run, naming the field and value.
     pub fn check(&self) -> Result<(), PassError> {
-        if !(1..=4).contains(&self.candidates) {
-            return Err(PassError::Input(format!("candidates {}: must be 1 to 4", self.candidates)));
-        }
-        if !matches!(self.block_size, 4 | 8 | 16 | 32) {
-            return Err(PassError::Input(format!(
-                "block size {}: must be 4, 8, 16 or 32 (a power of two the histogram kernel holds)",
-                self.block_size
-            )));
-        }
+        self.selection.validate().map_err(|error| PassError::Input(error.to_string()))?;
         if self.temporal_candidates > 4 {
             return Err(PassError::Input(format!("temporal candidates {}: must be 0 to 4", self.temporal_candidates)));
         }
@@ -163,15 +137,6 @@ impl RestirSettings {
             return Err(PassError::Input(format!(
                 "min roughness {}: must be a GGX alpha of 0 or more",
                 self.min_roughness
-            )));
-        }
-        if self.method == Method::Strata
-            && self.candidates != 4
-            && matches!(self.sampler, SamplerVariant::Antithetic | SamplerVariant::Heitz)
-        {
-            return Err(PassError::Input(format!(
-                "sampler {:?} takes exactly 4 candidates, not {}",
-                self.sampler, self.candidates
             )));
         }
         Ok(())

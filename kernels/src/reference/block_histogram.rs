@@ -14,13 +14,18 @@ pub struct HistogramOutput {
     pub stats: Vec<BlockStats>,
 }
 
-/// The candidates as the kernel clusters them without object masking
-/// (`HistogramParams.masking` = 0): every object id becomes 0, except `OBJECT_ID_NONE`.
+/// The cluster of its block a candidate joins (paper §4.3, WGSL `cluster_of` in
+/// `strata/masking.wgsl`): its object id with masking, else 0; pixels without a candidate
+/// keep [`OBJECT_ID_NONE`] either way.
+pub fn cluster_of(candidate: Candidate, masking: bool) -> u32 {
+    if masking || candidate.object_id == OBJECT_ID_NONE { candidate.object_id } else { 0 }
+}
+
+/// The candidates with their object ids replaced by their clusters ([`cluster_of`]):
+/// what [`block_histogram`], which sorts by object id, needs to state a pass with
+/// masking off.
 pub fn unmasked(candidates: &[Candidate]) -> Vec<Candidate> {
-    candidates
-        .iter()
-        .map(|&c| Candidate { object_id: if c.object_id == OBJECT_ID_NONE { c.object_id } else { 0 }, ..c })
-        .collect()
+    candidates.iter().map(|&c| Candidate { object_id: cluster_of(c, false), ..c }).collect()
 }
 
 /// Sort key of a pixel's candidate.

@@ -1,12 +1,19 @@
-//! What the embeddable selection kernels (`strata_select`, `strata_resample`,
-//! `wgsl/embed/`) compute, stated in plain Rust with the same f32 operations in the same
+//! What the stratified selection computes (`kernels/wgsl/strata/selection.wgsl` and
+//! `resampling.wgsl`, through the embeddable kernels `strata_select` and
+//! `strata_resample`), stated in plain Rust with the same f32 operations in the same
 //! order, so that a backend's output can be compared bit for bit (up to the registry's
-//! small ULP bound for the float outputs).
+//! small ULP bound for the float outputs). The positions come from the one table of
+//! patterns, [`crate::selection::patterns`].
 
 use crate::blue_noise::BlueNoiseTables;
 use crate::embed_types::{
-    CANONICAL_SLOT, INVALID_SLOT, MAX_SELECTED, NO_PAYLOAD, NO_SLOT, ResampleInput, ResampleOutput, SelectedCandidates,
+    CANONICAL_SLOT, INVALID_SLOT, NO_PAYLOAD, NO_SLOT, ResampleInput, ResampleOutput, SelectedCandidates,
     SelectionParams,
+};
+use crate::selection::patterns::BELOW_ONE;
+use crate::selection::{
+    MAX_SELECTED, SAMPLER_HEITZ, SAMPLER_RANDOM, SAMPLER_RANDOM_OFFSET, SAMPLER_RANDOM_OFFSET_BLUE_NOISE,
+    StratifiedPattern,
 };
 use crate::types::{Candidate, ClusterSpan, OBJECT_ID_NONE};
 
@@ -21,52 +28,84 @@ fn unit_float(bits: u32) -> f32 {
     (bits >> 8) as f32 * (1.0 / 16_777_216.0)
 }
 
-const BELOW_ONE: f32 = 0.999_999_94;
-
 fn fract(x: f32) -> f32 {
     x - x.floor()
 }
 
-/// The K selection positions in [0, 1) and the resampling number of one pixel in one
-/// frame (WGSL `selection_numbers`).
-pub fn selection_numbers(params: &SelectionParams, tables: &BlueNoiseTables, x: u32, y: u32) -> ([f32; 4], f32) {
-    let mut state = selection_hash(x ^ selection_hash(y ^ selection_hash(params.frame ^ selection_hash(params.seed))));
+/// One pixel's selection numbers in one frame (WGSL `SelectionNumbers`): the positions
+/// of its slots in [0, 1) and its resampling number.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SelectionNumbers {
+    /// Slot positions (slots from K on are meaningless).
+    pub positions: [f32; 4],
+    /// The resampling number.
+    pub resample: f32,
+}
+
+/// WGSL `selection_numbers`: the numbers of `count` slots (clamped to 1..=4) of pixel
+/// (x, y) in frame `frame` of render `seed` for sampler variant `sampler` (its
+/// [`crate::selection::SamplerVariant::id`]; unknown ids behave as antithetic), from the sampler's dimension
+/// pair `pair` (0: spatial slots, 1: temporal slots).
+pub fn selection_numbers(
+    tables: &BlueNoiseTables,
+    (x, y): (u32, u32),
+    frame: u32,
+    seed: u32,
+    sampler: u32,
+    count: u32,
+    pair: u32,
+) -> SelectionNumbers {
+    let mut state = selection_hash(
+        x ^ selection_hash(
+            y ^ selection_hash(frame ^ selection_hash(seed.wrapping_add(pair.wrapping_mul(0x9e37_79b9)))),
+        ),
+    );
     let mut white = || {
         state = selection_hash(state);
         unit_float(state)
     };
     let blue = |sample_index: u32, dimension: u32, white: &mut dyn FnMut() -> f32| {
-        let shift = unit_float(selection_hash(params.seed ^ selection_hash(0x5eed_u32.wrapping_add(dimension))));
+        let shift = unit_float(selection_hash(seed ^ selection_hash(0x5eed_u32.wrapping_add(dimension))));
         let k = tables.stratum(x, y, sample_index, dimension) as f32;
         fract((k + white()) / 256.0 + shift).min(BELOW_ONE)
     };
-    let k = params.candidates.clamp(1, MAX_SELECTED) as f32;
-    let sample_index = params.frame & 255;
-    let offsets = |u: f32| [0.0f32, 1.0, 2.0, 3.0].map(|step| (u + step / k).min(BELOW_ONE));
-    match params.sampler {
-        0 => {
+    let k = count.clamp(1, MAX_SELECTED);
+    let (position_dimension, resample_dimension) = (2 * pair, 2 * pair + 1);
+    let sample_index = frame & 255;
+    let stratified = |b: f32| {
+        let variant = if sampler == SAMPLER_RANDOM_OFFSET || sampler == SAMPLER_RANDOM_OFFSET_BLUE_NOISE {
+            StratifiedPattern::random_offset(k)
+        } else {
+            StratifiedPattern::antithetic(k)
+        };
+        variant.positions(b)
+    };
+    match sampler {
+        SAMPLER_RANDOM => {
             let positions = [white(), white(), white(), white()];
-            (positions, white())
+            SelectionNumbers { positions, resample: white() }
         }
-        1 => {
-            let first = params.frame.wrapping_mul(4);
-            let positions = [0, 1, 2, 3].map(|j| blue(first.wrapping_add(j), 0, &mut white));
-            (positions, blue(first, 1, &mut white))
+        SAMPLER_HEITZ => {
+            let first = k.wrapping_mul(frame);
+            let positions = [0, 1, 2, 3].map(|j| blue(first.wrapping_add(j), position_dimension, &mut white));
+            SelectionNumbers { positions, resample: blue(first, resample_dimension, &mut white) }
         }
-        2 => {
-            let u = white() / k;
-            (offsets(u), white())
-        }
-        3 => {
-            let u = blue(sample_index, 0, &mut white) / k;
-            (offsets(u), blue(sample_index, 1, &mut white))
+        SAMPLER_RANDOM_OFFSET => {
+            let b = white();
+            SelectionNumbers { positions: stratified(b), resample: white() }
         }
         _ => {
-            let u = blue(sample_index, 0, &mut white) * 0.25;
-            let positions = [u, 0.5 - u, 0.5 + u, 1.0 - u].map(|p| p.min(BELOW_ONE));
-            (positions, blue(sample_index, 1, &mut white))
+            let b = blue(sample_index, position_dimension, &mut white);
+            SelectionNumbers { positions: stratified(b), resample: blue(sample_index, resample_dimension, &mut white) }
         }
     }
+}
+
+/// WGSL `run_member`: index into the sorted list of the member at `position` of the run
+/// `span` (not empty).
+pub fn run_member(span: ClusterSpan, position: f32) -> u32 {
+    let n = span.length;
+    span.offset + ((position * n as f32).floor() as u32).min(n - 1)
 }
 
 /// `strata_select` on the CPU: per pixel, the K payloads of its cluster's run at its
@@ -83,18 +122,20 @@ pub fn select(
     for y in 0..params.height {
         for x in 0..params.width {
             let pixel = (y * params.width + x) as usize;
-            let (positions, resample_number) = selection_numbers(params, tables, x, y);
-            let mut result = SelectedCandidates { payloads: [NO_PAYLOAD; 4], resample_number, ..Default::default() };
+            let k = params.candidates.clamp(1, MAX_SELECTED);
+            let numbers = selection_numbers(tables, (x, y), params.frame, params.seed, params.sampler, k, 0);
+            let mut result = SelectedCandidates {
+                payloads: [NO_PAYLOAD; 4],
+                resample_number: numbers.resample,
+                ..Default::default()
+            };
             let span = spans[pixel];
             if candidates[pixel].object_id != OBJECT_ID_NONE && span.length > 0 {
-                let k = params.candidates.clamp(1, MAX_SELECTED);
-                let n = span.length;
-                result.run_length = n;
+                result.run_length = span.length;
                 result.run_valid = span.valid;
                 result.selected = k;
-                for (payload, position) in result.payloads.iter_mut().zip(positions).take(k as usize) {
-                    let index = span.offset + ((position * n as f32).floor() as u32).min(n - 1);
-                    let source = sorted_pixels[index as usize];
+                for (payload, &position) in result.payloads.iter_mut().zip(&numbers.positions).take(k as usize) {
+                    let source = sorted_pixels[run_member(span, position) as usize];
                     *payload = if params.identity_payload != 0 { source } else { payloads[source as usize] };
                 }
             }

@@ -1,11 +1,10 @@
 // strata_resample: stratified resampling by inverse CDF (paper §4.2): one of the pixel's
 // own canonical sample and its K selected samples, in proportion to the engine's
 // resampling weights, using the pixel's resampling number from strata_select (the second
-// dimension of the sampler) instead of a streaming reservoir's random numbers:
-//   u = r * sum(w);  the first of (canonical, slot 0, ..., slot K-1) whose running sum
-//   exceeds u; W = sum(w) / target(chosen).
-// Rounding may leave u past the last running sum: then the last sample of positive weight
-// is taken. A NaN, infinite or negative weight or target marks the pixel INVALID_SLOT.
+// dimension of the sampler) instead of a streaming reservoir's random numbers
+// (strata/resampling.wgsl: inverse_cdf_first / inverse_cdf_next over (canonical, slot 0,
+// ..., slot K-1) with u = r * sum(w)); W = sum(w) / target(chosen).
+// A NaN, infinite or negative weight or target marks the pixel INVALID_SLOT.
 //
 // Bindings (group 0):
 //   0 uniform            SelectionParams
@@ -49,23 +48,15 @@ fn strata_resample(@builtin(global_invocation_id) id: vec3<u32>) {
         resampled[pixel] = ResampleOutput(NO_PAYLOAD, NO_SLOT, 0.0, 0.0);
         return;
     }
-    let u = selection.resample_number * total;
-    var running = input.canonical_weight;
-    var found = u < running;
-    var slot_chosen = NO_SLOT;
-    if input.canonical_weight > 0.0 {
-        slot_chosen = CANONICAL_SLOT;
-    }
+    let first = select(NO_SLOT, CANONICAL_SLOT, input.canonical_weight > 0.0);
+    var choice = inverse_cdf_first(selection.resample_number * total, input.canonical_weight, first);
     for (var slot = 0u; slot < k; slot++) {
-        if !found && input.weights[slot] > 0.0 {
-            running += input.weights[slot];
-            slot_chosen = slot;
-            found = u < running;
-        }
+        choice = inverse_cdf_next(choice, input.weights[slot], slot);
     }
+    let slot_chosen = choice.chosen;
     var payload = input.canonical_payload;
     var target_value = input.canonical_target;
-    if slot_chosen < MAX_SELECTED {
+    if slot_chosen < k {
         payload = selection.payloads[slot_chosen];
         target_value = input.targets[slot_chosen];
     }

@@ -1,11 +1,10 @@
-// strata_select: the stratified selection of the paper (§4.2, Fig. 3) for an engine's own
-// candidates. Each pixel with a candidate takes K <= 4 members of its cluster's run in its
-// block's luminance-sorted list (the histogram pass's output) at the positions of the
-// chosen sampler variant (Table 2; antithetic + temporal blue noise by default):
-//   index = run.offset + min(floor(position * n), n - 1),   n = run length,
-// and gets their payload indices. Every member of a run is selected K/n times in
-// expectation over renders whatever the keys (each position is uniform on [0, 1)), so the
-// engine's resampling stays unbiased with a fixed 1/K normalisation.
+// strata_select: the stratified selection of the paper (§4.2, Fig. 3, Table 2) for an
+// engine's own candidates. Each pixel with a candidate takes K <= 4 members of its
+// cluster's run in its block's luminance-sorted list (the histogram pass's output) at the
+// positions of the chosen sampler variant (strata/selection.wgsl: selection_numbers with
+// the spatial dimension pair, run_member) and gets their payload indices. Every member of
+// a run is selected K/n times in expectation over renders whatever the keys, for every K
+// and sampler, so the engine's resampling stays unbiased with a fixed 1/K normalisation.
 //
 // Bindings (group 0):
 //   0 uniform            SelectionParams
@@ -14,10 +13,8 @@
 //                                                   identity_payload = 1; bind any buffer)
 //   3 storage, read      array<u32>                 sorted_pixels (histogram output)
 //   4 storage, read      array<ClusterSpan>         spans (histogram output)
-//   5 storage, read      array<u32>                 blue_noise_sobol
-//   6 storage, read      array<u32>                 blue_noise_scrambling
-//   7 storage, read      array<u32>                 blue_noise_ranking
-//   8 storage, rw        array<SelectedCandidates>  one per pixel
+//   5 storage, read      array<u32>                 blue_noise (BlueNoiseTables::packed)
+//   6 storage, rw        array<SelectedCandidates>  one per pixel
 //
 // Dispatch: 8 x 8 pixels per workgroup, ceil(width / 8) x ceil(height / 8) workgroups.
 
@@ -26,10 +23,8 @@
 @group(0) @binding(2) var<storage, read> payloads: array<u32>;
 @group(0) @binding(3) var<storage, read> sorted_pixels: array<u32>;
 @group(0) @binding(4) var<storage, read> spans: array<ClusterSpan>;
-@group(0) @binding(5) var<storage, read> blue_noise_sobol: array<u32>;
-@group(0) @binding(6) var<storage, read> blue_noise_scrambling: array<u32>;
-@group(0) @binding(7) var<storage, read> blue_noise_ranking: array<u32>;
-@group(0) @binding(8) var<storage, read_write> selections: array<SelectedCandidates>;
+@group(0) @binding(5) var<storage, read> blue_noise: array<u32>;
+@group(0) @binding(6) var<storage, read_write> selections: array<SelectedCandidates>;
 
 fn payload_of(pixel: u32) -> u32 {
     if params.identity_payload != 0u {
@@ -44,21 +39,19 @@ fn strata_select(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let pixel = id.y * params.width + id.x;
-    let numbers = selection_numbers(id.xy);
+    let k = clamp(params.candidates, 1u, MAX_SELECTED);
+    let numbers = selection_numbers(id.xy, params.frame, params.seed, params.sampler, k, 0u);
     var result = SelectedCandidates(vec4<u32>(NO_PAYLOAD), numbers.resample, 0u, 0u, 0u);
     let span = spans[pixel];
     if candidates[pixel].object_id == OBJECT_ID_NONE || span.length == 0u {
         selections[pixel] = result;
         return;
     }
-    let k = clamp(params.candidates, 1u, MAX_SELECTED);
-    let n = span.length;
-    result.run_length = n;
+    result.run_length = span.length;
     result.run_valid = span.valid;
     result.selected = k;
     for (var slot = 0u; slot < k; slot++) {
-        let index = span.offset + min(u32(floor(numbers.positions[slot] * f32(n))), n - 1u);
-        result.payloads[slot] = payload_of(sorted_pixels[index]);
+        result.payloads[slot] = payload_of(sorted_pixels[run_member(span, numbers.positions[slot])]);
     }
     selections[pixel] = result;
 }

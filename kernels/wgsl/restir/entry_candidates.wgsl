@@ -205,7 +205,7 @@ fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
     }
     var object = OBJECT_ID_NONE;
     if (primary.flags & PRIMARY_RESAMPLE) != 0u {
-        object = select(0u, primary.object_id, restir.masking != 0u);
+        object = primary.object_id;
     }
     primary_out[pixel] = primary;
     candidates_out[pixel] = candidate;

@@ -4,11 +4,10 @@
 //
 // Selection, by RestirParams.method:
 //   strata      from its own cluster's run of the block's luminance-sorted list (the
-//               histogram pass), at K positions in [0, 1) that the host computes per
-//               pixel and frame from the sampler variant (the antithetic pattern of Fig. 3
-//               by default: u in [0, 1/4), {u, 1/2 - u, 1/2 + u, 1 - u});
-//               index = offset + min(floor(pos n), n - 1); resampling by inverse CDF with
-//               the host's second number (no streaming reservoir).
+//               histogram pass), at the K positions of RestirParams.sampler for this
+//               pixel and frame (strata/selection.wgsl, spatial dimension pair; the
+//               antithetic pattern of Fig. 3 by default); resampling by inverse CDF with
+//               the pair's second number (strata/resampling.wgsl), no streaming reservoir.
 //   restir      K uniformly random members of the same cluster (with replacement),
 //               streaming weighted reservoir sampling.
 //   restir-disc K uniformly random pixels in a disc of RestirParams.disc_radius pixels,
@@ -36,22 +35,16 @@
 //   11 storage, read     array<u32>            the histogram's sorted_pixels
 //   12 storage, read     array<ClusterSpan>    the histogram's per-pixel cluster run
 //   13 storage, rw       array<Reservoir>      this frame's reservoir per pixel (M = 1)
-//   14 storage, read     array<vec4<f32>>      per pixel three entries: [3p] the K <= 4 selection
-//                                          positions, [3p + 1].x the resampling number
-//                                          (.y and [3p + 2]: restir_temporal's)
+//   14 storage, read     array<u32>            blue_noise (BlueNoiseTables::packed)
 //
 // Dispatch: 8 x 8 pixels per workgroup. Shadow rays: up to 2K per pixel.
-
-// K is at most 4: the per-slot values live in vec4s (registers on every target; local
-// arrays would need array constructors, which glslang's HLSL front end rejects).
-const MAX_CANDIDATES: u32 = 4u;
 
 @group(0) @binding(9) var<storage, read> primaries: array<Primary>;
 @group(0) @binding(10) var<storage, read> path_candidates: array<PathCandidate>;
 @group(0) @binding(11) var<storage, read> sorted_pixels: array<u32>;
 @group(0) @binding(12) var<storage, read> spans: array<ClusterSpan>;
 @group(0) @binding(13) var<storage, read_write> reservoirs_out: array<Reservoir>;
-@group(0) @binding(14) var<storage, read> selection_numbers: array<vec4<f32>>;
+@group(0) @binding(14) var<storage, read> blue_noise: array<u32>;
 
 fn empty_reservoir() -> Reservoir {
     return Reservoir(PathCandidate(vec3<f32>(0.0), KIND_NONE, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), 0.0), 0.0, 0.0, 0.0, 0u);
@@ -82,9 +75,12 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
         return;
     }
     rng_seed(pixel, params.sample_index, params.seed ^ 0x5e1ec7u);
-    let positions = selection_numbers[3u * pixel];
-    let resample_number = selection_numbers[3u * pixel + 1u].x;
-    let k = min(restir.candidates, MAX_CANDIDATES);
+    let k = min(restir.candidates, MAX_SELECTED);
+    var numbers = SelectionNumbers(vec4<f32>(0.0), 0.0);
+    if restir.method == METHOD_STRATA {
+        numbers = selection_numbers(id.xy, params.sample_index, params.seed, restir.sampler, k, 0u);
+    }
+    let positions = numbers.positions;
     let c = path_candidates[pixel];
     // p̂_i(x_c) W_c: the canonical candidate was found from y1, so it is visible.
     let target_c = target_function(p, c);
@@ -152,19 +148,14 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
     var chosen = c;
     var chosen_target = target_c;
     if restir.method == METHOD_STRATA {
-        // Inverse CDF with the second sampler dimension.
-        // Rounding may leave u past the last partial sum: then the last candidate of
-        // positive weight is taken.
-        let u = resample_number * total;
-        var running = weight_c;
-        var found = u < running;
+        // Inverse CDF with the second sampler dimension; CANONICAL = MAX_SELECTED.
+        var choice = inverse_cdf_first(numbers.resample * total, weight_c, MAX_SELECTED);
         for (var slot = 0u; slot < k; slot++) {
-            if !found && weights[slot] > 0.0 {
-                running += weights[slot];
-                chosen = path_candidates[sources[slot]];
-                chosen_target = targets[slot];
-                found = u < running;
-            }
+            choice = inverse_cdf_next(choice, weights[slot], slot);
+        }
+        if choice.chosen < MAX_SELECTED {
+            chosen = path_candidates[sources[choice.chosen]];
+            chosen_target = targets[choice.chosen];
         }
     } else {
         // Streaming weighted reservoir sampling, in slot order after the canonical.

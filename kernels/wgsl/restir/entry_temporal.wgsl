@@ -4,7 +4,8 @@
 // T = RestirParams.temporal_candidates of 1 to 4 (paper Fig. 11), T more previous
 // reservoirs drawn like the spatial candidates: strata from its cluster's run of the
 // temporal histogram (the block's reprojected reservoirs sorted by p̂ W) at the temporal
-// sampler positions, restir uniformly from the same run, restir-disc from random pixels
+// sampler positions (strata/selection.wgsl, temporal dimension pair), restir uniformly
+// from the same run, restir-disc from random pixels
 // within disc_radius with a similar normal and depth; each drawn pixel contributes its
 // temporal source's reservoir (none: an empty slot). The own reservoir stays in: in a
 // static view it is the best-matched history, and replacing it by neighbours' raised the
@@ -23,7 +24,8 @@
 // pair is always there and every drawing pattern gives each run member the expected count
 // T/n, so the merge stays unbiased whatever the sort did (as for the spatial selection).
 // One sample is kept in proportion to w: by inverse CDF with the temporal resampling
-// number for strata with T > 0, by a streaming reservoir otherwise; W = sum(w) / p̂_c(Y);
+// number for strata with T > 0 (strata/resampling.wgsl), by a streaming reservoir
+// otherwise; W = sum(w) / p̂_c(Y);
 // M = M_c + mean_j M_j.
 // The shift is the identity on x2 (area measure) or on the direction (environment).
 //
@@ -36,8 +38,7 @@
 //   14 storage, read     array<u32>          the temporal histogram's sorted_pixels
 //   15 storage, read     array<ClusterSpan>  the temporal histogram's spans
 //   16 storage, read     array<u32>          temporal sources (restir_temporal_keys)
-//   17 storage, read     array<vec4<f32>>    selection numbers: [3p + 2] the T temporal
-//                                            positions, [3p + 1].y the temporal resampling number
+//   17 storage, read     array<u32>          blue_noise (BlueNoiseTables::packed)
 //
 // Dispatch: 8 x 8 pixels per workgroup. Shadow rays: 2 per merged previous reservoir.
 
@@ -49,10 +50,9 @@
 @group(0) @binding(14) var<storage, read> temporal_sorted_pixels: array<u32>;
 @group(0) @binding(15) var<storage, read> temporal_spans: array<ClusterSpan>;
 @group(0) @binding(16) var<storage, read> temporal_sources: array<u32>;
-@group(0) @binding(17) var<storage, read> selection_numbers: array<vec4<f32>>;
+@group(0) @binding(17) var<storage, read> blue_noise: array<u32>;
 
 const NO_SOURCE: u32 = 0xffffffffu;
-const MAX_TEMPORAL: u32 = 4u;
 
 // p̂ of `y` at primary hit `p`: luminance of its contribution, visibility included.
 fn target_at(p: Primary, y: PathCandidate, lane: u32) -> f32 {
@@ -142,7 +142,7 @@ fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
         return;
     }
     rng_seed(pixel, params.sample_index, params.seed ^ 0x7e3907u);
-    let drawn = min(restir.temporal_candidates, MAX_TEMPORAL);
+    let drawn = min(restir.temporal_candidates, MAX_SELECTED);
     let share = 1.0 / f32(1u + drawn);
     // The pixel's own reprojected reservoir.
     let own_source = temporal_sources[pixel];
@@ -150,7 +150,11 @@ fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
     var weight_current = own.current_part;
     var m_sum = own.m;
     // The drawn ones: per slot resampling weight, target here, source pixel.
-    let positions = selection_numbers[3u * pixel + 2u];
+    var numbers = SelectionNumbers(vec4<f32>(0.0), 0.0);
+    if restir.method == METHOD_STRATA && drawn > 0u {
+        numbers = selection_numbers(id.xy, params.sample_index, params.seed, restir.sampler, drawn, 1u);
+    }
+    let positions = numbers.positions;
     var weights = vec4<f32>(0.0);
     var targets = vec4<f32>(0.0);
     var sources = vec4<u32>(NO_SOURCE);
@@ -175,27 +179,17 @@ fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
         return;
     }
     // Choice among (current, own, drawn 0..T-1): OWN or a drawn slot, or none for current.
-    let OWN = MAX_TEMPORAL;
-    let NONE = MAX_TEMPORAL + 1u;
+    let OWN = MAX_SELECTED;
+    let NONE = MAX_SELECTED + 1u;
     var chosen = NONE;
     if restir.method == METHOD_STRATA && drawn > 0u {
-        // Inverse CDF with the temporal resampling number; rounding may leave u past the
-        // last partial sum: then the last entry of positive weight is taken.
-        let u = selection_numbers[3u * pixel + 1u].y * total;
-        var running = weight_current;
-        var found = u < running;
-        if !found && own.weight > 0.0 {
-            running += own.weight;
-            chosen = OWN;
-            found = u < running;
-        }
+        // Inverse CDF with the temporal resampling number.
+        var choice = inverse_cdf_first(numbers.resample * total, weight_current, NONE);
+        choice = inverse_cdf_next(choice, own.weight, OWN);
         for (var slot = 0u; slot < drawn; slot++) {
-            if !found && weights[slot] > 0.0 {
-                running += weights[slot];
-                chosen = slot;
-                found = u < running;
-            }
+            choice = inverse_cdf_next(choice, weights[slot], slot);
         }
+        chosen = choice.chosen;
     } else {
         // Streaming weighted reservoir sampling: current, own, then the drawn slots.
         var running = weight_current;
@@ -217,7 +211,7 @@ fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
     if chosen == OWN {
         merged.sample = previous_reservoirs[own_source].sample;
         merged.target_value = own.target_here;
-    } else if chosen < MAX_TEMPORAL {
+    } else if chosen < MAX_SELECTED {
         merged.sample = previous_reservoirs[sources[chosen]].sample;
         merged.target_value = targets[chosen];
     }

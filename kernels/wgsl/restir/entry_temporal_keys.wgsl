@@ -5,7 +5,7 @@
 // multiple-temporal-reservoir mode (paper Fig. 11: "sampling temporal reservoirs
 // similarly to spatial candidates"), it also writes the histogram input of the temporal
 // candidates: key = luminance of the source reservoir's own estimate p̂ W (its f(Y) W),
-// cluster = the pixel's object id (§4.3). A pixel without a source keeps its cluster with
+// object id = the pixel's (the histogram clusters by it with masking on, §4.3). A pixel without a source keeps its cluster with
 // an invalid key (it sorts last in the run; drawing it gives an empty slot), so a
 // disoccluded pixel can still draw its neighbours' histories.
 //
@@ -54,7 +54,7 @@ fn restir_temporal_keys(@builtin(global_invocation_id) id: vec3<u32>) {
     var key = -1.0;
     var object = OBJECT_ID_NONE;
     if restir.temporal != 0u && (p.flags & PRIMARY_RESAMPLE) != 0u {
-        object = select(0u, p.object_id, restir.masking != 0u);
+        object = p.object_id;
         let q = reproject(p.position);
         if q != NO_SOURCE {
             let previous = previous_primaries[q];

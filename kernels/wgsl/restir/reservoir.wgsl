@@ -25,16 +25,17 @@ const PRIMARY_HIT: u32 = 1u;       // the camera ray hit a surface
 const PRIMARY_RESAMPLE: u32 = 2u;  // y1 is rough enough to reconnect from: the pixel resamples
 
 // RestirParams.method
-const METHOD_STRATA: u32 = 0u;       // histogram + antithetic selection, inverse-CDF resampling (ours)
+const METHOD_STRATA: u32 = 0u;       // histogram + stratified selection, inverse-CDF resampling (ours)
 const METHOD_RESTIR: u32 = 1u;       // K uniformly random from the same cluster, streaming reservoir
 const METHOD_RESTIR_DISC: u32 = 2u;  // K uniformly random in a disc, normal/depth rejection
 
 struct RestirParams {
     method: u32,
-    // K: candidates selected per pixel (4).
+    // K: candidates selected per pixel (1 to 4).
     candidates: u32,
-    // 1: the histogram clusters by object id (§4.3); 0: one cluster per block.
-    masking: u32,
+    // strata's sampler variant (SAMPLER_* of strata/selection.wgsl, Table 2); object
+    // masking (§4.3) is the histogram's own setting (HistogramParams.masking).
+    sampler: u32,
     // 1: merge with the previous frame's reservoir.
     temporal: u32,
     // Cap of the previous reservoir's M before a temporal merge (paper: 20).

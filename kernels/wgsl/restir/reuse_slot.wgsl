@@ -1,8 +1,8 @@
 // Where a reuse slot of a pixel looks, by RestirParams.method: shared by restir_select
 // (the K spatial candidates, paper §4.2) and restir_temporal (the T extra previous-frame
 // reservoirs of Fig. 11), so both draw their neighbours the same way.
-//   strata      position `pos` in [0, 1) of the pixel's sorted cluster run (the host's
-//               stratified positions): index = offset + min(floor(pos n), n - 1)
+//   strata      position `pos` in [0, 1) of the pixel's sorted cluster run (the
+//               stratified positions of strata/selection.wgsl, run_member)
 //   restir      the same run at a uniformly random position
 //   restir-disc a uniformly random pixel of the disc of RestirParams.disc_radius pixels,
 //               kept only if its primary hit resamples, faces the same way (normals
@@ -34,16 +34,15 @@ fn disc_neighbour(x: u32, y: u32, p: Primary) -> u32 {
 }
 
 // The index into a sorted list that a slot with position `position` takes in the run
-// `span` (strata: the position; restir: a uniform draw instead), or NO_PIXEL for an
-// empty run.
+// `span` (strata: the stratified position, strata/selection.wgsl; restir: a uniform draw
+// instead), or NO_PIXEL for an empty run.
 fn run_index(span: ClusterSpan, position: f32) -> u32 {
-    let n = span.length;
-    if n == 0u {
+    if span.length == 0u {
         return NO_PIXEL;
     }
     var pos = position;
     if restir.method == METHOD_RESTIR {
         pos = random();
     }
-    return span.offset + min(u32(floor(pos * f32(n))), n - 1u);
+    return run_member(span, pos);
 }

@@ -1,5 +1,6 @@
 // Entry point of the block histogram without subgroup operations (any adapter, the
-// GL backend and the CPU interpreter included). See block_sort.wgsl.
+// GL backend and the CPU interpreter included): paper §4.1. Bindings and dispatch:
+// strata/histogram.wgsl.
 
 // Never called: with zero lane bits every exchange stays in registers or workgroup memory.
 fn lane_exchange(value: vec4<u32>, mask: u32) -> vec4<u32> {

@@ -1,14 +1,16 @@
-// Per-block histogram pass (paper §4.1 "histogram of candidates", §4.3 object masking).
+// The block histogram (paper §4.1, "histogram of candidates"): the stratification's
+// ordering. Shared by the renderer (block_histogram, block_histogram_subgroup) and the
+// embeddable pass, which run the same two entry points (strata/entry_histogram*.wgsl).
 //
 // The image is cut into B x B blocks (B in {4, 8, 16, 32}; edge blocks are partial),
 // optionally shifted by (shift_x, shift_y) (§5.3 block shifting: the first row and
-// column of blocks are then partial too). Without masking (params.masking = 0) every
-// candidate of a block is in one cluster.
-// Each block's candidates are ordered by (object id, canonical key, pixel index), so
-// that every object's candidates form one contiguous run sorted by luminance: the
-// histogram the stratified selection pass draws from. Invalid candidates (NaN, +-Inf,
-// negative keys) sort last within their object's run, and pixels without a candidate
-// (OBJECT_ID_NONE) form the block's last run; both are counted in BlockStats.
+// column of blocks are then partial too). Each candidate joins a cluster of its block
+// (strata/masking.wgsl, §4.3: its object id, or one cluster per block without masking).
+// Each block's candidates are ordered by (cluster, canonical key, pixel index), so that
+// every cluster's candidates form one contiguous run sorted by luminance: the histogram
+// the stratified selection (strata/selection.wgsl, §4.2) draws from. Invalid candidates
+// (NaN, +-Inf, negative keys) sort last within their cluster's run, and pixels without a
+// candidate (OBJECT_ID_NONE) form the block's last run; both are counted in BlockStats.
 //
 // Bindings (group 0):
 //   0 uniform            HistogramParams   sizes of the dispatch
@@ -313,10 +315,7 @@ fn pixel_of(rect: BlockRect, local: u32) -> u32 {
 fn load_element(rect: BlockRect, local: u32) -> vec3<u32> {
     if column_of(local) < rect.width && row_of(local) < rect.height {
         let candidate = candidates[pixel_of(rect, local)];
-        // Without masking every candidate of the block is in cluster 0 (pixels without a
-        // candidate keep OBJECT_ID_NONE, the block's last run).
-        let unmasked = params.masking == 0u && candidate.object_id != OBJECT_ID_NONE;
-        return vec3<u32>(select(candidate.object_id, 0u, unmasked), canonical_key(candidate), local);
+        return vec3<u32>(cluster_of(candidate, params.masking != 0u), canonical_key(candidate), local);
     }
     return vec3<u32>(OBJECT_ID_NONE, SENTINEL_KEY, local);
 }

@@ -1,4 +1,5 @@
-// Entry point of the block histogram that exchanges elements between subgroup lanes
+// Entry point of the block histogram (paper §4.1; bindings and dispatch:
+// strata/histogram.wgsl) that exchanges elements between subgroup lanes
 // with subgroupShuffleXor instead of workgroup memory (needs the SUBGROUP feature).
 // The lanes are used only if every lane's id is its local index modulo the subgroup
 // size (true of 1-D workgroups on the drivers we know; checked here, not assumed) and

@@ -1,28 +1,23 @@
-// Records of the embeddable stratified selection (paper §4.2, Fig. 3, Table 2): the WGSL
-// twins of strata_kernels::embed_types (a test checks every offset). An engine that owns
-// its candidates, reservoirs, shift mapping and shading writes one Candidate per pixel
-// (common/candidate.wgsl: luminance key + cluster id) and optionally one payload index per
-// pixel; the histogram pass sorts each block; strata_select gives every pixel K payload
-// indices of its own cluster's run at stratified positions; strata_resample, given the
-// engine's resampling weights, picks one by inverse CDF.
+// The buffer contract of the embeddable selection (strata-embed): the records an engine
+// and the strata_select / strata_resample kernels exchange, the WGSL twins of
+// strata_kernels::embed_types (a test checks every offset and constant). An engine that
+// owns its candidates, reservoirs, shift mapping and shading writes one Candidate per
+// pixel (strata/candidate.wgsl: luminance key + cluster id) and optionally one payload
+// index per pixel; the histogram pass sorts each block; strata_select gives every pixel K
+// payload indices of its own cluster's run at stratified positions; strata_resample,
+// given the engine's resampling weights, picks one by inverse CDF (paper §4.2, whose
+// functions are in strata/selection.wgsl). Self-contained with strata/candidate.wgsl, so
+// that an engine can prepend both to its own shaders (strata_embed::wgsl::contract_source).
 
 // A slot without a candidate, or a pixel without a selection.
 const NO_PAYLOAD: u32 = 0xffffffffu;
-// ResampleOutput.slot: the pixel's own (canonical) sample was chosen.
+// ResampleOutput.slot: the pixel's own (canonical) sample was chosen (the slot after the
+// most selected ones, MAX_SELECTED of strata/selection.wgsl).
 const CANONICAL_SLOT: u32 = 4u;
 // ResampleOutput.slot: every weight was zero; nothing chosen.
 const NO_SLOT: u32 = 0xffffffffu;
 // ResampleOutput.slot: a weight or target was NaN, infinite or negative; nothing chosen.
 const INVALID_SLOT: u32 = 0xfffffffeu;
-// Most candidates selected per pixel (one vec4 of payloads).
-const MAX_SELECTED: u32 = 4u;
-
-// SelectionParams.sampler: the paper's Table 2 variants.
-const SAMPLER_RANDOM: u32 = 0u;
-const SAMPLER_HEITZ: u32 = 1u;
-const SAMPLER_RANDOM_OFFSET: u32 = 2u;
-const SAMPLER_RANDOM_OFFSET_BLUE_NOISE: u32 = 3u;
-const SAMPLER_ANTITHETIC: u32 = 4u;
 
 // Per-frame settings of strata_select and strata_resample (a uniform).
 struct SelectionParams {
@@ -34,7 +29,8 @@ struct SelectionParams {
     seed: u32,
     // K in 1..=4.
     candidates: u32,
-    // SAMPLER_*.
+    // The sampler variant (SAMPLER_* of strata/selection.wgsl: 0 random, 1 heitz,
+    // 2 random offset, 3 random offset + blue noise, 4 antithetic).
     sampler: u32,
     // 1: payload = pixel index (the payloads buffer is not read).
     identity_payload: u32,

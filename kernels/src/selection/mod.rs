@@ -1,0 +1,19 @@
+//! The paper's stratified selection (§4.2, Fig. 3, Table 2) on the host side: the one
+//! settings struct every user shares ([`SelectionSettings`]), the sampler variants
+//! ([`SamplerVariant`]) and the table of position patterns ([`patterns`]).
+//!
+//! The GPU statement is `kernels/wgsl/strata/selection.wgsl` (positions and numbers) and
+//! `kernels/wgsl/strata/resampling.wgsl` (the inverse-CDF choice); the renderer's passes
+//! and the embeddable pass both call it. [`crate::reference::stratified_selection`] states
+//! the same in plain Rust for bit-exact tests, by evaluating [`patterns`].
+
+pub mod patterns;
+mod sampler;
+mod settings;
+
+pub use patterns::{MAX_SELECTED, Pattern, StratifiedPattern};
+pub use sampler::{
+    SAMPLER_ANTITHETIC, SAMPLER_HEITZ, SAMPLER_RANDOM, SAMPLER_RANDOM_OFFSET, SAMPLER_RANDOM_OFFSET_BLUE_NOISE,
+    SamplerVariant,
+};
+pub use settings::{SelectionSettings, SettingError};

@@ -1,0 +1,83 @@
+//! [`SamplerVariant`]: where the selection's numbers come from, the variants of the
+//! paper's Table 2 (ablation of histogram sampling strategies).
+
+use super::patterns::{Pattern, pattern};
+
+/// How the selection draws its random numbers and places its K slots (Table 2). "Temporal
+/// blue noise" means one sample of Heitz et al. 2019's sampler
+/// ([`crate::blue_noise::BlueNoiseTables`]) per pixel and frame, sample index frame mod
+/// 256: dimension 0 places the spatial slots and dimension 1 drives the resampling (2 and
+/// 3 for the temporal slots of Fig. 11). Every variant is unbiased for every K: each
+/// position is uniform on [0, 1) over independent renders.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum SamplerVariant {
+    /// Uncorrelated slots (Table 2's "ReSTIR"): K independent white-noise positions per
+    /// pixel and frame, and a white-noise resampling number; no stratification within or
+    /// across frames.
+    Random,
+    /// Heitz et al. 2019 with K samples per frame: slot j takes its position from
+    /// dimension 0 at sample index (K·frame + j) mod 256, K consecutive points of the
+    /// pixel's sequence; resampling from dimension 1 at sample index K·frame.
+    Heitz,
+    /// Random-offset stratification with white noise: one number b per pixel and frame,
+    /// slot j at (j + b) / K. Stratified within a frame, uncorrelated across frames.
+    RandomOffset,
+    /// Random offset + temporal blue noise: slot j at (j + b) / K with b from the
+    /// blue-noise sampler; resampling from its second dimension.
+    RandomOffsetBlueNoise,
+    /// Antithetic + temporal blue noise (the paper's method, the default): b from the
+    /// blue-noise sampler, mirrored slots (Fig. 3; K = 4: {u, ½ − u, ½ + u, 1 − u} with
+    /// u = b/4; see [`super::patterns`] for K < 4); resampling from its second dimension.
+    #[default]
+    Antithetic,
+}
+
+impl SamplerVariant {
+    /// Every variant, in Table 2's order.
+    pub const ALL: [SamplerVariant; 5] = [
+        SamplerVariant::Random,
+        SamplerVariant::Heitz,
+        SamplerVariant::RandomOffset,
+        SamplerVariant::RandomOffsetBlueNoise,
+        SamplerVariant::Antithetic,
+    ];
+
+    /// The WGSL `SAMPLER_*` constant of the variant (`kernels/wgsl/strata/selection.wgsl`).
+    pub fn id(self) -> u32 {
+        match self {
+            SamplerVariant::Random => SAMPLER_RANDOM,
+            SamplerVariant::Heitz => SAMPLER_HEITZ,
+            SamplerVariant::RandomOffset => SAMPLER_RANDOM_OFFSET,
+            SamplerVariant::RandomOffsetBlueNoise => SAMPLER_RANDOM_OFFSET_BLUE_NOISE,
+            SamplerVariant::Antithetic => SAMPLER_ANTITHETIC,
+        }
+    }
+
+    /// The name on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            SamplerVariant::Random => "random",
+            SamplerVariant::Heitz => "heitz",
+            SamplerVariant::RandomOffset => "random-offset",
+            SamplerVariant::RandomOffsetBlueNoise => "random-offset-blue-noise",
+            SamplerVariant::Antithetic => "antithetic",
+        }
+    }
+
+    /// The position pattern of `count` slots.
+    pub fn pattern(self, count: u32) -> Pattern {
+        pattern(self, count)
+    }
+}
+
+/// WGSL `SAMPLER_RANDOM`.
+pub const SAMPLER_RANDOM: u32 = 0;
+/// WGSL `SAMPLER_HEITZ`.
+pub const SAMPLER_HEITZ: u32 = 1;
+/// WGSL `SAMPLER_RANDOM_OFFSET`.
+pub const SAMPLER_RANDOM_OFFSET: u32 = 2;
+/// WGSL `SAMPLER_RANDOM_OFFSET_BLUE_NOISE`.
+pub const SAMPLER_RANDOM_OFFSET_BLUE_NOISE: u32 = 3;
+/// WGSL `SAMPLER_ANTITHETIC`.
+pub const SAMPLER_ANTITHETIC: u32 = 4;

@@ -18,6 +18,7 @@
 pub mod binding;
 pub mod block_grid;
 pub mod blue_noise;
+pub mod constants;
 pub mod embed_types;
 pub mod error;
 pub mod glslang;

@@ -11,7 +11,7 @@ pub mod patterns;
 mod sampler;
 mod settings;
 
-pub use patterns::{MAX_SELECTED, Pattern, StratifiedPattern};
+pub use patterns::{BELOW_ONE, MAX_SELECTED, Pattern, StratifiedPattern};
 pub use sampler::{
     SAMPLER_ANTITHETIC, SAMPLER_HEITZ, SAMPLER_RANDOM, SAMPLER_RANDOM_OFFSET, SAMPLER_RANDOM_OFFSET_BLUE_NOISE,
     SamplerVariant,

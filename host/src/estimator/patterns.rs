@@ -1,6 +1,9 @@
-//! Selection patterns of K = 4 positions in [0, 1) over a sorted pool (paper Fig. 3).
+//! Selection patterns of K = 4 positions in [0, 1) over a sorted pool (paper Fig. 3),
+//! evaluated from the one statement of the patterns in [`strata_kernels::selection`].
 
 use rand::Rng;
+use strata_kernels::selection::StratifiedPattern;
+use strata_kernels::selection::patterns::index_of as selection_index;
 
 /// Candidates selected per pixel.
 pub const K: usize = 4;
@@ -21,21 +24,28 @@ impl SelectionPattern {
     pub const ALL: [SelectionPattern; 3] =
         [SelectionPattern::UniformRandom, SelectionPattern::RandomOffset, SelectionPattern::Antithetic];
 
-    /// Positions for the random number(s): one u ∈ [0, 1) scaled as the pattern needs;
-    /// `UniformRandom` draws its own K numbers from `rng`.
-    pub fn positions(self, u: f64, rng: &mut impl Rng) -> [f64; K] {
-        let q = u / K as f64;
+    /// The stratified pattern's slots, `None` for independent positions.
+    fn stratified(self) -> Option<StratifiedPattern> {
         match self {
-            SelectionPattern::UniformRandom => std::array::from_fn(|_| rng.random::<f64>()),
-            SelectionPattern::RandomOffset => std::array::from_fn(|j| q + j as f64 / K as f64),
-            SelectionPattern::Antithetic => [q, 0.5 - q, 0.5 + q, 1.0 - q],
+            SelectionPattern::UniformRandom => None,
+            SelectionPattern::RandomOffset => Some(StratifiedPattern::random_offset(K as u32)),
+            SelectionPattern::Antithetic => Some(StratifiedPattern::antithetic(K as u32)),
+        }
+    }
+
+    /// Positions for the pattern's one number u ∈ [0, 1) (b of
+    /// [`StratifiedPattern`]); `UniformRandom` draws its own K numbers from `rng`.
+    pub fn positions(self, u: f64, rng: &mut impl Rng) -> [f64; K] {
+        match self.stratified() {
+            None => std::array::from_fn(|_| rng.random::<f64>()),
+            Some(pattern) => std::array::from_fn(|j| pattern.position(j, u)),
         }
     }
 }
 
 /// Index of position `pos` in a pool of `n`: ⌊pos·n⌋ clamped to n − 1.
 pub fn index_of(pos: f64, n: usize) -> usize {
-    ((pos * n as f64) as usize).min(n - 1)
+    selection_index(pos, n)
 }
 
 /// The K selected indices into a sorted pool of `n` (duplicates possible).
@@ -45,27 +55,20 @@ pub fn select(pattern: SelectionPattern, n: usize, rng: &mut impl Rng) -> [usize
 }
 
 /// Exact expected selection count of every index of a pool of `n`: for the stratified
-/// patterns each position is affine in u ∈ [0, 1/K) (density K), so the measure of u
-/// mapping to each index is integrated in closed form; uniform random is K/n by
-/// construction.
+/// patterns each position sweeps its stratum of width 1/K uniformly as u sweeps [0, 1)
+/// (density K there), so the measure of u mapping to each index is integrated in closed
+/// form; uniform random is K/n by construction.
 pub fn expected_counts(pattern: SelectionPattern, n: usize) -> Vec<f64> {
-    let mut counts = vec![0.0; n];
-    let (offsets, slopes): ([f64; K], [f64; K]) = match pattern {
-        SelectionPattern::UniformRandom => {
-            return vec![K as f64 / n as f64; n];
-        }
-        SelectionPattern::RandomOffset => (std::array::from_fn(|j| j as f64 / K as f64), [1.0; K]),
-        SelectionPattern::Antithetic => ([0.0, 0.5, 0.5, 1.0], [1.0, -1.0, 1.0, -1.0]),
+    let Some(stratified) = pattern.stratified() else {
+        return vec![K as f64 / n as f64; n];
     };
-    let width = 1.0 / K as f64;
-    for (offset, slope) in offsets.into_iter().zip(slopes) {
-        // pos(u) = offset + slope·u sweeps an interval of length 1/K; the clamp only
-        // matters at pos = 1, a set of measure zero.
-        let (low, high) = if slope > 0.0 { (offset, offset + width) } else { (offset - width, offset) };
+    let mut counts = vec![0.0; n];
+    for (low, high) in stratified.strata() {
+        // The clamp below 1 only matters at pos = 1, a set of measure zero.
         for (i, count) in counts.iter_mut().enumerate() {
             let cell = (i as f64 / n as f64, (i + 1) as f64 / n as f64);
             let overlap = (high.min(cell.1) - low.max(cell.0)).max(0.0);
-            // Density of u is K, and |dpos/du| = 1.
+            // Density of the position is K on its stratum.
             *count += K as f64 * overlap;
         }
     }

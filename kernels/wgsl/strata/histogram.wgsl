@@ -33,7 +33,7 @@
 // 8 round trips (16 barriers) without subgroups and 2 with 8-wide subgroups, against 36
 // barriers for the naive one-step-per-barrier network. Workgroup memory: 12.75 KiB.
 //
-// Invalid inputs: see canonical_key (common/candidate.wgsl). Every output element is
+// Invalid inputs: see canonical_key (strata/candidate.wgsl). Every output element is
 // written for every pixel; sentinel slots past a partial block's pixels write nothing.
 
 const ELEMS: u32 = 16u;

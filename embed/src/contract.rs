@@ -94,7 +94,7 @@ impl BufferRole {
         match self {
             BufferRole::Candidates => ("Candidate", &[("block_histogram", 1), ("strata_select", 1)]),
             BufferRole::Payloads => ("u32", &[("strata_select", 2)]),
-            BufferRole::Selections => ("SelectedCandidates", &[("strata_select", 8), ("strata_resample", 1)]),
+            BufferRole::Selections => ("SelectedCandidates", &[("strata_select", 6), ("strata_resample", 1)]),
             BufferRole::ResampleInputs => ("ResampleInput", &[("strata_resample", 2)]),
             BufferRole::Resampled => ("ResampleOutput", &[("strata_resample", 3)]),
         }

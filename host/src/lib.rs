@@ -4,7 +4,6 @@
 //! [`Backend`]: strata_backends::Backend
 
 pub mod backend_choice;
-pub mod check;
 pub mod compare;
 pub mod estimator;
 pub mod histogram_pass;
@@ -13,7 +12,6 @@ pub mod plot;
 pub mod render;
 pub mod restir;
 pub mod rgb_image;
-pub mod run_kernel;
 pub mod scene;
 pub mod synthetic;
 pub mod trace_pass;

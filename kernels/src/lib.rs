@@ -1,7 +1,9 @@
 //! strata's compute kernels, written once in WGSL.
 //!
-//! * [`registry`]: every kernel the project ships, parsed and validated by naga, with
-//!   its entry point, workgroup size and bindings read from naga's IR.
+//! * [`catalogue`]: every kernel the project ships, as declared (fragments, entry point,
+//!   features, float tolerance); [`registry`]: each parsed and validated by naga, with
+//!   its workgroup size and bindings read from naga's IR.
+//! * [`constants`]: the WGSL constants the host shares, checked against their twins.
 //! * [`types`]: the `#[repr(C)]` host twins of the structs the kernels share with the
 //!   host, checked against naga's layout by [`layout`].
 //! * [`translate`]: naga's SPIR-V, HLSL, MSL and GLSL back ends with the options every
@@ -18,6 +20,7 @@
 pub mod binding;
 pub mod block_grid;
 pub mod blue_noise;
+pub mod catalogue;
 pub mod constants;
 pub mod embed_types;
 pub mod error;

@@ -2,8 +2,8 @@
 //! backend, outputs identical to the reference. Under `STRATA_REQUIRE_GPU=1` every
 //! Vulkan backend must be available.
 
-use strata::check::{CellResult, CheckConfig, backend_slots, kernel_checks, run_check};
 use strata_backends::gpu_required;
+use strata_check::{CellResult, CheckConfig, backend_slots, kernel_checks, run_check};
 
 #[test]
 fn every_kernel_is_identical_on_every_backend() {

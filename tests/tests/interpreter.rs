@@ -65,7 +65,7 @@ fn uniform_floats(seed: u32, count: usize) -> Vec<u32> {
 /// implementations, a few ULPs; values that cancel to near zero turn a small absolute
 /// error into many ULPs, so 0.5 % of outliers beyond 64 ULP are allowed.
 fn assert_close_to_lavapipe(what: &str, got: Vec<u32>, want: Vec<u32>) {
-    use strata::check::{Compare, Output, compare_outputs};
+    use strata_check::{Compare, Output, compare_outputs};
     let expected = [Output { name: "output", words: want, compare: Compare::Float { ulp: 64, max_outside: 0.005 } }];
     let agreement = compare_outputs(&[Output { name: "output", words: got, compare: Compare::Exact }], &expected)
         .unwrap_or_else(|mismatch| panic!("{what}: {mismatch}"));

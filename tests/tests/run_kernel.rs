@@ -2,7 +2,7 @@
 //! written to files, agreement reported, bad input named.
 
 use std::path::PathBuf;
-use strata::run_kernel::{RunRequest, disagreement, run_kernel};
+use strata_check::run_kernel::{RunRequest, disagreement, run_kernel};
 
 const SQUARE: &str = r#"
 @group(0) @binding(0) var<storage, read> input: array<u32>;

@@ -13,11 +13,11 @@
 
 use std::time::Instant;
 
-use strata::check::{Agreement, Compare, Output, compare_outputs};
 use strata_backends::ash_backend::{AshBackend, AshOptions, SpirvSource};
 use strata_backends::backend::{download, upload};
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_backends::{Backend, BackendError, Bind, BufferId, gpu_required};
+use strata_check::{Agreement, Compare, Output, compare_outputs};
 use strata_kernels::Kernel;
 
 fn kernel(path: &str, source: &str) -> Kernel {

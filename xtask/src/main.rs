@@ -77,14 +77,22 @@ fn main() -> Result<()> {
         Command::Shaders { strict, out } => shaders(strict, out),
         Command::Check { full, kernel } => check(full, &kernel),
         Command::Run { shader, entry, workgroups, buffers, sizes, backend, out } => {
-            run(strata::run_kernel::RunRequest { shader, entry, workgroups, buffers, sizes, backends: backend, out })
+            run(strata_check::run_kernel::RunRequest {
+                shader,
+                entry,
+                workgroups,
+                buffers,
+                sizes,
+                backends: backend,
+                out,
+            })
         }
     }
 }
 
 fn check(full: bool, only: &[String]) -> Result<()> {
     let registry = Registry::shared()?;
-    let mut checks = strata::check::kernel_checks();
+    let mut checks = strata_check::kernel_checks();
     if let Some(unknown) = only.iter().find(|name| !checks.iter().any(|c| registry.get(c.kernel()).name() == *name)) {
         let names: Vec<&str> = checks.iter().map(|c| registry.get(c.kernel()).name()).collect();
         bail!("--kernel {unknown}: no such kernel (kernels: {})", names.join(", "));
@@ -92,7 +100,7 @@ fn check(full: bool, only: &[String]) -> Result<()> {
     if !only.is_empty() {
         checks.retain(|c| only.iter().any(|name| registry.get(c.kernel()).name() == name));
     }
-    let report = strata::check::run_checks(strata::check::CheckConfig { full }, checks);
+    let report = strata_check::run_checks(strata_check::CheckConfig { full }, checks);
     print!("{}", report.render());
     let failures = report.failures();
     if !failures.is_empty() {
@@ -165,8 +173,8 @@ fn parse_size(text: &str) -> Result<(u32, u32, u64), String> {
     Ok((g, b, v.parse().map_err(|e| format!("size `{v}`: {e}"))?))
 }
 
-fn run(request: strata::run_kernel::RunRequest) -> Result<()> {
-    let runs = strata::run_kernel::run_kernel(&request)?;
+fn run(request: strata_check::run_kernel::RunRequest) -> Result<()> {
+    let runs = strata_check::run_kernel::run_kernel(&request)?;
     let mut failed = false;
     for run in &runs {
         match &run.outputs {
@@ -183,7 +191,7 @@ fn run(request: strata::run_kernel::RunRequest) -> Result<()> {
         }
     }
     if runs.iter().filter(|r| r.outputs.is_ok()).count() > 1 {
-        match strata::run_kernel::disagreement(&runs) {
+        match strata_check::run_kernel::disagreement(&runs) {
             None => println!("backends agree: every output identical"),
             Some(difference) => bail!("backends disagree: {difference}"),
         }

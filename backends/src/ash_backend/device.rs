@@ -1,7 +1,7 @@
 //! Vulkan instance, device, queue, memory and command submission for the ash backend.
 
-use super::AshOptions;
-use super::pipelines::AshPipeline;
+use super::device_setup::{DeviceObjects, pick_device};
+use super::{AshOptions, vk_error};
 use crate::device_info::{DeviceInfo, DeviceLimits};
 use crate::error::BackendError;
 use ash::vk;
@@ -11,20 +11,6 @@ use std::time::Duration;
 use strata_kernels::{BindingKind, Kernel};
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
-
-fn vk_error(operation: &str, result: vk::Result) -> BackendError {
-    match result {
-        vk::Result::ERROR_DEVICE_LOST => BackendError::DeviceLost { backend: "ash".into(), reason: operation.into() },
-        vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY => {
-            BackendError::OutOfMemory { backend: "ash".into(), operation: operation.into() }
-        }
-        other => BackendError::Validation {
-            backend: "ash".into(),
-            operation: operation.into(),
-            message: format!("{other:?}"),
-        },
-    }
-}
 
 type Messages = Arc<Mutex<Vec<String>>>;
 
@@ -51,6 +37,17 @@ unsafe extern "system" fn on_validation_message(
 }
 
 /// Everything Vulkan that outlives a dispatch.
+/// The Vulkan objects a dispatch binds, as [`super::pipelines`] creates them per kernel.
+#[derive(Clone, Copy)]
+pub(super) struct ComputePipeline {
+    /// The descriptor-set layout of group 0.
+    pub(super) set_layout: vk::DescriptorSetLayout,
+    /// The pipeline layout.
+    pub(super) layout: vk::PipelineLayout,
+    /// The compute pipeline.
+    pub(super) pipeline: vk::Pipeline,
+}
+
 pub(super) struct VulkanDevice {
     _entry: ash::Entry,
     instance: ash::Instance,
@@ -355,7 +352,7 @@ impl VulkanDevice {
     /// Records, submits and waits for one dispatch; returns its device time if `timed`.
     pub(super) fn dispatch(
         &self,
-        pipeline: &AshPipeline,
+        pipeline: ComputePipeline,
         kernel: &Kernel,
         buffers: &[(u32, vk::Buffer)],
         workgroups: [u32; 3],
@@ -499,72 +496,6 @@ impl Drop for VulkanDevice {
     }
 }
 
-/// The device's long-lived objects while they are being created.
-#[derive(Default)]
-struct DeviceObjects {
-    command_pool: Option<vk::CommandPool>,
-    command_buffer: Option<vk::CommandBuffer>,
-    fence: Option<vk::Fence>,
-    query_pool: Option<vk::QueryPool>,
-}
-
-impl DeviceObjects {
-    fn create(&mut self, device: &ash::Device, family: u32, timestamps: bool) -> Result<(), BackendError> {
-        // SAFETY: valid device; on error the caller destroys what was created.
-        unsafe {
-            let pool = device
-                .create_command_pool(
-                    &vk::CommandPoolCreateInfo::default()
-                        .queue_family_index(family)
-                        .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER),
-                    None,
-                )
-                .map_err(|e| vk_error("creating the command pool", e))?;
-            self.command_pool = Some(pool);
-            let buffers = device
-                .allocate_command_buffers(
-                    &vk::CommandBufferAllocateInfo::default()
-                        .command_pool(pool)
-                        .level(vk::CommandBufferLevel::PRIMARY)
-                        .command_buffer_count(1),
-                )
-                .map_err(|e| vk_error("allocating a command buffer", e))?;
-            self.command_buffer = Some(buffers[0]);
-            self.fence = Some(
-                device
-                    .create_fence(&vk::FenceCreateInfo::default(), None)
-                    .map_err(|e| vk_error("creating a fence", e))?,
-            );
-            if timestamps {
-                self.query_pool = Some(
-                    device
-                        .create_query_pool(
-                            &vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(2),
-                            None,
-                        )
-                        .map_err(|e| vk_error("creating the timestamp query pool", e))?,
-                );
-            }
-        }
-        Ok(())
-    }
-
-    fn destroy(&mut self, device: &ash::Device) {
-        // SAFETY: nothing was submitted; each object is destroyed once.
-        unsafe {
-            if let Some(pool) = self.query_pool.take() {
-                device.destroy_query_pool(pool, None);
-            }
-            if let Some(fence) = self.fence.take() {
-                device.destroy_fence(fence, None);
-            }
-            if let Some(pool) = self.command_pool.take() {
-                device.destroy_command_pool(pool, None);
-            }
-        }
-    }
-}
-
 /// Instance and messenger until the device exists: destroyed if opening fails.
 struct PartialInstance {
     instance: Option<ash::Instance>,
@@ -592,37 +523,4 @@ impl Drop for PartialInstance {
             }
         }
     }
-}
-
-/// The best physical device with a compute queue and Vulkan 1.1: discrete first, CPU last.
-fn pick_device(instance: &ash::Instance, options: AshOptions) -> Result<(vk::PhysicalDevice, u32), BackendError> {
-    // SAFETY: plain enumeration.
-    let devices = unsafe { instance.enumerate_physical_devices() }.map_err(|e| vk_error("enumerating devices", e))?;
-    let rank = |kind: vk::PhysicalDeviceType| match kind {
-        vk::PhysicalDeviceType::DISCRETE_GPU => 0,
-        vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
-        vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
-        vk::PhysicalDeviceType::CPU => 3,
-        _ => 4,
-    };
-    let mut best = None;
-    for device in devices {
-        // SAFETY: valid handle from enumeration.
-        let properties = unsafe { instance.get_physical_device_properties(device) };
-        if properties.api_version < vk::API_VERSION_1_1 {
-            continue;
-        }
-        let families = unsafe { instance.get_physical_device_queue_family_properties(device) };
-        let Some(family) = families.iter().position(|f| f.queue_flags.contains(vk::QueueFlags::COMPUTE)) else {
-            continue;
-        };
-        let key = rank(properties.device_type);
-        if best.is_none_or(|(k, _, _)| key < k) {
-            best = Some((key, device, family as u32));
-        }
-    }
-    best.map(|(_, device, family)| (device, family)).ok_or_else(|| BackendError::NoAdapter {
-        backend: options.source.name().into(),
-        reason: "no Vulkan 1.1 device with a compute queue".into(),
-    })
 }

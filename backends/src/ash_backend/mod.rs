@@ -7,6 +7,7 @@
 //! does its own memory management.
 
 mod device;
+mod device_setup;
 mod pipelines;
 
 use crate::backend::{Backend, Bind, BufferId};
@@ -120,7 +121,7 @@ impl AshBackend {
             .iter()
             .map(|bind| Ok((bind.binding, self.buffer(bind.buffer)?.buffer)))
             .collect::<Result<Vec<_>, BackendError>>()?;
-        self.vulkan.dispatch(&pipeline, kernel, &buffers, workgroups, timed)
+        self.vulkan.dispatch(pipeline.handles(), kernel, &buffers, workgroups, timed)
     }
 }
 
@@ -192,5 +193,20 @@ impl Drop for AshBackend {
             self.vulkan.destroy_buffer(entry.buffer, entry.memory);
         }
         self.pipelines.destroy(&self.vulkan);
+    }
+}
+
+/// A failed Vulkan call as a backend error naming what was being done.
+fn vk_error(operation: &str, result: vk::Result) -> BackendError {
+    match result {
+        vk::Result::ERROR_DEVICE_LOST => BackendError::DeviceLost { backend: "ash".into(), reason: operation.into() },
+        vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY => {
+            BackendError::OutOfMemory { backend: "ash".into(), operation: operation.into() }
+        }
+        other => BackendError::Validation {
+            backend: "ash".into(),
+            operation: operation.into(),
+            message: format!("{other:?}"),
+        },
     }
 }

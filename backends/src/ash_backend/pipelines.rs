@@ -2,7 +2,7 @@
 //! from glslang on naga's GLSL / HLSL), descriptor set 0 laid out from the registry.
 
 use super::SpirvSource;
-use super::device::VulkanDevice;
+use super::device::{ComputePipeline, VulkanDevice};
 use crate::error::BackendError;
 use ash::vk;
 use std::collections::HashMap;
@@ -17,6 +17,13 @@ pub(super) struct AshPipeline {
     pub(super) set_layout: vk::DescriptorSetLayout,
     pub(super) layout: vk::PipelineLayout,
     pub(super) pipeline: vk::Pipeline,
+}
+
+impl AshPipeline {
+    /// What a dispatch binds.
+    pub(super) fn handles(&self) -> ComputePipeline {
+        ComputePipeline { set_layout: self.set_layout, layout: self.layout, pipeline: self.pipeline }
+    }
 }
 
 pub(super) struct PipelineCache {

@@ -14,9 +14,12 @@
 //! around the accept block, loops to a backward jump, `break`/`continue` to forward
 //! jumps patched when the construct closes, `switch` to a table of (value, target).
 
+use super::constant::{compose, global_value, literal};
 use super::error::unsupported;
-use super::expression::{Place, const_value, global_value};
 use super::insn::{CallInsn, CollectiveFun, CollectiveInsn, GatherInsn, Insn, Reg};
+use super::layout::{
+    Piece, Place, byte_addressed, contains_f16, is_half, is_wide, load_plan, member_step, shape, words_of,
+};
 use super::memory;
 use crate::error::BackendError;
 use naga::{Expression, Handle, Module, Statement, TypeInner};
@@ -28,165 +31,6 @@ pub(super) const INLINE_EXPRESSIONS: usize = 400;
 pub(super) const INLINE_DEPTH: u32 = 8;
 /// Marks an expression without a register yet.
 const NONE: Reg = Reg::MAX;
-
-/// Words of a value of type `inner` (bool and every 32-bit scalar: one word; 64-bit
-/// integers: two, the low word first).
-pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String> {
-    Ok(match *inner {
-        TypeInner::Atomic(s) if s.width != 4 => return Err(format!("{}-bit atomics", s.width * 8)),
-        TypeInner::Scalar(s) | TypeInner::Atomic(s) => {
-            scalar_words(s).ok_or_else(|| format!("{}-bit scalars", s.width * 8))?
-        }
-        TypeInner::Vector { size, scalar } => {
-            size as u32 * scalar_words(scalar).ok_or_else(|| format!("{}-bit vectors", scalar.width * 8))?
-        }
-        TypeInner::Pointer { .. } | TypeInner::ValuePointer { .. } => 2,
-        TypeInner::Matrix { scalar, .. } if scalar.width == 2 => return Err("f16 matrices".into()),
-        TypeInner::Matrix { columns, rows, .. } => {
-            // Columns are padded like vec3 → 4 words in memory.
-            let row_words = if rows == naga::VectorSize::Tri { 4 } else { rows as u32 };
-            columns as u32 * row_words
-        }
-        // Register layout of composites holding f16: a word per f16, members and
-        // elements one after the other (naga's 2-byte layout is used in buffers only).
-        TypeInner::Array { base, size, .. } if contains_f16(module, &module.types[base].inner) => match size {
-            naga::ArraySize::Constant(n) => n.get() * words_of(module, &module.types[base].inner)?,
-            _ => return Err("runtime-sized arrays as values".into()),
-        },
-        TypeInner::Struct { ref members, .. } if contains_f16(module, inner) => {
-            let mut words = 0;
-            for member in members {
-                words += words_of(module, &module.types[member.ty].inner)?;
-            }
-            words
-        }
-        TypeInner::Array { base, size, stride } => {
-            // The element type must be supported too.
-            words_of(module, &module.types[base].inner)?;
-            match size {
-                naga::ArraySize::Constant(n) => n.get() * stride / 4,
-                _ => return Err("runtime-sized arrays as values".into()),
-            }
-        }
-        TypeInner::Struct { span, .. } => span / 4,
-        _ => return Err(format!("type {inner:?}")),
-    })
-}
-
-/// Words of one scalar: 1 for bool and 32-bit scalars, 2 for 64-bit integers; `None`
-/// for scalars the interpreter does not support.
-///
-/// An f16 takes a word of its own in registers, holding the f32 of equal value (every
-/// operation producing an f16 rounds to binary16). Registers, function, private and
-/// workgroup memory (which only the interpreter sees) use this register layout; bound
-/// buffers use naga's (two bytes per f16), and loads and stores of types holding f16
-/// convert between the two ([`load_plan`]). Pointers into buffers count bytes,
-/// pointers elsewhere count words. f16 matrices are refused.
-pub(super) fn scalar_words(scalar: naga::Scalar) -> Option<u32> {
-    match (scalar.kind, scalar.width) {
-        (naga::ScalarKind::Bool, _) | (_, 4) | (naga::ScalarKind::Float, 2) => Some(1),
-        (naga::ScalarKind::Sint | naga::ScalarKind::Uint, 8) => Some(2),
-        _ => None,
-    }
-}
-
-/// Whether pointers into `space` count bytes (bound buffers, laid out as naga says)
-/// rather than register words.
-pub(super) fn byte_addressed(space: naga::AddressSpace) -> bool {
-    matches!(space, naga::AddressSpace::Uniform | naga::AddressSpace::Storage { .. })
-}
-
-/// Offset of member `index` of struct `inner`: bytes (`bytes`), else register words.
-pub(super) fn member_step(module: &Module, inner: &TypeInner, index: u32, bytes: bool) -> u32 {
-    let TypeInner::Struct { ref members, .. } = *inner else { return 0 };
-    if bytes {
-        members[index as usize].offset
-    } else if !contains_f16(module, inner) {
-        members[index as usize].offset / 4
-    } else {
-        members[..index as usize].iter().map(|m| words_of(module, &module.types[m.ty].inner).unwrap_or(0)).sum()
-    }
-}
-
-/// Distance between elements of an array of `base` with naga stride `stride`: bytes
-/// (`bytes`), else register words.
-pub(super) fn element_step(module: &Module, base: Handle<naga::Type>, stride: u32, bytes: bool) -> u32 {
-    let inner = &module.types[base].inner;
-    if bytes {
-        stride
-    } else if !contains_f16(module, inner) {
-        stride / 4
-    } else {
-        words_of(module, inner).unwrap_or(0)
-    }
-}
-
-/// Distance between components of a vector of `scalar`: bytes (`bytes`), else words.
-pub(super) fn component_step(scalar: naga::Scalar, bytes: bool) -> u32 {
-    match (bytes, scalar.width) {
-        (true, 1) => 4, // bool
-        (true, width) => u32::from(width),
-        (false, 8) if scalar.kind != naga::ScalarKind::Float => 2,
-        (false, _) => 1,
-    }
-}
-
-/// One piece of a load or store between a buffer (naga's layout) and registers.
-#[derive(Clone, Copy, Debug)]
-pub(super) enum Piece {
-    /// `len` words at byte offset `memory` ↔ register word `reg`.
-    Words { memory: u32, reg: u32, len: u32 },
-    /// The binary16 at byte offset `memory` ↔ the f32 at register word `reg`.
-    Half { memory: u32, reg: u32 },
-}
-
-/// How a value of type `inner` holding f16 moves between a buffer at byte `memory` and
-/// registers at word `reg`.
-pub(super) fn load_plan(module: &Module, inner: &TypeInner, memory: u32, reg: u32, out: &mut Vec<Piece>) {
-    if !contains_f16(module, inner) {
-        let len = words_of(module, inner).unwrap_or(0);
-        match out.last_mut() {
-            Some(Piece::Words { memory: m, reg: r, len: l }) if *m + 4 * *l == memory && *r + *l == reg => *l += len,
-            _ => out.push(Piece::Words { memory, reg, len }),
-        }
-        return;
-    }
-    match *inner {
-        TypeInner::Scalar(_) => out.push(Piece::Half { memory, reg }),
-        TypeInner::Vector { size, .. } => {
-            out.extend((0..size as u32).map(|i| Piece::Half { memory: memory + 2 * i, reg: reg + i }))
-        }
-        TypeInner::Array { base, size: naga::ArraySize::Constant(n), stride } => {
-            let words = words_of(module, &module.types[base].inner).unwrap_or(0);
-            for i in 0..n.get() {
-                load_plan(module, &module.types[base].inner, memory + i * stride, reg + i * words, out);
-            }
-        }
-        TypeInner::Struct { ref members, .. } => {
-            for (i, member) in members.iter().enumerate() {
-                let step = member_step(module, inner, i as u32, false);
-                load_plan(module, &module.types[member.ty].inner, memory + member.offset, reg + step, out);
-            }
-        }
-        _ => {}
-    }
-}
-
-/// Whether a value of type `inner` holds an f16 anywhere.
-pub(super) fn contains_f16(module: &Module, inner: &TypeInner) -> bool {
-    match *inner {
-        TypeInner::Scalar(s) | TypeInner::Vector { scalar: s, .. } | TypeInner::Matrix { scalar: s, .. } => {
-            s.kind == naga::ScalarKind::Float && s.width == 2
-        }
-        TypeInner::Array { base, .. } | TypeInner::BindingArray { base, .. } => {
-            contains_f16(module, &module.types[base].inner)
-        }
-        TypeInner::Struct { ref members, .. } => {
-            members.iter().any(|m| contains_f16(module, &module.types[m.ty].inner))
-        }
-        _ => false,
-    }
-}
 
 /// Byte offsets where source lines start, for span → line lookups.
 pub(super) struct LineIndex(Vec<usize>);
@@ -792,8 +636,8 @@ impl Compiler<'_> {
             }
             Statement::SubgroupCollectiveOperation { op, collective_op, argument, result } => {
                 let ty = self.ty(scope, *argument);
-                let kind = match super::expression::shape(ty) {
-                    Some((kind, _)) if !super::expression::is_wide(ty) && !super::expression::is_half(ty) => kind,
+                let kind = match shape(ty) {
+                    Some((kind, _)) if !is_wide(ty) && !is_half(ty) => kind,
                     _ => return Err(unsupported(&format!("subgroup {op:?} {collective_op:?} on {ty:?}"), line)),
                 };
                 let collective = CollectiveInsn {
@@ -1007,4 +851,31 @@ pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> 
         workgroup_words,
         private_init,
     })
+}
+
+/// The value of a constant expression of a function, if it can be computed from values
+/// already in the template (literals, constants, zero values, splats and compositions).
+pub(super) fn const_value(compiler: &Compiler, scope: &Scope, handle: Handle<Expression>) -> Option<Vec<u32>> {
+    let module = compiler.module;
+    let value_of = |h: Handle<Expression>| -> Option<&[u32]> {
+        let i = h.index();
+        if !scope.constant[i] {
+            return None;
+        }
+        let reg = scope.regs[i] as usize;
+        Some(&compiler.template[reg..reg + scope.lens[i] as usize])
+    };
+    let len = scope.lens[handle.index()] as usize;
+    let value = match &scope.function.expressions[handle] {
+        Expression::Literal(value) => literal(value)?,
+        Expression::Constant(c) => compiler.global_values[module.constants[*c].init.index()].clone(),
+        Expression::ZeroValue(_) => vec![0; len],
+        Expression::Splat { size, value } => value_of(*value)?.repeat(*size as usize),
+        Expression::Compose { components, .. } => {
+            let parts: Option<Vec<&[u32]>> = components.iter().map(|c| value_of(*c)).collect();
+            compose(module, compiler.ty(scope, handle), &parts?).ok()?
+        }
+        _ => return None,
+    };
+    (value.len() == len).then_some(value)
 }

@@ -5,8 +5,13 @@
 //! [`Insn::Fail`] naming the construct and its line, reported only if reached.
 
 use super::arith;
-use super::decode::{Compiler, Scope, byte_addressed, component_step, element_step, member_step, words_of};
+use super::constant::{compose_offsets, literal};
+use super::decode::{Compiler, Scope};
 use super::insn::{BinOp, Insn, Reg, UnOp};
+use super::layout::{
+    Place, byte_addressed, component_step, component_words, element_step, is_half, is_wide, member_step, scalar_shape,
+    shape,
+};
 use super::matrix::column_words;
 use super::wide;
 use crate::error::BackendError;
@@ -15,152 +20,6 @@ use smallvec::{SmallVec, smallvec};
 
 /// A value: its words, inline up to a vec4.
 pub(super) type Words = SmallVec<[u32; 4]>;
-
-/// Where a pointer points, when that is known at compile time.
-#[derive(Clone, Copy, Debug)]
-pub(super) enum Place {
-    /// A local variable: its register in the running frame.
-    Local(Reg),
-    /// Workgroup memory at this word.
-    Workgroup(u32),
-    /// Private memory at this word.
-    Private(u32),
-    /// Bound buffer (slot, byte).
-    Buffer(u32, u32),
-}
-
-impl Place {
-    fn offset(self, step: u32) -> Self {
-        match self {
-            Place::Local(r) => Place::Local(r + step),
-            Place::Workgroup(a) => Place::Workgroup(a + step),
-            Place::Private(a) => Place::Private(a + step),
-            Place::Buffer(b, a) => Place::Buffer(b, a + step),
-        }
-    }
-}
-
-/// Scalar kind and component count of a scalar or vector type.
-pub(super) fn shape(inner: &TypeInner) -> Option<(ScalarKind, usize)> {
-    match *inner {
-        TypeInner::Scalar(s) | TypeInner::Atomic(s) => Some((s.kind, 1)),
-        TypeInner::Vector { size, scalar } => Some((scalar.kind, size as usize)),
-        _ => None,
-    }
-}
-
-/// A literal's words (64-bit integers: low word first).
-fn literal(value: &naga::Literal) -> Option<Vec<u32>> {
-    let wide = |v: u64| vec![v as u32, (v >> 32) as u32];
-    Some(match *value {
-        naga::Literal::F32(v) => vec![v.to_bits()],
-        naga::Literal::U32(v) => vec![v],
-        naga::Literal::I32(v) => vec![v as u32],
-        naga::Literal::Bool(v) => vec![u32::from(v)],
-        naga::Literal::U64(v) => wide(v),
-        naga::Literal::I64(v) => wide(v as u64),
-        naga::Literal::F16(v) => vec![v.to_f32().to_bits()],
-        _ => return None,
-    })
-}
-
-/// Scalar and component count of a scalar or vector type.
-pub(super) fn scalar_shape(inner: &TypeInner) -> Option<(naga::Scalar, usize)> {
-    match *inner {
-        TypeInner::Scalar(s) | TypeInner::Atomic(s) => Some((s, 1)),
-        TypeInner::Vector { size, scalar } => Some((scalar, size as usize)),
-        _ => None,
-    }
-}
-
-/// Whether `inner` is a 64-bit integer scalar or vector.
-pub(super) fn is_wide(inner: &TypeInner) -> bool {
-    scalar_shape(inner).is_some_and(|(s, _)| wide::is_wide(s))
-}
-
-/// Whether `inner` is an f16 scalar or vector.
-pub(super) fn is_half(inner: &TypeInner) -> bool {
-    scalar_shape(inner).is_some_and(|(s, _)| s.kind == ScalarKind::Float && s.width == 2)
-}
-
-/// Words per component of a vector (or of a pointer to one) of scalar `scalar`.
-fn component_words(scalar: naga::Scalar) -> u32 {
-    if wide::is_wide(scalar) { 2 } else { 1 }
-}
-
-/// Value of a constant expression of the module (`global_expressions`).
-pub(super) fn global_value(
-    module: &naga::Module,
-    values: &[Vec<u32>],
-    handle: Handle<Expression>,
-) -> Result<Vec<u32>, String> {
-    let inner_of = |ty: Handle<naga::Type>| &module.types[ty].inner;
-    Ok(match &module.global_expressions[handle] {
-        Expression::Literal(value) => literal(value).ok_or_else(|| format!("literal {value:?}"))?,
-        Expression::Constant(c) => values[module.constants[*c].init.index()].clone(),
-        Expression::ZeroValue(ty) => vec![0; words_of(module, inner_of(*ty))? as usize],
-        Expression::Splat { size, value } => values[value.index()].repeat(*size as usize),
-        Expression::Compose { ty, components } => {
-            let parts: Vec<&[u32]> = components.iter().map(|c| values[c.index()].as_slice()).collect();
-            compose(module, inner_of(*ty), &parts)?
-        }
-        other => return Err(format!("constant expression {other:?}")),
-    })
-}
-
-/// Word offset of each part of a value of type `inner` composed of parts of `lens` words.
-fn compose_offsets(module: &naga::Module, inner: &TypeInner, lens: &[u32]) -> Result<Vec<u32>, String> {
-    Ok(match *inner {
-        TypeInner::Vector { .. } => lens.iter().scan(0, |at, len| Some(std::mem::replace(at, *at + len))).collect(),
-        TypeInner::Struct { .. } => (0..lens.len() as u32).map(|i| member_step(module, inner, i, false)).collect(),
-        TypeInner::Array { base, stride, .. } => {
-            let step = element_step(module, base, stride, false);
-            (0..lens.len() as u32).map(|i| i * step).collect()
-        }
-        TypeInner::Matrix { rows, .. } => (0..lens.len()).map(|i| (i * column_words(rows)) as u32).collect(),
-        _ => return Err(format!("composing {inner:?}")),
-    })
-}
-
-/// Lays out `parts` as a value of type `inner`.
-pub(super) fn compose(module: &naga::Module, inner: &TypeInner, parts: &[&[u32]]) -> Result<Vec<u32>, String> {
-    let mut out = vec![0u32; words_of(module, inner)? as usize];
-    let lens: Vec<u32> = parts.iter().map(|p| p.len() as u32).collect();
-    let offsets = compose_offsets(module, inner, &lens)?;
-    for (part, at) in parts.iter().zip(offsets) {
-        let at = at as usize;
-        let len = part.len().min(out.len().saturating_sub(at));
-        out[at..at + len].copy_from_slice(&part[..len]);
-    }
-    Ok(out)
-}
-
-/// The value of a constant expression of a function, if it can be computed from values
-/// already in the template (literals, constants, zero values, splats and compositions).
-pub(super) fn const_value(compiler: &Compiler, scope: &Scope, handle: Handle<Expression>) -> Option<Vec<u32>> {
-    let module = compiler.module;
-    let value_of = |h: Handle<Expression>| -> Option<&[u32]> {
-        let i = h.index();
-        if !scope.constant[i] {
-            return None;
-        }
-        let reg = scope.regs[i] as usize;
-        Some(&compiler.template[reg..reg + scope.lens[i] as usize])
-    };
-    let len = scope.lens[handle.index()] as usize;
-    let value = match &scope.function.expressions[handle] {
-        Expression::Literal(value) => literal(value)?,
-        Expression::Constant(c) => compiler.global_values[module.constants[*c].init.index()].clone(),
-        Expression::ZeroValue(_) => vec![0; len],
-        Expression::Splat { size, value } => value_of(*value)?.repeat(*size as usize),
-        Expression::Compose { components, .. } => {
-            let parts: Option<Vec<&[u32]>> = components.iter().map(|c| value_of(*c)).collect();
-            compose(module, compiler.ty(scope, handle), &parts?).ok()?
-        }
-        _ => return None,
-    };
-    (value.len() == len).then_some(value)
-}
 
 /// The f32 dot product of two vectors of f32 words: a sequential sum of products, no fused
 /// multiply-add, starting from the first product rather than +0 so that products that are

@@ -8,7 +8,7 @@
 //! (literals, constants, pointers to globals) are filled into each code's register
 //! template once and never recomputed.
 
-use super::decode::Piece;
+use super::layout::Piece;
 use naga::ScalarKind;
 
 /// Word offset of a value in the frame's register file.

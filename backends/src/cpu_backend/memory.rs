@@ -8,8 +8,8 @@
 //!
 //! Out-of-bounds words read as 0 and are not written.
 
-use super::decode::Piece;
 use super::insn::Reg;
+use super::layout::Piece;
 use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Tag of a pointer into a bound buffer (the low 24 bits: its binding slot).

@@ -37,12 +37,14 @@
 //! an error naming the construct and its WGSL line, never a panic.
 
 mod arith;
+mod constant;
 mod decode;
 mod error;
 mod exec;
 mod expression;
 mod insn;
 mod interp;
+mod layout;
 mod matrix;
 mod memory;
 mod wide;

@@ -11,9 +11,9 @@
 //! way, as words with outliers.
 
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
-use crate::histogram_pass::PassError;
-use crate::render::{GpuScene, RenderSettings};
-use crate::restir::{FrameBuffers, Method, RestirRenderer, RestirSettings};
+use strata::histogram_pass::PassError;
+use strata::render::{GpuScene, RenderSettings};
+use strata::restir::{FrameBuffers, Method, RestirRenderer, RestirSettings};
 use strata_backends::Backend;
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_kernels::selection::{SamplerVariant, SelectionSettings};

@@ -1,7 +1,7 @@
 //! Check of the empty kernel: it must leave its buffer exactly as it was.
 
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
-use crate::histogram_pass::PassError;
+use strata::histogram_pass::PassError;
 use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, Bind};
 use strata_kernels::{KernelId, Registry};

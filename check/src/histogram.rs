@@ -5,8 +5,8 @@
 //! the reference bit for bit.
 
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
-use crate::histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};
-use crate::synthetic::{CandidateMix, candidate_image};
+use strata::histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};
+use strata::synthetic::{CandidateMix, candidate_image};
 use strata_backends::Backend;
 use strata_kernels::reference::block_histogram::{HistogramOutput, block_histogram, unmasked};
 use strata_kernels::types::{BLOCK_SIZES, Candidate, OBJECT_ID_NONE};

@@ -2,6 +2,10 @@
 //! every registry kernel on every available backend with generated inputs, compared
 //! with the kernel's Rust reference. Integer and ordering outputs must be bit-exact;
 //! float outputs must stay within the ULP bound the registry declares for the kernel.
+//! Also [`run_kernel`]: any WGSL compute shader on chosen backends (`cargo xtask run`).
+//!
+//! Tooling, not product: the renderer (`strata`) and the embeddable pass know nothing of
+//! it; `xtask` and the tests use it.
 
 mod backends;
 mod camera;
@@ -11,6 +15,7 @@ mod histogram;
 mod path;
 mod report;
 mod restir;
+pub mod run_kernel;
 mod selection;
 mod trace;
 
@@ -18,7 +23,7 @@ pub use backends::{BackendSlot, backend_slots};
 pub use compare::{Agreement, Compare, Mismatch, Output, compare_outputs};
 pub use report::{CellResult, CheckReport};
 
-use crate::histogram_pass::PassError;
+use strata::histogram_pass::PassError;
 use strata_backends::Backend;
 use strata_kernels::KernelId;
 

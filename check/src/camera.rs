@@ -3,9 +3,9 @@
 //! within the registry's ULP bound, no outliers allowed.
 
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
-use crate::histogram_pass::PassError;
-use crate::scene::{CameraFrame, default_scene};
-use crate::trace_pass::camera_rays;
+use strata::histogram_pass::PassError;
+use strata::scene::{CameraFrame, default_scene};
+use strata::trace_pass::camera_rays;
 use strata_backends::Backend;
 use strata_kernels::reference::camera_rays::camera_rays as reference_rays;
 use strata_kernels::trace_types::{CameraParams, Ray};

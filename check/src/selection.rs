@@ -6,10 +6,10 @@
 //! resampling numbers and weights within the registry's ULP bound.
 
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
-use crate::histogram_pass::PassError;
-use crate::synthetic::{CandidateMix, candidate_image};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg32;
+use strata::histogram_pass::PassError;
+use strata::synthetic::{CandidateMix, candidate_image};
 use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, Bind};
 use strata_kernels::blue_noise::BlueNoiseTables;

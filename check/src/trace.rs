@@ -5,9 +5,9 @@
 //! at a near-tie.
 
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
-use crate::histogram_pass::PassError;
-use crate::synthetic::{rays_into_cube, triangle_soup};
-use crate::trace_pass::{SceneBvh, TracePass};
+use strata::histogram_pass::PassError;
+use strata::synthetic::{rays_into_cube, triangle_soup};
+use strata::trace_pass::{SceneBvh, TracePass};
 use strata_backends::Backend;
 use strata_kernels::reference::bvh_trace::closest_hit;
 use strata_kernels::trace_types::Hit;

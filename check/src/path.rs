@@ -8,9 +8,9 @@
 //! an environment map, at a few sizes with partial workgroups, one sample per pixel.
 
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
-use crate::histogram_pass::PassError;
-use crate::render::{GpuScene, RenderSettings, render};
-use crate::scene::{Environment, Material, Scene, default_scene};
+use strata::histogram_pass::PassError;
+use strata::render::{GpuScene, RenderSettings, render};
+use strata::scene::{Environment, Material, Scene, default_scene};
 use strata_backends::Backend;
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_kernels::{KernelId, Registry};

@@ -2,7 +2,7 @@
 //! files or zero-filled, outputs written back, and with several backends a verdict on
 //! whether they agree. For engine developers checking their own kernels.
 
-use crate::check::{BackendSlot, backend_slots};
+use crate::{BackendSlot, backend_slots};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 use strata_backends::{Backend, Bind};

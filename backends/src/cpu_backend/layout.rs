@@ -1,0 +1,227 @@
+//! Where values live: the words a naga type takes in registers, the byte and word steps
+//! of fields, elements and components in each address space, how f16 values move
+//! between buffers and registers, and what a pointer points at when that is known at
+//! compile time. Shared by the compiler ([`super::decode`], [`super::expression`]), the
+//! instructions ([`super::insn`]) and memory access ([`super::memory`]), and dependent on
+//! none of them.
+
+use super::insn::Reg;
+use super::wide;
+use naga::{Handle, Module, ScalarKind, TypeInner};
+
+/// Words of a value of type `inner` (bool and every 32-bit scalar: one word; 64-bit
+/// integers: two, the low word first).
+pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String> {
+    Ok(match *inner {
+        TypeInner::Atomic(s) if s.width != 4 => return Err(format!("{}-bit atomics", s.width * 8)),
+        TypeInner::Scalar(s) | TypeInner::Atomic(s) => {
+            scalar_words(s).ok_or_else(|| format!("{}-bit scalars", s.width * 8))?
+        }
+        TypeInner::Vector { size, scalar } => {
+            size as u32 * scalar_words(scalar).ok_or_else(|| format!("{}-bit vectors", scalar.width * 8))?
+        }
+        TypeInner::Pointer { .. } | TypeInner::ValuePointer { .. } => 2,
+        TypeInner::Matrix { scalar, .. } if scalar.width == 2 => return Err("f16 matrices".into()),
+        TypeInner::Matrix { columns, rows, .. } => {
+            // Columns are padded like vec3 → 4 words in memory.
+            let row_words = if rows == naga::VectorSize::Tri { 4 } else { rows as u32 };
+            columns as u32 * row_words
+        }
+        // Register layout of composites holding f16: a word per f16, members and
+        // elements one after the other (naga's 2-byte layout is used in buffers only).
+        TypeInner::Array { base, size, .. } if contains_f16(module, &module.types[base].inner) => match size {
+            naga::ArraySize::Constant(n) => n.get() * words_of(module, &module.types[base].inner)?,
+            _ => return Err("runtime-sized arrays as values".into()),
+        },
+        TypeInner::Struct { ref members, .. } if contains_f16(module, inner) => {
+            let mut words = 0;
+            for member in members {
+                words += words_of(module, &module.types[member.ty].inner)?;
+            }
+            words
+        }
+        TypeInner::Array { base, size, stride } => {
+            // The element type must be supported too.
+            words_of(module, &module.types[base].inner)?;
+            match size {
+                naga::ArraySize::Constant(n) => n.get() * stride / 4,
+                _ => return Err("runtime-sized arrays as values".into()),
+            }
+        }
+        TypeInner::Struct { span, .. } => span / 4,
+        _ => return Err(format!("type {inner:?}")),
+    })
+}
+
+/// Words of one scalar: 1 for bool and 32-bit scalars, 2 for 64-bit integers; `None`
+/// for scalars the interpreter does not support.
+///
+/// An f16 takes a word of its own in registers, holding the f32 of equal value (every
+/// operation producing an f16 rounds to binary16). Registers, function, private and
+/// workgroup memory (which only the interpreter sees) use this register layout; bound
+/// buffers use naga's (two bytes per f16), and loads and stores of types holding f16
+/// convert between the two ([`load_plan`]). Pointers into buffers count bytes,
+/// pointers elsewhere count words. f16 matrices are refused.
+pub(super) fn scalar_words(scalar: naga::Scalar) -> Option<u32> {
+    match (scalar.kind, scalar.width) {
+        (naga::ScalarKind::Bool, _) | (_, 4) | (naga::ScalarKind::Float, 2) => Some(1),
+        (naga::ScalarKind::Sint | naga::ScalarKind::Uint, 8) => Some(2),
+        _ => None,
+    }
+}
+
+/// Whether pointers into `space` count bytes (bound buffers, laid out as naga says)
+/// rather than register words.
+pub(super) fn byte_addressed(space: naga::AddressSpace) -> bool {
+    matches!(space, naga::AddressSpace::Uniform | naga::AddressSpace::Storage { .. })
+}
+
+/// Offset of member `index` of struct `inner`: bytes (`bytes`), else register words.
+pub(super) fn member_step(module: &Module, inner: &TypeInner, index: u32, bytes: bool) -> u32 {
+    let TypeInner::Struct { ref members, .. } = *inner else { return 0 };
+    if bytes {
+        members[index as usize].offset
+    } else if !contains_f16(module, inner) {
+        members[index as usize].offset / 4
+    } else {
+        members[..index as usize].iter().map(|m| words_of(module, &module.types[m.ty].inner).unwrap_or(0)).sum()
+    }
+}
+
+/// Distance between elements of an array of `base` with naga stride `stride`: bytes
+/// (`bytes`), else register words.
+pub(super) fn element_step(module: &Module, base: Handle<naga::Type>, stride: u32, bytes: bool) -> u32 {
+    let inner = &module.types[base].inner;
+    if bytes {
+        stride
+    } else if !contains_f16(module, inner) {
+        stride / 4
+    } else {
+        words_of(module, inner).unwrap_or(0)
+    }
+}
+
+/// Distance between components of a vector of `scalar`: bytes (`bytes`), else words.
+pub(super) fn component_step(scalar: naga::Scalar, bytes: bool) -> u32 {
+    match (bytes, scalar.width) {
+        (true, 1) => 4, // bool
+        (true, width) => u32::from(width),
+        (false, 8) if scalar.kind != naga::ScalarKind::Float => 2,
+        (false, _) => 1,
+    }
+}
+
+/// One piece of a load or store between a buffer (naga's layout) and registers.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Piece {
+    /// `len` words at byte offset `memory` ↔ register word `reg`.
+    Words { memory: u32, reg: u32, len: u32 },
+    /// The binary16 at byte offset `memory` ↔ the f32 at register word `reg`.
+    Half { memory: u32, reg: u32 },
+}
+
+/// How a value of type `inner` holding f16 moves between a buffer at byte `memory` and
+/// registers at word `reg`.
+pub(super) fn load_plan(module: &Module, inner: &TypeInner, memory: u32, reg: u32, out: &mut Vec<Piece>) {
+    if !contains_f16(module, inner) {
+        let len = words_of(module, inner).unwrap_or(0);
+        match out.last_mut() {
+            Some(Piece::Words { memory: m, reg: r, len: l }) if *m + 4 * *l == memory && *r + *l == reg => *l += len,
+            _ => out.push(Piece::Words { memory, reg, len }),
+        }
+        return;
+    }
+    match *inner {
+        TypeInner::Scalar(_) => out.push(Piece::Half { memory, reg }),
+        TypeInner::Vector { size, .. } => {
+            out.extend((0..size as u32).map(|i| Piece::Half { memory: memory + 2 * i, reg: reg + i }))
+        }
+        TypeInner::Array { base, size: naga::ArraySize::Constant(n), stride } => {
+            let words = words_of(module, &module.types[base].inner).unwrap_or(0);
+            for i in 0..n.get() {
+                load_plan(module, &module.types[base].inner, memory + i * stride, reg + i * words, out);
+            }
+        }
+        TypeInner::Struct { ref members, .. } => {
+            for (i, member) in members.iter().enumerate() {
+                let step = member_step(module, inner, i as u32, false);
+                load_plan(module, &module.types[member.ty].inner, memory + member.offset, reg + step, out);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// Whether a value of type `inner` holds an f16 anywhere.
+pub(super) fn contains_f16(module: &Module, inner: &TypeInner) -> bool {
+    match *inner {
+        TypeInner::Scalar(s) | TypeInner::Vector { scalar: s, .. } | TypeInner::Matrix { scalar: s, .. } => {
+            s.kind == naga::ScalarKind::Float && s.width == 2
+        }
+        TypeInner::Array { base, .. } | TypeInner::BindingArray { base, .. } => {
+            contains_f16(module, &module.types[base].inner)
+        }
+        TypeInner::Struct { ref members, .. } => {
+            members.iter().any(|m| contains_f16(module, &module.types[m.ty].inner))
+        }
+        _ => false,
+    }
+}
+
+/// Where a pointer points, when that is known at compile time.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Place {
+    /// A local variable: its register in the running frame.
+    Local(Reg),
+    /// Workgroup memory at this word.
+    Workgroup(u32),
+    /// Private memory at this word.
+    Private(u32),
+    /// Bound buffer (slot, byte).
+    Buffer(u32, u32),
+}
+
+impl Place {
+    /// The place `step` words or bytes further.
+    pub(super) fn offset(self, step: u32) -> Self {
+        match self {
+            Place::Local(r) => Place::Local(r + step),
+            Place::Workgroup(a) => Place::Workgroup(a + step),
+            Place::Private(a) => Place::Private(a + step),
+            Place::Buffer(b, a) => Place::Buffer(b, a + step),
+        }
+    }
+}
+
+/// Scalar kind and component count of a scalar or vector type.
+pub(super) fn shape(inner: &TypeInner) -> Option<(ScalarKind, usize)> {
+    match *inner {
+        TypeInner::Scalar(s) | TypeInner::Atomic(s) => Some((s.kind, 1)),
+        TypeInner::Vector { size, scalar } => Some((scalar.kind, size as usize)),
+        _ => None,
+    }
+}
+
+/// Scalar and component count of a scalar or vector type.
+pub(super) fn scalar_shape(inner: &TypeInner) -> Option<(naga::Scalar, usize)> {
+    match *inner {
+        TypeInner::Scalar(s) | TypeInner::Atomic(s) => Some((s, 1)),
+        TypeInner::Vector { size, scalar } => Some((scalar, size as usize)),
+        _ => None,
+    }
+}
+
+/// Whether `inner` is a 64-bit integer scalar or vector.
+pub(super) fn is_wide(inner: &TypeInner) -> bool {
+    scalar_shape(inner).is_some_and(|(s, _)| wide::is_wide(s))
+}
+
+/// Whether `inner` is an f16 scalar or vector.
+pub(super) fn is_half(inner: &TypeInner) -> bool {
+    scalar_shape(inner).is_some_and(|(s, _)| s.kind == ScalarKind::Float && s.width == 2)
+}
+
+/// Words per component of a vector (or of a pointer to one) of scalar `scalar`.
+pub(super) fn component_words(scalar: naga::Scalar) -> u32 {
+    if wide::is_wide(scalar) { 2 } else { 1 }
+}

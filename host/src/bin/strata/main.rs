@@ -1,0 +1,349 @@
+//! The `strata` command line.
+
+mod compare_command;
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use std::time::Instant;
+use strata::backend_choice::{BackendChoice, open_backend};
+use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
+use strata::metrics::{self, Metric};
+use strata::render::{GpuScene, LightSampling, RenderSettings};
+use strata::restir::Method;
+use strata::rgb_image::RgbImage;
+use strata::scene::{Scene, default_scene, load_scene_file};
+use strata::synthetic::{CandidateMix, candidate_image};
+use strata_kernels::BlockGrid;
+use strata_kernels::reference::block_histogram::block_histogram;
+
+/// strata: histogram-stratified ReSTIR.
+#[derive(Parser)]
+#[command(version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run the block-histogram kernel on a generated candidate image, check it against
+    /// the Rust reference and print what it did.
+    Histogram(HistogramArgs),
+    /// Path-trace a scene progressively (the reference mode) and write a linear float EXR
+    /// and a tone-mapped sRGB PNG preview.
+    Render(RenderArgs),
+    /// Render the ReSTIR methods from the same seeds and measure every frame against a
+    /// reference: images, error maps, a CSV and a summary table.
+    Compare(compare_command::CompareArgs),
+    /// Plot RelMSE against frame from a `strata compare` errors.csv as an SVG.
+    Plot(PlotArgs),
+    /// Compare an EXR image with a reference EXR: MSE, RelMSE (paper and common forms),
+    /// pRelMSE; optionally write the per-pixel RelMSE map as EXR and false-colour PNG.
+    Metrics(MetricsArgs),
+}
+
+#[derive(clap::Args)]
+struct PlotArgs {
+    /// errors.csv written by `strata compare`.
+    csv: PathBuf,
+    /// The SVG to write.
+    #[arg(long, default_value = "relmse.svg")]
+    out: PathBuf,
+    /// Title of the plot.
+    #[arg(long, default_value = "RelMSE against frame")]
+    title: String,
+}
+
+#[derive(clap::Args)]
+struct MetricsArgs {
+    /// The image (linear RGB EXR).
+    image: PathBuf,
+    /// The reference (linear RGB EXR of the same size).
+    reference: PathBuf,
+    /// Write the per-pixel error map of `--map-metric` to this EXR, and a false-colour
+    /// PNG beside it.
+    #[arg(long)]
+    map: Option<PathBuf>,
+    /// Metric of the error map.
+    #[arg(long, value_enum, default_value_t = Metric::Relmse)]
+    map_metric: Metric,
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// Scene file (`scene.json` of the shared scenes); the built-in default scene when
+    /// left out.
+    scene: Option<PathBuf>,
+    /// Samples per pixel.
+    #[arg(long, default_value_t = 64)]
+    spp: u32,
+    /// Output folder (created if missing).
+    #[arg(long, default_value = "out/render")]
+    out: PathBuf,
+    /// Image width (default: the scene camera's).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height (default: the scene camera's).
+    #[arg(long)]
+    height: Option<u32>,
+    /// Path segments including the camera ray (default: the scene's).
+    #[arg(long)]
+    max_depth: Option<u32>,
+    /// Seed of the render.
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// How light is found.
+    #[arg(long, value_enum, default_value_t = LightSampling::Mis)]
+    light_sampling: LightSampling,
+    /// Turn Russian roulette off.
+    #[arg(long)]
+    no_russian_roulette: bool,
+    /// Exposure of the PNG preview (the EXR is never scaled).
+    #[arg(long, default_value_t = 1.0)]
+    exposure: f32,
+    /// Backend to run on.
+    #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
+    backend: BackendChoice,
+}
+
+#[derive(clap::Args)]
+struct HistogramArgs {
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 1920)]
+    width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 1080)]
+    height: u32,
+    /// Block size B (blocks are B x B): 4, 8, 16 or 32.
+    #[arg(long, default_value_t = 16)]
+    block_size: u32,
+    /// Seed of the generated candidates.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Distinct object ids in the generated image.
+    #[arg(long, default_value_t = 6)]
+    objects: u32,
+    /// Share of awkward candidates (NaN, infinite, negative keys, misses, empty pixels).
+    #[arg(long, default_value_t = 0.05)]
+    awkward: f64,
+    /// Backend to run on.
+    #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
+    backend: BackendChoice,
+    /// Kernel variant.
+    #[arg(long, value_enum, default_value_t = VariantArg::Auto)]
+    variant: VariantArg,
+    /// Timed repetitions (timestamp queries) after the checked run.
+    #[arg(long, default_value_t = 5)]
+    repeat: u32,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum VariantArg {
+    Auto,
+    Portable,
+    Subgroup,
+}
+
+fn main() -> Result<()> {
+    match Cli::parse().command {
+        Command::Histogram(args) => histogram(args),
+        Command::Render(args) => render(args),
+        Command::Metrics(args) => metrics(args),
+        Command::Compare(args) => compare_command::compare(args),
+        Command::Plot(args) => plot(args),
+    }
+}
+
+/// The scene file (or the built-in scene) and its render settings at the requested size.
+pub(crate) fn scene_and_settings(
+    scene: &Option<PathBuf>,
+    width: Option<u32>,
+    height: Option<u32>,
+) -> Result<(Scene, RenderSettings)> {
+    let scene = match scene {
+        Some(path) => load_scene_file(path)?,
+        None => default_scene(),
+    };
+    let width = width.unwrap_or(scene.camera.width);
+    let height = height.unwrap_or(scene.camera.height);
+    // Said before a backend opens or a reference starts rendering.
+    for (flag, value) in [("--width", width), ("--height", height)] {
+        if value == 0 {
+            bail!("{flag} 0: the image must be at least 1x1 pixels");
+        }
+    }
+    let settings = RenderSettings::for_scene(&scene, width, height, 1);
+    Ok((scene, settings))
+}
+
+fn plot(args: PlotArgs) -> Result<()> {
+    let text = std::fs::read_to_string(&args.csv).with_context(|| format!("{}: cannot read", args.csv.display()))?;
+    let errors =
+        strata::compare::parse_errors_csv(&text).map_err(|e| anyhow::anyhow!("{}: {e}", args.csv.display()))?;
+    let mut methods: Vec<Method> = Vec::new();
+    for e in &errors {
+        if !methods.contains(&e.method) {
+            methods.push(e.method);
+        }
+    }
+    let frames = errors.iter().map(|e| e.frame + 1).max().unwrap_or(1);
+    std::fs::write(&args.out, strata::plot::relmse_svg(&errors, &methods, frames, &args.title))
+        .with_context(|| format!("{}: cannot write", args.out.display()))?;
+    println!("wrote {}", args.out.display());
+    compare_command::print_ratio_over_frames(&errors, frames);
+    Ok(())
+}
+
+fn metrics(args: MetricsArgs) -> Result<()> {
+    let image = RgbImage::read_exr(&args.image)?;
+    let reference = RgbImage::read_exr(&args.reference)?;
+    let context = || format!("{} against {}", args.image.display(), args.reference.display());
+    println!("mse            {:.6e}", metrics::mse(&image, &reference).with_context(context)?);
+    println!("relmse         {:.6e}", metrics::relmse(&image, &reference).with_context(context)?);
+    println!("relmse-common  {:.6e}", metrics::relmse_common(&image, &reference).with_context(context)?);
+    println!("prelmse        {:.6e}", metrics::prelmse(&image, &reference).with_context(context)?);
+    println!("relmse-luma    {:.6e}", metrics::relmse_luminance(&image, &reference).with_context(context)?);
+    let (m, r) = (image.mean(), reference.mean());
+    println!("mean image     ({:.5}, {:.5}, {:.5})", m[0], m[1], m[2]);
+    println!("mean reference ({:.5}, {:.5}, {:.5})", r[0], r[1], r[2]);
+    if let Some(path) = &args.map {
+        let map = metrics::error_map(&image, &reference, args.map_metric)?;
+        let map_image =
+            RgbImage { width: image.width, height: image.height, pixels: map.iter().map(|&e| [e as f32; 3]).collect() };
+        map_image.write_exr(path)?;
+        let png = path.with_extension("png");
+        metrics::false_colour(&map, image.width, image.height).write_png(&png, 1.0)?;
+        println!("wrote {} and {}", path.display(), png.display());
+    }
+    Ok(())
+}
+
+fn render(args: RenderArgs) -> Result<()> {
+    let (scene, defaults) = scene_and_settings(&args.scene, args.width, args.height)?;
+    if args.spp == 0 {
+        bail!("--spp 0: at least one sample per pixel is needed");
+    }
+    let settings = RenderSettings {
+        seed: args.seed,
+        max_depth: args.max_depth.unwrap_or(scene.max_depth),
+        light_sampling: args.light_sampling,
+        russian_roulette: !args.no_russian_roulette,
+        ..defaults
+    };
+    let gpu_scene = GpuScene::build(&scene)?;
+    let mut backend = open_backend(args.backend)?;
+    println!("backend: {}", backend.info().summary());
+    println!(
+        "scene: {} ({} triangles, {} emissive, environment: {}), {}x{}, {} spp, max depth {}",
+        scene.name,
+        gpu_scene.triangles.len(),
+        gpu_scene.light_count(),
+        if scene.environment.is_some() { "yes" } else { "no" },
+        settings.camera.width,
+        settings.camera.height,
+        args.spp,
+        settings.max_depth
+    );
+    std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create the folder", args.out.display()))?;
+    let bar = indicatif::ProgressBar::new(u64::from(args.spp));
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} spp, {elapsed} elapsed, eta {eta}")
+            .expect("a valid template"),
+    );
+    let started = Instant::now();
+    let image = strata::render::render(backend.as_mut(), &gpu_scene, &settings, args.spp, |done| {
+        bar.set_position(u64::from(done))
+    })?;
+    bar.finish_and_clear();
+    let seconds = started.elapsed().as_secs_f64();
+    let stem = args.scene.as_ref().and_then(|p| scene_stem(p)).unwrap_or_else(|| "default".into());
+    let exr = args.out.join(format!("{stem}.exr"));
+    let png = args.out.join(format!("{stem}.png"));
+    image.write_exr(&exr)?;
+    image.write_png(&png, args.exposure)?;
+    let mean = image.mean();
+    println!(
+        "rendered in {seconds:.1} s ({:.1} ms per sample per pixel); mean radiance ({:.4}, {:.4}, {:.4})",
+        seconds * 1e3 / f64::from(args.spp),
+        mean[0],
+        mean[1],
+        mean[2]
+    );
+    println!("wrote {} and {}", exr.display(), png.display());
+    Ok(())
+}
+
+/// `cornell-box` for `.../cornell-box/scene.json`, else the file stem.
+pub(crate) fn scene_stem(path: &std::path::Path) -> Option<String> {
+    let stem = path.file_stem()?.to_string_lossy().into_owned();
+    if let Some(variant) = stem.strip_prefix("scene") {
+        let folder = path.parent()?.file_name()?.to_string_lossy().into_owned();
+        return Some(format!("{folder}{variant}"));
+    }
+    Some(stem)
+}
+
+fn histogram(args: HistogramArgs) -> Result<()> {
+    let grid = BlockGrid::new(args.width, args.height, args.block_size)?;
+    if !(0.0..=1.0).contains(&args.awkward) {
+        bail!("--awkward {}: must be a share between 0 and 1", args.awkward);
+    }
+    let mut backend = open_backend(args.backend)?;
+    println!("backend: {}", backend.info().summary());
+    let variant = match args.variant {
+        VariantArg::Auto => HistogramVariant::Auto,
+        VariantArg::Portable => HistogramVariant::Portable,
+        VariantArg::Subgroup => HistogramVariant::Subgroup,
+    };
+    let mix = CandidateMix { objects: args.objects, awkward: args.awkward, ..Default::default() };
+    let candidates = candidate_image(grid.width, grid.height, args.seed, mix);
+    let pass = BlockHistogramPass::new(backend.as_mut(), variant, grid)?;
+    println!(
+        "kernel: {} ({} invocations per workgroup, {:?} workgroups)",
+        pass.kernel().name(),
+        pass.kernel().invocations(),
+        pass.workgroups()
+    );
+    let started = Instant::now();
+    let output = pass.run(backend.as_mut(), &candidates)?;
+    let wall = started.elapsed();
+    let reference = block_histogram(grid, &candidates);
+    let matches = output == reference;
+    let clusters: u64 = output.stats.iter().map(|s| u64::from(s.clusters)).sum();
+    let invalid: u64 = output.stats.iter().map(|s| u64::from(s.invalid)).sum();
+    let empty: u64 = output.stats.iter().map(|s| u64::from(s.empty)).sum();
+    println!(
+        "image: {}x{} = {} candidates, {} blocks of {}x{}",
+        grid.width,
+        grid.height,
+        grid.pixel_count(),
+        grid.block_count(),
+        grid.block_size,
+        grid.block_size
+    );
+    println!(
+        "clusters: {clusters} ({:.2} per block); invalid keys: {invalid}; pixels without candidate: {empty}",
+        clusters as f64 / f64::from(grid.block_count())
+    );
+    println!("first run (upload, dispatch, read-back): {:.1} ms", wall.as_secs_f64() * 1e3);
+    if backend.info().timestamps && args.repeat > 0 {
+        let mut times = Vec::new();
+        for _ in 0..args.repeat {
+            times.push(pass.dispatch_timed(backend.as_mut())?.as_secs_f64() * 1e3);
+        }
+        times.sort_by(f64::total_cmp);
+        println!(
+            "kernel time (timestamp queries, {} runs): median {:.2} ms, min {:.2} ms",
+            times.len(),
+            times[times.len() / 2],
+            times[0]
+        );
+    }
+    pass.destroy(backend.as_mut())?;
+    if !matches {
+        bail!("the kernel's output differs from the Rust reference");
+    }
+    println!("output identical to the Rust reference: yes");
+    Ok(())
+}

@@ -1,0 +1,251 @@
+//! The catalogue of kernels strata ships: each kernel's name, WGSL fragments (composed in
+//! order), entry point, device features and cross-backend float tolerance. The
+//! [`crate::registry`] parses and validates what this declares.
+
+use crate::fragment;
+use crate::source::Fragment;
+use naga::valid::Capabilities;
+use std::borrow::Cow;
+
+/// Names a registry kernel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum KernelId {
+    /// Per-block histogram: candidates clustered by object id and sorted by key
+    /// (paper §4.1, §4.3), without subgroup operations.
+    BlockHistogram,
+    /// The same pass exchanging elements between subgroup lanes (needs subgroups).
+    BlockHistogramSubgroup,
+    /// Does nothing: measures dispatch overhead.
+    Empty,
+    /// Closest hit of a batch of rays through obvhs' BVH2, watertight triangle test.
+    BvhClosestHit,
+    /// Primary rays of the pinhole camera, one per pixel, optionally jittered.
+    CameraRays,
+    /// Progressive path tracing: one sample per pixel added to a running sum (NEE + MIS,
+    /// area and environment lights, diffuse, GGX conductor, dielectric).
+    PathTrace,
+    /// ReSTIR pass 1: G-buffer, each pixel's own estimate and its path candidate.
+    RestirCandidates,
+    /// ReSTIR pass 3: selection of K candidates (strata, restir or restir-disc) and
+    /// resampling with the pixel's canonical candidate.
+    RestirSelect,
+    /// ReSTIR pass 4a: temporal sources (reprojection, disocclusion) and the temporal
+    /// histogram's input.
+    RestirTemporalKeys,
+    /// ReSTIR pass 4b: temporal reuse (M cap, one or several previous reservoirs).
+    RestirTemporal,
+    /// ReSTIR pass 5: shading of the reservoirs' samples with one shadow ray.
+    RestirShade,
+    /// Embedding: K payload indices per pixel from its cluster's run at the stratified
+    /// positions of the chosen sampler variant (paper §4.2, Fig. 3, Table 2).
+    StrataSelect,
+    /// Embedding: inverse-CDF resampling of the engine's weights (paper §4.2).
+    StrataResample,
+    /// A kernel from outside the registry ([`Kernel::from_wgsl`]), keyed by a hash of its
+    /// source and entry point so that backends can cache its pipeline.
+    External(u64),
+}
+
+impl KernelId {
+    /// Every registry kernel.
+    pub const ALL: [KernelId; 13] = [
+        KernelId::BlockHistogram,
+        KernelId::BlockHistogramSubgroup,
+        KernelId::Empty,
+        KernelId::BvhClosestHit,
+        KernelId::CameraRays,
+        KernelId::PathTrace,
+        KernelId::RestirCandidates,
+        KernelId::RestirSelect,
+        KernelId::RestirTemporalKeys,
+        KernelId::RestirTemporal,
+        KernelId::RestirShade,
+        KernelId::StrataSelect,
+        KernelId::StrataResample,
+    ];
+
+    /// What the registry knows of this kernel before parsing it.
+    pub fn spec(self) -> Option<KernelSpec> {
+        // The paper's histogram (§4.1) with object masking (§4.3).
+        let histogram = || {
+            [fragment!("strata/candidate.wgsl"), fragment!("strata/masking.wgsl"), fragment!("strata/histogram.wgsl")]
+        };
+        // The paper's selection (§4.2): positions from the blue-noise sampler, then the
+        // inverse-CDF resampling.
+        let selection = || {
+            vec![
+                fragment!("strata/blue_noise.wgsl"),
+                fragment!("strata/selection.wgsl"),
+                fragment!("strata/resampling.wgsl"),
+            ]
+        };
+        // Every ReSTIR pass: the scene and the path tracer's functions, the candidate
+        // records of the histogram, then its own entry point.
+        // The path tracer's functions, shared by path_trace and the ReSTIR passes.
+        let renderer = || {
+            vec![
+                fragment!("trace/bvh.wgsl"),
+                fragment!("trace/traverse.wgsl"),
+                fragment!("render/scene.wgsl"),
+                fragment!("render/random.wgsl"),
+                fragment!("render/environment.wgsl"),
+                fragment!("render/albedo.wgsl"),
+                fragment!("render/bsdf.wgsl"),
+                fragment!("render/lights.wgsl"),
+                fragment!("render/path.wgsl"),
+            ]
+        };
+        // A ReSTIR pass: the renderer, the shared records, then `pass` (its entry point last).
+        let restir = |name: &'static str, pass: &[Fragment]| KernelSpec {
+            name: name.into(),
+            fragments: [
+                renderer(),
+                vec![fragment!("strata/candidate.wgsl"), fragment!("restir/reservoir.wgsl")],
+                pass.to_vec(),
+            ]
+            .concat(),
+            entry_point: name.into(),
+            features: KernelFeatures::empty(),
+            // Paths and reconnections branch on float results, and environment lookups
+            // use atan2/acos (4096 ULP in Vulkan): as for path_trace.
+            float_ulp_bound: Some(4096),
+        };
+        Some(match self {
+            KernelId::BlockHistogram => KernelSpec {
+                name: "block_histogram".into(),
+                fragments: [histogram().to_vec(), vec![fragment!("strata/entry_histogram.wgsl")]].concat(),
+                entry_point: "block_histogram".into(),
+                features: KernelFeatures::empty(),
+                float_ulp_bound: None,
+            },
+            KernelId::BlockHistogramSubgroup => KernelSpec {
+                name: "block_histogram_subgroup".into(),
+                fragments: [histogram().to_vec(), vec![fragment!("strata/entry_histogram_subgroup.wgsl")]].concat(),
+                entry_point: "block_histogram_subgroup".into(),
+                features: KernelFeatures::SUBGROUP,
+                float_ulp_bound: None,
+            },
+            KernelId::Empty => KernelSpec {
+                name: "empty".into(),
+                fragments: vec![fragment!("util/empty.wgsl")],
+                entry_point: "empty".into(),
+                features: KernelFeatures::empty(),
+                float_ulp_bound: None,
+            },
+            KernelId::BvhClosestHit => KernelSpec {
+                name: "bvh_closest_hit".into(),
+                fragments: vec![
+                    fragment!("trace/bvh.wgsl"),
+                    fragment!("trace/traverse.wgsl"),
+                    fragment!("trace/entry_closest_hit.wgsl"),
+                ],
+                entry_point: "bvh_closest_hit".into(),
+                features: KernelFeatures::empty(),
+                // Backends may contract products into fused multiply-adds; hits that change
+                // triangle at near-ties are counted separately (see the check).
+                float_ulp_bound: Some(8),
+            },
+            KernelId::CameraRays => KernelSpec {
+                name: "camera_rays".into(),
+                fragments: vec![fragment!("trace/bvh.wgsl"), fragment!("trace/camera_rays.wgsl")],
+                entry_point: "camera_rays_main".into(),
+                features: KernelFeatures::empty(),
+                // normalize() and the divisions may round differently (inverse square
+                // root, reciprocals, fused multiply-adds).
+                float_ulp_bound: Some(16),
+            },
+            KernelId::PathTrace => KernelSpec {
+                name: "path_trace".into(),
+                fragments: [renderer(), vec![fragment!("render/entry_path_trace.wgsl")]].concat(),
+                entry_point: "path_trace".into(),
+                features: KernelFeatures::empty(),
+                // Paths branch on float comparisons: a one-ULP difference can send a
+                // path elsewhere, so pixels are compared with a bound and outliers. The
+                // bound is Vulkan's precision for atan2 and acos (4096 ULP, used by every
+                // environment lookup), which lavapipe's approximations do use: its
+                // radiance differs from the interpreter's correctly rounded Rust
+                // functions by ~2100 ULP in environment-lit pixels.
+                float_ulp_bound: Some(4096),
+            },
+            KernelId::RestirCandidates => restir("restir_candidates", &[fragment!("restir/entry_candidates.wgsl")]),
+            KernelId::RestirSelect => restir(
+                "restir_select",
+                &[selection(), vec![fragment!("restir/reuse_slot.wgsl"), fragment!("restir/entry_select.wgsl")]]
+                    .concat(),
+            ),
+            KernelId::RestirTemporalKeys => {
+                restir("restir_temporal_keys", &[fragment!("restir/entry_temporal_keys.wgsl")])
+            }
+            KernelId::RestirTemporal => restir(
+                "restir_temporal",
+                &[selection(), vec![fragment!("restir/reuse_slot.wgsl"), fragment!("restir/entry_temporal.wgsl")]]
+                    .concat(),
+            ),
+            KernelId::RestirShade => restir("restir_shade", &[fragment!("restir/entry_shade.wgsl")]),
+            KernelId::StrataSelect => KernelSpec {
+                name: "strata_select".into(),
+                fragments: [
+                    vec![fragment!("strata/candidate.wgsl")],
+                    selection(),
+                    vec![fragment!("embed/contract.wgsl"), fragment!("embed/entry_select.wgsl")],
+                ]
+                .concat(),
+                entry_point: "strata_select".into(),
+                features: KernelFeatures::empty(),
+                // Payload indices are integers; the resampling number is the one float
+                // output (divisions and fract: a few ULP).
+                float_ulp_bound: Some(4),
+            },
+            KernelId::StrataResample => KernelSpec {
+                name: "strata_resample".into(),
+                fragments: vec![
+                    fragment!("strata/resampling.wgsl"),
+                    fragment!("embed/contract.wgsl"),
+                    fragment!("embed/entry_resample.wgsl"),
+                ],
+                entry_point: "strata_resample".into(),
+                features: KernelFeatures::empty(),
+                // W = sum / target: one division after K + 1 additions.
+                float_ulp_bound: Some(4),
+            },
+            KernelId::External(_) => return None,
+        })
+    }
+}
+
+/// Optional device features a kernel needs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct KernelFeatures {
+    /// Subgroup operations in compute shaders.
+    pub subgroup: bool,
+}
+
+impl KernelFeatures {
+    /// Nothing beyond core WebGPU.
+    pub const fn empty() -> Self {
+        Self { subgroup: false }
+    }
+    /// Subgroup operations.
+    pub const SUBGROUP: Self = Self { subgroup: true };
+
+    /// naga's validator capabilities for these features.
+    pub(crate) fn capabilities(self) -> Capabilities {
+        if self.subgroup { Capabilities::SUBGROUP | Capabilities::SUBGROUP_BARRIER } else { Capabilities::empty() }
+    }
+}
+
+/// A kernel as declared in the registry.
+#[derive(Clone, Debug)]
+pub struct KernelSpec {
+    /// Registry name (also the name of translated files).
+    pub name: Cow<'static, str>,
+    /// WGSL fragments, concatenated in order.
+    pub fragments: Vec<Fragment>,
+    /// The compute entry point.
+    pub entry_point: Cow<'static, str>,
+    /// Device features the kernel needs.
+    pub features: KernelFeatures,
+    /// Largest difference in ULPs allowed between backends for float outputs; `None`
+    /// when every output is an integer or an ordering, compared bit for bit.
+    pub float_ulp_bound: Option<u32>,
+}

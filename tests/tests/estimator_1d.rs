@@ -3,7 +3,7 @@
 //! selection (random offset, antithetic) has lower variance than uniform random
 //! selection. Prints the measured variances.
 
-use strata::estimator::{OneDimensionalProblem, SelectionPattern, run_estimates};
+use strata_estimator::{OneDimensionalProblem, SelectionPattern, run_estimates};
 
 #[test]
 fn every_pattern_is_unbiased_and_stratification_lowers_variance() {

@@ -17,7 +17,7 @@
 //! `STRATA_REQUIRE_GPU=1`.
 
 use std::path::{Path, PathBuf};
-use strata::metrics;
+use strata::evaluation::metrics;
 use strata::render::{GpuScene, LightSampling, RenderSettings, render};
 use strata::rgb_image::RgbImage;
 use strata::scene::{Camera, Environment, Material, Scene, Shape};

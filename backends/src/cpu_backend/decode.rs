@@ -10,9 +10,8 @@
 //! expression's uses are dominated by its emission), so a field of a struct value, a
 //! component of a vector or a bitcast is the source's register range itself, not a copy.
 //!
-//! Statements lower to jumps as a structured program would: `if` to a conditional jump
-//! around the accept block, loops to a backward jump, `break`/`continue` to forward
-//! jumps patched when the construct closes, `switch` to a table of (value, target).
+//! Expressions lower in [`super::expression`] (math builtins in [`super::math_call`]),
+//! statements in [`super::statement`].
 
 use super::constant::{compose, global_value, literal};
 use super::error::unsupported;
@@ -185,11 +184,11 @@ impl Compiler<'_> {
         self.push(Insn::Fail(Box::new((what, line))));
     }
 
-    fn here(&self) -> u32 {
+    pub(super) fn here(&self) -> u32 {
         self.insns.len() as u32
     }
 
-    fn patch(&mut self, at: usize, to: u32) {
+    pub(super) fn patch(&mut self, at: usize, to: u32) {
         match &mut self.insns[at] {
             Insn::Jump(target) | Insn::JumpUnless { target, .. } => *target = to,
             _ => unreachable!("only jumps are patched"),
@@ -214,7 +213,7 @@ impl Compiler<'_> {
     /// compile-time values into the template, the pre-emitted expressions (arguments,
     /// variables, constants) and the variables' initialisation.
     #[allow(clippy::too_many_arguments)]
-    fn open<'f>(
+    pub(super) fn open<'f>(
         &mut self,
         function: &'f naga::Function,
         info: &'f naga::valid::FunctionInfo,
@@ -344,13 +343,6 @@ impl Compiler<'_> {
         Ok(scope)
     }
 
-    fn block(&mut self, scope: &mut Scope, block: &naga::Block) -> Result<(), BackendError> {
-        for (statement, span) in block.span_iter() {
-            self.statement(scope, statement, *span)?;
-        }
-        Ok(())
-    }
-
     /// The place an expression points to, if known when compiling.
     fn place(&self, scope: &Scope, pointer: Handle<Expression>) -> Option<Place> {
         scope.places[pointer.index()]
@@ -431,272 +423,6 @@ impl Compiler<'_> {
                 self.push(Insn::Load { dst, pointer, len });
             }
         }
-    }
-
-    fn statement(&mut self, scope: &mut Scope, statement: &Statement, span: naga::Span) -> Result<(), BackendError> {
-        let line = self.lines_of.line(span);
-        self.line = line;
-        self.source = scope.source;
-        match statement {
-            Statement::Emit(range) => {
-                for handle in range.clone() {
-                    if !scope.pre_emitted[handle.index()] {
-                        self.expression(scope, handle)?;
-                    }
-                }
-            }
-            Statement::Block(block) => self.block(scope, block)?,
-            Statement::If { condition, accept, reject } => {
-                let cond = self.reg(scope, *condition);
-                self.line = line;
-                let jump_reject = self.push(Insn::JumpUnless { cond, target: 0 });
-                self.block(scope, accept)?;
-                self.line = line;
-                self.source = scope.source;
-                if reject.is_empty() {
-                    let end = self.here();
-                    self.patch(jump_reject, end);
-                } else {
-                    let jump_end = self.push(Insn::Jump(0));
-                    let reject_start = self.here();
-                    self.patch(jump_reject, reject_start);
-                    self.block(scope, reject)?;
-                    let end = self.here();
-                    self.patch(jump_end, end);
-                }
-            }
-            Statement::Switch { selector, cases } => {
-                let selector = self.reg(scope, *selector);
-                let switch_at = self.push(Insn::Switch { selector, cases: Box::new([]), default: 0 });
-                // A switch is a breakable construct.
-                scope.loops.push((Vec::new(), Vec::new()));
-                let mut targets = Vec::new();
-                let mut fallthrough_jumps: Vec<usize> = Vec::new();
-                let mut end_jumps = Vec::new();
-                for case in cases {
-                    let start = self.here();
-                    for at in fallthrough_jumps.drain(..) {
-                        self.patch(at, start);
-                    }
-                    let value = match case.value {
-                        naga::SwitchValue::I32(v) => Some(v as u32),
-                        naga::SwitchValue::U32(v) => Some(v),
-                        naga::SwitchValue::Default => None,
-                    };
-                    targets.push((value, start));
-                    self.block(scope, &case.body)?;
-                    self.line = line;
-                    self.source = scope.source;
-                    let jump = self.push(Insn::Jump(0));
-                    if case.fall_through {
-                        fallthrough_jumps.push(jump);
-                    } else {
-                        end_jumps.push(jump);
-                    }
-                }
-                let end = self.here();
-                for at in end_jumps.into_iter().chain(fallthrough_jumps) {
-                    self.patch(at, end);
-                }
-                let (breaks, continues) = scope.loops.pop().expect("pushed above");
-                for at in breaks {
-                    self.patch(at, end);
-                }
-                // `continue` inside a switch belongs to the enclosing loop.
-                if let Some(outer) = scope.loops.last_mut() {
-                    outer.1.extend(continues);
-                }
-                // The first case with the selector's value, else the first default, else the end.
-                let mut listed: Vec<(u32, u32)> = Vec::new();
-                for (value, target) in &targets {
-                    if let Some(value) = value
-                        && !listed.iter().any(|(v, _)| v == value)
-                    {
-                        listed.push((*value, *target));
-                    }
-                }
-                let default = targets.iter().find(|(v, _)| v.is_none()).map_or(end, |(_, t)| *t);
-                self.insns[switch_at] = Insn::Switch { selector, cases: listed.into_boxed_slice(), default };
-            }
-            Statement::Loop { body, continuing, break_if } => {
-                let start = self.here();
-                scope.loops.push((Vec::new(), Vec::new()));
-                self.block(scope, body)?;
-                let continuing_start = self.here();
-                self.block(scope, continuing)?;
-                self.line = line;
-                self.source = scope.source;
-                match break_if {
-                    // Loop again unless the condition holds; fall through to the end if it does.
-                    Some(condition) => {
-                        let cond = self.reg(scope, *condition);
-                        self.push(Insn::JumpUnless { cond, target: start })
-                    }
-                    None => self.push(Insn::Jump(start)),
-                };
-                let end = self.here();
-                let (breaks, continues) = scope.loops.pop().expect("pushed above");
-                for at in breaks {
-                    self.patch(at, end);
-                }
-                for at in continues {
-                    self.patch(at, continuing_start);
-                }
-            }
-            Statement::Break => {
-                let at = self.push(Insn::Jump(0));
-                scope.loops.last_mut().ok_or_else(|| unsupported("`break` outside a loop", line))?.0.push(at);
-            }
-            Statement::Continue => {
-                let at = self.push(Insn::Jump(0));
-                // Continue skips enclosing switches: recorded on the innermost construct
-                // and moved outwards when a switch closes.
-                scope.loops.last_mut().ok_or_else(|| unsupported("`continue` outside a loop", line))?.1.push(at);
-            }
-            Statement::Return { value } => {
-                let value = value.map(|v| (self.reg(scope, v), scope.lens[v.index()]));
-                self.line = line;
-                if scope.inlined {
-                    if let (Some((src, len)), Some((dst, words))) = (value, scope.result) {
-                        self.copy(dst, src, len.min(words));
-                    }
-                    let at = self.push(Insn::Jump(0));
-                    scope.returns.push(at);
-                } else {
-                    let (src, len) = value.unwrap_or((0, 0));
-                    self.push(Insn::Return { src, len });
-                }
-            }
-            Statement::ControlBarrier(_) => {
-                self.push(Insn::Barrier);
-            }
-            // Memory barriers order memory only; one thread runs a workgroup in order.
-            Statement::MemoryBarrier(_) => {}
-            Statement::Store { pointer, value } => {
-                let src = self.reg(scope, *value);
-                let len = scope.lens[value.index()];
-                self.store(scope, *pointer, src, len);
-            }
-            Statement::Call { function, arguments, result } => self.call(scope, *function, arguments, *result)?,
-            Statement::WorkGroupUniformLoad { pointer, result } => {
-                self.push(Insn::Barrier);
-                let dst = self.reg(scope, *result);
-                let len = scope.lens[result.index()];
-                self.line = line;
-                self.load(scope, *pointer, dst, len);
-                self.push(Insn::Barrier);
-            }
-            Statement::Atomic { pointer, fun, value, result } => {
-                let signed = matches!(self.ty(scope, *value), TypeInner::Scalar(s) if s.kind == naga::ScalarKind::Sint);
-                let compare = match fun {
-                    naga::AtomicFunction::Exchange { compare: Some(compare) } => Some(self.reg(scope, *compare)),
-                    _ => None,
-                };
-                let atomic = super::insn::AtomicInsn {
-                    pointer: self.reg(scope, *pointer),
-                    fun: *fun,
-                    value: self.reg(scope, *value),
-                    compare,
-                    signed,
-                    result: result.map(|r| self.reg(scope, r)),
-                };
-                self.line = line;
-                self.push(Insn::Atomic(Box::new(atomic)));
-            }
-            Statement::SubgroupGather { mode, argument, result } => {
-                use naga::GatherMode as G;
-                let index = match mode {
-                    G::BroadcastFirst | G::QuadSwap(_) => None,
-                    G::Broadcast(h)
-                    | G::Shuffle(h)
-                    | G::ShuffleDown(h)
-                    | G::ShuffleUp(h)
-                    | G::ShuffleXor(h)
-                    | G::QuadBroadcast(h) => Some(self.reg(scope, *h)),
-                };
-                let gather = GatherInsn {
-                    mode: *mode,
-                    index,
-                    argument: self.reg(scope, *argument),
-                    len: scope.lens[argument.index()],
-                    result: self.reg(scope, *result),
-                };
-                self.line = line;
-                self.push(Insn::Gather(Box::new(gather)));
-            }
-            Statement::SubgroupBallot { result, predicate } => {
-                let collective = CollectiveInsn {
-                    fun: CollectiveFun::Ballot { predicate: predicate.map(|p| self.reg(scope, p)) },
-                    argument: 0,
-                    len: 4,
-                    result: self.reg(scope, *result),
-                };
-                self.line = line;
-                self.push(Insn::Collective(Box::new(collective)));
-            }
-            Statement::SubgroupCollectiveOperation { op, collective_op, argument, result } => {
-                let ty = self.ty(scope, *argument);
-                let kind = match shape(ty) {
-                    Some((kind, _)) if !is_wide(ty) && !is_half(ty) => kind,
-                    _ => return Err(unsupported(&format!("subgroup {op:?} {collective_op:?} on {ty:?}"), line)),
-                };
-                let collective = CollectiveInsn {
-                    fun: CollectiveFun::Operation { op: *op, collective: *collective_op, kind },
-                    argument: self.reg(scope, *argument),
-                    len: scope.lens[argument.index()],
-                    result: self.reg(scope, *result),
-                };
-                self.line = line;
-                self.push(Insn::Collective(Box::new(collective)));
-            }
-            other => {
-                let name = format!("{other:?}");
-                let name = name.split([' ', '(', '{']).next().unwrap_or("statement").to_string();
-                return Err(unsupported(&format!("statement `{name}`"), line));
-            }
-        }
-        Ok(())
-    }
-
-    /// A call: inlined if the callee is small and the nesting shallow, else a `Call`.
-    fn call(
-        &mut self,
-        scope: &mut Scope,
-        function: Handle<naga::Function>,
-        arguments: &[Handle<Expression>],
-        result: Option<Handle<Expression>>,
-    ) -> Result<(), BackendError> {
-        let module = self.module;
-        let info = self.info;
-        let callee = &module.functions[function];
-        let line = self.line;
-        let result = result.map(|r| (self.reg(scope, r), scope.lens[r.index()]));
-        if callee.expressions.len() <= INLINE_EXPRESSIONS && scope.depth < INLINE_DEPTH {
-            let values: Vec<(Reg, Option<Place>)> =
-                arguments.iter().map(|a| (self.reg(scope, *a), scope.places[a.index()])).collect();
-            let mut unused = Vec::new();
-            let mut inner = self.open(callee, &info[function], Some(&values), result, scope.depth + 1, &mut unused)?;
-            self.block(&mut inner, &callee.body)?;
-            let end = self.here();
-            for at in std::mem::take(&mut inner.returns) {
-                self.patch(at, end);
-            }
-        } else {
-            let callee_arguments = &self.arguments[function.index()];
-            let arguments = callee_arguments
-                .iter()
-                .map(|&(i, dst, len)| {
-                    let src = self.reg(scope, arguments[i as usize]);
-                    (src, len, dst)
-                })
-                .collect();
-            self.line = line;
-            self.source = scope.source;
-            self.push(Insn::Call(Box::new(CallInsn { code: function.index() as u32, arguments, result })));
-        }
-        self.line = line;
-        self.source = scope.source;
-        Ok(())
     }
 }
 

@@ -8,6 +8,7 @@
 use super::insn::Reg;
 use super::wide;
 use naga::{Handle, Module, ScalarKind, TypeInner};
+use smallvec::SmallVec;
 
 /// Words of a value of type `inner` (bool and every 32-bit scalar: one word; 64-bit
 /// integers: two, the low word first).
@@ -225,3 +226,6 @@ pub(super) fn is_half(inner: &TypeInner) -> bool {
 pub(super) fn component_words(scalar: naga::Scalar) -> u32 {
     if wide::is_wide(scalar) { 2 } else { 1 }
 }
+
+/// A value: its words, inline up to a vec4.
+pub(super) type Words = SmallVec<[u32; 4]>;

@@ -45,8 +45,10 @@ mod expression;
 mod insn;
 mod interp;
 mod layout;
+mod math_call;
 mod matrix;
 mod memory;
+mod statement;
 mod wide;
 
 use crate::backend::{Backend, Bind, BufferId};

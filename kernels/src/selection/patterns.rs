@@ -21,7 +21,7 @@
 //!
 //! The WGSL twin is `stratified_positions` in `kernels/wgsl/strata/selection.wgsl`; the
 //! kernels' Rust reference ([`crate::reference::stratified_selection`]) and the 1-D
-//! estimator study (`strata::estimator` in the host crate) evaluate this table rather than restating it.
+//! estimator study (the `strata-estimator` crate, `estimator/`) evaluate this table rather than restating it.
 
 use super::SamplerVariant;
 

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 use strata::backend_choice::{BackendChoice, open_backend};
 use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
-use strata::metrics::{self, Metric};
+use strata::evaluation::metrics::{self, Metric};
 use strata::render::{GpuScene, LightSampling, RenderSettings};
 use strata::restir::Method;
 use strata::rgb_image::RgbImage;
@@ -180,7 +180,7 @@ pub(crate) fn scene_and_settings(
 fn plot(args: PlotArgs) -> Result<()> {
     let text = std::fs::read_to_string(&args.csv).with_context(|| format!("{}: cannot read", args.csv.display()))?;
     let errors =
-        strata::compare::parse_errors_csv(&text).map_err(|e| anyhow::anyhow!("{}: {e}", args.csv.display()))?;
+        strata::evaluation::compare::parse_errors_csv(&text).map_err(|e| anyhow::anyhow!("{}: {e}", args.csv.display()))?;
     let mut methods: Vec<Method> = Vec::new();
     for e in &errors {
         if !methods.contains(&e.method) {
@@ -188,10 +188,10 @@ fn plot(args: PlotArgs) -> Result<()> {
         }
     }
     let frames = errors.iter().map(|e| e.frame + 1).max().unwrap_or(1);
-    std::fs::write(&args.out, strata::plot::relmse_svg(&errors, &methods, frames, &args.title))
+    std::fs::write(&args.out, strata::evaluation::plot::relmse_svg(&errors, &methods, frames, &args.title))
         .with_context(|| format!("{}: cannot write", args.out.display()))?;
     println!("wrote {}", args.out.display());
-    compare_command::print_ratio_over_frames(&errors, frames);
+    strata::evaluation::summary::print_ratio_over_frames(&errors, frames);
     Ok(())
 }
 

@@ -3,7 +3,7 @@
 //! mean ± 95 % confidence interval over seeds.
 
 use crate::histogram_pass::PassError;
-use crate::metrics::{self, MeanInterval};
+use crate::evaluation::metrics::{self, MeanInterval};
 use crate::render::{GpuScene, RenderSettings};
 use crate::restir::{Method, RestirRenderer, RestirSettings};
 use crate::rgb_image::RgbImage;

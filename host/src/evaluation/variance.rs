@@ -11,7 +11,7 @@
 //! the seeds' images per pixel and channel, leaves it out; the reference only scales
 //! each pixel, exactly as in RelMSE.
 
-use crate::metrics::{MeanInterval, MetricError, student_t_975};
+use crate::evaluation::metrics::{MeanInterval, MetricError, student_t_975};
 use crate::rgb_image::RgbImage;
 
 /// Per pixel and channel: the sum and the sum of squares of the seeds' values.
@@ -60,7 +60,7 @@ fn check(images: &[RgbImage], reference: &RgbImage) -> Result<(), MetricError> {
     if images.len() < 3 {
         return Err(MetricError::TooFewSeeds(images.len()));
     }
-    images.iter().try_for_each(|image| crate::metrics::check(image, reference))
+    images.iter().try_for_each(|image| crate::evaluation::metrics::check(image, reference))
 }
 
 /// Mean over pixels and channels of the seeds' sample variance ÷ (reference + 1e-4);

@@ -1,7 +1,7 @@
 //! A self-contained SVG plot of RelMSE against frame count, one line per method with
 //! its 95 % confidence band over seeds (`strata compare` writes it as `relmse.svg`).
 
-use crate::compare::{FrameError, relmse_over_seeds};
+use crate::evaluation::compare::{FrameError, relmse_over_seeds};
 use crate::restir::Method;
 
 const WIDTH: f64 = 640.0;

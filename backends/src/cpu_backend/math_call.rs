@@ -1,0 +1,248 @@
+//! Lowering WGSL's math builtins (`naga::Expression::Math`): each call becomes a closure
+//! over the reference implementation of [`super::arith`] (and [`super::matrix`]),
+//! applied value by value, with f16 results rounded to binary16.
+
+use super::arith;
+use super::decode::{Compiler, Scope};
+use super::insn::{Insn, Reg};
+use super::layout::{Words, is_half, is_wide, scalar_shape, shape};
+use super::wide;
+use naga::{Expression, Handle, ScalarKind, TypeInner};
+use smallvec::smallvec;
+
+/// The f32 dot product of two vectors of f32 words: a sequential sum of products, no fused
+/// multiply-add, starting from the first product rather than +0 so that products that are
+/// all -0 sum to -0.
+fn dot(a: &[u32], b: &[u32]) -> f32 {
+    let f = f32::from_bits;
+    (1..a.len()).fold(f(a[0]) * f(b[0]), |acc, i| acc + f(a[i]) * f(b[i]))
+}
+
+/// Math functions on vectors and scalars (the reference implementation, value by value).
+#[allow(clippy::too_many_arguments)]
+fn math(
+    fun: naga::MathFunction,
+    kind: ScalarKind,
+    comps: usize,
+    a: &[u32],
+    b: Option<&[u32]>,
+    c: Option<&[u32]>,
+    d: Option<&[u32]>,
+) -> Option<Words> {
+    use naga::MathFunction as M;
+    let f = f32::from_bits;
+    let pick = |v: Option<&[u32]>, i: usize| v.map_or(0, |v| v[if v.len() == 1 { 0 } else { i }]);
+    match fun {
+        M::Dot if kind == ScalarKind::Float => Some(smallvec![dot(&a[..comps], &b?[..comps]).to_bits()]),
+        M::Dot => {
+            let b = b?;
+            Some(smallvec![(0..comps).fold(0u32, |acc, i| acc.wrapping_add(a[i].wrapping_mul(b[i])))])
+        }
+        M::Length => Some(smallvec![(0..comps).fold(0.0f32, |acc, i| acc + f(a[i]) * f(a[i])).sqrt().to_bits()]),
+        M::Distance => {
+            let b = b?;
+            let sum = (0..comps).fold(0.0f32, |acc, i| {
+                let d = f(a[i]) - f(b[i]);
+                acc + d * d
+            });
+            Some(smallvec![sum.sqrt().to_bits()])
+        }
+        M::Normalize => {
+            let length = (0..comps).fold(0.0f32, |acc, i| acc + f(a[i]) * f(a[i])).sqrt();
+            Some(a.iter().map(|&x| (f(x) / length).to_bits()).collect())
+        }
+        M::Cross => {
+            let b = b?;
+            let (x, y) = (|i: usize| f(a[i]), |i: usize| f(b[i]));
+            Some(smallvec![
+                (x(1) * y(2) - x(2) * y(1)).to_bits(),
+                (x(2) * y(0) - x(0) * y(2)).to_bits(),
+                (x(0) * y(1) - x(1) * y(0)).to_bits(),
+            ])
+        }
+        M::Reflect => {
+            // e1 - 2 dot(e2, e1) e2
+            let b = b?;
+            let d = dot(&b[..comps], &a[..comps]);
+            Some((0..comps).map(|i| (f(a[i]) - 2.0 * d * f(b[i])).to_bits()).collect())
+        }
+        M::Refract => {
+            // k = 1 - η² (1 - dot(e2, e1)²); k < 0: the zero vector; else
+            // η e1 - (η dot(e2, e1) + sqrt(k)) e2.
+            let (b, eta) = (b?, f(c?[0]));
+            let d = dot(&b[..comps], &a[..comps]);
+            let k = 1.0 - eta * eta * (1.0 - d * d);
+            if k < 0.0 {
+                return Some((0..comps).map(|_| 0.0f32.to_bits()).collect());
+            }
+            let scale = eta * d + k.sqrt();
+            Some((0..comps).map(|i| (eta * f(a[i]) - scale * f(b[i])).to_bits()).collect())
+        }
+        M::FaceForward => {
+            // e1 if dot(e2, e3) < 0, else -e1.
+            let (b, c) = (b?, c?);
+            let keep = dot(&b[..comps], &c[..comps]) < 0.0;
+            Some(a[..comps].iter().map(|&x| if keep { x } else { (-f(x)).to_bits() }).collect())
+        }
+        M::Dot4I8Packed | M::Dot4U8Packed => {
+            let b = b?;
+            let signed = fun == M::Dot4I8Packed;
+            let byte = |word: u32, i: u32| {
+                let byte = (word >> (8 * i)) & 0xff;
+                if signed { byte as u8 as i8 as i32 as u32 } else { byte }
+            };
+            Some(smallvec![(0..4).fold(0u32, |acc, i| acc.wrapping_add(byte(a[0], i).wrapping_mul(byte(b[0], i))))])
+        }
+        M::ExtractBits | M::InsertBits => {
+            (0..comps).map(|i| arith::bits(fun, kind, a[i], pick(b, i), pick(c, i), pick(d, i))).collect()
+        }
+        _ => (0..comps).map(|i| arith::math(fun, kind, a[i], pick(b, i), pick(c, i))).collect(),
+    }
+}
+
+/// Reads `len` words at `reg` of a register file.
+pub(super) fn slice(regs: &[u32], (reg, len): (Reg, u32)) -> &[u32] {
+    &regs[reg as usize..(reg + len) as usize]
+}
+
+/// Writes `value` at `dst`, at most `len` words.
+pub(super) fn put(regs: &mut [u32], dst: Reg, len: u32, value: &[u32]) {
+    let n = (len as usize).min(value.len());
+    regs[dst as usize..dst as usize + n].copy_from_slice(&value[..n]);
+}
+
+impl Compiler<'_> {
+    /// A math function: a closure over the reference implementation.
+    pub(super) fn math(
+        &mut self,
+        scope: &mut Scope,
+        handle: Handle<Expression>,
+        fun: naga::MathFunction,
+        args: [Option<Handle<Expression>>; 4],
+    ) {
+        use naga::MathFunction as M;
+        let line = self.line;
+        let len = scope.lens[handle.index()];
+        let operands: Vec<Option<(Reg, u32)>> =
+            args.iter().map(|a| a.map(|h| (self.reg(scope, h), scope.lens[h.index()]))).collect();
+        let dst = self.reg(scope, handle);
+        let arg = args[0].expect("math functions have an argument");
+        let a = operands[0].expect("first argument");
+        let arg_type = self.ty(scope, arg).clone();
+        let compute: Result<super::insn::Compute, String> = match fun {
+            M::Transpose => match arg_type {
+                TypeInner::Matrix { columns, rows, .. } => Ok(Box::new(move |regs: &mut [u32]| {
+                    let value = super::matrix::transpose(slice(regs, a), columns, rows);
+                    put(regs, dst, len, &value);
+                })),
+                other => Err(format!("transpose of {other:?}")),
+            },
+            M::Determinant => match arg_type {
+                TypeInner::Matrix { columns, .. } => Ok(Box::new(move |regs: &mut [u32]| {
+                    let value = super::matrix::determinant(slice(regs, a), columns);
+                    put(regs, dst, len, &[value]);
+                })),
+                other => Err(format!("determinant of {other:?}")),
+            },
+            // Results are naga's predeclared structs: (fract, whole) and (fract, exp).
+            M::Modf | M::Frexp => match (shape(&arg_type), self.ty(scope, handle)) {
+                (Some((ScalarKind::Float, comps)), TypeInner::Struct { members, .. })
+                    if members.len() == 2 && a.1 as usize == comps =>
+                {
+                    let second = dst + member_step(self.module, self.ty(scope, handle), 1, false);
+                    Ok(Box::new(move |regs: &mut [u32]| {
+                        for i in 0..comps {
+                            let x = regs[a.0 as usize + i];
+                            let (first, other) = if fun == M::Modf { arith::modf(x) } else { arith::frexp(x) };
+                            regs[dst as usize + i] = first;
+                            regs[second as usize + i] = other;
+                        }
+                    }))
+                }
+                _ => Err(format!("{fun:?} of {arg_type:?}")),
+            },
+            _ if is_wide(&arg_type) => {
+                let (scalar, comps) = scalar_shape(&arg_type).expect("a scalar or vector");
+                let signed = scalar.kind == ScalarKind::Sint;
+                if wide::math(fun, signed, 0, 0, 0).is_none() {
+                    Err(format!("math function {fun:?} on 64-bit integers"))
+                } else {
+                    let (b, c) = (operands[1], operands[2]);
+                    Ok(Box::new(move |regs: &mut [u32]| {
+                        for i in 0..comps {
+                            let at = |o: Option<(Reg, u32)>| o.map_or(0, |(r, _)| wide::read(regs, r as usize + 2 * i));
+                            let value = wide::math(fun, signed, wide::read(regs, a.0 as usize + 2 * i), at(b), at(c));
+                            wide::write(regs, dst as usize + 2 * i, value.expect("probed"));
+                        }
+                    }))
+                }
+            }
+            _ if arith::pack(fun, &[0; 4]).is_some() => Ok(Box::new(move |regs: &mut [u32]| {
+                let value = arith::pack(fun, slice(regs, a)).expect("a pack function");
+                put(regs, dst, len, &[value]);
+            })),
+            _ if arith::unpack(fun, 0).is_some() => Ok(Box::new(move |regs: &mut [u32]| {
+                let value = arith::unpack(fun, regs[a.0 as usize]).expect("an unpack function");
+                put(regs, dst, len, &value);
+            })),
+            _ => match shape(&arg_type) {
+                None => Err(format!("{fun:?} on a composite")),
+                Some((kind, comps)) => {
+                    let zeros = [0u32; 4];
+                    let z = |o: Option<(Reg, u32)>| o.map(|(_, l)| &zeros[..(l as usize).min(4)]);
+                    let probe = math(fun, kind, comps, &zeros[..comps], z(operands[1]), z(operands[2]), z(operands[3]));
+                    if probe.is_none() {
+                        Err(format!("math function {fun:?} on {kind:?}"))
+                    } else {
+                        let (b, c, d) = (operands[1], operands[2], operands[3]);
+                        if let (M::Min | M::Max | M::Clamp | M::Abs, 1, ScalarKind::Uint | ScalarKind::Sint) =
+                            (fun, comps, kind)
+                        {
+                            // Integer clamps are common enough for a closure without allocation.
+                            Ok(Box::new(move |regs: &mut [u32]| {
+                                let x = regs[a.0 as usize];
+                                let y = b.map_or(0, |b| regs[b.0 as usize]);
+                                let z = c.map_or(0, |c| regs[c.0 as usize]);
+                                regs[dst as usize] = arith::math(fun, kind, x, y, z).expect("probed");
+                            }))
+                        } else {
+                            Ok(Box::new(move |regs: &mut [u32]| {
+                                let value = math(
+                                    fun,
+                                    kind,
+                                    comps,
+                                    slice(regs, a),
+                                    b.map(|b| slice(regs, b)),
+                                    c.map(|c| slice(regs, c)),
+                                    d.map(|d| slice(regs, d)),
+                                )
+                                .expect("probed");
+                                put(regs, dst, len, &value);
+                            }))
+                        }
+                    }
+                }
+            },
+        };
+        match compute {
+            Ok(compute) => {
+                self.push(Insn::Compute(compute));
+                // f16 results: computed in f32, rounded to binary16 once.
+                if is_half(self.ty(scope, handle)) {
+                    self.round_half(dst, len);
+                }
+            }
+            Err(what) => self.fail(what, line),
+        }
+    }
+
+    /// Rounds the `len` f16 values at `dst` (held as f32) to binary16.
+    pub(super) fn round_half(&mut self, dst: Reg, len: u32) {
+        let (dst, len) = (dst as usize, len as usize);
+        self.push(Insn::Compute(Box::new(move |regs: &mut [u32]| {
+            for x in &mut regs[dst..dst + len] {
+                *x = arith::round_f16(*x);
+            }
+        })));
+    }
+}

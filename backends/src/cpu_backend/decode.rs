@@ -15,13 +15,11 @@
 
 use super::constant::{compose, global_value, literal};
 use super::error::unsupported;
-use super::insn::{CallInsn, CollectiveFun, CollectiveInsn, GatherInsn, Insn, Reg};
-use super::layout::{
-    Piece, Place, byte_addressed, contains_f16, is_half, is_wide, load_plan, member_step, shape, words_of,
-};
+use super::insn::{Insn, Reg};
+use super::layout::{Piece, Place, byte_addressed, contains_f16, load_plan, member_step, words_of};
 use super::memory;
 use crate::error::BackendError;
-use naga::{Expression, Handle, Module, Statement, TypeInner};
+use naga::{Expression, Handle, Module, TypeInner};
 use strata_kernels::Kernel;
 
 /// Callees with at most this many IR expressions are inlined.
@@ -116,7 +114,7 @@ pub(super) struct Scope<'a> {
     /// Inlining depth.
     pub depth: u32,
     /// Per enclosing breakable construct: (break jumps, continue jumps).
-    loops: Vec<(Vec<usize>, Vec<usize>)>,
+    pub(super) loops: Vec<(Vec<usize>, Vec<usize>)>,
 }
 
 /// Compiles one code: instructions, registers and the module context they need.
@@ -125,7 +123,7 @@ pub(super) struct Compiler<'a> {
     pub module: &'a Module,
     /// Its validation info.
     pub info: &'a naga::valid::ModuleInfo,
-    lines_of: &'a LineIndex,
+    pub(super) lines_of: &'a LineIndex,
     /// Per global variable: (region tag, word offset).
     pub globals: &'a [(u32, u32)],
     /// Values of the module's constant expressions.
@@ -134,7 +132,7 @@ pub(super) struct Compiler<'a> {
     pub buffer_count: usize,
     names: &'a mut Vec<String>,
     /// Per module function already compiled: its arguments' registers.
-    arguments: &'a [Vec<(u32, Reg, u32)>],
+    pub(super) arguments: &'a [Vec<(u32, Reg, u32)>],
     /// The code being built.
     pub insns: Vec<Insn>,
     insn_lines: Vec<u32>,

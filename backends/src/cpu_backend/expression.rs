@@ -9,8 +9,8 @@ use super::constant::{compose_offsets, literal};
 use super::decode::{Compiler, Scope};
 use super::insn::{BinOp, Insn, Reg, UnOp};
 use super::layout::{
-    Place, byte_addressed, component_step, component_words, element_step, is_half, is_wide, member_step, scalar_shape,
-    shape,
+    Place, Words, byte_addressed, component_step, component_words, element_step, is_half, is_wide, member_step,
+    scalar_shape, shape,
 };
 use super::math_call::{put, slice};
 use super::matrix::column_words;
@@ -18,7 +18,6 @@ use super::wide;
 use crate::error::BackendError;
 use naga::{Expression, Handle, ScalarKind, TypeInner};
 use smallvec::smallvec;
-
 
 impl Compiler<'_> {
     /// Lowers expression `handle` of `scope`: gives it a register (its own or its

@@ -5,7 +5,7 @@
 use super::arith;
 use super::decode::{Compiler, Scope};
 use super::insn::{Insn, Reg};
-use super::layout::{Words, is_half, is_wide, scalar_shape, shape};
+use super::layout::{Words, is_half, is_wide, member_step, scalar_shape, shape};
 use super::wide;
 use naga::{Expression, Handle, ScalarKind, TypeInner};
 use smallvec::smallvec;

@@ -2,8 +2,8 @@
 //! measured against a reference, with a CSV of every measurement and a summary of
 //! mean ± 95 % confidence interval over seeds.
 
-use crate::histogram_pass::PassError;
 use crate::evaluation::metrics::{self, MeanInterval};
+use crate::histogram_pass::PassError;
 use crate::render::{GpuScene, RenderSettings};
 use crate::restir::{Method, RestirRenderer, RestirSettings};
 use crate::rgb_image::RgbImage;

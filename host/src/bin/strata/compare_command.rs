@@ -7,8 +7,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 use strata::backend_choice::{BackendChoice, open_backend};
 use strata::evaluation::compare::{
-    Comparison, FrameError, errors_csv, luminance_relmse_ratio, relmse_over_seeds, relmse_ratio,
-    relmse_ratio_over_frames, run_comparison,
+    Comparison, FrameError, errors_csv, luminance_relmse_ratio, relmse_over_seeds, relmse_ratio, run_comparison,
 };
 use strata::evaluation::metrics::{self, MeanInterval, Metric};
 use strata::evaluation::summary;

@@ -7,8 +7,8 @@ use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::time::Instant;
 use strata::backend_choice::{BackendChoice, open_backend};
-use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
 use strata::evaluation::metrics::{self, Metric};
+use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
 use strata::render::{GpuScene, LightSampling, RenderSettings};
 use strata::restir::Method;
 use strata::rgb_image::RgbImage;
@@ -179,8 +179,8 @@ pub(crate) fn scene_and_settings(
 
 fn plot(args: PlotArgs) -> Result<()> {
     let text = std::fs::read_to_string(&args.csv).with_context(|| format!("{}: cannot read", args.csv.display()))?;
-    let errors =
-        strata::evaluation::compare::parse_errors_csv(&text).map_err(|e| anyhow::anyhow!("{}: {e}", args.csv.display()))?;
+    let errors = strata::evaluation::compare::parse_errors_csv(&text)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", args.csv.display()))?;
     let mut methods: Vec<Method> = Vec::new();
     for e in &errors {
         if !methods.contains(&e.method) {

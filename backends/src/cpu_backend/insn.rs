@@ -9,10 +9,8 @@
 //! template once and never recomputed.
 
 use super::layout::Piece;
+pub(super) use super::layout::Reg;
 use naga::ScalarKind;
-
-/// Word offset of a value in the frame's register file.
-pub(super) type Reg = u32;
 
 /// A scalar binary operator resolved for its operand kind (WGSL semantics, see
 /// [`BinOp::apply`]).

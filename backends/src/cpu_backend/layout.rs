@@ -5,10 +5,12 @@
 //! instructions ([`super::insn`]) and memory access ([`super::memory`]), and dependent on
 //! none of them.
 
-use super::insn::Reg;
 use super::wide;
 use naga::{Handle, Module, ScalarKind, TypeInner};
 use smallvec::SmallVec;
+
+/// Word offset of a value in the frame's register file.
+pub(super) type Reg = u32;
 
 /// Words of a value of type `inner` (bool and every 32-bit scalar: one word; 64-bit
 /// integers: two, the low word first).

@@ -4,13 +4,9 @@
 
 use anyhow::{Context, Result, bail};
 use std::path::PathBuf;
-use std::time::Instant;
 use strata::backend_choice::{BackendChoice, open_backend};
-use strata::evaluation::compare::{
-    Comparison, FrameError, errors_csv, luminance_relmse_ratio, relmse_over_seeds, relmse_ratio, run_comparison,
-};
-use strata::evaluation::metrics::{self, MeanInterval, Metric};
-use strata::evaluation::summary;
+use strata::evaluation::compare::Comparison;
+use strata::evaluation::report::{ReportOptions, run_and_report};
 use strata::render::{GpuScene, RenderSettings};
 use strata::restir::{Method, RestirSettings, ShadedParts};
 use strata::rgb_image::RgbImage;
@@ -18,9 +14,6 @@ use strata::scene::parse_camera_path;
 use strata_kernels::selection::SelectionSettings;
 
 use super::{scene_and_settings, scene_stem};
-
-/// A paired ratio of one error column between two methods at one frame.
-type RatioOf = fn(&[FrameError], Method, Method, u32) -> Option<MeanInterval>;
 
 #[derive(clap::Args)]
 pub(crate) struct CompareArgs {
@@ -161,7 +154,16 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
         accumulate: args.accumulate,
         cameras,
     };
-    run_and_report(&args, backend.as_mut(), &gpu_scene, &render, scene.extent(), &comparison, &references)
+    let options = ReportOptions {
+        methods: args.methods.clone(),
+        frames: args.frames,
+        seeds: args.seeds,
+        out: args.out.clone(),
+        exposure: args.exposure,
+        scene_name: args.scene.as_ref().and_then(|p| scene_stem(p)).unwrap_or_else(|| "default scene".into()),
+        accumulate: args.accumulate,
+    };
+    run_and_report(&options, backend.as_mut(), &gpu_scene, &render, scene.extent(), &comparison, &references)
 }
 
 /// The reference image: `--reference`, or path-traced at `--reference-spp` and written
@@ -188,114 +190,4 @@ fn single_reference(
             image
         }
     })
-}
-
-/// Runs `comparison`, writes its images, error maps and CSV, prints the summary.
-fn run_and_report(
-    args: &CompareArgs,
-    backend: &mut dyn strata_backends::Backend,
-    gpu_scene: &GpuScene,
-    render: &RenderSettings,
-    extent: f32,
-    comparison: &Comparison,
-    references: &[RgbImage],
-) -> Result<()> {
-    let total = u64::from(args.frames) * u64::from(args.seeds) * args.methods.len() as u64;
-    let bar = indicatif::ProgressBar::new(total);
-    let started = Instant::now();
-    let mut write_error: Option<anyhow::Error> = None;
-    let shown: Vec<u32> = (0..args.frames).filter(|f| (f + 1).is_power_of_two() || f + 1 == args.frames).collect();
-    // Every seed's image of the shown frames, for the variance over seeds.
-    let mut seed_images: std::collections::HashMap<(Method, u32), Vec<RgbImage>> = Default::default();
-    let errors =
-        run_comparison(backend, gpu_scene, render, extent, comparison, references, |method, seed, frame, image| {
-            bar.inc(1);
-            if args.seeds >= 3 && shown.contains(&frame) {
-                seed_images.entry((method, frame)).or_default().push(image.clone());
-            }
-            // Images of the first seed: the first frame and every power of two.
-            if seed == 1 && ((frame + 1).is_power_of_two() || frame + 1 == args.frames) {
-                let stem = args.out.join(format!("{}_frame{:03}", method.name(), frame + 1));
-                let result = (|| -> Result<()> {
-                    image.write_exr(&stem.with_extension("exr"))?;
-                    image.write_png(&stem.with_extension("png"), args.exposure)?;
-                    let reference = references.get(frame as usize).unwrap_or(&references[0]);
-                    let map = metrics::error_map(image, reference, Metric::Relmse)?;
-                    let error_stem = args.out.join(format!("{}_frame{:03}_relmse", method.name(), frame + 1));
-                    metrics::false_colour(&map, image.width, image.height)
-                        .write_png(&error_stem.with_extension("png"), 1.0)?;
-                    RgbImage {
-                        width: image.width,
-                        height: image.height,
-                        pixels: map.iter().map(|&e| [e as f32; 3]).collect(),
-                    }
-                    .write_exr(&error_stem.with_extension("exr"))?;
-                    Ok(())
-                })();
-                if let Err(error) = result {
-                    write_error.get_or_insert(error);
-                }
-            }
-        })?;
-    bar.finish_and_clear();
-    if let Some(error) = write_error {
-        return Err(error);
-    }
-    let csv = args.out.join("errors.csv");
-    std::fs::write(&csv, errors_csv(&errors)).with_context(|| format!("{}: cannot write", csv.display()))?;
-    let title = format!(
-        "{} {}x{}, {} seeds{}",
-        args.scene.as_ref().and_then(|p| scene_stem(p)).unwrap_or_else(|| "default scene".into()),
-        render.camera.width,
-        render.camera.height,
-        args.seeds,
-        if args.accumulate { ", accumulated frames" } else { ", temporal reuse" }
-    );
-    let plot = args.out.join("relmse.svg");
-    std::fs::write(&plot, strata::evaluation::plot::relmse_svg(&errors, &args.methods, args.frames, &title))
-        .with_context(|| format!("{}: cannot write", plot.display()))?;
-    println!(
-        "{} frames x {} seeds x {} methods in {:.1} s; RelMSE (paper's form), mean ± 95% CI over seeds:",
-        args.frames,
-        args.seeds,
-        args.methods.len(),
-        started.elapsed().as_secs_f64()
-    );
-    print!("{:<18}", "method");
-    for f in &shown {
-        print!(" | {:>20}", format!("frame {}", f + 1));
-    }
-    println!();
-    for &method in &args.methods {
-        print!("{:<18}", method.name());
-        for &f in &shown {
-            print!(" | {:>20}", relmse_over_seeds(&errors, method, f).to_string());
-        }
-        println!();
-    }
-    if args.methods.contains(&Method::Strata) {
-        for baseline in [Method::Restir, Method::RestirDisc] {
-            if !args.methods.contains(&baseline) {
-                continue;
-            }
-            for (suffix, ratio_of) in [("", relmse_ratio as RatioOf), (" luma", luminance_relmse_ratio)] {
-                print!("{:<18}", format!("÷ {}{suffix}", baseline.name()));
-                for &f in &shown {
-                    let ratio = ratio_of(&errors, Method::Strata, baseline, f);
-                    let text = ratio.map(|r| format!("{:.3} ± {:.3}", r.mean, r.half_width)).unwrap_or_default();
-                    print!(" | {text:>20}");
-                }
-                println!();
-            }
-        }
-        summary::print_ratio_over_frames(&errors, args.frames);
-    }
-    let mut wrote = format!("{}, {}", csv.display(), plot.display());
-    if args.seeds >= 3 {
-        let path = args.out.join("variance.csv");
-        summary::print_variance(&args.methods, &shown, &seed_images, references, &path)?;
-        wrote += &format!(", {}", path.display());
-    }
-    println!("wrote {wrote} and images in {}", args.out.display());
-    Ok(())
 }

@@ -16,15 +16,21 @@ use strata_kernels::blue_noise::BlueNoiseTables;
 use strata_kernels::embed_types::{ResampleInput, ResampleOutput, SelectedCandidates, SelectionParams};
 use strata_kernels::reference::block_histogram::{HistogramOutput, block_histogram};
 use strata_kernels::reference::stratified_selection::{resample, select};
-use strata_kernels::selection::SamplerVariant;
+use strata_kernels::selection::{MAX_SELECTED, SamplerVariant};
 use strata_kernels::types::Candidate;
 use strata_kernels::{BlockGrid, KernelId, Registry};
 
 /// Checks [`KernelId::StrataSelect`] or [`KernelId::StrataResample`].
 pub struct SelectionCheck(pub KernelId);
 
-/// Every sampler variant of Table 2, one per case family.
+/// Every sampler variant of Table 2.
 const SAMPLERS: [SamplerVariant; 5] = SamplerVariant::ALL;
+
+/// The sampler variant and K of a case family: the 20 families are every variant × every
+/// K from 1 to 4 (each K has its own stratified pattern).
+fn sampler_and_k(family: u32) -> (SamplerVariant, u32) {
+    (SAMPLERS[family as usize % SAMPLERS.len()], 1 + family / SAMPLERS.len() as u32 % MAX_SELECTED)
+}
 
 /// The generated inputs of one case.
 struct Inputs {
@@ -52,8 +58,8 @@ fn inputs(case: &Case) -> Inputs {
         height,
         frame: (case.seed * 37 % 1000) as u32,
         seed: case.seed as u32,
-        candidates: 1 + (case.seed % 4) as u32,
-        sampler: SAMPLERS[case.family as usize % SAMPLERS.len()].id(),
+        candidates: sampler_and_k(case.family).1,
+        sampler: sampler_and_k(case.family).0.id(),
         identity_payload: (case.seed % 2) as u32,
         _pad: 0,
     };
@@ -133,17 +139,24 @@ impl KernelCheck for SelectionCheck {
     }
 
     fn cases(&self, config: CheckConfig) -> Vec<Case> {
-        let (seeds, sizes): (u64, &[(u32, u32, u32)]) = if config.full {
-            (20, &[(1, 1, 4), (17, 33, 8), (64, 64, 16), (129, 65, 32)])
+        // Seed s runs family s mod 20 (every variant × K) at every size; the quick check
+        // keeps the 1 x 1 image for one seed in five.
+        let families = SAMPLERS.len() as u64 * u64::from(MAX_SELECTED);
+        let sizes: &[(u32, u32, u32)] = if config.full {
+            &[(1, 1, 4), (17, 33, 8), (64, 64, 16), (129, 65, 32)]
         } else {
-            (5, &[(1, 1, 4), (17, 33, 8), (40, 24, 16)])
+            &[(1, 1, 4), (17, 33, 8), (40, 24, 16)]
         };
         let mut cases = Vec::new();
-        for seed in 0..seeds {
+        for seed in 0..families {
             for &(width, height, block_size) in sizes {
-                let family = (seed % SAMPLERS.len() as u64) as u32;
+                if !config.full && width == 1 && seed % 5 != 0 {
+                    continue;
+                }
+                let family = (seed % families) as u32;
+                let (sampler, k) = sampler_and_k(family);
                 cases.push(Case {
-                    label: format!("{width}x{height} B={block_size} seed {seed} {:?}", SAMPLERS[family as usize]),
+                    label: format!("{width}x{height} B={block_size} seed {seed} {sampler:?} K={k}"),
                     width,
                     height,
                     block_size,

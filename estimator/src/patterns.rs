@@ -3,7 +3,7 @@
 
 use rand::Rng;
 use strata_kernels::selection::StratifiedPattern;
-use strata_kernels::selection::patterns::index_of as selection_index;
+pub use strata_kernels::selection::patterns::index_of;
 
 /// Candidates selected per pixel.
 pub const K: usize = 4;
@@ -41,11 +41,6 @@ impl SelectionPattern {
             Some(pattern) => std::array::from_fn(|j| pattern.position(j, u)),
         }
     }
-}
-
-/// Index of position `pos` in a pool of `n`: ⌊pos·n⌋ clamped to n − 1.
-pub fn index_of(pos: f64, n: usize) -> usize {
-    selection_index(pos, n)
 }
 
 /// The K selected indices into a sorted pool of `n` (duplicates possible).

@@ -11,10 +11,7 @@ use crate::embed_types::{
     SelectionParams,
 };
 use crate::selection::patterns::BELOW_ONE;
-use crate::selection::{
-    MAX_SELECTED, SAMPLER_HEITZ, SAMPLER_RANDOM, SAMPLER_RANDOM_OFFSET, SAMPLER_RANDOM_OFFSET_BLUE_NOISE,
-    StratifiedPattern,
-};
+use crate::selection::{MAX_SELECTED, Pattern, SamplerVariant};
 use crate::types::{Candidate, ClusterSpan, OBJECT_ID_NONE};
 
 /// PCG hash (Jarzynski and Olano 2020), WGSL `selection_hash`.
@@ -44,8 +41,8 @@ pub struct SelectionNumbers {
 
 /// WGSL `selection_numbers`: the numbers of `count` slots (clamped to 1..=4) of pixel
 /// (x, y) in frame `frame` of render `seed` for sampler variant `sampler` (its
-/// [`crate::selection::SamplerVariant::id`]; unknown ids behave as antithetic), from the sampler's dimension
-/// pair `pair` (0: spatial slots, 1: temporal slots).
+/// [`SamplerVariant::id`]; unknown ids behave as antithetic), from the sampler's
+/// dimension pair `pair` (0: spatial slots, 1: temporal slots).
 pub fn selection_numbers(
     tables: &BlueNoiseTables,
     (x, y): (u32, u32),
@@ -72,29 +69,27 @@ pub fn selection_numbers(
     let k = count.clamp(1, MAX_SELECTED);
     let (position_dimension, resample_dimension) = (2 * pair, 2 * pair + 1);
     let sample_index = frame & 255;
-    let stratified = |b: f32| {
-        let variant = if sampler == SAMPLER_RANDOM_OFFSET || sampler == SAMPLER_RANDOM_OFFSET_BLUE_NOISE {
-            StratifiedPattern::random_offset(k)
-        } else {
-            StratifiedPattern::antithetic(k)
-        };
-        variant.positions(b)
+    // Unknown ids behave as antithetic, as WGSL's default branch does.
+    let variant = SamplerVariant::from_id(sampler).unwrap_or(SamplerVariant::Antithetic);
+    let stratified = |b: f32| match variant.pattern(k) {
+        Pattern::Stratified(pattern) => pattern.positions(b),
+        Pattern::Independent => unreachable!("only stratified variants place their slots from one number"),
     };
-    match sampler {
-        SAMPLER_RANDOM => {
+    match variant {
+        SamplerVariant::Random => {
             let positions = [white(), white(), white(), white()];
             SelectionNumbers { positions, resample: white() }
         }
-        SAMPLER_HEITZ => {
+        SamplerVariant::Heitz => {
             let first = k.wrapping_mul(frame);
             let positions = [0, 1, 2, 3].map(|j| blue(first.wrapping_add(j), position_dimension, &mut white));
             SelectionNumbers { positions, resample: blue(first, resample_dimension, &mut white) }
         }
-        SAMPLER_RANDOM_OFFSET => {
+        SamplerVariant::RandomOffset => {
             let b = white();
             SelectionNumbers { positions: stratified(b), resample: white() }
         }
-        _ => {
+        SamplerVariant::RandomOffsetBlueNoise | SamplerVariant::Antithetic => {
             let b = blue(sample_index, position_dimension, &mut white);
             SelectionNumbers { positions: stratified(b), resample: blue(sample_index, resample_dimension, &mut white) }
         }

@@ -23,8 +23,6 @@
 //! kernels' Rust reference ([`crate::reference::stratified_selection`]) and the 1-D
 //! estimator study (the `strata-estimator` crate, `estimator/`) evaluate this table rather than restating it.
 
-use super::SamplerVariant;
-
 /// Most slots a pixel selects (WGSL `MAX_SELECTED`; the per-slot values live in `vec4`s).
 pub const MAX_SELECTED: u32 = 4;
 
@@ -94,17 +92,6 @@ impl StratifiedPattern {
     }
 }
 
-/// The position pattern of a sampler variant with `count` slots.
-pub fn pattern(sampler: SamplerVariant, count: u32) -> Pattern {
-    match sampler {
-        SamplerVariant::Random | SamplerVariant::Heitz => Pattern::Independent,
-        SamplerVariant::RandomOffset | SamplerVariant::RandomOffsetBlueNoise => {
-            Pattern::Stratified(StratifiedPattern::random_offset(count))
-        }
-        SamplerVariant::Antithetic => Pattern::Stratified(StratifiedPattern::antithetic(count)),
-    }
-}
-
 /// Index into a pool of `n` (> 0) of position `position` in [0, 1]: ⌊position · n⌋
 /// clamped to n − 1 (WGSL `run_member` without the run's offset).
 pub fn index_of(position: f64, n: usize) -> usize {
@@ -114,6 +101,7 @@ pub fn index_of(position: f64, n: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::selection::SamplerVariant;
 
     const STRATIFIED: [SamplerVariant; 3] =
         [SamplerVariant::RandomOffset, SamplerVariant::RandomOffsetBlueNoise, SamplerVariant::Antithetic];
@@ -124,7 +112,7 @@ mod tests {
     fn every_stratified_pattern_tiles_the_unit_interval_once() {
         for sampler in STRATIFIED {
             for count in 1..=MAX_SELECTED {
-                let Pattern::Stratified(p) = pattern(sampler, count) else { panic!("{sampler:?} is stratified") };
+                let Pattern::Stratified(p) = sampler.pattern(count) else { panic!("{sampler:?} is stratified") };
                 let mut strata = p.strata();
                 strata.sort_by(|a, b| a.0.total_cmp(&b.0));
                 let mut edge = 0.0;
@@ -163,7 +151,7 @@ mod tests {
     fn positions_stay_below_one() {
         for sampler in STRATIFIED {
             for count in 1..=MAX_SELECTED {
-                let Pattern::Stratified(p) = pattern(sampler, count) else { unreachable!() };
+                let Pattern::Stratified(p) = sampler.pattern(count) else { unreachable!() };
                 for b in [0.0, 1e-9, 0.5, BELOW_ONE] {
                     for &position in &p.positions(b)[..count as usize] {
                         assert!((0.0..1.0).contains(&position), "{sampler:?} K = {count} b = {b}: {position}");

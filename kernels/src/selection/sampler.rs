@@ -1,7 +1,7 @@
 //! [`SamplerVariant`]: where the selection's numbers come from, the variants of the
 //! paper's Table 2 (ablation of histogram sampling strategies).
 
-use super::patterns::{Pattern, pattern};
+use super::patterns::{Pattern, StratifiedPattern};
 
 /// How the selection draws its random numbers and places its K slots (Table 2). "Temporal
 /// blue noise" means one sample of Heitz et al. 2019's sampler
@@ -54,20 +54,20 @@ impl SamplerVariant {
         }
     }
 
-    /// The name on the command line and in reports.
-    pub fn name(self) -> &'static str {
-        match self {
-            SamplerVariant::Random => "random",
-            SamplerVariant::Heitz => "heitz",
-            SamplerVariant::RandomOffset => "random-offset",
-            SamplerVariant::RandomOffsetBlueNoise => "random-offset-blue-noise",
-            SamplerVariant::Antithetic => "antithetic",
-        }
+    /// The variant whose [`Self::id`] is `id`, if any.
+    pub fn from_id(id: u32) -> Option<Self> {
+        Self::ALL.into_iter().find(|variant| variant.id() == id)
     }
 
-    /// The position pattern of `count` slots.
+    /// The position pattern of `count` slots (the table of [`super::patterns`]).
     pub fn pattern(self, count: u32) -> Pattern {
-        pattern(self, count)
+        match self {
+            SamplerVariant::Random | SamplerVariant::Heitz => Pattern::Independent,
+            SamplerVariant::RandomOffset | SamplerVariant::RandomOffsetBlueNoise => {
+                Pattern::Stratified(StratifiedPattern::random_offset(count))
+            }
+            SamplerVariant::Antithetic => Pattern::Stratified(StratifiedPattern::antithetic(count)),
+        }
     }
 }
 

@@ -2,11 +2,13 @@
 //! every registry kernel on every available backend with generated inputs, compared
 //! with the kernel's Rust reference. Integer and ordering outputs must be bit-exact;
 //! float outputs must stay within the ULP bound the registry declares for the kernel.
-//! Also [`run_kernel`]: any WGSL compute shader on chosen backends (`cargo xtask run`).
+//! Also [`run_kernel`]: any WGSL compute shader on chosen backends (`cargo xtask run`),
+//! judged by [`agreement`] against a reference backend under a declared tolerance.
 //!
 //! Tooling, not product: the renderer (`strata`) and the embeddable pass know nothing of
 //! it; `xtask` and the tests use it.
 
+pub mod agreement;
 mod backends;
 mod camera;
 mod compare;

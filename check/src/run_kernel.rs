@@ -1,12 +1,14 @@
 //! Running any WGSL compute shader on chosen backends (`cargo xtask run`): buffers from
-//! files or zero-filled, outputs written back, and with several backends a verdict on
-//! whether they agree. For engine developers checking their own kernels.
+//! files or zero-filled, `override` constants set by name, outputs written back, and
+//! with several backends each output buffer judged against a reference backend under a
+//! declared tolerance (see [`crate::agreement`]). For engine developers checking their
+//! own kernels.
 
 use crate::{BackendSlot, backend_slots};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 use strata_backends::{Backend, Bind};
-use strata_kernels::Kernel;
+use strata_kernels::{Kernel, WordKinds};
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -21,10 +23,25 @@ pub struct RunRequest {
     pub buffers: Vec<(u32, u32, PathBuf)>,
     /// Zero-filled buffer sizes in bytes: (group, binding, bytes).
     pub sizes: Vec<(u32, u32, u64)>,
+    /// Values of `override` constants, by name; the rest keep their WGSL defaults.
+    pub overrides: Vec<(String, f64)>,
     /// Backend names (`cpu`, `wgpu-vulkan`, `wgpu-gl`, `ash`, `ash-glsl`, `ash-hlsl`; `all`).
     pub backends: Vec<String>,
     /// Where output buffers are written (one folder per backend).
     pub out: PathBuf,
+}
+
+/// One writable buffer after a run.
+#[derive(Clone, Debug)]
+pub struct OutputBuffer {
+    /// `@binding` number (group 0).
+    pub binding: u32,
+    /// WGSL variable name.
+    pub name: String,
+    /// Contents.
+    pub bytes: Vec<u8>,
+    /// What each word holds (from the IR), for comparing.
+    pub kinds: WordKinds,
 }
 
 /// One backend's run.
@@ -32,122 +49,171 @@ pub struct RunRequest {
 pub struct BackendRun {
     /// Backend name.
     pub backend: String,
-    /// Writable buffers after the run: (binding, variable name, bytes), or the error.
-    pub outputs: Result<Vec<(u32, String, Vec<u8>)>, String>,
+    /// Writable buffers after the run, or why the backend could not run the shader.
+    pub outputs: Result<Vec<OutputBuffer>, String>,
 }
 
-/// Loads the shader; subgroup operations are allowed if the module needs them.
-pub fn load_shader(path: &Path, entry: &str) -> Result<Kernel> {
+/// Loads the shader with `overrides`; subgroup operations are allowed if the module
+/// needs them.
+pub fn load_shader(path: &Path, entry: &str, overrides: &[(String, f64)]) -> Result<Kernel> {
     let source = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
     let name = path.display().to_string();
-    match Kernel::from_wgsl(&name, source.clone(), entry, false) {
+    match Kernel::from_wgsl_with_overrides(&name, source.clone(), entry, false, overrides) {
         Ok(kernel) => Ok(kernel),
-        Err(first) => Kernel::from_wgsl(&name, source, entry, true).map_err(|_| anyhow::anyhow!("{first}")),
+        Err(first) => Kernel::from_wgsl_with_overrides(&name, source, entry, true, overrides)
+            .map_err(|_| anyhow::anyhow!("{first}")),
     }
 }
 
-fn contents(request: &RunRequest, binding: &strata_kernels::BindingInfo) -> Result<Vec<u8>> {
-    if let Some((_, _, file)) = request.buffers.iter().find(|(g, b, _)| *g == binding.group && *b == binding.binding) {
-        let mut bytes = std::fs::read(file).with_context(|| format!("cannot read buffer file {}", file.display()))?;
-        if bytes.is_empty() {
-            bail!("buffer file {} is empty", file.display());
-        }
-        bytes.resize(bytes.len().div_ceil(4) * 4, 0);
-        return Ok(bytes);
-    }
-    if let Some((_, _, size)) = request.sizes.iter().find(|(g, b, _)| *g == binding.group && *b == binding.binding) {
-        if *size == 0 {
-            bail!("--size {}:{}=0: buffers need at least one byte", binding.group, binding.binding);
-        }
-        return Ok(vec![0; (size.div_ceil(4) * 4) as usize]);
-    }
-    Ok(vec![0; binding.min_size().div_ceil(4) as usize * 4])
-}
+/// Initial contents of every binding of `kernel`: given bytes (rounded up to whole
+/// words), or zeros of the binding's minimum size.
+pub type Inputs = Vec<(u32, Vec<u8>)>;
 
-fn run_on(backend: &mut dyn Backend, kernel: &Kernel, request: &RunRequest) -> Result<Vec<(u32, String, Vec<u8>)>> {
+fn run_on(backend: &mut dyn Backend, kernel: &Kernel, inputs: &Inputs, workgroups: [u32; 3]) -> Result<Vec<OutputBuffer>> {
     backend.check_kernel(kernel)?;
     let mut binds = Vec::new();
     for binding in &kernel.bindings {
-        let bytes = contents(request, binding)?;
+        let bytes = match inputs.iter().find(|(b, _)| *b == binding.binding) {
+            Some((_, bytes)) => {
+                let mut bytes = bytes.clone();
+                bytes.resize(bytes.len().div_ceil(4) * 4, 0);
+                bytes
+            }
+            None => vec![0; binding.min_size().div_ceil(4) as usize * 4],
+        };
         let buffer = backend.create_buffer(&binding.name, bytes.len() as u64)?;
         backend.write_buffer(buffer, 0, &bytes)?;
         binds.push((binding, buffer));
     }
     let plain: Vec<Bind> = binds.iter().map(|(b, id)| Bind::new(b.binding, *id)).collect();
-    backend.dispatch(kernel, &plain, request.workgroups)?;
+    backend.dispatch(kernel, &plain, workgroups)?;
     let mut outputs = Vec::new();
     for (binding, buffer) in &binds {
         if binding.is_writable() {
-            outputs.push((binding.binding, binding.name.clone(), backend.read_buffer(*buffer)?));
+            outputs.push(OutputBuffer {
+                binding: binding.binding,
+                name: binding.name.clone(),
+                bytes: backend.read_buffer(*buffer)?,
+                kinds: binding.words.clone(),
+            });
         }
         backend.destroy_buffer(*buffer)?;
     }
     Ok(outputs)
 }
 
-/// Runs the request on every named backend and writes the outputs under `request.out`.
-pub fn run_kernel(request: &RunRequest) -> Result<Vec<BackendRun>> {
-    for (group, binding, _) in &request.buffers {
-        if *group != 0 {
-            bail!("--buffer {group}:{binding}: only @group(0) is supported");
-        }
+/// The backend slots named by `names` (`all` for every one; `wgpu` is `wgpu-vulkan`).
+pub fn named_slots(names: &[String]) -> Result<Vec<BackendSlot>> {
+    let slots = backend_slots();
+    if names.iter().any(|b| b == "all") {
+        return Ok(slots);
     }
-    let kernel = load_shader(&request.shader, &request.entry)?;
-    for (group, binding, file) in &request.buffers {
-        if kernel.binding(*group, *binding).is_none() {
-            bail!("--buffer {group}:{binding}={}: entry point `{}` has no such binding", file.display(), request.entry);
-        }
-    }
-    let slots: Vec<BackendSlot> = backend_slots();
-    let names: Vec<String> = if request.backends.iter().any(|b| b == "all") {
-        slots.iter().map(|s| s.name.to_string()).collect()
-    } else {
-        request.backends.clone()
-    };
-    let mut runs = Vec::new();
+    let mut chosen = Vec::new();
     for name in names {
-        let alias = match name.as_str() {
-            "wgpu" => "wgpu-vulkan",
-            other => other,
-        };
+        let alias = if name == "wgpu" { "wgpu-vulkan" } else { name.as_str() };
         let Some(slot) = slots.iter().find(|s| s.name == alias) else {
             let known: Vec<_> = slots.iter().map(|s| s.name).collect();
             bail!("unknown backend `{name}`: one of {}, wgpu or all", known.join(", "));
         };
-        let outputs = (slot.open)()
-            .map_err(anyhow::Error::from)
-            .and_then(|mut backend| run_on(backend.as_mut(), &kernel, request))
-            .map_err(|e| e.to_string());
-        if let Ok(outputs) = &outputs {
-            let dir = request.out.join(slot.name);
-            std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
-            for (binding, variable, bytes) in outputs {
-                let file = dir.join(format!("0_{binding}_{variable}.bin"));
-                std::fs::write(&file, bytes).with_context(|| format!("cannot write {}", file.display()))?;
-            }
-        }
-        runs.push(BackendRun { backend: slot.name.to_string(), outputs });
+        chosen.push(BackendSlot { name: slot.name, open: slot.open, needs_vulkan: slot.needs_vulkan });
     }
-    Ok(runs)
+    Ok(chosen)
 }
 
-/// The first disagreement between runs that succeeded, as text; `None` if they agree.
-pub fn disagreement(runs: &[BackendRun]) -> Option<String> {
-    let mut ok = runs.iter().filter_map(|r| r.outputs.as_ref().ok().map(|o| (&r.backend, o)));
-    let (first_name, first) = ok.next()?;
-    for (name, outputs) in ok {
-        for ((binding, variable, a), (_, _, b)) in first.iter().zip(outputs.iter()) {
-            if let Some(word) = (0..a.len() / 4).find(|&w| a[4 * w..4 * w + 4] != b[4 * w..4 * w + 4]) {
-                let read = |bytes: &[u8]| {
-                    u32::from_le_bytes([bytes[4 * word], bytes[4 * word + 1], bytes[4 * word + 2], bytes[4 * word + 3]])
+/// Runs a loaded kernel with `inputs` on every slot; a backend that cannot open or
+/// fails records its error instead of outputs.
+pub fn run_loaded(kernel: &Kernel, inputs: &Inputs, workgroups: [u32; 3], slots: &[BackendSlot]) -> Vec<BackendRun> {
+    slots
+        .iter()
+        .map(|slot| BackendRun {
+            backend: slot.name.to_string(),
+            outputs: (slot.open)()
+                .map_err(anyhow::Error::from)
+                .and_then(|mut backend| run_on(backend.as_mut(), kernel, inputs, workgroups))
+                .map_err(|e| format!("{e:#}")),
+        })
+        .collect()
+}
+
+/// What [`run_kernel`] ran and what came of it.
+#[derive(Debug)]
+pub struct RunOutcome {
+    /// The shader as loaded (overrides applied).
+    pub kernel: Kernel,
+    /// One run per backend, in the order named.
+    pub runs: Vec<BackendRun>,
+}
+
+/// The math functions of the interpreter whose results differ from GPU drivers' within
+/// Vulkan's precision (not bit for bit) that `kernel`'s entry point calls, by WGSL name.
+pub fn inexact_functions(kernel: &Kernel) -> Vec<&'static str> {
+    use naga::MathFunction as M;
+    let mut used = Vec::new();
+    let mut look = |expressions: &naga::Arena<naga::Expression>| {
+        for (_, expression) in expressions.iter() {
+            if let naga::Expression::Math { fun, .. } = expression {
+                let name = match fun {
+                    M::Exp => "exp",
+                    M::Exp2 => "exp2",
+                    M::Log => "log",
+                    M::Log2 => "log2",
+                    M::Pow => "pow",
+                    _ => continue,
                 };
-                return Some(format!(
-                    "binding {binding} `{variable}` word {word}: {first_name} {:#x}, {name} {:#x}",
-                    read(a),
-                    read(b)
-                ));
+                if !used.contains(&name) {
+                    used.push(name);
+                }
+            }
+        }
+    };
+    for (_, function) in kernel.module.functions.iter() {
+        look(&function.expressions);
+    }
+    look(&kernel.module.entry_points[kernel.entry_index()].function.expressions);
+    used
+}
+
+/// Runs the request on every named backend and writes the outputs under `request.out`
+/// (`BACKEND/0_BINDING_NAME.bin`).
+pub fn run_kernel(request: &RunRequest) -> Result<RunOutcome> {
+    let groups = request.buffers.iter().map(|(g, b, _)| (g, b)).chain(request.sizes.iter().map(|(g, b, _)| (g, b)));
+    for (group, binding) in groups {
+        if *group != 0 {
+            bail!("--buffer/--size {group}:{binding}: only @group(0) is supported");
+        }
+    }
+    let kernel = load_shader(&request.shader, &request.entry, &request.overrides)?;
+    let slots = named_slots(&request.backends)?;
+    let mut inputs = Inputs::new();
+    for (_, binding, file) in &request.buffers {
+        if kernel.binding(0, *binding).is_none() {
+            bail!("--buffer 0:{binding}={}: entry point `{}` has no such binding", file.display(), request.entry);
+        }
+        let bytes = std::fs::read(file).with_context(|| format!("cannot read buffer file {}", file.display()))?;
+        if bytes.is_empty() {
+            bail!("buffer file {} is empty", file.display());
+        }
+        inputs.push((*binding, bytes));
+    }
+    for (_, binding, size) in &request.sizes {
+        if kernel.binding(0, *binding).is_none() {
+            bail!("--size 0:{binding}={size}: entry point `{}` has no such binding", request.entry);
+        }
+        if *size == 0 {
+            bail!("--size 0:{binding}=0: buffers need at least one byte");
+        }
+        inputs.push((*binding, vec![0; *size as usize]));
+    }
+    let runs = run_loaded(&kernel, &inputs, request.workgroups, &slots);
+    for run in &runs {
+        if let Ok(outputs) = &run.outputs {
+            let dir = request.out.join(&run.backend);
+            std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+            for output in outputs {
+                let file = dir.join(format!("0_{}_{}.bin", output.binding, output.name));
+                std::fs::write(&file, &output.bytes).with_context(|| format!("cannot write {}", file.display()))?;
             }
         }
     }
-    None
+    Ok(RunOutcome { kernel, runs })
 }

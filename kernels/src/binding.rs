@@ -1,5 +1,6 @@
 //! A kernel's resource bindings, read from naga's IR (never maintained by hand).
 
+use crate::word_kinds::WordKinds;
 use naga::proc::Layouter;
 
 /// Whether a binding is a uniform or a storage buffer.
@@ -47,6 +48,8 @@ pub struct BindingInfo {
     pub kind: BindingKind,
     /// What the buffer holds.
     pub element: ElementLayout,
+    /// What each 32-bit word holds (f32, integer, padding), for comparing outputs.
+    pub words: WordKinds,
 }
 
 impl BindingInfo {

@@ -43,6 +43,14 @@ pub enum KernelError {
         /// What is not supported.
         reason: String,
     },
+    /// Pipeline-overridable constants could not be resolved.
+    #[error("kernel `{kernel}`: override: {message}")]
+    Override {
+        /// Registry name of the kernel.
+        kernel: String,
+        /// What is wrong, naming the constant.
+        message: String,
+    },
     /// A naga back end failed.
     #[error("kernel `{kernel}`: {target} translation failed: {message}")]
     Translation {

@@ -57,7 +57,10 @@ pub fn compile(kernel: &Kernel, input: GlslangInput, dir: &Path) -> Result<(Vec<
             (translate::hlsl(kernel, TranslateOptions { workgroup_zero_init: WorkgroupZeroInit::Off }), "hlsl")
         }
     };
-    let translation = translation.map_err(|e| ToolError::Failed(e.to_string()))?;
+    let mut translation = translation.map_err(|e| ToolError::Failed(e.to_string()))?;
+    if input == GlslangInput::Hlsl {
+        translation.text = byte_address_lengths_in_bytes(&translation.text)?;
+    }
     let source = dir.join(format!("{}.{extension}", kernel.name()));
     let output = dir.join(format!("{}.{extension}.spv", kernel.name()));
     std::fs::write(&source, &translation.text).map_err(|e| ToolError::Failed(format!("{}: {e}", source.display())))?;
@@ -75,4 +78,35 @@ pub fn compile(kernel: &Kernel, input: GlslangInput, dir: &Path) -> Result<(Vec<
     }
     let words = bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect();
     Ok((words, translation.entry_point))
+}
+
+/// The statement in naga's `arrayLength` helpers (`NagaBufferLength`,
+/// `NagaRWBufferLength`) that asks a `(RW)ByteAddressBuffer` for its size.
+const GET_DIMENSIONS: &str = "    buffer.GetDimensions(ret);\n";
+
+/// Works around a glslang bug on the HLSL path: glslang's HLSL front end (12.0.0, as
+/// Debian ships it) compiles `ByteAddressBuffer::GetDimensions(out uint)` to
+/// `OpArrayLength` of the buffer's `uint` array, which counts 4-byte words, where HLSL
+/// defines (and DXC returns) bytes. naga's `arrayLength` helpers divide that size by
+/// the array stride, so under glslang every runtime array read 4× too short: a loop to
+/// `arrayLength` saw a quarter of its elements (a flocking step found almost no
+/// neighbours). Scaling the result by 4 inside naga's helpers restores bytes.
+///
+/// `tests/tests/glslang_hlsl_buffer_length.rs` holds a six-line HLSL reproducer: it
+/// fails when a glslang that returns bytes is installed, and then this function must
+/// go. Refuses (rather than compile something wrong) HLSL whose `GetDimensions` calls
+/// are not all in naga's helpers as this function knows them.
+pub fn byte_address_lengths_in_bytes(hlsl: &str) -> Result<String, ToolError> {
+    let calls = hlsl.matches(".GetDimensions(").count();
+    let helpers = hlsl.matches(GET_DIMENSIONS).count();
+    if calls != helpers {
+        return Err(ToolError::Failed(format!(
+            "naga's HLSL has {calls} GetDimensions call(s), {helpers} of them in the buffer-length helpers this \
+             workaround knows (kernels/src/glslang.rs): naga's output changed, update the workaround"
+        )));
+    }
+    Ok(hlsl.replace(
+        GET_DIMENSIONS,
+        "    buffer.GetDimensions(ret);\n    ret = ret * 4u; // glslang returns 4-byte words, not bytes\n",
+    ))
 }

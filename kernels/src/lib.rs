@@ -36,8 +36,10 @@ pub mod trace_types;
 pub mod translate;
 pub mod types;
 pub mod validate;
+pub mod word_kinds;
 
 pub use binding::{BindingAccess, BindingInfo, BindingKind, ElementLayout};
 pub use block_grid::{BlockGrid, BlockRect, GridError};
 pub use error::KernelError;
 pub use registry::{Kernel, KernelId, Registry};
+pub use word_kinds::{WordKind, WordKinds};

@@ -5,6 +5,7 @@ use crate::binding::{BindingAccess, BindingInfo, BindingKind, element_layout};
 pub use crate::catalogue::{KernelFeatures, KernelId, KernelSpec};
 use crate::error::KernelError;
 use crate::source::{ComposedSource, Fragment};
+use crate::word_kinds::WordKinds;
 use naga::valid::{Capabilities, ModuleInfo, ShaderStages, SubgroupOperationSet, ValidationFlags};
 
 /// What the validator allows in external kernels ([`Kernel::from_wgsl`]) beyond the
@@ -87,15 +88,39 @@ impl Kernel {
             kernel: format!("{id:?}"),
             entry: "(external kernels are made with Kernel::from_wgsl)".into(),
         })?;
-        Self::from_spec(id, spec)
+        Self::from_spec(id, spec, &[])
     }
 
     /// A kernel that is not in the registry: WGSL source from `path`, entry point
     /// `entry_point`, validated with subgroup operations allowed when `subgroup` is set.
+    /// Pipeline-overridable constants (`override`) keep their WGSL defaults; see
+    /// [`Kernel::from_wgsl_with_overrides`].
     pub fn from_wgsl(path: &str, source: String, entry_point: &str, subgroup: bool) -> Result<Kernel, KernelError> {
+        Self::from_wgsl_with_overrides(path, source, entry_point, subgroup, &[])
+    }
+
+    /// [`Kernel::from_wgsl`] with values for the module's `override` constants, by name
+    /// (or by `@id` number as text); the others keep their WGSL defaults.
+    ///
+    /// The overrides are resolved here, once, by naga's pipeline-constant processing
+    /// (the same code wgpu runs at pipeline creation): the kernel's module, workgroup
+    /// size and bindings are those of the specialised pipeline, so every backend (the
+    /// interpreter, wgpu, ash on naga's SPIR-V and on glslang's GLSL and HLSL) runs the
+    /// same specialised shader. Naming a constant the module lacks, a value that does not
+    /// fit its type, or leaving one without a default unset is an error naming it.
+    pub fn from_wgsl_with_overrides(
+        path: &str,
+        source: String,
+        entry_point: &str,
+        subgroup: bool,
+        overrides: &[(String, f64)],
+    ) -> Result<Kernel, KernelError> {
         use std::hash::{Hash, Hasher};
         let mut hasher = std::collections::hash_map::DefaultHasher::new();
         (&source, entry_point, subgroup).hash(&mut hasher);
+        for (name, value) in overrides {
+            (name, value.to_bits()).hash(&mut hasher);
+        }
         let spec = KernelSpec {
             name: entry_point.to_string().into(),
             fragments: vec![Fragment { path: path.to_string().into(), text: source.into() }],
@@ -103,10 +128,10 @@ impl Kernel {
             features: if subgroup { KernelFeatures::SUBGROUP } else { KernelFeatures::empty() },
             float_ulp_bound: None,
         };
-        Self::from_spec(KernelId::External(hasher.finish()), spec)
+        Self::from_spec(KernelId::External(hasher.finish()), spec, overrides)
     }
 
-    fn from_spec(id: KernelId, spec: KernelSpec) -> Result<Kernel, KernelError> {
+    fn from_spec(id: KernelId, spec: KernelSpec, overrides: &[(String, f64)]) -> Result<Kernel, KernelError> {
         let source = ComposedSource::compose(&spec.fragments);
         let module = naga::front::wgsl::parse_str(&source.text).map_err(|error| {
             let location = error
@@ -134,6 +159,7 @@ impl Kernel {
                 kernel: spec.name.to_string(),
                 message: error.emit_to_string(&source.text),
             })?;
+        let (module, info) = specialise(&spec, module, info, overrides)?;
         let entry_index = module
             .entry_points
             .iter()
@@ -146,6 +172,44 @@ impl Kernel {
         let bindings = describe_bindings(&spec.name, &module, &info, entry_index)?;
         Ok(Kernel { id, spec, source, module, info, workgroup_size, bindings })
     }
+}
+
+/// Replaces the module's `override` constants by `overrides` or their defaults (naga's
+/// `process_overrides`, keeping only the kernel's entry point); a module without
+/// overrides is returned as it is.
+fn specialise(
+    spec: &KernelSpec,
+    module: naga::Module,
+    info: ModuleInfo,
+    overrides: &[(String, f64)],
+) -> Result<(naga::Module, ModuleInfo), KernelError> {
+    if module.overrides.is_empty() && overrides.is_empty() {
+        return Ok((module, info));
+    }
+    let error = |message: String| KernelError::Override { kernel: spec.name.to_string(), message };
+    let mut constants = naga::back::PipelineConstants::default();
+    for (name, value) in overrides {
+        if constants.insert(name.clone(), *value).is_some() {
+            return Err(error(format!("`{name}` is given twice")));
+        }
+    }
+    let declared: Vec<String> = module.overrides.iter().filter_map(|(_, o)| o.name.clone()).collect();
+    let entry = (naga::ShaderStage::Compute, spec.entry_point.as_ref());
+    let (module, info) =
+        naga::back::pipeline_constants::process_overrides(&module, &info, Some(entry), &constants).map_err(|e| {
+            use naga::back::pipeline_constants::PipelineConstantError as E;
+            let declared = if declared.is_empty() { "none".to_string() } else { declared.join(", ") };
+            error(match e {
+                E::NotFound(name) => format!("`{name}` is not an override of this shader (it declares: {declared})"),
+                E::MissingValue(name) => format!("`{name}` has no default: give it a value"),
+                E::SrcNeedsToBeFinite | E::DstRangeTooSmall => {
+                    let given = overrides.iter().map(|(n, v)| format!("{n}={v}")).collect::<Vec<_>>().join(", ");
+                    format!("a value does not fit its override's type ({given}): {e}")
+                }
+                other => other.to_string(),
+            })
+        })?;
+    Ok((module.into_owned(), info.into_owned()))
 }
 
 fn describe_bindings(
@@ -197,6 +261,7 @@ fn describe_bindings(
             name,
             kind,
             element: element_layout(module, &layouter, var.ty),
+            words: WordKinds::of_type(module, &layouter, var.ty),
         });
     }
     bindings.sort_by_key(|b| (b.group, b.binding));

@@ -175,7 +175,10 @@ fn translated_name<E: std::fmt::Display>(
     target: &'static str,
     names: Vec<Result<String, E>>,
 ) -> Result<String, KernelError> {
-    match names.into_iter().nth(kernel.entry_index()) {
+    // With an entry point chosen in the pipeline options, the back ends write (and name)
+    // that one alone; otherwise one name per entry point of the module.
+    let index = if names.len() == 1 { 0 } else { kernel.entry_index() };
+    match names.into_iter().nth(index) {
         Some(Ok(name)) => Ok(name),
         Some(Err(e)) => Err(error(kernel, target, e)),
         None => Err(error(kernel, target, "the back end reported no entry point name")),

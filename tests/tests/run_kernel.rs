@@ -2,7 +2,8 @@
 //! written to files, agreement reported, bad input named.
 
 use std::path::PathBuf;
-use strata_check::run_kernel::{RunRequest, disagreement, run_kernel};
+use strata_check::agreement::{Tolerance, judge};
+use strata_check::run_kernel::{RunRequest, run_kernel};
 
 const SQUARE: &str = r#"
 @group(0) @binding(0) var<storage, read> input: array<u32>;
@@ -25,6 +26,7 @@ fn setup(name: &str) -> (PathBuf, RunRequest) {
         workgroups: [2, 1, 1],
         buffers: vec![(0, 0, dir.join("in.bin"))],
         sizes: vec![(0, 1, 512)],
+        overrides: Vec::new(),
         backends: vec!["cpu".into()],
         out: dir.join("out"),
     };
@@ -34,7 +36,7 @@ fn setup(name: &str) -> (PathBuf, RunRequest) {
 #[test]
 fn a_shader_runs_on_the_interpreter_and_its_output_is_written() {
     let (dir, request) = setup("cpu");
-    let runs = run_kernel(&request).unwrap();
+    let runs = run_kernel(&request).unwrap().runs;
     assert_eq!(runs.len(), 1);
     let bytes = std::fs::read(dir.join("out/cpu/0_1_output.bin")).unwrap();
     let words: Vec<u32> = bytes.chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().unwrap())).collect();
@@ -47,14 +49,15 @@ fn a_shader_runs_on_the_interpreter_and_its_output_is_written() {
 fn every_backend_agrees_on_a_foreign_shader() {
     let (dir, mut request) = setup("all");
     request.backends = vec!["all".into()];
-    let runs = run_kernel(&request).unwrap();
+    let runs = run_kernel(&request).unwrap().runs;
     for run in &runs {
         if let Err(error) = &run.outputs {
             let skippable = !strata_backends::gpu_required() || run.backend == "wgpu-gl";
             assert!(skippable, "{} failed: {error}", run.backend);
         }
     }
-    assert_eq!(disagreement(&runs), None);
+    let judgement = judge(&runs, Some("cpu"), &Tolerance::default()).unwrap();
+    assert!(judgement.buffers.iter().all(|b| b.differing == 0), "{judgement:?}");
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -69,9 +72,17 @@ fn bad_requests_are_named() {
     let error = run_kernel(&request).unwrap_err().to_string();
     assert!(error.contains("--buffer 0:7") && error.contains("no such binding"), "{error}");
     request.buffers = vec![(0, 0, dir.join("missing.bin"))];
-    let runs = run_kernel(&request).unwrap();
-    let error = runs[0].outputs.as_ref().unwrap_err();
+    let error = run_kernel(&request).unwrap_err().to_string();
     assert!(error.contains("missing.bin"), "{error}");
+    request.buffers = Vec::new();
+    request.sizes = vec![(0, 9, 16)];
+    let error = run_kernel(&request).unwrap_err().to_string();
+    assert!(error.contains("--size 0:9=16") && error.contains("no such binding"), "{error}");
+    request.sizes = Vec::new();
+    request.overrides = vec![("width".into(), 3.0)];
+    let error = run_kernel(&request).unwrap_err().to_string();
+    assert!(error.contains("`width` is not an override"), "{error}");
+    request.overrides = Vec::new();
     request.entry = "nope".into();
     let error = run_kernel(&request).unwrap_err().to_string();
     assert!(error.contains("nope"), "{error}");

@@ -10,13 +10,22 @@
 //!   GLSL and HLSL) with generated inputs and compares the outputs with the kernels'
 //!   references; prints a kernels × backends table and exits non-zero on any mismatch.
 //! * `cargo xtask run FILE.wgsl --entry NAME --workgroups X,Y,Z --buffer 0:B=FILE ...
-//!   [--size 0:B=BYTES] --backend cpu|wgpu|wgpu-gl|ash|ash-glsl|ash-hlsl|all [--out DIR]`:
+//!   [--size 0:B=BYTES] [--override NAME=VALUE ...] [--ulp N | --ulp BUFFER=N ...] [--abs E | --abs BUFFER=E ...]
+//!   [--reference BACKEND] --backend cpu|wgpu|wgpu-gl|ash|ash-glsl|ash-hlsl|all [--out DIR]`:
 //!   runs any WGSL compute shader, writes every writable buffer to
-//!   `DIR/BACKEND/0_B_NAME.bin`, and with several backends says whether they agree.
+//!   `DIR/BACKEND/0_B_NAME.bin`, and with several backends reports per backend and
+//!   buffer whether it is identical to the reference backend's, or how many words
+//!   differ and by how many ULP; exits non-zero only when a backend fails or a buffer
+//!   exceeds the tolerance (integers: exact; f32 words: `--ulp`, default 0).
+//!
+//! Errors, a disagreement included, print one line (no backtrace, whatever
+//! `RUST_BACKTRACE` says: they are findings, not bugs of xtask) and exit with 1.
 
 use anyhow::{Result, bail};
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
+use strata_check::agreement::{Tolerance, judge};
+use strata_check::run_kernel::RunRequest;
 use strata_kernels::Registry;
 use strata_kernels::validate::{Target, Verdict, translate_and_validate};
 
@@ -54,9 +63,28 @@ enum Command {
         /// GROUP:BINDING=BYTES: a zero-filled buffer of that size (default: the binding's minimum).
         #[arg(long = "size", value_parser = parse_size)]
         sizes: Vec<(u32, u32, u64)>,
-        /// Backends, comma-separated, or `all`.
+        /// NAME=VALUE: the value of an `override` constant (repeatable; by name, or by
+        /// `@id` number). Others keep their WGSL defaults. Applied once, by naga, before
+        /// any backend sees the shader, so every backend runs the same specialisation.
+        #[arg(long = "override", value_parser = parse_override)]
+        overrides: Vec<(String, f64)>,
+        /// Backends, comma-separated, or `all` (cpu, wgpu-vulkan, wgpu-gl, ash, ash-glsl,
+        /// ash-hlsl; `wgpu` means wgpu-vulkan).
         #[arg(long, default_value = "cpu", value_delimiter = ',')]
         backend: Vec<String>,
+        /// Tolerance for f32 words: N units in the last place for every buffer, or
+        /// BUFFER=N for one output buffer (repeatable). Integer words (detected from the
+        /// IR) must always be identical; padding is not compared. Default 0.
+        #[arg(long = "ulp", value_parser = parse_ulp)]
+        ulp: Vec<(Option<String>, u32)>,
+        /// Absolute floor for f32 words: E for every buffer or BUFFER=E for one
+        /// (repeatable); words this close pass whatever their ULP distance (results that
+        /// cancel to near zero, `log` near 1). Default: off.
+        #[arg(long = "abs", value_parser = parse_abs)]
+        abs: Vec<(Option<String>, f32)>,
+        /// The backend the others are compared with (default: the first that ran).
+        #[arg(long)]
+        reference: Option<String>,
         /// Output folder.
         #[arg(long, default_value = "target/run")]
         out: PathBuf,
@@ -72,21 +100,20 @@ enum Command {
     },
 }
 
-fn main() -> Result<()> {
-    match Cli::parse().command {
+fn main() {
+    let result = match Cli::parse().command {
         Command::Shaders { strict, out } => shaders(strict, out),
         Command::Check { full, kernel } => check(full, &kernel),
-        Command::Run { shader, entry, workgroups, buffers, sizes, backend, out } => {
-            run(strata_check::run_kernel::RunRequest {
-                shader,
-                entry,
-                workgroups,
-                buffers,
-                sizes,
-                backends: backend,
-                out,
-            })
+        Command::Run { shader, entry, workgroups, buffers, sizes, overrides, backend, ulp, abs, reference, out } => {
+            let tolerance = tolerance(&ulp, &abs);
+            let request = RunRequest { shader, entry, workgroups, buffers, sizes, overrides, backends: backend, out };
+            run(request, &tolerance, reference.as_deref())
         }
+    };
+    if let Err(error) = result {
+        // `{:#}` puts anyhow's causes on the line; `{:?}` would add a backtrace.
+        eprintln!("error: {error:#}");
+        std::process::exit(1);
     }
 }
 
@@ -173,31 +200,110 @@ fn parse_size(text: &str) -> Result<(u32, u32, u64), String> {
     Ok((g, b, v.parse().map_err(|e| format!("size `{v}`: {e}"))?))
 }
 
-fn run(request: strata_check::run_kernel::RunRequest) -> Result<()> {
-    let runs = strata_check::run_kernel::run_kernel(&request)?;
-    let mut failed = false;
+fn parse_override(text: &str) -> Result<(String, f64), String> {
+    let (name, value) = text.split_once('=').ok_or_else(|| format!("`{text}`: expected NAME=VALUE"))?;
+    let value: f64 = value.trim().parse().map_err(|e| format!("`{text}`: value `{value}`: {e}"))?;
+    if name.trim().is_empty() {
+        return Err(format!("`{text}`: expected NAME=VALUE"));
+    }
+    Ok((name.trim().to_string(), value))
+}
+
+/// `N` (every buffer) or `BUFFER=N` (one buffer).
+fn parse_bound<T: std::str::FromStr>(text: &str, what: &str) -> Result<(Option<String>, T), String>
+where
+    T::Err: std::fmt::Display,
+{
+    let (buffer, bound) = match text.split_once('=') {
+        Some((buffer, bound)) => (Some(buffer.trim().to_string()), bound),
+        None => (None, text),
+    };
+    let bound = bound.trim().parse().map_err(|e| format!("`{text}`: {what} `{bound}`: {e}"))?;
+    Ok((buffer, bound))
+}
+
+fn parse_ulp(text: &str) -> Result<(Option<String>, u32), String> {
+    parse_bound(text, "ULP bound")
+}
+
+fn parse_abs(text: &str) -> Result<(Option<String>, f32), String> {
+    let (buffer, bound): (Option<String>, f32) = parse_bound(text, "absolute bound")?;
+    if !(bound.is_finite() && bound >= 0.0) {
+        return Err(format!("`{text}`: the absolute bound must be a finite number ≥ 0"));
+    }
+    Ok((buffer, bound))
+}
+
+/// The tolerance of `--ulp` and `--abs`: plain values for every buffer, `BUFFER=` ones
+/// for that buffer (whose other half falls back to the plain value).
+fn tolerance(ulp: &[(Option<String>, u32)], abs: &[(Option<String>, f32)]) -> Tolerance {
+    let mut tolerance = Tolerance::default();
+    for (buffer, bound) in ulp {
+        if buffer.is_none() {
+            tolerance.float.ulp = *bound;
+        }
+    }
+    for (buffer, bound) in abs {
+        if buffer.is_none() {
+            tolerance.float.abs = *bound;
+        }
+    }
+    let named = ulp.iter().filter_map(|(b, _)| b.clone()).chain(abs.iter().filter_map(|(b, _)| b.clone()));
+    for name in named {
+        if tolerance.per_buffer.iter().any(|(n, _)| *n == name) {
+            continue;
+        }
+        let mut bound = tolerance.float;
+        if let Some((_, ulp)) = ulp.iter().rev().find(|(b, _)| b.as_deref() == Some(&name)) {
+            bound.ulp = *ulp;
+        }
+        if let Some((_, abs)) = abs.iter().rev().find(|(b, _)| b.as_deref() == Some(&name)) {
+            bound.abs = *abs;
+        }
+        tolerance.per_buffer.push((name, bound));
+    }
+    tolerance
+}
+
+fn run(request: RunRequest, tolerance: &Tolerance, reference: Option<&str>) -> Result<()> {
+    let outcome = strata_check::run_kernel::run_kernel(&request)?;
+    let runs = outcome.runs;
     for run in &runs {
         match &run.outputs {
             Ok(outputs) => println!(
-                "{:<12} ok: {} output buffer(s) in {}",
+                "{:<12} ran: {} output buffer(s) in {}",
                 run.backend,
                 outputs.len(),
                 request.out.join(&run.backend).display()
             ),
-            Err(error) => {
-                failed = true;
-                println!("{:<12} FAILED: {error}", run.backend);
-            }
+            Err(error) => println!("{:<12} FAILED: {}", run.backend, error.replace('\n', " ")),
         }
     }
-    if runs.iter().filter(|r| r.outputs.is_ok()).count() > 1 {
-        match strata_check::run_kernel::disagreement(&runs) {
-            None => println!("backends agree: every output identical"),
-            Some(difference) => bail!("backends disagree: {difference}"),
+    let ran = runs.iter().filter(|r| r.outputs.is_ok()).count();
+    if ran > 1 || reference.is_some() {
+        let judgement = judge(&runs, reference, tolerance).map_err(anyhow::Error::msg)?;
+        println!("against {}:", judgement.reference);
+        for buffer in &judgement.buffers {
+            println!("{:<12} {} `{}`: {}", buffer.backend, buffer.binding, buffer.name, buffer.describe());
+        }
+        let inexact = strata_check::run_kernel::inexact_functions(&outcome.kernel);
+        let interpreter_compared = runs.iter().any(|r| r.backend == "cpu" && r.outputs.is_ok());
+        if interpreter_compared && !inexact.is_empty() && judgement.buffers.iter().any(|b| b.max_ulp > 0) {
+            println!(
+                "note: the shader calls {}; the interpreter computes them within 1 ULP and GPU drivers \
+                 within Vulkan's precision, so float outputs differ by a few ULP (README, \"Running your own \
+                 kernels\", gives the bound per function)",
+                inexact.join(", ")
+            );
+        }
+        let beyond = judgement.buffers.iter().filter(|b| !b.passes()).count();
+        if beyond > 0 {
+            bail!("{beyond} output buffer(s) beyond the tolerance (integers exact, f32 within --ulp)");
         }
     }
-    if failed {
-        bail!("the shader failed on at least one backend");
+    let failed = runs.len() - ran;
+    if failed > 0 {
+        bail!("{failed} backend(s) could not run the shader");
     }
     Ok(())
 }

@@ -1,0 +1,255 @@
+//! How closely backends agree on a shader's outputs (`cargo xtask run`, the corpus
+//! test): every output buffer of every backend against the same buffer of a reference
+//! backend, word by word, with each word's kind read from the IR. Integer words
+//! (`u32`, `i32`, atomics, ids, flags, counts) must be identical; `f32` words may differ
+//! by a declared number of units in the last place; padding is skipped. The verdict
+//! names how many words differ and the largest ULP distance, never only the first.
+
+use crate::compare::ulp_distance;
+use crate::run_kernel::BackendRun;
+use strata_kernels::WordKind;
+
+/// How far an `f32` word may be from the reference's.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FloatBound {
+    /// Units in the last place (0: bit-exact).
+    pub ulp: u32,
+    /// Values this close in absolute terms pass whatever their ULP distance (0: off).
+    /// A result that cancels to near zero (a difference of two velocities, `log` near
+    /// 1) keeps the absolute error of its operands, which is many ULPs of the small
+    /// result; Vulkan states `log`'s precision near 1 this way (2^-21 absolute).
+    pub abs: f32,
+}
+
+impl FloatBound {
+    /// Whether `got` is within the bound of `want` (bit patterns).
+    pub fn admits(&self, got: u32, want: u32) -> bool {
+        ulp_distance(got, want) <= self.ulp || (f32::from_bits(got) - f32::from_bits(want)).abs() <= self.abs
+    }
+}
+
+/// The bounds for `f32` words: one for every buffer, or per buffer name.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Tolerance {
+    /// Bound for buffers not named in `per_buffer` (default: bit-exact).
+    pub float: FloatBound,
+    /// (WGSL variable name, bound) overrides.
+    pub per_buffer: Vec<(String, FloatBound)>,
+}
+
+impl Tolerance {
+    /// The bound for buffer `name`.
+    pub fn bound_for(&self, name: &str) -> FloatBound {
+        self.per_buffer.iter().find(|(n, _)| n == name).map_or(self.float, |(_, bound)| *bound)
+    }
+}
+
+/// One backend's buffer against the reference's.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BufferAgreement {
+    /// The backend judged.
+    pub backend: String,
+    /// `@binding` number.
+    pub binding: u32,
+    /// WGSL variable name.
+    pub name: String,
+    /// Words compared (padding excluded).
+    pub words: usize,
+    /// Words not bit-identical (integers and floats).
+    pub differing: usize,
+    /// Integer words not identical.
+    pub integers_differing: usize,
+    /// Float words beyond the bound.
+    pub floats_beyond: usize,
+    /// Largest ULP distance among float words (NaN against a number counts as
+    /// `u32::MAX`).
+    pub max_ulp: u32,
+    /// The bound applied to float words.
+    pub bound: FloatBound,
+    /// The first word beyond the tolerance: (index, this backend's bits, reference bits).
+    pub first_beyond: Option<(usize, u32, u32)>,
+}
+
+impl BufferAgreement {
+    /// Whether the buffer is within the tolerance.
+    pub fn passes(&self) -> bool {
+        self.integers_differing == 0 && self.floats_beyond == 0
+    }
+
+    /// One line: identical, within the bound, or how far beyond it.
+    pub fn describe(&self) -> String {
+        if self.differing == 0 {
+            return format!("identical ({} words)", self.words);
+        }
+        let mut text = format!("{} of {} words differ", self.differing, self.words);
+        if self.max_ulp > 0 {
+            text += &format!(", max {} ULP on floats (bound {}", ulp_text(self.max_ulp), self.bound.ulp);
+            if self.bound.abs > 0.0 {
+                text += &format!(" or {:e} absolute", self.bound.abs);
+            }
+            text += ")";
+        }
+        if self.integers_differing > 0 {
+            text += &format!(", {} integer words differ", self.integers_differing);
+        }
+        if self.floats_beyond > 0 {
+            text += &format!(", {} floats beyond the bound", self.floats_beyond);
+        }
+        if let Some((index, got, want)) = self.first_beyond {
+            text += &format!("; first at word {index}: {got:#010x}, reference {want:#010x}");
+        }
+        text + if self.passes() { ": within tolerance" } else { ": FAILS" }
+    }
+}
+
+fn ulp_text(ulp: u32) -> String {
+    if ulp == u32::MAX { "NaN-vs-number".into() } else { ulp.to_string() }
+}
+
+/// Every backend's judgement against the reference.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Judgement {
+    /// The reference backend.
+    pub reference: String,
+    /// Every output buffer of every other backend that ran.
+    pub buffers: Vec<BufferAgreement>,
+    /// Backends that could not run the shader, with why.
+    pub failed: Vec<(String, String)>,
+}
+
+impl Judgement {
+    /// Whether every backend ran and every buffer is within tolerance.
+    pub fn passes(&self) -> bool {
+        self.failed.is_empty() && self.buffers.iter().all(BufferAgreement::passes)
+    }
+}
+
+/// Judges every run against the reference: `reference` by name, or the first backend
+/// that ran. `None` if fewer than one backend ran; an error if the named reference did
+/// not run.
+pub fn judge(runs: &[BackendRun], reference: Option<&str>, tolerance: &Tolerance) -> Result<Judgement, String> {
+    let failed: Vec<(String, String)> = runs
+        .iter()
+        .filter_map(|r| r.outputs.as_ref().err().map(|e| (r.backend.clone(), e.clone())))
+        .collect();
+    let reference_run = match reference {
+        Some(name) => runs.iter().find(|r| r.backend == name).ok_or_else(|| format!("reference `{name}` did not run"))?,
+        None => runs.iter().find(|r| r.outputs.is_ok()).ok_or_else(|| "no backend ran the shader".to_string())?,
+    };
+    let reference_outputs = reference_run
+        .outputs
+        .as_ref()
+        .map_err(|e| format!("the reference `{}` failed: {e}", reference_run.backend))?;
+    let mut buffers = Vec::new();
+    for run in runs.iter().filter(|r| r.backend != reference_run.backend) {
+        let Ok(outputs) = &run.outputs else { continue };
+        for (want, got) in reference_outputs.iter().zip(outputs) {
+            let bound = tolerance.bound_for(&want.name);
+            let mut agreement = BufferAgreement {
+                backend: run.backend.clone(),
+                binding: want.binding,
+                name: want.name.clone(),
+                words: 0,
+                differing: 0,
+                integers_differing: 0,
+                floats_beyond: 0,
+                max_ulp: 0,
+                bound,
+                first_beyond: None,
+            };
+            let words = want.bytes.len().max(got.bytes.len()) / 4;
+            for index in 0..words {
+                let kind = want.kinds.of(index);
+                if kind == WordKind::Padding {
+                    continue;
+                }
+                agreement.words += 1;
+                let read = |bytes: &[u8]| bytes.get(4 * index..4 * index + 4).map(|w| u32::from_le_bytes(w.try_into().unwrap()));
+                let (Some(g), Some(w)) = (read(&got.bytes), read(&want.bytes)) else {
+                    // Sizes differ: count the missing word as an integer mismatch.
+                    agreement.differing += 1;
+                    agreement.integers_differing += 1;
+                    continue;
+                };
+                if g == w {
+                    continue;
+                }
+                agreement.differing += 1;
+                let beyond = match kind {
+                    WordKind::Float => {
+                        let distance = ulp_distance(g, w);
+                        agreement.max_ulp = agreement.max_ulp.max(distance);
+                        let beyond = !bound.admits(g, w);
+                        agreement.floats_beyond += usize::from(beyond);
+                        beyond
+                    }
+                    _ => {
+                        agreement.integers_differing += 1;
+                        true
+                    }
+                };
+                if beyond && agreement.first_beyond.is_none() {
+                    agreement.first_beyond = Some((index, g, w));
+                }
+            }
+            buffers.push(agreement);
+        }
+    }
+    Ok(Judgement { reference: reference_run.backend.clone(), buffers, failed })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::run_kernel::OutputBuffer;
+    use strata_kernels::WordKinds;
+
+    fn ulps(ulp: u32) -> Tolerance {
+        Tolerance { float: FloatBound { ulp, abs: 0.0 }, ..Tolerance::default() }
+    }
+
+    fn run(backend: &str, words: &[u32]) -> BackendRun {
+        let bytes = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+        // Words alternate: integer, float, padding, float.
+        let kinds = WordKinds { head: Vec::new(), tail: vec![WordKind::Integer, WordKind::Float, WordKind::Padding, WordKind::Float] };
+        BackendRun { backend: backend.into(), outputs: Ok(vec![OutputBuffer { binding: 1, name: "out".into(), bytes, kinds }]) }
+    }
+
+    #[test]
+    fn integers_must_match_floats_may_differ_within_the_bound_padding_is_skipped() {
+        let one = 1.0f32.to_bits();
+        let reference = run("cpu", &[7, one, 0, one, 8, one, 0, one]);
+        let close = run("gl", &[7, one + 3, 0xdead, one, 8, one, 0, one - 2]);
+        let tolerance = ulps(3);
+        let judgement = judge(&[reference.clone(), close.clone()], None, &tolerance).unwrap();
+        let buffer = &judgement.buffers[0];
+        assert_eq!((buffer.words, buffer.differing, buffer.max_ulp), (6, 2, 3));
+        assert!(judgement.passes(), "{}", buffer.describe());
+        let strict = ulps(2);
+        let judgement = judge(&[reference.clone(), close.clone()], None, &strict).unwrap();
+        assert!(!judgement.passes());
+        assert_eq!(judgement.buffers[0].first_beyond, Some((1, one + 3, one)));
+        let per_buffer = Tolerance { per_buffer: vec![("out".into(), FloatBound { ulp: 3, abs: 0.0 })], ..Tolerance::default() };
+        assert!(judge(&[reference.clone(), close.clone()], None, &per_buffer).unwrap().passes());
+        // One ULP of 1.0 is 1.2e-7: an absolute floor of 4e-7 covers three.
+        let absolute = Tolerance { float: FloatBound { ulp: 0, abs: 4e-7 }, ..Tolerance::default() };
+        assert!(judge(&[reference.clone(), close.clone()], None, &absolute).unwrap().passes());
+        let too_small = Tolerance { float: FloatBound { ulp: 0, abs: 2e-7 }, ..Tolerance::default() };
+        assert!(!judge(&[reference.clone(), close], None, &too_small).unwrap().passes());
+        let wrong_id = run("hlsl", &[7, one, 0, one, 9, one, 0, one]);
+        let judgement = judge(&[reference, wrong_id], None, &ulps(1000)).unwrap();
+        assert_eq!(judgement.buffers[0].integers_differing, 1);
+        assert!(judgement.buffers[0].describe().ends_with("FAILS"), "{}", judgement.buffers[0].describe());
+    }
+
+    #[test]
+    fn a_failed_backend_fails_the_judgement_and_a_named_reference_must_have_run() {
+        let reference = run("cpu", &[1, 0, 0, 0]);
+        let broken = BackendRun { backend: "ash-hlsl".into(), outputs: Err("glslang rejected it".into()) };
+        let judgement = judge(&[reference.clone(), broken.clone()], None, &Tolerance::default()).unwrap();
+        assert!(!judgement.passes());
+        assert_eq!(judgement.failed, vec![("ash-hlsl".to_string(), "glslang rejected it".to_string())]);
+        assert!(judge(&[reference.clone(), broken], Some("ash-hlsl"), &Tolerance::default()).is_err());
+        assert!(judge(&[reference], Some("metal"), &Tolerance::default()).unwrap_err().contains("metal"));
+    }
+}

@@ -1,0 +1,365 @@
+//! Shaders written the way outside projects write them (`tests/data/corpus/`, written
+//! here): overrides in `@workgroup_size` and in expressions, a uniform struct of seven
+//! f32, read-only runtime arrays of structs read through `arrayLength`,
+//! `distance`/`normalize`/`exp`/`log`/`pow` in loops, atomics on storage and workgroup
+//! memory, 2-D and 3-D dispatches, `select` on vectors, u32 wrap-around and signed
+//! division and remainder. Each runs on all six paths (the interpreter, wgpu on Vulkan
+//! and GL, ash on naga's SPIR-V and on glslang's compilation of naga's GLSL and HLSL)
+//! through the same code as `cargo xtask run`, and every output buffer is judged against
+//! the interpreter's: integer words bit for bit, f32 words within the bound the case
+//! declares, with the reason beside it. Every case also checks that the judgement fails
+//! once one backend's output is corrupted (an integer word and, where there are floats,
+//! a float word moved past its bound).
+
+use strata_backends::{BackendError, GPU_REQUIRED_VARIABLE, gpu_required};
+use strata_check::BackendSlot;
+use strata_check::agreement::{FloatBound, Judgement, Tolerance, judge};
+use strata_check::run_kernel::{BackendRun, Inputs, named_slots, run_loaded};
+use strata_kernels::{Kernel, WordKind};
+
+/// The slots that can open here; a slot without a device is skipped, or fails the test
+/// under `STRATA_REQUIRE_GPU=1` when it needs Vulkan.
+fn available_slots() -> Vec<BackendSlot> {
+    let mut slots = Vec::new();
+    for slot in named_slots(&["all".to_string()]).unwrap() {
+        match (slot.open)() {
+            Ok(_) => slots.push(slot),
+            Err(error @ BackendError::NoAdapter { .. }) if !(gpu_required() && slot.needs_vulkan) => {
+                eprintln!("SKIPPED {} in the corpus: {error} (see {GPU_REQUIRED_VARIABLE})", slot.name);
+            }
+            Err(error) => panic!("{}: {error}", slot.name),
+        }
+    }
+    slots
+}
+
+/// One corpus shader run.
+struct Case {
+    file: &'static str,
+    entry: &'static str,
+    overrides: Vec<(String, f64)>,
+    workgroups: [u32; 3],
+    inputs: Inputs,
+    /// Bounds for f32 buffers (integers are always exact), each with why.
+    bounds: Vec<(&'static str, FloatBound, &'static str)>,
+    /// Reorders outputs whose order backends may choose (atomic slot claims).
+    normalise: Option<fn(&mut BackendRun)>,
+}
+
+fn source(file: &str) -> String {
+    let path = format!("{}/data/corpus/{file}", env!("CARGO_MANIFEST_DIR"));
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
+fn bytes<T: bytemuck::NoUninit>(values: &[T]) -> Vec<u8> {
+    bytemuck::cast_slice(values).to_vec()
+}
+
+/// A small deterministic generator (LCG, high bits).
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u32 {
+        self.0 = self.0.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+        (self.0 >> 32) as u32
+    }
+
+    fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * ((self.next() >> 8) as f32 / (1u32 << 24) as f32)
+    }
+}
+
+fn run_case(case: &Case, slots: &[BackendSlot]) -> (Kernel, Vec<BackendRun>, Judgement) {
+    let kernel = Kernel::from_wgsl_with_overrides(case.file, source(case.file), case.entry, false, &case.overrides)
+        .unwrap_or_else(|e| panic!("{}: {e}", case.file));
+    let mut runs = run_loaded(&kernel, &case.inputs, case.workgroups, slots);
+    if let Some(normalise) = case.normalise {
+        runs.iter_mut().for_each(normalise);
+    }
+    let tolerance = Tolerance {
+        float: FloatBound::default(),
+        per_buffer: case.bounds.iter().map(|(name, bound, _)| (name.to_string(), *bound)).collect(),
+    };
+    let judgement = judge(&runs, Some("cpu"), &tolerance).unwrap_or_else(|e| panic!("{}: {e}", case.file));
+    for buffer in &judgement.buffers {
+        eprintln!("{} {:<12} `{}`: {}", case.file, buffer.backend, buffer.name, buffer.describe());
+    }
+    (kernel, runs, judgement)
+}
+
+/// Runs the case, asserts every backend within tolerance, then corrupts the last
+/// backend's output and asserts that the judgement catches it.
+fn check(case: Case) {
+    let slots = available_slots();
+    let (_, runs, judgement) = run_case(&case, &slots);
+    let failures: Vec<String> = judgement
+        .failed
+        .iter()
+        .map(|(backend, why)| format!("{backend} failed: {why}"))
+        .chain(judgement.buffers.iter().filter(|b| !b.passes()).map(|b| format!("{} `{}`: {}", b.backend, b.name, b.describe())))
+        .collect();
+    assert!(failures.is_empty(), "{}:\n{}", case.file, failures.join("\n"));
+
+    // Negative control: the same judgement must fail on a corrupted output.
+    let tolerance = Tolerance {
+        float: FloatBound::default(),
+        per_buffer: case.bounds.iter().map(|(name, bound, _)| (name.to_string(), *bound)).collect(),
+    };
+    let last = runs.last().expect("at least the interpreter ran");
+    if last.backend == "cpu" {
+        return;
+    }
+    let outputs = last.outputs.as_ref().expect("checked above");
+    for kind in [WordKind::Integer, WordKind::Float] {
+        let Some((buffer, index)) = outputs
+            .iter()
+            .enumerate()
+            .find_map(|(b, o)| (0..o.bytes.len() / 4).find(|&i| o.kinds.of(i) == kind).map(|i| (b, i)))
+        else {
+            continue;
+        };
+        let mut corrupted = runs.clone();
+        let output = &mut corrupted.last_mut().unwrap().outputs.as_mut().unwrap()[buffer];
+        let name = output.name.clone();
+        let word = &mut output.bytes[4 * index..4 * index + 4];
+        let value = u32::from_le_bytes(word.try_into().unwrap());
+        // Integers: one bit; floats: far past any bound (flip the sign and exponent's top).
+        let bad = if kind == WordKind::Integer { value ^ 1 } else { value ^ 0xc000_0000 };
+        word.copy_from_slice(&bad.to_le_bytes());
+        let verdict = judge(&corrupted, Some("cpu"), &tolerance).unwrap();
+        assert!(!verdict.passes(), "{}: a corrupted {kind:?} word of `{name}` was not caught", case.file);
+    }
+}
+
+#[test]
+fn flocking_with_a_seven_float_uniform_and_array_length_agrees_everywhere() {
+    let mut rng = Rng(11);
+    let count = 1024usize;
+    let mut boids = Vec::new();
+    for _ in 0..count {
+        boids.extend([rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-0.1, 0.1), rng.range(-0.1, 0.1)]);
+    }
+    // dt, cohesion, separation, alignment distances, their three scales (+ padding).
+    let sim = [0.04f32, 0.1, 0.025, 0.025, 0.02, 0.05, 0.005, 0.0];
+    check(Case {
+        file: "flock2d.wgsl",
+        entry: "main",
+        overrides: Vec::new(),
+        workgroups: [count.div_ceil(64) as u32, 1, 1],
+        inputs: vec![(0, bytes(&sim)), (1, bytes(&boids)), (2, vec![0; count * 16]), (3, vec![0; count * 16])],
+        bounds: vec![(
+            "boids_out",
+            FloatBound { ulp: 4, abs: 1.5e-8 },
+            "the Vulkan paths are bit-identical to the interpreter; wgpu-gl (Mesa's GL compiler) differs by \
+             up to 2 ULP of the operands, ~4e-9 at the 0.1 speed scale, which after cancellation is up to 512 \
+             ULP of a velocity near 1e-4: two ULPs of 0.1 absolute (1.5e-8) cover it",
+        )],
+        normalise: None,
+    });
+}
+
+fn life_case(overrides: Vec<(String, f64)>, tile: u32) -> Case {
+    let (width, height) = (64u32, 48u32);
+    let mut rng = Rng(5);
+    let cells: Vec<u32> = (0..width * height).map(|_| u32::from(rng.next() % 100 < 35)).collect();
+    Case {
+        file: "life.wgsl",
+        entry: "main",
+        overrides,
+        workgroups: [width.div_ceil(tile), height.div_ceil(tile), 1],
+        inputs: vec![(0, bytes(&[width, height])), (1, bytes(&cells)), (2, vec![0; (width * height * 4) as usize])],
+        bounds: Vec::new(),
+        normalise: None,
+    }
+}
+
+#[test]
+fn overrides_in_workgroup_size_and_expressions_agree_everywhere() {
+    // The defaults: 8 × 8 workgroups, Conway's rule.
+    check(life_case(Vec::new(), 8));
+    // Overridden: 4 × 4 workgroups (four times as many) and birth on 2 neighbours.
+    check(life_case(vec![("tile".into(), 4.0), ("birth".into(), 2.0)], 4));
+}
+
+#[test]
+fn overriding_a_constant_changes_the_result_identically() {
+    let slots = available_slots();
+    let (_, default_runs, _) = run_case(&life_case(Vec::new(), 8), &slots);
+    let (_, overridden, _) = run_case(&life_case(vec![("birth".into(), 2.0)], 8), &slots);
+    let cells = |runs: &[BackendRun]| runs[0].outputs.as_ref().unwrap()[0].bytes.clone();
+    assert_ne!(cells(&default_runs), cells(&overridden), "birth = 2 must change the generation");
+    // Leaving tile at 8 with 4 × 4 dispatch sizes would leave cells unwritten: the
+    // workgroup size really is the override's.
+    let kernel = Kernel::from_wgsl_with_overrides("life.wgsl", source("life.wgsl"), "main", false, &[("tile".into(), 4.0)])
+        .unwrap();
+    assert_eq!(kernel.workgroup_size, [4, 4, 1]);
+}
+
+#[test]
+fn bad_overrides_are_named() {
+    let load = |overrides: &[(String, f64)]| {
+        Kernel::from_wgsl_with_overrides("life.wgsl", source("life.wgsl"), "main", false, overrides)
+            .unwrap_err()
+            .to_string()
+    };
+    let error = load(&[("tiles".into(), 4.0)]);
+    assert!(error.contains("`tiles` is not an override") && error.contains("tile, birth"), "{error}");
+    let error = load(&[("tile".into(), -1.0)]);
+    assert!(error.contains("tile=-1"), "{error}");
+    let error = load(&[("tile".into(), 0.0)]);
+    assert!(error.contains("workgroup_size"), "{error}");
+    let error = load(&[("birth".into(), 2.0), ("birth".into(), 3.0)]);
+    assert!(error.contains("`birth` is given twice"), "{error}");
+}
+
+#[test]
+fn softmax_with_exp_agrees_within_the_precision_of_exp() {
+    let (rows, columns) = (32u32, 200u32);
+    let mut rng = Rng(3);
+    let logits: Vec<f32> = (0..rows * columns).map(|_| rng.range(-9.0, 9.0)).collect();
+    check(Case {
+        file: "softmax.wgsl",
+        entry: "main",
+        overrides: Vec::new(),
+        workgroups: [rows, 1, 1],
+        inputs: vec![(0, bytes(&[rows, columns])), (1, bytes(&logits)), (2, vec![0; (rows * columns * 4) as usize])],
+        bounds: vec![(
+            "probabilities",
+            FloatBound { ulp: 40, abs: 0.0 },
+            "every GPU path is bit-identical to every other; the interpreter's exp is the platform's \
+             (within 1 ULP) and lavapipe's is within Vulkan's 3 + 2|x| ULP with x = logit - max down to -18 \
+             here (39 ULP); the sum and the quotient add a rounding each",
+        )],
+        normalise: None,
+    });
+}
+
+fn transcendental_case(entry: &'static str, bounds: Vec<(&'static str, FloatBound, &'static str)>) -> Case {
+    let count = 4096usize;
+    let mut rng = Rng(17);
+    let inputs: Vec<f32> = (0..count).map(|_| rng.range(0.05, 8.0)).collect();
+    let mut buffers = vec![(0, bytes(&inputs))];
+    buffers.extend((1..=5).map(|b| (b, vec![0u8; count * 4])));
+    Case {
+        file: "transcendentals.wgsl",
+        entry,
+        overrides: Vec::new(),
+        workgroups: [count.div_ceil(64) as u32, 1, 1],
+        inputs: buffers,
+        bounds,
+        normalise: None,
+    }
+}
+
+/// The interpreter's bounds against lavapipe per function (README, "Running your own
+/// kernels"): measured on this corpus, within Vulkan's precision requirements.
+const NEAR_ONE: f32 = 4.8e-7; // 2^-21: Vulkan's absolute bound for log and log2 on [0.5, 2]
+
+#[test]
+fn exp_log_and_pow_agree_within_their_stated_bounds() {
+    let why = "the interpreter's functions are the platform's (within 1 ULP); lavapipe's are within \
+               Vulkan's: exp and exp2 3 + 2|x| ULP, log and log2 3 ULP outside [0.5, 2] and 2^-21 \
+               absolute inside, pow as exp2(y log2 x)";
+    check(transcendental_case(
+        "main",
+        vec![
+            ("exps", FloatBound { ulp: 11, abs: 0.0 }, why),
+            ("logs", FloatBound { ulp: 4, abs: NEAR_ONE }, why),
+            ("pows", FloatBound { ulp: 6, abs: 0.0 }, why),
+            ("exp2s", FloatBound { ulp: 11, abs: 0.0 }, why),
+            ("log2s", FloatBound { ulp: 4, abs: NEAR_ONE }, why),
+        ],
+    ));
+    // Four steps of each, each step a contraction: the bounds of one step, a few times.
+    check(transcendental_case(
+        "iterated",
+        vec![
+            ("exps", FloatBound { ulp: 8, abs: 0.0 }, why),
+            ("logs", FloatBound { ulp: 4, abs: 0.0 }, why),
+            ("pows", FloatBound { ulp: 16, abs: 0.0 }, why),
+            ("exp2s", FloatBound { ulp: 8, abs: 0.0 }, why),
+            ("log2s", FloatBound { ulp: 4, abs: 0.0 }, why),
+        ],
+    ));
+}
+
+/// The slot each workgroup claims depends on the order workgroups run in; the values
+/// must be the same multiset.
+fn sort_slots(run: &mut BackendRun) {
+    if let Ok(outputs) = &mut run.outputs {
+        for output in outputs.iter_mut().filter(|o| o.name == "slots") {
+            let mut words: Vec<u32> = bytemuck::pod_collect_to_vec(&output.bytes);
+            words.sort_unstable();
+            output.bytes = bytes(&words);
+        }
+    }
+}
+
+#[test]
+fn storage_and_workgroup_atomics_are_exact_everywhere() {
+    let count = 5000u32;
+    let workgroups = count.div_ceil(128);
+    let mut rng = Rng(23);
+    let values: Vec<u32> = (0..count).map(|_| rng.next()).collect();
+    let summary = [u32::MAX, 0, 0, 0, 0];
+    let case = Case {
+        file: "atomics.wgsl",
+        entry: "main",
+        overrides: Vec::new(),
+        workgroups: [workgroups, 1, 1],
+        inputs: vec![(0, bytes(&values)), (1, vec![0; 256]), (2, bytes(&summary)), (3, vec![0; workgroups as usize * 4])],
+        bounds: Vec::new(),
+        normalise: Some(sort_slots),
+    };
+    // The interpreter against plain Rust: the histogram, min, max, or, xor.
+    let (_, runs, _) = run_case(&case, &[named_slots(&["cpu".into()]).unwrap().remove(0)]);
+    let outputs = runs[0].outputs.as_ref().unwrap();
+    let bins: Vec<u32> = bytemuck::pod_collect_to_vec(&outputs[0].bytes);
+    let mut want = vec![0u32; 64];
+    values.iter().for_each(|v| want[(v >> 26) as usize] += 1);
+    assert_eq!(bins, want);
+    let summary: Vec<u32> = bytemuck::pod_collect_to_vec(&outputs[1].bytes);
+    let or = values.iter().fold(0, |a, v| a | (v & 0x0f0f_0f0f));
+    let xor = values.iter().fold(0, |a, v| a ^ v);
+    let extremes = (*values.iter().min().unwrap(), *values.iter().max().unwrap());
+    assert_eq!(summary, vec![extremes.0, extremes.1, or, xor, workgroups]);
+    check(case);
+}
+
+#[test]
+fn a_3d_dispatch_with_wrapping_integers_and_vector_select_agrees_everywhere() {
+    let dims = [13u32, 9, 7, 0x0123_4567];
+    let voxels = (dims[0] * dims[1] * dims[2]) as usize;
+    let case = Case {
+        file: "volume.wgsl",
+        entry: "main",
+        overrides: Vec::new(),
+        workgroups: [dims[0].div_ceil(4), dims[1].div_ceil(4), dims[2].div_ceil(4)],
+        inputs: vec![(0, bytes(&dims)), (1, vec![0; voxels * 16]), (2, vec![0; voxels * 4])],
+        bounds: vec![(
+            "shades",
+            FloatBound { ulp: 2, abs: 0.0 },
+            "a three-term dot product: the HLSL path (glslang's OpDot) and Mesa's GL compiler round it \
+             differently from a multiply-then-add, by up to 2 ULP",
+        )],
+        normalise: None,
+    };
+    // The interpreter against plain Rust for the integer words (WGSL's wrapping and
+    // truncating semantics).
+    let (_, runs, _) = run_case(&case, &[named_slots(&["cpu".into()]).unwrap().remove(0)]);
+    let words: Vec<u32> = bytemuck::pod_collect_to_vec(&runs[0].outputs.as_ref().unwrap()[0].bytes);
+    let hash = |v: u32| {
+        let h = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+        let h = ((h >> ((h >> 28) + 4)) ^ h).wrapping_mul(277_803_737);
+        (h >> 22) ^ h
+    };
+    for index in 0..voxels as u32 {
+        let h = hash(index ^ dims[3]);
+        let wrapped = h.wrapping_mul(0x9E37_79B9).wrapping_add(0xFFFF_FFF0);
+        let divisor = if h & 1 == 1 { 5 } else { -7 };
+        let signed = h as i32;
+        let want = [wrapped, wrapped << (h & 31), signed.wrapping_div(divisor) as u32, signed.wrapping_rem(divisor) as u32];
+        assert_eq!(&words[4 * index as usize..4 * index as usize + 4], &want, "voxel {index}");
+    }
+    check(case);
+}

@@ -15,9 +15,9 @@ pub struct FloatBound {
     /// Units in the last place (0: bit-exact).
     pub ulp: u32,
     /// Values this close in absolute terms pass whatever their ULP distance (0: off).
-    /// A result that cancels to near zero (a difference of two velocities, `log` near
-    /// 1) keeps the absolute error of its operands, which is many ULPs of the small
-    /// result; Vulkan states `log`'s precision near 1 this way (2^-21 absolute).
+    /// A result that cancels to near zero (a difference of two velocities, or `log` of
+    /// a value near one) keeps the absolute error of its operands, which is many ULPs of
+    /// the small result; Vulkan states `log`'s precision near one this way (2^-21).
     pub abs: f32,
 }
 
@@ -128,18 +128,16 @@ impl Judgement {
 /// that ran. `None` if fewer than one backend ran; an error if the named reference did
 /// not run.
 pub fn judge(runs: &[BackendRun], reference: Option<&str>, tolerance: &Tolerance) -> Result<Judgement, String> {
-    let failed: Vec<(String, String)> = runs
-        .iter()
-        .filter_map(|r| r.outputs.as_ref().err().map(|e| (r.backend.clone(), e.clone())))
-        .collect();
+    let failed: Vec<(String, String)> =
+        runs.iter().filter_map(|r| r.outputs.as_ref().err().map(|e| (r.backend.clone(), e.clone()))).collect();
     let reference_run = match reference {
-        Some(name) => runs.iter().find(|r| r.backend == name).ok_or_else(|| format!("reference `{name}` did not run"))?,
+        Some(name) => {
+            runs.iter().find(|r| r.backend == name).ok_or_else(|| format!("reference `{name}` did not run"))?
+        }
         None => runs.iter().find(|r| r.outputs.is_ok()).ok_or_else(|| "no backend ran the shader".to_string())?,
     };
-    let reference_outputs = reference_run
-        .outputs
-        .as_ref()
-        .map_err(|e| format!("the reference `{}` failed: {e}", reference_run.backend))?;
+    let reference_outputs =
+        reference_run.outputs.as_ref().map_err(|e| format!("the reference `{}` failed: {e}", reference_run.backend))?;
     let mut buffers = Vec::new();
     for run in runs.iter().filter(|r| r.backend != reference_run.backend) {
         let Ok(outputs) = &run.outputs else { continue };
@@ -164,7 +162,9 @@ pub fn judge(runs: &[BackendRun], reference: Option<&str>, tolerance: &Tolerance
                     continue;
                 }
                 agreement.words += 1;
-                let read = |bytes: &[u8]| bytes.get(4 * index..4 * index + 4).map(|w| u32::from_le_bytes(w.try_into().unwrap()));
+                let read = |bytes: &[u8]| {
+                    bytes.get(4 * index..4 * index + 4).map(|w| u32::from_le_bytes(w.try_into().unwrap()))
+                };
                 let (Some(g), Some(w)) = (read(&got.bytes), read(&want.bytes)) else {
                     // Sizes differ: count the missing word as an integer mismatch.
                     agreement.differing += 1;
@@ -211,8 +211,14 @@ mod tests {
     fn run(backend: &str, words: &[u32]) -> BackendRun {
         let bytes = words.iter().flat_map(|w| w.to_le_bytes()).collect();
         // Words alternate: integer, float, padding, float.
-        let kinds = WordKinds { head: Vec::new(), tail: vec![WordKind::Integer, WordKind::Float, WordKind::Padding, WordKind::Float] };
-        BackendRun { backend: backend.into(), outputs: Ok(vec![OutputBuffer { binding: 1, name: "out".into(), bytes, kinds }]) }
+        let kinds = WordKinds {
+            head: Vec::new(),
+            tail: vec![WordKind::Integer, WordKind::Float, WordKind::Padding, WordKind::Float],
+        };
+        BackendRun {
+            backend: backend.into(),
+            outputs: Ok(vec![OutputBuffer { binding: 1, name: "out".into(), bytes, kinds }]),
+        }
     }
 
     #[test]
@@ -229,7 +235,8 @@ mod tests {
         let judgement = judge(&[reference.clone(), close.clone()], None, &strict).unwrap();
         assert!(!judgement.passes());
         assert_eq!(judgement.buffers[0].first_beyond, Some((1, one + 3, one)));
-        let per_buffer = Tolerance { per_buffer: vec![("out".into(), FloatBound { ulp: 3, abs: 0.0 })], ..Tolerance::default() };
+        let per_buffer =
+            Tolerance { per_buffer: vec![("out".into(), FloatBound { ulp: 3, abs: 0.0 })], ..Tolerance::default() };
         assert!(judge(&[reference.clone(), close.clone()], None, &per_buffer).unwrap().passes());
         // One ULP of 1.0 is 1.2e-7: an absolute floor of 4e-7 covers three.
         let absolute = Tolerance { float: FloatBound { ulp: 0, abs: 4e-7 }, ..Tolerance::default() };

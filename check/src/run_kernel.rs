@@ -69,7 +69,12 @@ pub fn load_shader(path: &Path, entry: &str, overrides: &[(String, f64)]) -> Res
 /// words), or zeros of the binding's minimum size.
 pub type Inputs = Vec<(u32, Vec<u8>)>;
 
-fn run_on(backend: &mut dyn Backend, kernel: &Kernel, inputs: &Inputs, workgroups: [u32; 3]) -> Result<Vec<OutputBuffer>> {
+fn run_on(
+    backend: &mut dyn Backend,
+    kernel: &Kernel,
+    inputs: &Inputs,
+    workgroups: [u32; 3],
+) -> Result<Vec<OutputBuffer>> {
     backend.check_kernel(kernel)?;
     let mut binds = Vec::new();
     for binding in &kernel.bindings {

@@ -25,6 +25,7 @@ pub mod constants;
 pub mod embed_types;
 pub mod error;
 pub mod glslang;
+pub mod integer_division;
 pub mod layout;
 pub mod reference;
 pub mod registry;

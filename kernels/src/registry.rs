@@ -195,8 +195,8 @@ fn specialise(
     }
     let declared: Vec<String> = module.overrides.iter().filter_map(|(_, o)| o.name.clone()).collect();
     let entry = (naga::ShaderStage::Compute, spec.entry_point.as_ref());
-    let (module, info) =
-        naga::back::pipeline_constants::process_overrides(&module, &info, Some(entry), &constants).map_err(|e| {
+    let (module, info) = naga::back::pipeline_constants::process_overrides(&module, &info, Some(entry), &constants)
+        .map_err(|e| {
             use naga::back::pipeline_constants::PipelineConstantError as E;
             let declared = if declared.is_empty() { "none".to_string() } else { declared.join(", ") };
             error(match e {

@@ -5,7 +5,8 @@
 //! * HLSL shader model 6.0 (wave intrinsics for the subgroup kernels); registers follow
 //!   WGSL: `@group(g) @binding(b)` → `register(?b, space g)`.
 //! * MSL 2.3 with an explicit per-entry-point buffer map (`[[buffer(b)]]`).
-//! * GLSL 4.50 core with `layout(binding = b)` from a binding map (GLSL has no sets).
+//! * GLSL 4.50 core with `layout(binding = b)` from a binding map (GLSL has no sets),
+//!   integer `/` and `%` written as helpers with WGSL's meaning (`integer_division`).
 //!
 //! WGSL zero-initialises workgroup memory. [`WorkgroupZeroInit`] says who does it: naga's
 //! polyfill (a store loop and a barrier in the shader: correct everywhere, slow on
@@ -156,17 +157,18 @@ pub fn glsl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, K
         entry_point: kernel.entry_point().into(),
         multiview: None,
     };
+    // GLSL leaves integer `%` of negative numbers and division by zero undefined; WGSL
+    // does not (see `integer_division`).
+    let defined = crate::integer_division::define_integer_division_validated(&kernel.module, &kernel.info)
+        .map_err(|e| error(kernel, "GLSL", e))?;
+    let (module, info) = match &defined {
+        Some((module, info)) => (module, info),
+        None => (&kernel.module, &kernel.info),
+    };
     let mut text = String::new();
-    glsl::Writer::new(
-        &mut text,
-        &kernel.module,
-        &kernel.info,
-        &glsl_options,
-        &pipeline,
-        naga::proc::BoundsCheckPolicies::default(),
-    )
-    .and_then(|mut writer| writer.write())
-    .map_err(|e| error(kernel, "GLSL", e))?;
+    glsl::Writer::new(&mut text, module, info, &glsl_options, &pipeline, naga::proc::BoundsCheckPolicies::default())
+        .and_then(|mut writer| writer.write())
+        .map_err(|e| error(kernel, "GLSL", e))?;
     Ok(Translation { text, words: Vec::new(), entry_point: "main".into() })
 }
 

@@ -149,15 +149,15 @@ mod tests {
     use WordKind::{Float as F, Integer as I, Padding as P};
 
     #[test]
-    fn a_struct_of_seven_floats_has_one_word_of_padding() {
+    fn a_struct_of_seven_floats_is_followed_by_padding() {
         let k = kinds(
             "struct S { a: f32, b: f32, c: f32, d: f32, e: f32, f: f32, g: f32 }
              @group(0) @binding(0) var<uniform> s: S;",
         );
-        // A uniform struct is rounded up to 16 bytes: seven floats, then padding.
-        assert_eq!(k.head, vec![F, F, F, F, F, F, F, P]);
+        // Seven floats (28 bytes); the rest of a 32-byte uniform buffer is padding.
+        assert_eq!(k.head, vec![F; 7]);
         assert!(k.tail.is_empty());
-        assert_eq!(k.of(9), P);
+        assert_eq!((k.of(6), k.of(7)), (F, P));
     }
 
     #[test]

@@ -48,47 +48,7 @@ enum Command {
         out: PathBuf,
     },
     /// Run any WGSL compute shader on chosen backends.
-    Run {
-        /// The WGSL file.
-        shader: PathBuf,
-        /// Compute entry point.
-        #[arg(long)]
-        entry: String,
-        /// Workgroups X,Y,Z.
-        #[arg(long, value_parser = parse_workgroups, default_value = "1,1,1")]
-        workgroups: [u32; 3],
-        /// GROUP:BINDING=FILE: buffer contents (repeatable).
-        #[arg(long = "buffer", value_parser = parse_buffer)]
-        buffers: Vec<(u32, u32, PathBuf)>,
-        /// GROUP:BINDING=BYTES: a zero-filled buffer of that size (default: the binding's minimum).
-        #[arg(long = "size", value_parser = parse_size)]
-        sizes: Vec<(u32, u32, u64)>,
-        /// NAME=VALUE: the value of an `override` constant (repeatable; by name, or by
-        /// `@id` number). Others keep their WGSL defaults. Applied once, by naga, before
-        /// any backend sees the shader, so every backend runs the same specialisation.
-        #[arg(long = "override", value_parser = parse_override)]
-        overrides: Vec<(String, f64)>,
-        /// Backends, comma-separated, or `all` (cpu, wgpu-vulkan, wgpu-gl, ash, ash-glsl,
-        /// ash-hlsl; `wgpu` means wgpu-vulkan).
-        #[arg(long, default_value = "cpu", value_delimiter = ',')]
-        backend: Vec<String>,
-        /// Tolerance for f32 words: N units in the last place for every buffer, or
-        /// BUFFER=N for one output buffer (repeatable). Integer words (detected from the
-        /// IR) must always be identical; padding is not compared. Default 0.
-        #[arg(long = "ulp", value_parser = parse_ulp)]
-        ulp: Vec<(Option<String>, u32)>,
-        /// Absolute floor for f32 words: E for every buffer or BUFFER=E for one
-        /// (repeatable); words this close pass whatever their ULP distance (results that
-        /// cancel to near zero, `log` near 1). Default: off.
-        #[arg(long = "abs", value_parser = parse_abs)]
-        abs: Vec<(Option<String>, f32)>,
-        /// The backend the others are compared with (default: the first that ran).
-        #[arg(long)]
-        reference: Option<String>,
-        /// Output folder.
-        #[arg(long, default_value = "target/run")]
-        out: PathBuf,
-    },
+    Run(Box<RunArgs>),
     /// Check that every kernel gives identical outputs on every backend.
     Check {
         /// At least 20 seeds at several sizes per kernel (default: 3 seeds, small sizes).
@@ -100,11 +60,57 @@ enum Command {
     },
 }
 
+/// `cargo xtask run`'s arguments.
+#[derive(clap::Args)]
+struct RunArgs {
+    /// The WGSL file.
+    shader: PathBuf,
+    /// Compute entry point.
+    #[arg(long)]
+    entry: String,
+    /// Workgroups X,Y,Z.
+    #[arg(long, value_parser = parse_workgroups, default_value = "1,1,1")]
+    workgroups: [u32; 3],
+    /// GROUP:BINDING=FILE: buffer contents (repeatable).
+    #[arg(long = "buffer", value_parser = parse_buffer)]
+    buffers: Vec<(u32, u32, PathBuf)>,
+    /// GROUP:BINDING=BYTES: a zero-filled buffer of that size (default: the binding's minimum).
+    #[arg(long = "size", value_parser = parse_size)]
+    sizes: Vec<(u32, u32, u64)>,
+    /// NAME=VALUE: the value of an `override` constant (repeatable; by name, or by
+    /// `@id` number). Others keep their WGSL defaults. Applied once, by naga, before
+    /// any backend sees the shader, so every backend runs the same specialisation.
+    #[arg(long = "override", value_parser = parse_override)]
+    overrides: Vec<(String, f64)>,
+    /// Backends, comma-separated, or `all` (cpu, wgpu-vulkan, wgpu-gl, ash, ash-glsl,
+    /// ash-hlsl; `wgpu` means wgpu-vulkan).
+    #[arg(long, default_value = "cpu", value_delimiter = ',')]
+    backend: Vec<String>,
+    /// Tolerance for f32 words: N units in the last place for every buffer, or
+    /// BUFFER=N for one output buffer (repeatable). Integer words (detected from the
+    /// IR) must always be identical; padding is not compared. Default 0.
+    #[arg(long = "ulp", value_parser = parse_ulp)]
+    ulp: Vec<(Option<String>, u32)>,
+    /// Absolute floor for f32 words: E for every buffer or BUFFER=E for one
+    /// (repeatable); words this close pass whatever their ULP distance (results that
+    /// cancel to near zero, `log` near 1). Default: off.
+    #[arg(long = "abs", value_parser = parse_abs)]
+    abs: Vec<(Option<String>, f32)>,
+    /// The backend the others are compared with (default: the first that ran).
+    #[arg(long)]
+    reference: Option<String>,
+    /// Output folder.
+    #[arg(long, default_value = "target/run")]
+    out: PathBuf,
+}
+
 fn main() {
     let result = match Cli::parse().command {
         Command::Shaders { strict, out } => shaders(strict, out),
         Command::Check { full, kernel } => check(full, &kernel),
-        Command::Run { shader, entry, workgroups, buffers, sizes, overrides, backend, ulp, abs, reference, out } => {
+        Command::Run(args) => {
+            let RunArgs { shader, entry, workgroups, buffers, sizes, overrides, backend, ulp, abs, reference, out } =
+                *args;
             let tolerance = tolerance(&ulp, &abs);
             let request = RunRequest { shader, entry, workgroups, buffers, sizes, overrides, backends: backend, out };
             run(request, &tolerance, reference.as_deref())
@@ -281,6 +287,7 @@ fn run(request: RunRequest, tolerance: &Tolerance, reference: Option<&str>) -> R
     }
     let ran = runs.iter().filter(|r| r.outputs.is_ok()).count();
     if ran > 1 || reference.is_some() {
+        let reference = reference.map(|name| if name == "wgpu" { "wgpu-vulkan" } else { name });
         let judgement = judge(&runs, reference, tolerance).map_err(anyhow::Error::msg)?;
         println!("against {}:", judgement.reference);
         for buffer in &judgement.buffers {

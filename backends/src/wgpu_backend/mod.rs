@@ -147,7 +147,7 @@ impl WgpuBackend {
             queue,
             info,
             buffers: BufferTable::default(),
-            pipelines: PipelineCache::default(),
+            pipelines: PipelineCache::new(options.api == WgpuApi::Gl),
             errors,
             timestamps,
         })

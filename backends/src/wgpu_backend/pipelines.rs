@@ -14,12 +14,19 @@ pub(super) struct Pipeline {
     pub(super) layout: wgpu::BindGroupLayout,
 }
 
-#[derive(Default)]
 pub(super) struct PipelineCache {
     pipelines: HashMap<KernelId, Arc<Pipeline>>,
+    /// Whether integer `/` and `%` are rewritten with WGSL's meaning before wgpu sees the
+    /// module: wgpu's GL back end writes them as GLSL's, undefined for negative operands
+    /// and zero divisors (`strata_kernels::integer_division`).
+    define_integer_division: bool,
 }
 
 impl PipelineCache {
+    pub(super) fn new(define_integer_division: bool) -> Self {
+        Self { pipelines: HashMap::new(), define_integer_division }
+    }
+
     pub(super) fn get_or_create(
         &mut self,
         device: &wgpu::Device,
@@ -58,9 +65,21 @@ impl PipelineCache {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
+        let defined = if self.define_integer_division {
+            strata_kernels::integer_division::define_integer_division_validated(&kernel.module, &kernel.info).map_err(
+                |message| BackendError::Validation {
+                    backend: "wgpu-gl".into(),
+                    operation: format!("integer division helpers for `{}`", kernel.name()),
+                    message,
+                },
+            )?
+        } else {
+            None
+        };
+        let naga_module = defined.map_or_else(|| kernel.module.clone(), |(module, _)| module);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(kernel.name()),
-            source: wgpu::ShaderSource::Naga(Cow::Owned(kernel.module.clone())),
+            source: wgpu::ShaderSource::Naga(Cow::Owned(naga_module)),
         });
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(kernel.name()),

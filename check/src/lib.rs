@@ -15,6 +15,7 @@ mod compare;
 mod empty;
 mod histogram;
 mod path;
+pub mod replay;
 mod report;
 mod restir;
 pub mod run_kernel;

@@ -88,3 +88,47 @@ fn bad_requests_are_named() {
     assert!(error.contains("nope"), "{error}");
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn a_shader_with_overrides_runs_everywhere_with_and_without_override() {
+    let dir = std::env::temp_dir().join(format!("strata-run-override-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (width, height) = (32u32, 16u32);
+    let size: Vec<u8> = [width, height].iter().flat_map(|v| v.to_le_bytes()).collect();
+    // A glider in an empty grid.
+    let mut cells = vec![0u32; (width * height) as usize];
+    for (x, y) in [(1, 0), (2, 1), (0, 2), (1, 2), (2, 2)] {
+        cells[(y * width + x) as usize] = 1;
+    }
+    std::fs::write(dir.join("size.bin"), size).unwrap();
+    std::fs::write(dir.join("cells.bin"), cells.iter().flat_map(|c| c.to_le_bytes()).collect::<Vec<u8>>()).unwrap();
+    let shader = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data/corpus/life.wgsl");
+    let mut live = Vec::new();
+    for (overrides, tile) in [(Vec::new(), 8), (vec![("tile".to_string(), 4.0), ("birth".to_string(), 2.0)], 4)] {
+        let request = RunRequest {
+            shader: shader.clone(),
+            entry: "main".into(),
+            workgroups: [width / tile, height / tile, 1],
+            buffers: vec![(0, 0, dir.join("size.bin")), (0, 1, dir.join("cells.bin"))],
+            sizes: vec![(0, 2, u64::from(width * height * 4))],
+            overrides,
+            backends: vec!["all".into()],
+            out: dir.join(format!("out{tile}")),
+        };
+        let runs = run_kernel(&request).unwrap().runs;
+        for run in &runs {
+            if let Err(error) = &run.outputs {
+                let skippable = !strata_backends::gpu_required() || run.backend == "wgpu-gl";
+                assert!(skippable, "{} failed: {error}", run.backend);
+            }
+        }
+        let judgement = judge(&runs, Some("cpu"), &Tolerance::default()).unwrap();
+        assert!(judgement.buffers.iter().all(|b| b.differing == 0), "{judgement:?}");
+        let count = &runs[0].outputs.as_ref().unwrap()[1].bytes;
+        live.push(u32::from_le_bytes(count[..4].try_into().unwrap()));
+    }
+    // Conway's rule keeps the glider's five cells; birth on two neighbours grows it.
+    assert_eq!(live[0], 5);
+    assert_ne!(live[1], 5);
+    std::fs::remove_dir_all(dir).unwrap();
+}

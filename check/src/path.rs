@@ -9,14 +9,13 @@
 //! diffuse) and a furnace-like scene with a conductor, a dielectric and an environment
 //! map, at sizes with partial workgroups up to 128².
 
-use super::replay::{Recording, RecordingBackend, outputs, replay};
+use super::replay::{Recording, recorded, recorded_outputs, replayed_outputs};
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use strata::histogram_pass::PassError;
 use strata::render::{GpuScene, RenderSettings, render};
 use strata::scene::{Environment, Material, Scene, default_scene};
 use strata_backends::Backend;
-use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_kernels::{KernelId, Registry};
 
 /// Checks [`KernelId::PathTrace`].
@@ -62,19 +61,10 @@ fn settings(case: &Case, scene: &Scene) -> RenderSettings {
 /// The interpreter's one-sample render of `case` with its `path_trace` dispatch
 /// recorded, once per case.
 fn recording(case: &Case) -> Arc<Recording> {
-    static RECORDINGS: Mutex<Vec<(String, Arc<Recording>)>> = Mutex::new(Vec::new());
-    let mut recordings = RECORDINGS.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-    if let Some((_, recording)) = recordings.iter().find(|(label, _)| *label == case.label) {
-        return Arc::clone(recording);
-    }
     let scene = scene(case);
-    let mut interpreter = CpuBackend::new(CpuOptions::default()).expect("the interpreter always opens");
-    let mut recorder = RecordingBackend::new(&mut interpreter, &[KernelId::PathTrace]);
-    let gpu_scene = GpuScene::build(&scene).expect("the check's scenes build");
-    render(&mut recorder, &gpu_scene, &settings(case, &scene), 1, |_| {}).expect("the interpreter path traces");
-    let recording = Arc::new(std::mem::take(&mut recorder.recording));
-    recordings.push((case.label.clone(), Arc::clone(&recording)));
-    recording
+    recorded(&[KernelId::PathTrace], &case.label, |backend| {
+        render(backend, &GpuScene::build(&scene)?, &settings(case, &scene), 1, |_| {}).map(drop)
+    })
 }
 
 /// The share of values that may exceed the bound, per case. On identical inputs (the
@@ -121,10 +111,7 @@ impl KernelCheck for PathTraceCheck {
     }
 
     fn run(&self, backend: &mut dyn Backend, case: &Case) -> Result<Vec<Output>, PassError> {
-        let recording = recording(case);
-        let dispatch = &recording[&KernelId::PathTrace];
-        let after = replay(backend, Registry::shared()?.get(KernelId::PathTrace), dispatch)?;
-        Ok(outputs(KernelId::PathTrace, dispatch, &after, float_compare()))
+        Ok(replayed_outputs(backend, KernelId::PathTrace, &recording(case), float_compare())?)
     }
 
     fn quick_slots(&self) -> Option<&'static [&'static str]> {
@@ -132,9 +119,6 @@ impl KernelCheck for PathTraceCheck {
     }
 
     fn reference(&self, case: &Case) -> Vec<Output> {
-        let recording = recording(case);
-        let dispatch = &recording[&KernelId::PathTrace];
-        let after: Vec<Vec<u8>> = dispatch.binds.iter().map(|(_, _, after)| after.clone()).collect();
-        outputs(KernelId::PathTrace, dispatch, &after, float_compare())
+        recorded_outputs(KernelId::PathTrace, &recording(case), float_compare())
     }
 }

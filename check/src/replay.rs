@@ -13,6 +13,7 @@
 
 use crate::compare::{Compare, Output};
 use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 use strata_backends::{Backend, BackendError, Bind, BufferId, DeviceInfo};
 use strata_kernels::{Kernel, KernelId, Registry, WordKind};
@@ -93,6 +94,52 @@ impl Backend for RecordingBackend<'_> {
         self.dispatch(kernel, binds, workgroups)?;
         Ok(Duration::ZERO)
     }
+}
+
+/// The recording of `kernels` made by `run` on the interpreter, made once per process
+/// for each `(kernels, key)`: every kernel's check and every backend replay the same.
+pub fn recorded(
+    kernels: &[KernelId],
+    key: &str,
+    run: impl FnOnce(&mut dyn Backend) -> Result<(), strata::histogram_pass::PassError>,
+) -> Arc<Recording> {
+    static RECORDINGS: Mutex<Vec<(String, Arc<Recording>)>> = Mutex::new(Vec::new());
+    let key = format!("{kernels:?} {key}");
+    let mut recordings = RECORDINGS.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    if let Some((_, recording)) = recordings.iter().find(|(k, _)| *k == key) {
+        return Arc::clone(recording);
+    }
+    let mut interpreter =
+        strata_backends::cpu_backend::CpuBackend::new(Default::default()).expect("the interpreter always opens");
+    let mut recorder = RecordingBackend::new(&mut interpreter, kernels);
+    run(&mut recorder).unwrap_or_else(|e| panic!("the interpreter runs {key}: {e}"));
+    let recording = Arc::new(std::mem::take(&mut recorder.recording));
+    recordings.push((key, Arc::clone(&recording)));
+    recording
+}
+
+/// The interpreter's outputs of its recorded dispatch of `kernel_id`, as [`outputs`].
+pub fn recorded_outputs(kernel_id: KernelId, recording: &Recording, float: Compare) -> Vec<Output> {
+    let dispatch = &recording[&kernel_id];
+    let after: Vec<Vec<u8>> = dispatch.binds.iter().map(|(_, _, after)| after.clone()).collect();
+    outputs(kernel_id, dispatch, &after, float)
+}
+
+/// Replays the recorded dispatch of `kernel_id` on `backend`, as [`outputs`].
+pub fn replayed_outputs(
+    backend: &mut dyn Backend,
+    kernel_id: KernelId,
+    recording: &Recording,
+    float: Compare,
+) -> Result<Vec<Output>, BackendError> {
+    let dispatch = &recording[&kernel_id];
+    let registry = Registry::shared().map_err(|e| BackendError::Validation {
+        backend: "replay".into(),
+        operation: "registry".into(),
+        message: e.to_string(),
+    })?;
+    let after = replay(backend, registry.get(kernel_id), dispatch)?;
+    Ok(outputs(kernel_id, dispatch, &after, float))
 }
 
 /// Runs the recorded dispatch of `kernel` on `backend` from the recorded inputs and

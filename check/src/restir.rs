@@ -9,14 +9,13 @@
 //! sources) must be identical and f32 words within the registry's bound for the kernel
 //! (its reasons are in the catalogue), with at most one value in 10 000 beyond it.
 
-use super::replay::{Recording, RecordingBackend, outputs, replay};
+use super::replay::{Recording, recorded, recorded_outputs, replayed_outputs};
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use strata::histogram_pass::PassError;
 use strata::render::{GpuScene, RenderSettings};
 use strata::restir::{Method, RestirRenderer, RestirSettings};
 use strata_backends::Backend;
-use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_kernels::selection::{SamplerVariant, SelectionSettings};
 use strata_kernels::{KernelId, Registry};
 
@@ -65,20 +64,9 @@ const RESTIR_KERNELS: [KernelId; 5] = [
     KernelId::RestirShade,
 ];
 
-/// The interpreter's two-frame chain of `case`, recorded once per case (every kernel's
-/// check and every backend replay the same recording).
+/// The interpreter's two-frame chain of `case`, recorded once per case.
 fn recording(case: &Case) -> Arc<Recording> {
-    static RECORDINGS: Mutex<Vec<(String, Arc<Recording>)>> = Mutex::new(Vec::new());
-    let mut recordings = RECORDINGS.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-    if let Some((_, recording)) = recordings.iter().find(|(label, _)| *label == case.label) {
-        return Arc::clone(recording);
-    }
-    let mut interpreter = CpuBackend::new(CpuOptions::default()).expect("the interpreter always opens");
-    let mut recorder = RecordingBackend::new(&mut interpreter, &RESTIR_KERNELS);
-    frame(&mut recorder, case).expect("the interpreter runs the ReSTIR frame");
-    let recording = Arc::new(std::mem::take(&mut recorder.recording));
-    recordings.push((case.label.clone(), Arc::clone(&recording)));
-    recording
+    recorded(&RESTIR_KERNELS, &case.label, |backend| frame(backend, case))
 }
 
 impl RestirCheck {
@@ -89,10 +77,6 @@ impl RestirCheck {
         // units) is many ULPs of its small value (2 of 196 608 values at 128², glass,
         // metal and environment room).
         Compare::Float { ulp, max_outside: 1e-4 }
-    }
-
-    fn dispatch(&self, case: &Case) -> (Arc<Recording>, KernelId) {
-        (recording(case), self.0)
     }
 }
 
@@ -128,11 +112,7 @@ impl KernelCheck for RestirCheck {
     }
 
     fn run(&self, backend: &mut dyn Backend, case: &Case) -> Result<Vec<Output>, PassError> {
-        let (recording, id) = self.dispatch(case);
-        let dispatch = &recording[&id];
-        let kernel = Registry::shared()?.get(id);
-        let after = replay(backend, kernel, dispatch)?;
-        Ok(outputs(id, dispatch, &after, self.float_compare()))
+        Ok(replayed_outputs(backend, self.0, &recording(case), self.float_compare())?)
     }
 
     fn quick_slots(&self) -> Option<&'static [&'static str]> {
@@ -140,9 +120,6 @@ impl KernelCheck for RestirCheck {
     }
 
     fn reference(&self, case: &Case) -> Vec<Output> {
-        let (recording, id) = self.dispatch(case);
-        let dispatch = &recording[&id];
-        let after: Vec<Vec<u8>> = dispatch.binds.iter().map(|(_, _, after)| after.clone()).collect();
-        outputs(id, dispatch, &after, self.float_compare())
+        recorded_outputs(self.0, &recording(case), self.float_compare())
     }
 }

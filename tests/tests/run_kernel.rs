@@ -33,6 +33,19 @@ fn setup(name: &str) -> (PathBuf, RunRequest) {
     (dir, request)
 }
 
+/// Every backend ran (wgpu-gl may lack a device, as may every GPU backend without
+/// `STRATA_REQUIRE_GPU=1`) and every output is bit-identical to the interpreter's.
+fn every_backend_agrees(runs: &[strata_check::run_kernel::BackendRun]) {
+    for run in runs {
+        if let Err(error) = &run.outputs {
+            let skippable = !strata_backends::gpu_required() || run.backend == "wgpu-gl";
+            assert!(skippable, "{} failed: {error}", run.backend);
+        }
+    }
+    let judgement = judge(runs, Some("cpu"), &Tolerance::default()).unwrap();
+    assert!(judgement.buffers.iter().all(|b| b.differing == 0), "{judgement:?}");
+}
+
 #[test]
 fn a_shader_runs_on_the_interpreter_and_its_output_is_written() {
     let (dir, request) = setup("cpu");
@@ -49,15 +62,7 @@ fn a_shader_runs_on_the_interpreter_and_its_output_is_written() {
 fn every_backend_agrees_on_a_foreign_shader() {
     let (dir, mut request) = setup("all");
     request.backends = vec!["all".into()];
-    let runs = run_kernel(&request).unwrap().runs;
-    for run in &runs {
-        if let Err(error) = &run.outputs {
-            let skippable = !strata_backends::gpu_required() || run.backend == "wgpu-gl";
-            assert!(skippable, "{} failed: {error}", run.backend);
-        }
-    }
-    let judgement = judge(&runs, Some("cpu"), &Tolerance::default()).unwrap();
-    assert!(judgement.buffers.iter().all(|b| b.differing == 0), "{judgement:?}");
+    every_backend_agrees(&run_kernel(&request).unwrap().runs);
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -116,14 +121,7 @@ fn a_shader_with_overrides_runs_everywhere_with_and_without_override() {
             out: dir.join(format!("out{tile}")),
         };
         let runs = run_kernel(&request).unwrap().runs;
-        for run in &runs {
-            if let Err(error) = &run.outputs {
-                let skippable = !strata_backends::gpu_required() || run.backend == "wgpu-gl";
-                assert!(skippable, "{} failed: {error}", run.backend);
-            }
-        }
-        let judgement = judge(&runs, Some("cpu"), &Tolerance::default()).unwrap();
-        assert!(judgement.buffers.iter().all(|b| b.differing == 0), "{judgement:?}");
+        every_backend_agrees(&runs);
         let count = &runs[0].outputs.as_ref().unwrap()[1].bytes;
         live.push(u32::from_le_bytes(count[..4].try_into().unwrap()));
     }

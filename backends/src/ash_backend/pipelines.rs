@@ -49,7 +49,12 @@ impl PipelineCache {
             SpirvSource::GlslangFromGlsl => GlslangInput::Glsl,
             SpirvSource::GlslangFromHlsl => GlslangInput::Hlsl,
         };
-        let dir = std::env::temp_dir().join(format!("strata-glslang-{}", std::process::id()));
+        // One folder per compilation: threads of one process compile kernels of the same
+        // name (every external kernel is named after its entry point, often `main`), and
+        // each removes its folder when done.
+        static COMPILATIONS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let n = COMPILATIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!("strata-glslang-{}-{n}", std::process::id()));
         let result = glslang::compile(kernel, glslang_input, &dir);
         let _ = std::fs::remove_dir_all(&dir);
         result.map_err(|error| BackendError::Validation {

@@ -6,6 +6,7 @@
 pub mod backend_choice;
 pub mod evaluation;
 pub mod histogram_pass;
+pub mod progress;
 pub mod render;
 pub mod restir;
 pub mod rgb_image;

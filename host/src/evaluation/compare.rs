@@ -50,7 +50,7 @@ pub struct Comparison {
 
 /// Renders every method × seed × frame of `comparison` and measures each frame against
 /// its reference (`references[frame]`, or `references[0]` for every frame); `on_frame`
-/// sees every image (method, seed, frame, image).
+/// sees every image (method, seed, frame, image, the wall time of rendering it).
 pub fn run_comparison(
     backend: &mut dyn Backend,
     scene: &GpuScene,
@@ -58,7 +58,7 @@ pub fn run_comparison(
     scene_extent: f32,
     comparison: &Comparison,
     references: &[RgbImage],
-    mut on_frame: impl FnMut(Method, u32, u32, &RgbImage),
+    mut on_frame: impl FnMut(Method, u32, u32, &RgbImage, std::time::Duration),
 ) -> Result<Vec<FrameError>, PassError> {
     let mut errors = Vec::new();
     for &method in &comparison.methods {
@@ -70,7 +70,9 @@ pub fn run_comparison(
             let result = (|| {
                 for frame in 0..comparison.frames {
                     let camera = comparison.cameras.get(frame as usize);
+                    let started = std::time::Instant::now();
                     let (image, stats) = renderer.render_frame(backend, camera)?;
+                    let render_time = started.elapsed();
                     let reference = references.get(frame as usize).unwrap_or(&references[0]);
                     if stats.invalid_pixels > 0 {
                         return Err(PassError::Input(format!(
@@ -111,7 +113,7 @@ pub fn run_comparison(
                         mse: measure(metrics::mse(&shown, reference))?,
                         relmse_luminance: Some(measure(metrics::relmse_luminance(&shown, reference))?),
                     });
-                    on_frame(method, seed, frame, &shown);
+                    on_frame(method, seed, frame, &shown, render_time);
                 }
                 Ok(())
             })();

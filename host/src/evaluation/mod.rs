@@ -1,13 +1,18 @@
 //! Evaluation of the renderer: [`compare`] renders every method from the same seeds
 //! against a reference, [`metrics`] and [`variance`] measure the images (with and
-//! without the reference), [`plot`] draws RelMSE over frames, [`summary`] prints the
-//! ratio and variance tables and [`report`] runs a whole comparison from a plain options
-//! struct. It runs the renderer and the command line runs it, so it is
+//! without the reference), [`plot`] draws RelMSE and ratios over frames, [`summary`]
+//! makes the ratio and variance tables, [`crops`] picks close-ups, [`page`] writes
+//! `report.html`, [`record`] says what ran where, [`output_folder`] keeps one run per
+//! folder, and [`report`] runs a whole comparison from a plain options struct. It runs the renderer and the command line runs it, so it is
 //! a module of the host crate rather than a crate below it.
 
 pub mod compare;
+pub mod crops;
 pub mod metrics;
+pub mod output_folder;
+pub mod page;
 pub mod plot;
+pub mod record;
 pub mod report;
 pub mod summary;
 pub mod variance;

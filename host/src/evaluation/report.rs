@@ -1,19 +1,25 @@
 //! What `strata compare` does once the reference exists: every method and seed rendered
-//! ([`super::compare::run_comparison`]), the first seed's images and error maps written,
-//! `errors.csv`, `relmse.svg` and (with 3 seeds or more) `variance.csv`, and the summary
-//! printed. Driven by [`ReportOptions`], a plain struct: the command line fills it from
-//! its arguments, and anything else (a script, a test, a report page) can too.
+//! ([`super::compare::run_comparison`]) and, in the output folder, the first seed's
+//! images and error maps at the written frames, `errors.csv`, the plots, `variance.csv`
+//! (3 seeds or more), `summary.txt` (the printed summary), `run.json` (the run's
+//! record) and `report.html` (all of it on one page, [`super::page`]). Driven by
+//! [`ReportOptions`], a plain struct: the command line fills it from its arguments, and
+//! anything else (a script, a test) can too.
 
-use super::compare::{
-    Comparison, FrameError, errors_csv, luminance_relmse_ratio, relmse_over_seeds, relmse_ratio, run_comparison,
-};
-use super::metrics::{self, MeanInterval, Metric};
+use super::compare::{Comparison, errors_csv, run_comparison};
+use super::crops::{self, Crop};
+use super::metrics::{self, Metric};
+use super::page::{CropShown, FrameImages, MethodImage, Page};
+use super::record::{MethodTime, RunRecord};
+use super::summary::{self, SeedImages, Table};
+use crate::progress::Progress;
 use crate::render::{GpuScene, RenderSettings};
 use crate::restir::Method;
 use crate::rgb_image::RgbImage;
 use anyhow::{Context, Result};
-use std::path::PathBuf;
-use std::time::Instant;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 /// What to run and where to write it.
 #[derive(Clone, Debug, PartialEq)]
@@ -24,22 +30,41 @@ pub struct ReportOptions {
     pub frames: u32,
     /// Independent renders (seeds 1..=N) per method.
     pub seeds: u32,
-    /// Output folder (exists).
+    /// Output folder (exists, and holds no earlier run's files: see
+    /// [`super::output_folder::prepare`]).
     pub out: PathBuf,
     /// Exposure of the PNG previews.
     pub exposure: f32,
-    /// The scene's name in the plot's title.
+    /// The scene's name in titles.
     pub scene_name: String,
-    /// Frames accumulated rather than temporally reused (said in the plot's title).
+    /// Frames accumulated rather than temporally reused (said in the titles).
     pub accumulate: bool,
+    /// Close-ups the user asked for (`--crop`), shown before the automatic ones.
+    pub crops: Vec<Crop>,
+    /// Automatic close-ups, chosen where the methods differ most.
+    pub automatic_crops: usize,
+    /// The run's record so far (what, where, when); the frame times and the whole run's
+    /// duration are filled in here.
+    pub record: RunRecord,
+    /// When the run began (the reference included), for the record's duration.
+    pub started: Instant,
 }
 
-/// A paired ratio of one error column between two methods at one frame.
-type RatioOf = fn(&[FrameError], Method, Method, u32) -> Option<MeanInterval>;
+/// The frames whose images are written and shown: 1, 2, 4, … and the last (0-based).
+pub fn shown_frames(frames: u32) -> Vec<u32> {
+    (0..frames).filter(|f| (f + 1).is_power_of_two() || f + 1 == frames).collect()
+}
+
+/// Seed 1's image of one method at one shown frame, as the page needs it.
+struct Written {
+    image: String,
+    error_map: String,
+    relmse: f64,
+    map: Vec<f64>,
+}
 
 /// Renders every method and seed, writes the files and prints the summary (see the
 /// module docs).
-/// Runs `comparison`, writes its images, error maps and CSV, prints the summary.
 pub fn run_and_report(
     options: &ReportOptions,
     backend: &mut dyn strata_backends::Backend,
@@ -49,103 +74,224 @@ pub fn run_and_report(
     comparison: &Comparison,
     references: &[RgbImage],
 ) -> Result<()> {
+    let out = &options.out;
     let total = u64::from(options.frames) * u64::from(options.seeds) * options.methods.len() as u64;
-    let bar = indicatif::ProgressBar::new(total);
-    let started = Instant::now();
+    let mut progress = Progress::new("methods", total, "frames");
+    let compared = Instant::now();
     let mut write_error: Option<anyhow::Error> = None;
-    let shown: Vec<u32> =
-        (0..options.frames).filter(|f| (f + 1).is_power_of_two() || f + 1 == options.frames).collect();
-    // Every seed's image of the shown frames, for the variance over seeds.
-    let mut seed_images: std::collections::HashMap<(Method, u32), Vec<RgbImage>> = Default::default();
-    let errors =
-        run_comparison(backend, gpu_scene, render, extent, comparison, references, |method, seed, frame, image| {
-            bar.inc(1);
-            if options.seeds >= 3 && shown.contains(&frame) {
+    let shown = shown_frames(options.frames);
+    let mut seed_images: SeedImages = HashMap::new();
+    let mut written: HashMap<(Method, u32), Written> = HashMap::new();
+    let mut render_time: HashMap<Method, (Duration, u32)> = HashMap::new();
+    let errors = run_comparison(
+        backend,
+        gpu_scene,
+        render,
+        extent,
+        comparison,
+        references,
+        |method, seed, frame, image, took| {
+            progress.inc(1);
+            let time = render_time.entry(method).or_default();
+            time.0 += took;
+            time.1 += 1;
+            if !shown.contains(&frame) {
+                return;
+            }
+            if options.seeds >= 3 {
                 seed_images.entry((method, frame)).or_default().push(image.clone());
             }
-            // Images of the first seed: the first frame and every power of two.
-            if seed == 1 && ((frame + 1).is_power_of_two() || frame + 1 == options.frames) {
-                let stem = options.out.join(format!("{}_frame{:03}", method.name(), frame + 1));
-                let result = (|| -> Result<()> {
-                    image.write_exr(&stem.with_extension("exr"))?;
-                    image.write_png(&stem.with_extension("png"), options.exposure)?;
-                    let reference = references.get(frame as usize).unwrap_or(&references[0]);
-                    let map = metrics::error_map(image, reference, Metric::Relmse)?;
-                    let error_stem = options.out.join(format!("{}_frame{:03}_relmse", method.name(), frame + 1));
-                    metrics::false_colour(&map, image.width, image.height)
-                        .write_png(&error_stem.with_extension("png"), 1.0)?;
-                    RgbImage {
-                        width: image.width,
-                        height: image.height,
-                        pixels: map.iter().map(|&e| [e as f32; 3]).collect(),
+            if seed == 1 {
+                let reference = references.get(frame as usize).unwrap_or(&references[0]);
+                match write_frame(out, method, frame, image, reference, options.exposure) {
+                    Ok(w) => {
+                        written.insert((method, frame), w);
                     }
-                    .write_exr(&error_stem.with_extension("exr"))?;
-                    Ok(())
-                })();
-                if let Err(error) = result {
-                    write_error.get_or_insert(error);
+                    Err(error) => {
+                        write_error.get_or_insert(error);
+                    }
                 }
             }
-        })?;
-    bar.finish_and_clear();
+        },
+    )?;
+    progress.finish();
     if let Some(error) = write_error {
         return Err(error);
     }
-    let csv = options.out.join("errors.csv");
-    std::fs::write(&csv, errors_csv(&errors)).with_context(|| format!("{}: cannot write", csv.display()))?;
+    let compare_seconds = compared.elapsed().as_secs_f64();
+    write(&out.join("errors.csv"), errors_csv(&errors))?;
+
+    // Plots.
+    let mode = if options.accumulate { "accumulated frames" } else { "temporal reuse" };
     let title = format!(
-        "{} {}x{}, {} seeds{}",
-        options.scene_name,
-        render.camera.width,
-        render.camera.height,
-        options.seeds,
-        if options.accumulate { ", accumulated frames" } else { ", temporal reuse" }
+        "{} {}x{}, {} seeds, {mode}",
+        options.scene_name, render.camera.width, render.camera.height, options.seeds
     );
-    let plot = options.out.join("relmse.svg");
-    std::fs::write(&plot, super::plot::relmse_svg(&errors, &options.methods, options.frames, &title))
-        .with_context(|| format!("{}: cannot write", plot.display()))?;
-    println!(
-        "{} frames x {} seeds x {} methods in {:.1} s; RelMSE (paper's form), mean ± 95% CI over seeds:",
+    super::plot::write_relmse_plot(&errors, &options.methods, options.frames, &title, &out.join("relmse"))?;
+    let mut plots =
+        vec![("relmse.svg".to_string(), "RelMSE against frame: mean and 95 % interval over seeds".to_string())];
+    if super::plot::write_ratio_plot(&errors, options.frames, &title, &out.join("relmse_ratio"))? {
+        plots.push((
+            "relmse_ratio.svg".to_string(),
+            "strata ÷ each baseline against frame: paired per seed, mean and 95 % interval".to_string(),
+        ));
+    }
+
+    // The summary: printed, in summary.txt and on the page.
+    let heading = format!(
+        "{} frames x {} seeds x {} methods in {compare_seconds:.1} s; RelMSE (paper's form), mean ± 95% CI over seeds:",
         options.frames,
         options.seeds,
         options.methods.len(),
-        started.elapsed().as_secs_f64()
     );
-    print!("{:<18}", "method");
-    for f in &shown {
-        print!(" | {:>20}", format!("frame {}", f + 1));
+    let mut tables: Vec<Table> = vec![summary::relmse_table(&errors, &options.methods, &shown, &heading)];
+    let mut text = tables[0].to_text();
+    for line in summary::whole_run_lines(&errors, options.frames) {
+        text += &format!("{line}\n");
     }
-    println!();
-    for &method in &options.methods {
-        print!("{:<18}", method.name());
-        for &f in &shown {
-            print!(" | {:>20}", relmse_over_seeds(&errors, method, f).to_string());
-        }
-        println!();
-    }
-    if options.methods.contains(&Method::Strata) {
-        for baseline in [Method::Restir, Method::RestirDisc] {
-            if !options.methods.contains(&baseline) {
-                continue;
-            }
-            for (suffix, ratio_of) in [("", relmse_ratio as RatioOf), (" luma", luminance_relmse_ratio)] {
-                print!("{:<18}", format!("÷ {}{suffix}", baseline.name()));
-                for &f in &shown {
-                    let ratio = ratio_of(&errors, Method::Strata, baseline, f);
-                    let text = ratio.map(|r| format!("{:.3} ± {:.3}", r.mean, r.half_width)).unwrap_or_default();
-                    print!(" | {text:>20}");
-                }
-                println!();
-            }
-        }
-        super::summary::print_ratio_over_frames(&errors, options.frames);
-    }
-    let mut wrote = format!("{}, {}", csv.display(), plot.display());
     if options.seeds >= 3 {
-        let path = options.out.join("variance.csv");
-        super::summary::print_variance(&options.methods, &shown, &seed_images, references, &path)?;
-        wrote += &format!(", {}", path.display());
+        let (variance, csv) = summary::variance_tables(&options.methods, &shown, &seed_images, references)?;
+        write(&out.join("variance.csv"), csv)?;
+        for table in &variance {
+            text += &table.to_text();
+        }
+        tables.extend(variance);
     }
-    println!("wrote {wrote} and images in {}", options.out.display());
+    print!("{text}");
+
+    // The record.
+    let mut record = options.record.clone();
+    record.frame_ms = options
+        .methods
+        .iter()
+        .filter_map(|&m| {
+            let (time, count) = render_time.get(&m)?;
+            Some(MethodTime { method: m.name().to_string(), frame_ms: time.as_secs_f64() * 1e3 / f64::from(*count) })
+        })
+        .collect();
+    record.seconds = options.started.elapsed().as_secs_f64();
+    let record_text: String = record.lines().iter().map(|(k, v)| format!("{k}: {v}\n")).collect();
+    write(&out.join("summary.txt"), format!("{text}\n{record_text}"))?;
+    write(&out.join("run.json"), record.to_json())?;
+
+    // The page.
+    let reference_png = write_reference_pngs(out, references, &shown, options.exposure)?;
+    write_colour_bar(&out.join("relmse_colourbar.png"))?;
+    let (width, height) = (render.camera.width, render.camera.height);
+    let page_crops = choose_crops(options, &written, width, height);
+    let frames = shown
+        .iter()
+        .map(|&frame| FrameImages {
+            frame,
+            reference: reference_png(frame),
+            methods: options
+                .methods
+                .iter()
+                .filter_map(|&method| {
+                    let w = written.get(&(method, frame))?;
+                    Some(MethodImage {
+                        method,
+                        image: w.image.clone(),
+                        error_map: w.error_map.clone(),
+                        relmse: w.relmse,
+                        crop_relmse: page_crops.iter().map(|c| c.crop.mean_of(&w.map, width)).collect(),
+                    })
+                })
+                .collect(),
+        })
+        .collect();
+    let last = shown.last().copied().unwrap_or(0);
+    let page = Page {
+        title: format!("strata compare: {}, {mode}", options.scene_name),
+        record: &record,
+        size: (width, height),
+        frames,
+        crops: page_crops,
+        crop_frames: if last == 0 { vec![0] } else { vec![0, last] },
+        whole_run: summary::whole_run_ratios(&errors),
+        plots,
+        tables,
+        colour_bar: "relmse_colourbar.png".to_string(),
+    };
+    let report = out.join("report.html");
+    write(&report, page.to_html())?;
+    println!("wrote the report {} (with summary.txt, run.json, errors.csv, plots and images)", report.display());
     Ok(())
+}
+
+/// Writes `text` to `path`; an error names the file.
+fn write(path: &Path, text: String) -> Result<()> {
+    std::fs::write(path, text).with_context(|| format!("{}: cannot write", path.display()))
+}
+
+/// Writes one seed-1 frame of a method: EXR and PNG, and its RelMSE map as EXR and
+/// false-colour PNG.
+fn write_frame(
+    out: &Path,
+    method: Method,
+    frame: u32,
+    image: &RgbImage,
+    reference: &RgbImage,
+    exposure: f32,
+) -> Result<Written> {
+    let stem = format!("{}_frame{:03}", method.name(), frame + 1);
+    image.write_exr(&out.join(format!("{stem}.exr")))?;
+    image.write_png(&out.join(format!("{stem}.png")), exposure)?;
+    let map = metrics::error_map(image, reference, Metric::Relmse)?;
+    metrics::false_colour(&map, image.width, image.height).write_png(&out.join(format!("{stem}_relmse.png")), 1.0)?;
+    RgbImage { width: image.width, height: image.height, pixels: map.iter().map(|&e| [e as f32; 3]).collect() }
+        .write_exr(&out.join(format!("{stem}_relmse.exr")))?;
+    let relmse = map.iter().sum::<f64>() / map.len().max(1) as f64;
+    Ok(Written { image: format!("{stem}.png"), error_map: format!("{stem}_relmse.png"), relmse, map })
+}
+
+/// The reference PNGs the page shows: `reference.png` for a static camera, one per shown
+/// frame for a moving one. Returns the file name of each frame's reference.
+fn write_reference_pngs(
+    out: &Path,
+    references: &[RgbImage],
+    shown: &[u32],
+    exposure: f32,
+) -> Result<impl Fn(u32) -> String + use<>> {
+    let moving = references.len() > 1;
+    if moving {
+        for &frame in shown {
+            let reference = references.get(frame as usize).unwrap_or(&references[0]);
+            reference.write_png(&out.join(format!("reference_frame{:03}.png", frame + 1)), exposure)?;
+        }
+    } else {
+        references[0].write_png(&out.join("reference.png"), exposure)?;
+    }
+    Ok(
+        move |frame: u32| {
+            if moving { format!("reference_frame{:03}.png", frame + 1) } else { "reference.png".to_string() }
+        },
+    )
+}
+
+/// The error maps' colour bar: [`metrics::false_colour`] over RelMSE 1e-4 to 1.
+fn write_colour_bar(path: &Path) -> Result<()> {
+    let (width, height) = (320u32, 14u32);
+    let map: Vec<f64> = (0..height)
+        .flat_map(|_| (0..width).map(move |x| 10f64.powf(-4.0 + 4.0 * f64::from(x) / f64::from(width - 1))))
+        .collect();
+    Ok(metrics::false_colour(&map, width, height).write_png(path, 1.0)?)
+}
+
+/// The user's crops, then the automatic ones, chosen on frame 1's error maps.
+fn choose_crops(
+    options: &ReportOptions,
+    written: &HashMap<(Method, u32), Written>,
+    width: u32,
+    height: u32,
+) -> Vec<CropShown> {
+    let maps: Vec<Vec<f64>> =
+        options.methods.iter().filter_map(|&m| written.get(&(m, 0)).map(|w| w.map.clone())).collect();
+    let automatic = crops::where_methods_differ(&maps, width, height, options.automatic_crops, &options.crops);
+    options
+        .crops
+        .iter()
+        .map(|&crop| CropShown { crop, automatic: false })
+        .chain(automatic.into_iter().map(|crop| CropShown { crop, automatic: true }))
+        .collect()
 }

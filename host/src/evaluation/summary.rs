@@ -1,49 +1,181 @@
-//! The printed summary of `strata compare`: strata's whole-run ratio to each baseline and
-//! the reference-free table of relative variance over seeds (with `variance.csv`).
-//! Plain data in, text out; the command line decides what to show.
+//! The summary of `strata compare` as data: tables of RelMSE over seeds with strata's
+//! paired ratios, strata's whole-run ratio to each baseline, and the reference-free
+//! tables of relative variance over seeds (with `variance.csv`). Plain data in, tables
+//! out; [`Table::to_text`] prints them (stdout, `summary.txt`) and the report page
+//! writes the same tables as HTML, so the two never disagree.
 
-use super::compare::{FrameError, relmse_ratio_over_frames};
-use super::metrics;
+use super::compare::{FrameError, luminance_relmse_ratio, relmse_over_seeds, relmse_ratio, relmse_ratio_over_frames};
+use super::metrics::{self, MeanInterval};
 use crate::restir::Method;
 use crate::rgb_image::RgbImage;
-use anyhow::{Context, Result};
+use anyhow::Result;
 
-/// strata ÷ each baseline over the whole run, one paired ratio per baseline the errors
-/// hold ([`relmse_ratio_over_frames`]).
-pub fn print_ratio_over_frames(errors: &[FrameError], frames: u32) {
-    for baseline in [Method::Restir, Method::RestirDisc] {
-        if let Some(r) = relmse_ratio_over_frames(errors, Method::Strata, baseline) {
-            println!(
-                "strata ÷ {} over frames 1-{frames} (per seed, RelMSE summed over the frames): {:.4} ± {:.4} ({} seeds)",
-                baseline.name(),
-                r.mean,
-                r.half_width,
-                r.count
-            );
+/// A table with a label column and one column per shown frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Table {
+    /// What the table shows, one sentence.
+    pub title: String,
+    /// Header of the label column, then of each value column.
+    pub columns: Vec<String>,
+    /// The rows.
+    pub rows: Vec<Row>,
+}
+
+/// One row of a [`Table`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    /// The row's label (a method, or "÷ baseline" for strata's ratio to it).
+    pub label: String,
+    /// One cell per value column (empty where there is nothing to show).
+    pub cells: Vec<String>,
+    /// A ratio row (strata ÷ a baseline) rather than a method's own values.
+    pub is_ratio: bool,
+}
+
+impl Table {
+    /// The table as fixed-width text: the title, then rows of `label | cell | …`.
+    pub fn to_text(&self) -> String {
+        let mut text = format!("{}\n", self.title);
+        let line = |label: &str, cells: &[String]| {
+            let mut line = format!("{label:<18}");
+            for cell in cells {
+                line += &format!(" | {cell:>20}");
+            }
+            line + "\n"
+        };
+        if let Some((label, cells)) = self.columns.split_first() {
+            text += &line(label, cells);
         }
+        for row in &self.rows {
+            text += &line(&row.label, &row.cells);
+        }
+        text
     }
 }
 
-/// The reference-free summary ([`super::variance`]), of the images and of their
-/// luminance: each method's relative variance over seeds at the shown frames, strata's
-/// ratio to each baseline with its jackknife interval, and `variance.csv` (method, frame,
-/// relvar, vs_restir / vs_restir_disc ratio ± half-width for strata, relvar_luminance).
-pub fn print_variance(
+/// A paired ratio of one error column between two methods at one frame.
+type RatioOf = fn(&[FrameError], Method, Method, u32) -> Option<MeanInterval>;
+
+/// `mean ± half-width` to 3 decimals, or empty.
+fn ratio_cell(ratio: Option<MeanInterval>) -> String {
+    ratio.map(|r| format!("{:.3} ± {:.3}", r.mean, r.half_width)).unwrap_or_default()
+}
+
+/// The baselines among `methods` that strata can be compared with.
+fn baselines(methods: &[Method]) -> Vec<Method> {
+    if !methods.contains(&Method::Strata) {
+        return Vec::new();
+    }
+    [Method::Restir, Method::RestirDisc].into_iter().filter(|b| methods.contains(b)).collect()
+}
+
+/// The frame columns' headers, "frame N" (1-based).
+fn frame_columns(first: &str, shown: &[u32]) -> Vec<String> {
+    std::iter::once(first.to_string()).chain(shown.iter().map(|f| format!("frame {}", f + 1))).collect()
+}
+
+/// RelMSE of each method at the shown frames (mean ± 95 % CI over seeds), then strata ÷
+/// each baseline, paired per seed, of RelMSE and of luminance RelMSE.
+pub fn relmse_table(errors: &[FrameError], methods: &[Method], shown: &[u32], title: &str) -> Table {
+    let mut rows: Vec<Row> = methods
+        .iter()
+        .map(|&m| Row {
+            label: m.name().to_string(),
+            cells: shown.iter().map(|&f| relmse_over_seeds(errors, m, f).to_string()).collect(),
+            is_ratio: false,
+        })
+        .collect();
+    for baseline in baselines(methods) {
+        for (suffix, ratio_of) in [("", relmse_ratio as RatioOf), (" luma", luminance_relmse_ratio)] {
+            rows.push(Row {
+                label: format!("÷ {}{suffix}", baseline.name()),
+                cells: shown.iter().map(|&f| ratio_cell(ratio_of(errors, Method::Strata, baseline, f))).collect(),
+                is_ratio: true,
+            });
+        }
+    }
+    Table { title: title.to_string(), columns: frame_columns("method", shown), rows }
+}
+
+/// strata ÷ one baseline over a whole run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WholeRunRatio {
+    /// The baseline.
+    pub baseline: Method,
+    /// Mean and 95 % interval over seeds of the per-seed ratio of summed RelMSE.
+    pub ratio: MeanInterval,
+}
+
+/// strata ÷ each baseline the errors hold, over the whole run ([`relmse_ratio_over_frames`]).
+pub fn whole_run_ratios(errors: &[FrameError]) -> Vec<WholeRunRatio> {
+    [Method::Restir, Method::RestirDisc]
+        .into_iter()
+        .filter_map(|baseline| {
+            Some(WholeRunRatio { baseline, ratio: relmse_ratio_over_frames(errors, Method::Strata, baseline)? })
+        })
+        .collect()
+}
+
+/// The sentence `strata compare` and `strata plot` print for each [`WholeRunRatio`].
+pub fn whole_run_lines(errors: &[FrameError], frames: u32) -> Vec<String> {
+    whole_run_ratios(errors)
+        .iter()
+        .map(|w| {
+            format!(
+                "strata ÷ {} over frames 1-{frames} (per seed, RelMSE summed over the frames): {:.4} ± {:.4} ({} seeds)",
+                w.baseline.name(),
+                w.ratio.mean,
+                w.ratio.half_width,
+                w.ratio.count
+            )
+        })
+        .collect()
+}
+
+/// Prints [`whole_run_lines`].
+pub fn print_ratio_over_frames(errors: &[FrameError], frames: u32) {
+    for line in whole_run_lines(errors, frames) {
+        println!("{line}");
+    }
+}
+
+/// Every seed's image of each (method, shown frame), for the variance over seeds.
+pub type SeedImages = std::collections::HashMap<(Method, u32), Vec<RgbImage>>;
+
+/// The reference-free summary ([`super::variance`]) of the images and of their
+/// luminance: each method's relative variance over seeds at the shown frames and
+/// strata's ratio to each baseline with its jackknife interval; and the text of
+/// `variance.csv` (method, frame, relvar, vs_restir / vs_restir_disc ratio ± half-width
+/// for strata, relvar_luminance).
+pub fn variance_tables(
     methods: &[Method],
     shown: &[u32],
-    seed_images: &std::collections::HashMap<(Method, u32), Vec<RgbImage>>,
+    seed_images: &SeedImages,
     references: &[RgbImage],
-    path: &std::path::Path,
-) -> Result<()> {
+) -> Result<(Vec<Table>, String)> {
     use super::variance::{relative_variance, variance_ratio};
     let reference = |frame: u32| references.get(frame as usize).unwrap_or(&references[0]).clone();
     let images = |method: Method, frame: u32| seed_images.get(&(method, frame)).cloned().unwrap_or_default();
     let grey_reference = |frame: u32| metrics::luminance_image(&reference(frame));
     let grey = |method: Method, frame: u32| images(method, frame).iter().map(metrics::luminance_image).collect();
-    println!("relative variance over seeds (reference-free RelMSE; ratio ± 95% jackknife interval):");
-    print_variance_rows(methods, shown, "", &images, &reference)?;
-    println!("the same of luminance (the error without colour noise):");
-    print_variance_rows(methods, shown, " luma", &grey, &grey_reference)?;
+    let tables = vec![
+        variance_table(
+            "relative variance over seeds (reference-free RelMSE; ratio ± 95% jackknife interval):",
+            methods,
+            shown,
+            "",
+            &images,
+            &reference,
+        )?,
+        variance_table(
+            "the same of luminance (the error without colour noise):",
+            methods,
+            shown,
+            " luma",
+            &grey,
+            &grey_reference,
+        )?,
+    ];
     let mut csv = String::from(
         "method,frame,relvar,vs_restir,vs_restir_half_width,vs_restir_disc,vs_restir_disc_half_width,relvar_luminance\n",
     );
@@ -63,40 +195,83 @@ pub fn print_variance(
             csv += &format!("{},{},{value:.6e}{ratios},{luminance:.6e}\n", method.name(), f + 1);
         }
     }
-    std::fs::write(path, csv).with_context(|| format!("{}: cannot write", path.display()))?;
-    Ok(())
+    Ok((tables, csv))
 }
 
-/// One table of [`print_variance`]: a row per method, then strata ÷ each baseline; row
+/// One table of [`variance_tables`]: a row per method, then strata ÷ each baseline; row
 /// labels end with `suffix`.
-fn print_variance_rows(
+fn variance_table(
+    title: &str,
     methods: &[Method],
     shown: &[u32],
     suffix: &str,
     images: &dyn Fn(Method, u32) -> Vec<RgbImage>,
     reference: &dyn Fn(u32) -> RgbImage,
-) -> Result<()> {
+) -> Result<Table> {
     use super::variance::{relative_variance, variance_ratio};
+    let mut rows = Vec::new();
     for &method in methods {
-        print!("{:<18}", format!("{}{suffix}", method.name()));
-        for &f in shown {
-            let value = relative_variance(&images(method, f), &reference(f))?;
-            print!(" | {:>20}", format!("{value:.4e}"));
-        }
-        println!();
+        let cells = shown
+            .iter()
+            .map(|&f| Ok(format!("{:.4e}", relative_variance(&images(method, f), &reference(f))?)))
+            .collect::<Result<Vec<String>>>()?;
+        rows.push(Row { label: format!("{}{suffix}", method.name()), cells, is_ratio: false });
     }
-    if methods.contains(&Method::Strata) {
-        for baseline in [Method::Restir, Method::RestirDisc] {
-            if !methods.contains(&baseline) {
-                continue;
-            }
-            print!("{:<18}", format!("÷ {}{suffix}", baseline.name()));
-            for &f in shown {
+    for baseline in baselines(methods) {
+        let cells = shown
+            .iter()
+            .map(|&f| {
                 let r = variance_ratio(&images(Method::Strata, f), &images(baseline, f), &reference(f))?;
-                print!(" | {:>20}", format!("{:.3} ± {:.3}", r.mean, r.half_width));
-            }
-            println!();
-        }
+                Ok(format!("{:.3} ± {:.3}", r.mean, r.half_width))
+            })
+            .collect::<Result<Vec<String>>>()?;
+        rows.push(Row { label: format!("÷ {}{suffix}", baseline.name()), cells, is_ratio: true });
     }
-    Ok(())
+    Ok(Table { title: title.to_string(), columns: frame_columns("method", shown), rows })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn errors() -> Vec<FrameError> {
+        let mut errors = Vec::new();
+        for seed in 1..=3 {
+            for frame in 0..2 {
+                for (method, relmse) in [(Method::Restir, 2.0), (Method::Strata, 1.0 + f64::from(seed) * 0.01)] {
+                    errors.push(FrameError {
+                        method,
+                        frame,
+                        seed,
+                        relmse,
+                        prelmse: relmse,
+                        mse: relmse,
+                        relmse_luminance: Some(relmse),
+                    });
+                }
+            }
+        }
+        errors
+    }
+
+    #[test]
+    fn the_relmse_table_has_a_row_per_method_and_ratio_and_prints_them() {
+        let table = relmse_table(&errors(), &[Method::Restir, Method::Strata], &[0, 1], "RelMSE:");
+        let labels: Vec<&str> = table.rows.iter().map(|r| r.label.as_str()).collect();
+        assert_eq!(labels, ["restir", "strata", "÷ restir", "÷ restir luma"]);
+        assert_eq!(table.columns, ["method", "frame 1", "frame 2"]);
+        assert!(table.rows[2].cells[0].starts_with("0.510 ± 0.01"), "{:?}", table.rows[2]);
+        let text = table.to_text();
+        assert!(text.starts_with("RelMSE:\nmethod             |              frame 1 |"), "{text}");
+        assert_eq!(text.lines().count(), 6);
+        // No strata, no ratio rows.
+        assert_eq!(relmse_table(&errors(), &[Method::Restir], &[0], "").rows.len(), 1);
+    }
+
+    #[test]
+    fn whole_run_ratios_name_their_baseline() {
+        let lines = whole_run_lines(&errors(), 2);
+        assert_eq!(lines.len(), 1);
+        assert!(lines[0].starts_with("strata ÷ restir over frames 1-2") && lines[0].contains("(3 seeds)"), "{lines:?}");
+    }
 }

@@ -1,12 +1,17 @@
-//! `strata compare`: its arguments, the run of every method and seed against the
-//! reference, and the printed summary (ratios with intervals, ratios over frames,
-//! variance over seeds).
+//! `strata compare`: its arguments, the reference (read or path-traced, sized to the
+//! backend), and the run of every method and seed against it, which writes the report
+//! (`strata::evaluation::report`).
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use std::path::PathBuf;
+use std::time::Instant;
 use strata::backend_choice::{BackendChoice, open_backend};
 use strata::evaluation::compare::Comparison;
+use strata::evaluation::crops::{self, Crop};
+use strata::evaluation::output_folder;
+use strata::evaluation::record::{self, RunRecord};
 use strata::evaluation::report::{ReportOptions, run_and_report};
+use strata::progress::Progress;
 use strata::render::{GpuScene, RenderSettings};
 use strata::restir::{Method, RestirSettings, ShadedParts};
 use strata::rgb_image::RgbImage;
@@ -28,16 +33,25 @@ pub(crate) struct CompareArgs {
     /// Independent renders (seeds 1..=N) per method.
     #[arg(long, default_value_t = 8)]
     seeds: u32,
-    /// Output folder.
+    /// Output folder: `report.html` and everything it shows. Files an earlier run wrote
+    /// there are removed first; other files are left alone.
     #[arg(long, default_value = "out/compare")]
     out: PathBuf,
     /// Reference image (linear EXR of the same size); rendered by the path tracer when
     /// left out.
     #[arg(long)]
     reference: Option<PathBuf>,
-    /// Samples per pixel of the rendered reference.
-    #[arg(long, default_value_t = 1024)]
-    reference_spp: u32,
+    /// Samples per pixel of the rendered reference [default: 1024 on a Vulkan or GL
+    /// device, 256 on the CPU interpreter, which is about 8x slower].
+    #[arg(long)]
+    reference_spp: Option<u32>,
+    /// A close-up for the report, `x,y,w,h` in pixels (repeatable); shown before the
+    /// automatic ones.
+    #[arg(long, value_name = "X,Y,W,H")]
+    crop: Vec<Crop>,
+    /// Close-ups chosen automatically where the methods' errors differ most.
+    #[arg(long, default_value_t = 2)]
+    auto_crops: usize,
     /// Image width (default: the scene camera's).
     #[arg(long)]
     width: Option<u32>,
@@ -86,8 +100,22 @@ pub(crate) struct CompareArgs {
     backend: BackendChoice,
 }
 
+/// Reference samples per pixel when `--reference-spp` is left out: fewer on the CPU
+/// interpreter, so that the README's first command ends in minutes there too.
+fn default_reference_spp(backend: &dyn strata_backends::Backend) -> u32 {
+    if backend.info().backend == "cpu" { 256 } else { 1024 }
+}
+
 pub(crate) fn compare(args: CompareArgs) -> Result<()> {
+    let started = Instant::now();
+    let date = record::now_rfc3339();
     let (scene, render) = scene_and_settings(&args.scene, args.width, args.height)?;
+    for crop in &args.crop {
+        crops::check_inside(crop, render.camera.width, render.camera.height)?;
+    }
+    if args.reference_spp == Some(0) {
+        bail!("--reference-spp 0: at least one sample per pixel is needed");
+    }
     let render = RenderSettings { pixel_centres: args.pixel_centres, ..render };
     if args.frames == 0 || args.seeds == 0 {
         bail!("--frames and --seeds must be at least 1");
@@ -106,7 +134,7 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
     let gpu_scene = GpuScene::build(&scene)?;
     let mut backend = open_backend(args.backend)?;
     println!("backend: {}", backend.info().summary());
-    std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create the folder", args.out.display()))?;
+    let reference_spp = args.reference_spp.unwrap_or_else(|| default_reference_spp(backend.as_ref()));
     let camera_path = parse_camera_path(&args.camera_path, &render.camera)?;
     let cameras: Vec<_> = if camera_path.is_static() {
         Vec::new()
@@ -116,24 +144,40 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
     if !cameras.is_empty() && args.reference.is_some() {
         bail!("--reference: a moving camera (--camera-path {}) needs a reference per frame", args.camera_path);
     }
-    let references = if cameras.is_empty() {
-        vec![single_reference(&args, backend.as_mut(), &gpu_scene, &render)?]
+    // A reference file is read before the folder is cleared, so it may lie in it.
+    let given_reference = args.reference.as_deref().map(RgbImage::read_exr).transpose()?;
+    let removed = output_folder::prepare(&args.out, args.reference.as_deref())?;
+    if !removed.is_empty() {
+        println!("removed {} files of an earlier run from {}", removed.len(), args.out.display());
+    }
+    let reference_text;
+    let references = if let Some(image) = given_reference {
+        reference_text = format!("{}", args.reference.as_ref().map(|p| p.display().to_string()).unwrap_or_default());
+        vec![image]
+    } else if cameras.is_empty() {
+        let rendered = Instant::now();
+        let image = rendered_reference(&args, reference_spp, backend.as_mut(), &gpu_scene, &render)?;
+        reference_text =
+            format!("path-traced, {reference_spp} spp, in {}", strata::progress::words(rendered.elapsed()));
+        vec![image]
     } else {
-        println!(
-            "rendering {} references (one per frame): {} spp path tracing each",
-            cameras.len(),
-            args.reference_spp
-        );
-        let bar = indicatif::ProgressBar::new(cameras.len() as u64);
+        println!("rendering {} references (one per frame): {reference_spp} spp path tracing each", cameras.len(),);
+        let rendered = Instant::now();
+        let mut progress = Progress::new("references", cameras.len() as u64, "frames");
         let mut references = Vec::new();
         for (frame, camera) in cameras.iter().enumerate() {
             let settings = RenderSettings { seed: 0x7ef + frame as u32, camera: camera.clone(), ..render.clone() };
-            let image = strata::render::render(backend.as_mut(), &gpu_scene, &settings, args.reference_spp, |_| {})?;
+            let image = strata::render::render(backend.as_mut(), &gpu_scene, &settings, reference_spp, |_| {})?;
             image.write_exr(&args.out.join(format!("reference_frame{:03}.exr", frame + 1)))?;
             references.push(image);
-            bar.inc(1);
+            progress.inc(1);
         }
-        bar.finish_and_clear();
+        progress.finish();
+        reference_text = format!(
+            "path-traced per frame ({}), {reference_spp} spp each, in {}",
+            args.camera_path,
+            strata::progress::words(rendered.elapsed())
+        );
         references
     };
     let reference = &references[0];
@@ -154,40 +198,77 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
         accumulate: args.accumulate,
         cameras,
     };
+    let scene_name = args.scene.as_ref().and_then(|p| scene_stem(p)).unwrap_or_else(|| "default scene".into());
+    let record = RunRecord {
+        command_line: record::command_line(),
+        backend: backend.info().summary(),
+        version: env!("CARGO_PKG_VERSION").to_string(),
+        git_revision: record::GIT_REVISION.to_string(),
+        date,
+        scene: scene_name.clone(),
+        width: render.camera.width,
+        height: render.camera.height,
+        frames: args.frames,
+        seeds: args.seeds,
+        temporal: !args.accumulate,
+        reference: reference_text,
+        settings: settings_record(&restir, &args),
+        frame_ms: Vec::new(),
+        seconds: 0.0,
+    };
     let options = ReportOptions {
         methods: args.methods.clone(),
         frames: args.frames,
         seeds: args.seeds,
         out: args.out.clone(),
         exposure: args.exposure,
-        scene_name: args.scene.as_ref().and_then(|p| scene_stem(p)).unwrap_or_else(|| "default scene".into()),
+        scene_name,
         accumulate: args.accumulate,
+        crops: args.crop.clone(),
+        automatic_crops: args.auto_crops,
+        record,
+        started,
     };
     run_and_report(&options, backend.as_mut(), &gpu_scene, &render, scene.extent(), &comparison, &references)
 }
 
-/// The reference image: `--reference`, or path-traced at `--reference-spp` and written
-/// to the output folder.
-fn single_reference(
+/// The settings every method shared, by name, for the run's record.
+fn settings_record(restir: &RestirSettings, args: &CompareArgs) -> serde_json::Map<String, serde_json::Value> {
+    let s = &restir.selection;
+    let mut map = serde_json::Map::new();
+    let mut put = |name: &str, value: serde_json::Value| {
+        map.insert(name.to_string(), value);
+    };
+    put("methods", args.methods.iter().map(|m| m.name()).collect::<Vec<_>>().join(",").into());
+    put("block_size", s.block_size.into());
+    put("candidates", s.candidates.into());
+    put("masking", s.masking.into());
+    put("block_shift", s.block_shift.into());
+    let name = |v: &dyn Fn() -> Option<clap::builder::PossibleValue>| v().map(|p| p.get_name().to_string());
+    put("sampler", name(&|| clap::ValueEnum::to_possible_value(&s.sampler)).into());
+    put("temporal_candidates", restir.temporal_candidates.into());
+    put("temporal_cap", f64::from(restir.temporal_cap).into());
+    put("min_roughness", f64::from(restir.min_roughness).into());
+    put("min_distance", f64::from(restir.min_distance).into());
+    put("pixel_centres", args.pixel_centres.into());
+    put("shaded_parts", name(&|| clap::ValueEnum::to_possible_value(&restir.shaded_parts)).into());
+    put("camera_path", args.camera_path.clone().into());
+    map
+}
+
+/// The reference path-traced at `spp` and written to the output folder.
+fn rendered_reference(
     args: &CompareArgs,
+    spp: u32,
     backend: &mut dyn strata_backends::Backend,
     gpu_scene: &GpuScene,
     render: &RenderSettings,
 ) -> Result<RgbImage> {
-    Ok(match &args.reference {
-        Some(path) => RgbImage::read_exr(path)?,
-        None => {
-            println!("rendering the reference: {} spp path tracing", args.reference_spp);
-            let settings = RenderSettings { seed: 0x7ef, ..render.clone() };
-            let bar = indicatif::ProgressBar::new(u64::from(args.reference_spp));
-            let image = strata::render::render(backend, gpu_scene, &settings, args.reference_spp, |done| {
-                bar.set_position(u64::from(done))
-            })?;
-            bar.finish_and_clear();
-            let path = args.out.join("reference.exr");
-            image.write_exr(&path)?;
-            image.write_png(&args.out.join("reference.png"), args.exposure)?;
-            image
-        }
-    })
+    println!("rendering the reference: {spp} spp path tracing at {}x{}", render.camera.width, render.camera.height);
+    let settings = RenderSettings { seed: 0x7ef, ..render.clone() };
+    let mut progress = Progress::new("reference", u64::from(spp), "spp");
+    let image = strata::render::render(backend, gpu_scene, &settings, spp, |done| progress.set(u64::from(done)))?;
+    progress.finish();
+    image.write_exr(&args.out.join("reference.exr"))?;
+    Ok(image)
 }

@@ -45,14 +45,23 @@ enum Command {
 
 #[derive(clap::Args)]
 struct PlotArgs {
-    /// errors.csv written by `strata compare`.
-    csv: PathBuf,
-    /// The SVG to write.
-    #[arg(long, default_value = "relmse.svg")]
-    out: PathBuf,
-    /// Title of the plot.
-    #[arg(long, default_value = "RelMSE against frame")]
-    title: String,
+    /// errors.csv files written by `strata compare`. One gives the RelMSE plot and the
+    /// strata ÷ baseline plot; several are overlaid (methods keep their colours, runs get
+    /// line styles), e.g. block shift off and on.
+    #[arg(required = true, value_name = "CSV")]
+    csv: Vec<PathBuf>,
+    /// The legend's name of each CSV, in the CSVs' order (as many as CSVs). Default: each
+    /// CSV's folder name, or its file name where folder names repeat.
+    #[arg(long = "label", value_name = "NAME")]
+    labels: Vec<String>,
+    /// Where to write, without extension (a `.svg` or `.png` given is dropped). One CSV:
+    /// STEM.svg/.png and STEM_ratio.svg/.png (default stem `relmse`); several:
+    /// STEM_relmse.svg/.png and STEM_ratio.svg/.png (default stem `overlay`).
+    #[arg(long, value_name = "STEM")]
+    out: Option<PathBuf>,
+    /// Title of the plots. Default: the labels.
+    #[arg(long)]
+    title: Option<String>,
 }
 
 #[derive(clap::Args)]
@@ -178,20 +187,75 @@ pub(crate) fn scene_and_settings(
 }
 
 fn plot(args: PlotArgs) -> Result<()> {
-    let text = std::fs::read_to_string(&args.csv).with_context(|| format!("{}: cannot read", args.csv.display()))?;
-    let errors = strata::evaluation::compare::parse_errors_csv(&text)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", args.csv.display()))?;
-    let mut methods: Vec<Method> = Vec::new();
-    for e in &errors {
-        if !methods.contains(&e.method) {
-            methods.push(e.method);
+    use strata::evaluation::{compare, plot, summary};
+    /// Each CSV's folder name; its file name where folder names repeat or are missing;
+    /// its path where those repeat too.
+    fn default_labels(paths: &[PathBuf]) -> Vec<String> {
+        let distinct = |labels: &[Option<String>]| {
+            labels.iter().all(Option::is_some) && labels.iter().enumerate().all(|(i, l)| !labels[..i].contains(l))
+        };
+        let name = |p: Option<&std::ffi::OsStr>| p.map(|n| n.to_string_lossy().into_owned()).filter(|n| !n.is_empty());
+        let folders: Vec<Option<String>> = paths.iter().map(|p| name(p.parent().and_then(|p| p.file_name()))).collect();
+        let files: Vec<Option<String>> = paths.iter().map(|p| name(p.file_stem())).collect();
+        match (distinct(&folders), distinct(&files)) {
+            (true, _) => folders.into_iter().flatten().collect(),
+            (false, true) => files.into_iter().flatten().collect(),
+            _ => paths.iter().map(|p| p.display().to_string()).collect(),
         }
     }
-    let frames = errors.iter().map(|e| e.frame + 1).max().unwrap_or(1);
-    std::fs::write(&args.out, strata::evaluation::plot::relmse_svg(&errors, &methods, frames, &args.title))
-        .with_context(|| format!("{}: cannot write", args.out.display()))?;
-    println!("wrote {}", args.out.display());
-    strata::evaluation::summary::print_ratio_over_frames(&errors, frames);
+    if !args.labels.is_empty() && args.labels.len() != args.csv.len() {
+        bail!(
+            "{} --label for {} CSV files: give one label per CSV, in the same order, or none",
+            args.labels.len(),
+            args.csv.len()
+        );
+    }
+    let labels = if args.labels.is_empty() { default_labels(&args.csv) } else { args.labels.clone() };
+    let mut runs = Vec::new();
+    for (path, label) in args.csv.iter().zip(labels) {
+        let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
+        let errors = compare::parse_errors_csv(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        runs.push((label, errors));
+    }
+    let several = runs.len() > 1;
+    let mut stem = args.out.clone().unwrap_or_else(|| PathBuf::from(if several { "overlay" } else { "relmse" }));
+    if stem.extension().is_some_and(|e| e == "svg" || e == "png") {
+        stem.set_extension("");
+    }
+    let title =
+        args.title.clone().unwrap_or_else(|| runs.iter().map(|(l, _)| l.as_str()).collect::<Vec<_>>().join(" vs "));
+    let frames_of = |errors: &[compare::FrameError]| errors.iter().map(|e| e.frame + 1).max().unwrap_or(1);
+    let written: Vec<PathBuf> = if several {
+        plot::write_overlay_plots(&runs, &title, &stem)?
+    } else {
+        let errors = &runs[0].1;
+        let mut methods: Vec<Method> = Vec::new();
+        for e in errors {
+            if !methods.contains(&e.method) {
+                methods.push(e.method);
+            }
+        }
+        let frames = frames_of(errors);
+        let with = |suffix: &str| {
+            let mut name = stem.as_os_str().to_owned();
+            name.push(suffix);
+            PathBuf::from(name)
+        };
+        plot::write_relmse_plot(errors, &methods, frames, &title, &stem)?;
+        let mut written = vec![with(".svg"), with(".png")];
+        let ratio = with("_ratio");
+        if plot::write_ratio_plot(errors, frames, &title, &ratio)? {
+            written.extend([with("_ratio.svg"), with("_ratio.png")]);
+        }
+        written
+    };
+    println!("wrote {}", written.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "));
+    for (label, errors) in &runs {
+        if several {
+            println!("{label}:");
+        }
+        summary::print_ratio_over_frames(errors, frames_of(errors));
+    }
     Ok(())
 }
 

@@ -1,0 +1,86 @@
+//! The data of a plot: lines of (frame, mean, 95 % band) made from `errors.csv` rows,
+//! one per method (RelMSE over seeds) or per baseline (strata's paired ratio to it).
+//! Points that cannot be drawn (no rows, a mean that is NaN or infinite, or not positive
+//! on a log axis) are left out, and the line has a gap there.
+
+use super::style::Dash;
+use crate::evaluation::compare::{FrameError, relmse_over_seeds, relmse_ratio};
+use crate::evaluation::metrics::MeanInterval;
+use crate::restir::Method;
+
+/// One frame of a line.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Point {
+    /// Frame, counted from 1.
+    pub frame: u32,
+    /// The mean over seeds.
+    pub mean: f64,
+    /// The 95 % interval (low, high); `None` with fewer than two seeds.
+    pub band: Option<(f64, f64)>,
+}
+
+/// One line of a plot with its legend entry.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct Series {
+    /// The legend's text.
+    pub label: String,
+    /// CSS hex colour.
+    pub colour: &'static str,
+    /// Line style.
+    pub dash: Dash,
+    /// The drawable points, by frame.
+    pub points: Vec<Point>,
+}
+
+/// The methods in their fixed order (legend and drawing order never depend on the order
+/// of the rows or of a method list).
+pub(super) fn all_methods() -> &'static [Method] {
+    <Method as clap::ValueEnum>::value_variants()
+}
+
+/// The baselines strata is compared with: every other method.
+pub(super) fn baselines() -> impl Iterator<Item = Method> {
+    all_methods().iter().copied().filter(|&m| m != Method::Strata)
+}
+
+/// Frames 1..=N that `errors` hold (N the largest frame; 0 for no rows).
+pub(super) fn frame_count(errors: &[FrameError]) -> u32 {
+    errors.iter().map(|e| e.frame.saturating_add(1)).max().unwrap_or(0)
+}
+
+/// `method`'s RelMSE over seeds at frames 1..=`frames`; only positive finite means.
+pub(super) fn relmse_points(errors: &[FrameError], method: Method, frames: u32) -> Vec<Point> {
+    (0..frames).filter_map(|f| point(f, relmse_over_seeds(errors, method, f)).filter(|p| p.mean > 0.0)).collect()
+}
+
+/// strata ÷ `baseline`, paired per seed, at frames 1..=`frames`; only finite means.
+pub(super) fn ratio_points(errors: &[FrameError], baseline: Method, frames: u32) -> Vec<Point> {
+    (0..frames).filter_map(|f| point(f, relmse_ratio(errors, Method::Strata, baseline, f)?)).collect()
+}
+
+/// The point of 0-based `frame`, if its mean can be drawn; its band if the half-width is
+/// finite.
+fn point(frame: u32, interval: MeanInterval) -> Option<Point> {
+    (interval.count > 0 && interval.mean.is_finite()).then(|| Point {
+        frame: frame + 1,
+        mean: interval.mean,
+        band: interval
+            .half_width
+            .is_finite()
+            .then_some((interval.mean - interval.half_width, interval.mean + interval.half_width)),
+    })
+}
+
+/// The runs of consecutive frames in `points` (a missing frame splits the line).
+pub(super) fn segments(points: &[Point]) -> Vec<&[Point]> {
+    points.chunk_by(|a, b| b.frame == a.frame + 1).collect()
+}
+
+/// The runs of consecutive frames that all have a band.
+pub(super) fn band_segments(points: &[Point]) -> Vec<&[Point]> {
+    segments(points)
+        .into_iter()
+        .flat_map(|segment| segment.split(|p| p.band.is_none()))
+        .filter(|run| !run.is_empty())
+        .collect()
+}

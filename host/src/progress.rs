@@ -1,0 +1,152 @@
+//! Progress of long work as a person watching it wants it: on a terminal a labelled bar
+//! with elapsed time and an estimate of what is left (indicatif); when standard error is
+//! not a terminal (CI logs, `nohup`, a pipe), where indicatif draws nothing, one plain
+//! line every [`PLAIN_LINE_EVERY`] and a last one when the work ends, so a log still
+//! shows that the run is alive and how far it got.
+//!
+//! The estimate of the whole work is also said once, in words, as soon as the first
+//! step has been timed (see [`Progress::inc`]), so a run that will take many minutes
+//! says so before it takes them.
+
+use std::io::IsTerminal;
+use std::time::{Duration, Instant};
+
+/// How often a plain progress line is printed when standard error is not a terminal.
+pub const PLAIN_LINE_EVERY: Duration = Duration::from_secs(15);
+
+/// Work longer than this (estimated after the first step) is announced with its
+/// estimated duration.
+const ANNOUNCE_FROM: Duration = Duration::from_secs(20);
+
+/// One piece of long work counted in steps (samples per pixel, frames).
+pub struct Progress {
+    label: String,
+    unit: &'static str,
+    total: u64,
+    position: u64,
+    started: Instant,
+    last_plain_line: Instant,
+    announced: bool,
+    bar: Option<indicatif::ProgressBar>,
+}
+
+impl Progress {
+    /// Starts counting `total` steps of `unit` (e.g. "spp", "frames") for the work
+    /// named `label` (e.g. "reference"), drawing a bar when standard error is a terminal.
+    pub fn new(label: impl Into<String>, total: u64, unit: &'static str) -> Progress {
+        let label = label.into();
+        let bar = std::io::stderr().is_terminal().then(|| {
+            let bar = indicatif::ProgressBar::new(total);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template(&format!(
+                    "{{msg}} {{bar:32}} {{pos}}/{{len}} {unit}, {{elapsed}} elapsed, about {{eta}} left"
+                ))
+                .expect("a valid progress template"),
+            );
+            bar.set_message(label.clone());
+            bar
+        });
+        let now = Instant::now();
+        Progress { label, unit, total, position: 0, started: now, last_plain_line: now, announced: false, bar }
+    }
+
+    /// Sets the number of steps done.
+    pub fn set(&mut self, position: u64) {
+        self.position = position.min(self.total);
+        if let Some(bar) = &self.bar {
+            bar.set_position(self.position);
+        }
+        let elapsed = self.started.elapsed();
+        if !self.announced && self.position > 0 {
+            self.announced = true;
+            let estimate = self.estimated_total(elapsed);
+            if estimate >= ANNOUNCE_FROM {
+                self.say(&format!(
+                    "{}: {} {} estimated to take {} (from the first {})",
+                    self.label,
+                    self.total,
+                    self.unit,
+                    words(estimate),
+                    self.unit
+                ));
+            }
+        }
+        if self.bar.is_none() && self.last_plain_line.elapsed() >= PLAIN_LINE_EVERY && self.position < self.total {
+            self.last_plain_line = Instant::now();
+            let left = self.estimated_total(elapsed).saturating_sub(elapsed);
+            eprintln!(
+                "{}: {}/{} {}, {} elapsed, about {} left",
+                self.label,
+                self.position,
+                self.total,
+                self.unit,
+                words(elapsed),
+                words(left)
+            );
+        }
+    }
+
+    /// Adds `steps` to the steps done.
+    pub fn inc(&mut self, steps: u64) {
+        self.set(self.position + steps);
+    }
+
+    /// Ends the bar; a plain line says how long the work took.
+    pub fn finish(self) -> Duration {
+        let elapsed = self.started.elapsed();
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+        if self.bar.is_none() && elapsed >= PLAIN_LINE_EVERY {
+            eprintln!("{}: {} {} in {}", self.label, self.position, self.unit, words(elapsed));
+        }
+        elapsed
+    }
+
+    /// The whole work's duration extrapolated from the steps done so far.
+    fn estimated_total(&self, elapsed: Duration) -> Duration {
+        if self.position == 0 {
+            return Duration::ZERO;
+        }
+        elapsed.mul_f64(self.total as f64 / self.position as f64)
+    }
+
+    /// A line that stays above the bar.
+    fn say(&self, line: &str) {
+        match &self.bar {
+            Some(bar) => bar.println(line),
+            None => eprintln!("{line}"),
+        }
+    }
+}
+
+/// A duration as a person says it: "42 s", "3 min 5 s", "1 h 12 min".
+pub fn words(duration: Duration) -> String {
+    let seconds = duration.as_secs_f64().round() as u64;
+    match seconds {
+        0..60 => format!("{seconds} s"),
+        60..3600 => format!("{} min {} s", seconds / 60, seconds % 60),
+        _ => format!("{} h {} min", seconds / 3600, seconds % 3600 / 60),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn durations_read_as_words() {
+        assert_eq!(words(Duration::from_millis(400)), "0 s");
+        assert_eq!(words(Duration::from_secs(59)), "59 s");
+        assert_eq!(words(Duration::from_secs(185)), "3 min 5 s");
+        assert_eq!(words(Duration::from_secs(3600 + 12 * 60 + 5)), "1 h 12 min");
+    }
+
+    #[test]
+    fn the_estimate_extrapolates_the_steps_done() {
+        let mut progress = Progress::new("test", 10, "frames");
+        assert_eq!(progress.estimated_total(Duration::from_secs(3)), Duration::ZERO);
+        progress.position = 2;
+        assert_eq!(progress.estimated_total(Duration::from_secs(3)), Duration::from_secs(15));
+    }
+}

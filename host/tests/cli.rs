@@ -203,3 +203,45 @@ fn a_reference_of_another_size_is_refused_naming_both_sizes() {
 fn out_str(path: &Path) -> &str {
     path.to_str().expect("a UTF-8 temporary path")
 }
+
+#[test]
+fn a_user_mistake_is_one_line_without_a_backtrace_even_with_rust_backtrace_set() {
+    let out = scratch("one-line-error");
+    let missing = out.join("no-such-reference.exr");
+    let output = Command::new(env!("CARGO_BIN_EXE_strata"))
+        .args(["compare", "--width", "8", "--height", "8", "--reference"])
+        .arg(&missing)
+        .arg("--out")
+        .arg(&out)
+        .env("RUST_BACKTRACE", "1")
+        .env("RUST_LIB_BACKTRACE", "1")
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .expect("the strata binary runs");
+    let stderr = text(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "more than one line:\n{stderr}");
+    assert!(lines[0].starts_with("error: ") && lines[0].contains("no-such-reference.exr"), "{stderr}");
+    assert!(!stderr.to_lowercase().contains("backtrace"), "{stderr}");
+}
+
+#[test]
+fn a_second_run_into_the_same_folder_replaces_the_first_runs_files() {
+    let out = scratch("rerun");
+    std::fs::write(out.join("strata_frame999.png"), b"an older run's image").unwrap();
+    std::fs::write(out.join("notes.txt"), b"the user's own file").unwrap();
+    let args = ["compare", "--width", "8", "--height", "8", "--frames", "1", "--seeds", "2", "--reference-spp", "2"];
+    let output = strata_without_vulkan(&[&args[..], &["--out", out_str(&out)]].concat());
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    assert!(text(&output.stdout).contains("removed 1 files of an earlier run"), "{}", text(&output.stdout));
+    assert!(!out.join("strata_frame999.png").exists() && out.join("notes.txt").exists());
+    for file in ["report.html", "summary.txt", "run.json", "errors.csv", "relmse.svg", "relmse.png", "reference.png"] {
+        assert!(out.join(file).exists(), "no {file}");
+    }
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    assert_eq!(record["width"], 8);
+    assert!(record["command_line"].as_str().unwrap().contains("--reference-spp 2"), "{record}");
+    assert!(record["backend"].as_str().unwrap().starts_with("cpu"), "{record}");
+}

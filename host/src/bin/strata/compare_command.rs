@@ -24,14 +24,15 @@ use super::{scene_and_settings, scene_stem};
 pub(crate) struct CompareArgs {
     /// Scene file; the built-in default scene when left out.
     scene: Option<PathBuf>,
-    /// Frames per seed.
-    #[arg(long, default_value_t = 32)]
+    /// Frames per seed (the measurements in BENCHMARKS.md use 32).
+    #[arg(long, default_value_t = 16)]
     frames: u32,
     /// Methods, comma-separated.
     #[arg(long, value_enum, value_delimiter = ',', default_values_t = [Method::Restir, Method::RestirDisc, Method::Strata])]
     methods: Vec<Method>,
-    /// Independent renders (seeds 1..=N) per method.
-    #[arg(long, default_value_t = 8)]
+    /// Independent renders (seeds 1..=N) per method; the intervals need 2, the variance
+    /// tables 3 (the measurements in BENCHMARKS.md use 8).
+    #[arg(long, default_value_t = 4)]
     seeds: u32,
     /// Output folder: `report.html` and everything it shows. Files an earlier run wrote
     /// there are removed first; other files are left alone.
@@ -52,10 +53,10 @@ pub(crate) struct CompareArgs {
     /// Close-ups chosen automatically where the methods' errors differ most.
     #[arg(long, default_value_t = 2)]
     auto_crops: usize,
-    /// Image width (default: the scene camera's).
+    /// Image width [default: the scene camera's; half of it on the CPU interpreter].
     #[arg(long)]
     width: Option<u32>,
-    /// Image height (default: the scene camera's).
+    /// Image height [default: the scene camera's; half of it on the CPU interpreter].
     #[arg(long)]
     height: Option<u32>,
     /// The histogram and the selection (§4.1-4.3), shared by every method except where
@@ -100,6 +101,31 @@ pub(crate) struct CompareArgs {
     backend: BackendChoice,
 }
 
+/// The render settings at the size to run: on the CPU interpreter, which is about 8x
+/// slower than lavapipe, half the scene camera's width and height unless `--width` or
+/// `--height` was given (a reference file fixes the size too), said up front.
+fn sized_to_backend(
+    args: &CompareArgs,
+    render: RenderSettings,
+    backend: &dyn strata_backends::Backend,
+    reference_spp: u32,
+) -> RenderSettings {
+    let chosen = args.width.is_some() || args.height.is_some() || args.reference.is_some();
+    if backend.info().backend != "cpu" || chosen {
+        return render;
+    }
+    let (width, height) = ((render.camera.width / 2).max(1), (render.camera.height / 2).max(1));
+    println!(
+        "on the CPU interpreter: rendering at {width}x{height} (half the scene camera's {}x{}) with a {reference_spp}-spp \
+         reference, to finish in minutes; --width, --height and --reference-spp choose",
+        render.camera.width, render.camera.height
+    );
+    let mut camera = render.camera.clone();
+    camera.width = width;
+    camera.height = height;
+    RenderSettings { camera, ..render }
+}
+
 /// Reference samples per pixel when `--reference-spp` is left out: fewer on the CPU
 /// interpreter, so that the README's first command ends in minutes there too.
 fn default_reference_spp(backend: &dyn strata_backends::Backend) -> u32 {
@@ -110,12 +136,12 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
     let started = Instant::now();
     let date = record::now_rfc3339();
     let (scene, render) = scene_and_settings(&args.scene, args.width, args.height)?;
-    for crop in &args.crop {
-        crops::check_inside(crop, render.camera.width, render.camera.height)?;
-    }
     if args.reference_spp == Some(0) {
         bail!("--reference-spp 0: at least one sample per pixel is needed");
     }
+    // Read before any long work, and before the output folder is cleared (the file may
+    // lie in it).
+    let given_reference = args.reference.as_deref().map(RgbImage::read_exr).transpose()?;
     let render = RenderSettings { pixel_centres: args.pixel_centres, ..render };
     if args.frames == 0 || args.seeds == 0 {
         bail!("--frames and --seeds must be at least 1");
@@ -135,6 +161,10 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
     let mut backend = open_backend(args.backend)?;
     println!("backend: {}", backend.info().summary());
     let reference_spp = args.reference_spp.unwrap_or_else(|| default_reference_spp(backend.as_ref()));
+    let render = sized_to_backend(&args, render, backend.as_ref(), reference_spp);
+    for crop in &args.crop {
+        crops::check_inside(crop, render.camera.width, render.camera.height)?;
+    }
     let camera_path = parse_camera_path(&args.camera_path, &render.camera)?;
     let cameras: Vec<_> = if camera_path.is_static() {
         Vec::new()
@@ -144,15 +174,13 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
     if !cameras.is_empty() && args.reference.is_some() {
         bail!("--reference: a moving camera (--camera-path {}) needs a reference per frame", args.camera_path);
     }
-    // A reference file is read before the folder is cleared, so it may lie in it.
-    let given_reference = args.reference.as_deref().map(RgbImage::read_exr).transpose()?;
     let removed = output_folder::prepare(&args.out, args.reference.as_deref())?;
     if !removed.is_empty() {
         println!("removed {} files of an earlier run from {}", removed.len(), args.out.display());
     }
     let reference_text;
     let references = if let Some(image) = given_reference {
-        reference_text = format!("{}", args.reference.as_ref().map(|p| p.display().to_string()).unwrap_or_default());
+        reference_text = args.reference.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
         vec![image]
     } else if cameras.is_empty() {
         let rendered = Instant::now();

@@ -36,7 +36,8 @@ enum Command {
     /// Render the ReSTIR methods from the same seeds and measure every frame against a
     /// reference: images, error maps, a CSV and a summary table.
     Compare(compare_command::CompareArgs),
-    /// Plot RelMSE against frame from a `strata compare` errors.csv as an SVG.
+    /// Plot RelMSE and strata's ratio to each baseline against frame from one or more
+    /// `strata compare` errors.csv files (several are overlaid), as SVG and PNG.
     Plot(PlotArgs),
     /// Compare an EXR image with a reference EXR: MSE, RelMSE (paper and common forms),
     /// pRelMSE; optionally write the per-pixel RelMSE map as EXR and false-colour PNG.
@@ -154,13 +155,23 @@ enum VariantArg {
     Subgroup,
 }
 
-fn main() -> Result<()> {
-    match Cli::parse().command {
+/// Runs the command; an error (a user's mistake, a missing file, a device that refuses)
+/// is one line on standard error and exit status 1, with no backtrace whatever
+/// `RUST_BACKTRACE` says. Panics, which are bugs, keep theirs.
+fn main() -> std::process::ExitCode {
+    let result = match Cli::parse().command {
         Command::Histogram(args) => histogram(args),
         Command::Render(args) => render(args),
         Command::Metrics(args) => metrics(args),
         Command::Compare(args) => compare_command::compare(args),
         Command::Plot(args) => plot(args),
+    };
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            std::process::ExitCode::FAILURE
+        }
     }
 }
 
@@ -251,7 +262,10 @@ fn plot(args: PlotArgs) -> Result<()> {
     };
     println!("wrote {}", written.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "));
     for (label, errors) in &runs {
-        if several {
+        let has_ratio = [Method::Restir, Method::RestirDisc]
+            .iter()
+            .any(|&b| compare::relmse_ratio_over_frames(errors, Method::Strata, b).is_some());
+        if several && has_ratio {
             println!("{label}:");
         }
         summary::print_ratio_over_frames(errors, frames_of(errors));
@@ -310,16 +324,12 @@ fn render(args: RenderArgs) -> Result<()> {
         settings.max_depth
     );
     std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create the folder", args.out.display()))?;
-    let bar = indicatif::ProgressBar::new(u64::from(args.spp));
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} spp, {elapsed} elapsed, eta {eta}")
-            .expect("a valid template"),
-    );
+    let mut progress = strata::progress::Progress::new("render", u64::from(args.spp), "spp");
     let started = Instant::now();
     let image = strata::render::render(backend.as_mut(), &gpu_scene, &settings, args.spp, |done| {
-        bar.set_position(u64::from(done))
+        progress.set(u64::from(done))
     })?;
-    bar.finish_and_clear();
+    progress.finish();
     let seconds = started.elapsed().as_secs_f64();
     let stem = args.scene.as_ref().and_then(|p| scene_stem(p)).unwrap_or_else(|| "default".into());
     let exr = args.out.join(format!("{stem}.exr"));

@@ -164,13 +164,18 @@ impl Ranged for Axis {
     }
 }
 
-/// 1, 2 or 5 times a power of ten, the nearest at or above `rough`.
+/// 1, 2 or 5 times a power of ten, the nearest to `rough` (by ratio).
 fn nice_step(rough: f64) -> f64 {
     if !(rough > 0.0 && rough.is_finite()) {
         return 1.0;
     }
     let power = 10f64.powf(rough.log10().floor());
-    [1.0, 2.0, 5.0, 10.0].into_iter().map(|m| m * power).find(|s| *s >= rough * (1.0 - 1e-9)).unwrap_or(10.0 * power)
+    let distance = |s: f64| (s / rough).ln().abs();
+    [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|m| m * power)
+        .min_by(|a, b| distance(*a).total_cmp(&distance(*b)))
+        .unwrap_or(power)
 }
 
 /// The multiples of `step` in `start..=end`.
@@ -190,10 +195,10 @@ fn fixed(value: f64, decimals: usize) -> String {
     }
 }
 
-/// A positive tick value as short text: plain decimals from 0.001 to 9999, else `2e-5`.
+/// A positive tick value as short text: plain decimals from 0.0001 to 9999, else `2e-5`.
 fn number(value: f64) -> String {
     let exponent = value.log10().floor();
-    if (-3.0..4.0).contains(&exponent) {
+    if (-4.0..4.0).contains(&exponent) {
         format!("{value:.*}", (-exponent).max(0.0) as usize)
     } else {
         let mantissa = value / 10f64.powf(exponent);
@@ -215,10 +220,10 @@ mod tests {
         let decade = Axis::log10(0.0085, 0.0195);
         assert_eq!(
             decade.ticks.iter().map(|&t| decade.label(t)).collect::<Vec<_>>(),
-            ["0.010", "0.012", "0.014", "0.016", "0.018"]
+            ["0.010", "0.012", "0.014", "0.016", "0.018", "0.020"]
         );
         let tiny = Axis::log10(1.1e-5, 1.9e-5);
-        assert_eq!(tiny.label(tiny.ticks[0]), "1.2e-5");
+        assert_eq!(tiny.label(tiny.ticks[1]), "1.2e-5");
         let three = Axis::log10(0.008, 0.3);
         assert_eq!(
             three.ticks.iter().map(|&t| three.label(t)).collect::<Vec<_>>(),
@@ -226,7 +231,10 @@ mod tests {
         );
         let wide = Axis::log10(1e-9, 1.0);
         assert!(wide.ticks.len() <= 10, "{:?}", wide.ticks);
-        assert_eq!(wide.label(1e-6), "1e-6");
+        assert_eq!(
+            (wide.label(1e-6), wide.label(5e-4), wide.label(0.01)),
+            ("1e-6".into(), "0.0005".into(), "0.01".into())
+        );
         let linear = Axis::linear(0.8, 1.0);
         assert_eq!(linear.label(0.85), "0.85");
         assert!(linear.ticks.contains(&1.0) || linear.ticks.iter().any(|t| (t - 1.0).abs() < 1e-9));

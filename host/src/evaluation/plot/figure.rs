@@ -101,7 +101,8 @@ pub(super) fn draw<DB: DrawingBackend>(
     for series in &shown {
         text_width = text_width.max(root.estimate_text_size(&series.label, &entry)?.0 as i32);
     }
-    let legend_width = if shown.is_empty() { px(16.0) } else { text_width + px(72.0) };
+    // At most 45 % of the width: a longer label runs off the canvas, the plot stays.
+    let legend_width = if shown.is_empty() { px(16.0) } else { (text_width + px(72.0)).min(width as i32 * 45 / 100) };
     let (plot_area, _) = root.split_horizontally(width as i32 - legend_width);
 
     let x_axis = Axis::frames(figure.frames);
@@ -112,7 +113,7 @@ pub(super) fn draw<DB: DrawingBackend>(
     for tick in y_axis.ticks() {
         widest = widest.max(root.estimate_text_size(&y_axis.label(*tick), &tick_label)?.0 as i32);
     }
-    let y_label_area = widest + px(14.0 + 22.0 + 12.0);
+    let y_label_area = widest + px(10.0 + 20.0 + 8.0);
     let mut chart = ChartBuilder::on(&plot_area)
         .margin_top(px(52.0))
         .margin_left(px(12.0))

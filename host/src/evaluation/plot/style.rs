@@ -58,7 +58,7 @@ pub(super) fn run_dash(index: usize) -> Dash {
 /// corners, so a dash bends with the line.
 pub(super) fn dash_pieces(points: &[(f64, f64)], dash: Dash, scale: f64) -> Vec<Vec<(f64, f64)>> {
     let pattern: Vec<f64> = dash.0.iter().map(|l| l * scale).collect();
-    if pattern.is_empty() || pattern.iter().any(|l| !(*l > 0.0)) {
+    if pattern.is_empty() || pattern.iter().any(|l| l.is_nan() || *l <= 0.0) {
         return vec![points.to_vec()];
     }
     let mut pieces = Vec::new();

@@ -85,14 +85,26 @@ fn every_method_has_one_colour_whatever_the_order() {
     assert!(colours.iter().all(|c| c.len() == 7 && c.starts_with('#')), "{colours:?}");
     assert!(colours[0] != colours[1] && colours[1] != colours[2] && colours[0] != colours[2]);
     let errors = rows(&methods, 4, 2);
-    let forward = relmse_svg(&errors, &methods, 4, "t");
-    let backward = relmse_svg(&errors, &[Method::RestirDisc, Method::Restir, Method::Strata], 4, "t");
-    let strata_only = relmse_svg(&errors, &[Method::Strata], 4, "t");
-    for svg in [&forward, &backward] {
-        let lines = data_lines(svg);
-        assert_eq!(lines, colours.iter().map(|c| c.to_string()).collect::<Vec<_>>(), "{svg}");
+    // Each line's colour is its method's, whatever the order or the subset asked for.
+    for asked in [
+        &methods[..],
+        &[Method::RestirDisc, Method::Restir, Method::Strata],
+        &[Method::RestirDisc],
+        &[Method::Restir, Method::Strata],
+    ] {
+        let figure = relmse_figure(&errors, asked, 4, "t");
+        assert_eq!(figure.series.len(), asked.len());
+        for series in &figure.series {
+            let method = methods.iter().find(|m| m.name() == series.label).unwrap();
+            assert_eq!(series.colour, method_colour(*method), "{} when asked for {asked:?}", series.label);
+        }
+        // The SVG draws those colours: one line each.
+        let mut drawn = data_lines(&relmse_svg(&errors, asked, 4, "t"));
+        let mut expected: Vec<String> = asked.iter().map(|&m| method_colour(m).to_lowercase()).collect();
+        drawn.sort();
+        expected.sort();
+        assert_eq!(drawn, expected);
     }
-    assert_eq!(data_lines(&strata_only), [method_colour(Method::Strata)]);
 }
 
 #[test]
@@ -222,22 +234,4 @@ fn dashes_alternate_and_keep_corners() {
     let pieces = dash_pieces(&[(0.0, 0.0), (4.0, 0.0), (4.0, 4.0)], Dash(&[6.0, 100.0]), 1.0);
     assert_eq!(pieces, [vec![(0.0, 0.0), (4.0, 0.0), (4.0, 2.0)]]);
     assert_eq!(dash_pieces(&[(0.0, 0.0), (1.0, 1.0)], Dash::SOLID, 2.0), [vec![(0.0, 0.0), (1.0, 1.0)]]);
-}
-
-#[test]
-#[ignore]
-fn scratch_render_examples() {
-    let read = |p: &str| crate::evaluation::compare::parse_errors_csv(&std::fs::read_to_string(p).unwrap()).unwrap();
-    std::fs::create_dir_all("/tmp/plots").unwrap();
-    let root = env!("CARGO_MANIFEST_DIR").to_string() + "/../benchmarks/restir/";
-    let errors = read(&(root.clone() + "default_temporal_256/errors.csv"));
-    let frames = errors.iter().map(|e| e.frame + 1).max().unwrap();
-    let methods = [Method::Strata, Method::Restir, Method::RestirDisc];
-    write_relmse_plot(&errors, &methods, frames, "default_temporal_256", Path::new("/tmp/plots/relmse")).unwrap();
-    write_ratio_plot(&errors, frames, "default_temporal_256", Path::new("/tmp/plots/relmse_ratio")).unwrap();
-    let runs = vec![
-        ("off".to_string(), read(&(root.clone() + "block_shift/off.csv"))),
-        ("on".to_string(), read(&(root + "block_shift/on.csv"))),
-    ];
-    write_overlay_plots(&runs, "block shift off vs on", Path::new("/tmp/plots/overlay")).unwrap();
 }

@@ -3,6 +3,7 @@
 //!
 //! [`Backend`]: strata_backends::Backend
 
+pub mod atomic_file;
 pub mod backend_choice;
 pub mod evaluation;
 pub mod histogram_pass;

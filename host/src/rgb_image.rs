@@ -57,22 +57,58 @@ impl RgbImage {
         Ok(image.layer_data.channel_data.pixels)
     }
 
-    /// Writes a float32 RGB EXR.
+    /// The first pixel (x, y) with a NaN or infinite channel, in row order.
+    pub fn first_non_finite(&self) -> Option<(u32, u32)> {
+        let index = self.pixels.iter().position(|p| p.iter().any(|c| !c.is_finite()))?;
+        let width = self.width.max(1) as usize;
+        Some(((index % width) as u32, (index / width) as u32))
+    }
+
+    /// Refuses an image with a NaN or infinite pixel, naming the first, so that no
+    /// output file hides one.
+    fn check_finite(&self, path: &Path) -> Result<(), ImageError> {
+        match self.first_non_finite() {
+            None => Ok(()),
+            Some((x, y)) => Err(ImageError {
+                path: path.display().to_string(),
+                message: format!(
+                    "pixel ({x}, {y}) is {:?}: an image with non-finite values is not written",
+                    self.pixels[(y * self.width + x) as usize]
+                ),
+            }),
+        }
+    }
+
+    /// Writes a float32 RGB EXR, complete or not at all ([`crate::atomic_file`]).
     pub fn write_exr(&self, path: &Path) -> Result<(), ImageError> {
+        self.check_finite(path)?;
         let width = self.width as usize;
-        exr::prelude::write_rgb_file(path, width, self.height as usize, |x, y| {
-            let p = self.pixels[y * width + x];
-            (p[0], p[1], p[2])
+        crate::atomic_file::write_with(path, |temporary| {
+            exr::prelude::write_rgb_file(temporary, width, self.height as usize, |x, y| {
+                let p = self.pixels[y * width + x];
+                (p[0], p[1], p[2])
+            })
         })
         .map_err(|e| ImageError { path: path.display().to_string(), message: e.to_string() })
     }
 
-    /// Writes an 8-bit sRGB PNG: radiance × `exposure`, clamped to [0, 1], sRGB-encoded.
+    /// Writes an 8-bit sRGB PNG: radiance × `exposure`, clamped to [0, 1], sRGB-encoded;
+    /// complete or not at all.
     pub fn write_png(&self, path: &Path, exposure: f32) -> Result<(), ImageError> {
+        self.check_finite(path)?;
         let bytes: Vec<u8> =
             self.pixels.iter().flat_map(|p| p.map(|c| linear_to_srgb8(c * exposure))).collect::<Vec<_>>();
-        image::save_buffer(path, &bytes, self.width, self.height, image::ExtendedColorType::Rgb8)
-            .map_err(|e| ImageError { path: path.display().to_string(), message: e.to_string() })
+        crate::atomic_file::write_with(path, |temporary| {
+            image::save_buffer_with_format(
+                temporary,
+                &bytes,
+                self.width,
+                self.height,
+                image::ExtendedColorType::Rgb8,
+                image::ImageFormat::Png,
+            )
+        })
+        .map_err(|e| ImageError { path: path.display().to_string(), message: e.to_string() })
     }
 }
 

@@ -1,11 +1,67 @@
-//! The folder a `strata compare` run writes into, kept to one run at a time: before a
-//! run writes anything, the files an earlier run wrote there (recognised by name:
-//! [`is_run_output`]) are removed, so an old run's images never sit beside a new run's
-//! CSV. Files with other names are left alone, and so is the reference image the new
-//! run reads, wherever it lies.
+//! The folder a `strata compare` run writes into, kept to one run at a time. A run takes
+//! the folder's lock file first (a second run while it is held is refused, naming the
+//! process); then the files an earlier run wrote there (recognised by name:
+//! [`is_run_output`]) and temporary files a killed run left are removed, so an old
+//! run's images never sit beside a new run's CSV. Files with other names are left alone,
+//! and so is the reference image the new run reads, wherever it lies.
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
+
+/// The lock file's name in the folder.
+pub const LOCK_NAME: &str = ".strata-compare.lock";
+
+/// The folder's lock, held while a run writes into it; dropping it removes the lock file.
+#[derive(Debug)]
+pub struct FolderLock {
+    path: PathBuf,
+}
+
+impl Drop for FolderLock {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.path);
+    }
+}
+
+/// Whether process `pid` is running (Linux and other systems with `/proc`; elsewhere
+/// every lock counts as held).
+fn process_is_running(pid: u32) -> bool {
+    if !Path::new("/proc/self").exists() {
+        return true;
+    }
+    Path::new(&format!("/proc/{pid}")).exists()
+}
+
+/// Takes `folder`'s lock, or says which run holds it. A lock whose process has ended
+/// (a killed run) is taken over.
+pub fn lock(folder: &Path) -> Result<FolderLock> {
+    let path = folder.join(LOCK_NAME);
+    for _ in 0..2 {
+        match std::fs::OpenOptions::new().write(true).create_new(true).open(&path) {
+            Ok(mut file) => {
+                use std::io::Write;
+                file.write_all(std::process::id().to_string().as_bytes())
+                    .with_context(|| format!("{}: cannot write the lock", path.display()))?;
+                return Ok(FolderLock { path });
+            }
+            Err(error) if error.kind() == std::io::ErrorKind::AlreadyExists => {
+                let holder = std::fs::read_to_string(&path).ok().and_then(|t| t.trim().parse::<u32>().ok());
+                match holder {
+                    Some(pid) if process_is_running(pid) => bail!(
+                        "{}: another strata compare (process {pid}) is writing into this folder; wait for it or \
+                         choose another --out",
+                        folder.display()
+                    ),
+                    // A run that was killed, or a lock half-written: take it over.
+                    _ => std::fs::remove_file(&path)
+                        .with_context(|| format!("{}: cannot remove a stale lock", path.display()))?,
+                }
+            }
+            Err(error) => return Err(error).with_context(|| format!("{}: cannot create the lock", path.display())),
+        }
+    }
+    bail!("{}: the lock keeps being taken by other runs", folder.display())
+}
 
 /// Whether `name` is a file a comparison run writes: the CSVs, the summary, the record,
 /// the report page and its plots and colour bar, the reference and every method's frame
@@ -31,10 +87,13 @@ pub fn is_run_output(name: &str) -> bool {
     methods.contains(&prefix) && !frame.is_empty() && frame.bytes().all(|b| b.is_ascii_digit())
 }
 
-/// Creates `folder` if needed and removes the files an earlier run wrote there, except
-/// `keep` (an input of this run). Returns the names removed.
-pub fn prepare(folder: &Path, keep: Option<&Path>) -> Result<Vec<String>> {
+/// Creates `folder` if needed, takes its [`lock`] and removes the files an earlier run
+/// wrote there and temporary files a killed run left ([`crate::atomic_file`]), except
+/// `keep` (an input of this run). Returns the lock, to hold until the run has written
+/// everything, and the names removed.
+pub fn prepare(folder: &Path, keep: Option<&Path>) -> Result<(FolderLock, Vec<String>)> {
     std::fs::create_dir_all(folder).with_context(|| format!("{}: cannot create the folder", folder.display()))?;
+    let lock = lock(folder)?;
     let keep: Option<PathBuf> = keep.and_then(|k| k.canonicalize().ok());
     let mut removed = Vec::new();
     let entries = std::fs::read_dir(folder).with_context(|| format!("{}: cannot list the folder", folder.display()))?;
@@ -42,7 +101,8 @@ pub fn prepare(folder: &Path, keep: Option<&Path>) -> Result<Vec<String>> {
         let entry = entry.with_context(|| format!("{}: cannot list the folder", folder.display()))?;
         let name = entry.file_name().to_string_lossy().into_owned();
         let path = entry.path();
-        if !is_run_output(&name) || !entry.file_type().is_ok_and(|t| t.is_file()) {
+        let leftover = crate::atomic_file::is_temporary(&name);
+        if !(is_run_output(&name) || leftover) || !entry.file_type().is_ok_and(|t| t.is_file()) {
             continue;
         }
         if keep.is_some() && path.canonicalize().ok() == keep {
@@ -53,7 +113,7 @@ pub fn prepare(folder: &Path, keep: Option<&Path>) -> Result<Vec<String>> {
         removed.push(name);
     }
     removed.sort();
-    Ok(removed)
+    Ok((lock, removed))
 }
 
 #[cfg(test)]
@@ -92,13 +152,22 @@ mod tests {
         let folder = std::env::temp_dir().join(format!("strata-output-folder-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&folder);
         std::fs::create_dir_all(&folder).unwrap();
-        for name in ["errors.csv", "strata_frame001.png", "notes.txt", "reference.exr"] {
+        for name in ["errors.csv", "strata_frame001.png", "notes.txt", "reference.exr", ".relmse.tmp-77.png"] {
             std::fs::write(folder.join(name), b"x").unwrap();
         }
-        let removed = prepare(&folder, Some(&folder.join("reference.exr"))).unwrap();
-        assert_eq!(removed, ["errors.csv", "strata_frame001.png"]);
+        let (lock, removed) = prepare(&folder, Some(&folder.join("reference.exr"))).unwrap();
+        assert_eq!(removed, [".relmse.tmp-77.png", "errors.csv", "strata_frame001.png"]);
         assert!(folder.join("notes.txt").exists() && folder.join("reference.exr").exists());
-        assert!(prepare(&folder, None).unwrap() == ["reference.exr"]);
+        // While the lock is held a second run is refused, naming this process.
+        let refused = prepare(&folder, None).unwrap_err().to_string();
+        assert!(refused.contains(&format!("process {}", std::process::id())), "{refused}");
+        drop(lock);
+        assert!(!folder.join(LOCK_NAME).exists());
+        // A lock left by a process that has ended is taken over.
+        std::fs::write(folder.join(LOCK_NAME), u32::MAX.to_string()).unwrap();
+        let (_lock, removed) = prepare(&folder, None).unwrap();
+        assert_eq!(removed, ["reference.exr"]);
+        drop(_lock);
         std::fs::remove_dir_all(&folder).unwrap();
     }
 }

@@ -16,7 +16,7 @@ use crate::progress::Progress;
 use crate::render::{GpuScene, RenderSettings};
 use crate::restir::Method;
 use crate::rgb_image::RgbImage;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -219,9 +219,9 @@ pub fn run_and_report(
     Ok(())
 }
 
-/// Writes `text` to `path`; an error names the file.
+/// Writes `text` to `path`, complete or not at all; an error names the file.
 fn write(path: &Path, text: String) -> Result<()> {
-    std::fs::write(path, text).with_context(|| format!("{}: cannot write", path.display()))
+    crate::atomic_file::write(path, text)
 }
 
 /// Writes one seed-1 frame of a method: EXR and PNG, and its RelMSE map as EXR and

@@ -174,7 +174,8 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
     if !cameras.is_empty() && args.reference.is_some() {
         bail!("--reference: a moving camera (--camera-path {}) needs a reference per frame", args.camera_path);
     }
-    let removed = output_folder::prepare(&args.out, args.reference.as_deref())?;
+    // Held until the report is written: a second run into the folder is refused meanwhile.
+    let (_lock, removed) = output_folder::prepare(&args.out, args.reference.as_deref())?;
     if !removed.is_empty() {
         println!("removed {} files of an earlier run from {}", removed.len(), args.out.display());
     }

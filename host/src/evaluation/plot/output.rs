@@ -73,9 +73,14 @@ pub(super) fn png(figure: &Figure) -> Result<image::RgbImage> {
 pub(super) fn write(figure: &Figure, stem: &Path) -> Result<Vec<PathBuf>> {
     let (svg_path, png_path) = (with_suffix(stem, ".svg"), with_suffix(stem, ".png"));
     let document = svg(figure).with_context(|| format!("{}: cannot write", svg_path.display()))?;
-    std::fs::write(&svg_path, document).with_context(|| format!("{}: cannot write", svg_path.display()))?;
+    crate::atomic_file::write(&svg_path, document)?;
     png(figure)
-        .and_then(|image| Ok(image.save_with_format(&png_path, image::ImageFormat::Png)?))
+        .and_then(|image| {
+            crate::atomic_file::write_with(&png_path, |temporary| {
+                image.save_with_format(temporary, image::ImageFormat::Png)
+            })
+            .map_err(|e| anyhow!("{e}"))
+        })
         .with_context(|| format!("{}: cannot write", png_path.display()))?;
     Ok(vec![svg_path, png_path])
 }

@@ -153,6 +153,16 @@ impl WgpuBackend {
         })
     }
 
+    /// The device memory allocations alive once submitted work has completed (count,
+    /// bytes), from wgpu's allocator report: what a leak check watches over a long run
+    /// (wgpu frees destroyed resources when it next polls, so this waits for the device
+    /// first). `None` where wgpu keeps no report (its GL backend).
+    pub fn live_allocations(&self) -> Option<(usize, u64)> {
+        self.device.poll(wgpu::PollType::wait_indefinitely()).ok()?;
+        let report = self.device.generate_allocator_report()?;
+        Some((report.allocations.len(), report.total_allocated_bytes))
+    }
+
     fn encode(
         &mut self,
         kernel: &Kernel,

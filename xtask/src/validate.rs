@@ -1,0 +1,218 @@
+//! `cargo xtask validate`: the programs that record Vulkan work, run under
+//! `VK_LAYER_KHRONOS_validation` with synchronization validation on (the check that
+//! finds a missing barrier, which lavapipe's in-order execution hides) and best
+//! practices reported: `strata render` and `strata compare` (all three methods, temporal
+//! and accumulated) on wgpu and on ash, both `strata-embed` examples (the ash one
+//! records its own barriers into the engine's command buffer), and `xtask check`.
+//!
+//! The layer is switched on from outside (`VK_INSTANCE_LAYERS`, and a layer settings
+//! file through `VK_LAYER_SETTINGS_PATH`) so every program runs exactly as users run
+//! it. Each writes its own log under `target/validation/`; any error or warning that is
+//! not a best-practices note fails the run, naming the program and the message ID.
+//! Best-practices notes are counted and printed, not asserted (several are about
+//! desktop GPUs and do not apply to lavapipe).
+//!
+//! Measured on lavapipe: removing the barrier between the uniform updates and the
+//! dispatches in `embed/src/ash_selection.rs` gives 12 `SYNC-HAZARD-READ-AFTER-WRITE`
+//! errors in `ash_embed`.
+
+use anyhow::{Context, Result, bail};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// One program run under the layer.
+struct Step {
+    name: &'static str,
+    program: PathBuf,
+    args: Vec<&'static str>,
+}
+
+/// The workspace root (xtask's manifest folder's parent).
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("xtask lies in the workspace").to_path_buf()
+}
+
+/// What one message of the layer's log says: its ID, severity and first line.
+#[derive(Debug, PartialEq)]
+struct Message {
+    id: String,
+    severity: String,
+    text: String,
+}
+
+/// Messages of Debian 12's layer (1.3.239) that are its own mistakes, each with the
+/// text that must be in the message and why it is not ours.
+const KNOWN_LAYER_MISTAKES: [(&str, &str, &str); 1] = [(
+    "UNASSIGNED-CoreValidation-Shader-InconsistentSpirv",
+    "Invalid source language operand: 10",
+    "wgpu's debug builds mark naga's SPIR-V with OpSource WGSL (10), which this layer's SPIR-V tables predate",
+)];
+
+/// The messages of a log written with `VK_DBG_LAYER_ACTION_LOG_MSG`: each starts with a
+/// line `ID(SEVERITY / TYPE): msgNum: …`.
+fn messages(log: &str) -> Vec<Message> {
+    log.lines()
+        .filter(|line| line.contains("): msgNum: "))
+        .filter_map(|line| {
+            let (id, rest) = line.split_once('(')?;
+            let severity = rest.split_once(" / ")?.0;
+            Some(Message { id: id.trim().to_string(), severity: severity.to_string(), text: line.to_string() })
+        })
+        .collect()
+}
+
+/// Whether a message is a best-practices note (reported, not asserted).
+fn is_best_practice(message: &Message) -> bool {
+    message.id.contains("BestPractices")
+}
+
+/// Whether a message is one of [`KNOWN_LAYER_MISTAKES`].
+fn is_known_layer_mistake(message: &Message) -> bool {
+    KNOWN_LAYER_MISTAKES.iter().any(|(id, text, _)| message.id == *id && message.text.contains(text))
+}
+
+/// Runs every step under the layer; fails on any error or warning that is not a
+/// best-practices note.
+pub fn validate() -> Result<()> {
+    let root = root();
+    let target = root.join("target");
+    let folder = target.join("validation");
+    std::fs::create_dir_all(&folder).with_context(|| format!("{}: cannot create", folder.display()))?;
+    let status = Command::new(env!("CARGO"))
+        .current_dir(&root)
+        .args(["build", "-q", "-p", "strata", "--bin", "strata", "-p", "strata-embed", "--examples"])
+        .status()
+        .context("cargo build")?;
+    if !status.success() {
+        bail!("building strata and the embed examples failed");
+    }
+    let debug = target.join("debug");
+    let strata = debug.join("strata");
+    let out = folder.join("out");
+    let out_str = out.to_str().context("a UTF-8 target path")?.to_string();
+    let out_arg: &'static str = Box::leak(out_str.into_boxed_str());
+    let small = ["--width", "24", "--height", "24"];
+    let compare = |extra: &[&'static str]| -> Vec<&'static str> {
+        let mut args = vec!["compare"];
+        args.extend(small);
+        args.extend(["--frames", "3", "--seeds", "2", "--reference-spp", "4", "--out", out_arg]);
+        args.extend(extra);
+        args
+    };
+    let render = |extra: &[&'static str]| -> Vec<&'static str> {
+        let mut args = vec!["render"];
+        args.extend(small);
+        args.extend(["--spp", "4", "--out", out_arg]);
+        args.extend(extra);
+        args
+    };
+    let steps = vec![
+        Step { name: "render-wgpu", program: strata.clone(), args: render(&[]) },
+        Step { name: "render-ash", program: strata.clone(), args: render(&["--backend", "ash"]) },
+        Step { name: "compare-wgpu", program: strata.clone(), args: compare(&[]) },
+        Step { name: "compare-wgpu-accumulate", program: strata.clone(), args: compare(&["--accumulate"]) },
+        Step { name: "compare-ash", program: strata.clone(), args: compare(&["--backend", "ash"]) },
+        Step {
+            name: "compare-ash-accumulate",
+            program: strata.clone(),
+            args: compare(&["--backend", "ash", "--accumulate"]),
+        },
+        Step { name: "wgpu_embed", program: debug.join("examples").join("wgpu_embed"), args: vec![] },
+        Step { name: "ash_embed", program: debug.join("examples").join("ash_embed"), args: vec![] },
+        Step { name: "xtask-check", program: std::env::current_exe()?, args: vec!["check"] },
+    ];
+    let mut failures = Vec::new();
+    let mut notes: BTreeMap<String, usize> = BTreeMap::new();
+    for step in &steps {
+        let log = folder.join(format!("{}.log", step.name));
+        let _ = std::fs::remove_file(&log);
+        let settings = folder.join(format!("{}.settings.txt", step.name));
+        std::fs::write(
+            &settings,
+            format!(
+                "khronos_validation.report_flags = error,warn,perf\n\
+                 khronos_validation.debug_action = VK_DBG_LAYER_ACTION_LOG_MSG\n\
+                 khronos_validation.log_filename = {}\n\
+                 khronos_validation.enables = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT,\
+                 VK_VALIDATION_FEATURE_ENABLE_BEST_PRACTICES_EXT\n",
+                log.display()
+            ),
+        )
+        .with_context(|| format!("{}: cannot write", settings.display()))?;
+        let output = Command::new(&step.program)
+            .args(&step.args)
+            .current_dir(&root)
+            .env("VK_INSTANCE_LAYERS", "VK_LAYER_KHRONOS_validation")
+            .env("VK_LAYER_SETTINGS_PATH", &settings)
+            .output()
+            .with_context(|| format!("{}: cannot run {}", step.name, step.program.display()))?;
+        if !output.status.success() {
+            bail!(
+                "{} failed under the validation layer:\n{}",
+                step.name,
+                String::from_utf8_lossy(&output.stderr).lines().last().unwrap_or("")
+            );
+        }
+        let text = std::fs::read_to_string(&log).with_context(|| {
+            format!("{}: the validation layer wrote no log (is vulkan-validationlayers installed?)", log.display())
+        })?;
+        let mut errors: BTreeMap<String, usize> = BTreeMap::new();
+        for message in messages(&text) {
+            if is_best_practice(&message) {
+                *notes.entry(message.id).or_default() += 1;
+            } else if is_known_layer_mistake(&message) {
+                *notes.entry(format!("{} (the layer's mistake, see KNOWN_LAYER_MISTAKES)", message.id)).or_default() +=
+                    1;
+            } else {
+                *errors.entry(format!("{} ({})", message.id, message.severity)).or_default() += 1;
+            }
+        }
+        println!(
+            "{:<26} {}",
+            step.name,
+            if errors.is_empty() {
+                "clean".to_string()
+            } else {
+                format!("{} messages", errors.values().sum::<usize>())
+            }
+        );
+        for (id, count) in errors {
+            failures.push(format!("{}: {id} x{count} (log: {})", step.name, log.display()));
+        }
+    }
+    if !notes.is_empty() {
+        println!("best-practices notes and known mistakes of the layer (reported, not asserted):");
+        for (id, count) in &notes {
+            println!("  {id} x{count}");
+        }
+    }
+    if !failures.is_empty() {
+        bail!("the validation layer reported:\n{}", failures.join("\n"));
+    }
+    println!("no validation error or warning, synchronization validation on, in {} programs", steps.len());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn log_messages_are_read_with_their_id_and_severity() {
+        let log = "SYNC-HAZARD-READ-AFTER-WRITE(ERROR / SPEC): msgNum: -455515022 - Validation Error: [ x ]\n    \
+                   detail line\nUNASSIGNED-BestPractices-vkCreateDevice(WARN / PERF): msgNum: 1 - note\n";
+        let found = messages(log);
+        assert_eq!(found.len(), 2);
+        assert_eq!((found[0].id.as_str(), found[0].severity.as_str()), ("SYNC-HAZARD-READ-AFTER-WRITE", "ERROR"));
+        assert!(!is_best_practice(&found[0]) && is_best_practice(&found[1]));
+        assert!(!is_known_layer_mistake(&found[0]));
+        let mistake = messages(
+            "UNASSIGNED-CoreValidation-Shader-InconsistentSpirv(ERROR / SPEC): msgNum: 7 - SPIR-V module not valid: \
+             Invalid source language operand: 10\n",
+        );
+        assert!(is_known_layer_mistake(&mistake[0]));
+        let other = messages("UNASSIGNED-CoreValidation-Shader-InconsistentSpirv(ERROR / SPEC): msgNum: 7 - other\n");
+        assert!(!is_known_layer_mistake(&other[0]));
+    }
+}

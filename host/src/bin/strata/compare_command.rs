@@ -171,6 +171,13 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
     } else {
         (0..args.frames).map(|f| camera_path.camera_at(&render.camera, f)).collect()
     };
+    if !camera_path.is_static() && args.accumulate {
+        bail!(
+            "--accumulate with --camera-path {}: accumulated frames would average different viewpoints and be \
+             measured against one frame's reference; accumulate with a static camera, or use temporal reuse",
+            args.camera_path
+        );
+    }
     if !cameras.is_empty() && args.reference.is_some() {
         bail!("--reference: a moving camera (--camera-path {}) needs a reference per frame", args.camera_path);
     }

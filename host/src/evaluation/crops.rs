@@ -4,7 +4,8 @@
 //!
 //! "Differ most" is measured on the per-pixel RelMSE maps of the images the page shows
 //! (seed 1): a window's score is the spread, largest minus smallest, of the methods'
-//! mean error in it. Windows are scanned at a quarter of their side with summed-area
+//! mean error in it, relative to their average (an absolute spread always lands on the
+//! aliased edges of emitters, where every method is equally bad). Windows are scanned at a quarter of their side with summed-area
 //! tables, and the best ones that do not overlap are kept, so two close-ups never show
 //! the same pixels.
 
@@ -100,9 +101,12 @@ pub fn where_methods_differ(maps: &[Vec<f64>], width: u32, height: u32, count: u
         for x in positions(width) {
             let sums: Vec<f64> = tables.iter().map(|t| t.sum(x, y, side, side)).collect();
             let (low, high) = sums.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)));
-            let spread = high - low;
-            if spread.is_finite() && spread > 0.0 {
-                scored.push((spread, Crop { x, y, width: side, height: side }));
+            let mean = sums.iter().sum::<f64>() / sums.len() as f64;
+            // Relative: where every method is bad alike (an emitter's aliased edge) the
+            // spread is large but tells nothing about the methods.
+            let score = (high - low) / mean;
+            if score.is_finite() && score > 0.0 {
+                scored.push((score, Crop { x, y, width: side, height: side }));
             }
         }
     }

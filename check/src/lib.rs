@@ -5,6 +5,9 @@
 //! Also [`run_kernel`]: any WGSL compute shader on chosen backends (`cargo xtask run`),
 //! judged by [`agreement`] against a reference backend under a declared tolerance.
 //!
+//! And [`fuzz`]: the fuzz harness of the scene, image and CSV loaders (`cargo xtask
+//! fuzz`, and a short fixed-seed run under `cargo test`).
+//!
 //! Tooling, not product: the renderer (`strata`) and the embeddable pass know nothing of
 //! it; `xtask` and the tests use it.
 
@@ -13,6 +16,7 @@ mod backends;
 mod camera;
 mod compare;
 mod empty;
+pub mod fuzz;
 mod histogram;
 mod path;
 pub mod replay;

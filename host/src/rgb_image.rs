@@ -42,19 +42,30 @@ impl RgbImage {
         sum.map(|s| s / self.pixels.len().max(1) as f64)
     }
 
-    /// Reads the R, G and B channels of an EXR's first layer.
+    /// Reads the R, G and B channels of an EXR's first layer through
+    /// [`crate::scene::decode_rgb_exr`] (its size checked before anything is allocated,
+    /// decoding on this thread with a decoder's panic turned into an error) and refuses
+    /// an image with a NaN or infinite pixel, naming the first: a reference with one
+    /// would make every RelMSE NaN.
     pub fn read_exr(path: &Path) -> Result<RgbImage, ImageError> {
         let error = |message: String| ImageError { path: path.display().to_string(), message };
-        let image = exr::prelude::read_first_rgba_layer_from_file(
-            path,
-            |resolution, _| RgbImage::new(resolution.width() as u32, resolution.height() as u32),
-            |image: &mut RgbImage, position: exr::math::Vec2<usize>, (r, g, b, _a): (f32, f32, f32, f32)| {
-                let index = position.y() * image.width as usize + position.x();
-                image.pixels[index] = [r, g, b];
-            },
-        )
-        .map_err(|e| error(e.to_string()))?;
-        Ok(image.layer_data.channel_data.pixels)
+        let bytes = std::fs::read(path).map_err(|e| error(e.to_string()))?;
+        let exr = crate::scene::decode_rgb_exr(path, &bytes).map_err(|e| match e {
+            crate::scene::SceneError::Image { message, .. } => error(message),
+            other => error(other.to_string()),
+        })?;
+        let (width, height) = (u32::try_from(exr.width), u32::try_from(exr.height));
+        let (Ok(width), Ok(height)) = (width, height) else {
+            return Err(error(format!("{}x{} pixels is too large", exr.width, exr.height)));
+        };
+        let image = RgbImage { width, height, pixels: exr.texels };
+        if let Some((x, y)) = image.first_non_finite() {
+            return Err(error(format!(
+                "pixel ({x}, {y}) is {:?}: an image with non-finite values cannot be measured",
+                image.pixels[(y * width + x) as usize]
+            )));
+        }
+        Ok(image)
     }
 
     /// The first pixel (x, y) with a NaN or infinite channel, in row order.

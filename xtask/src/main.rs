@@ -18,8 +18,26 @@
 //!   differ and by how many ULP; exits non-zero only when a backend fails or a buffer
 //!   exceeds the tolerance (integers: exact; f32 words: `--ulp`, default 0).
 //!
+//! * `cargo xtask fuzz [--target T,...] [--seconds N] [--executions N] [--seed S]
+//!   [--crash-dir DIR] [--hang-ms MS] [--no-shared]`: fuzzes the loaders (scene JSON, PLY,
+//!   glTF/GLB, OBJ/MTL, EXR, errors.csv; `strata_check::fuzz`), each target for N seconds
+//!   (default 10) or N executions from the seed (default 1); prints per target the
+//!   executions, rate, distinct outcomes and findings. A panic or a loaded scene with a NaN
+//!   where a number must be finite is written to `tests/data/fuzz/<target>/crash-<hash>`
+//!   and the run exits 1 naming it; a hang (an input over 2 s) or one allocation over
+//!   1 GiB writes `hang-`/`huge-<hash>` and exits 2 or 3 at once. Commit the files: the
+//!   `fuzz_regressions` test runs each of them again.
+//!
+//! * `cargo xtask validate`: `strata render`, `strata compare` (temporal and
+//!   accumulated, wgpu and ash), both embed examples and `xtask check` under
+//!   `VK_LAYER_KHRONOS_validation` with synchronization validation; fails on any error or
+//!   warning, reports best-practices notes (see `validate.rs`).
+//!
 //! Errors, a disagreement included, print one line (no backtrace, whatever
 //! `RUST_BACKTRACE` says: they are findings, not bugs of xtask) and exit with 1.
+
+mod fuzz;
+mod validate;
 
 use anyhow::{Result, bail};
 use clap::{Parser, Subcommand};
@@ -28,6 +46,10 @@ use strata_check::agreement::{Tolerance, judge};
 use strata_check::run_kernel::RunRequest;
 use strata_kernels::Registry;
 use strata_kernels::validate::{Target, Verdict, translate_and_validate};
+
+/// The system allocator, with a limit per allocation while a fuzz input runs.
+#[global_allocator]
+static ALLOCATOR: strata_check::fuzz::GuardedAllocator = strata_check::fuzz::GuardedAllocator;
 
 #[derive(Parser)]
 #[command(about = "strata project automation")]
@@ -58,6 +80,11 @@ enum Command {
         #[arg(long, value_delimiter = ',')]
         kernel: Vec<String>,
     },
+    /// Fuzz the scene, image and CSV loaders (structure-aware mutation, fixed seed).
+    Fuzz(fuzz::FuzzArgs),
+    /// Run render, compare, the embed examples and the check under the Vulkan validation
+    /// layer with synchronization validation; fail on any error or warning.
+    Validate,
 }
 
 /// `cargo xtask run`'s arguments.
@@ -108,6 +135,8 @@ fn main() {
     let result = match Cli::parse().command {
         Command::Shaders { strict, out } => shaders(strict, out),
         Command::Check { full, kernel } => check(full, &kernel),
+        Command::Validate => validate::validate(),
+        Command::Fuzz(args) => fuzz::fuzz(args),
         Command::Run(args) => {
             let RunArgs { shader, entry, workgroups, buffers, sizes, overrides, backend, ulp, abs, reference, out } =
                 *args;

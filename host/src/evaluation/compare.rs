@@ -228,7 +228,13 @@ pub fn parse_errors_csv(text: &str) -> Result<Vec<FrameError>, String> {
         let method = <Method as clap::ValueEnum>::from_str(fields[0], false)
             .map_err(|_| format!("line {number}: unknown method `{}`", fields[0]))?;
         let int = |i: usize| fields[i].parse::<u32>().map_err(|e| format!("line {number}, field {}: {e}", i + 1));
-        let float = |i: usize| fields[i].parse::<f64>().map_err(|e| format!("line {number}, field {}: {e}", i + 1));
+        // Errors are finite and non-negative: anything else is a damaged file, not a
+        // measurement to average.
+        let float = |i: usize| match fields[i].parse::<f64>() {
+            Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+            Ok(v) => Err(format!("line {number}, field {}: {v} is not an error (finite, 0 or more)", i + 1)),
+            Err(e) => Err(format!("line {number}, field {}: {e}", i + 1)),
+        };
         let frame = int(1)?;
         if frame == 0 {
             return Err(format!("line {number}: frames are counted from 1"));
@@ -275,6 +281,10 @@ mod tests {
         assert!(parse_errors_csv(bad).unwrap_err().contains("line 2"));
         let unknown = "method,frame,seed,relmse,prelmse,mse\nfoo,1,1,0.1,0.1,0.1\n";
         assert!(parse_errors_csv(unknown).unwrap_err().contains("`foo`"));
+        for value in ["NaN", "inf", "-0.5"] {
+            let bad = format!("method,frame,seed,relmse,prelmse,mse\nstrata,1,1,{value},0.1,0.1\n");
+            assert!(parse_errors_csv(&bad).unwrap_err().contains("field 4"), "{value}");
+        }
     }
 
     #[test]

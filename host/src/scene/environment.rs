@@ -2,6 +2,7 @@
 //! radiance scale and rotation, loaded and checked on the host.
 
 use super::SceneError;
+use super::exr_decode::{RgbExr, decode_rgb_exr};
 use std::path::{Path, PathBuf};
 
 /// A loaded environment map.
@@ -25,33 +26,21 @@ impl Environment {
     /// Loads `file` (RGB, half or float samples), refusing negative or non-finite
     /// radiance with the pixel named, and a `to_world` that is not a rotation.
     pub fn load(file: &Path, scale: f32, to_world: Option<[[f32; 4]; 4]>) -> Result<Environment, SceneError> {
+        let bytes = std::fs::read(file).map_err(|source| SceneError::Io { path: file.into(), source })?;
+        Environment::from_exr_bytes(file, &bytes, scale, to_world)
+    }
+
+    /// [`Environment::load`] of the EXR file in `bytes` (`file` names it in errors),
+    /// decoded by [`decode_rgb_exr`] (which refuses an image larger than its file can hold
+    /// before allocating its pixels).
+    pub fn from_exr_bytes(
+        file: &Path,
+        bytes: &[u8],
+        scale: f32,
+        to_world: Option<[[f32; 4]; 4]>,
+    ) -> Result<Environment, SceneError> {
         let error = |message: String| SceneError::Image { path: file.into(), message };
-        if !file.exists() {
-            return Err(SceneError::Io { path: file.into(), source: std::io::ErrorKind::NotFound.into() });
-        }
-        let meta = exr::meta::MetaData::read_from_file(file, false).map_err(|e| error(e.to_string()))?;
-        let header = meta.headers.first().ok_or_else(|| error("the EXR has no layer".into()))?;
-        for name in ["R", "G", "B"] {
-            let channel = header.channels.list.iter().find(|c| c.name.to_string() == name).ok_or_else(|| {
-                let names: Vec<String> = header.channels.list.iter().map(|c| c.name.to_string()).collect();
-                error(format!("not an RGB image: no channel `{name}` (channels: {})", names.join(", ")))
-            })?;
-            if channel.sample_type == exr::meta::attribute::SampleType::U32 {
-                return Err(error(format!("channel `{name}` holds integers, not half or float radiance")));
-            }
-        }
-        let image = exr::prelude::read_first_rgba_layer_from_file(
-            file,
-            |resolution, _| (resolution.width(), vec![[0.0f32; 3]; resolution.width() * resolution.height()]),
-            |(width, texels): &mut (usize, Vec<[f32; 3]>),
-             position: exr::math::Vec2<usize>,
-             (r, g, b, _a): (f32, f32, f32, f32)| {
-                texels[position.y() * *width + position.x()] = [r, g, b];
-            },
-        )
-        .map_err(|e| error(e.to_string()))?;
-        let (width, texels) = image.layer_data.channel_data.pixels;
-        let height = texels.len() / width.max(1);
+        let RgbExr { width, height, texels } = decode_rgb_exr(file, bytes)?;
         if width == 0 || height == 0 {
             return Err(error("the image has no pixels".into()));
         }

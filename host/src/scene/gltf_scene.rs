@@ -16,7 +16,7 @@
 //!   beyond the whole scene. Without a perspective camera: a camera framing the scene,
 //!   looking down −Z.
 //! * Materials (metallic-roughness): `metallicFactor` ≥ 0.5 gives a GGX conductor with
-//!   alpha = max(roughness², 10⁻³) whose complex IOR reproduces the base colour
+//!   alpha = max(roughness², 10⁻³) (factors outside [0, 1]: an error) whose complex IOR reproduces the base colour
 //!   (Gulbrandsen 2014, edge tint = base colour); otherwise a diffuse material with the
 //!   base colour factor, times the base colour texture (decoded as sRGB, the factor baked
 //!   into its texels) read with the texture's `texCoord` set. `doubleSided` gives
@@ -30,13 +30,20 @@
 //!
 //! Errors name the file and the glTF field (`meshes[0].primitives[1].mode`,
 //! `accessors[3]`, ...): a missing file, malformed JSON or GLB, an invalid document, data
-//! outside its buffer, an accessor of the wrong type. The `gltf` crate can panic on some
-//! malformed documents; such a panic becomes an error too.
+//! outside its buffer, an accessor of the wrong type, an accessor whose declared count
+//! needs more bytes than its buffer view holds (checked before anything is allocated), a
+//! NaN, infinite or negative colour factor, a singular or non-finite node transform. The
+//! `gltf` crate can panic on some malformed documents; such a panic becomes an error too.
+//! Buffers and images named by URI are `data:` URIs or files relative to the glTF file,
+//! read through the loader's [`FileSource`].
 
+use super::files::{self, DiskFiles, FileSource};
 use super::mesh_util::{
     DEFAULT_IMAGE_SIDE, MIN_ALPHA, assemble_scene, bounds, checked_triangles, default_material, emission,
     far_clip_beyond, metal, tinted, without_panic,
 };
+use super::texture::{decode_image, rgba8};
+use super::uri::{self, Resolved};
 use super::{Albedo, Camera, Material, Scene, SceneError, Shape, Texture};
 use glam::{Mat3, Mat4, Vec3};
 use gltf::Document;
@@ -49,7 +56,14 @@ use std::path::Path;
 /// Loads a glTF 2.0 file (`.gltf` or `.glb`) as a scene (module documentation).
 pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
     let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
-    without_panic(|| load_bytes(path, &bytes)).unwrap_or_else(|message| Err(json_error(path, "(document)", message)))
+    load_gltf_from(path, &bytes, &DiskFiles)
+}
+
+/// Loads the glTF 2.0 document in `bytes` (JSON or GLB, the contents of `path`), reading
+/// the buffers and images it names by relative URI through `files`.
+pub fn load_gltf_from(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene, SceneError> {
+    without_panic(|| load_bytes(path, bytes, files))
+        .unwrap_or_else(|message| Err(json_error(path, "(document)", message)))
 }
 
 /// A glTF error: `field` is the JSON path of the problem.
@@ -58,18 +72,13 @@ fn json_error(path: &Path, field: impl Into<String>, message: impl Into<String>)
 }
 
 /// Loads the document in `bytes`, read from `path`.
-fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, SceneError> {
-    let raw = raw_json(bytes);
+fn load_bytes(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene, SceneError> {
+    check_glb_header(path, bytes)?;
+    let raw = raw_json(bytes).map_err(|message| json_error(path, "(document)", message))?;
     check_position_accessors(path, &raw)?;
     let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(bytes).map_err(|e| document_error(path, e))?;
     let folder = path.parent().unwrap_or(Path::new("."));
-    let buffers = gltf::import_buffers(&document, Some(folder), blob).map_err(|e| {
-        let field = match e {
-            gltf::Error::BufferLength { buffer, .. } => format!("buffers[{buffer}]"),
-            _ => "buffers".into(),
-        };
-        json_error(path, field, format!("cannot load the buffer data: {e}"))
-    })?;
+    let buffers = load_buffers(path, folder, &document, blob, files)?;
     for view in document.views() {
         let available = buffers.get(view.buffer().index()).map_or(0, |b| b.len());
         if view.offset().checked_add(view.length()).is_none_or(|end| end > available) {
@@ -85,9 +94,11 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, SceneError> {
             ));
         }
     }
+    check_accessor_sizes(path, &document)?;
     let mut loader = Loader {
         path,
         folder,
+        files,
         raw,
         buffers,
         materials: Vec::new(),
@@ -111,7 +122,121 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, SceneError> {
         None => None,
     };
     let name = path.file_stem().map_or_else(|| path.display().to_string(), |s| s.to_string_lossy().into_owned());
-    Ok(assemble_scene(name, camera, (loader.materials, loader.material_names), shapes, loader.textures))
+    assemble_scene(name, camera, (loader.materials, loader.material_names), shapes, loader.textures)
+        .map_err(|message| json_error(path, "(scene)", message))
+}
+
+/// The contents of every buffer of `document`: the GLB's binary chunk, a `data:` URI, or a
+/// file relative to `folder` read through `files`; each padded to a multiple of 4 bytes and
+/// at least as long as its declared `byteLength`.
+fn load_buffers(
+    path: &Path,
+    folder: &Path,
+    document: &Document,
+    mut blob: Option<Vec<u8>>,
+    files: &dyn FileSource,
+) -> Result<Vec<gltf::buffer::Data>, SceneError> {
+    let mut buffers = Vec::new();
+    for buffer in document.buffers() {
+        let field = format!("buffers[{}]", buffer.index());
+        let mut data = match buffer.source() {
+            gltf::buffer::Source::Bin => blob
+                .take()
+                .ok_or_else(|| json_error(path, &field, "cannot load the buffer data: the GLB has no binary chunk"))?,
+            gltf::buffer::Source::Uri(text) => match uri::resolve(text, folder)
+                .map_err(|message| json_error(path, &field, format!("cannot load the buffer data: {message}")))?
+            {
+                Resolved::Data(data) => data,
+                Resolved::File(file) => files::read(files, &file)?,
+            },
+        };
+        while !data.len().is_multiple_of(4) {
+            data.push(0);
+        }
+        if data.len() < buffer.length() {
+            return Err(json_error(
+                path,
+                field,
+                format!("cannot load the buffer data: byteLength {} but only {} bytes", buffer.length(), data.len()),
+            ));
+        }
+        buffers.push(gltf::buffer::Data(data));
+    }
+    Ok(buffers)
+}
+
+/// Refuses an accessor whose declared elements cannot fit in its buffer view (before any
+/// of them is read or allocated): `count` elements of `stride` bytes from `byteOffset` must
+/// end within the view. Sparse accessors' index and value views are checked the same way.
+fn check_accessor_sizes(path: &Path, document: &Document) -> Result<(), SceneError> {
+    for accessor in document.accessors() {
+        let field = format!("accessors[{}]", accessor.index());
+        let fits = |view: &gltf::buffer::View, offset: usize, count: usize, element: usize| {
+            let stride = view.stride().unwrap_or(element).max(element);
+            let needed = match count {
+                0 => Some(0),
+                n => {
+                    (n - 1).checked_mul(stride).and_then(|b| b.checked_add(element)).and_then(|b| b.checked_add(offset))
+                }
+            };
+            needed.is_some_and(|needed| needed <= view.length())
+        };
+        if let Some(view) = accessor.view()
+            && !fits(&view, accessor.offset(), accessor.count(), accessor.size())
+        {
+            return Err(json_error(
+                path,
+                field,
+                format!(
+                    "{} elements of {} bytes from byte {} do not fit in bufferViews[{}] ({} bytes)",
+                    accessor.count(),
+                    accessor.size(),
+                    accessor.offset(),
+                    view.index(),
+                    view.length()
+                ),
+            ));
+        }
+        if let Some(sparse) = accessor.sparse() {
+            let (indices, values) = (sparse.indices(), sparse.values());
+            let index_size = indices.index_type().size();
+            if sparse.count() > accessor.count()
+                || !fits(&indices.view(), indices.offset(), sparse.count(), index_size)
+                || !fits(&values.view(), values.offset(), sparse.count(), accessor.size())
+            {
+                return Err(json_error(
+                    path,
+                    format!("{field}.sparse"),
+                    format!(
+                        "{} sparse elements do not fit in the accessor ({} elements) or in their buffer views",
+                        sparse.count(),
+                        accessor.count()
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Refuses a GLB whose header declares a total length shorter than the header itself or
+/// longer than the file (which the `gltf` crate subtracts without checking).
+fn check_glb_header(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
+    if !bytes.starts_with(b"glTF") {
+        return Ok(());
+    }
+    let field = |at: usize| bytes.get(at..at + 4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
+    let (Some(length), Some(_version)) = (field(8), field(4)) else {
+        return Err(json_error(path, "(GLB container)", "not a valid GLB file: the header is cut short"));
+    };
+    if !(12..=bytes.len()).contains(&length) {
+        return Err(json_error(
+            path,
+            "(GLB container)",
+            format!("not a valid GLB file: the header declares {length} bytes, the file has {}", bytes.len()),
+        ));
+    }
+    Ok(())
 }
 
 /// The error of a document the `gltf` crate refuses.
@@ -133,18 +258,21 @@ fn document_error(path: &Path, error: gltf::Error) -> SceneError {
     }
 }
 
-/// The document's JSON as plain values (for the extensions the `gltf` crate drops);
-/// `Null` if it cannot be read (the crate has accepted it by then, so this does not happen).
-fn raw_json(bytes: &[u8]) -> serde_json::Value {
+/// The document's JSON as plain values (for the extensions the `gltf` crate drops, and
+/// for the checks made before the crate validates the document); `Null` if the container
+/// is not a GLB the crate can split (it then refuses the file itself), an error if the JSON
+/// cannot be read as plain values (nested deeper than 128 levels: the crate skips unknown
+/// fields without that limit, so its validation could not be guarded).
+fn raw_json(bytes: &[u8]) -> Result<serde_json::Value, String> {
     let json = if bytes.starts_with(b"glTF") {
         match gltf::Glb::from_slice(bytes) {
             Ok(glb) => glb.json.into_owned(),
-            Err(_) => return serde_json::Value::Null,
+            Err(_) => return Ok(serde_json::Value::Null),
         }
     } else {
         bytes.to_vec()
     };
-    serde_json::from_slice(&json).unwrap_or(serde_json::Value::Null)
+    serde_json::from_slice(&json).map_err(|e| format!("not valid glTF JSON: {e}"))
 }
 
 /// Refuses a POSITION attribute naming an accessor that does not exist, which the `gltf`
@@ -182,6 +310,8 @@ struct Loader<'a> {
     path: &'a Path,
     /// Where relative URIs start.
     folder: &'a Path,
+    /// Where files named by URI are read.
+    files: &'a dyn FileSource,
     /// The document as plain JSON.
     raw: serde_json::Value,
     /// Buffer contents, by index.
@@ -216,11 +346,15 @@ impl Loader<'_> {
         let pbr = material.pbr_metallic_roughness();
         let [r, g, b, _] = pbr.base_color_factor();
         let (metallic, roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
-        if [r, g, b, metallic, roughness].iter().any(|c| !c.is_finite() || *c < 0.0) {
+        if [r, g, b, metallic, roughness].iter().any(|c| !c.is_finite() || *c < 0.0)
+            || metallic > 1.0
+            || roughness > 1.0
+        {
             return Err(self.error(
                 format!("{field}.pbrMetallicRoughness"),
                 format!(
-                    "base colour {:?}, metallic {metallic}, roughness {roughness}: must be finite and ≥ 0",
+                    "base colour {:?}, metallic {metallic}, roughness {roughness}: must be finite and ≥ 0 \
+                     (metallic and roughness ≤ 1)",
                     [r, g, b]
                 ),
             ));
@@ -266,7 +400,7 @@ impl Loader<'_> {
         }
         let field = format!("images[{}]", image.index());
         let json = self.raw.pointer(&format!("/images/{}", image.index()));
-        let has = |name: &str| json.and_then(|j| j.get(name)).is_some();
+        let has = |name: &str| json.and_then(|j| j.get(name)).is_some_and(|v| !v.is_null());
         if has("bufferView") && !has("mimeType") {
             return Err(self.error(field, "an image in a buffer view needs a `mimeType`"));
         }
@@ -277,16 +411,31 @@ impl Loader<'_> {
             gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => format!("`{uri}`"),
             _ => "the image".into(),
         };
-        let data = gltf::image::Data::from_source(image.source(), Some(self.folder), &self.buffers)
-            .map_err(|e| self.error(field.clone(), format!("cannot decode {what}: {e}")))?;
-        let rgba = rgba8(&data);
-        if data.width == 0 || data.height == 0 || rgba.len() != 4 * data.width as usize * data.height as usize {
-            return Err(
-                self.error(field, format!("{what}: {}×{} pixels do not match its data", data.width, data.height))
-            );
-        }
         let name = format!("{}#{field}", self.path.display());
-        self.textures.push(tinted(Texture::from_rgba8(name, data.width, data.height, &rgba, true), tint));
+        let encoded = match image.source() {
+            gltf::image::Source::View { view, .. } => {
+                let bytes = self
+                    .buffers
+                    .get(view.buffer().index())
+                    .and_then(|buffer| buffer.0.get(view.offset()..view.offset().checked_add(view.length())?));
+                bytes
+                    .ok_or_else(|| self.error(field.clone(), "the image's buffer view lies outside its buffer"))?
+                    .to_vec()
+            }
+            gltf::image::Source::Uri { uri, .. } => match uri::resolve(uri, self.folder)
+                .map_err(|message| self.error(field.clone(), format!("cannot decode {what}: {message}")))?
+            {
+                Resolved::Data(data) => data,
+                Resolved::File(file) => files::read(self.files, &file)?,
+            },
+        };
+        let decoded = decode_image(Path::new(&name), &encoded)?;
+        let (width, height) = (decoded.width(), decoded.height());
+        let rgba = rgba8(&decoded);
+        if width == 0 || height == 0 || rgba.len() != 4 * width as usize * height as usize {
+            return Err(self.error(field, format!("{what}: {width}×{height} pixels do not match its data")));
+        }
+        self.textures.push(tinted(Texture::from_rgba8(name, width, height, &rgba, true), tint));
         self.texture_cache.insert(key, self.textures.len() - 1);
         Ok(self.textures.len() - 1)
     }
@@ -463,70 +612,48 @@ impl Loader<'_> {
             return Err(self.error(field, format!("yfov {yfov} must lie in (0, π)")));
         }
         let (width, height) = match perspective.aspect_ratio() {
-            Some(aspect) if aspect.is_finite() && aspect > 0.0 => {
+            Some(aspect) if aspect.is_finite() && aspect > 0.0 && DEFAULT_IMAGE_SIDE as f32 / aspect <= 8192.0 => {
                 (DEFAULT_IMAGE_SIDE, ((DEFAULT_IMAGE_SIDE as f32 / aspect).round() as u32).max(1))
             }
-            Some(aspect) => return Err(self.error(field, format!("aspectRatio {aspect} must be > 0"))),
+            Some(aspect) => {
+                return Err(self.error(
+                    field,
+                    format!("aspectRatio {aspect} must be ≥ 1/16 (the image is {DEFAULT_IMAGE_SIDE} pixels wide)"),
+                ));
+            }
             None => (DEFAULT_IMAGE_SIDE, DEFAULT_IMAGE_SIDE),
         };
         let near_clip = perspective.znear();
         if !(near_clip.is_finite() && near_clip > 0.0) {
             return Err(self.error(field, format!("znear {near_clip} must be > 0")));
         }
+        let far_clip = perspective.zfar();
+        if let Some(far) = far_clip.filter(|&far| !(far.is_finite() && far > near_clip)) {
+            return Err(self.error(field, format!("zfar {far} must be finite and beyond znear {near_clip}")));
+        }
         let origin = world.transform_point3(Vec3::ZERO);
         let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
-        let up = world.transform_vector3(Vec3::Y);
-        if forward == Vec3::ZERO || forward.cross(up).length_squared() <= 0.0 {
+        let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
+        if forward == Vec3::ZERO
+            || forward.cross(up).length_squared().is_nan()
+            || forward.cross(up).length_squared() <= 1e-12
+        {
             return Err(self.error(format!("nodes[{node}]"), "the camera's transform has no view direction or up"));
         }
         let fov_x = 2.0 * ((yfov * 0.5).tan() * width as f32 / height as f32).atan();
+        if !(fov_x.to_degrees() > 1e-3 && fov_x.to_degrees() < 180.0) {
+            return Err(self.error(field, format!("yfov {yfov} gives a horizontal opening of {fov_x} radians")));
+        }
         Ok(Camera {
             origin: origin.into(),
             target: (origin + forward).into(),
-            up: up.normalize().into(),
+            up: up.into(),
             fov_deg: fov_x.to_degrees(),
             fov_axis: "x".into(),
             width,
             height,
             near_clip,
-            far_clip: perspective.zfar().unwrap_or_else(|| far_clip_beyond(origin, scene_bounds)),
+            far_clip: far_clip.unwrap_or_else(|| far_clip_beyond(origin, scene_bounds)),
         })
     }
-}
-
-/// The pixels of a decoded image as 8-bit RGBA (grey replicated, 16-bit and float
-/// channels rounded to 8 bits, alpha 255 where there is none).
-fn rgba8(data: &gltf::image::Data) -> Vec<u8> {
-    use gltf::image::Format;
-    let (channels, bytes) = match data.format {
-        Format::R8 => (1, 1),
-        Format::R8G8 => (2, 1),
-        Format::R8G8B8 => (3, 1),
-        Format::R8G8B8A8 => (4, 1),
-        Format::R16 => (1, 2),
-        Format::R16G16 => (2, 2),
-        Format::R16G16B16 => (3, 2),
-        Format::R16G16B16A16 => (4, 2),
-        Format::R32G32B32FLOAT => (3, 4),
-        Format::R32G32B32A32FLOAT => (4, 4),
-    };
-    let channel = |c: &[u8]| -> u8 {
-        match bytes {
-            1 => c[0],
-            2 => ((u32::from(u16::from_ne_bytes([c[0], c[1]])) * 255 + 32767) / 65535) as u8,
-            _ => (f32::from_ne_bytes([c[0], c[1], c[2], c[3]]).clamp(0.0, 1.0) * 255.0).round() as u8,
-        }
-    };
-    data.pixels
-        .chunks_exact(channels * bytes)
-        .flat_map(|pixel| {
-            let value: Vec<u8> = pixel.chunks_exact(bytes).map(channel).collect();
-            match channels {
-                1 => [value[0], value[0], value[0], 255],
-                2 => [value[0], value[0], value[0], value[1]],
-                3 => [value[0], value[1], value[2], 255],
-                _ => [value[0], value[1], value[2], value[3]],
-            }
-        })
-        .collect()
 }

@@ -139,16 +139,35 @@ pub(super) fn framing_camera(shapes: &[Shape]) -> Camera {
 }
 
 /// A scene with the default integrator settings; the framing camera if `camera` is `None`.
+/// An error if the camera is not finite: vertices so far apart that their extent overflows
+/// f32 leave no camera that frames them (nor a far clip beyond them).
 pub(super) fn assemble_scene(
     name: String,
     camera: Option<Camera>,
     (materials, material_names): (Vec<Material>, Vec<String>),
     shapes: Vec<Shape>,
     textures: Vec<Texture>,
-) -> Scene {
-    Scene {
+) -> Result<Scene, String> {
+    let camera = camera.unwrap_or_else(|| framing_camera(&shapes));
+    let numbers = [camera.origin, camera.target, camera.up].concat();
+    if super::CameraFrame::new(&camera).is_none_or(|f| !(f.forward.is_finite() && f.right.is_finite())) {
+        return Err(format!(
+            "the camera looks from {:?} along its up vector {:?} (or at a point it cannot tell from its own position)",
+            camera.origin, camera.up
+        ));
+    }
+    if numbers.iter().any(|c| !c.is_finite())
+        || !(camera.near_clip.is_finite() && camera.far_clip.is_finite() && camera.far_clip > camera.near_clip)
+    {
+        let (lo, hi) = bounds(&shapes);
+        return Err(format!(
+            "the scene's extent from {lo} to {hi} overflows f32: no camera frames it (origin {:?}, far clip {})",
+            camera.origin, camera.far_clip
+        ));
+    }
+    Ok(Scene {
         name,
-        camera: camera.unwrap_or_else(|| framing_camera(&shapes)),
+        camera,
         max_depth: DEFAULT_MAX_DEPTH,
         rr_depth: DEFAULT_RR_DEPTH,
         materials,
@@ -156,7 +175,7 @@ pub(super) fn assemble_scene(
         shapes,
         textures,
         environment: None,
-    }
+    })
 }
 
 /// A GGX conductor whose normal-incidence reflectance is `colour`, with the same colour as

@@ -11,29 +11,47 @@
 //! that does not exist. Zero-area triangles inside an otherwise valid mesh are dropped
 //! and counted (the reference scenes contain some: 62 in veach-ajar's door handle); they
 //! cannot be hit and carry no light.
+//!
+//! Numbers are checked where they are read: a NaN, infinite or (where it means nothing)
+//! negative camera field, reflectance, emitted radiance, material parameter, texture or
+//! environment texel, or a transform that is singular or not finite, is an error naming
+//! the field; nothing is clamped. Sizes are checked before allocating: a count declared in
+//! a file (PLY elements, glTF accessors, EXR data windows) must fit in the bytes that
+//! follow. Every loader reads through a [`FileSource`], so a scene can be loaded from
+//! memory ([`load_scene_from`], [`MemoryFiles`]) as well as from disk.
 
 mod camera_path;
 mod camera_rays;
 mod default_scene;
 mod description;
+mod description_check;
 mod environment;
+mod exr_decode;
+mod files;
 mod gltf_scene;
 mod material;
 mod mesh_util;
+mod obj_check;
 mod obj_scene;
 mod ply;
 mod texture;
+mod uri;
 
 pub use camera_path::{CameraKeyframe, CameraPath, parse_camera_path};
 pub use camera_rays::CameraFrame;
 pub use default_scene::default_scene;
 pub use description::{Camera, EmitterDescription, EnvironmentDescription, MaterialDescription, Reflectance};
+pub use description_check::MAX_IMAGE_SIDE;
 pub use environment::Environment;
-pub use gltf_scene::load_gltf;
+pub use exr_decode::{
+    MAX_BLOCK_BYTES, MAX_BLOCK_BYTES_PER_FILE_BYTE, MAX_EXR_TEXELS, MAX_TEXELS_PER_FILE_BYTE, RgbExr, decode_rgb_exr,
+};
+pub use files::{DiskFiles, FileSource, MemoryFiles};
+pub use gltf_scene::{load_gltf, load_gltf_from};
 pub use material::{Albedo, Material};
-pub use obj_scene::load_obj;
-pub use ply::{PlyMesh, read_ply};
-pub use texture::{Texture, srgb_to_linear};
+pub use obj_scene::{load_obj, load_obj_from};
+pub use ply::{PlyMesh, parse_ply, read_ply};
+pub use texture::{MAX_TEXTURE_BYTES, Texture, srgb_to_linear};
 
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -125,15 +143,25 @@ pub struct Scene {
 impl Scene {
     /// Loads `scene.json` and the meshes it names (paths relative to its folder).
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
+        Scene::load_from(path, &DiskFiles)
+    }
+
+    /// Loads the scene description `path` and the files it names through `files`.
+    pub fn load_from(path: &Path, files: &dyn FileSource) -> Result<Scene, SceneError> {
+        let bytes = files::read(files, path)?;
+        let text = String::from_utf8(bytes).map_err(|source| SceneError::Io {
+            path: path.into(),
+            source: std::io::Error::new(std::io::ErrorKind::InvalidData, source),
+        })?;
         let description = description::parse(path, &text)?;
+        description_check::check(path, &description)?;
         let folder = path.parent().unwrap_or(Path::new("."));
         let mut material_names: Vec<String> = description.materials.keys().cloned().collect();
         material_names.sort();
         let mut textures = Vec::new();
         let materials = material_names
             .iter()
-            .map(|name| resolve_material(path, folder, name, &description.materials[name], &mut textures))
+            .map(|name| resolve_material(path, folder, name, &description.materials[name], files, &mut textures))
             .collect::<Result<Vec<_>, _>>()?;
         let mut shapes = Vec::with_capacity(description.shapes.len());
         for (index, shape) in description.shapes.iter().enumerate() {
@@ -148,7 +176,7 @@ impl Scene {
                     ),
                 })?;
             let mesh_path = folder.join(&shape.mesh);
-            let mesh = read_ply(&mesh_path)?;
+            let mesh = parse_ply(&mesh_path, &files::read(files, &mesh_path)?)?;
             let (triangles, uvs, degenerate_dropped) = mesh.triangles_without_degenerate();
             if triangles.is_empty() {
                 return Err(SceneError::Ply {
@@ -168,7 +196,10 @@ impl Scene {
             });
         }
         let environment = match description.environment {
-            Some(e) => Some(Environment::load(&folder.join(&e.file), e.scale, e.to_world)?),
+            Some(e) => {
+                let file = folder.join(&e.file);
+                Some(Environment::from_exr_bytes(&file, &files::read(files, &file)?, e.scale, e.to_world)?)
+            }
             None => None,
         };
         Ok(Scene {
@@ -213,10 +244,15 @@ impl Scene {
 /// Loads a scene file by its extension: `.json` (the shared scenes' description), `.gltf`
 /// or `.glb` (glTF 2.0), `.obj` (Wavefront OBJ with its MTL libraries).
 pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
+    load_scene_from(path, &DiskFiles)
+}
+
+/// [`load_scene_file`] reading the scene file and every file it names through `files`.
+pub fn load_scene_from(path: &Path, files: &dyn FileSource) -> Result<Scene, SceneError> {
     match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
-        Some("json") => Scene::load(path),
-        Some("gltf" | "glb") => load_gltf(path),
-        Some("obj") => load_obj(path),
+        Some("json") => Scene::load_from(path, files),
+        Some("gltf" | "glb") => load_gltf_from(path, &files::read(files, path)?, files),
+        Some("obj") => load_obj_from(path, &files::read(files, path)?, files),
         other => Err(SceneError::Json {
             path: path.into(),
             field: "(file)".into(),
@@ -236,6 +272,7 @@ fn resolve_material(
     folder: &Path,
     name: &str,
     description: &MaterialDescription,
+    files: &dyn FileSource,
     textures: &mut Vec<Texture>,
 ) -> Result<Material, SceneError> {
     let field = |field: &str, message: String| SceneError::Json {
@@ -262,7 +299,8 @@ fn resolve_material(
                     if let Some(wrap) = wrap.as_deref().filter(|w| *w != "repeat") {
                         return Err(field("reflectance.wrap", format!("`{wrap}`: only `repeat` is supported")));
                     }
-                    textures.push(Texture::load(&folder.join(texture), *srgb)?);
+                    let file = folder.join(texture);
+                    textures.push(Texture::decode(&file, &files::read(files, &file)?, *srgb)?);
                     Albedo::Texture { texture: textures.len() - 1, uv_scale: uv_scale.unwrap_or([1.0, 1.0]) }
                 }
             };

@@ -10,7 +10,7 @@
 //! * Camera: OBJ has none, so a camera framing the scene looks down −Z.
 //! * Materials, in this order of precedence:
 //!   - `Pm` ≥ 0.5 (the PBR extension): a GGX conductor reproducing the colour `Kd` (as glTF
-//!     metals), alpha = max(`Pr`², 10⁻³), `Pr` 1 when absent;
+//!     metals), alpha = max(`Pr`², 10⁻³), `Pr` 1 when absent (outside [0, 1]: an error);
 //!   - `illum` 4, 6, 7 or 9 (the transparent models), `d` < 1 or `Tr` > 0: a smooth
 //!     dielectric with interior IOR `Ni` (1.5 when absent) and exterior IOR 1. `Tf` is not
 //!     looked at: exporters write `Tf 1 1 1` for opaque materials too;
@@ -28,12 +28,16 @@
 //!   0.8.
 //!
 //! Errors name the file and the object or material: a missing OBJ, a malformed OBJ or MTL,
-//! a non-finite vertex, a mesh whose triangles all have zero area, an unreadable texture.
+//! a non-finite vertex or texture coordinate, a NaN, infinite or negative colour, a mesh
+//! whose triangles all have zero area, an unreadable texture. The material libraries and
+//! textures are read through the loader's [`FileSource`].
 
+use super::files::{self, DiskFiles, FileSource};
 use super::mesh_util::{
     DEFAULT_GREY, MIN_ALPHA, assemble_scene, checked_triangles, default_material, emission, metal, tinted,
     without_panic,
 };
+use super::obj_check;
 use super::{Albedo, Material, Scene, SceneError, Shape, Texture};
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -43,7 +47,13 @@ use std::path::{Path, PathBuf};
 /// (module documentation).
 pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
     let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
-    without_panic(|| load_bytes(path, &bytes)).unwrap_or_else(|message| Err(obj_error(path, "(file)", message)))
+    load_obj_from(path, &bytes, &DiskFiles)
+}
+
+/// Loads the OBJ in `bytes` (the contents of `path`), reading the MTL libraries and
+/// textures it names through `files`.
+pub fn load_obj_from(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene, SceneError> {
+    without_panic(|| load_bytes(path, bytes, files)).unwrap_or_else(|message| Err(obj_error(path, "(file)", message)))
 }
 
 /// An error about `element` of the OBJ or MTL file `path`.
@@ -52,13 +62,13 @@ fn obj_error(path: &Path, element: impl Into<String>, message: impl Into<String>
 }
 
 /// Loads the OBJ in `bytes`, read from `path`.
-fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, SceneError> {
+fn load_bytes(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene, SceneError> {
     let folder = path.parent().unwrap_or(Path::new("."));
     let library_error = RefCell::new(None);
     let library_of = RefCell::new(HashMap::new());
     let load_library = |relative: &Path| {
         let library = folder.join(relative);
-        let text = match std::fs::read(&library) {
+        let text = match files.read(&library) {
             Ok(text) => text,
             Err(error) => {
                 if error.kind() == std::io::ErrorKind::NotFound {
@@ -73,6 +83,10 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, SceneError> {
                 return Err(tobj::LoadError::OpenFileFailed);
             }
         };
+        if let Some((line, problem)) = obj_check::short_colour(&String::from_utf8_lossy(&text)) {
+            *library_error.borrow_mut() = Some(obj_error(&library, format!("line {line}"), problem));
+            return Err(tobj::LoadError::MaterialParseError);
+        }
         let loaded = tobj::load_mtl_buf(&mut text.as_slice());
         match &loaded {
             Ok((materials, _)) => {
@@ -85,6 +99,9 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, SceneError> {
         }
         loaded
     };
+    if let Some((line, problem)) = obj_check::bad_face_index(&String::from_utf8_lossy(bytes)) {
+        return Err(obj_error(path, format!("line {line}"), problem));
+    }
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
     let (models, materials) = tobj::load_obj_buf(&mut &bytes[..], &options, load_library)
         .map_err(|e| obj_error(path, "(file)", format!("not a valid OBJ file: {e}")))?;
@@ -92,7 +109,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, SceneError> {
         return Err(error);
     }
     let library_of = library_of.into_inner();
-    let mut converter = MaterialConverter { textures: Vec::new(), texture_cache: HashMap::new() };
+    let mut converter = MaterialConverter { files, textures: Vec::new(), texture_cache: HashMap::new() };
     let mut scene_materials = Vec::new();
     let mut names = Vec::new();
     let mut emissions = Vec::new();
@@ -142,18 +159,21 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, SceneError> {
         return Err(obj_error(path, "faces", "the file has no triangles"));
     }
     let name = path.file_stem().map_or_else(|| path.display().to_string(), |s| s.to_string_lossy().into_owned());
-    Ok(assemble_scene(name, None, (scene_materials, names), shapes, converter.textures))
+    assemble_scene(name, None, (scene_materials, names), shapes, converter.textures)
+        .map_err(|message| obj_error(path, "(scene)", message))
 }
 
 /// Turns MTL materials into the renderer's, loading their textures.
-struct MaterialConverter {
+struct MaterialConverter<'a> {
+    /// Where textures are read.
+    files: &'a dyn FileSource,
     /// Decoded textures.
     textures: Vec<Texture>,
     /// Texture index by (file, tint bits).
     texture_cache: HashMap<(PathBuf, [u32; 3]), usize>,
 }
 
-impl MaterialConverter {
+impl MaterialConverter<'_> {
     /// The BSDF and emitted radiance of `material` from the library `library` (module
     /// documentation).
     fn convert(
@@ -177,28 +197,39 @@ impl MaterialConverter {
                 other => Ok(other),
             }
         };
+        let scalar = |statement: &str, value: Option<f32>, least: f32| -> Result<Option<f32>, SceneError> {
+            match value {
+                Some(v) if !(v.is_finite() && v >= least) => {
+                    Err(obj_error(library, element(statement), format!("{v} must be finite and ≥ {least}")))
+                }
+                other => Ok(other),
+            }
+        };
+        let dissolve = scalar("d", material.dissolve, 0.0)?;
+        let optical_density = scalar("Ni", material.optical_density, f32::MIN_POSITIVE)?;
+        let shininess = scalar("Ns", material.shininess, 0.0)?;
         let kd = colour("Kd", material.diffuse)?;
         let ks = colour("Ks", material.specular)?;
         let radiance = emission(material.emissive.unwrap_or([0.0; 3]))
             .map_err(|message| obj_error(library, element("Ke"), message))?;
         let transparent =
-            material.dissolve.is_some_and(|d| d < 1.0) || number("Tr")?.is_some_and(|transparency| transparency > 0.0);
+            dissolve.is_some_and(|d| d < 1.0) || number("Tr")?.is_some_and(|transparency| transparency > 0.0);
         let illum = material.illumination_model;
         let bsdf = if let Some(metallic) = number("Pm")?
             && metallic >= 0.5
         {
             let roughness = number("Pr")?.unwrap_or(1.0);
+            if !(0.0..=1.0).contains(&roughness) {
+                return Err(obj_error(library, element("Pr"), format!("{roughness} must lie in [0, 1]")));
+            }
             metal(kd.unwrap_or([DEFAULT_GREY; 3]), (roughness * roughness).max(MIN_ALPHA), true)
         } else if transparent || matches!(illum, Some(4 | 6 | 7 | 9)) {
-            let int_ior = material.optical_density.filter(|n| n.is_finite() && *n > 0.0).unwrap_or(1.5);
+            let int_ior = optical_density.unwrap_or(1.5);
             Material::Dielectric { int_ior, ext_ior: 1.0 }
         } else if let (Some(3 | 5), Some(ks)) = (illum, ks)
             && ks.iter().any(|&c| c > 0.0)
         {
-            let alpha = material
-                .shininess
-                .filter(|n| n.is_finite() && *n >= 0.0)
-                .map_or(MIN_ALPHA, |n| (2.0 / (n + 2.0)).sqrt());
+            let alpha = shininess.map_or(MIN_ALPHA, |n| (2.0 / (n + 2.0)).sqrt());
             metal(ks, alpha, true)
         } else if let Some(map) = &material.diffuse_texture {
             let file =
@@ -218,7 +249,8 @@ impl MaterialConverter {
         if let Some(&index) = self.texture_cache.get(&key) {
             return Ok(index);
         }
-        self.textures.push(tinted(Texture::load(&key.0, true)?, tint));
+        let texture = Texture::decode(&key.0, &files::read(self.files, &key.0)?, true)?;
+        self.textures.push(tinted(texture, tint));
         self.texture_cache.insert(key, self.textures.len() - 1);
         Ok(self.textures.len() - 1)
     }

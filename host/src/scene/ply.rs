@@ -2,6 +2,11 @@
 //! "Geometry"): vertices with float `x y z` and optional `s t`, faces as
 //! `list uchar int vertex_indices`, triangles only. Other scalar property types are
 //! read and ignored; ASCII and big-endian files are refused with a clear error.
+//!
+//! A header that declares more elements than the rest of the file can hold (each element
+//! needs at least the bytes of its scalar properties and list counts) is refused before
+//! anything is read; so are non-finite positions and texture coordinates, and face indices
+//! that are not whole numbers within the vertex list.
 
 use super::SceneError;
 use std::path::{Path, PathBuf};
@@ -83,9 +88,14 @@ fn ply_error(path: &Path, element: impl Into<String>, message: impl Into<String>
     SceneError::Ply { path: PathBuf::from(path), element: element.into(), message: message.into() }
 }
 
-/// Reads a binary little-endian PLY triangle mesh.
+/// Reads a binary little-endian PLY triangle mesh from the file `path`.
 pub fn read_ply(path: &Path) -> Result<PlyMesh, SceneError> {
     let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
+    parse_ply(path, &bytes)
+}
+
+/// Reads the binary little-endian PLY triangle mesh in `bytes` (`path` names it in errors).
+pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<PlyMesh, SceneError> {
     let header_end = bytes
         .windows(11)
         .position(|w| w == b"end_header\n")
@@ -134,6 +144,31 @@ pub fn read_ply(path: &Path) -> Result<PlyMesh, SceneError> {
     let mut mesh = PlyMesh { positions: Vec::new(), uvs: None, faces: Vec::new() };
     let truncated = |what: String| ply_error(path, what, "the file ends early (truncated)");
     for element in &elements {
+        // The fewest bytes one element takes: its scalars and its lists' counts.
+        let smallest: usize = element
+            .properties
+            .iter()
+            .map(|p| match p {
+                Property::Scalar(_, kind) | Property::List(_, kind, _) => kind.size(),
+            })
+            .sum();
+        let remaining = bytes.len() - offset;
+        if smallest == 0 {
+            if element.count > 0 && (element.name == "vertex" || element.name == "face") {
+                return Err(ply_error(path, format!("element {}", element.name), "the element has no properties"));
+            }
+            continue;
+        }
+        if element.count.checked_mul(smallest).is_none_or(|needed| needed > remaining) {
+            return Err(ply_error(
+                path,
+                format!("element {}", element.name),
+                format!(
+                    "the header declares {} elements of at least {smallest} bytes, but only {remaining} bytes follow",
+                    element.count
+                ),
+            ));
+        }
         for index in 0..element.count {
             let mut values: Vec<(&str, f64)> = Vec::new();
             let mut list: Vec<f64> = Vec::new();
@@ -181,7 +216,15 @@ pub fn read_ply(path: &Path) -> Result<PlyMesh, SceneError> {
                     }
                     mesh.positions.push(position);
                     if let (Some(s), Some(t)) = (get("s").or(get("u")), get("t").or(get("v"))) {
-                        mesh.uvs.get_or_insert_with(Vec::new).push([s as f32, t as f32]);
+                        let uv = [s as f32, t as f32];
+                        if uv.iter().any(|c| !c.is_finite()) {
+                            return Err(ply_error(
+                                path,
+                                format!("vertex {index}"),
+                                format!("texture coordinate is not finite: {uv:?}"),
+                            ));
+                        }
+                        mesh.uvs.get_or_insert_with(Vec::new).push(uv);
                     }
                 }
                 "face" => {
@@ -193,7 +236,8 @@ pub fn read_ply(path: &Path) -> Result<PlyMesh, SceneError> {
                         ));
                     }
                     let face = [list[0], list[1], list[2]];
-                    if let Some(bad) = face.iter().find(|&&i| i < 0.0 || i as usize >= mesh.positions.len()) {
+                    let outside = |i: f64| !(i >= 0.0 && i.fract() == 0.0 && i < mesh.positions.len() as f64);
+                    if let Some(bad) = face.iter().find(|&&i| outside(i)) {
                         return Err(ply_error(
                             path,
                             format!("face {index}"),

@@ -1,0 +1,61 @@
+//! Where the scene loaders read their files from: the disk ([`DiskFiles`], what
+//! [`super::load_scene_file`] uses) or a map of names to bytes ([`MemoryFiles`], for
+//! loading a scene held in memory, as the fuzz harness does). Every loader reads the scene
+//! file and everything it names (meshes, buffers, material libraries, textures,
+//! environment maps) through one [`FileSource`], so nothing else touches the file system.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// Something that hands out the bytes of a file by its path.
+pub trait FileSource {
+    /// The whole contents of `path` (paths are joined to the scene file's folder by the
+    /// loaders before they ask).
+    fn read(&self, path: &Path) -> std::io::Result<Vec<u8>>;
+}
+
+/// The file system.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct DiskFiles;
+
+impl FileSource for DiskFiles {
+    fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
+        std::fs::read(path)
+    }
+}
+
+/// Files held in memory, by path; a path not in the map is "not found", unless a
+/// fallback by extension answers for it.
+#[derive(Clone, Debug, Default)]
+pub struct MemoryFiles {
+    /// Contents by exact path.
+    pub files: HashMap<PathBuf, Vec<u8>>,
+    /// Contents for any other path with this (lower-case) extension, e.g. `ply`.
+    pub by_extension: HashMap<String, Vec<u8>>,
+}
+
+impl MemoryFiles {
+    /// Adds (or replaces) the file `path`.
+    pub fn insert(&mut self, path: impl Into<PathBuf>, bytes: impl Into<Vec<u8>>) -> &mut Self {
+        self.files.insert(path.into(), bytes.into());
+        self
+    }
+}
+
+impl FileSource for MemoryFiles {
+    fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
+        if let Some(bytes) = self.files.get(path) {
+            return Ok(bytes.clone());
+        }
+        let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        match extension.and_then(|e| self.by_extension.get(&e)) {
+            Some(bytes) => Ok(bytes.clone()),
+            None => Err(std::io::ErrorKind::NotFound.into()),
+        }
+    }
+}
+
+/// Reads `path` through `files`, as a [`super::SceneError::Io`] naming it on failure.
+pub(super) fn read(files: &dyn FileSource, path: &Path) -> Result<Vec<u8>, super::SceneError> {
+    files.read(path).map_err(|source| super::SceneError::Io { path: path.into(), source })
+}

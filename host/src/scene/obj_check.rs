@@ -1,0 +1,79 @@
+//! Checks of OBJ and MTL text made before `tobj` parses it, for what `tobj` does not
+//! check itself: a face index of 0 or beyond the vertices, texture coordinates or normals
+//! that exist (`tobj` computes `index × 3` unchecked, which overflows on huge indices), and a
+//! colour statement (`Ka`, `Kd`, `Ks`, `Ke`) with fewer than three numbers (`tobj` unwraps
+//! it). Each is an error naming the line.
+
+/// The first face (or line, or point) of `text` with a vertex, texture or normal index
+/// that is 0 or lies outside the elements declared so far (relative, negative indices)
+/// or in the whole file (absolute ones): its line number and what is wrong.
+pub(super) fn bad_face_index(text: &str) -> Option<(usize, String)> {
+    let mut totals = [0i64; 3];
+    for line in text.lines() {
+        match line.split_whitespace().next() {
+            Some("v") => totals[0] += 1,
+            Some("vt") => totals[1] += 1,
+            Some("vn") => totals[2] += 1,
+            _ => {}
+        }
+    }
+    let mut counts = [0i64; 3];
+    for (number, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => counts[0] += 1,
+            Some("vt") => counts[1] += 1,
+            Some("vn") => counts[2] += 1,
+            Some("f" | "l" | "p") => {
+                for corner in words {
+                    for (kind, index) in corner.split('/').enumerate().take(3) {
+                        // Not a number: tobj refuses the line itself.
+                        let Ok(index) = index.parse::<i64>() else { continue };
+                        let what = ["vertex", "texture coordinate", "normal"][kind];
+                        let valid =
+                            if index < 0 { index >= -counts[kind] } else { index >= 1 && index <= totals[kind] };
+                        if !valid {
+                            return Some((
+                                number + 1,
+                                format!(
+                                    "{what} index {index} out of range ({} declared before the line, {} in the file)",
+                                    counts[kind], totals[kind]
+                                ),
+                            ));
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    None
+}
+
+/// The first colour statement of the MTL `text` with fewer than three numbers: its line
+/// number and statement.
+pub(super) fn short_colour(text: &str) -> Option<(usize, String)> {
+    text.lines().enumerate().find_map(|(number, line)| {
+        let mut words = line.split_whitespace();
+        let statement = words.next()?;
+        (["Ka", "Kd", "Ks", "Ke"].contains(&statement) && words.count() < 3)
+            .then(|| (number + 1, format!("`{}` needs three numbers (r g b)", line.trim())))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn faces_beyond_their_elements_and_short_colours_are_found() {
+        let good = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 -1/-1\n";
+        assert_eq!(bad_face_index(good), None);
+        assert_eq!(bad_face_index("v 0 0 0\nf 1 2 0\n").unwrap().0, 2);
+        assert!(bad_face_index("v 0 0 0\nf -2 1 1\n").unwrap().1.contains("vertex index -2"));
+        assert!(bad_face_index("v 0 0 0\nf 1/9223372036854775807 1 1\n").unwrap().1.contains("texture coordinate"));
+        assert!(bad_face_index("f -1 1 1\nv 0 0 0\n").is_some(), "relative to what is declared before");
+        assert_eq!(short_colour("newmtl a\nKd 1 1 1\n"), None);
+        assert_eq!(short_colour("newmtl a\nKe 1\n").unwrap().0, 2);
+    }
+}

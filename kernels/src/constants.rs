@@ -53,6 +53,8 @@ pub const SHARED: &[(&str, ConstantValue)] = {
         ("METHOD_STRATA", U32(restir_types::METHOD_STRATA)),
         ("METHOD_RESTIR", U32(restir_types::METHOD_RESTIR)),
         ("METHOD_RESTIR_DISC", U32(restir_types::METHOD_RESTIR_DISC)),
+        ("SHADING_SAMPLE", U32(restir_types::SHADING_SAMPLE)),
+        ("SHADING_EXPECTATION", U32(restir_types::SHADING_EXPECTATION)),
         ("FLAG_SAMPLE_LIGHTS", U32(render_types::FLAG_SAMPLE_LIGHTS)),
         ("FLAG_HIT_LIGHTS", U32(render_types::FLAG_HIT_LIGHTS)),
         ("FLAG_RUSSIAN_ROULETTE", U32(render_types::FLAG_RUSSIAN_ROULETTE)),

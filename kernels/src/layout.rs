@@ -157,11 +157,15 @@ shader_struct!(
         temporal_candidates,
         previous_up,
         shaded_parts,
+        shading,
+        _pad0,
+        _pad1,
+        _pad2,
     ]
 );
 shader_struct!(Primary, "Primary", [position, object_id, normal, material, wo, flags, albedo, depth]);
 shader_struct!(PathCandidate, "PathCandidate", [position, kind, normal, light, reflected, weight]);
-shader_struct!(Reservoir, "Reservoir", [sample, weight, count, target_value, _pad]);
+shader_struct!(Reservoir, "Reservoir", [sample, weight, count, target_value, _pad, expected, _pad_expected]);
 
 /// Compares `T` with the struct `T::WGSL_NAME` of `module`; the error lists every
 /// difference.

@@ -24,6 +24,12 @@ pub const METHOD_RESTIR: u32 = 1;
 /// `RestirParams.method`: K uniformly random pixels in a disc.
 pub const METHOD_RESTIR_DISC: u32 = 2;
 
+/// `RestirParams.shading`: the resampled part is the kept sample's f(Y) V W.
+pub const SHADING_SAMPLE: u32 = 0;
+/// `RestirParams.shading`: the resampled part is `Reservoir::expected`, the expectation of
+/// the frame's final resampling over its choice.
+pub const SHADING_EXPECTATION: u32 = 1;
+
 /// Settings of the ReSTIR kernels (WGSL `RestirParams`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -62,6 +68,14 @@ pub struct RestirParams {
     /// What restir_shade writes: bit 0 the pixel's own estimate, bit 1 the reservoir's
     /// sample (3: the image; 1 or 2: a diagnostic of one part).
     pub shaded_parts: u32,
+    /// `SHADING_*`: the resampled part as the kept sample or as `Reservoir::expected`.
+    pub shading: u32,
+    /// Padding.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+    /// Padding.
+    pub _pad2: u32,
 }
 
 /// One pixel's primary hit (WGSL `Primary`).
@@ -118,4 +132,9 @@ pub struct Reservoir {
     pub target_value: f32,
     /// Padding.
     pub _pad: u32,
+    /// The expectation of the frame's final resampling over its choice at this pixel
+    /// (RGB): what `SHADING_EXPECTATION` shades.
+    pub expected: [f32; 3],
+    /// Padding.
+    pub _pad_expected: f32,
 }

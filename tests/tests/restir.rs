@@ -11,7 +11,7 @@
 //! Needs Vulkan (skips without it unless `STRATA_REQUIRE_GPU=1`).
 
 use strata::render::{GpuScene, PathTracer, RenderSettings};
-use strata::restir::{Method, RestirRenderer, RestirSettings, ShadedParts};
+use strata::restir::{Method, RestirRenderer, RestirSettings, ShadedParts, Shading};
 use strata::rgb_image::RgbImage;
 use strata::scene::{Camera, CameraPath, Scene, default_scene};
 use strata_backends::{Backend, gpu_required};
@@ -415,8 +415,9 @@ fn glass_metal_environment_scene() -> Scene {
 }
 
 /// Every method stays unbiased where glass, glossy and rough metal and an environment
-/// map decide which pixels and candidates are reused, with and without temporal reuse;
-/// a 3 % bias is caught on the same scene.
+/// map decide which pixels and candidates are reused, with and without temporal reuse,
+/// shading the kept sample or the final resampling's expectation; a 3 % bias is caught
+/// on the same scene.
 #[test]
 fn glass_metal_and_environment_reuse_stays_unbiased() {
     let Some(mut backend) = strata_tests::vulkan_backend("glass_metal_and_environment_reuse_stays_unbiased") else {
@@ -425,25 +426,66 @@ fn glass_metal_and_environment_reuse_stays_unbiased() {
     };
     let scene = glass_metal_environment_scene();
     let reference = reference(&mut backend, &scene, 2048);
-    for method in [Method::Strata, Method::Restir, Method::RestirDisc] {
-        let restir = RestirSettings { method, temporal: false, selection: blocks_of_8(), ..RestirSettings::default() };
-        let ours = restir_frames(&mut backend, &scene, restir, 1..9, 64);
-        assert_unbiased(
-            &format!("{} without temporal reuse, glass/metal/environment", method.name()),
-            &z_scores(&ours, &reference),
-        );
-        if method == Method::Strata {
-            let mut brighter = ours.clone();
-            brighter.sum.iter_mut().for_each(|s| *s *= 1.03);
-            brighter.squares.iter_mut().for_each(|s| *s *= 1.03 * 1.03);
-            let z = z_scores(&brighter, &reference);
-            let pooled = z.iter().sum::<f64>() / (z.len() as f64).sqrt();
-            assert!(pooled > 4.5, "a 3 % bias gives pooled z {pooled:.2} only");
+    for shading in [Shading::Sample, Shading::Expectation] {
+        for method in [Method::Strata, Method::Restir, Method::RestirDisc] {
+            let restir = RestirSettings {
+                method,
+                shading,
+                temporal: false,
+                selection: blocks_of_8(),
+                ..RestirSettings::default()
+            };
+            let ours = restir_frames(&mut backend, &scene, restir, 1..9, 32);
+            let what = format!("{} ({shading:?}) without temporal reuse, glass/metal/environment", method.name());
+            assert_unbiased(&what, &z_scores(&ours, &reference));
+            if method == Method::Strata && shading == Shading::Sample {
+                let mut brighter = ours.clone();
+                brighter.sum.iter_mut().for_each(|s| *s *= 1.03);
+                brighter.squares.iter_mut().for_each(|s| *s *= 1.03 * 1.03);
+                let z = z_scores(&brighter, &reference);
+                let pooled = z.iter().sum::<f64>() / (z.len() as f64).sqrt();
+                assert!(pooled > 4.5, "a 3 % bias gives pooled z {pooled:.2} only");
+            }
+            let restir = RestirSettings { method, shading, selection: blocks_of_8(), ..RestirSettings::default() };
+            let ours = restir_frames(&mut backend, &scene, restir, 1..97, 6);
+            let what = format!("{} ({shading:?}) with temporal reuse, frame 6, glass/metal/environment", method.name());
+            assert_unbiased(&what, &z_scores(&ours, &reference));
         }
-        let restir = RestirSettings { method, selection: blocks_of_8(), ..RestirSettings::default() };
+    }
+}
+
+/// Shading with the expectation of the final resampling (`Shading::Expectation`) keeps
+/// every method unbiased on the default scene, with and without temporal reuse, and
+/// lowers the frames' spread (it is a conditional expectation of the sample's estimate).
+#[test]
+fn expectation_shading_stays_unbiased() {
+    let Some(mut backend) = strata_tests::vulkan_backend("expectation_shading_stays_unbiased") else {
+        assert!(!gpu_required());
+        return;
+    };
+    let scene = default_scene();
+    let reference = reference(&mut backend, &scene, 2048);
+    for method in [Method::Strata, Method::Restir, Method::RestirDisc] {
+        let settings = |shading| RestirSettings {
+            method,
+            shading,
+            temporal: false,
+            selection: blocks_of_8(),
+            ..RestirSettings::default()
+        };
+        let expected = restir_frames(&mut backend, &scene, settings(Shading::Expectation), 1..9, 64);
+        assert_unbiased(&format!("{} expectation, no temporal reuse", method.name()), &z_scores(&expected, &reference));
+        let sampled = restir_frames(&mut backend, &scene, settings(Shading::Sample), 1..9, 64);
+        let spread = |stats: &RegionStats| (0..stats.sum.len()).map(|i| stats.variance_of_mean(i)).sum::<f64>();
+        assert!(
+            spread(&expected) < spread(&sampled),
+            "{}: the expectation's frames spread more than the sample's",
+            method.name()
+        );
+        let restir = RestirSettings { shading: Shading::Expectation, temporal: true, ..settings(Shading::Expectation) };
         let ours = restir_frames(&mut backend, &scene, restir, 1..129, 6);
         assert_unbiased(
-            &format!("{} with temporal reuse, frame 6, glass/metal/environment", method.name()),
+            &format!("{} expectation, temporal reuse, frame 6", method.name()),
             &z_scores(&ours, &reference),
         );
     }

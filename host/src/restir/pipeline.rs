@@ -2,7 +2,7 @@
 //! buffers (two G-buffers and two reservoir buffers alternate for temporal reuse), and
 //! the five passes dispatched in order.
 
-use super::{Method, RestirSettings};
+use super::{Method, RestirSettings, Shading};
 use crate::histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};
 use crate::render::{GpuScene, RenderSettings, SceneBuffers};
 use crate::rgb_image::RgbImage;
@@ -14,6 +14,7 @@ use strata_kernels::blue_noise::BlueNoiseTables;
 use strata_kernels::render_types::{FLAG_HIT_LIGHTS, FLAG_SAMPLE_LIGHTS, RenderParams};
 use strata_kernels::restir_types::{
     METHOD_RESTIR, METHOD_RESTIR_DISC, METHOD_STRATA, PathCandidate, Primary, Reservoir, RestirParams,
+    SHADING_EXPECTATION, SHADING_SAMPLE,
 };
 use strata_kernels::types::Candidate;
 use strata_kernels::{BlockGrid, Kernel, KernelId, Registry};
@@ -225,6 +226,11 @@ impl RestirRenderer {
             temporal_candidates: self.settings.temporal_candidates,
             previous_up: previous.up.into(),
             shaded_parts: self.settings.shaded_parts.bits(),
+            shading: match self.settings.shading {
+                Shading::Sample => SHADING_SAMPLE,
+                Shading::Expectation => SHADING_EXPECTATION,
+            },
+            ..RestirParams::default()
         };
         backend.write_buffer(self.restir_params, 0, bytemuck::bytes_of(&restir))?;
         let (width, height) = (camera.width, camera.height);

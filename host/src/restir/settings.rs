@@ -62,6 +62,22 @@ impl ShadedParts {
     }
 }
 
+/// What the shading pass adds for the resampled part of a pixel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
+pub enum Shading {
+    /// The kept sample, f(Y) V W, with one shadow ray (the paper's; default).
+    #[default]
+    Sample,
+    /// The expectation of the frame's final resampling over its choice, sum_i w_i f(x_i)
+    /// / p̂(x_i) over every candidate it chose from (the spatial selection's canonical and
+    /// K candidates without temporal reuse; the temporal merge's current and previous
+    /// reservoirs with it): unbiased (it is E[f(Y) W | candidates]), never noisier, no
+    /// shadow ray (p̂ already includes visibility), and the colours of every candidate
+    /// reach the image instead of the one kept (a luminance p̂ cannot resample colour).
+    /// The reservoir kept for reuse is unchanged.
+    Expectation,
+}
+
 /// Settings of a ReSTIR render; the defaults are the paper's (§5.1).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RestirSettings {
@@ -96,6 +112,9 @@ pub struct RestirSettings {
     pub min_distance: f32,
     /// Which parts of the estimate the frame shows (a diagnostic). Default: all.
     pub shaded_parts: ShadedParts,
+    /// The resampled part as the kept sample or as the final resampling's expectation.
+    /// Default: the sample (the paper's).
+    pub shading: Shading,
 }
 
 impl Default for RestirSettings {
@@ -110,6 +129,7 @@ impl Default for RestirSettings {
             min_roughness: 0.2,
             min_distance: 0.0,
             shaded_parts: ShadedParts::All,
+            shading: Shading::Sample,
         }
     }
 }

@@ -47,7 +47,7 @@
 @group(0) @binding(14) var<storage, read> blue_noise: array<u32>;
 
 fn empty_reservoir() -> Reservoir {
-    return Reservoir(PathCandidate(vec3<f32>(0.0), KIND_NONE, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), 0.0), 0.0, 0.0, 0.0, 0u);
+    return Reservoir(PathCandidate(vec3<f32>(0.0), KIND_NONE, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), 0.0), 0.0, 0.0, 0.0, 0u, vec3<f32>(0.0), 0.0);
 }
 
 // The pixel that selection slot `slot` of pixel (x, y) takes, or NO_PIXEL for none
@@ -173,7 +173,23 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
     var result = empty_reservoir();
     result.count = 1.0;
     if chosen_target > 0.0 {
-        result = Reservoir(chosen, total / chosen_target, 1.0, chosen_target, 0u);
+        result = Reservoir(chosen, total / chosen_target, 1.0, chosen_target, 0u, vec3<f32>(0.0), 0.0);
     }
+    // The expectation over the choice: sum_i w_i f(x_i) / p̂(x_i), each candidate's f
+    // here (visible wherever its weight is positive, as p̂ required).
+    var expected = vec3<f32>(0.0);
+    if weight_c > 0.0 && target_c > 0.0 {
+        expected += weight_c / target_c * integrand(p, c);
+    }
+    for (var slot = 0u; slot < k; slot++) {
+        if weights[slot] > 0.0 && targets[slot] > 0.0 {
+            var x = c;
+            if sources[slot] != pixel {
+                x = path_candidates[sources[slot]];
+            }
+            expected += weights[slot] / targets[slot] * integrand(p, x);
+        }
+    }
+    result.expected = expected;
     reservoirs_out[pixel] = result;
 }

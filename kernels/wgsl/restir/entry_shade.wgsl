@@ -1,6 +1,8 @@
 // ReSTIR pass 5: shading. Each pixel's image value is what it estimated on its own
 // (emission at y1, next-event estimation there, or its whole path when it does not
-// resample) plus its reservoir's sample: f(Y) V(y1, Y) W, with one shadow ray. A sample
+// resample) plus its reservoir's part: with RestirParams.shading = SHADING_SAMPLE its
+// sample, f(Y) V(y1, Y) W, with one shadow ray; with SHADING_EXPECTATION the expectation
+// of the frame's final resampling over its choice (Reservoir.expected, no ray). A sample
 // of kind PRIVATE can only be the pixel's own (nobody else can reconnect to it) and was
 // found along an unoccluded ray: it needs no shadow ray. RestirParams.shaded_parts can
 // leave out either part, to measure the other's variance (a diagnostic).
@@ -31,7 +33,9 @@ fn restir_shade(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_inv
         radiance = vec3<f32>(0.0);
     }
     let reservoir = reservoirs[pixel];
-    if (restir.shaded_parts & 2u) != 0u && (p.flags & PRIMARY_RESAMPLE) != 0u && reservoir.weight > 0.0 {
+    if (restir.shaded_parts & 2u) != 0u && (p.flags & PRIMARY_RESAMPLE) != 0u && restir.shading == SHADING_EXPECTATION {
+        radiance += reservoir.expected;
+    } else if (restir.shaded_parts & 2u) != 0u && (p.flags & PRIMARY_RESAMPLE) != 0u && reservoir.weight > 0.0 {
         let y = reservoir.sample;
         var seen = y.kind == KIND_PRIVATE;
         if !seen {

@@ -175,9 +175,27 @@ fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
     merged.count = current.count + m_sum * share;
     if !(total > 0.0) || !(total < INFINITY) {
         merged.weight = 0.0;
+        merged.expected = vec3<f32>(0.0);
         merged_reservoirs[pixel] = merged;
         return;
     }
+    // The expectation over this merge's choice, sum_i w_i f(y_i) / p̂(y_i) (each y_i's f
+    // here; p̂ > 0 means it was visible): what SHADING_EXPECTATION adds in place of
+    // f(Y) V W. The current reservoir's part uses its kept sample, not select's own
+    // expectation: its MIS weight depends on which sample select kept.
+    var expected = vec3<f32>(0.0);
+    if weight_current > 0.0 && current.target_value > 0.0 {
+        expected += weight_current / current.target_value * integrand(p, current.sample);
+    }
+    if own.weight > 0.0 && own.target_here > 0.0 {
+        expected += own.weight / own.target_here * integrand(p, previous_reservoirs[own_source].sample);
+    }
+    for (var slot = 0u; slot < drawn; slot++) {
+        if weights[slot] > 0.0 && targets[slot] > 0.0 {
+            expected += weights[slot] / targets[slot] * integrand(p, previous_reservoirs[sources[slot]].sample);
+        }
+    }
+    merged.expected = expected;
     // Choice among (current, own, drawn 0..T-1): OWN or a drawn slot, or none for current.
     let OWN = MAX_SELECTED;
     let NONE = MAX_SELECTED + 1u;

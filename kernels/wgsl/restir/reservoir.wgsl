@@ -29,6 +29,10 @@ const METHOD_STRATA: u32 = 0u;       // histogram + stratified selection, invers
 const METHOD_RESTIR: u32 = 1u;       // K uniformly random from the same cluster, streaming reservoir
 const METHOD_RESTIR_DISC: u32 = 2u;  // K uniformly random in a disc, normal/depth rejection
 
+// RestirParams.shading: what restir_shade adds for the resampled part.
+const SHADING_SAMPLE: u32 = 0u;       // f(Y) V W of the kept sample, one shadow ray
+const SHADING_EXPECTATION: u32 = 1u;  // Reservoir.expected: the final resampling's expectation
+
 struct RestirParams {
     method: u32,
     // K: candidates selected per pixel (1 to 4).
@@ -59,6 +63,12 @@ struct RestirParams {
     // What restir_shade writes: bit 0 the pixel's own estimate (base), bit 1 the
     // reservoir's sample; 3 for the image, 1 or 2 to measure one part's variance.
     shaded_parts: u32,
+    // SHADING_*: the resampled part as the kept sample or as the expectation of the
+    // frame's final resampling (Reservoir.expected).
+    shading: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // The G-buffer: what the camera ray of a pixel hit.
@@ -100,6 +110,13 @@ struct Reservoir {
     // p̂ of `sample` at this pixel (luminance of its contribution, visibility included).
     target_value: f32,
     _pad: u32,
+    // The expectation, over the choice alone, of this frame's final resampling at this
+    // pixel: sum_i w_i f(x_i) / p̂(x_i) over every candidate i it chose from (RGB,
+    // visibility included, as in p̂). E[f(Y) W | candidates] = this, so shading with it
+    // in place of f(Y) V W is unbiased and never noisier; it costs no ray (p̂ already
+    // traced each candidate's visibility). Not merged over frames: only `sample` is.
+    expected: vec3<f32>,
+    _pad_expected: f32,
 }
 
 @group(0) @binding(8) var<uniform> restir: RestirParams;

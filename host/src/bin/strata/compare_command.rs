@@ -13,7 +13,7 @@ use strata::evaluation::record::{self, RunRecord};
 use strata::evaluation::report::{ReportOptions, run_and_report};
 use strata::progress::Progress;
 use strata::render::{GpuScene, RenderSettings};
-use strata::restir::{Method, RestirSettings, ShadedParts};
+use strata::restir::{Method, RestirSettings, ShadedParts, Shading};
 use strata::rgb_image::RgbImage;
 use strata::scene::parse_camera_path;
 use strata_kernels::selection::SelectionSettings;
@@ -80,6 +80,11 @@ pub(crate) struct CompareArgs {
     /// seeds, since each part alone is biased against the reference).
     #[arg(long, value_enum, default_value_t = ShadedParts::All)]
     shaded_parts: ShadedParts,
+    /// The resampled part of each pixel: the kept sample f(Y) V W (one shadow ray), or
+    /// the expectation of the frame's final resampling over its choice (every
+    /// candidate's colour, no ray; unbiased), for every method alike.
+    #[arg(long, value_enum, default_value_t = Shading::Sample)]
+    shading: Shading,
     /// A conductor at the primary hit resamples only from this GGX alpha up; smoother
     /// ones path-trace on their own (1 sample per frame, no reuse).
     #[arg(long, default_value_t = RestirSettings::default().min_roughness)]
@@ -151,6 +156,7 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
         temporal: !args.accumulate,
         temporal_candidates: args.temporal_candidates,
         shaded_parts: args.shaded_parts,
+        shading: args.shading,
         min_roughness: args.min_roughness,
         min_distance: args.min_distance,
         ..RestirSettings::default()
@@ -288,6 +294,7 @@ fn settings_record(restir: &RestirSettings, args: &CompareArgs) -> serde_json::M
     put("min_distance", f64::from(restir.min_distance).into());
     put("pixel_centres", args.pixel_centres.into());
     put("shaded_parts", name(&|| clap::ValueEnum::to_possible_value(&restir.shaded_parts)).into());
+    put("shading", name(&|| clap::ValueEnum::to_possible_value(&restir.shading)).into());
     put("camera_path", args.camera_path.clone().into());
     map
 }

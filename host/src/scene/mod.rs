@@ -28,6 +28,7 @@ mod description_check;
 mod environment;
 mod exr_decode;
 mod files;
+mod gltf_check;
 mod gltf_scene;
 mod material;
 mod mesh_util;

@@ -14,7 +14,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::Duration;
 use strata::render::{GpuScene, PathTracer, RenderSettings};
-use strata::restir::{Method, RestirRenderer, RestirSettings};
+use strata::restir::{Method, RestirRenderer, RestirSettings, Shading};
 use strata::scene::{Scene, default_scene};
 use strata_backends::Backend;
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
@@ -44,11 +44,20 @@ fn restir_frames(c: &mut Criterion, backend: &mut dyn Backend) {
     let render = settings(&scene, 256);
     let mut group = c.benchmark_group("restir_frame_256");
     group.sample_size(10).measurement_time(Duration::from_secs(10));
-    for method in [Method::Strata, Method::Restir, Method::RestirDisc] {
-        let restir = RestirSettings { method, ..RestirSettings::default() };
+    // Every method with each shading of the resampled part (`expectation`: no shadow ray
+    // in the shading pass, a few more BSDF evaluations in select and temporal).
+    let runs = [Shading::Sample, Shading::Expectation]
+        .into_iter()
+        .flat_map(|shading| [Method::Strata, Method::Restir, Method::RestirDisc].map(|method| (method, shading)));
+    for (method, shading) in runs {
+        let restir = RestirSettings { method, shading, ..RestirSettings::default() };
         let mut renderer = RestirRenderer::new(backend, &gpu_scene, &render, restir, scene.extent()).expect("renderer");
         renderer.set_timed(true);
-        group.bench_function(method.name(), |b| {
+        let name = match shading {
+            Shading::Sample => method.name().to_string(),
+            Shading::Expectation => format!("{}/expectation", method.name()),
+        };
+        group.bench_function(name, |b| {
             b.iter_custom(|n| {
                 (0..n)
                     .map(|_| renderer.render_frame(backend, None).expect("frame").1.pass_times.iter().sum::<Duration>())

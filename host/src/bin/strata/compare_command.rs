@@ -66,6 +66,10 @@ pub(crate) struct CompareArgs {
     /// No temporal reuse: frames are accumulated instead (Fig. 5 / 10).
     #[arg(long)]
     accumulate: bool,
+    /// Cap of the previous reservoir's M before a temporal merge (the paper's 20): lower
+    /// reacts faster and lets a rare bright sample fade sooner, higher reuses more.
+    #[arg(long, default_value_t = RestirSettings::default().temporal_cap)]
+    temporal_cap: f32,
     /// Previous reservoirs drawn per pixel like spatial candidates (the paper's Fig. 11),
     /// 0 to 4, merged besides the pixel's own reprojected one.
     #[arg(long, default_value_t = 0)]
@@ -155,6 +159,7 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
         selection: args.selection,
         temporal: !args.accumulate,
         temporal_candidates: args.temporal_candidates,
+        temporal_cap: args.temporal_cap,
         shaded_parts: args.shaded_parts,
         shading: args.shading,
         min_roughness: args.min_roughness,

@@ -241,6 +241,14 @@ fn a_second_run_into_the_same_folder_replaces_the_first_runs_files() {
     for file in ["report.html", "summary.txt", "run.json", "errors.csv", "relmse.svg", "relmse.png", "reference.png"] {
         assert!(out.join(file).exists(), "no {file}");
     }
+    // Every file the run wrote is one a later run recognises and removes (the names in
+    // report.rs and in output_folder.rs cannot drift apart), and nothing hidden is left.
+    for entry in std::fs::read_dir(&out).unwrap() {
+        let name = entry.unwrap().file_name().to_string_lossy().into_owned();
+        if name != "notes.txt" {
+            assert!(strata::evaluation::output_folder::is_run_output(&name), "`{name}` would survive a later run");
+        }
+    }
     let record: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
     assert_eq!(record["width"], 8);

@@ -49,8 +49,9 @@ pub fn lock(folder: &Path) -> Result<FolderLock> {
                 match holder {
                     Some(pid) if process_is_running(pid) => bail!(
                         "{}: another strata compare (process {pid}) is writing into this folder; wait for it or \
-                         choose another --out",
-                        folder.display()
+                         choose another --out (if no such run is going on, remove {})",
+                        folder.display(),
+                        path.display()
                     ),
                     // A run that was killed, or a lock half-written: take it over.
                     _ => std::fs::remove_file(&path)

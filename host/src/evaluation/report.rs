@@ -21,30 +21,23 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-/// What to run and where to write it.
+/// What to run and where to write it. The scene, size, frames, seeds and mode are the
+/// record's ([`RunRecord`]), stated once.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ReportOptions {
     /// The methods, in the order their rows are printed.
     pub methods: Vec<Method>,
-    /// Frames per seed.
-    pub frames: u32,
-    /// Independent renders (seeds 1..=N) per method.
-    pub seeds: u32,
     /// Output folder (exists, and holds no earlier run's files: see
     /// [`super::output_folder::prepare`]).
     pub out: PathBuf,
     /// Exposure of the PNG previews.
     pub exposure: f32,
-    /// The scene's name in titles.
-    pub scene_name: String,
-    /// Frames accumulated rather than temporally reused (said in the titles).
-    pub accumulate: bool,
     /// Close-ups the user asked for (`--crop`), shown before the automatic ones.
     pub crops: Vec<Crop>,
     /// Automatic close-ups, chosen where the methods differ most.
     pub automatic_crops: usize,
-    /// The run's record so far (what, where, when); the frame times and the whole run's
-    /// duration are filled in here.
+    /// The run's record so far (what, where, when: scene, size, frames, seeds, mode); the
+    /// frame times and the whole run's duration are filled in here.
     pub record: RunRecord,
     /// When the run began (the reference included), for the record's duration.
     pub started: Instant,
@@ -75,11 +68,12 @@ pub fn run_and_report(
     references: &[RgbImage],
 ) -> Result<()> {
     let out = &options.out;
-    let total = u64::from(options.frames) * u64::from(options.seeds) * options.methods.len() as u64;
+    let (frames, seeds) = (options.record.frames, options.record.seeds);
+    let total = u64::from(frames) * u64::from(seeds) * options.methods.len() as u64;
     let mut progress = Progress::new("methods", total, "frames");
     let compared = Instant::now();
     let mut write_error: Option<anyhow::Error> = None;
-    let shown = shown_frames(options.frames);
+    let shown = shown_frames(frames);
     let mut seed_images: SeedImages = HashMap::new();
     let mut written: HashMap<(Method, u32), Written> = HashMap::new();
     let mut render_time: HashMap<Method, (Duration, u32)> = HashMap::new();
@@ -98,7 +92,7 @@ pub fn run_and_report(
             if !shown.contains(&frame) {
                 return;
             }
-            if options.seeds >= 3 {
+            if seeds >= 3 {
                 seed_images.entry((method, frame)).or_default().push(image.clone());
             }
             if seed == 1 {
@@ -122,15 +116,13 @@ pub fn run_and_report(
     write(&out.join("errors.csv"), errors_csv(&errors))?;
 
     // Plots.
-    let mode = if options.accumulate { "accumulated frames" } else { "temporal reuse" };
-    let title = format!(
-        "{} {}x{}, {} seeds, {mode}",
-        options.scene_name, render.camera.width, render.camera.height, options.seeds
-    );
-    super::plot::write_relmse_plot(&errors, &options.methods, options.frames, &title, &out.join("relmse"))?;
+    let mode = if options.record.temporal { "temporal reuse" } else { "accumulated frames" };
+    let title =
+        format!("{} {}x{}, {} seeds, {mode}", options.record.scene, render.camera.width, render.camera.height, seeds);
+    super::plot::write_relmse_plot(&errors, &options.methods, frames, &title, &out.join("relmse"))?;
     let mut plots =
         vec![("relmse.svg".to_string(), "RelMSE against frame: mean and 95 % interval over seeds".to_string())];
-    if super::plot::write_ratio_plot(&errors, options.frames, &title, &out.join("relmse_ratio"))? {
+    if super::plot::write_ratio_plot(&errors, frames, &title, &out.join("relmse_ratio"))? {
         plots.push((
             "relmse_ratio.svg".to_string(),
             "strata ÷ each baseline against frame: paired per seed, mean and 95 % interval".to_string(),
@@ -140,16 +132,16 @@ pub fn run_and_report(
     // The summary: printed, in summary.txt and on the page.
     let heading = format!(
         "{} frames x {} seeds x {} methods in {compare_seconds:.1} s; RelMSE (paper's form), mean ± 95% CI over seeds:",
-        options.frames,
-        options.seeds,
+        frames,
+        seeds,
         options.methods.len(),
     );
     let mut tables: Vec<Table> = vec![summary::relmse_table(&errors, &options.methods, &shown, &heading)];
     let mut text = tables[0].to_text();
-    for line in summary::whole_run_lines(&errors, options.frames) {
+    for line in summary::whole_run_lines(&errors, frames) {
         text += &format!("{line}\n");
     }
-    if options.seeds >= 3 {
+    if seeds >= 3 {
         let (variance, csv) = summary::variance_tables(&options.methods, &shown, &seed_images, references)?;
         write(&out.join("variance.csv"), csv)?;
         for table in &variance {
@@ -202,7 +194,7 @@ pub fn run_and_report(
         .collect();
     let last = shown.last().copied().unwrap_or(0);
     let page = Page {
-        title: format!("strata compare: {}, {mode}", options.scene_name),
+        title: format!("strata compare: {}, {mode}", options.record.scene),
         record: &record,
         size: (width, height),
         frames,

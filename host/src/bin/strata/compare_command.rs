@@ -120,7 +120,7 @@ fn sized_to_backend(
     reference_spp: u32,
 ) -> RenderSettings {
     let chosen = args.width.is_some() || args.height.is_some() || args.reference.is_some();
-    if backend.info().backend != "cpu" || chosen {
+    if !on_interpreter(backend) || chosen {
         return render;
     }
     let (width, height) = ((render.camera.width / 2).max(1), (render.camera.height / 2).max(1));
@@ -138,7 +138,12 @@ fn sized_to_backend(
 /// Reference samples per pixel when `--reference-spp` is left out: fewer on the CPU
 /// interpreter, so that the README's first command ends in minutes there too.
 fn default_reference_spp(backend: &dyn strata_backends::Backend) -> u32 {
-    if backend.info().backend == "cpu" { 256 } else { 1024 }
+    if on_interpreter(backend) { 256 } else { 1024 }
+}
+
+/// Whether `backend` is the CPU interpreter (about 8x slower than lavapipe).
+fn on_interpreter(backend: &dyn strata_backends::Backend) -> bool {
+    backend.info().backend == "cpu"
 }
 
 pub(crate) fn compare(args: CompareArgs) -> Result<()> {
@@ -245,14 +250,13 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
         accumulate: args.accumulate,
         cameras,
     };
-    let scene_name = args.scene.as_ref().and_then(|p| scene_stem(p)).unwrap_or_else(|| "default scene".into());
     let record = RunRecord {
         command_line: record::command_line(),
         backend: backend.info().summary(),
         version: env!("CARGO_PKG_VERSION").to_string(),
         git_revision: record::GIT_REVISION.to_string(),
         date,
-        scene: scene_name.clone(),
+        scene: args.scene.as_ref().and_then(|p| scene_stem(p)).unwrap_or_else(|| "default scene".into()),
         width: render.camera.width,
         height: render.camera.height,
         frames: args.frames,
@@ -265,12 +269,8 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
     };
     let options = ReportOptions {
         methods: args.methods.clone(),
-        frames: args.frames,
-        seeds: args.seeds,
         out: args.out.clone(),
         exposure: args.exposure,
-        scene_name,
-        accumulate: args.accumulate,
         crops: args.crop.clone(),
         automatic_crops: args.auto_crops,
         record,

@@ -80,6 +80,8 @@ pub const KERNEL_PRIVATE: &[&str] = &[
     "INVOCATIONS",
     "MAX_SEGMENTS",
     "SENTINEL_KEY",
+    // The traversal stack's entries kept in registers (trace/traverse.wgsl).
+    "REGISTER_STACK",
     // "No temporal source" and "no pixel" between two ReSTIR passes' locals.
     "NO_SOURCE",
     "NO_PIXEL",

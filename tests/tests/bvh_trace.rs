@@ -113,3 +113,78 @@ fn scene_camera_rays_agree_with_obvhs_on_vulkan() {
     };
     scene_camera_rays_agree_with_obvhs(&mut backend);
 }
+
+/// A hand-built BVH whose traversal stack grows by one entry per level: inner node k has
+/// the next inner node on the left and leaf k on the right, every box the same, so the
+/// left child is visited first and leaf k waits on the stack. Leaf k holds a triangle in
+/// the plane z = k; ray r starts at z = -1 with tmin just short of z = r, so its closest
+/// hit is triangle r, reached only through the stack entry pushed at level r. With more
+/// levels than TRACE_STACK_DEPTH the traversal reports STACK_OVERFLOW.
+fn chain_bvh(levels: u32) -> SceneBvh {
+    use strata_kernels::trace_types::{GpuBvhNode, GpuTriangle};
+    let top = levels as f32 + 1.0;
+    let node = |prim_count, first_index| GpuBvhNode {
+        aabb_min: [-10.0, -10.0, -1.0],
+        aabb_max: [10.0, 10.0, top],
+        prim_count,
+        first_index,
+        ..Default::default()
+    };
+    let mut nodes = vec![node(0, 1)];
+    for k in 0..levels {
+        // Children of inner node k at 2k + 1 (left) and 2k + 2 (right: leaf k).
+        nodes.push(if k + 1 < levels { node(0, 2 * k + 3) } else { node(1, levels) });
+        nodes.push(node(1, k));
+    }
+    let triangles = (0..=levels)
+        .map(|k| {
+            let z = k as f32;
+            GpuTriangle { v0: [-10.0, -10.0, z], v1: [10.0, -10.0, z], v2: [0.0, 10.0, z], ..Default::default() }
+        })
+        .collect();
+    SceneBvh { nodes, primitive_indices: (0..=levels).collect(), triangles }
+}
+
+fn deep_stacks(backend: &mut dyn Backend) {
+    use strata_kernels::reference::bvh_trace::closest_hit;
+    use strata_kernels::trace_types::{STACK_OVERFLOW, TRACE_STACK_DEPTH};
+    for levels in [3, 20, TRACE_STACK_DEPTH, TRACE_STACK_DEPTH + 1] {
+        let scene = chain_bvh(levels);
+        // Every ray of ray_count, so that all 64 lanes of a workgroup (each with its own
+        // slice of the stack in workgroup memory) go deep.
+        let ray_count = 150;
+        let rays: Vec<Ray> = (0..ray_count)
+            .map(|i| {
+                let r = i % (levels + 1);
+                Ray { origin: [0.0, 0.0, -1.0], tmin: r as f32 + 0.5, direction: [0.0, 0.0, 1.0], tmax: 1e30 }
+            })
+            .collect();
+        let pass = TracePass::new(backend, &scene).unwrap();
+        let hits = pass.trace(backend, &rays).unwrap();
+        pass.destroy(backend).unwrap();
+        for (i, (hit, ray)) in hits.iter().zip(&rays).enumerate() {
+            let r = i as u32 % (levels + 1);
+            let expected = if levels > TRACE_STACK_DEPTH { STACK_OVERFLOW } else { r };
+            assert_eq!(hit.primitive, expected, "{levels} levels, ray {r}: {hit:?}");
+            let reference = closest_hit(&scene.nodes, &scene.primitive_indices, &scene.triangles, ray);
+            assert_eq!(reference.primitive, expected, "reference, {levels} levels, ray {r}");
+            if expected != STACK_OVERFLOW {
+                assert_eq!(hit.t, r as f32 + 1.0, "{levels} levels, ray {r}");
+            }
+        }
+    }
+}
+
+#[test]
+fn deep_stacks_spill_and_overflow_on_the_interpreter() {
+    deep_stacks(&mut CpuBackend::new(CpuOptions::default()).unwrap());
+}
+
+#[test]
+fn deep_stacks_spill_and_overflow_on_vulkan() {
+    let Some(mut backend) = strata_tests::vulkan_backend("deep_stacks_spill_and_overflow_on_vulkan") else {
+        assert!(!gpu_required());
+        return;
+    };
+    deep_stacks(&mut backend);
+}

@@ -132,7 +132,7 @@ struct EmissiveTriangle {
 @group(0) @binding(6) var<storage, read> texels: array<vec4<f32>>;
 @group(0) @binding(7) var<storage, read> environment_cdf: array<f32>;
 
-var<workgroup> trace_stack: array<u32, 3072>;
+var<workgroup> trace_stack: array<u32, 2560>;
 
 // The triangles were reordered into leaf order on the host.
 fn leaf_triangle(slot: u32) -> u32 {

@@ -9,7 +9,8 @@
 //   5 storage, rw        array<Hit>      one hit per ray
 //
 // Dispatch: 64 rays per workgroup, ceil(rays / 64) workgroups in rows of
-// params.workgroups_x. The traversal stack lives in workgroup memory (TRACE_STACK_DEPTH
+// params.workgroups_x. The traversal stack's newest REGISTER_STACK entries live in
+// registers, the rest in workgroup memory (TRACE_STACK_DEPTH - REGISTER_STACK = 40
 // entries per invocation): function-local arrays do not translate to every target.
 
 struct TraceParams {
@@ -26,7 +27,7 @@ struct TraceParams {
 @group(0) @binding(4) var<storage, read> rays: array<Ray>;
 @group(0) @binding(5) var<storage, read_write> hits: array<Hit>;
 
-var<workgroup> trace_stack: array<u32, 3072>;
+var<workgroup> trace_stack: array<u32, 2560>;
 
 @compute @workgroup_size(64)
 fn bvh_closest_hit(

@@ -1,12 +1,14 @@
 // BVH2 traversal shared by every kernel that traces rays (closest hit and any hit).
 //
 // Needs, from the including kernel: the storage arrays `nodes` (BvhNode) and `triangles`
-// (Triangle), the workgroup array `trace_stack` with TRACE_STACK_DEPTH words per
-// invocation, and `fn leaf_triangle(slot: u32) -> u32` mapping a leaf's primitive slot
+// (Triangle), the workgroup array `trace_stack` with TRACE_STACK_DEPTH - REGISTER_STACK
+// words per invocation, and `fn leaf_triangle(slot: u32) -> u32` mapping a leaf's primitive slot
 // to an index into `triangles` (through obvhs' primitive_indices, or the identity when
 // the triangles were reordered into leaf order on the host).
 
 const TRACE_STACK_DEPTH: u32 = 48u;
+// How many of the stack's newest entries are kept in registers (top0 .. top7).
+const REGISTER_STACK: u32 = 8u;
 
 // The closest hit in (ray.tmin, ray.tmax), or with `any_hit` the first hit found there
 // (shadow rays: only primitive != MISS matters). `lane` picks this invocation's slice of
@@ -15,8 +17,20 @@ fn traverse(ray: Ray, lane: u32, any_hit: bool) -> Hit {
     let shear = make_shear(ray.direction);
     let inv_dir = safe_inverse(ray.direction);
     var best = Hit(ray.tmax, 0.0, 0.0, MISS);
-    let base = lane * TRACE_STACK_DEPTH;
+    let base = lane * (TRACE_STACK_DEPTH - REGISTER_STACK);
+    // The stack's newest REGISTER_STACK entries live in registers (top0 the newest);
+    // deeper entries spill to trace_stack. On lavapipe every per-lane access to
+    // workgroup memory becomes scalar loads and stores, so most pushes and pops stay in
+    // registers instead.
     var depth = 0u;
+    var top0 = 0u;
+    var top1 = 0u;
+    var top2 = 0u;
+    var top3 = 0u;
+    var top4 = 0u;
+    var top5 = 0u;
+    var top6 = 0u;
+    var top7 = 0u;
     var node_index = 0u;
     if enter_box(nodes[0], ray.origin, inv_dir, ray.tmin, best.t) < 0.0 {
         return best;
@@ -47,7 +61,17 @@ fn traverse(ray: Ray, lane: u32, any_hit: bool) -> Hit {
                 if depth == TRACE_STACK_DEPTH {
                     return Hit(ray.tmax, 0.0, 0.0, STACK_OVERFLOW);
                 }
-                trace_stack[base + depth] = select(left, right, near_is_left);
+                if depth >= REGISTER_STACK {
+                    trace_stack[base + depth - REGISTER_STACK] = top7;
+                }
+                top7 = top6;
+                top6 = top5;
+                top5 = top4;
+                top4 = top3;
+                top3 = top2;
+                top2 = top1;
+                top1 = top0;
+                top0 = select(left, right, near_is_left);
                 depth += 1u;
                 node_index = select(right, left, near_is_left);
                 continue;
@@ -61,7 +85,17 @@ fn traverse(ray: Ray, lane: u32, any_hit: bool) -> Hit {
             break;
         }
         depth -= 1u;
-        node_index = trace_stack[base + depth];
+        node_index = top0;
+        top0 = top1;
+        top1 = top2;
+        top2 = top3;
+        top3 = top4;
+        top4 = top5;
+        top5 = top6;
+        top6 = top7;
+        if depth >= REGISTER_STACK {
+            top7 = trace_stack[base + depth - REGISTER_STACK];
+        }
     }
     return best;
 }

@@ -12,6 +12,14 @@ pub const FLAG_RUSSIAN_ROULETTE: u32 = 4;
 /// `RenderParams.flags`: camera rays through pixel centres instead of a random point of
 /// each pixel (no film jitter; a diagnostic: the image is then a point-sampled one).
 pub const FLAG_PIXEL_CENTRES: u32 = 8;
+/// `RenderParams.flags`: a pixel's film positions over its sample indices (frames) follow
+/// the R2 sequence from a per-pixel random start, instead of independent uniform points:
+/// each sample alone is still a uniform point of the pixel, and successive samples
+/// cover it evenly.
+pub const FLAG_STRATIFIED_FILM: u32 = 16;
+/// The R2 sequence's step (Roberts 2018: 1/φ₂ and 1/φ₂², φ₂ the plastic number) in
+/// 0.32 fixed point, so that every backend computes the same film position.
+pub const R2_STEP: [u32; 2] = [3_242_174_889, 2_447_445_414];
 
 /// `Material.kind`: Lambertian diffuse.
 pub const MATERIAL_DIFFUSE: u32 = 0;

@@ -156,6 +156,7 @@ fn settings_for(scene: &Scene, width: u32, height: u32, light_sampling: LightSam
         light_sampling,
         russian_roulette: rr,
         pixel_centres: false,
+        stratified_film: false,
     }
 }
 

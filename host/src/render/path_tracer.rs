@@ -8,7 +8,7 @@ use crate::scene::{Camera, CameraFrame};
 use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, BackendError, Bind, BufferId};
 use strata_kernels::render_types::{
-    FLAG_HIT_LIGHTS, FLAG_PIXEL_CENTRES, FLAG_RUSSIAN_ROULETTE, FLAG_SAMPLE_LIGHTS, RenderParams,
+    FLAG_HIT_LIGHTS, FLAG_PIXEL_CENTRES, FLAG_RUSSIAN_ROULETTE, FLAG_SAMPLE_LIGHTS, FLAG_STRATIFIED_FILM, RenderParams,
 };
 use strata_kernels::{Kernel, KernelId, Registry};
 
@@ -44,6 +44,12 @@ pub struct RenderSettings {
     /// point-sampled one, so compare it with a reference rendered the same way). Default
     /// off: each sample takes a uniform point of its pixel.
     pub pixel_centres: bool,
+    /// Film positions of a pixel's successive samples (frames, for ReSTIR) from its own
+    /// R2 sequence with a random start, instead of independent uniform points: still
+    /// uniform sample by sample (unbiased), and evenly spread over the pixel across
+    /// samples, so accumulated frames lose their anti-aliasing noise faster. Default
+    /// off. Not with `pixel_centres`.
+    pub stratified_film: bool,
 }
 
 impl RenderSettings {
@@ -58,6 +64,7 @@ impl RenderSettings {
             light_sampling: LightSampling::Mis,
             russian_roulette: true,
             pixel_centres: false,
+            stratified_film: false,
         }
     }
 
@@ -84,12 +91,18 @@ impl RenderSettings {
         if !(camera.fov_deg > 0.0 && camera.fov_deg < 180.0) {
             return Err(PassError::Input(format!("camera: fov_deg {} must be in (0, 180)", camera.fov_deg)));
         }
+        if self.pixel_centres && self.stratified_film {
+            return Err(PassError::Input(
+                "pixel centres and a stratified film sequence exclude each other: choose one".into(),
+            ));
+        }
         let flags = match self.light_sampling {
             LightSampling::Mis => FLAG_SAMPLE_LIGHTS | FLAG_HIT_LIGHTS,
             LightSampling::Nee => FLAG_SAMPLE_LIGHTS,
             LightSampling::Bsdf => FLAG_HIT_LIGHTS,
         } | if self.russian_roulette { FLAG_RUSSIAN_ROULETTE } else { 0 }
-            | if self.pixel_centres { FLAG_PIXEL_CENTRES } else { 0 };
+            | if self.pixel_centres { FLAG_PIXEL_CENTRES } else { 0 }
+            | if self.stratified_film { FLAG_STRATIFIED_FILM } else { 0 };
         Ok(RenderParams {
             width: camera.width,
             height: camera.height,

@@ -18,12 +18,32 @@ const FLAG_SAMPLE_LIGHTS: u32 = 1u;      // next-event estimation
 const FLAG_HIT_LIGHTS: u32 = 2u;         // emission found by BSDF sampling counts
 const FLAG_RUSSIAN_ROULETTE: u32 = 4u;   // from depth rr_depth
 const FLAG_PIXEL_CENTRES: u32 = 8u;      // camera rays through pixel centres (no film jitter)
+const FLAG_STRATIFIED_FILM: u32 = 16u;   // film positions from the pixel's R2 sequence
+
+// The R2 sequence's step (Roberts 2018) in 0.32 fixed point.
+const R2_STEP_X: u32 = 3242174889u;
+const R2_STEP_Y: u32 = 2447445414u;
 
 // The film position of pixel `pixel`'s camera ray: a uniform point of the pixel from
 // `u` in [0, 1)², or its centre with FLAG_PIXEL_CENTRES.
+//
+// With FLAG_STRATIFIED_FILM, `u` is ignored (the caller still draws it, so the rest of
+// its random numbers stay paired with an unstratified run) and sample n of the pixel
+// takes point n of the R2 sequence shifted by a per-pixel random start (Cranley-Patterson
+// rotation). The start is uniform, so each sample alone is a uniform point of the pixel
+// (unbiased frame by frame and sample by sample); along n the points cover the pixel
+// evenly, so averaging successive frames averages away the anti-aliasing noise faster
+// than independent points do. Integer arithmetic (wrapping 0.32 fixed point), so every
+// backend computes the same position.
 fn film_position(pixel: vec2<u32>, u: vec2<f32>) -> vec2<f32> {
     if (params.flags & FLAG_PIXEL_CENTRES) != 0u {
         return vec2<f32>(pixel) + vec2<f32>(0.5);
+    }
+    if (params.flags & FLAG_STRATIFIED_FILM) != 0u {
+        let start_x = pcg_hash(pcg_hash(params.seed ^ 0xf11ef11eu) ^ (pixel.y * params.width + pixel.x));
+        let start_y = pcg_hash(start_x);
+        let fixed = vec2<u32>(start_x + params.sample_index * R2_STEP_X, start_y + params.sample_index * R2_STEP_Y);
+        return vec2<f32>(pixel) + vec2<f32>(fixed >> vec2<u32>(8u)) * (1.0 / 16777216.0);
     }
     return vec2<f32>(pixel) + u;
 }

@@ -79,6 +79,12 @@ pub(crate) struct CompareArgs {
     /// same primary hit every frame).
     #[arg(long)]
     pixel_centres: bool,
+    /// Film positions of each pixel's successive frames from its own R2 sequence with a
+    /// random start (uniform frame by frame, so unbiased; evenly spread over the pixel
+    /// across frames), for the methods and the rendered reference alike, in place of
+    /// independent uniform points.
+    #[arg(long, conflicts_with = "pixel_centres")]
+    stratified_film: bool,
     /// Which parts of each pixel's estimate the frames show (a diagnostic: `base` is what
     /// no selection touches, `resampled` the reservoir's sample; read their variance over
     /// seeds, since each part alone is biased against the reference).
@@ -156,7 +162,7 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
     // Read before any long work, and before the output folder is cleared (the file may
     // lie in it).
     let given_reference = args.reference.as_deref().map(RgbImage::read_exr).transpose()?;
-    let render = RenderSettings { pixel_centres: args.pixel_centres, ..render };
+    let render = RenderSettings { pixel_centres: args.pixel_centres, stratified_film: args.stratified_film, ..render };
     if args.frames == 0 || args.seeds == 0 {
         bail!("--frames and --seeds must be at least 1");
     }
@@ -298,6 +304,7 @@ fn settings_record(restir: &RestirSettings, args: &CompareArgs) -> serde_json::M
     put("min_roughness", f64::from(restir.min_roughness).into());
     put("min_distance", f64::from(restir.min_distance).into());
     put("pixel_centres", args.pixel_centres.into());
+    put("stratified_film", args.stratified_film.into());
     put("shaded_parts", name(&|| clap::ValueEnum::to_possible_value(&restir.shaded_parts)).into());
     put("shading", name(&|| clap::ValueEnum::to_possible_value(&restir.shading)).into());
     put("camera_path", args.camera_path.clone().into());

@@ -6,6 +6,8 @@
 //! * `native_reference`: the whole Rust reference (sort, spans, counters), one thread.
 //! * `wgpu_portable`, `wgpu_subgroup`: the kernel's device time per dispatch from
 //!   timestamp queries (candidates already uploaded; outputs left on the device).
+//! * `wgpu_rank`: the `block_histogram_rank` kernel (same outputs, positions by counting),
+//!   same measure.
 //!
 //! Run: `cargo bench -p strata-benches --bench block_sort`.
 
@@ -49,9 +51,11 @@ fn block_sort(c: &mut Criterion) {
         }
     };
     eprintln!("device: {}", backend.info().summary());
-    for (name, variant) in
-        [("wgpu_portable", HistogramVariant::Portable), ("wgpu_subgroup", HistogramVariant::Subgroup)]
-    {
+    for (name, variant) in [
+        ("wgpu_portable", HistogramVariant::Portable),
+        ("wgpu_subgroup", HistogramVariant::Subgroup),
+        ("wgpu_rank", HistogramVariant::Rank),
+    ] {
         let pass = match BlockHistogramPass::new(&mut backend, variant, grid) {
             Ok(pass) => pass,
             Err(error) => {

@@ -92,6 +92,7 @@ impl KernelCheck for HistogramCheck {
         let grid = grid(case)?;
         let variant = match self.0 {
             KernelId::BlockHistogramSubgroup => HistogramVariant::Subgroup,
+            KernelId::BlockHistogramRank => HistogramVariant::Rank,
             _ => HistogramVariant::Portable,
         };
         let pass = BlockHistogramPass::with_masking(backend, variant, grid, masking(case))?;

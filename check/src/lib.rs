@@ -82,6 +82,7 @@ pub fn kernel_checks() -> Vec<Box<dyn KernelCheck>> {
     vec![
         Box::new(histogram::HistogramCheck(KernelId::BlockHistogram)),
         Box::new(histogram::HistogramCheck(KernelId::BlockHistogramSubgroup)),
+        Box::new(histogram::HistogramCheck(KernelId::BlockHistogramRank)),
         Box::new(empty::EmptyCheck),
         Box::new(trace::TraceCheck),
         Box::new(camera::CameraCheck),

@@ -125,11 +125,10 @@ impl AshSelection {
                 why: "naga's SPIR-V 1.3 needs Vulkan 1.1".into(),
             });
         }
-        let histogram_module = if subgroup_shuffles(vulkan.instance, vulkan.physical_device) {
-            ModuleId::HistogramSubgroup
-        } else {
-            ModuleId::Histogram
-        };
+        let histogram_module = crate::wgsl::histogram_module(
+            settings.block_size,
+            subgroup_shuffles(vulkan.instance, vulkan.physical_device),
+        );
         let limits = properties.limits;
         let blocks = max_blocks(&settings, width, height);
         check_limits(DeviceLimits::vulkan(&limits), &VULKAN_NAMES, histogram_module, width, height, blocks)?;

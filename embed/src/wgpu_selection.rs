@@ -127,7 +127,8 @@ impl WgpuSelection {
     /// counters, the blue-noise tables: about 1.3 MiB + 16 bytes per pixel) for a
     /// `width` × `height` image. Fails, naming the setting or the device limit, when the
     /// settings are out of range or the device cannot run the pass at this size. Uses
-    /// the subgroup histogram when the device was created with `Features::SUBGROUP`.
+    /// the histogram module [`crate::wgsl::histogram_module`] picks (subgroups when the
+    /// device was created with `Features::SUBGROUP`).
     /// Frames belong to the render of seed 0 until [`Self::set_seed`].
     pub fn new(
         device: &wgpu::Device,
@@ -136,11 +137,8 @@ impl WgpuSelection {
         height: u32,
     ) -> Result<Self, EmbedError> {
         crate::frame::grid(&settings, width, height)?;
-        let histogram_module = if device.features().contains(wgpu::Features::SUBGROUP) {
-            ModuleId::HistogramSubgroup
-        } else {
-            ModuleId::Histogram
-        };
+        let histogram_module =
+            crate::wgsl::histogram_module(settings.block_size, device.features().contains(wgpu::Features::SUBGROUP));
         let limits = device.limits();
         let blocks = max_blocks(&settings, width, height);
         check_limits(DeviceLimits::wgpu(&limits), &WGPU_NAMES, histogram_module, width, height, blocks)?;

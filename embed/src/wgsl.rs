@@ -2,7 +2,8 @@
 //! themselves: each module is self-contained (structs, constants, functions and one
 //! entry point) and comes with its bind-group layout, read from naga's IR.
 //!
-//! Run order per frame: [`ModuleId::Histogram`] (or its subgroup twin), then
+//! Run order per frame: a histogram module ([`histogram_module`] picks one of the three,
+//! which give the same output), then
 //! [`ModuleId::Select`], then, if the engine resamples with the pass,
 //! [`ModuleId::Resample`]; a storage barrier between each. Uniform contents: the
 //! [`crate::frame::frame_params`] of the frame.
@@ -17,6 +18,9 @@ pub enum ModuleId {
     Histogram,
     /// The same with subgroup shuffles (needs subgroup operations; same output).
     HistogramSubgroup,
+    /// The same output by ranking: each candidate's position counted over its block
+    /// (portable; faster than the network up to 16 × 16 blocks where measured).
+    HistogramRank,
     /// `strata_select`.
     Select,
     /// `strata_resample`.
@@ -25,16 +29,36 @@ pub enum ModuleId {
 
 impl ModuleId {
     /// Every module.
-    pub const ALL: [ModuleId; 4] =
-        [ModuleId::Histogram, ModuleId::HistogramSubgroup, ModuleId::Select, ModuleId::Resample];
+    pub const ALL: [ModuleId; 5] = [
+        ModuleId::Histogram,
+        ModuleId::HistogramSubgroup,
+        ModuleId::HistogramRank,
+        ModuleId::Select,
+        ModuleId::Resample,
+    ];
 
     pub(crate) fn kernel(self) -> KernelId {
         match self {
             ModuleId::Histogram => KernelId::BlockHistogram,
             ModuleId::HistogramSubgroup => KernelId::BlockHistogramSubgroup,
+            ModuleId::HistogramRank => KernelId::BlockHistogramRank,
             ModuleId::Select => KernelId::StrataSelect,
             ModuleId::Resample => KernelId::StrataResample,
         }
+    }
+}
+
+/// The histogram module to run for `block_size` on a device with or without subgroup
+/// shuffles (the choice strata's own renderer makes; every choice gives the same
+/// output): ranking up to 16 × 16 blocks, the sorting network at 32 × 32, where ranking's
+/// B² comparisons per candidate cost more (BENCHMARKS.md, block_sort).
+pub fn histogram_module(block_size: u32, subgroups: bool) -> ModuleId {
+    if block_size <= 16 {
+        ModuleId::HistogramRank
+    } else if subgroups {
+        ModuleId::HistogramSubgroup
+    } else {
+        ModuleId::Histogram
     }
 }
 

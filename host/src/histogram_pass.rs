@@ -26,7 +26,13 @@ pub enum HistogramVariant {
     Portable,
     /// Subgroup shuffles for the middle strides; needs subgroup support.
     Subgroup,
-    /// Subgroup if the device has subgroups, else portable.
+    /// Each element's position counted over its block (`block_histogram_rank`); runs
+    /// everywhere, same outputs.
+    Rank,
+    /// The fastest measured (BENCHMARKS.md, block_sort): ranking up to B = 16 (on lavapipe
+    /// 1.4-2.5x faster than the network at B = 4, 8, 16, and on the interpreter too); at
+    /// B = 32, where ranking's n comparisons per element cost more, the network with
+    /// subgroups if the device has them, else without.
     Auto,
 }
 
@@ -96,6 +102,8 @@ impl BlockHistogramPass {
         let id = match variant {
             HistogramVariant::Portable => KernelId::BlockHistogram,
             HistogramVariant::Subgroup => KernelId::BlockHistogramSubgroup,
+            HistogramVariant::Rank => KernelId::BlockHistogramRank,
+            HistogramVariant::Auto if grid.block_size <= 16 => KernelId::BlockHistogramRank,
             HistogramVariant::Auto if backend.info().subgroup_sizes.is_some() => KernelId::BlockHistogramSubgroup,
             HistogramVariant::Auto => KernelId::BlockHistogram,
         };

@@ -15,6 +15,9 @@ pub enum KernelId {
     BlockHistogram,
     /// The same pass exchanging elements between subgroup lanes (needs subgroups).
     BlockHistogramSubgroup,
+    /// The same pass (same outputs) by ranking: each element's position counted over its
+    /// block instead of a sorting network; no subgroup operations.
+    BlockHistogramRank,
     /// Does nothing: measures dispatch overhead.
     Empty,
     /// Closest hit of a batch of rays through obvhs' BVH2, watertight triangle test.
@@ -48,9 +51,10 @@ pub enum KernelId {
 
 impl KernelId {
     /// Every registry kernel.
-    pub const ALL: [KernelId; 13] = [
+    pub const ALL: [KernelId; 14] = [
         KernelId::BlockHistogram,
         KernelId::BlockHistogramSubgroup,
+        KernelId::BlockHistogramRank,
         KernelId::Empty,
         KernelId::BvhClosestHit,
         KernelId::CameraRays,
@@ -129,6 +133,17 @@ impl KernelId {
                 fragments: [histogram().to_vec(), vec![fragment!("strata/entry_histogram_subgroup.wgsl")]].concat(),
                 entry_point: "block_histogram_subgroup".into(),
                 features: KernelFeatures::SUBGROUP,
+                float_ulp_bound: None,
+            },
+            KernelId::BlockHistogramRank => KernelSpec {
+                name: "block_histogram_rank".into(),
+                fragments: [
+                    histogram().to_vec(),
+                    vec![fragment!("strata/histogram_rank.wgsl"), fragment!("strata/entry_histogram_rank.wgsl")],
+                ]
+                .concat(),
+                entry_point: "block_histogram_rank".into(),
+                features: KernelFeatures::empty(),
                 float_ulp_bound: None,
             },
             KernelId::Empty => KernelSpec {

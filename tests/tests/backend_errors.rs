@@ -87,8 +87,12 @@ fn a_device_without_subgroups_refuses_the_subgroup_kernel() {
     let error = BlockHistogramPass::new(&mut backend, HistogramVariant::Subgroup, grid).err().unwrap();
     assert!(matches!(error, PassError::Backend(BackendError::MissingFeature { .. })), "{error}");
     assert!(error.to_string().contains("needs subgroup operations"), "{error}");
-    // Auto falls back to the portable kernel, which must still be right.
+    // Auto takes the ranking kernel up to B = 16 and, at B = 32, falls back from the
+    // subgroup network to the portable one.
     let pass = BlockHistogramPass::new(&mut backend, HistogramVariant::Auto, grid).unwrap();
+    assert_eq!(pass.kernel().id, KernelId::BlockHistogramRank);
+    let large = BlockGrid::new(40, 40, 32).unwrap();
+    let pass = BlockHistogramPass::new(&mut backend, HistogramVariant::Auto, large).unwrap();
     assert_eq!(pass.kernel().id, KernelId::BlockHistogram);
 }
 

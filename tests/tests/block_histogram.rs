@@ -71,9 +71,15 @@ fn subgroup_matches_reference_on_small_images() {
 }
 
 #[test]
-fn both_variants_match_reference_at_1080p() {
+fn rank_matches_reference_on_small_images() {
+    check_sizes(HistogramVariant::Rank, SMALL, 0x5eed_0006);
+}
+
+#[test]
+fn every_variant_matches_reference_at_1080p() {
     check_sizes(HistogramVariant::Portable, &[(1920, 1080)], 0x5eed_0003);
     check_sizes(HistogramVariant::Subgroup, &[(1920, 1080)], 0x5eed_0004);
+    check_sizes(HistogramVariant::Rank, &[(1920, 1080)], 0x5eed_0007);
 }
 
 /// The portable kernel on wgpu's GL backend (naga's GLSL on llvmpipe's OpenGL), which
@@ -95,7 +101,7 @@ fn portable_matches_reference_on_gl() {
 }
 
 /// Shifted block grids (§5.3: the first row and column of blocks partial too) and object
-/// masking off (one cluster per block), both variants, against the reference.
+/// masking off (one cluster per block), every variant, against the reference.
 #[test]
 fn shifted_grids_and_unmasked_clusters_match_reference() {
     let Some(mut backend) = vulkan_backend("block_histogram") else {
@@ -112,7 +118,7 @@ fn shifted_grids_and_unmasked_clusters_match_reference() {
                     candidate_image(width, height, seed, CandidateMix { awkward: 0.08, ..Default::default() });
                 let want = if masking { candidates.clone() } else { unmasked(&candidates) };
                 let want = block_histogram(grid, &want);
-                for variant in [HistogramVariant::Portable, HistogramVariant::Subgroup] {
+                for variant in [HistogramVariant::Portable, HistogramVariant::Subgroup, HistogramVariant::Rank] {
                     let pass = BlockHistogramPass::with_masking(&mut backend, variant, grid, masking).unwrap();
                     pass.poison_outputs(&mut backend, POISON).unwrap();
                     let got = pass.run(&mut backend, &candidates).unwrap_or_else(|e| panic!("{e}"));

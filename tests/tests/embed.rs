@@ -225,11 +225,9 @@ fn exported_wgsl_modules_give_the_same_outputs() {
     let selections = storage(&vec![0; pixels * size_of::<SelectedCandidates>()]);
     let input_buffer = storage(bytemuck::cast_slice(&inputs));
     let resampled = storage(&vec![0; pixels * size_of::<ResampleOutput>()]);
-    let histogram_id = if device.features().contains(wgpu::Features::SUBGROUP) {
-        ModuleId::HistogramSubgroup
-    } else {
-        ModuleId::Histogram
-    };
+    let histogram_id =
+        strata_embed::wgsl::histogram_module(settings.block_size, device.features().contains(wgpu::Features::SUBGROUP));
+    assert_eq!(histogram_id, ModuleId::HistogramRank, "16 x 16 blocks rank");
     let runs: [(ModuleId, Vec<&wgpu::Buffer>, [u32; 3]); 3] = [
         (
             histogram_id,

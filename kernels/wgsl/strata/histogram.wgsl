@@ -514,29 +514,74 @@ fn finish_elements(rect: BlockRect, begin: u32, segment: u32, first: u32, el: El
     }
 }
 
-// The whole pass for one workgroup; `lane_bits` = log2 of the subgroup size usable for
-// shuffles (0: none). Must be called in uniform control flow.
-fn run_block_histogram(t: u32, workgroup_id: vec3<u32>, lane_bits: u32) {
+// A workgroup's blocks and this invocation's place among them.
+struct BlockSetup {
+    // The workgroup's first block and its number of blocks (segments).
+    first_block: u32,
+    segments: u32,
+    // log2 of the slots per block.
+    log_n: u32,
+    // This invocation's first slot, its block (segment) and that slot's position in the
+    // block. An invocation's ELEMS consecutive slots lie in one block (blocks have at
+    // least 16 slots), so the block geometry is computed once.
+    base: u32,
+    segment: u32,
+    first: u32,
+    rect: BlockRect,
+}
+
+// Clears the workgroup's counters and places this invocation.
+fn setup_block_histogram(t: u32, workgroup_id: vec3<u32>) -> BlockSetup {
     let log_n = 2u * params.log2_block_size;
     let segments = SLOTS >> log_n;
     let first_block = (workgroup_id.y * params.workgroups_x + workgroup_id.x) * segments;
-
     for (var i = t; i < 3u * MAX_SEGMENTS; i += INVOCATIONS) {
         atomicStore(&shared_stats[i], 0u);
     }
-
-    // Load in the natural layout. An invocation's ELEMS consecutive slots lie in one
-    // block (blocks have at least 16 slots), so the block geometry is computed once.
     let base = slot_of(t, 0u, 0u);
     let segment = base >> log_n;
     let first = base & ((1u << log_n) - 1u);
-    let rect = block_rect(first_block + segment);
-    var el = Elements(
-        load_candidates(rect, first),
-        load_candidates(rect, first + 4u),
-        load_candidates(rect, first + 8u),
-        load_candidates(rect, first + 12u),
+    return BlockSetup(first_block, segments, log_n, base, segment, first, block_rect(first_block + segment));
+}
+
+// This invocation's elements in the natural layout (unsorted).
+fn load_block_elements(setup: BlockSetup) -> Elements {
+    return Elements(
+        load_candidates(setup.rect, setup.first),
+        load_candidates(setup.rect, setup.first + 4u),
+        load_candidates(setup.rect, setup.first + 8u),
+        load_candidates(setup.rect, setup.first + 12u),
     );
+}
+
+// Runs, spans and counters once the blocks are sorted: `el` holds this invocation's
+// sorted positions first..first+15, and workgroup memory every sorted block in the
+// natural layout. Must be called in uniform control flow.
+fn finish_block_histogram(setup: BlockSetup, el: Elements) {
+    if setup.rect.exists {
+        finish_elements(setup.rect, setup.base - setup.first, setup.segment, setup.first, el);
+    }
+    workgroupBarrier();
+    // Invocation t writes the counters of segments t, t + INVOCATIONS, ...
+    let t = setup.base >> ELEM_BITS;
+    for (var segment = t; segment < setup.segments; segment += INVOCATIONS) {
+        let block = setup.first_block + segment;
+        if block < params.blocks_x * params.blocks_y {
+            block_stats[block] = BlockStats(
+                atomicLoad(&shared_stats[3u * segment]),
+                atomicLoad(&shared_stats[3u * segment + 1u]),
+                atomicLoad(&shared_stats[3u * segment + 2u]),
+            );
+        }
+    }
+}
+
+// The whole pass for one workgroup with the bitonic network; `lane_bits` = log2 of the
+// subgroup size usable for shuffles (0: none). Must be called in uniform control flow.
+fn run_block_histogram(t: u32, workgroup_id: vec3<u32>, lane_bits: u32) {
+    let setup = setup_block_histogram(t, workgroup_id);
+    let log_n = setup.log_n;
+    var el = load_block_elements(setup);
 
     // Bitonic sort of every n-slot segment.
     var current_lo = 0u;
@@ -565,22 +610,5 @@ fn run_block_histogram(t: u32, workgroup_id: vec3<u32>, lane_bits: u32) {
     workgroupBarrier();
     store_registers(el, t, 0u);
     workgroupBarrier();
-
-    // Runs, spans and counters. After the sort, an invocation's slots still lie in one
-    // block, now holding sorted positions first..first+15.
-    if rect.exists {
-        finish_elements(rect, base - first, segment, first, el);
-    }
-
-    workgroupBarrier();
-    for (var segment = t; segment < segments; segment += INVOCATIONS) {
-        let block = first_block + segment;
-        if block < params.blocks_x * params.blocks_y {
-            block_stats[block] = BlockStats(
-                atomicLoad(&shared_stats[3u * segment]),
-                atomicLoad(&shared_stats[3u * segment + 1u]),
-                atomicLoad(&shared_stats[3u * segment + 2u]),
-            );
-        }
-    }
+    finish_block_histogram(setup, el);
 }

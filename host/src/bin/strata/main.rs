@@ -150,9 +150,14 @@ struct HistogramArgs {
 
 #[derive(Clone, Copy, clap::ValueEnum)]
 enum VariantArg {
+    /// The best for this device and block size (the ranking kernel up to B = 16).
     Auto,
+    /// The bitonic network through workgroup memory.
     Portable,
+    /// The bitonic network with subgroup shuffles.
     Subgroup,
+    /// Positions counted over each block (same outputs).
+    Rank,
 }
 
 /// Runs the command; an error (a user's mistake, a missing file, a device that refuses)
@@ -369,6 +374,7 @@ fn histogram(args: HistogramArgs) -> Result<()> {
         VariantArg::Auto => HistogramVariant::Auto,
         VariantArg::Portable => HistogramVariant::Portable,
         VariantArg::Subgroup => HistogramVariant::Subgroup,
+        VariantArg::Rank => HistogramVariant::Rank,
     };
     let mix = CandidateMix { objects: args.objects, awkward: args.awkward, ..Default::default() };
     let candidates = candidate_image(grid.width, grid.height, args.seed, mix);

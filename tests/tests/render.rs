@@ -18,7 +18,7 @@
 
 use std::path::{Path, PathBuf};
 use strata::evaluation::metrics;
-use strata::render::{GpuScene, LightSampling, RenderSettings, render};
+use strata::render::{Film, GpuScene, LightSampling, RenderSettings, render};
 use strata::rgb_image::RgbImage;
 use strata::scene::{Camera, Environment, Material, Scene, Shape};
 use strata_backends::{Backend, gpu_required};
@@ -155,8 +155,8 @@ fn settings_for(scene: &Scene, width: u32, height: u32, light_sampling: LightSam
         rr_depth: scene.rr_depth,
         light_sampling,
         russian_roulette: rr,
-        pixel_centres: false,
-        stratified_film: false,
+        // The default film sequence: what `strata render` and compare's references use.
+        film: Film::default(),
     }
 }
 

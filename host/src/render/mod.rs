@@ -9,4 +9,4 @@ pub mod gpu_scene;
 pub mod path_tracer;
 
 pub use gpu_scene::GpuScene;
-pub use path_tracer::{LightSampling, PathTracer, RenderSettings, SceneBuffers, render};
+pub use path_tracer::{Film, LightSampling, PathTracer, RenderSettings, SceneBuffers, render};

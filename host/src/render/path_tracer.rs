@@ -25,6 +25,34 @@ pub enum LightSampling {
     Bsdf,
 }
 
+/// Where in its pixel each camera ray starts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum Film {
+    /// Successive samples (frames, for ReSTIR) of a pixel take successive points of its
+    /// own R2 sequence from a random start (the default): each sample alone is a uniform
+    /// point of the pixel, so every estimate stays unbiased, and across samples the
+    /// points cover the pixel evenly, so accumulated frames and references lose their
+    /// anti-aliasing noise faster (BENCHMARKS.md, "Levers: the film sequence").
+    #[default]
+    Stratified,
+    /// Independent uniform points of the pixel (white noise; the default before
+    /// 2026-11-25 and in the measurements made before).
+    White,
+    /// The pixel centre, no jitter: a diagnostic, the image is then point-sampled
+    /// (aliased), so compare it with a reference rendered the same way.
+    Centres,
+}
+
+impl Film {
+    fn flags(self) -> u32 {
+        match self {
+            Film::Stratified => FLAG_STRATIFIED_FILM,
+            Film::White => 0,
+            Film::Centres => FLAG_PIXEL_CENTRES,
+        }
+    }
+}
+
 /// What one render computes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
@@ -40,16 +68,8 @@ pub struct RenderSettings {
     pub light_sampling: LightSampling,
     /// Russian roulette on (unbiased either way).
     pub russian_roulette: bool,
-    /// Camera rays through pixel centres, no film jitter (a diagnostic: the image is the
-    /// point-sampled one, so compare it with a reference rendered the same way). Default
-    /// off: each sample takes a uniform point of its pixel.
-    pub pixel_centres: bool,
-    /// Film positions of a pixel's successive samples (frames, for ReSTIR) from its own
-    /// R2 sequence with a random start, instead of independent uniform points: still
-    /// uniform sample by sample (unbiased), and evenly spread over the pixel across
-    /// samples, so accumulated frames lose their anti-aliasing noise faster. Default
-    /// off. Not with `pixel_centres`.
-    pub stratified_film: bool,
+    /// Where in its pixel each camera ray starts. Default: [`Film::Stratified`].
+    pub film: Film,
 }
 
 impl RenderSettings {
@@ -63,8 +83,7 @@ impl RenderSettings {
             rr_depth: scene.rr_depth,
             light_sampling: LightSampling::Mis,
             russian_roulette: true,
-            pixel_centres: false,
-            stratified_film: false,
+            film: Film::default(),
         }
     }
 
@@ -91,18 +110,12 @@ impl RenderSettings {
         if !(camera.fov_deg > 0.0 && camera.fov_deg < 180.0) {
             return Err(PassError::Input(format!("camera: fov_deg {} must be in (0, 180)", camera.fov_deg)));
         }
-        if self.pixel_centres && self.stratified_film {
-            return Err(PassError::Input(
-                "pixel centres and a stratified film sequence exclude each other: choose one".into(),
-            ));
-        }
         let flags = match self.light_sampling {
             LightSampling::Mis => FLAG_SAMPLE_LIGHTS | FLAG_HIT_LIGHTS,
             LightSampling::Nee => FLAG_SAMPLE_LIGHTS,
             LightSampling::Bsdf => FLAG_HIT_LIGHTS,
         } | if self.russian_roulette { FLAG_RUSSIAN_ROULETTE } else { 0 }
-            | if self.pixel_centres { FLAG_PIXEL_CENTRES } else { 0 }
-            | if self.stratified_film { FLAG_STRATIFIED_FILM } else { 0 };
+            | self.film.flags();
         Ok(RenderParams {
             width: camera.width,
             height: camera.height,

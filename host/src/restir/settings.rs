@@ -65,8 +65,8 @@ impl ShadedParts {
 /// What the shading pass adds for the resampled part of a pixel.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
 pub enum Shading {
-    /// The kept sample, f(Y) V W, with one shadow ray (the paper's; default).
-    #[default]
+    /// The kept sample, f(Y) V W, with one shadow ray (the paper's; the default before
+    /// 2026-11-25 and in the measurements made before).
     Sample,
     /// The expectation of the frame's final resampling over its choice, sum_i w_i f(x_i)
     /// / p̂(x_i) over every candidate it chose from (the spatial selection's canonical and
@@ -74,7 +74,9 @@ pub enum Shading {
     /// reservoirs with it): unbiased (it is E[f(Y) W | candidates]), never noisier, no
     /// shadow ray (p̂ already includes visibility), and the colours of every candidate
     /// reach the image instead of the one kept (a luminance p̂ cannot resample colour).
-    /// The reservoir kept for reuse is unchanged.
+    /// The reservoir kept for reuse is unchanged. The default: every method's error is
+    /// lower at no cost (BENCHMARKS.md, "Levers").
+    #[default]
     Expectation,
 }
 
@@ -113,7 +115,7 @@ pub struct RestirSettings {
     /// Which parts of the estimate the frame shows (a diagnostic). Default: all.
     pub shaded_parts: ShadedParts,
     /// The resampled part as the kept sample or as the final resampling's expectation.
-    /// Default: the sample (the paper's).
+    /// Default: the expectation.
     pub shading: Shading,
 }
 
@@ -129,7 +131,7 @@ impl Default for RestirSettings {
             min_roughness: 0.2,
             min_distance: 0.0,
             shaded_parts: ShadedParts::All,
-            shading: Shading::Sample,
+            shading: Shading::Expectation,
         }
     }
 }

@@ -12,7 +12,7 @@ use strata::evaluation::output_folder;
 use strata::evaluation::record::{self, RunRecord};
 use strata::evaluation::report::{ReportOptions, run_and_report};
 use strata::progress::Progress;
-use strata::render::{GpuScene, RenderSettings};
+use strata::render::{Film, GpuScene, RenderSettings};
 use strata::restir::{Method, RestirSettings, ShadedParts, Shading};
 use strata::rgb_image::RgbImage;
 use strata::scene::parse_camera_path;
@@ -79,21 +79,23 @@ pub(crate) struct CompareArgs {
     /// same primary hit every frame).
     #[arg(long)]
     pixel_centres: bool,
-    /// Film positions of each pixel's successive frames from its own R2 sequence with a
-    /// random start (uniform frame by frame, so unbiased; evenly spread over the pixel
-    /// across frames), for the methods and the rendered reference alike, in place of
-    /// independent uniform points.
-    #[arg(long, conflicts_with = "pixel_centres")]
-    stratified_film: bool,
+    /// Where in its pixel each frame's camera ray starts, for the methods and the
+    /// rendered reference alike: `stratified`, successive points of the pixel's own R2
+    /// sequence from a random start (uniform frame by frame, so unbiased, and evenly
+    /// spread across frames), or `white`, independent uniform points (the default before
+    /// 2026-11-25). `--pixel-centres` removes the jitter instead.
+    #[arg(long, value_enum, default_value_t = Film::Stratified, conflicts_with = "pixel_centres")]
+    film: Film,
     /// Which parts of each pixel's estimate the frames show (a diagnostic: `base` is what
     /// no selection touches, `resampled` the reservoir's sample; read their variance over
     /// seeds, since each part alone is biased against the reference).
     #[arg(long, value_enum, default_value_t = ShadedParts::All)]
     shaded_parts: ShadedParts,
-    /// The resampled part of each pixel: the kept sample f(Y) V W (one shadow ray), or
-    /// the expectation of the frame's final resampling over its choice (every
-    /// candidate's colour, no ray; unbiased), for every method alike.
-    #[arg(long, value_enum, default_value_t = Shading::Sample)]
+    /// The resampled part of each pixel, for every method alike: the expectation of the
+    /// frame's final resampling over its choice (every candidate's colour, no ray;
+    /// unbiased), or the kept sample f(Y) V W with one shadow ray (the paper's, and the
+    /// default before 2026-11-25).
+    #[arg(long, value_enum, default_value_t = Shading::Expectation)]
     shading: Shading,
     /// A conductor at the primary hit resamples only from this GGX alpha up; smoother
     /// ones path-trace on their own (1 sample per frame, no reuse).
@@ -162,7 +164,8 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
     // Read before any long work, and before the output folder is cleared (the file may
     // lie in it).
     let given_reference = args.reference.as_deref().map(RgbImage::read_exr).transpose()?;
-    let render = RenderSettings { pixel_centres: args.pixel_centres, stratified_film: args.stratified_film, ..render };
+    let film = if args.pixel_centres { Film::Centres } else { args.film };
+    let render = RenderSettings { film, ..render };
     if args.frames == 0 || args.seeds == 0 {
         bail!("--frames and --seeds must be at least 1");
     }
@@ -269,7 +272,7 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
         seeds: args.seeds,
         temporal: !args.accumulate,
         reference: reference_text,
-        settings: settings_record(&restir, &args),
+        settings: settings_record(&restir, &args, render.film),
         frame_ms: Vec::new(),
         seconds: 0.0,
     };
@@ -286,7 +289,11 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
 }
 
 /// The settings every method shared, by name, for the run's record.
-fn settings_record(restir: &RestirSettings, args: &CompareArgs) -> serde_json::Map<String, serde_json::Value> {
+fn settings_record(
+    restir: &RestirSettings,
+    args: &CompareArgs,
+    film: Film,
+) -> serde_json::Map<String, serde_json::Value> {
     let s = &restir.selection;
     let mut map = serde_json::Map::new();
     let mut put = |name: &str, value: serde_json::Value| {
@@ -303,8 +310,7 @@ fn settings_record(restir: &RestirSettings, args: &CompareArgs) -> serde_json::M
     put("temporal_cap", f64::from(restir.temporal_cap).into());
     put("min_roughness", f64::from(restir.min_roughness).into());
     put("min_distance", f64::from(restir.min_distance).into());
-    put("pixel_centres", args.pixel_centres.into());
-    put("stratified_film", args.stratified_film.into());
+    put("film", name(&|| clap::ValueEnum::to_possible_value(&film)).into());
     put("shaded_parts", name(&|| clap::ValueEnum::to_possible_value(&restir.shaded_parts)).into());
     put("shading", name(&|| clap::ValueEnum::to_possible_value(&restir.shading)).into());
     put("camera_path", args.camera_path.clone().into());

@@ -36,7 +36,8 @@ pub enum Film {
     #[default]
     Stratified,
     /// Independent uniform points of the pixel (white noise; the default before
-    /// 2026-11-25 and in the measurements made before).
+    /// 2026-11-25, and `strata compare`'s with temporal reuse, where consecutive frames
+    /// close together in the pixel reuse each other's reservoirs better).
     White,
     /// The pixel centre, no jitter: a diagnostic, the image is then point-sampled
     /// (aliased), so compare it with a reference rendered the same way.

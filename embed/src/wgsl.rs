@@ -49,16 +49,13 @@ impl ModuleId {
 }
 
 /// The histogram module to run for `block_size` on a device with or without subgroup
-/// shuffles (the choice strata's own renderer makes; every choice gives the same
-/// output): ranking up to 16 × 16 blocks, the sorting network at 32 × 32, where ranking's
-/// B² comparisons per candidate cost more (BENCHMARKS.md, block_sort).
+/// shuffles: the choice strata's own renderer makes ([`KernelId::fastest_histogram`];
+/// every choice gives the same output).
 pub fn histogram_module(block_size: u32, subgroups: bool) -> ModuleId {
-    if block_size <= 16 {
-        ModuleId::HistogramRank
-    } else if subgroups {
-        ModuleId::HistogramSubgroup
-    } else {
-        ModuleId::Histogram
+    match KernelId::fastest_histogram(block_size, subgroups) {
+        KernelId::BlockHistogramRank => ModuleId::HistogramRank,
+        KernelId::BlockHistogramSubgroup => ModuleId::HistogramSubgroup,
+        _ => ModuleId::Histogram,
     }
 }
 

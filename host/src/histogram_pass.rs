@@ -29,10 +29,8 @@ pub enum HistogramVariant {
     /// Each element's position counted over its block (`block_histogram_rank`); runs
     /// everywhere, same outputs.
     Rank,
-    /// The fastest measured (BENCHMARKS.md, block_sort): ranking up to B = 16 (on lavapipe
-    /// 1.4-2.5x faster than the network at B = 4, 8, 16, and on the interpreter too); at
-    /// B = 32, where ranking's n comparisons per element cost more, the network with
-    /// subgroups if the device has them, else without.
+    /// The fastest measured ([`KernelId::fastest_histogram`]): ranking up to B = 16, the
+    /// network at B = 32 (with subgroups if the device has them).
     Auto,
 }
 
@@ -103,9 +101,9 @@ impl BlockHistogramPass {
             HistogramVariant::Portable => KernelId::BlockHistogram,
             HistogramVariant::Subgroup => KernelId::BlockHistogramSubgroup,
             HistogramVariant::Rank => KernelId::BlockHistogramRank,
-            HistogramVariant::Auto if grid.block_size <= 16 => KernelId::BlockHistogramRank,
-            HistogramVariant::Auto if backend.info().subgroup_sizes.is_some() => KernelId::BlockHistogramSubgroup,
-            HistogramVariant::Auto => KernelId::BlockHistogram,
+            HistogramVariant::Auto => {
+                KernelId::fastest_histogram(grid.block_size, backend.info().subgroup_sizes.is_some())
+            }
         };
         let kernel = registry.get(id);
         backend.check_kernel(kernel)?;

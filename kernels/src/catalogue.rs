@@ -68,6 +68,21 @@ impl KernelId {
         KernelId::StrataResample,
     ];
 
+    /// The fastest block-histogram kernel for `block_size` on a device with or without
+    /// subgroup shuffles (all three give the same output): ranking up to 16 × 16 blocks,
+    /// the sorting network at 32 × 32, where ranking's B² comparisons per candidate cost
+    /// more (BENCHMARKS.md, block_sort). The one home of this choice: the renderer's
+    /// `HistogramVariant::Auto` and the embed pass both call it.
+    pub fn fastest_histogram(block_size: u32, subgroups: bool) -> KernelId {
+        if block_size <= 16 {
+            KernelId::BlockHistogramRank
+        } else if subgroups {
+            KernelId::BlockHistogramSubgroup
+        } else {
+            KernelId::BlockHistogram
+        }
+    }
+
     /// What the registry knows of this kernel before parsing it.
     pub fn spec(self) -> Option<KernelSpec> {
         // The paper's histogram (§4.1) with object masking (§4.3).

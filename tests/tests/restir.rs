@@ -164,32 +164,11 @@ fn restir_frames(
     seeds: std::ops::Range<u32>,
     frames: u32,
 ) -> RegionStats {
-    restir_frames_moving(backend, scene, restir, seeds, frames, &CameraPath::Static)
+    restir_frames_along(backend, scene, restir, seeds, frames, &CameraPath::Static, |render| render)
 }
 
-fn restir_frames_moving(
-    backend: &mut dyn Backend,
-    scene: &Scene,
-    restir: RestirSettings,
-    seeds: std::ops::Range<u32>,
-    frames: u32,
-    path: &CameraPath,
-) -> RegionStats {
-    restir_frames_along(backend, scene, restir, seeds, frames, path, |render| render)
-}
-
-/// [`restir_frames`] with the render settings of each seed changed by `adjust`.
-fn restir_frames_with(
-    backend: &mut dyn Backend,
-    scene: &Scene,
-    restir: RestirSettings,
-    seeds: std::ops::Range<u32>,
-    frames: u32,
-    adjust: impl Fn(RenderSettings) -> RenderSettings,
-) -> RegionStats {
-    restir_frames_along(backend, scene, restir, seeds, frames, &CameraPath::Static, adjust)
-}
-
+/// [`restir_frames`] with the camera moving along `path` and each seed's render settings
+/// changed by `adjust`.
 fn restir_frames_along(
     backend: &mut dyn Backend,
     scene: &Scene,
@@ -472,7 +451,7 @@ fn temporal_reuse_with_a_moving_camera_stays_unbiased() {
         selection: SelectionSettings { block_shift: true, ..blocks_of_8() },
         ..RestirSettings::default()
     };
-    let ours = restir_frames_moving(&mut backend, &scene, restir, 1..129, 6, &path);
+    let ours = restir_frames_along(&mut backend, &scene, restir, 1..129, 6, &path, |render| render);
     assert_unbiased("strata with temporal reuse, orbiting camera, shifting grid, frame 6", &ours, &reference);
 }
 
@@ -604,10 +583,10 @@ fn both_film_sequences_stay_unbiased() {
         for temporal in [true, false] {
             let restir = RestirSettings { method, temporal, selection: blocks_of_8(), ..RestirSettings::default() };
             let (seeds, frames) = if temporal { (1..129, 6) } else { (1..9, 64) };
-            let ours = restir_frames_with(&mut backend, &scene, restir, seeds, frames, |render| RenderSettings {
-                film: Film::White,
-                ..render
-            });
+            let ours =
+                restir_frames_along(&mut backend, &scene, restir, seeds, frames, &CameraPath::Static, |render| {
+                    RenderSettings { film: Film::White, ..render }
+                });
             let what =
                 format!("{} white film, {}", method.name(), if temporal { "temporal, frame 6" } else { "accumulated" });
             assert_unbiased(&what, &ours, &reference);

@@ -1,6 +1,6 @@
 //! Running a compiled kernel: workgroups in parallel on the machine's cores, the
-//! invocations of a workgroup round-robin from barrier to barrier, each a resumable
-//! stack of frames (see [`super::interp`]).
+//! invocations of a workgroup together from barrier to barrier, each a resumable stack
+//! of frames (see [`super::interp`]).
 
 use super::decode::Program;
 use super::error::{invalid, unsupported};
@@ -153,11 +153,11 @@ fn run_workgroup(
     }
     let mut executed = 0u64;
     let mut stops = Vec::with_capacity(count);
+    let mut reached = Vec::with_capacity(count);
     loop {
+        interp::run_until_sync(program, &mut invocations, buffers, workgroup, &mut executed, &mut reached)?;
         stops.clear();
-        for invocation in &mut invocations {
-            stops.push(interp::run(program, invocation, buffers, workgroup, &mut executed)?);
-        }
+        stops.extend(reached.iter().map(|stop| stop.expect("every invocation stopped")));
         if stops.iter().all(|s| *s == Stop::Done) {
             break;
         }

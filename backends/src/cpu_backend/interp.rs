@@ -1,12 +1,29 @@
-//! The dispatch loop: runs one invocation's bytecode until it ends or reaches a
-//! barrier or subgroup gather, where it stops (the barrier's instruction still next) so
-//! that the workgroup's other invocations can catch up.
+//! The dispatch loop, a workgroup at a time: runs the bytecode of every invocation of a
+//! workgroup until each ends or reaches a barrier or subgroup operation, where it stops
+//! (that instruction still next) so that [`super::exec`] can synchronise them.
+//!
+//! Invocations at the same place (the same instruction of the same call stack) run as
+//! one *group*: each instruction is decoded and dispatched once and executed for every
+//! member, in local-index order, before the next. That is what makes the interpreter
+//! fast: a kernel's invocations mostly run the same instructions, so the dispatch's
+//! branch is decided once per instruction and workgroup instead of once per invocation.
+//! Divergence is handled by scheduling, not masks: when a branch splits a group, each
+//! member keeps its own next instruction, and the group to run next is always the one
+//! *furthest behind* (smallest instruction index, outermost frame first; inside a call
+//! before back in its caller). Structured code is laid out in order, so the lanes ahead
+//! wait at the join (the end of an `if`, a loop's exit, a call's return) until the
+//! others arrive, and a group stops as soon as it reaches the place where another waits,
+//! so they merge there. Every invocation still executes exactly the instructions it
+//! would alone; only the interleaving between barriers changes, which a kernel free of
+//! data races cannot observe (outputs are checked byte for byte against the
+//! one-invocation-at-a-time executor this replaced: BENCHMARKS.md, "interpreter").
 
 use super::decode::Program;
 use super::error::{invalid, unsupported};
-use super::insn::{BinOp, Insn};
+use super::insn::{BinOp, CallInsn, Insn};
 use super::memory::{BUFFER, Frame, Memory, TAG_MASK, copy_regs, read_buffer, read_mixed, write_buffer, write_mixed};
 use crate::error::BackendError;
+use std::cmp::Ordering;
 use std::sync::atomic::AtomicU32;
 
 /// Why an invocation stopped running.
@@ -55,298 +72,568 @@ fn component_wise(
     }
 }
 
-/// Runs `invocation` until it stops; counts executed instructions into `executed`.
-pub(super) fn run(
+/// One member of a running group: the registers of its running frame and the memory
+/// only it sees.
+struct Lane<'a> {
+    regs: &'a mut [u32],
+    private: &'a mut [u32],
+    callers: &'a mut [Frame],
+}
+
+/// Why a group stopped running together.
+enum GroupEnd {
+    /// It reached the place where other invocations wait (or a uniform jump did): every
+    /// member continues at this instruction.
+    Meet(u32),
+    /// A branch sent the members different ways: each continues at its entry of
+    /// `targets`.
+    Split,
+    /// Every member calls (the instruction after the call is the return address).
+    Call(u32),
+    /// Every member returns `len` words from `src`.
+    Return { src: u32, len: u32 },
+    /// Every member stopped at the barrier or subgroup operation at this instruction.
+    Sync(u32),
+}
+
+/// Orders two invocations by how far they are: the one to run first is `Less`. Call
+/// stacks compare outermost frame first by instruction index (a caller's index is its
+/// return address); where one stack continues the other's, the deeper one is behind
+/// (it must still return to where the other already is).
+fn position(a: &Invocation, b: &Invocation) -> Ordering {
+    let (pa, pb) = (a.frame.as_ref().map_or(u32::MAX, |f| f.pc), b.frame.as_ref().map_or(u32::MAX, |f| f.pc));
+    let (da, db) = (a.callers.len(), b.callers.len());
+    for (ca, cb) in a.callers.iter().zip(&b.callers) {
+        if ca.pc != cb.pc {
+            return ca.pc.cmp(&cb.pc);
+        }
+    }
+    match da.cmp(&db) {
+        Ordering::Equal => pa.cmp(&pb),
+        // `a` is shallower: compare its instruction with `b`'s return address at that depth.
+        Ordering::Less => pa.cmp(&b.callers[da].pc).then(Ordering::Greater),
+        Ordering::Greater => a.callers[db].pc.cmp(&pb).then(Ordering::Less),
+    }
+}
+
+/// Where `other` is in the frame `leader` runs, if it is in that frame (same callers) or
+/// inside a call made from it: the instruction at which the leader's group must stop to
+/// meet it.
+fn meeting_point(leader: &Invocation, other: &Invocation) -> Option<u32> {
+    let depth = leader.callers.len();
+    if other.callers.len() < depth || leader.callers.iter().zip(&other.callers).any(|(a, b)| a.pc != b.pc) {
+        return None;
+    }
+    match other.callers.get(depth) {
+        Some(frame) => Some(frame.pc),
+        None => other.frame.as_ref().map(|f| f.pc),
+    }
+}
+
+/// Runs every invocation of a workgroup until it returns from the entry point or stops
+/// at a barrier or subgroup operation; `stops[i]` says where invocation `i` stopped.
+/// Counts executed instructions (per invocation) into `executed`.
+pub(super) fn run_until_sync(
     program: &Program,
-    invocation: &mut Invocation,
+    invocations: &mut [Invocation],
     buffers: &[Vec<AtomicU32>],
     workgroup: &mut [u32],
     executed: &mut u64,
-) -> Result<Stop, BackendError> {
-    let Invocation { frame: running, callers, spare, private, .. } = invocation;
+    stops: &mut Vec<Option<Stop>>,
+) -> Result<(), BackendError> {
+    stops.clear();
+    stops.extend(invocations.iter().map(|inv| if inv.frame.is_some() { None } else { Some(Stop::Done) }));
+    let mut members: Vec<usize> = Vec::with_capacity(invocations.len());
+    let mut targets: Vec<u32> = Vec::with_capacity(invocations.len());
+    // While no invocation is inside a call (the common case: small functions are
+    // inlined), where an invocation is is its next instruction alone: the group to run is
+    // then found from these words (`u32::MAX`: stopped) instead of by comparing stacks.
+    let mut pcs: Vec<u32> = invocations
+        .iter()
+        .zip(stops.iter())
+        .map(|(inv, stop)| if stop.is_none() { inv.frame.as_ref().map_or(u32::MAX, |f| f.pc) } else { u32::MAX })
+        .collect();
+    let mut in_calls = invocations.iter().filter(|inv| !inv.callers.is_empty()).count();
+    loop {
+        // The group furthest behind, and the instruction where it meets the next one.
+        members.clear();
+        let mut meet = u32::MAX;
+        let leader = if in_calls == 0 {
+            let behind = pcs.iter().copied().min().unwrap_or(u32::MAX);
+            if behind == u32::MAX {
+                return Ok(());
+            }
+            for (i, &pc) in pcs.iter().enumerate() {
+                if pc == behind {
+                    members.push(i);
+                } else {
+                    meet = meet.min(pc);
+                }
+            }
+            members[0]
+        } else {
+            let mut leader = None;
+            for (i, stop) in stops.iter().enumerate() {
+                if stop.is_none() && leader.is_none_or(|l: usize| position(&invocations[i], &invocations[l]).is_lt()) {
+                    leader = Some(i);
+                }
+            }
+            let Some(leader) = leader else { return Ok(()) };
+            for (i, stop) in stops.iter().enumerate() {
+                if stop.is_some() {
+                    continue;
+                }
+                if position(&invocations[i], &invocations[leader]).is_eq() {
+                    members.push(i);
+                } else if let Some(pc) = meeting_point(&invocations[leader], &invocations[i]) {
+                    meet = meet.min(pc);
+                }
+            }
+            leader
+        };
+        let frame = invocations[leader].frame.as_ref().expect("running invocations have frames");
+        let (code_index, pc) = (frame.code, frame.pc);
+        let end = {
+            let mut lanes = Vec::with_capacity(members.len());
+            let mut next = members.iter().copied().peekable();
+            for (i, invocation) in invocations.iter_mut().enumerate() {
+                if next.peek() == Some(&i) {
+                    next.next();
+                    let Invocation { frame, private, callers, .. } = invocation;
+                    let frame = frame.as_mut().expect("running invocations have frames");
+                    lanes.push(Lane {
+                        regs: &mut frame.regs[..],
+                        private: &mut private[..],
+                        callers: &mut callers[..],
+                    });
+                }
+            }
+            run_group(program, code_index, pc, meet, &mut lanes, buffers, workgroup, executed, &mut targets)?
+        };
+        match end {
+            GroupEnd::Meet(pc) => {
+                for &i in &members {
+                    invocations[i].frame.as_mut().expect("running").pc = pc;
+                }
+            }
+            GroupEnd::Split => {
+                for (&i, &pc) in members.iter().zip(&targets) {
+                    invocations[i].frame.as_mut().expect("running").pc = pc;
+                }
+            }
+            GroupEnd::Sync(pc) => {
+                for &i in &members {
+                    invocations[i].frame.as_mut().expect("running").pc = pc;
+                    stops[i] = Some(Stop::Sync(code_index, pc));
+                }
+            }
+            GroupEnd::Call(return_pc) => {
+                let Insn::Call(call) = &program.codes[code_index as usize].insns[return_pc as usize - 1] else {
+                    unreachable!("a group ends with Call at a call instruction")
+                };
+                for &i in &members {
+                    in_calls += usize::from(invocations[i].callers.is_empty());
+                    call_function(program, &mut invocations[i], call, return_pc)?;
+                }
+            }
+            GroupEnd::Return { src, len } => {
+                for &i in &members {
+                    if return_from_function(&mut invocations[i], src, len) {
+                        stops[i] = Some(Stop::Done);
+                    }
+                    in_calls -= usize::from(stops[i].is_none() && invocations[i].callers.is_empty());
+                }
+            }
+        }
+        for &i in &members {
+            pcs[i] = match (&stops[i], &invocations[i].frame) {
+                (None, Some(frame)) => frame.pc,
+                _ => u32::MAX,
+            };
+        }
+    }
+}
+
+/// Pushes a frame for `call` on `invocation`'s stack, its caller continuing at `return_pc`.
+fn call_function(
+    program: &Program,
+    invocation: &mut Invocation,
+    call: &CallInsn,
+    return_pc: u32,
+) -> Result<(), BackendError> {
+    let Invocation { frame: running, callers, spare, .. } = invocation;
+    if callers.len() >= 256 {
+        return Err(invalid(&program.name, "call depth above 256 (recursion?)".into()));
+    }
+    let frame = running.as_mut().expect("running");
+    let callee = &program.codes[call.code as usize];
+    let mut callee_regs = spare.pop().unwrap_or_default();
+    callee_regs.clear();
+    callee_regs.extend_from_slice(&callee.template);
+    for &(src, len, dst) in call.arguments.iter() {
+        callee_regs[dst as usize..(dst + len) as usize]
+            .copy_from_slice(&frame.regs[src as usize..(src + len) as usize]);
+    }
+    let depth = callers.len() as u32 + 1;
+    for &(reg, offset) in &callee.local_pointers {
+        callee_regs[reg as usize] = super::memory::FUNCTION | depth;
+        callee_regs[reg as usize + 1] = offset;
+    }
+    frame.pc = return_pc;
+    let callee_frame = Frame { code: call.code, pc: 0, regs: callee_regs, result: call.result };
+    callers.push(std::mem::replace(frame, callee_frame));
+    Ok(())
+}
+
+/// Pops `invocation`'s running frame, copying `len` words from `src` to the caller's
+/// result registers; true when it returned from the entry point.
+fn return_from_function(invocation: &mut Invocation, src: u32, len: u32) -> bool {
+    let Invocation { frame: running, callers, spare, .. } = invocation;
+    let returned = running.take().expect("running");
+    match callers.pop() {
+        None => {
+            spare.push(returned.regs);
+            true
+        }
+        Some(mut caller) => {
+            if let Some((dst, words)) = returned.result
+                && len > 0
+            {
+                let (src, words) = (src as usize, words.min(len) as usize);
+                caller.regs[dst as usize..dst as usize + words].copy_from_slice(&returned.regs[src..src + words]);
+            }
+            spare.push(returned.regs);
+            *running = Some(caller);
+            false
+        }
+    }
+}
+
+/// Runs the group `lanes` (all at instruction `pc` of code `code_index`) together until
+/// it reaches `meet`, a branch splits it (each member's next instruction into
+/// `targets`), it calls or returns, or it stops at a barrier or subgroup operation.
+#[allow(clippy::too_many_arguments)]
+fn run_group(
+    program: &Program,
+    code_index: u32,
+    pc: u32,
+    meet: u32,
+    lanes: &mut [Lane],
+    buffers: &[Vec<AtomicU32>],
+    workgroup: &mut [u32],
+    executed: &mut u64,
+    targets: &mut Vec<u32>,
+) -> Result<GroupEnd, BackendError> {
+    let insns = &program.codes[code_index as usize].insns[..];
+    let width = lanes.len() as u64;
+    let mut pc = pc as usize;
     let mut count = 0u64;
-    let result = 'frames: loop {
-        let Some(frame) = running.as_mut() else { break Ok(Stop::Done) };
-        let code_index = frame.code;
-        let code = &program.codes[code_index as usize];
-        let insns = &code.insns[..];
-        let regs = &mut frame.regs[..];
-        let mut pc = frame.pc as usize;
-        loop {
-            let insn = &insns[pc];
-            pc += 1;
-            count += 1;
-            match insn {
-                Insn::Copy1 { dst, src } => regs[*dst as usize] = regs[*src as usize],
-                Insn::Copy2 { dst, src } => copy_regs(regs, *dst as usize, *src as usize, 2),
-                Insn::Copy3 { dst, src } => copy_regs(regs, *dst as usize, *src as usize, 3),
-                Insn::Copy4 { dst, src } => copy_regs(regs, *dst as usize, *src as usize, 4),
-                Insn::Copy { dst, src, len } => copy_regs(regs, *dst as usize, *src as usize, *len as usize),
-                Insn::Zero { dst, len } => regs[*dst as usize..(*dst + *len) as usize].fill(0),
-                Insn::Bin { op, dst, a, b } => {
-                    let (x, y) = (regs[*a as usize], regs[*b as usize]);
-                    regs[*dst as usize] = match op {
-                        BinOp::AddF => (f32::from_bits(x) + f32::from_bits(y)).to_bits(),
-                        BinOp::MulF => (f32::from_bits(x) * f32::from_bits(y)).to_bits(),
-                        BinOp::AddI => x.wrapping_add(y),
-                        BinOp::Eq => bool_bits(x == y),
-                        BinOp::And => x & y,
-                        _ => op.apply(x, y),
-                    };
-                }
-                Insn::BinV { op, dst, a, b, n, sa, sb } => {
-                    let operands = (*dst as usize, *a as usize, *b as usize, *n as usize, *sa as usize, *sb as usize);
-                    // One loop per operator, the operator's match outside it.
-                    macro_rules! per_operator {
-                        ($($variant:ident),*) => {
-                            match op {
-                                $(BinOp::$variant => component_wise(regs, operands, |x, y| BinOp::$variant.apply(x, y)),)*
-                            }
-                        };
-                    }
-                    per_operator!(
-                        AddF, SubF, MulF, DivF, ModF, AddI, SubI, MulI, DivU, DivS, ModU, ModS, EqF, NeF, LtF, LeF,
-                        GtF, GeF, Eq, Ne, LtS, LeS, GtS, GeS, LtU, LeU, GtU, GeU, And, Xor, Or, LogicalAnd, LogicalOr,
-                        Shl, ShrU, ShrS
+    let end = loop {
+        // At or past an invocation that waits: let it catch up (and merge when equal).
+        if pc >= meet as usize {
+            break GroupEnd::Meet(pc as u32);
+        }
+        let insn = &insns[pc];
+        pc += 1;
+        count += 1;
+        match insn {
+            Insn::Jump(target) => pc = *target as usize,
+            Insn::JumpUnless { cond, target } => {
+                let taken = lanes.iter().filter(|lane| lane.regs[*cond as usize] == 0).count();
+                if taken == lanes.len() {
+                    pc = *target as usize;
+                } else if taken > 0 {
+                    targets.clear();
+                    targets.extend(
+                        lanes.iter().map(|lane| if lane.regs[*cond as usize] == 0 { *target } else { pc as u32 }),
                     );
+                    break GroupEnd::Split;
                 }
-                Insn::Un { op, dst, src, n } => {
-                    for i in 0..*n as usize {
-                        regs[*dst as usize + i] = op.apply(regs[*src as usize + i]);
-                    }
+            }
+            Insn::Switch { selector, cases, default } => {
+                let target = |lane: &Lane| {
+                    let value = lane.regs[*selector as usize];
+                    cases.iter().find(|(v, _)| *v == value).map_or(*default, |(_, t)| *t)
+                };
+                let first = target(&lanes[0]);
+                if lanes.iter().all(|lane| target(lane) == first) {
+                    pc = first as usize;
+                } else {
+                    targets.clear();
+                    targets.extend(lanes.iter().map(target));
+                    break GroupEnd::Split;
                 }
-                Insn::Select { dst, cond, accept, reject, n, sc } => {
-                    let (dst, cond, accept, reject) =
-                        (*dst as usize, *cond as usize, *accept as usize, *reject as usize);
-                    let sc = *sc as usize;
-                    for i in 0..*n as usize {
-                        regs[dst + i] = if regs[cond + i * sc] != 0 { regs[accept + i] } else { regs[reject + i] };
-                    }
+            }
+            Insn::Call(_) => break GroupEnd::Call(pc as u32),
+            Insn::Return { src, len } => break GroupEnd::Return { src: *src, len: *len },
+            Insn::Barrier | Insn::Gather(_) | Insn::Collective(_) => break GroupEnd::Sync(pc as u32 - 1),
+            Insn::Fail(failure) => return Err(unsupported(&failure.0, failure.1)),
+            // The most frequent instructions get their own loop over the members, their
+            // operands and operator decoded once for the whole group.
+            Insn::Copy1 { dst, src } => {
+                let (dst, src) = (*dst as usize, *src as usize);
+                for lane in lanes.iter_mut() {
+                    lane.regs[dst] = lane.regs[src];
                 }
-                Insn::Swizzle { dst, src, pattern, n } => {
-                    let src = *src as usize;
-                    let v = [
-                        regs[src + pattern[0] as usize],
-                        regs[src + pattern[1] as usize],
-                        regs[src + pattern[2] as usize],
-                        regs[src + pattern[3] as usize],
-                    ];
-                    let n = *n as usize;
-                    regs[*dst as usize..*dst as usize + n].copy_from_slice(&v[..n]);
-                }
-                Insn::Splat { dst, src, n } => {
-                    let v = regs[*src as usize];
-                    regs[*dst as usize..*dst as usize + *n as usize].fill(v);
-                }
-                Insn::Convert { from, to, dst, src, n } => {
-                    for i in 0..*n as usize {
-                        regs[*dst as usize + i] =
-                            super::arith::convert(regs[*src as usize + i], *from, *to).expect("checked when compiled");
-                    }
-                }
-                Insn::Extract { dst, base, index, count, stride, len } => {
-                    let at = (regs[*index as usize] as usize).min(count.saturating_sub(1) as usize) * *stride as usize;
-                    copy_regs(regs, *dst as usize, *base as usize + at, *len as usize);
-                }
-                Insn::PtrAdd { dst, base, add } => {
-                    let (dst, base) = (*dst as usize, *base as usize);
-                    regs[dst] = regs[base];
-                    regs[dst + 1] = regs[base + 1].wrapping_add(*add);
-                }
-                Insn::PtrIndex { dst, base, index, count, stride } => {
-                    let (dst, base) = (*dst as usize, *base as usize);
-                    let at = (regs[*index as usize] as usize).min(count.saturating_sub(1) as usize) * *stride as usize;
-                    regs[dst] = regs[base];
-                    regs[dst + 1] = (regs[base + 1] as usize + at) as u32;
-                }
-                Insn::PtrIndexRt { dst, base, index, stride } => {
-                    let (dst, base) = (*dst as usize, *base as usize);
-                    let (tag, offset) = (regs[base], regs[base + 1] as usize);
-                    let memory = Memory {
-                        buffers,
-                        workgroup: &mut *workgroup,
-                        private: &mut private[..],
-                        callers: &mut callers[..],
-                    };
-                    let stride = *stride as usize;
-                    let len = (memory.words(regs, tag).saturating_sub(offset) / stride.max(1)).max(1);
-                    let at = (regs[*index as usize] as usize).min(len - 1) * stride;
-                    regs[dst] = tag;
-                    regs[dst + 1] = (offset + at) as u32;
-                }
-                Insn::Load { dst, pointer, len } => {
-                    let pointer = (regs[*pointer as usize], regs[*pointer as usize + 1]);
-                    let mut memory = Memory {
-                        buffers,
-                        workgroup: &mut *workgroup,
-                        private: &mut private[..],
-                        callers: &mut callers[..],
-                    };
-                    memory.load(regs, pointer, *dst as usize, *len as usize);
-                }
-                Insn::Store { pointer, src, len } => {
-                    let pointer = (regs[*pointer as usize], regs[*pointer as usize + 1]);
-                    let mut memory = Memory {
-                        buffers,
-                        workgroup: &mut *workgroup,
-                        private: &mut private[..],
-                        callers: &mut callers[..],
-                    };
-                    memory.store(regs, pointer, *src as usize, *len as usize);
-                }
-                Insn::LoadMixed { dst, pointer, plan } => {
-                    let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1]);
-                    // Only pointers into buffers get a plan.
-                    if tag & TAG_MASK == BUFFER {
-                        let buffer = &buffers[(tag & !TAG_MASK) as usize];
-                        read_mixed(buffer, offset as usize, regs, *dst as usize, plan);
-                    }
-                }
-                Insn::StoreMixed { pointer, src, plan } => {
-                    let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1]);
-                    if tag & TAG_MASK == BUFFER {
-                        let buffer = &buffers[(tag & !TAG_MASK) as usize];
-                        write_mixed(buffer, offset as usize, regs, *src as usize, plan);
-                    }
-                }
-                Insn::LoadWorkgroup { dst, address, len } => {
-                    let (dst, address, len) = (*dst as usize, *address as usize, *len as usize);
-                    regs[dst..dst + len].copy_from_slice(&workgroup[address..address + len]);
-                }
-                Insn::StoreWorkgroup { address, src, len } => {
-                    let (src, address, len) = (*src as usize, *address as usize, *len as usize);
-                    workgroup[address..address + len].copy_from_slice(&regs[src..src + len]);
-                }
-                Insn::LoadPrivate { dst, address, len } => {
-                    let (dst, address, len) = (*dst as usize, *address as usize, *len as usize);
-                    regs[dst..dst + len].copy_from_slice(&private[address..address + len]);
-                }
-                Insn::StorePrivate { address, src, len } => {
-                    let (src, address, len) = (*src as usize, *address as usize, *len as usize);
-                    private[address..address + len].copy_from_slice(&regs[src..src + len]);
-                }
-                Insn::LoadBuffer { dst, buffer, address, len } => {
-                    let (dst, len) = (*dst as usize, *len as usize);
-                    read_buffer(&buffers[*buffer as usize], *address as usize, &mut regs[dst..dst + len]);
-                }
-                Insn::StoreBuffer { buffer, address, src, len } => {
-                    let (src, len) = (*src as usize, *len as usize);
-                    write_buffer(&buffers[*buffer as usize], *address as usize, &regs[src..src + len]);
-                }
-                Insn::ArrayLength { dst, pointer, stride } => {
-                    let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1]);
-                    let memory = Memory {
-                        buffers,
-                        workgroup: &mut *workgroup,
-                        private: &mut private[..],
-                        callers: &mut callers[..],
-                    };
-                    let words = memory.words(regs, tag);
-                    regs[*dst as usize] = (words.saturating_sub(offset as usize) / (*stride).max(1) as usize) as u32;
-                }
-                Insn::Compute(compute) => compute(regs),
-                Insn::Jump(target) => pc = *target as usize,
-                Insn::JumpUnless { cond, target } => {
-                    if regs[*cond as usize] == 0 {
-                        pc = *target as usize;
-                    }
-                }
-                Insn::Switch { selector, cases, default } => {
-                    let value = regs[*selector as usize];
-                    pc = cases.iter().find(|(v, _)| *v == value).map_or(*default, |(_, t)| *t) as usize;
-                }
-                Insn::Call(call) => {
-                    if callers.len() >= 256 {
-                        break 'frames Err(invalid(&program.name, "call depth above 256 (recursion?)".into()));
-                    }
-                    let callee = &program.codes[call.code as usize];
-                    let mut callee_regs = spare.pop().unwrap_or_default();
-                    callee_regs.clear();
-                    callee_regs.extend_from_slice(&callee.template);
-                    for &(src, len, dst) in call.arguments.iter() {
-                        callee_regs[dst as usize..(dst + len) as usize]
-                            .copy_from_slice(&regs[src as usize..(src + len) as usize]);
-                    }
-                    let depth = callers.len() as u32 + 1;
-                    for &(reg, offset) in &callee.local_pointers {
-                        callee_regs[reg as usize] = super::memory::FUNCTION | depth;
-                        callee_regs[reg as usize + 1] = offset;
-                    }
-                    frame.pc = pc as u32;
-                    let callee_frame = Frame { code: call.code, pc: 0, regs: callee_regs, result: call.result };
-                    callers.push(std::mem::replace(frame, callee_frame));
-                    continue 'frames;
-                }
-                Insn::Return { src, len } => {
-                    let returned = running.take().expect("running");
-                    match callers.pop() {
-                        None => {
-                            spare.push(returned.regs);
-                            break 'frames Ok(Stop::Done);
-                        }
-                        Some(mut caller) => {
-                            if let Some((dst, words)) = returned.result
-                                && *len > 0
-                            {
-                                let (src, words) = (*src as usize, words.min(*len) as usize);
-                                caller.regs[dst as usize..dst as usize + words]
-                                    .copy_from_slice(&returned.regs[src..src + words]);
-                            }
-                            spare.push(returned.regs);
-                            *running = Some(caller);
-                            continue 'frames;
-                        }
-                    }
-                }
-                Insn::Barrier | Insn::Gather(_) | Insn::Collective(_) => {
-                    frame.pc = pc as u32 - 1;
-                    break 'frames Ok(Stop::Sync(code_index, pc as u32 - 1));
-                }
-                Insn::Atomic(atomic) => {
-                    use naga::AtomicFunction as A;
-                    let pointer = (regs[atomic.pointer as usize], regs[atomic.pointer as usize + 1]);
-                    let operand = regs[atomic.value as usize];
-                    let expected = atomic.compare.map(|c| regs[c as usize]);
-                    let (fun, signed) = (atomic.fun, atomic.signed);
-                    let apply = move |old: u32| -> u32 {
-                        match fun {
-                            A::Add => old.wrapping_add(operand),
-                            A::Subtract => old.wrapping_sub(operand),
-                            A::And => old & operand,
-                            A::InclusiveOr => old | operand,
-                            A::ExclusiveOr => old ^ operand,
-                            A::Min if signed => (old as i32).min(operand as i32) as u32,
-                            A::Max if signed => (old as i32).max(operand as i32) as u32,
-                            A::Min => old.min(operand),
-                            A::Max => old.max(operand),
-                            A::Exchange { compare: None } => operand,
-                            A::Exchange { compare: Some(_) } => {
-                                if Some(old) == expected {
-                                    operand
-                                } else {
-                                    old
-                                }
-                            }
+            }
+            Insn::Bin { op, dst, a, b } => {
+                let (dst, a, b) = (*dst as usize, *a as usize, *b as usize);
+                macro_rules! per_operator {
+                    ($($variant:ident),*) => {
+                        match op {
+                            $(BinOp::$variant => for lane in lanes.iter_mut() {
+                                let regs = &mut *lane.regs;
+                                regs[dst] = BinOp::$variant.apply(regs[a], regs[b]);
+                            },)*
                         }
                     };
-                    let mut memory = Memory {
-                        buffers,
-                        workgroup: &mut *workgroup,
-                        private: &mut private[..],
-                        callers: &mut callers[..],
-                    };
-                    let old = memory.atomic(regs, pointer, apply);
-                    if let Some(result) = atomic.result {
-                        regs[result as usize] = old;
-                        if let Some(expected) = expected {
-                            regs[result as usize + 1] = u32::from(old == expected);
-                        }
-                    }
                 }
-                Insn::Fail(failure) => break 'frames Err(unsupported(&failure.0, failure.1)),
+                per_operator!(
+                    AddF, SubF, MulF, DivF, ModF, AddI, SubI, MulI, DivU, DivS, ModU, ModS, EqF, NeF, LtF, LeF, GtF,
+                    GeF, Eq, Ne, LtS, LeS, GtS, GeS, LtU, LeU, GtU, GeU, And, Xor, Or, LogicalAnd, LogicalOr, Shl,
+                    ShrU, ShrS
+                );
+            }
+            Insn::BinV { op, dst, a, b, n, sa, sb } => {
+                let operands = (*dst as usize, *a as usize, *b as usize, *n as usize, *sa as usize, *sb as usize);
+                macro_rules! per_operator {
+                    ($($variant:ident),*) => {
+                        match op {
+                            $(BinOp::$variant => for lane in lanes.iter_mut() {
+                                component_wise(lane.regs, operands, |x, y| BinOp::$variant.apply(x, y));
+                            },)*
+                        }
+                    };
+                }
+                per_operator!(
+                    AddF, SubF, MulF, DivF, ModF, AddI, SubI, MulI, DivU, DivS, ModU, ModS, EqF, NeF, LtF, LeF, GtF,
+                    GeF, Eq, Ne, LtS, LeS, GtS, GeS, LtU, LeU, GtU, GeU, And, Xor, Or, LogicalAnd, LogicalOr, Shl,
+                    ShrU, ShrS
+                );
+            }
+            Insn::Copy4 { dst, src } => {
+                let (dst, src) = (*dst as usize, *src as usize);
+                for lane in lanes.iter_mut() {
+                    copy_regs(lane.regs, dst, src, 4);
+                }
+            }
+            Insn::Compute(compute) => {
+                for lane in lanes.iter_mut() {
+                    compute(lane.regs);
+                }
+            }
+            _ => {
+                for lane in lanes.iter_mut() {
+                    execute(insn, lane, buffers, workgroup);
+                }
             }
         }
     };
-    *executed += count;
-    result
+    *executed += count * width;
+    Ok(end)
+}
+
+/// Executes one instruction that is not control flow for one invocation.
+#[inline(always)]
+fn execute(insn: &Insn, lane: &mut Lane, buffers: &[Vec<AtomicU32>], workgroup: &mut [u32]) {
+    let Lane { regs, private, callers } = lane;
+    let regs = &mut **regs;
+    match insn {
+        Insn::Copy1 { dst, src } => regs[*dst as usize] = regs[*src as usize],
+        Insn::Copy2 { dst, src } => copy_regs(regs, *dst as usize, *src as usize, 2),
+        Insn::Copy3 { dst, src } => copy_regs(regs, *dst as usize, *src as usize, 3),
+        Insn::Copy4 { dst, src } => copy_regs(regs, *dst as usize, *src as usize, 4),
+        Insn::Copy { dst, src, len } => copy_regs(regs, *dst as usize, *src as usize, *len as usize),
+        Insn::Zero { dst, len } => regs[*dst as usize..(*dst + *len) as usize].fill(0),
+        Insn::Bin { op, dst, a, b } => {
+            let (x, y) = (regs[*a as usize], regs[*b as usize]);
+            regs[*dst as usize] = match op {
+                BinOp::AddF => (f32::from_bits(x) + f32::from_bits(y)).to_bits(),
+                BinOp::MulF => (f32::from_bits(x) * f32::from_bits(y)).to_bits(),
+                BinOp::AddI => x.wrapping_add(y),
+                BinOp::Eq => bool_bits(x == y),
+                BinOp::And => x & y,
+                _ => op.apply(x, y),
+            };
+        }
+        Insn::BinV { op, dst, a, b, n, sa, sb } => {
+            let operands = (*dst as usize, *a as usize, *b as usize, *n as usize, *sa as usize, *sb as usize);
+            // One loop per operator, the operator's match outside it.
+            macro_rules! per_operator {
+                ($($variant:ident),*) => {
+                    match op {
+                        $(BinOp::$variant => component_wise(regs, operands, |x, y| BinOp::$variant.apply(x, y)),)*
+                    }
+                };
+            }
+            per_operator!(
+                AddF, SubF, MulF, DivF, ModF, AddI, SubI, MulI, DivU, DivS, ModU, ModS, EqF, NeF, LtF, LeF, GtF, GeF,
+                Eq, Ne, LtS, LeS, GtS, GeS, LtU, LeU, GtU, GeU, And, Xor, Or, LogicalAnd, LogicalOr, Shl, ShrU, ShrS
+            );
+        }
+        Insn::Un { op, dst, src, n } => {
+            for i in 0..*n as usize {
+                regs[*dst as usize + i] = op.apply(regs[*src as usize + i]);
+            }
+        }
+        Insn::Select { dst, cond, accept, reject, n, sc } => {
+            let (dst, cond, accept, reject) = (*dst as usize, *cond as usize, *accept as usize, *reject as usize);
+            let sc = *sc as usize;
+            for i in 0..*n as usize {
+                regs[dst + i] = if regs[cond + i * sc] != 0 { regs[accept + i] } else { regs[reject + i] };
+            }
+        }
+        Insn::Swizzle { dst, src, pattern, n } => {
+            let src = *src as usize;
+            let v = [
+                regs[src + pattern[0] as usize],
+                regs[src + pattern[1] as usize],
+                regs[src + pattern[2] as usize],
+                regs[src + pattern[3] as usize],
+            ];
+            let n = *n as usize;
+            regs[*dst as usize..*dst as usize + n].copy_from_slice(&v[..n]);
+        }
+        Insn::Splat { dst, src, n } => {
+            let v = regs[*src as usize];
+            regs[*dst as usize..*dst as usize + *n as usize].fill(v);
+        }
+        Insn::Convert { from, to, dst, src, n } => {
+            for i in 0..*n as usize {
+                regs[*dst as usize + i] =
+                    super::arith::convert(regs[*src as usize + i], *from, *to).expect("checked when compiled");
+            }
+        }
+        Insn::Extract { dst, base, index, count, stride, len } => {
+            let at = (regs[*index as usize] as usize).min(count.saturating_sub(1) as usize) * *stride as usize;
+            copy_regs(regs, *dst as usize, *base as usize + at, *len as usize);
+        }
+        Insn::PtrAdd { dst, base, add } => {
+            let (dst, base) = (*dst as usize, *base as usize);
+            regs[dst] = regs[base];
+            regs[dst + 1] = regs[base + 1].wrapping_add(*add);
+        }
+        Insn::PtrIndex { dst, base, index, count, stride } => {
+            let (dst, base) = (*dst as usize, *base as usize);
+            let at = (regs[*index as usize] as usize).min(count.saturating_sub(1) as usize) * *stride as usize;
+            regs[dst] = regs[base];
+            regs[dst + 1] = (regs[base + 1] as usize + at) as u32;
+        }
+        Insn::PtrIndexRt { dst, base, index, stride } => {
+            let (dst, base) = (*dst as usize, *base as usize);
+            let (tag, offset) = (regs[base], regs[base + 1] as usize);
+            let memory =
+                Memory { buffers, workgroup: &mut *workgroup, private: &mut private[..], callers: &mut callers[..] };
+            let stride = *stride as usize;
+            let len = (memory.words(regs, tag).saturating_sub(offset) / stride.max(1)).max(1);
+            let at = (regs[*index as usize] as usize).min(len - 1) * stride;
+            regs[dst] = tag;
+            regs[dst + 1] = (offset + at) as u32;
+        }
+        Insn::Load { dst, pointer, len } => {
+            let pointer = (regs[*pointer as usize], regs[*pointer as usize + 1]);
+            let mut memory =
+                Memory { buffers, workgroup: &mut *workgroup, private: &mut private[..], callers: &mut callers[..] };
+            memory.load(regs, pointer, *dst as usize, *len as usize);
+        }
+        Insn::Store { pointer, src, len } => {
+            let pointer = (regs[*pointer as usize], regs[*pointer as usize + 1]);
+            let mut memory =
+                Memory { buffers, workgroup: &mut *workgroup, private: &mut private[..], callers: &mut callers[..] };
+            memory.store(regs, pointer, *src as usize, *len as usize);
+        }
+        Insn::LoadMixed { dst, pointer, plan } => {
+            let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1]);
+            // Only pointers into buffers get a plan.
+            if tag & TAG_MASK == BUFFER {
+                let buffer = &buffers[(tag & !TAG_MASK) as usize];
+                read_mixed(buffer, offset as usize, regs, *dst as usize, plan);
+            }
+        }
+        Insn::StoreMixed { pointer, src, plan } => {
+            let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1]);
+            if tag & TAG_MASK == BUFFER {
+                let buffer = &buffers[(tag & !TAG_MASK) as usize];
+                write_mixed(buffer, offset as usize, regs, *src as usize, plan);
+            }
+        }
+        Insn::LoadWorkgroup { dst, address, len } => {
+            let (dst, address, len) = (*dst as usize, *address as usize, *len as usize);
+            regs[dst..dst + len].copy_from_slice(&workgroup[address..address + len]);
+        }
+        Insn::StoreWorkgroup { address, src, len } => {
+            let (src, address, len) = (*src as usize, *address as usize, *len as usize);
+            workgroup[address..address + len].copy_from_slice(&regs[src..src + len]);
+        }
+        Insn::LoadPrivate { dst, address, len } => {
+            let (dst, address, len) = (*dst as usize, *address as usize, *len as usize);
+            regs[dst..dst + len].copy_from_slice(&private[address..address + len]);
+        }
+        Insn::StorePrivate { address, src, len } => {
+            let (src, address, len) = (*src as usize, *address as usize, *len as usize);
+            private[address..address + len].copy_from_slice(&regs[src..src + len]);
+        }
+        Insn::LoadBuffer { dst, buffer, address, len } => {
+            let (dst, len) = (*dst as usize, *len as usize);
+            read_buffer(&buffers[*buffer as usize], *address as usize, &mut regs[dst..dst + len]);
+        }
+        Insn::StoreBuffer { buffer, address, src, len } => {
+            let (src, len) = (*src as usize, *len as usize);
+            write_buffer(&buffers[*buffer as usize], *address as usize, &regs[src..src + len]);
+        }
+        Insn::ArrayLength { dst, pointer, stride } => {
+            let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1]);
+            let memory =
+                Memory { buffers, workgroup: &mut *workgroup, private: &mut private[..], callers: &mut callers[..] };
+            let words = memory.words(regs, tag);
+            regs[*dst as usize] = (words.saturating_sub(offset as usize) / (*stride).max(1) as usize) as u32;
+        }
+        Insn::Compute(compute) => compute(regs),
+        Insn::Atomic(atomic) => {
+            use naga::AtomicFunction as A;
+            let pointer = (regs[atomic.pointer as usize], regs[atomic.pointer as usize + 1]);
+            let operand = regs[atomic.value as usize];
+            let expected = atomic.compare.map(|c| regs[c as usize]);
+            let (fun, signed) = (atomic.fun, atomic.signed);
+            let apply = move |old: u32| -> u32 {
+                match fun {
+                    A::Add => old.wrapping_add(operand),
+                    A::Subtract => old.wrapping_sub(operand),
+                    A::And => old & operand,
+                    A::InclusiveOr => old | operand,
+                    A::ExclusiveOr => old ^ operand,
+                    A::Min if signed => (old as i32).min(operand as i32) as u32,
+                    A::Max if signed => (old as i32).max(operand as i32) as u32,
+                    A::Min => old.min(operand),
+                    A::Max => old.max(operand),
+                    A::Exchange { compare: None } => operand,
+                    A::Exchange { compare: Some(_) } => {
+                        if Some(old) == expected {
+                            operand
+                        } else {
+                            old
+                        }
+                    }
+                }
+            };
+            let mut memory =
+                Memory { buffers, workgroup: &mut *workgroup, private: &mut private[..], callers: &mut callers[..] };
+            let old = memory.atomic(regs, pointer, apply);
+            if let Some(result) = atomic.result {
+                regs[result as usize] = old;
+                if let Some(expected) = expected {
+                    regs[result as usize + 1] = u32::from(old == expected);
+                }
+            }
+        }
+        Insn::Jump(_)
+        | Insn::JumpUnless { .. }
+        | Insn::Switch { .. }
+        | Insn::Call(_)
+        | Insn::Return { .. }
+        | Insn::Barrier
+        | Insn::Gather(_)
+        | Insn::Collective(_)
+        | Insn::Fail(_) => unreachable!("control flow is run by the group"),
+    }
 }

@@ -5,10 +5,9 @@
 use super::arith;
 use super::decode::{Compiler, Scope};
 use super::insn::{Insn, Reg};
-use super::layout::{Words, is_half, is_wide, member_step, scalar_shape, shape};
+use super::layout::{is_half, is_wide, member_step, scalar_shape, shape};
 use super::wide;
 use naga::{Expression, Handle, ScalarKind, TypeInner};
-use smallvec::smallvec;
 
 /// The f32 dot product of two vectors of f32 words: a sequential sum of products, no fused
 /// multiply-add, starting from the first product rather than +0 so that products that are
@@ -18,8 +17,12 @@ fn dot(a: &[u32], b: &[u32]) -> f32 {
     (1..a.len()).fold(f(a[0]) * f(b[0]), |acc, i| acc + f(a[i]) * f(b[i]))
 }
 
-/// Math functions on vectors and scalars (the reference implementation, value by value).
+/// Math functions on vectors and scalars (the reference implementation, value by value):
+/// writes the result's words into `out` and returns how many (`None`: WGSL has no such
+/// function for these operands). Results are written in place rather than collected,
+/// because this runs once per call and invocation.
 #[allow(clippy::too_many_arguments)]
+#[inline]
 fn math(
     fun: naga::MathFunction,
     kind: ScalarKind,
@@ -28,43 +31,53 @@ fn math(
     b: Option<&[u32]>,
     c: Option<&[u32]>,
     d: Option<&[u32]>,
-) -> Option<Words> {
+    out: &mut [u32; 4],
+) -> Option<usize> {
     use naga::MathFunction as M;
     let f = f32::from_bits;
     let pick = |v: Option<&[u32]>, i: usize| v.map_or(0, |v| v[if v.len() == 1 { 0 } else { i }]);
+    let one = |out: &mut [u32; 4], word: u32| {
+        out[0] = word;
+        Some(1)
+    };
     match fun {
-        M::Dot if kind == ScalarKind::Float => Some(smallvec![dot(&a[..comps], &b?[..comps]).to_bits()]),
+        M::Dot if kind == ScalarKind::Float => one(out, dot(&a[..comps], &b?[..comps]).to_bits()),
         M::Dot => {
             let b = b?;
-            Some(smallvec![(0..comps).fold(0u32, |acc, i| acc.wrapping_add(a[i].wrapping_mul(b[i])))])
+            one(out, (0..comps).fold(0u32, |acc, i| acc.wrapping_add(a[i].wrapping_mul(b[i]))))
         }
-        M::Length => Some(smallvec![(0..comps).fold(0.0f32, |acc, i| acc + f(a[i]) * f(a[i])).sqrt().to_bits()]),
+        M::Length => one(out, (0..comps).fold(0.0f32, |acc, i| acc + f(a[i]) * f(a[i])).sqrt().to_bits()),
         M::Distance => {
             let b = b?;
             let sum = (0..comps).fold(0.0f32, |acc, i| {
                 let d = f(a[i]) - f(b[i]);
                 acc + d * d
             });
-            Some(smallvec![sum.sqrt().to_bits()])
+            one(out, sum.sqrt().to_bits())
         }
         M::Normalize => {
             let length = (0..comps).fold(0.0f32, |acc, i| acc + f(a[i]) * f(a[i])).sqrt();
-            Some(a.iter().map(|&x| (f(x) / length).to_bits()).collect())
+            for (o, &x) in out.iter_mut().zip(a) {
+                *o = (f(x) / length).to_bits();
+            }
+            Some(a.len())
         }
         M::Cross => {
             let b = b?;
             let (x, y) = (|i: usize| f(a[i]), |i: usize| f(b[i]));
-            Some(smallvec![
-                (x(1) * y(2) - x(2) * y(1)).to_bits(),
-                (x(2) * y(0) - x(0) * y(2)).to_bits(),
-                (x(0) * y(1) - x(1) * y(0)).to_bits(),
-            ])
+            out[0] = (x(1) * y(2) - x(2) * y(1)).to_bits();
+            out[1] = (x(2) * y(0) - x(0) * y(2)).to_bits();
+            out[2] = (x(0) * y(1) - x(1) * y(0)).to_bits();
+            Some(3)
         }
         M::Reflect => {
             // e1 - 2 dot(e2, e1) e2
             let b = b?;
             let d = dot(&b[..comps], &a[..comps]);
-            Some((0..comps).map(|i| (f(a[i]) - 2.0 * d * f(b[i])).to_bits()).collect())
+            for i in 0..comps {
+                out[i] = (f(a[i]) - 2.0 * d * f(b[i])).to_bits();
+            }
+            Some(comps)
         }
         M::Refract => {
             // k = 1 - η² (1 - dot(e2, e1)²); k < 0: the zero vector; else
@@ -73,16 +86,23 @@ fn math(
             let d = dot(&b[..comps], &a[..comps]);
             let k = 1.0 - eta * eta * (1.0 - d * d);
             if k < 0.0 {
-                return Some((0..comps).map(|_| 0.0f32.to_bits()).collect());
+                out[..comps].fill(0.0f32.to_bits());
+                return Some(comps);
             }
             let scale = eta * d + k.sqrt();
-            Some((0..comps).map(|i| (eta * f(a[i]) - scale * f(b[i])).to_bits()).collect())
+            for i in 0..comps {
+                out[i] = (eta * f(a[i]) - scale * f(b[i])).to_bits();
+            }
+            Some(comps)
         }
         M::FaceForward => {
             // e1 if dot(e2, e3) < 0, else -e1.
             let (b, c) = (b?, c?);
             let keep = dot(&b[..comps], &c[..comps]) < 0.0;
-            Some(a[..comps].iter().map(|&x| if keep { x } else { (-f(x)).to_bits() }).collect())
+            for i in 0..comps {
+                out[i] = if keep { a[i] } else { (-f(a[i])).to_bits() };
+            }
+            Some(comps)
         }
         M::Dot4I8Packed | M::Dot4U8Packed => {
             let b = b?;
@@ -91,12 +111,20 @@ fn math(
                 let byte = (word >> (8 * i)) & 0xff;
                 if signed { byte as u8 as i8 as i32 as u32 } else { byte }
             };
-            Some(smallvec![(0..4).fold(0u32, |acc, i| acc.wrapping_add(byte(a[0], i).wrapping_mul(byte(b[0], i))))])
+            one(out, (0..4).fold(0u32, |acc, i| acc.wrapping_add(byte(a[0], i).wrapping_mul(byte(b[0], i)))))
         }
         M::ExtractBits | M::InsertBits => {
-            (0..comps).map(|i| arith::bits(fun, kind, a[i], pick(b, i), pick(c, i), pick(d, i))).collect()
+            for i in 0..comps {
+                out[i] = arith::bits(fun, kind, a[i], pick(b, i), pick(c, i), pick(d, i))?;
+            }
+            Some(comps)
         }
-        _ => (0..comps).map(|i| arith::math(fun, kind, a[i], pick(b, i), pick(c, i))).collect(),
+        _ => {
+            for i in 0..comps {
+                out[i] = arith::math(fun, kind, a[i], pick(b, i), pick(c, i))?;
+            }
+            Some(comps)
+        }
     }
 }
 
@@ -190,7 +218,16 @@ impl Compiler<'_> {
                 Some((kind, comps)) => {
                     let zeros = [0u32; 4];
                     let z = |o: Option<(Reg, u32)>| o.map(|(_, l)| &zeros[..(l as usize).min(4)]);
-                    let probe = math(fun, kind, comps, &zeros[..comps], z(operands[1]), z(operands[2]), z(operands[3]));
+                    let probe = math(
+                        fun,
+                        kind,
+                        comps,
+                        &zeros[..comps],
+                        z(operands[1]),
+                        z(operands[2]),
+                        z(operands[3]),
+                        &mut [0; 4],
+                    );
                     if probe.is_none() {
                         Err(format!("math function {fun:?} on {kind:?}"))
                     } else {
@@ -207,7 +244,8 @@ impl Compiler<'_> {
                             }))
                         } else {
                             Ok(Box::new(move |regs: &mut [u32]| {
-                                let value = math(
+                                let mut value = [0u32; 4];
+                                let words = math(
                                     fun,
                                     kind,
                                     comps,
@@ -215,9 +253,10 @@ impl Compiler<'_> {
                                     b.map(|b| slice(regs, b)),
                                     c.map(|c| slice(regs, c)),
                                     d.map(|d| slice(regs, d)),
+                                    &mut value,
                                 )
                                 .expect("probed");
-                                put(regs, dst, len, &value);
+                                put(regs, dst, len, &value[..words]);
                             }))
                         }
                     }

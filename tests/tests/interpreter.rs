@@ -193,6 +193,115 @@ fn control_flow_calls_pointers_and_atomics_follow_wgsl() {
     assert_eq!(got, control_flow_reference(&inputs));
 }
 
+/// A chain of ten functions, deeper than the interpreter inlines (8 levels), entered at
+/// two depths from divergent branches, with lane-dependent loops and a `switch` at the
+/// bottom and a pointer into the entry point's variable passed all the way down: the
+/// workgroup-at-a-time executor must run each invocation's own path through real calls
+/// and bring the invocations back together for the barrier.
+const DIVERGENT_CALLS: &str = r#"
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+var<workgroup> total: atomic<u32>;
+var<workgroup> slots: array<u32, 64>;
+
+fn l9(p: ptr<function, u32>, x: u32) -> u32 {
+    var n = x;
+    var steps = 0u;
+    loop {
+        if n <= 1u { break; }
+        switch n % 3u {
+            case 0u: { n = n / 3u; }
+            case 1u: { n = n - 1u; }
+            default: { n = n + 1u; }
+        }
+        steps += 1u;
+    }
+    *p += steps;
+    return steps;
+}
+fn l8(p: ptr<function, u32>, x: u32) -> u32 {
+    if (x & 1u) == 0u { return l9(p, x) + 1u; }
+    return l9(p, x + 7u);
+}
+fn l7(p: ptr<function, u32>, x: u32) -> u32 { return l8(p, x) + 1u; }
+fn l6(p: ptr<function, u32>, x: u32) -> u32 { return l7(p, x) + 1u; }
+fn l5(p: ptr<function, u32>, x: u32) -> u32 { return l6(p, x) + 1u; }
+fn l4(p: ptr<function, u32>, x: u32) -> u32 { return l5(p, x) + 1u; }
+fn l3(p: ptr<function, u32>, x: u32) -> u32 { return l4(p, x) + 1u; }
+fn l2(p: ptr<function, u32>, x: u32) -> u32 { return l3(p, x) + 1u; }
+fn l1(p: ptr<function, u32>, x: u32) -> u32 { return l2(p, x) + 1u; }
+fn l0(p: ptr<function, u32>, x: u32) -> u32 { return l1(p, x) + 1u; }
+
+@compute @workgroup_size(64)
+fn main(@builtin(local_invocation_index) li: u32, @builtin(global_invocation_id) id: vec3<u32>) {
+    let x = input[id.x];
+    var acc = 0u;
+    var result = 0u;
+    if x % 3u == 0u {
+        result = l0(&acc, x % 500u);
+    } else if x % 3u == 1u {
+        result = 1000u + l3(&acc, x % 300u);
+    }
+    slots[li] = result;
+    atomicAdd(&total, acc);
+    workgroupBarrier();
+    output[id.x * 3u] = result;
+    output[id.x * 3u + 1u] = acc;
+    output[id.x * 3u + 2u] = slots[63u - li] + atomicLoad(&total);
+}
+"#;
+
+/// What the divergent-calls kernel must compute, stated in Rust.
+fn divergent_calls_reference(inputs: &[u32]) -> Vec<u32> {
+    let steps = |x: u32| {
+        let (mut n, mut steps) = (x, 0u32);
+        while n > 1 {
+            n = match n % 3 {
+                0 => n / 3,
+                1 => n - 1,
+                _ => n + 1,
+            };
+            steps += 1;
+        }
+        steps
+    };
+    // l8: (result, what it adds to *p); l0 adds 8 on top of it, l3 adds 5.
+    let l8 = |x: u32| if x & 1 == 0 { (steps(x) + 1, steps(x)) } else { (steps(x + 7), steps(x + 7)) };
+    let mut out = Vec::new();
+    for group in inputs.chunks(64) {
+        let per_lane: Vec<(u32, u32)> = group
+            .iter()
+            .map(|&x| match x % 3 {
+                0 => {
+                    let (r, a) = l8(x % 500);
+                    (r + 8, a)
+                }
+                1 => {
+                    let (r, a) = l8(x % 300);
+                    (1000 + r + 5, a)
+                }
+                _ => (0, 0),
+            })
+            .collect();
+        let total: u32 = per_lane.iter().map(|&(_, a)| a).sum();
+        for (li, &(result, acc)) in per_lane.iter().enumerate() {
+            out.extend([result, acc, per_lane[63 - li].0 + total]);
+        }
+    }
+    out
+}
+
+#[test]
+fn divergent_calls_of_functions_not_inlined_reconverge() {
+    let kernel = Kernel::from_wgsl("divergent_calls.wgsl", DIVERGENT_CALLS.into(), "main", false).unwrap();
+    let inputs: Vec<u32> = (0..128u32).map(|i| i.wrapping_mul(2_246_822_519).rotate_left(7) ^ i).collect();
+    for subgroup_size in [None, Some(8)] {
+        let mut cpu = CpuBackend::new(CpuOptions { subgroup_size }).unwrap();
+        let got = run_words(&mut cpu, &kernel, &inputs, 128 * 3, 2);
+        assert_eq!(got, divergent_calls_reference(&inputs), "subgroup size {subgroup_size:?}");
+    }
+}
+
 const INTEGER_SEMANTICS: &str = r#"
 @group(0) @binding(0) var<storage, read> input: array<u32>;
 @group(0) @binding(1) var<storage, read_write> output: array<u32>;

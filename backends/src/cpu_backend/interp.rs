@@ -21,7 +21,10 @@
 use super::decode::Program;
 use super::error::{invalid, unsupported};
 use super::insn::{BinOp, CallInsn, Insn};
-use super::memory::{BUFFER, Frame, Memory, TAG_MASK, copy_regs, read_buffer, read_mixed, write_buffer, write_mixed};
+use super::memory::{
+    BUFFER, Frame, Memory, TAG_MASK, copy_regs, copy_words, read_buffer, read_mixed, write_buffer, write_mixed,
+    zero_words,
+};
 use crate::error::BackendError;
 use std::cmp::Ordering;
 use std::sync::atomic::AtomicU32;
@@ -422,6 +425,35 @@ fn run_group(
                     compute(lane.regs);
                 }
             }
+            Insn::Copy { dst, src, len } => {
+                let (dst, src, len) = (*dst as usize, *src as usize, *len as usize);
+                for lane in lanes.iter_mut() {
+                    copy_regs(lane.regs, dst, src, len);
+                }
+            }
+            Insn::Copy2 { dst, src } => {
+                let (dst, src) = (*dst as usize, *src as usize);
+                for lane in lanes.iter_mut() {
+                    copy_regs(lane.regs, dst, src, 2);
+                }
+            }
+            Insn::Select { dst, cond, accept, reject, n, sc } => {
+                let (dst, cond, accept, reject) = (*dst as usize, *cond as usize, *accept as usize, *reject as usize);
+                let (n, sc) = (*n as usize, *sc as usize);
+                for lane in lanes.iter_mut() {
+                    let regs = &mut *lane.regs;
+                    for i in 0..n {
+                        regs[dst + i] = if regs[cond + i * sc] != 0 { regs[accept + i] } else { regs[reject + i] };
+                    }
+                }
+            }
+            Insn::Splat { dst, src, n } => {
+                let (dst, src, n) = (*dst as usize, *src as usize, *n as usize);
+                for lane in lanes.iter_mut() {
+                    let value = lane.regs[src];
+                    lane.regs[dst..dst + n].fill(value);
+                }
+            }
             _ => {
                 for lane in lanes.iter_mut() {
                     execute(insn, lane, buffers, workgroup);
@@ -444,7 +476,7 @@ fn execute(insn: &Insn, lane: &mut Lane, buffers: &[Vec<AtomicU32>], workgroup: 
         Insn::Copy3 { dst, src } => copy_regs(regs, *dst as usize, *src as usize, 3),
         Insn::Copy4 { dst, src } => copy_regs(regs, *dst as usize, *src as usize, 4),
         Insn::Copy { dst, src, len } => copy_regs(regs, *dst as usize, *src as usize, *len as usize),
-        Insn::Zero { dst, len } => regs[*dst as usize..(*dst + *len) as usize].fill(0),
+        Insn::Zero { dst, len } => zero_words(&mut regs[*dst as usize..(*dst + *len) as usize]),
         Insn::Bin { op, dst, a, b } => {
             let (x, y) = (regs[*a as usize], regs[*b as usize]);
             regs[*dst as usize] = match op {
@@ -484,15 +516,29 @@ fn execute(insn: &Insn, lane: &mut Lane, buffers: &[Vec<AtomicU32>], workgroup: 
             }
         }
         Insn::Swizzle { dst, src, pattern, n } => {
-            let src = *src as usize;
-            let v = [
-                regs[src + pattern[0] as usize],
-                regs[src + pattern[1] as usize],
-                regs[src + pattern[2] as usize],
-                regs[src + pattern[3] as usize],
-            ];
-            let n = *n as usize;
-            regs[*dst as usize..*dst as usize + n].copy_from_slice(&v[..n]);
+            let (dst, src) = (*dst as usize, *src as usize);
+            let at = |i: usize| src + pattern[i] as usize;
+            // Component by component: gathering into an array and copying it out made
+            // the CPU forward two 4-byte stores into one 8-byte load, which stalls.
+            match *n {
+                2 => {
+                    let (x, y) = (regs[at(0)], regs[at(1)]);
+                    regs[dst] = x;
+                    regs[dst + 1] = y;
+                }
+                3 => {
+                    let (x, y, z) = (regs[at(0)], regs[at(1)], regs[at(2)]);
+                    regs[dst] = x;
+                    regs[dst + 1] = y;
+                    regs[dst + 2] = z;
+                }
+                _ => {
+                    let v = [regs[at(0)], regs[at(1)], regs[at(2)], regs[at(3)]];
+                    for (i, &x) in v.iter().enumerate().take(*n as usize) {
+                        regs[dst + i] = x;
+                    }
+                }
+            }
         }
         Insn::Splat { dst, src, n } => {
             let v = regs[*src as usize];
@@ -559,19 +605,19 @@ fn execute(insn: &Insn, lane: &mut Lane, buffers: &[Vec<AtomicU32>], workgroup: 
         }
         Insn::LoadWorkgroup { dst, address, len } => {
             let (dst, address, len) = (*dst as usize, *address as usize, *len as usize);
-            regs[dst..dst + len].copy_from_slice(&workgroup[address..address + len]);
+            copy_words(&mut regs[dst..dst + len], &workgroup[address..address + len]);
         }
         Insn::StoreWorkgroup { address, src, len } => {
             let (src, address, len) = (*src as usize, *address as usize, *len as usize);
-            workgroup[address..address + len].copy_from_slice(&regs[src..src + len]);
+            copy_words(&mut workgroup[address..address + len], &regs[src..src + len]);
         }
         Insn::LoadPrivate { dst, address, len } => {
             let (dst, address, len) = (*dst as usize, *address as usize, *len as usize);
-            regs[dst..dst + len].copy_from_slice(&private[address..address + len]);
+            copy_words(&mut regs[dst..dst + len], &private[address..address + len]);
         }
         Insn::StorePrivate { address, src, len } => {
             let (src, address, len) = (*src as usize, *address as usize, *len as usize);
-            private[address..address + len].copy_from_slice(&regs[src..src + len]);
+            copy_words(&mut private[address..address + len], &regs[src..src + len]);
         }
         Insn::LoadBuffer { dst, buffer, address, len } => {
             let (dst, len) = (*dst as usize, *len as usize);

@@ -104,6 +104,7 @@ pub(super) fn convert(value: u32, from: ScalarKind, to: ScalarKind) -> Option<u3
 /// of a NaN return the other operand (Rust's `f32::min`), transcendental functions use
 /// Rust's `f32` functions (correctly rounded or within a few ULP on glibc), `round` rounds
 /// half to even as WGSL requires.
+#[inline]
 pub(super) fn math(fun: MathFunction, kind: ScalarKind, x: u32, y: u32, z: u32) -> Option<u32> {
     use MathFunction as M;
     use ScalarKind as K;

@@ -83,6 +83,13 @@ struct Lane<'a> {
     callers: &'a mut [Frame],
 }
 
+/// An empty vector with the allocation of `lanes`, to borrow the next group's lanes into
+/// (groups are formed hundreds of thousands of times per dispatch).
+fn recycle<'b>(mut lanes: Vec<Lane<'_>>) -> Vec<Lane<'b>> {
+    lanes.clear();
+    lanes.into_iter().map(|_| unreachable!("the vector is empty")).collect()
+}
+
 /// Why a group stopped running together.
 enum GroupEnd {
     /// It reached the place where other invocations wait (or a uniform jump did): every
@@ -157,6 +164,7 @@ pub(super) fn run_until_sync(
         .map(|(inv, stop)| if stop.is_none() { inv.frame.as_ref().map_or(u32::MAX, |f| f.pc) } else { u32::MAX })
         .collect();
     let mut in_calls = invocations.iter().filter(|inv| !inv.callers.is_empty()).count();
+    let mut spare_lanes = Vec::new();
     loop {
         // The group furthest behind, and the instruction where it meets the next one.
         members.clear();
@@ -166,13 +174,15 @@ pub(super) fn run_until_sync(
             if behind == u32::MAX {
                 return Ok(());
             }
+            // Without branches: which invocations are members is unpredictable.
+            members.resize(pcs.len(), 0);
+            let mut count = 0;
             for (i, &pc) in pcs.iter().enumerate() {
-                if pc == behind {
-                    members.push(i);
-                } else {
-                    meet = meet.min(pc);
-                }
+                members[count] = i;
+                count += usize::from(pc == behind);
+                meet = meet.min(if pc == behind { u32::MAX } else { pc });
             }
+            members.truncate(count);
             members[0]
         } else {
             let mut leader = None;
@@ -197,21 +207,21 @@ pub(super) fn run_until_sync(
         let frame = invocations[leader].frame.as_ref().expect("running invocations have frames");
         let (code_index, pc) = (frame.code, frame.pc);
         let end = {
-            let mut lanes = Vec::with_capacity(members.len());
-            let mut next = members.iter().copied().peekable();
-            for (i, invocation) in invocations.iter_mut().enumerate() {
-                if next.peek() == Some(&i) {
-                    next.next();
-                    let Invocation { frame, private, callers, .. } = invocation;
-                    let frame = frame.as_mut().expect("running invocations have frames");
-                    lanes.push(Lane {
-                        regs: &mut frame.regs[..],
-                        private: &mut private[..],
-                        callers: &mut callers[..],
-                    });
-                }
+            let mut lanes = recycle(std::mem::take(&mut spare_lanes));
+            // The members' invocations, borrowed apart by splitting the slice at each
+            // (they are in increasing order).
+            let mut rest = &mut invocations[..];
+            let mut start = 0;
+            for &i in &members {
+                let (invocation, tail) = std::mem::take(&mut rest)[i - start..].split_first_mut().expect("a member");
+                (rest, start) = (tail, i + 1);
+                let Invocation { frame, private, callers, .. } = invocation;
+                let frame = frame.as_mut().expect("running invocations have frames");
+                lanes.push(Lane { regs: &mut frame.regs[..], private: &mut private[..], callers: &mut callers[..] });
             }
-            run_group(program, code_index, pc, meet, &mut lanes, buffers, workgroup, executed, &mut targets)?
+            let end = run_group(program, code_index, pc, meet, &mut lanes, buffers, workgroup, executed, &mut targets);
+            spare_lanes = recycle(lanes);
+            end?
         };
         match end {
             GroupEnd::Meet(pc) => {

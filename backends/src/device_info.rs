@@ -20,6 +20,11 @@ pub struct DeviceInfo {
 }
 
 impl DeviceInfo {
+    /// Whether this is strata's CPU interpreter of naga IR (the `cpu` backend).
+    pub fn is_interpreter(&self) -> bool {
+        self.backend == "cpu"
+    }
+
     /// One line for people: backend, adapter, type.
     pub fn summary(&self) -> String {
         format!("{} on {} ({}, {})", self.backend, self.adapter, self.device_type, self.driver)

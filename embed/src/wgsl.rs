@@ -48,11 +48,11 @@ impl ModuleId {
     }
 }
 
-/// The histogram module to run for `block_size` on a device with or without subgroup
-/// shuffles: the choice strata's own renderer makes ([`KernelId::fastest_histogram`];
+/// The histogram module to run for `block_size` on a GPU with or without subgroup
+/// shuffles: the choice strata's own renderer makes there ([`KernelId::fastest_histogram`];
 /// every choice gives the same output).
 pub fn histogram_module(block_size: u32, subgroups: bool) -> ModuleId {
-    match KernelId::fastest_histogram(block_size, subgroups) {
+    match KernelId::fastest_histogram(block_size, subgroups, strata_kernels::Executor::Gpu) {
         KernelId::BlockHistogramRank => ModuleId::HistogramRank,
         KernelId::BlockHistogramSubgroup => ModuleId::HistogramSubgroup,
         _ => ModuleId::Histogram,

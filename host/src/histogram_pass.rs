@@ -4,7 +4,7 @@ use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, BackendError, Bind, BufferId};
 use strata_kernels::reference::block_histogram::HistogramOutput;
 use strata_kernels::types::{BlockStats, Candidate, ClusterSpan};
-use strata_kernels::{BlockGrid, GridError, Kernel, KernelError, KernelId, Registry};
+use strata_kernels::{BlockGrid, Executor, GridError, Kernel, KernelError, KernelId, Registry};
 use thiserror::Error;
 
 /// Slots one workgroup sorts (`SLOTS` in `block_sort.wgsl`).
@@ -29,8 +29,9 @@ pub enum HistogramVariant {
     /// Each element's position counted over its block (`block_histogram_rank`); runs
     /// everywhere, same outputs.
     Rank,
-    /// The fastest measured ([`KernelId::fastest_histogram`]): ranking up to B = 16, the
-    /// network at B = 32 (with subgroups if the device has them).
+    /// The fastest measured ([`KernelId::fastest_histogram`]): on a GPU ranking up to
+    /// B = 16 and the network at B = 32, on the interpreter the network (with subgroups
+    /// if the device has them).
     Auto,
 }
 
@@ -102,7 +103,9 @@ impl BlockHistogramPass {
             HistogramVariant::Subgroup => KernelId::BlockHistogramSubgroup,
             HistogramVariant::Rank => KernelId::BlockHistogramRank,
             HistogramVariant::Auto => {
-                KernelId::fastest_histogram(grid.block_size, backend.info().subgroup_sizes.is_some())
+                let info = backend.info();
+                let executor = if info.is_interpreter() { Executor::Interpreter } else { Executor::Gpu };
+                KernelId::fastest_histogram(grid.block_size, info.subgroup_sizes.is_some(), executor)
             }
         };
         let kernel = registry.get(id);

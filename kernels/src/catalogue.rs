@@ -49,6 +49,18 @@ pub enum KernelId {
     External(u64),
 }
 
+/// What runs the kernels, for the choices that depend on it
+/// ([`KernelId::fastest_histogram`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Executor {
+    /// A GPU, or a driver that runs a workgroup's invocations side by side in SIMD
+    /// lanes (lavapipe).
+    Gpu,
+    /// strata's CPU interpreter of naga IR, which runs a workgroup's invocations one
+    /// after another for each instruction.
+    Interpreter,
+}
+
 impl KernelId {
     /// Every registry kernel.
     pub const ALL: [KernelId; 14] = [
@@ -68,13 +80,16 @@ impl KernelId {
         KernelId::StrataResample,
     ];
 
-    /// The fastest block-histogram kernel for `block_size` on a device with or without
-    /// subgroup shuffles (all three give the same output): ranking up to 16 × 16 blocks,
-    /// the sorting network at 32 × 32, where ranking's B² comparisons per candidate cost
-    /// more (BENCHMARKS.md, block_sort). The one home of this choice: the renderer's
-    /// `HistogramVariant::Auto` and the embed pass both call it.
-    pub fn fastest_histogram(block_size: u32, subgroups: bool) -> KernelId {
-        if block_size <= 16 {
+    /// The fastest block-histogram kernel for `block_size` on `executor`, with or without
+    /// subgroup shuffles (all three give the same output). On a GPU (and lavapipe, which
+    /// runs a workgroup's lanes as SIMD): ranking up to 16 × 16 blocks, the sorting
+    /// network at 32 × 32, where ranking's B² comparisons per candidate cost more. On
+    /// strata's interpreter, which pays every comparison lane by lane, the network at
+    /// every block size (ranking ties it at B = 4 and is 1.1×, 1.6× and 3.5× slower at
+    /// B = 8, 16, 32). BENCHMARKS.md, block_sort and interpreter. The one home of this
+    /// choice: the renderer's `HistogramVariant::Auto` and the embed pass both call it.
+    pub fn fastest_histogram(block_size: u32, subgroups: bool, executor: Executor) -> KernelId {
+        if block_size <= 16 && executor == Executor::Gpu {
             KernelId::BlockHistogramRank
         } else if subgroups {
             KernelId::BlockHistogramSubgroup

@@ -41,6 +41,7 @@ pub mod word_kinds;
 
 pub use binding::{BindingAccess, BindingInfo, BindingKind, ElementLayout};
 pub use block_grid::{BlockGrid, BlockRect, GridError};
+pub use catalogue::Executor;
 pub use error::KernelError;
 pub use registry::{Kernel, KernelId, Registry};
 pub use word_kinds::{WordKind, WordKinds};

@@ -45,6 +45,10 @@ pub(super) fn run(
             .map(|_| {
                 scope.spawn(|| -> Result<(), BackendError> {
                     let mut workgroup = vec![0u32; program.workgroup_words as usize];
+                    // Kept from one workgroup to the next so that their register files
+                    // (tens of kilobytes per invocation) are reused, not allocated again:
+                    // fresh ones cost more in page faults than the kernels' work.
+                    let mut invocations = Vec::new();
                     loop {
                         let index = next.fetch_add(1, Ordering::Relaxed);
                         if index >= total {
@@ -54,7 +58,15 @@ pub(super) fn run(
                         let wy = (index / u64::from(workgroups[0]) % u64::from(workgroups[1])) as u32;
                         let wz = (index / (u64::from(workgroups[0]) * u64::from(workgroups[1]))) as u32;
                         workgroup.fill(0);
-                        match run_workgroup(program, &shared, &mut workgroup, [wx, wy, wz], workgroups, subgroup_size) {
+                        match run_workgroup(
+                            program,
+                            &shared,
+                            &mut workgroup,
+                            &mut invocations,
+                            [wx, wy, wz],
+                            workgroups,
+                            subgroup_size,
+                        ) {
                             Ok(count) => {
                                 executed.fetch_add(count, Ordering::Relaxed);
                             }
@@ -95,10 +107,12 @@ fn builtin_value(builtin: naga::BuiltIn, b: &Builtins) -> Result<Vec<u32>, Backe
     })
 }
 
-/// The entry point's first frame for an invocation with builtins `b`.
-fn entry_frame(program: &Program, b: &Builtins) -> Result<Frame, BackendError> {
+/// The entry point's first frame for an invocation with builtins `b`, its registers in
+/// `regs` (a register file to reuse, or an empty vector).
+fn entry_frame(program: &Program, b: &Builtins, mut regs: Vec<u32>) -> Result<Frame, BackendError> {
     let code = &program.codes[program.entry as usize];
-    let mut regs = code.template.clone();
+    regs.clear();
+    regs.extend_from_slice(&code.template);
     for &(argument, reg, len) in &code.arguments {
         for &(builtin, offset) in &program.entry_arguments[argument as usize] {
             let value = builtin_value(builtin, b)?;
@@ -118,6 +132,7 @@ fn run_workgroup(
     program: &Program,
     buffers: &[Vec<AtomicU32>],
     workgroup: &mut [u32],
+    invocations: &mut Vec<Invocation>,
     [wx, wy, wz]: [u32; 3],
     workgroups: [u32; 3],
     subgroup_size: u32,
@@ -126,7 +141,7 @@ fn run_workgroup(
     let count = (sx * sy * sz) as usize;
     let subgroup_size = subgroup_size.max(1);
     let num_subgroups = (count as u32).div_ceil(subgroup_size);
-    let mut invocations = Vec::with_capacity(count);
+    invocations.truncate(count);
     for index in 0..count as u32 {
         let local = [index % sx, index / sx % sy, index / (sx * sy)];
         let builtins = Builtins {
@@ -140,22 +155,33 @@ fn run_workgroup(
             subgroup_id: index / subgroup_size,
             num_subgroups,
         };
-        invocations.push(Invocation {
-            frame: Some(entry_frame(program, &builtins)?),
-            callers: Vec::new(),
-            spare: Vec::new(),
-            private: program.private_init.clone(),
-            lane: builtins.lane,
-            subgroup_id: builtins.subgroup_id,
-            subgroup_size,
-            local_index: index,
-        });
+        if let Some(invocation) = invocations.get_mut(index as usize) {
+            // The previous workgroup's invocation: its register files become spares.
+            let Invocation { frame, callers, spare, private, .. } = invocation;
+            spare.extend(frame.take().into_iter().chain(callers.drain(..)).map(|frame| frame.regs));
+            let regs = spare.pop().unwrap_or_default();
+            *frame = Some(entry_frame(program, &builtins, regs)?);
+            private.clear();
+            private.extend_from_slice(&program.private_init);
+        } else {
+            invocations.push(Invocation {
+                frame: Some(entry_frame(program, &builtins, Vec::new())?),
+                callers: Vec::new(),
+                spare: Vec::new(),
+                private: program.private_init.clone(),
+                lane: builtins.lane,
+                subgroup_id: builtins.subgroup_id,
+                subgroup_size,
+                local_index: index,
+            });
+        }
     }
+    let invocations = &mut invocations[..];
     let mut executed = 0u64;
     let mut stops = Vec::with_capacity(count);
     let mut reached = Vec::with_capacity(count);
     loop {
-        interp::run_until_sync(program, &mut invocations, buffers, workgroup, &mut executed, &mut reached)?;
+        interp::run_until_sync(program, invocations, buffers, workgroup, &mut executed, &mut reached)?;
         stops.clear();
         stops.extend(reached.iter().map(|stop| stop.expect("every invocation stopped")));
         if stops.iter().all(|s| *s == Stop::Done) {
@@ -186,11 +212,11 @@ fn run_workgroup(
         // subgroup gather is computed for all invocations now.
         let Stop::Sync(code, pc) = first else { unreachable!() };
         match &program.codes[code as usize].insns[pc as usize] {
-            Insn::Gather(gather) => self::gather(&mut invocations, gather),
-            Insn::Collective(collective) => self::collective(&mut invocations, collective),
+            Insn::Gather(gather) => self::gather(invocations, gather),
+            Insn::Collective(collective) => self::collective(invocations, collective),
             _ => {}
         }
-        for invocation in &mut invocations {
+        for invocation in invocations.iter_mut() {
             invocation.frame.as_mut().expect("waiting invocations have frames").pc += 1;
         }
     }

@@ -154,7 +154,7 @@ fn default_reference_spp(backend: &dyn strata_backends::Backend) -> u32 {
 
 /// Whether `backend` is the CPU interpreter (about 8x slower than lavapipe).
 fn on_interpreter(backend: &dyn strata_backends::Backend) -> bool {
-    backend.info().backend == "cpu"
+    backend.info().is_interpreter()
 }
 
 pub(crate) fn compare(args: CompareArgs) -> Result<()> {

@@ -8,9 +8,10 @@
 //! source's registers, compile-time values in a register template. [`interp`] runs it;
 //! [`memory`] is the pointer model (offsets in bytes into bound buffers, in register
 //! words elsewhere). Workgroups run in parallel on the machine's cores;
-//! the invocations of a workgroup run round-robin from barrier to barrier ([`exec`]), each
+//! the invocations of a workgroup run together from barrier to barrier ([`exec`]), each
 //! a resumable stack of frames, so every invocation reaches a barrier before any passes
-//! it. A barrier or subgroup operation reached in non-uniform control flow is an error
+//! it; those at the same place run as one group, each instruction decoded once for the
+//! whole group ([`interp`]). A barrier or subgroup operation reached in non-uniform control flow is an error
 //! naming the line and function. Subgroup operations run with a configurable subgroup
 //! size (1, 8, 32, ...).
 //!

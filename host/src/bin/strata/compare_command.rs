@@ -43,7 +43,7 @@ pub(crate) struct CompareArgs {
     #[arg(long)]
     reference: Option<PathBuf>,
     /// Samples per pixel of the rendered reference [default: 1024 on a Vulkan or GL
-    /// device, 256 on the CPU interpreter, which is about 8x slower].
+    /// device, 256 on the CPU interpreter, which is about 6x slower].
     #[arg(long)]
     reference_spp: Option<u32>,
     /// A close-up for the report, `x,y,w,h` in pixels (repeatable); shown before the
@@ -121,7 +121,7 @@ pub(crate) struct CompareArgs {
     backend: BackendChoice,
 }
 
-/// The render settings at the size to run: on the CPU interpreter, which is about 8x
+/// The render settings at the size to run: on the CPU interpreter, which is about 6x
 /// slower than lavapipe, half the scene camera's width and height unless `--width` or
 /// `--height` was given (a reference file fixes the size too), said up front.
 fn sized_to_backend(
@@ -152,7 +152,7 @@ fn default_reference_spp(backend: &dyn strata_backends::Backend) -> u32 {
     if on_interpreter(backend) { 256 } else { 1024 }
 }
 
-/// Whether `backend` is the CPU interpreter (about 8x slower than lavapipe).
+/// Whether `backend` is the CPU interpreter (about 6x slower than lavapipe on the path tracer).
 fn on_interpreter(backend: &dyn strata_backends::Backend) -> bool {
     backend.info().is_interpreter()
 }

@@ -442,6 +442,26 @@ fn run_group(
                     copy_regs(lane.regs, dst, src, len);
                 }
             }
+            Insn::Copy3 { dst, src } => {
+                let (dst, src) = (*dst as usize, *src as usize);
+                for lane in lanes.iter_mut() {
+                    copy_regs(lane.regs, dst, src, 3);
+                }
+            }
+            Insn::Zero { dst, len } => {
+                let (dst, len) = (*dst as usize, *len as usize);
+                for lane in lanes.iter_mut() {
+                    zero_words(&mut lane.regs[dst..dst + len]);
+                }
+            }
+            Insn::Extract { dst, base, index, count, stride, len } => {
+                let (dst, base, index, len) = (*dst as usize, *base as usize, *index as usize, *len as usize);
+                let (last, stride) = (count.saturating_sub(1) as usize, *stride as usize);
+                for lane in lanes.iter_mut() {
+                    let at = (lane.regs[index] as usize).min(last) * stride;
+                    copy_regs(lane.regs, dst, base + at, len);
+                }
+            }
             Insn::Copy2 { dst, src } => {
                 let (dst, src) = (*dst as usize, *src as usize);
                 for lane in lanes.iter_mut() {

@@ -193,18 +193,20 @@ fn control_flow_calls_pointers_and_atomics_follow_wgsl() {
     assert_eq!(got, control_flow_reference(&inputs));
 }
 
-/// A chain of ten functions, deeper than the interpreter inlines (8 levels), entered at
-/// two depths from divergent branches, with lane-dependent loops and a `switch` at the
-/// bottom and a pointer into the entry point's variable passed all the way down: the
-/// workgroup-at-a-time executor must run each invocation's own path through real calls
-/// and bring the invocations back together for the barrier.
+/// Chains of functions deeper than the interpreter inlines (each function's code
+/// inlines 8 levels of callees, so `main` → `l8` → `l16` are real calls, and from the
+/// `l3` branch `main` → `l11` → `l19`): entered from divergent branches at two places,
+/// lane-dependent loops and a `switch` at the bottom, a pointer to the entry point's
+/// variable written two frames down, and a barrier inside a call that every invocation
+/// makes (`s9`, called through `s8`). The workgroup-at-a-time executor must run each
+/// invocation's own path through the calls and bring the invocations back together.
 const DIVERGENT_CALLS: &str = r#"
 @group(0) @binding(0) var<storage, read> input: array<u32>;
 @group(0) @binding(1) var<storage, read_write> output: array<u32>;
 var<workgroup> total: atomic<u32>;
 var<workgroup> slots: array<u32, 64>;
 
-fn l9(p: ptr<function, u32>, x: u32) -> u32 {
+fn l19(p: ptr<function, u32>, x: u32) -> u32 {
     var n = x;
     var steps = 0u;
     loop {
@@ -219,10 +221,20 @@ fn l9(p: ptr<function, u32>, x: u32) -> u32 {
     *p += steps;
     return steps;
 }
-fn l8(p: ptr<function, u32>, x: u32) -> u32 {
-    if (x & 1u) == 0u { return l9(p, x) + 1u; }
-    return l9(p, x + 7u);
+fn l18(p: ptr<function, u32>, x: u32) -> u32 {
+    if (x & 1u) == 0u { return l19(p, x) + 1u; }
+    return l19(p, x + 7u);
 }
+fn l17(p: ptr<function, u32>, x: u32) -> u32 { return l18(p, x) + 1u; }
+fn l16(p: ptr<function, u32>, x: u32) -> u32 { return l17(p, x) + 1u; }
+fn l15(p: ptr<function, u32>, x: u32) -> u32 { return l16(p, x) + 1u; }
+fn l14(p: ptr<function, u32>, x: u32) -> u32 { return l15(p, x) + 1u; }
+fn l13(p: ptr<function, u32>, x: u32) -> u32 { return l14(p, x) + 1u; }
+fn l12(p: ptr<function, u32>, x: u32) -> u32 { return l13(p, x) + 1u; }
+fn l11(p: ptr<function, u32>, x: u32) -> u32 { return l12(p, x) + 1u; }
+fn l10(p: ptr<function, u32>, x: u32) -> u32 { return l11(p, x) + 1u; }
+fn l9(p: ptr<function, u32>, x: u32) -> u32 { return l10(p, x) + 1u; }
+fn l8(p: ptr<function, u32>, x: u32) -> u32 { return l9(p, x) + 1u; }
 fn l7(p: ptr<function, u32>, x: u32) -> u32 { return l8(p, x) + 1u; }
 fn l6(p: ptr<function, u32>, x: u32) -> u32 { return l7(p, x) + 1u; }
 fn l5(p: ptr<function, u32>, x: u32) -> u32 { return l6(p, x) + 1u; }
@@ -231,6 +243,20 @@ fn l3(p: ptr<function, u32>, x: u32) -> u32 { return l4(p, x) + 1u; }
 fn l2(p: ptr<function, u32>, x: u32) -> u32 { return l3(p, x) + 1u; }
 fn l1(p: ptr<function, u32>, x: u32) -> u32 { return l2(p, x) + 1u; }
 fn l0(p: ptr<function, u32>, x: u32) -> u32 { return l1(p, x) + 1u; }
+
+fn s9(li: u32) -> u32 {
+    workgroupBarrier();
+    return slots[63u - li];
+}
+fn s8(li: u32) -> u32 { return s9(li) + 1u; }
+fn s7(li: u32) -> u32 { return s8(li) + 1u; }
+fn s6(li: u32) -> u32 { return s7(li) + 1u; }
+fn s5(li: u32) -> u32 { return s6(li) + 1u; }
+fn s4(li: u32) -> u32 { return s5(li) + 1u; }
+fn s3(li: u32) -> u32 { return s4(li) + 1u; }
+fn s2(li: u32) -> u32 { return s3(li) + 1u; }
+fn s1(li: u32) -> u32 { return s2(li) + 1u; }
+fn s0(li: u32) -> u32 { return s1(li) + 1u; }
 
 @compute @workgroup_size(64)
 fn main(@builtin(local_invocation_index) li: u32, @builtin(global_invocation_id) id: vec3<u32>) {
@@ -244,10 +270,11 @@ fn main(@builtin(local_invocation_index) li: u32, @builtin(global_invocation_id)
     }
     slots[li] = result;
     atomicAdd(&total, acc);
+    let mirrored = s0(li);
     workgroupBarrier();
     output[id.x * 3u] = result;
     output[id.x * 3u + 1u] = acc;
-    output[id.x * 3u + 2u] = slots[63u - li] + atomicLoad(&total);
+    output[id.x * 3u + 2u] = mirrored + atomicLoad(&total);
 }
 "#;
 
@@ -265,27 +292,28 @@ fn divergent_calls_reference(inputs: &[u32]) -> Vec<u32> {
         }
         steps
     };
-    // l8: (result, what it adds to *p); l0 adds 8 on top of it, l3 adds 5.
-    let l8 = |x: u32| if x & 1 == 0 { (steps(x) + 1, steps(x)) } else { (steps(x + 7), steps(x + 7)) };
+    // l18: (result, what it adds to *p); l0 adds 18 on top of it, l3 adds 15.
+    let l18 = |x: u32| if x & 1 == 0 { (steps(x) + 1, steps(x)) } else { (steps(x + 7), steps(x + 7)) };
     let mut out = Vec::new();
     for group in inputs.chunks(64) {
         let per_lane: Vec<(u32, u32)> = group
             .iter()
             .map(|&x| match x % 3 {
                 0 => {
-                    let (r, a) = l8(x % 500);
-                    (r + 8, a)
+                    let (r, a) = l18(x % 500);
+                    (r + 18, a)
                 }
                 1 => {
-                    let (r, a) = l8(x % 300);
-                    (1000 + r + 5, a)
+                    let (r, a) = l18(x % 300);
+                    (1000 + r + 15, a)
                 }
                 _ => (0, 0),
             })
             .collect();
         let total: u32 = per_lane.iter().map(|&(_, a)| a).sum();
         for (li, &(result, acc)) in per_lane.iter().enumerate() {
-            out.extend([result, acc, per_lane[63 - li].0 + total]);
+            // s0 returns slots[63 - li] plus one per level above s9.
+            out.extend([result, acc, per_lane[63 - li].0 + 9 + total]);
         }
     }
     out

@@ -44,7 +44,8 @@ pub(super) struct Invocation {
     pub frame: Option<Frame>,
     /// Callers of the running frame, outermost first.
     pub callers: Vec<Frame>,
-    /// Register files of returned frames, reused by later calls.
+    /// Register files of returned frames, reused by later calls (and by the entry frame
+    /// of the next workgroup the same thread runs).
     pub spare: Vec<Vec<u32>>,
     /// Private memory.
     pub private: Vec<u32>,

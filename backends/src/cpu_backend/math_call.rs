@@ -286,14 +286,17 @@ impl Compiler<'_> {
                     } else {
                         let (b, c, d) = (operands[1], operands[2], operands[3]);
                         if let Some(component) = specialised(fun, kind) {
-                            // Operands of one word are broadcast over the components.
-                            let at =
-                                |o: Option<(Reg, u32)>| o.map_or((0, 0), |(r, l)| (r as usize, usize::from(l > 1)));
-                            let ((a, sa), (b, sb), (c, sc)) = (at(Some(a)), at(b), at(c));
+                            // Operands of one word are broadcast over the components; absent
+                            // ones are 0, as in the general form.
+                            let at = |o: Option<(Reg, u32)>| o.map(|(r, l)| (r as usize, usize::from(l > 1)));
+                            let (a, sa) = at(Some(a)).expect("a first argument");
+                            let (b, c) = (at(b), at(c));
                             let (dst, n) = (dst as usize, comps.min(len as usize));
                             Ok(Box::new(move |regs: &mut [u32]| {
                                 for i in 0..n {
-                                    regs[dst + i] = component(regs[a + i * sa], regs[b + i * sb], regs[c + i * sc]);
+                                    let operand = |o: Option<(usize, usize)>| o.map_or(0, |(r, s)| regs[r + i * s]);
+                                    let (y, z) = (operand(b), operand(c));
+                                    regs[dst + i] = component(regs[a + i * sa], y, z);
                                 }
                             }))
                         } else if let (M::Dot, ScalarKind::Float, Some(b)) = (fun, kind, b) {

@@ -47,7 +47,7 @@ pub(super) struct Memory<'a> {
     pub callers: &'a mut [Frame],
 }
 
-/// Copies `len` words `src..` to `dst..` of `regs` (distinct, non-overlapping ranges).
+/// Copies `len` words `src..` to `dst..` of `regs` (the ranges may overlap).
 #[inline(always)]
 pub(super) fn copy_regs(regs: &mut [u32], dst: usize, src: usize, len: usize) {
     match len {
@@ -64,6 +64,8 @@ pub(super) fn copy_regs(regs: &mut [u32], dst: usize, src: usize, len: usize) {
             let v: [u32; 4] = regs[src..src + 4].try_into().expect("four words");
             regs[dst..dst + 4].copy_from_slice(&v);
         }
+        // Overlapping ranges (none are compiled today) keep `copy_within`'s semantics.
+        _ if dst.abs_diff(src) < len => regs.copy_within(src..src + len, dst),
         _ => {
             let (to, from) = if dst > src {
                 let (low, high) = regs.split_at_mut(dst);

@@ -59,11 +59,6 @@ pub(super) struct Invocation {
     pub local_index: u32,
 }
 
-#[inline(always)]
-fn bool_bits(b: bool) -> u32 {
-    u32::from(b)
-}
-
 /// `regs[dst + i] = f(regs[a + i * sa], regs[b + i * sb])` for `i < n`.
 #[inline(always)]
 fn component_wise(
@@ -76,6 +71,33 @@ fn component_wise(
     }
 }
 
+/// `copy_regs` in every member's registers.
+#[inline(always)]
+fn copy_in_each(lanes: &mut [Lane], dst: u32, src: u32, len: u32) {
+    let (dst, src, len) = (dst as usize, src as usize, len as usize);
+    for lane in lanes.iter_mut() {
+        copy_regs(lane.regs, dst, src, len);
+    }
+}
+
+/// `$body` with `$operator` bound to the constant `BinOp` equal to `$op`: one copy of the
+/// loop per operator, so that the operator is decided once, outside it.
+macro_rules! per_operator {
+    ($op:expr, |$operator:ident| $body:expr) => {
+        per_operator!(@ $op, $operator, $body, AddF, SubF, MulF, DivF, ModF, AddI, SubI, MulI, DivU, DivS,
+            ModU, ModS, EqF, NeF, LtF, LeF, GtF, GeF, Eq, Ne, LtS, LeS, GtS, GeS, LtU, LeU, GtU, GeU, And, Xor,
+            Or, LogicalAnd, LogicalOr, Shl, ShrU, ShrS)
+    };
+    (@ $op:expr, $operator:ident, $body:expr, $($variant:ident),*) => {
+        match $op {
+            $(BinOp::$variant => {
+                let $operator = BinOp::$variant;
+                $body
+            })*
+        }
+    };
+}
+
 /// One member of a running group: the registers of its running frame and the memory
 /// only it sees.
 struct Lane<'a> {
@@ -85,7 +107,8 @@ struct Lane<'a> {
 }
 
 /// An empty vector with the allocation of `lanes`, to borrow the next group's lanes into
-/// (groups are formed hundreds of thousands of times per dispatch).
+/// (groups are formed hundreds of thousands of times per dispatch; allocating each was
+/// 5 % of the path tracer).
 fn recycle<'b>(mut lanes: Vec<Lane<'_>>) -> Vec<Lane<'b>> {
     lanes.clear();
     lanes.into_iter().map(|_| unreachable!("the vector is empty")).collect()
@@ -164,6 +187,7 @@ pub(super) fn run_until_sync(
         .zip(stops.iter())
         .map(|(inv, stop)| if stop.is_none() { inv.frame.as_ref().map_or(u32::MAX, |f| f.pc) } else { u32::MAX })
         .collect();
+    // Runnable invocations inside a call (stopped ones no longer count).
     let mut in_calls = invocations.iter().filter(|inv| !inv.callers.is_empty()).count();
     let mut spare_lanes = Vec::new();
     loop {
@@ -240,6 +264,7 @@ pub(super) fn run_until_sync(
                 for &i in &members {
                     invocations[i].frame.as_mut().expect("running").pc = pc;
                     stops[i] = Some(Stop::Sync(code_index, pc));
+                    in_calls -= usize::from(!invocations[i].callers.is_empty());
                 }
             }
             GroupEnd::Call(return_pc) => {
@@ -384,90 +409,31 @@ fn run_group(
             Insn::Barrier | Insn::Gather(_) | Insn::Collective(_) => break GroupEnd::Sync(pc as u32 - 1),
             Insn::Fail(failure) => return Err(unsupported(&failure.0, failure.1)),
             // The most frequent instructions get their own loop over the members, their
-            // operands and operator decoded once for the whole group.
-            Insn::Copy1 { dst, src } => {
-                let (dst, src) = (*dst as usize, *src as usize);
-                for lane in lanes.iter_mut() {
-                    lane.regs[dst] = lane.regs[src];
-                }
-            }
-            Insn::Bin { op, dst, a, b } => {
-                let (dst, a, b) = (*dst as usize, *a as usize, *b as usize);
-                macro_rules! per_operator {
-                    ($($variant:ident),*) => {
-                        match op {
-                            $(BinOp::$variant => for lane in lanes.iter_mut() {
-                                let regs = &mut *lane.regs;
-                                regs[dst] = BinOp::$variant.apply(regs[a], regs[b]);
-                            },)*
-                        }
-                    };
-                }
-                per_operator!(
-                    AddF, SubF, MulF, DivF, ModF, AddI, SubI, MulI, DivU, DivS, ModU, ModS, EqF, NeF, LtF, LeF, GtF,
-                    GeF, Eq, Ne, LtS, LeS, GtS, GeS, LtU, LeU, GtU, GeU, And, Xor, Or, LogicalAnd, LogicalOr, Shl,
-                    ShrU, ShrS
-                );
-            }
-            Insn::BinV { op, dst, a, b, n, sa, sb } => {
-                let operands = (*dst as usize, *a as usize, *b as usize, *n as usize, *sa as usize, *sb as usize);
-                macro_rules! per_operator {
-                    ($($variant:ident),*) => {
-                        match op {
-                            $(BinOp::$variant => for lane in lanes.iter_mut() {
-                                component_wise(lane.regs, operands, |x, y| BinOp::$variant.apply(x, y));
-                            },)*
-                        }
-                    };
-                }
-                per_operator!(
-                    AddF, SubF, MulF, DivF, ModF, AddI, SubI, MulI, DivU, DivS, ModU, ModS, EqF, NeF, LtF, LeF, GtF,
-                    GeF, Eq, Ne, LtS, LeS, GtS, GeS, LtU, LeU, GtU, GeU, And, Xor, Or, LogicalAnd, LogicalOr, Shl,
-                    ShrU, ShrS
-                );
-            }
-            Insn::Copy4 { dst, src } => {
-                let (dst, src) = (*dst as usize, *src as usize);
-                for lane in lanes.iter_mut() {
-                    copy_regs(lane.regs, dst, src, 4);
-                }
-            }
-            Insn::Compute(compute) => {
-                for lane in lanes.iter_mut() {
-                    compute(lane.regs);
-                }
-            }
-            Insn::Copy { dst, src, len } => {
-                let (dst, src, len) = (*dst as usize, *src as usize, *len as usize);
-                for lane in lanes.iter_mut() {
-                    copy_regs(lane.regs, dst, src, len);
-                }
-            }
-            Insn::Copy3 { dst, src } => {
-                let (dst, src) = (*dst as usize, *src as usize);
-                for lane in lanes.iter_mut() {
-                    copy_regs(lane.regs, dst, src, 3);
-                }
-            }
+            // operands and operator decoded once for the whole group; `execute` runs the
+            // others member by member.
+            Insn::Copy1 { dst, src } => copy_in_each(lanes, *dst, *src, 1),
+            Insn::Copy2 { dst, src } => copy_in_each(lanes, *dst, *src, 2),
+            Insn::Copy3 { dst, src } => copy_in_each(lanes, *dst, *src, 3),
+            Insn::Copy4 { dst, src } => copy_in_each(lanes, *dst, *src, 4),
+            Insn::Copy { dst, src, len } => copy_in_each(lanes, *dst, *src, *len),
             Insn::Zero { dst, len } => {
                 let (dst, len) = (*dst as usize, *len as usize);
                 for lane in lanes.iter_mut() {
                     zero_words(&mut lane.regs[dst..dst + len]);
                 }
             }
-            Insn::Extract { dst, base, index, count, stride, len } => {
-                let (dst, base, index, len) = (*dst as usize, *base as usize, *index as usize, *len as usize);
-                let (last, stride) = (count.saturating_sub(1) as usize, *stride as usize);
-                for lane in lanes.iter_mut() {
-                    let at = (lane.regs[index] as usize).min(last) * stride;
-                    copy_regs(lane.regs, dst, base + at, len);
-                }
+            Insn::Bin { op, dst, a, b } => {
+                let (dst, a, b) = (*dst as usize, *a as usize, *b as usize);
+                per_operator!(op, |operator| for lane in lanes.iter_mut() {
+                    let regs = &mut *lane.regs;
+                    regs[dst] = operator.apply(regs[a], regs[b]);
+                });
             }
-            Insn::Copy2 { dst, src } => {
-                let (dst, src) = (*dst as usize, *src as usize);
-                for lane in lanes.iter_mut() {
-                    copy_regs(lane.regs, dst, src, 2);
-                }
+            Insn::BinV { op, dst, a, b, n, sa, sb } => {
+                let operands = (*dst as usize, *a as usize, *b as usize, *n as usize, *sa as usize, *sb as usize);
+                per_operator!(op, |operator| for lane in lanes.iter_mut() {
+                    component_wise(lane.regs, operands, |x, y| operator.apply(x, y));
+                });
             }
             Insn::Select { dst, cond, accept, reject, n, sc } => {
                 let (dst, cond, accept, reject) = (*dst as usize, *cond as usize, *accept as usize, *reject as usize);
@@ -486,6 +452,19 @@ fn run_group(
                     lane.regs[dst..dst + n].fill(value);
                 }
             }
+            Insn::Extract { dst, base, index, count, stride, len } => {
+                let (dst, base, index, len) = (*dst as usize, *base as usize, *index as usize, *len as usize);
+                let (last, stride) = (count.saturating_sub(1) as usize, *stride as usize);
+                for lane in lanes.iter_mut() {
+                    let at = (lane.regs[index] as usize).min(last) * stride;
+                    copy_regs(lane.regs, dst, base + at, len);
+                }
+            }
+            Insn::Compute(compute) => {
+                for lane in lanes.iter_mut() {
+                    compute(lane.regs);
+                }
+            }
             _ => {
                 for lane in lanes.iter_mut() {
                     execute(insn, lane, buffers, workgroup);
@@ -497,54 +476,16 @@ fn run_group(
     Ok(end)
 }
 
-/// Executes one instruction that is not control flow for one invocation.
+/// Executes, for one invocation, an instruction that `run_group` neither runs itself
+/// (control flow) nor loops over the group on its own (the most frequent ones).
 #[inline(always)]
 fn execute(insn: &Insn, lane: &mut Lane, buffers: &[Vec<AtomicU32>], workgroup: &mut [u32]) {
     let Lane { regs, private, callers } = lane;
     let regs = &mut **regs;
     match insn {
-        Insn::Copy1 { dst, src } => regs[*dst as usize] = regs[*src as usize],
-        Insn::Copy2 { dst, src } => copy_regs(regs, *dst as usize, *src as usize, 2),
-        Insn::Copy3 { dst, src } => copy_regs(regs, *dst as usize, *src as usize, 3),
-        Insn::Copy4 { dst, src } => copy_regs(regs, *dst as usize, *src as usize, 4),
-        Insn::Copy { dst, src, len } => copy_regs(regs, *dst as usize, *src as usize, *len as usize),
-        Insn::Zero { dst, len } => zero_words(&mut regs[*dst as usize..(*dst + *len) as usize]),
-        Insn::Bin { op, dst, a, b } => {
-            let (x, y) = (regs[*a as usize], regs[*b as usize]);
-            regs[*dst as usize] = match op {
-                BinOp::AddF => (f32::from_bits(x) + f32::from_bits(y)).to_bits(),
-                BinOp::MulF => (f32::from_bits(x) * f32::from_bits(y)).to_bits(),
-                BinOp::AddI => x.wrapping_add(y),
-                BinOp::Eq => bool_bits(x == y),
-                BinOp::And => x & y,
-                _ => op.apply(x, y),
-            };
-        }
-        Insn::BinV { op, dst, a, b, n, sa, sb } => {
-            let operands = (*dst as usize, *a as usize, *b as usize, *n as usize, *sa as usize, *sb as usize);
-            // One loop per operator, the operator's match outside it.
-            macro_rules! per_operator {
-                ($($variant:ident),*) => {
-                    match op {
-                        $(BinOp::$variant => component_wise(regs, operands, |x, y| BinOp::$variant.apply(x, y)),)*
-                    }
-                };
-            }
-            per_operator!(
-                AddF, SubF, MulF, DivF, ModF, AddI, SubI, MulI, DivU, DivS, ModU, ModS, EqF, NeF, LtF, LeF, GtF, GeF,
-                Eq, Ne, LtS, LeS, GtS, GeS, LtU, LeU, GtU, GeU, And, Xor, Or, LogicalAnd, LogicalOr, Shl, ShrU, ShrS
-            );
-        }
         Insn::Un { op, dst, src, n } => {
             for i in 0..*n as usize {
                 regs[*dst as usize + i] = op.apply(regs[*src as usize + i]);
-            }
-        }
-        Insn::Select { dst, cond, accept, reject, n, sc } => {
-            let (dst, cond, accept, reject) = (*dst as usize, *cond as usize, *accept as usize, *reject as usize);
-            let sc = *sc as usize;
-            for i in 0..*n as usize {
-                regs[dst + i] = if regs[cond + i * sc] != 0 { regs[accept + i] } else { regs[reject + i] };
             }
         }
         Insn::Swizzle { dst, src, pattern, n } => {
@@ -572,19 +513,11 @@ fn execute(insn: &Insn, lane: &mut Lane, buffers: &[Vec<AtomicU32>], workgroup: 
                 }
             }
         }
-        Insn::Splat { dst, src, n } => {
-            let v = regs[*src as usize];
-            regs[*dst as usize..*dst as usize + *n as usize].fill(v);
-        }
         Insn::Convert { from, to, dst, src, n } => {
             for i in 0..*n as usize {
                 regs[*dst as usize + i] =
                     super::arith::convert(regs[*src as usize + i], *from, *to).expect("checked when compiled");
             }
-        }
-        Insn::Extract { dst, base, index, count, stride, len } => {
-            let at = (regs[*index as usize] as usize).min(count.saturating_sub(1) as usize) * *stride as usize;
-            copy_regs(regs, *dst as usize, *base as usize + at, *len as usize);
         }
         Insn::PtrAdd { dst, base, add } => {
             let (dst, base) = (*dst as usize, *base as usize);
@@ -666,7 +599,6 @@ fn execute(insn: &Insn, lane: &mut Lane, buffers: &[Vec<AtomicU32>], workgroup: 
             let words = memory.words(regs, tag);
             regs[*dst as usize] = (words.saturating_sub(offset as usize) / (*stride).max(1) as usize) as u32;
         }
-        Insn::Compute(compute) => compute(regs),
         Insn::Atomic(atomic) => {
             use naga::AtomicFunction as A;
             let pointer = (regs[atomic.pointer as usize], regs[atomic.pointer as usize + 1]);
@@ -704,6 +636,18 @@ fn execute(insn: &Insn, lane: &mut Lane, buffers: &[Vec<AtomicU32>], workgroup: 
                 }
             }
         }
+        Insn::Copy1 { .. }
+        | Insn::Copy2 { .. }
+        | Insn::Copy3 { .. }
+        | Insn::Copy4 { .. }
+        | Insn::Copy { .. }
+        | Insn::Zero { .. }
+        | Insn::Bin { .. }
+        | Insn::BinV { .. }
+        | Insn::Select { .. }
+        | Insn::Splat { .. }
+        | Insn::Extract { .. }
+        | Insn::Compute(_) => unreachable!("run for the whole group by `run_group`"),
         Insn::Jump(_)
         | Insn::JumpUnless { .. }
         | Insn::Switch { .. }

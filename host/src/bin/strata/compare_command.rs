@@ -131,7 +131,7 @@ fn sized_to_backend(
     reference_spp: u32,
 ) -> RenderSettings {
     let chosen = args.width.is_some() || args.height.is_some() || args.reference.is_some();
-    if !on_interpreter(backend) || chosen {
+    if !backend.info().is_interpreter() || chosen {
         return render;
     }
     let (width, height) = ((render.camera.width / 2).max(1), (render.camera.height / 2).max(1));
@@ -149,12 +149,7 @@ fn sized_to_backend(
 /// Reference samples per pixel when `--reference-spp` is left out: fewer on the CPU
 /// interpreter, so that the README's first command ends in minutes there too.
 fn default_reference_spp(backend: &dyn strata_backends::Backend) -> u32 {
-    if on_interpreter(backend) { 256 } else { 1024 }
-}
-
-/// Whether `backend` is the CPU interpreter (about 6x slower than lavapipe on the path tracer).
-fn on_interpreter(backend: &dyn strata_backends::Backend) -> bool {
-    backend.info().is_interpreter()
+    if backend.info().is_interpreter() { 256 } else { 1024 }
 }
 
 pub(crate) fn compare(args: CompareArgs) -> Result<()> {

@@ -8,18 +8,25 @@
 //!   time summed), strata against the two baselines.
 //! * `histogram_share_256/B{4,8,16,32}`: strata frames at each block size; the histogram
 //!   pass's share of the frame is printed to stderr (criterion measures the whole frame).
+//! * `histogram_share_simt_256/B{4,8,16,32}`: the same frames on the CPU interpreter
+//!   (wall time); printed: the histogram's share of the frame in the issue slots of a
+//!   32-wide SIMT GPU (`strata_backends::cpu_backend::DispatchCounts`), a device-neutral
+//!   estimate of its share on a GPU, with the histogram kernel a GPU would run.
 //!
 //! Run: `cargo bench -p strata-benches --bench render`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::Duration;
+use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
 use strata::render::{GpuScene, PathTracer, RenderSettings};
 use strata::restir::{Method, RestirRenderer, RestirSettings, Shading};
 use strata::scene::{Scene, default_scene};
+use strata::synthetic::{CandidateMix, candidate_image};
 use strata_backends::Backend;
-use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
+use strata_backends::cpu_backend::{CpuBackend, CpuOptions, DispatchCounts, WARP_WIDTH};
 use strata_backends::wgpu_backend::{WgpuBackend, WgpuOptions};
 use strata_kernels::selection::SelectionSettings;
+use strata_kernels::{BlockGrid, Executor, KernelId};
 
 fn settings(scene: &Scene, size: u32) -> RenderSettings {
     RenderSettings::for_scene(scene, size, size, 1)
@@ -106,7 +113,88 @@ fn restir_frames(c: &mut Criterion, backend: &mut dyn Backend) {
     group.finish();
 }
 
+/// The histogram's share of a strata frame in SIMT issue slots (see the module doc).
+/// The interpreter's renderer runs the histogram network (its own fastest choice); the
+/// kernel a GPU would run (`KernelId::fastest_histogram` for `Executor::Gpu`) is counted
+/// on a generated 256² candidate image of the same grid, and the network on that image
+/// is printed beside the frame's own network count, to show how far the generated input
+/// stands in for the frame's.
+fn histogram_share_simt(c: &mut Criterion) {
+    let scene = default_scene();
+    let gpu_scene = GpuScene::build(&scene).expect("default scene");
+    let render = settings(&scene, 256);
+    let mut cpu = CpuBackend::new(CpuOptions { subgroup_size: Some(WARP_WIDTH) }).expect("interpreter");
+    let is_histogram = |id: &KernelId| {
+        matches!(id, KernelId::BlockHistogram | KernelId::BlockHistogramSubgroup | KernelId::BlockHistogramRank)
+    };
+    let mut group = c.benchmark_group("histogram_share_simt_256");
+    group.sample_size(10).sampling_mode(criterion::SamplingMode::Flat).measurement_time(Duration::from_secs(20));
+    for block_size in [4, 8, 16, 32] {
+        let selection = SelectionSettings { block_size, ..SelectionSettings::default() };
+        let restir = RestirSettings { selection, ..RestirSettings::default() };
+        let mut renderer =
+            RestirRenderer::new(&mut cpu, &gpu_scene, &render, restir, scene.extent()).expect("renderer");
+        // The first frame has no history to merge: count from the second on.
+        renderer.render_frame(&mut cpu, None).expect("frame");
+        cpu.take_counts_by_kernel();
+        let mut frames = 0u64;
+        group.bench_function(format!("B{block_size}"), |b| {
+            b.iter(|| {
+                frames += 1;
+                renderer.render_frame(&mut cpu, None).expect("frame")
+            })
+        });
+        renderer.destroy(&mut cpu).expect("destroy");
+        let counts = cpu.take_counts_by_kernel();
+        if frames == 0 {
+            continue;
+        }
+        let mut rest = DispatchCounts::default();
+        let mut network_in_frame = DispatchCounts::default();
+        for (id, count) in &counts {
+            if is_histogram(id) { network_in_frame += *count } else { rest += *count }
+        }
+        let grid = BlockGrid::new(256, 256, block_size).expect("grid");
+        let candidates = candidate_image(256, 256, 7, CandidateMix::default());
+        let mut standalone = |variant: HistogramVariant| {
+            let pass = BlockHistogramPass::with_masking(&mut cpu, variant, grid, selection.masking).expect("pass");
+            pass.upload_candidates(&mut cpu, &candidates).expect("upload");
+            pass.dispatch(&mut cpu).expect("dispatch");
+            pass.destroy(&mut cpu).expect("destroy");
+            cpu.take_counts_by_kernel().into_values().fold(DispatchCounts::default(), |mut a, b| {
+                a += b;
+                a
+            })
+        };
+        let gpu_variant = match KernelId::fastest_histogram(block_size, true, Executor::Gpu) {
+            KernelId::BlockHistogramRank => HistogramVariant::Rank,
+            KernelId::BlockHistogramSubgroup => HistogramVariant::Subgroup,
+            _ => HistogramVariant::Portable,
+        };
+        let gpu_histogram = standalone(gpu_variant);
+        let network_alone = standalone(HistogramVariant::Subgroup);
+        let per_frame = |n: u64| n as f64 / frames as f64;
+        let frame = gpu_histogram.warp_issues as f64 + per_frame(rest.warp_issues);
+        let share = |issues: f64| 100.0 * issues / frame;
+        eprintln!(
+            "B{block_size}: histogram ({gpu_variant:?}) {:.1} % of a frame's warp issues ({:.3e} of {frame:.3e}); \
+             the network: {:.3e} in the frame, {:.3e} on the generated image",
+            share(gpu_histogram.warp_issues as f64),
+            gpu_histogram.warp_issues as f64,
+            per_frame(network_in_frame.warp_issues),
+            network_alone.warp_issues as f64,
+        );
+        let mut passes: Vec<_> = counts.iter().filter(|(id, _)| !is_histogram(id)).collect();
+        passes.sort_by_key(|(id, _)| format!("{id:?}"));
+        for (id, count) in passes {
+            eprintln!("  {id:?}: {:.1} %", share(per_frame(count.warp_issues)));
+        }
+    }
+    group.finish();
+}
+
 fn render(c: &mut Criterion) {
+    histogram_share_simt(c);
     let mut wgpu = match WgpuBackend::new(WgpuOptions::default()) {
         Ok(backend) => backend,
         Err(error) => {

@@ -449,6 +449,45 @@ fn main(@builtin(local_invocation_index) i: u32) {
     assert!(message.contains("WGSL line 8 in `sync_step`"), "{message}");
 }
 
+/// The SIMT issue model (`DispatchCounts::warp_issues`): a warp with one busy lane costs
+/// as many issues as a full one, while the instruction count follows the busy lanes.
+#[test]
+fn warp_issues_charge_divergent_warps_as_full_ones() {
+    let source = r#"
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+@compute @workgroup_size(64)
+fn main(@builtin(local_invocation_index) i: u32) {
+    var x = i;
+    for (var n = 0u; n < input[i]; n++) {
+        x = x * 1664525u + 1013904223u;
+    }
+    output[i] = x;
+}
+"#;
+    let kernel = Kernel::from_wgsl("warp_issues.wgsl", source.into(), "main", false).unwrap();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let mut counts_with = |busy: &[u32]| {
+        let inputs: Vec<u32> = (0..64).map(|i| if busy.contains(&i) { 200 } else { 0 }).collect();
+        run_words(&mut cpu, &kernel, &inputs, 64, 1);
+        let counts = cpu.take_counts_by_kernel();
+        assert_eq!(counts.len(), 1, "one kernel dispatched");
+        counts[&kernel.id]
+    };
+    let all = counts_with(&(0..64).collect::<Vec<_>>());
+    let one_per_warp = counts_with(&[5, 40]);
+    let two_in_one_warp = counts_with(&[5, 6]);
+    // Both warps loop 200 times either way: the same issues, 2/64 of the instructions.
+    assert!(one_per_warp.instructions * 10 < all.instructions, "{one_per_warp:?} vs {all:?}");
+    let ratio = one_per_warp.warp_issues as f64 / all.warp_issues as f64;
+    assert!((0.95..=1.05).contains(&ratio), "{one_per_warp:?} vs {all:?}");
+    // One warp loops, the other does not: about half the issues.
+    let ratio = two_in_one_warp.warp_issues as f64 / all.warp_issues as f64;
+    assert!((0.45..=0.55).contains(&ratio), "{two_in_one_warp:?} vs {all:?}");
+    // A full workgroup: one issue per warp per instruction.
+    assert_eq!(all.instructions, 32 * all.warp_issues);
+}
+
 #[test]
 fn bad_subgroup_sizes_are_refused() {
     assert!(CpuBackend::new(CpuOptions { subgroup_size: Some(12) }).is_err());

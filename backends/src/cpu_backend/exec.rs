@@ -2,6 +2,7 @@
 //! invocations of a workgroup together from barrier to barrier, each a resumable stack
 //! of frames (see [`super::interp`]).
 
+use super::counts::DispatchCounts;
 use super::decode::Program;
 use super::error::{invalid, unsupported};
 use super::insn::Insn;
@@ -27,14 +28,15 @@ struct Builtins {
 /// Runs `program` on `workgroups` with `buffers` bound (in the kernel's binding order).
 /// Independent workgroups run in parallel on the machine's cores; buffer words are
 /// atomics (relaxed loads and stores, real read-modify-write for WGSL atomics). Returns
-/// the number of bytecode instructions executed.
+/// what the dispatch executed ([`DispatchCounts`]).
 pub(super) fn run(
     program: &Program,
     buffers: &mut [Vec<u32>],
     workgroups: [u32; 3],
     subgroup_size: u32,
-) -> Result<u64, BackendError> {
-    let executed = AtomicU64::new(0);
+) -> Result<DispatchCounts, BackendError> {
+    let instructions = AtomicU64::new(0);
+    let warp_issues = AtomicU64::new(0);
     let shared: Vec<Vec<AtomicU32>> =
         buffers.iter_mut().map(|words| std::mem::take(words).into_iter().map(AtomicU32::new).collect()).collect();
     let total = u64::from(workgroups[0]) * u64::from(workgroups[1]) * u64::from(workgroups[2]);
@@ -67,8 +69,9 @@ pub(super) fn run(
                             workgroups,
                             subgroup_size,
                         ) {
-                            Ok(count) => {
-                                executed.fetch_add(count, Ordering::Relaxed);
+                            Ok(counts) => {
+                                instructions.fetch_add(counts.instructions, Ordering::Relaxed);
+                                warp_issues.fetch_add(counts.warp_issues, Ordering::Relaxed);
                             }
                             Err(error) => {
                                 // Stop the other threads early.
@@ -88,7 +91,7 @@ pub(super) fn run(
     for (words, atomics) in buffers.iter_mut().zip(shared) {
         *words = atomics.into_iter().map(AtomicU32::into_inner).collect();
     }
-    result.map(|_| executed.into_inner())
+    result.map(|_| DispatchCounts { instructions: instructions.into_inner(), warp_issues: warp_issues.into_inner() })
 }
 
 fn builtin_value(builtin: naga::BuiltIn, b: &Builtins) -> Result<Vec<u32>, BackendError> {
@@ -136,7 +139,7 @@ fn run_workgroup(
     [wx, wy, wz]: [u32; 3],
     workgroups: [u32; 3],
     subgroup_size: u32,
-) -> Result<u64, BackendError> {
+) -> Result<DispatchCounts, BackendError> {
     let [sx, sy, sz] = program.workgroup_size;
     let count = (sx * sy * sz) as usize;
     let subgroup_size = subgroup_size.max(1);
@@ -177,11 +180,11 @@ fn run_workgroup(
         }
     }
     let invocations = &mut invocations[..];
-    let mut executed = 0u64;
+    let mut counts = DispatchCounts::default();
     let mut stops = Vec::with_capacity(count);
     let mut reached = Vec::with_capacity(count);
     loop {
-        interp::run_until_sync(program, invocations, buffers, workgroup, &mut executed, &mut reached)?;
+        interp::run_until_sync(program, invocations, buffers, workgroup, &mut counts, &mut reached)?;
         stops.clear();
         stops.extend(reached.iter().map(|stop| stop.expect("every invocation stopped")));
         if stops.iter().all(|s| *s == Stop::Done) {
@@ -220,7 +223,7 @@ fn run_workgroup(
             invocation.frame.as_mut().expect("waiting invocations have frames").pc += 1;
         }
     }
-    Ok(executed)
+    Ok(counts)
 }
 
 /// Computes a subgroup gather for every invocation of the workgroup.

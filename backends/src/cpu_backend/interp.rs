@@ -18,6 +18,7 @@
 //! data races cannot observe (outputs are checked byte for byte against the
 //! one-invocation-at-a-time executor this replaced: BENCHMARKS.md, "interpreter").
 
+use super::counts::DispatchCounts;
 use super::decode::Program;
 use super::error::{invalid, unsupported};
 use super::insn::{BinOp, CallInsn, Insn};
@@ -166,13 +167,13 @@ fn meeting_point(leader: &Invocation, other: &Invocation) -> Option<u32> {
 
 /// Runs every invocation of a workgroup until it returns from the entry point or stops
 /// at a barrier or subgroup operation; `stops[i]` says where invocation `i` stopped.
-/// Counts executed instructions (per invocation) into `executed`.
+/// Counts what the groups executed into `counts`.
 pub(super) fn run_until_sync(
     program: &Program,
     invocations: &mut [Invocation],
     buffers: &[Vec<AtomicU32>],
     workgroup: &mut [u32],
-    executed: &mut u64,
+    counts: &mut DispatchCounts,
     stops: &mut Vec<Option<Stop>>,
 ) -> Result<(), BackendError> {
     stops.clear();
@@ -245,8 +246,11 @@ pub(super) fn run_until_sync(
                 let frame = frame.as_mut().expect("running invocations have frames");
                 lanes.push(Lane { regs: &mut frame.regs[..], private: &mut private[..], callers: &mut callers[..] });
             }
-            let end = run_group(program, code_index, pc, meet, &mut lanes, buffers, workgroup, executed, &mut targets);
+            let mut steps = 0;
+            let end =
+                run_group(program, code_index, pc, meet, &mut lanes, buffers, workgroup, &mut steps, &mut targets);
             spare_lanes = recycle(lanes);
+            counts.add_group(steps, members.iter().map(|&i| invocations[i].local_index));
             end?
         };
         match end {
@@ -352,6 +356,7 @@ fn return_from_function(invocation: &mut Invocation, src: u32, len: u32) -> bool
 /// Runs the group `lanes` (all at instruction `pc` of code `code_index`) together until
 /// it reaches `meet`, a branch splits it (each member's next instruction into
 /// `targets`), it calls or returns, or it stops at a barrier or subgroup operation.
+/// `steps`: how many instructions the group executed (each for every member).
 #[allow(clippy::too_many_arguments)]
 fn run_group(
     program: &Program,
@@ -361,11 +366,10 @@ fn run_group(
     lanes: &mut [Lane],
     buffers: &[Vec<AtomicU32>],
     workgroup: &mut [u32],
-    executed: &mut u64,
+    steps: &mut u64,
     targets: &mut Vec<u32>,
 ) -> Result<GroupEnd, BackendError> {
     let insns = &program.codes[code_index as usize].insns[..];
-    let width = lanes.len() as u64;
     let mut pc = pc as usize;
     let mut count = 0u64;
     let end = loop {
@@ -472,7 +476,7 @@ fn run_group(
             }
         }
     };
-    *executed += count * width;
+    *steps = count;
     Ok(end)
 }
 

@@ -39,6 +39,7 @@
 
 mod arith;
 mod constant;
+mod counts;
 mod decode;
 mod error;
 mod exec;
@@ -56,6 +57,7 @@ use crate::backend::{Backend, Bind, BufferId};
 use crate::bindings_check::{check_binds, check_buffer_size, check_kernel_fits, check_workgroups, check_write};
 use crate::device_info::{DeviceInfo, DeviceLimits};
 use crate::error::BackendError;
+pub use counts::{DispatchCounts, WARP_WIDTH};
 use decode::Program;
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
@@ -87,7 +89,8 @@ pub struct CpuBackend {
     buffers: HashMap<u64, CpuBuffer>,
     next_buffer: u64,
     programs: HashMap<KernelId, Program>,
-    last_instructions: u64,
+    last_counts: DispatchCounts,
+    counts_by_kernel: HashMap<KernelId, DispatchCounts>,
 }
 
 impl CpuBackend {
@@ -125,7 +128,8 @@ impl CpuBackend {
             buffers: HashMap::new(),
             next_buffer: 0,
             programs: HashMap::new(),
-            last_instructions: 0,
+            last_counts: DispatchCounts::default(),
+            counts_by_kernel: HashMap::new(),
         })
     }
 
@@ -140,7 +144,14 @@ impl CpuBackend {
     /// figures; one instruction stands for one IR expression or statement or less,
     /// since inlining, register aliasing and compile-time constants remove some).
     pub fn instructions_in_last_dispatch(&self) -> u64 {
-        self.last_instructions
+        self.last_counts.instructions
+    }
+
+    /// What each kernel's dispatches executed since the last call (instructions and the
+    /// issue slots of a SIMT GPU, see [`DispatchCounts`]): a device-neutral profile, e.g.
+    /// of one pass's share of a frame. Taking them resets the tally.
+    pub fn take_counts_by_kernel(&mut self) -> HashMap<KernelId, DispatchCounts> {
+        std::mem::take(&mut self.counts_by_kernel)
     }
 
     fn buffer(&self, id: BufferId) -> Result<&CpuBuffer, BackendError> {
@@ -206,7 +217,8 @@ impl Backend for CpuBackend {
         for (id, words) in ids.iter().zip(bound) {
             self.buffers.get_mut(id).expect("checked").words = words;
         }
-        self.last_instructions = result?;
+        self.last_counts = result?;
+        *self.counts_by_kernel.entry(kernel.id).or_default() += self.last_counts;
         Ok(())
     }
 

@@ -4,6 +4,9 @@
 //! * `obvhs_native`: `Bvh2::ray_traverse` with obvhs' triangle intersection, one thread.
 //! * `obvhs_native_all_cores`: the same on one scoped thread per core, each taking the
 //!   next block of 1024 rays as it finishes one, so it uses the cores lavapipe uses.
+//! * `obvhs_cwbvh_native`: obvhs' compressed 8-wide BVH built from the same triangles
+//!   and traversed natively, one thread: what a wide BVH gains obvhs itself, i.e. the
+//!   baseline a wide-BVH kernel would have to be compared with.
 //! * `wgsl_wgpu`: the `bvh_closest_hit` kernel, device time per dispatch (timestamps).
 //!
 //! Scene: 50 000 small random triangles in a cube; 262 144 rays from around it.
@@ -51,6 +54,24 @@ fn trace(c: &mut Criterion) {
         })
     });
 
+    let cw = obvhs::cwbvh::builder::build_cwbvh_from_tris(
+        &tris,
+        obvhs::BvhBuildParams::fast_build(),
+        &mut Duration::default(),
+    );
+    group.bench_function("obvhs_cwbvh_native", |b| {
+        b.iter(|| {
+            let mut hits = 0u32;
+            for r in &rays {
+                let ray = ObvhsRay::new(Vec3A::from(r.origin), Vec3A::from(r.direction), r.tmin, r.tmax);
+                let mut hit = RayHit::none();
+                if cw.ray_traverse(ray, &mut hit, |ray, id| tris[cw.primitive_indices[id] as usize].intersect(ray)) {
+                    hits += 1;
+                }
+            }
+            black_box(hits)
+        })
+    });
     // Blocks of rays handed out to one thread per core as each finishes the last, so a
     // slow stretch of rays does not leave a core idle.
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());

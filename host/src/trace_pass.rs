@@ -22,7 +22,7 @@ pub struct SceneBvh {
 }
 
 impl SceneBvh {
-    /// Builds the BVH of `triangles` (each three vertices) with obvhs' fast preset.
+    /// Builds the BVH of `triangles` (each three vertices) with [`build_obvhs`].
     pub fn build(triangles: &[[[f32; 3]; 3]]) -> Result<Self, PassError> {
         if triangles.is_empty() {
             return Err(PassError::Input("a BVH needs at least one triangle".into()));
@@ -39,8 +39,16 @@ impl SceneBvh {
     }
 }
 
-/// obvhs triangles of `triangles` and their BVH2 (fast preset): what [`SceneBvh`]
-/// uploads, and what tests and benchmarks traverse natively to compare.
+/// At most this many triangles per BVH leaf. obvhs' fast preset allows 8, which suits
+/// one ray at a time; a GPU kernel runs 8 to 32 rays side by side, and a leaf loop costs
+/// as long as the longest leaf among them. Measured (BENCHMARKS.md, trace): 2 is the
+/// fastest for the WGSL kernel on lavapipe (−16 % against 8; 1 and 3 slower than 2) and
+/// leaves obvhs' own traversal as fast as with 8.
+pub const MAX_TRIANGLES_PER_LEAF: u32 = 2;
+
+/// obvhs triangles of `triangles` and their BVH2 (fast preset, at most
+/// [`MAX_TRIANGLES_PER_LEAF`] triangles per leaf): what [`SceneBvh`] uploads, and what
+/// tests and benchmarks traverse natively to compare.
 pub fn build_obvhs(triangles: &[[[f32; 3]; 3]]) -> (Vec<Triangle>, Bvh2) {
     let tris: Vec<Triangle> = triangles
         .iter()
@@ -48,7 +56,7 @@ pub fn build_obvhs(triangles: &[[[f32; 3]; 3]]) -> (Vec<Triangle>, Bvh2) {
         .collect();
     let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(
         &tris,
-        obvhs::BvhBuildParams::fast_build(),
+        obvhs::BvhBuildParams { max_prims_per_leaf: MAX_TRIANGLES_PER_LEAF, ..obvhs::BvhBuildParams::fast_build() },
         &mut std::time::Duration::default(),
     );
     (tris, bvh)

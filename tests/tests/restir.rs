@@ -291,7 +291,8 @@ fn shaded_parts_add_up_to_the_image() {
 
 /// `min_roughness` decides which conductors resample: with the default scene's white
 /// surfaces (floor, ceiling, back wall, boxes) made a GGX conductor of alpha 0.1, they have no
-/// resampled part at the default threshold of 0.2 and have one at 0.05.
+/// resampled part at a threshold of 0.2 (the default until 2026-11-25) and have one at 0.05
+/// (today's default).
 #[test]
 fn min_roughness_decides_which_conductors_resample() {
     let Some(mut backend) = strata_tests::vulkan_backend("min_roughness_decides_which_conductors_resample") else {
@@ -457,20 +458,22 @@ fn temporal_reuse_with_a_moving_camera_stays_unbiased() {
 
 /// The default room with what the diffuse scene never exercises: its tall box glass
 /// (primary hits path-trace alone; candidates on it stay private), its short box a GGX
-/// conductor of alpha 0.3 (resampled: above `min_roughness`), its back wall a conductor
-/// of alpha 0.1 (below it: path-traced alone), and an environment map shining in through
-/// the open front (candidates reconnected by direction).
+/// conductor of alpha 0.3 and its back wall a glossy one of alpha 0.1 (both resampled:
+/// from the default `min_roughness` of 0.05 up), its red wall a conductor of alpha 0.03
+/// (below it: path-traced alone), and an environment map shining in through the open
+/// front (candidates reconnected by direction).
 fn glass_metal_environment_scene() -> Scene {
     use strata::scene::{Environment, Material};
     let mut scene = default_scene();
     let metal = |alpha| Material::RoughConductor { alpha, eta: [0.2, 0.9, 1.1], k: [3.9, 2.4, 2.2], two_sided: true };
-    scene.materials.extend([Material::Dielectric { int_ior: 1.5, ext_ior: 1.0 }, metal(0.3), metal(0.1)]);
+    scene.materials.extend([Material::Dielectric { int_ior: 1.5, ext_ior: 1.0 }, metal(0.3), metal(0.1), metal(0.03)]);
     let count = scene.materials.len();
     for shape in &mut scene.shapes {
         match shape.name.as_str() {
-            "tall box" => shape.material = count - 3,
-            "short box" => shape.material = count - 2,
-            "back" => shape.material = count - 1,
+            "tall box" => shape.material = count - 4,
+            "short box" => shape.material = count - 3,
+            "back" => shape.material = count - 2,
+            "left" => shape.material = count - 1,
             _ => {}
         }
     }

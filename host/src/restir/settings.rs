@@ -106,7 +106,11 @@ pub struct RestirSettings {
     /// Neighbourhood radius in pixels of `restir-disc`. Default 30.
     pub disc_radius: f32,
     /// A conductor at the primary hit resamples only from this GGX alpha up (smoother ones
-    /// path-trace on their own: reconnecting through them is noisy). Default 0.2.
+    /// path-trace on their own: reconnecting through a near-mirror lobe is noisy). Default
+    /// 0.05: glossy surfaces down to alpha 0.05 resample (BENCHMARKS.md, "Glossy primary
+    /// hits resample": with temporal reuse every method's error halves on veach-ajar, whose
+    /// floor has alpha 0.1, and falls 3 % on objects-grid; the paper's scenes' 0.2 left
+    /// them to path-trace alone).
     pub min_roughness: f32,
     /// No reconnection to a vertex closer than this (scene units) to a primary hit
     /// (the geometry term is singular there). Default: 1e-3 of the scene's extent, set by
@@ -128,7 +132,7 @@ impl Default for RestirSettings {
             temporal: true,
             temporal_cap: 20.0,
             disc_radius: 30.0,
-            min_roughness: 0.2,
+            min_roughness: 0.05,
             min_distance: 0.0,
             shaded_parts: ShadedParts::All,
             shading: Shading::Expectation,

@@ -132,18 +132,23 @@ fn histogram_share_simt(c: &mut Criterion) {
     for block_size in [4, 8, 16, 32] {
         let selection = SelectionSettings { block_size, ..SelectionSettings::default() };
         let restir = RestirSettings { selection, ..RestirSettings::default() };
-        let mut renderer =
-            RestirRenderer::new(&mut cpu, &gpu_scene, &render, restir, scene.extent()).expect("renderer");
-        // The first frame has no history to merge: count from the second on.
-        renderer.render_frame(&mut cpu, None).expect("frame");
-        cpu.take_counts_by_kernel();
-        let mut frames = 0u64;
+        // Made on first use, so that a filter leaving this block size out renders nothing.
+        let mut running: Option<(RestirRenderer, u64)> = None;
         group.bench_function(format!("B{block_size}"), |b| {
+            let (renderer, frames) = running.get_or_insert_with(|| {
+                let mut renderer =
+                    RestirRenderer::new(&mut cpu, &gpu_scene, &render, restir, scene.extent()).expect("renderer");
+                // The first frame has no history to merge: count from the second on.
+                renderer.render_frame(&mut cpu, None).expect("frame");
+                cpu.take_counts_by_kernel();
+                (renderer, 0)
+            });
             b.iter(|| {
-                frames += 1;
+                *frames += 1;
                 renderer.render_frame(&mut cpu, None).expect("frame")
             })
         });
+        let Some((renderer, frames)) = running else { continue };
         renderer.destroy(&mut cpu).expect("destroy");
         let counts = cpu.take_counts_by_kernel();
         if frames == 0 {

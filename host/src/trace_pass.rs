@@ -40,7 +40,7 @@ impl SceneBvh {
 }
 
 /// At most this many triangles per BVH leaf. obvhs' fast preset allows 8, which suits
-/// one ray at a time; a GPU kernel runs 8 to 32 rays side by side, and a leaf loop costs
+/// one ray at a time; a GPU kernel runs 8 to 64 rays side by side, and a leaf loop costs
 /// as long as the longest leaf among them. Measured (BENCHMARKS.md, trace): 2 is the
 /// fastest for the WGSL kernel on lavapipe (−16 % against 8; 1 and 3 slower than 2) and
 /// leaves obvhs' own traversal as fast as with 8.

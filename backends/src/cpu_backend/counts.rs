@@ -34,10 +34,13 @@ impl DispatchCounts {
     /// Adds `steps` instructions executed together by a group whose members have the
     /// local invocation indices `members` (in increasing order).
     pub(super) fn add_group(&mut self, steps: u64, members: impl Iterator<Item = u32>) {
+        // Sorted members put each warp's lanes next to each other, so a warp is counted
+        // when it differs from the previous member's.
         let mut width = 0u64;
         let mut warps = 0u64;
         let mut last_warp = u32::MAX;
         for index in members {
+            debug_assert!(last_warp == u32::MAX || index / WARP_WIDTH >= last_warp, "members out of order");
             width += 1;
             let warp = index / WARP_WIDTH;
             warps += u64::from(warp != last_warp);

@@ -250,7 +250,8 @@ pub(super) fn run_until_sync(
             let end =
                 run_group(program, code_index, pc, meet, &mut lanes, buffers, workgroup, &mut steps, &mut targets);
             spare_lanes = recycle(lanes);
-            counts.add_group(steps, members.iter().map(|&i| invocations[i].local_index));
+            // An invocation's position in the workgroup is its local index (exec.rs).
+            counts.add_group(steps, members.iter().map(|&i| i as u32));
             end?
         };
         match end {

@@ -109,8 +109,8 @@ pub struct RestirSettings {
     /// path-trace on their own: reconnecting through a near-mirror lobe is noisy). Default
     /// 0.05: glossy surfaces down to alpha 0.05 resample (BENCHMARKS.md, "Glossy primary
     /// hits resample": with temporal reuse every method's error halves on veach-ajar, whose
-    /// floor has alpha 0.1, and falls 3 % on objects-grid; the paper's scenes' 0.2 left
-    /// them to path-trace alone).
+    /// floor has alpha 0.1, and falls 2–3 % on objects-grid; the previous default 0.2,
+    /// ReSTIR PT's rule, left such surfaces to path-trace alone).
     pub min_roughness: f32,
     /// No reconnection to a vertex closer than this (scene units) to a primary hit
     /// (the geometry term is singular there). Default: 1e-3 of the scene's extent, set by

@@ -8,7 +8,7 @@ use obvhs::bvh2::Bvh2;
 use obvhs::triangle::Triangle;
 use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, BackendError, Bind, BufferId};
-use strata_kernels::trace_types::{CameraParams, GpuBvhNode, GpuTriangle, Hit, Ray, TraceParams};
+use strata_kernels::trace_types::{CameraParams, GpuBvhNode, GpuTriangle, Hit, Ray, TRACE_STACK_DEPTH, TraceParams};
 use strata_kernels::{Kernel, KernelId, Registry};
 
 /// A triangle mesh with its BVH, in the layout the kernel reads.
@@ -31,12 +31,36 @@ impl SceneBvh {
             return Err(PassError::Input(format!("triangle {index} has a NaN or infinite coordinate")));
         }
         let (tris, bvh) = build_obvhs(triangles);
+        let depth = bvh_depth(&bvh);
+        if depth > TRACE_STACK_DEPTH {
+            return Err(PassError::Input(format!(
+                "the scene's BVH is {depth} levels deep, more than the {TRACE_STACK_DEPTH} its traversal stack holds \
+                 (geometry spread over very different scales)"
+            )));
+        }
         Ok(Self {
             nodes: bytemuck::cast_slice(&bvh.nodes).to_vec(),
             primitive_indices: bvh.primitive_indices.clone(),
             triangles: bytemuck::cast_slice(&tris).to_vec(),
         })
     }
+}
+
+/// Levels below the root of `bvh`'s deepest leaf: the most far children a traversal
+/// can have waiting on its stack at once.
+fn bvh_depth(bvh: &Bvh2) -> u32 {
+    let mut deepest = 0;
+    let mut pending = vec![(0usize, 0u32)];
+    while let Some((index, depth)) = pending.pop() {
+        let node = &bvh.nodes[index];
+        if node.prim_count > 0 || bvh.nodes.len() == 1 {
+            deepest = deepest.max(depth);
+        } else {
+            let left = node.first_index as usize;
+            pending.extend([(left, depth + 1), (left + 1, depth + 1)]);
+        }
+    }
+    deepest
 }
 
 /// At most this many triangles per BVH leaf. obvhs' fast preset allows 8, which suits
@@ -144,4 +168,37 @@ pub fn camera_rays(backend: &mut dyn Backend, params: &CameraParams) -> Result<V
     backend.destroy_buffer(params_buffer)?;
     backend.destroy_buffer(rays_buffer)?;
     Ok(rays?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tiny_triangle_at(x: f32) -> [[f32; 3]; 3] {
+        [[x, 0.0, 0.0], [x + 1e-3 * x.max(1.0), 0.0, 0.0], [x, 1e-3 * x.max(1.0), 0.0]]
+    }
+
+    #[test]
+    fn a_bvh_deeper_than_the_traversal_stack_is_refused_by_name() {
+        // Triangles at exponentially growing distances: each one's nearest cluster is all
+        // the ones before it, so the BVH is a chain one level per triangle.
+        let chain: Vec<_> = (0..80).map(|i| tiny_triangle_at(1.7f32.powi(i))).collect();
+        let (_, bvh) = build_obvhs(&chain);
+        assert!(bvh_depth(&bvh) > TRACE_STACK_DEPTH, "depth {}", bvh_depth(&bvh));
+        let message = SceneBvh::build(&chain).err().expect("refused").to_string();
+        assert!(message.contains("levels deep") && message.contains("48"), "{message}");
+        // A few of them make a shallow BVH, which is accepted.
+        assert!(SceneBvh::build(&chain[..8]).is_ok());
+    }
+
+    #[test]
+    fn bvh_depth_counts_levels_below_the_root() {
+        let (_, one) = build_obvhs(&[tiny_triangle_at(1.0)]);
+        assert_eq!(bvh_depth(&one), 0);
+        let spread: Vec<_> = (0..64).map(|i| tiny_triangle_at(i as f32 * 10.0)).collect();
+        let (_, bvh) = build_obvhs(&spread);
+        // 64 triangles in leaves of at most 2: at least 5 levels, far fewer than 64.
+        let depth = bvh_depth(&bvh);
+        assert!((5..20).contains(&depth), "depth {depth}");
+    }
 }

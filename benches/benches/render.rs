@@ -154,11 +154,8 @@ fn histogram_share_simt(c: &mut Criterion) {
         if frames == 0 {
             continue;
         }
-        let mut rest = DispatchCounts::default();
-        let mut network_in_frame = DispatchCounts::default();
-        for (id, count) in &counts {
-            if is_histogram(id) { network_in_frame += *count } else { rest += *count }
-        }
+        let rest: DispatchCounts = counts.iter().filter(|(id, _)| !is_histogram(id)).map(|(_, c)| *c).sum();
+        let network_in_frame: DispatchCounts = counts.iter().filter(|(id, _)| is_histogram(id)).map(|(_, c)| *c).sum();
         let grid = BlockGrid::new(256, 256, block_size).expect("grid");
         let candidates = candidate_image(256, 256, 7, CandidateMix::default());
         let mut standalone = |variant: HistogramVariant| {
@@ -166,10 +163,7 @@ fn histogram_share_simt(c: &mut Criterion) {
             pass.upload_candidates(&mut cpu, &candidates).expect("upload");
             pass.dispatch(&mut cpu).expect("dispatch");
             pass.destroy(&mut cpu).expect("destroy");
-            cpu.take_counts_by_kernel().into_values().fold(DispatchCounts::default(), |mut a, b| {
-                a += b;
-                a
-            })
+            cpu.take_counts_by_kernel().into_values().sum::<DispatchCounts>()
         };
         let gpu_variant = match KernelId::fastest_histogram(block_size, true, Executor::Gpu) {
             KernelId::BlockHistogramRank => HistogramVariant::Rank,

@@ -58,6 +58,15 @@ impl std::ops::AddAssign for DispatchCounts {
     }
 }
 
+impl std::iter::Sum for DispatchCounts {
+    fn sum<I: Iterator<Item = Self>>(counts: I) -> Self {
+        counts.fold(Self::default(), |mut total, c| {
+            total += c;
+            total
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

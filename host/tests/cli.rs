@@ -124,13 +124,14 @@ fn bad_compare_arguments_are_refused_before_anything_renders() {
         assert!(names.iter().all(|name| stderr.contains(name)), "{arguments:?}: {stderr}");
         assert!(!out.join("reference.exr").exists(), "{arguments:?} rendered a reference");
     }
-    let cases: [(&[&str], &[&str]); 7] = [
+    let cases: [(&[&str], &[&str]); 8] = [
         (&["--width", "0"], &["--width 0"]),
         (&["--temporal-cap", "0"], &["temporal cap 0"]),
         (&["--accumulate", "--camera-path", "orbit:2"], &["--accumulate", "--camera-path orbit:2"]),
         (&["--min-roughness", "NaN"], &["min roughness NaN"]),
         (&["--min-distance=-1"], &["min distance -1"]),
         (&["--temporal-candidates", "9"], &["temporal candidates 9"]),
+        (&["--specular-chain", "99"], &["specular chain 99"]),
         (&["--frames", "0"], &["--frames"]),
     ];
     for (arguments, names) in cases {

@@ -158,12 +158,16 @@ shader_struct!(
         previous_up,
         shaded_parts,
         shading,
-        _pad0,
+        specular_chain,
         _pad1,
         _pad2,
     ]
 );
-shader_struct!(Primary, "Primary", [position, object_id, normal, material, wo, flags, albedo, depth]);
+shader_struct!(
+    Primary,
+    "Primary",
+    [position, object_id, normal, material, wo, flags, albedo, depth, throughput, segment, camera_hit, _pad]
+);
 shader_struct!(PathCandidate, "PathCandidate", [position, kind, normal, light, reflected, weight]);
 shader_struct!(Reservoir, "Reservoir", [sample, weight, count, target_value, _pad, expected, _pad_expected]);
 

@@ -70,34 +70,44 @@ pub struct RestirParams {
     pub shaded_parts: u32,
     /// `SHADING_*`: the resampled part as the kept sample or as `Reservoir::expected`.
     pub shading: u32,
-    /// Padding.
-    pub _pad0: u32,
+    /// Smooth vertices a camera path may pass through to the vertex it resamples at (0:
+    /// only a rough primary hit resamples).
+    pub specular_chain: u32,
     /// Padding.
     pub _pad1: u32,
     /// Padding.
     pub _pad2: u32,
 }
 
-/// One pixel's primary hit (WGSL `Primary`).
+/// The vertex one pixel resamples at (WGSL `Primary`): the camera ray's hit, or the
+/// first rough vertex behind a chain of smooth ones.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Primary {
-    /// Hit position.
+    /// Vertex position.
     pub position: [f32; 3],
     /// Object id (the histogram's masking key).
     pub object_id: u32,
-    /// Geometric normal, flipped towards the camera for two-sided materials.
+    /// Geometric normal, flipped towards `wo` for two-sided materials.
     pub normal: [f32; 3],
     /// Material index.
     pub material: u32,
-    /// Unit direction towards the camera.
+    /// Unit direction towards the previous vertex (the camera, or the chain).
     pub wo: [f32; 3],
     /// `PRIMARY_*` bits.
     pub flags: u32,
-    /// Albedo at the hit.
+    /// Albedo at the vertex.
     pub albedo: [f32; 3],
-    /// Distance from the camera.
+    /// Length of the path from the camera.
     pub depth: f32,
+    /// Throughput of the smooth chain before the vertex (1 without one).
+    pub throughput: [f32; 3],
+    /// Number of the path segment that reached the vertex (1: the camera ray).
+    pub segment: u32,
+    /// The camera ray's hit (temporal reprojection follows it).
+    pub camera_hit: [f32; 3],
+    /// Padding.
+    pub _pad: u32,
 }
 
 /// One pixel's candidate (WGSL `PathCandidate`).

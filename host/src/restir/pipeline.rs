@@ -218,6 +218,7 @@ impl RestirRenderer {
             disc_radius: self.settings.disc_radius,
             min_distance: self.min_distance,
             min_roughness: self.settings.min_roughness,
+            specular_chain: self.settings.specular_chain,
             previous_origin: previous.origin.into(),
             previous_tan_half_x: previous.tan_half_x,
             previous_forward: previous.forward.into(),

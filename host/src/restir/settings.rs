@@ -112,6 +112,15 @@ pub struct RestirSettings {
     /// floor has alpha 0.1, and falls 2–3 % on objects-grid; the previous default 0.2,
     /// ReSTIR PT's rule, left such surfaces to path-trace alone).
     pub min_roughness: f32,
+    /// Smooth vertices (dielectrics, conductors below `min_roughness`) a camera path may
+    /// pass through to find the vertex it resamples at: a pixel seeing a mirror or glass
+    /// resamples at the first rough surface behind it, the chain's throughput weighting
+    /// the result (the primary surface replacement of RTXDI-style renderers, unbiased:
+    /// `restir/entry_candidates.wgsl` derives it). 0: only a rough primary hit resamples
+    /// and every other pixel path-traces alone (the only behaviour before 2026-11-26).
+    /// At most 16; the scene's `max_depth` bounds the chain too. Default 4 (a mirror,
+    /// a glass object in and out, glass seen in a mirror).
+    pub specular_chain: u32,
     /// No reconnection to a vertex closer than this (scene units) to a primary hit
     /// (the geometry term is singular there). Default: 1e-3 of the scene's extent, set by
     /// the renderer when 0.
@@ -133,6 +142,7 @@ impl Default for RestirSettings {
             temporal_cap: 20.0,
             disc_radius: 30.0,
             min_roughness: 0.05,
+            specular_chain: 4,
             min_distance: 0.0,
             shaded_parts: ShadedParts::All,
             shading: Shading::Expectation,
@@ -165,6 +175,16 @@ impl RestirSettings {
                 self.min_roughness
             )));
         }
+        if self.specular_chain > MAX_SPECULAR_CHAIN {
+            return Err(PassError::Input(format!(
+                "specular chain {}: must be 0 to {MAX_SPECULAR_CHAIN}",
+                self.specular_chain
+            )));
+        }
         Ok(())
     }
 }
+
+/// The longest smooth chain [`RestirSettings::specular_chain`] accepts (a path has at most
+/// the scene's `max_depth` segments anyway).
+pub const MAX_SPECULAR_CHAIN: u32 = 16;

@@ -1,15 +1,28 @@
 // ReSTIR pass 1 (paper §5.1 "candidate generation"): every pixel traces one path. Its
-// primary hit y1 goes to the G-buffer, with the object id that the histogram clusters
-// by (§4.3). The pixel draws two samples of the next vertex x2, one by BSDF sampling
-// (the path's continuation, with the radiance the rest of the path brings back) and one
-// by next-event estimation (a light point or environment direction), and keeps one by
-// RIS with balance-heuristic weights p̂ / (p_bsdf + p_light): its candidate, with its
-// unbiased contribution weight W, keyed for the histogram by the luminance of its own
-// estimate f(Y) W (§4.1). `base_radiance` holds what is not resampled: the emission y1
-// shows the camera. A pixel whose y1 is not rough enough to reconnect from (smooth
-// dielectric, a conductor below RestirParams.min_roughness) or whose camera ray escaped
-// does not resample: its whole path estimate goes to `base_radiance` and its histogram
-// candidate is OBJECT_ID_NONE.
+// resampling vertex y (the primary hit y1, see below) goes to the G-buffer, with the
+// object id that the histogram clusters by (§4.3). The pixel draws two samples of the
+// next vertex x after y, one by BSDF sampling (the path's continuation, with the
+// radiance the rest of the path brings back) and one by next-event estimation (a light
+// point or environment direction), and keeps one by RIS with balance-heuristic weights
+// p̂ / (p_bsdf + p_light): its candidate, with its unbiased contribution weight W, keyed
+// for the histogram by the luminance of its own estimate f(Y) W (§4.1). `base_radiance`
+// holds what is not resampled: the emission y1 shows the camera.
+//
+// Smooth primary hits (a dielectric, a conductor below RestirParams.min_roughness) are
+// too sharp to reconnect from. With RestirParams.specular_chain > 0 the path goes on
+// through up to that many smooth vertices exactly as the path tracer would (BSDF
+// sampling, next-event estimation at glossy conductors, MIS-weighted emission, Russian
+// roulette; all of it into `base_radiance`, weighted by the throughput so far) and the
+// first rough vertex it reaches becomes the pixel's resampling vertex, with the chain's
+// throughput, the segment number that reached it and the camera ray's hit (for temporal
+// reprojection) in its Primary. Why this stays unbiased: given the chain's random
+// numbers, which no other pixel sees, the pixel's resampled part estimates the light the
+// vertex reflects along the chain (every reuse rule below holds for any vertex, as for
+// y1), and the chain's throughput is the path tracer's unbiased weight of that light. A
+// pixel that reaches no rough vertex within the chain (the camera ray or the chain
+// escaped, the limit, a one-sided back face, the last segment) does not resample: its
+// whole path estimate goes to `base_radiance` and its histogram candidate is
+// OBJECT_ID_NONE. With specular_chain = 0 every smooth primary hit path-traces alone.
 //
 // Bindings (group 0): 0-7 the scene, 8 RestirParams (restir/reservoir.wgsl), and
 //   9  storage, rw       array<Primary>        G-buffer, one per pixel
@@ -67,6 +80,106 @@ fn vertex_candidate(vertex: Surface, origin: vec3<f32>, reflected: vec3<f32>) ->
 }
 
 
+// What drawing the candidate of one resampling vertex gives.
+struct Drawn {
+    candidate: PathCandidate,
+    // The traversal stack overflowed on one of its rays.
+    invalid: bool,
+}
+
+// The candidate of resampling vertex `primary`, on `surface` (its geometric normal not
+// flipped), drawn by BSDF sampling and next-event estimation and chosen by RIS. The
+// vertex after it is path segment primary.segment + 1: the rest of the path there is
+// estimated with the segments the path tracer would have left.
+fn draw_candidate(primary: Primary, surface: Surface, lane: u32) -> Drawn {
+    let material = materials[primary.material];
+    let albedo = primary.albedo;
+    let normal = primary.normal;
+    let next_segment = primary.segment + 1u;
+    var invalid = false;
+    let frame = make_frame(normal);
+    let wo = to_local(frame, primary.wo);
+    // Technique 1, BSDF sampling: the next vertex of the path.
+    var bsdf_candidate = no_candidate();
+    var bsdf_light_density = 0.0;
+    let sample = bsdf_sample(material, albedo, wo, random2(), random());
+    if any(sample.weight != vec3<f32>(0.0)) && sample.pdf > 0.0 {
+        let direction = normalize(to_world(frame, sample.wi));
+        let next = traverse(spawn_ray(surface.position, surface.normal, direction, INFINITY), lane, false);
+        if next.primitive == STACK_OVERFLOW {
+            invalid = true;
+        } else if next.primitive == MISS {
+            if params.env_width > 0u {
+                bsdf_candidate = PathCandidate(direction, KIND_ENVIRONMENT, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), 0.0);
+                bsdf_light_density = environment_light_pdf(direction);
+            }
+        } else {
+            let vertex = surface_at(next);
+            let rest = scatter_from(vertex, -direction, next_segment, lane);
+            invalid = invalid || rest.invalid;
+            bsdf_candidate = vertex_candidate(vertex, surface.position, rest.radiance);
+            if vertex.light != NO_LIGHT {
+                bsdf_light_density = light_area_density(vertex.light);
+            }
+        }
+    }
+    // Technique 2, next-event estimation: a point on a light or an environment
+    // direction, drawn as render/lights.wgsl draws them.
+    var light_candidate = no_candidate();
+    var light_density = 0.0;
+    let u_choice = random();
+    let u_light = random2();
+    if u_choice < params.environment_probability {
+        let direction = sample_environment(u_light);
+        light_density = environment_light_pdf(direction);
+        if light_density > 0.0 && unoccluded(surface.position, normal, direction, lane) {
+            light_candidate = PathCandidate(direction, KIND_ENVIRONMENT, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), 0.0);
+        }
+    } else if params.light_count > 0u {
+        let light = find_light(random());
+        let entry = lights[light];
+        let tri = triangles[entry.triangle];
+        let su = sqrt(u_light.x);
+        let b1 = u_light.y * su;
+        let b2 = su - u_light.y * su;
+        let point = (1.0 - su) * tri.v0 + b1 * tri.v1 + b2 * tri.v2;
+        let info = triangle_info[entry.triangle];
+        var uv = vec2<f32>(b1, b2);
+        if info.has_uv != 0u {
+            uv = (1.0 - su) * info.uv0 + b1 * info.uv1 + b2 * info.uv2;
+        }
+        let light_normal = normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
+        let light_surface = Surface(point, light_normal, uv, info.object_id, info.material, light);
+        light_density = light_area_density(light);
+        if visible(surface.position, normal, point, lane) {
+            // What the light reflects towards y (nothing for a black fixture).
+            var reflected = vec3<f32>(0.0);
+            let light_material = materials[info.material];
+            if light_material.kind != MATERIAL_DIFFUSE || any(albedo_at(light_material, uv) != vec3<f32>(0.0)) {
+                let rest = scatter_from(light_surface, normalize(surface.position - point), next_segment, lane);
+                invalid = invalid || rest.invalid;
+                reflected = rest.radiance;
+            }
+            light_candidate = vertex_candidate(light_surface, surface.position, reflected);
+        }
+    }
+    // RIS over the two samples, balance heuristic: w = p̂ / (p_bsdf + p_light).
+    let bsdf_ris = ris_weight(primary, bsdf_candidate, bsdf_light_density);
+    let light_ris = ris_weight(primary, light_candidate, light_density);
+    let total = bsdf_ris.y + light_ris.y;
+    var candidate = no_candidate();
+    if total > 0.0 && total < INFINITY {
+        if random() * total < light_ris.y {
+            candidate = light_candidate;
+            candidate.weight = total / light_ris.x;
+        } else {
+            candidate = bsdf_candidate;
+            candidate.weight = total / bsdf_ris.x;
+        }
+    }
+    return Drawn(candidate, invalid);
+}
+
 @compute @workgroup_size(8, 8)
 fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     if id.x >= params.width || id.y >= params.height {
@@ -75,7 +188,10 @@ fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
     let pixel = id.y * params.width + id.x;
     rng_seed(pixel, params.sample_index, params.seed);
     let ray = camera_ray(film_position(id.xy, random2()));
-    var primary = Primary(vec3<f32>(0.0), OBJECT_ID_NONE, vec3<f32>(0.0, 0.0, 1.0), 0u, -ray.direction, 0u, vec3<f32>(0.0), 0.0);
+    var primary = Primary(
+        vec3<f32>(0.0), OBJECT_ID_NONE, vec3<f32>(0.0, 0.0, 1.0), 0u, -ray.direction, 0u, vec3<f32>(0.0), 0.0,
+        vec3<f32>(1.0), 1u, vec3<f32>(0.0), 0u,
+    );
     var candidate = no_candidate();
     var base = vec3<f32>(0.0);
     var invalid = false;
@@ -87,117 +203,109 @@ fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
             base = environment_radiance(ray.direction);
         }
     } else {
-        let surface = surface_at(hit);
-        let material = materials[surface.material];
-        let wo_world = -ray.direction;
-        let cos_out = dot(surface.normal, wo_world);
+        let sample_lights = (params.flags & FLAG_SAMPLE_LIGHTS) != 0u;
+        let hit_lights = (params.flags & FLAG_HIT_LIGHTS) != 0u;
+        // The path's current vertex, the segment that reached it and what it carries.
+        var surface = surface_at(hit);
+        var wo_world = -ray.direction;
+        var cos_out = dot(surface.normal, wo_world);
+        var segment = 1u;
+        var length = hit.t;
+        var throughput = vec3<f32>(1.0);
+        var chain = 0u;
+        let camera_hit = surface.position;
         if surface.light != NO_LIGHT && cos_out > 0.0 {
             base = lights[surface.light].radiance;
         }
-        var normal = surface.normal;
-        if material.kind != MATERIAL_DIELECTRIC && cos_out < 0.0 && material.two_sided != 0u {
-            normal = -normal;
-        }
-        let rough = material.kind == MATERIAL_DIFFUSE
-            || (material.kind == MATERIAL_CONDUCTOR && material.alpha >= restir.min_roughness);
-        let front = material.kind == MATERIAL_DIELECTRIC || cos_out > 0.0 || material.two_sided != 0u;
-        let albedo = albedo_at(material, surface.uv);
-        primary = Primary(surface.position, surface.object_id, normal, surface.material, wo_world, PRIMARY_HIT, albedo, hit.t);
-        if !rough || !front {
-            let rest = scatter_from(surface, wo_world, 1u, lane);
-            base += rest.radiance;
-            invalid = rest.invalid;
-        } else {
-            primary.flags |= PRIMARY_RESAMPLE;
+        loop {
+            let material = materials[surface.material];
+            var normal = surface.normal;
+            if material.kind != MATERIAL_DIELECTRIC && cos_out < 0.0 && material.two_sided != 0u {
+                normal = -normal;
+            }
+            let rough = material.kind == MATERIAL_DIFFUSE
+                || (material.kind == MATERIAL_CONDUCTOR && material.alpha >= restir.min_roughness);
+            let front = material.kind == MATERIAL_DIELECTRIC || cos_out > 0.0 || material.two_sided != 0u;
+            let albedo = albedo_at(material, surface.uv);
+            primary = Primary(
+                surface.position, surface.object_id, normal, surface.material, wo_world, PRIMARY_HIT, albedo, length,
+                throughput, segment, camera_hit, 0u,
+            );
+            if rough && front && segment < params.max_depth {
+                primary.flags |= PRIMARY_RESAMPLE;
+                let drawn = draw_candidate(primary, surface, lane);
+                candidate = drawn.candidate;
+                invalid = invalid || drawn.invalid;
+                break;
+            }
+            if rough || !front || chain >= restir.specular_chain || segment >= params.max_depth {
+                // No resampling from here: the rest of the path, as the path tracer does it.
+                let rest = scatter_from(surface, wo_world, segment, lane);
+                base += throughput * rest.radiance;
+                invalid = invalid || rest.invalid;
+                break;
+            }
+            // One smooth vertex of the chain, exactly as render/path.wgsl's
+            // trace_path_from treats vertex number `segment`.
             let frame = make_frame(normal);
             let wo = to_local(frame, wo_world);
-            // Technique 1, BSDF sampling: the next vertex of the path.
-            var bsdf_candidate = no_candidate();
-            var bsdf_light_density = 0.0;
-            let sample = bsdf_sample(material, albedo, wo, random2(), random());
-            if any(sample.weight != vec3<f32>(0.0)) && sample.pdf > 0.0 {
-                let direction = normalize(to_world(frame, sample.wi));
-                let next = traverse(spawn_ray(surface.position, surface.normal, direction, INFINITY), lane, false);
-                if next.primitive == STACK_OVERFLOW {
-                    invalid = true;
-                } else if next.primitive == MISS {
-                    if params.env_width > 0u {
-                        bsdf_candidate = PathCandidate(direction, KIND_ENVIRONMENT, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), 0.0);
-                        bsdf_light_density = environment_light_pdf(direction);
-                    }
-                } else {
-                    let vertex = surface_at(next);
-                    let rest = scatter_from(vertex, -direction, 2u, lane);
-                    invalid = invalid || rest.invalid;
-                    bsdf_candidate = vertex_candidate(vertex, surface.position, rest.radiance);
-                    if vertex.light != NO_LIGHT {
-                        bsdf_light_density = light_area_density(vertex.light);
-                    }
-                }
+            if sample_lights && !is_specular(material) {
+                base += throughput * direct_light(surface.position, surface.normal, frame, material, albedo, wo, lane);
             }
-            // Technique 2, next-event estimation: a point on a light or an environment
-            // direction, drawn as render/lights.wgsl draws them.
-            var light_candidate = no_candidate();
-            var light_density = 0.0;
-            let u_choice = random();
-            let u_light = random2();
-            if u_choice < params.environment_probability {
-                let direction = sample_environment(u_light);
-                light_density = environment_light_pdf(direction);
-                if light_density > 0.0 && unoccluded(surface.position, normal, direction, lane) {
-                    light_candidate = PathCandidate(direction, KIND_ENVIRONMENT, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), 0.0);
-                }
-            } else if params.light_count > 0u {
-                let light = find_light(random());
-                let entry = lights[light];
-                let tri = triangles[entry.triangle];
-                let su = sqrt(u_light.x);
-                let b1 = u_light.y * su;
-                let b2 = su - u_light.y * su;
-                let point = (1.0 - su) * tri.v0 + b1 * tri.v1 + b2 * tri.v2;
-                let info = triangle_info[entry.triangle];
-                var uv = vec2<f32>(b1, b2);
-                if info.has_uv != 0u {
-                    uv = (1.0 - su) * info.uv0 + b1 * info.uv1 + b2 * info.uv2;
-                }
-                let light_normal = normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
-                let light_surface = Surface(point, light_normal, uv, info.object_id, info.material, light);
-                light_density = light_area_density(light);
-                if visible(surface.position, normal, point, lane) {
-                    // What the light reflects towards y1 (nothing for a black fixture).
-                    var reflected = vec3<f32>(0.0);
-                    let light_material = materials[info.material];
-                    if light_material.kind != MATERIAL_DIFFUSE || any(albedo_at(light_material, uv) != vec3<f32>(0.0)) {
-                        let rest = scatter_from(light_surface, normalize(surface.position - point), 2u, lane);
-                        invalid = invalid || rest.invalid;
-                        reflected = rest.radiance;
-                    }
-                    light_candidate = vertex_candidate(light_surface, surface.position, reflected);
-                }
+            let u = random2();
+            let sample = bsdf_sample(material, albedo, wo, u, random());
+            if all(sample.weight == vec3<f32>(0.0)) {
+                break;
             }
-            // RIS over the two samples, balance heuristic: w = p̂ / (p_bsdf + p_light).
-            let bsdf_ris = ris_weight(primary, bsdf_candidate, bsdf_light_density);
-            let light_ris = ris_weight(primary, light_candidate, light_density);
-            let total = bsdf_ris.y + light_ris.y;
-            if total > 0.0 && total < INFINITY {
-                if random() * total < light_ris.y {
-                    candidate = light_candidate;
-                    candidate.weight = total / light_ris.x;
-                } else {
-                    candidate = bsdf_candidate;
-                    candidate.weight = total / bsdf_ris.x;
+            throughput *= sample.weight;
+            let direction = normalize(to_world(frame, sample.wi));
+            let next_ray = spawn_ray(surface.position, surface.normal, direction, INFINITY);
+            if (params.flags & FLAG_RUSSIAN_ROULETTE) != 0u && segment >= params.rr_depth {
+                let survive = min(max(throughput.x, max(throughput.y, throughput.z)), 0.95);
+                if random() >= survive {
+                    break;
                 }
+                throughput /= survive;
+            }
+            segment += 1u;
+            chain += 1u;
+            let next = traverse(next_ray, lane, false);
+            if next.primitive == STACK_OVERFLOW {
+                invalid = true;
+                break;
+            }
+            let counts_emission = hit_lights || sample.specular || !sample_lights;
+            if next.primitive == MISS {
+                if params.env_width > 0u && counts_emission {
+                    var weight = 1.0;
+                    if sample_lights && !sample.specular {
+                        weight = mis_power(sample.pdf, environment_light_pdf(direction));
+                    }
+                    base += throughput * environment_radiance(direction) * weight;
+                }
+                break;
+            }
+            surface = surface_at(next);
+            wo_world = -direction;
+            cos_out = dot(surface.normal, wo_world);
+            length += next.t;
+            if surface.light != NO_LIGHT && cos_out > 0.0 && counts_emission {
+                var weight = 1.0;
+                if sample_lights && !sample.specular {
+                    weight = mis_power(sample.pdf, area_light_pdf(surface.light, next.t, cos_out));
+                }
+                base += throughput * lights[surface.light].radiance * weight;
             }
         }
     }
     var key = 0.0;
     if candidate.kind != KIND_NONE && candidate.weight > 0.0 && finite3(candidate.reflected) {
-        // The luminance of the pixel's own one-sample estimate f(Y) W.
+        // The luminance of the pixel's own one-sample estimate f(Y) W at its vertex.
         key = target_function(primary, candidate) * candidate.weight;
     } else {
         candidate = no_candidate();
     }
-    if invalid || !finite3(base) {
+    if invalid || !finite3(base) || !finite3(primary.throughput) {
         base = vec3<f32>(0.0);
         invalid = true;
         candidate = no_candidate();

@@ -21,7 +21,8 @@
 //   w_c = sum_j (1/K) p̂_i(x_c) / (p̂_i(x_c) + K p̂_j(x_c)) p̂_i(x_c) W_c
 //   w_j = (1/K) K p̂_j(x_j) / (p̂_i(x_j) + K p̂_j(x_j)) p̂_i(x_j) W_j
 // (with equal targets the canonical and each neighbour weigh 1 / (K + 1)).
-// with p̂_j(x) = 0 where pixel j cannot reconnect to x, visibility included (a shadow ray
+// with p̂_j(x) = 0 where pixel j cannot reconnect to x or reaches its resampling vertex
+// with another path segment (reservoir.wgsl, same_segment), visibility included (a shadow ray
 // from j's primary hit to x_c, one from ours to x_j). Each pair term depends on c and j only, never on
 // which other candidates were drawn, and every selection here draws each member of the
 // run (or of the disc) with a probability that does not depend on the candidates' own
@@ -99,6 +100,9 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
         }
         let neighbour = primaries[q];
         let x = path_candidates[q];
+        // Pixels reaching their resampling vertices with different segments share
+        // nothing (reservoir.wgsl, same_segment): p̂_j = 0 both ways.
+        let shares = same_segment(p, neighbour);
         sources[slot] = q;
         if q == pixel {
             // The pixel's own candidate drawn again: both halves of the pair are c.
@@ -116,7 +120,7 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
         // including the visibility from the neighbour's primary hit.
         if target_c > 0.0 {
             var target_neighbour_c = 0.0;
-            if c_shareable && reconnectable(neighbour, c) {
+            if shares && c_shareable && reconnectable(neighbour, c) {
                 target_neighbour_c = target_function(neighbour, c);
                 if target_neighbour_c > 0.0 && !candidate_visible(neighbour, c, lane) {
                     target_neighbour_c = 0.0;
@@ -126,7 +130,7 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
         }
         // The neighbour's half: x_j reconnected here, m_j = p̂_j / (p̂_i + p̂_j) at x_j
         // (p̂_j(x_j) > 0 and visible wherever W_j > 0).
-        if x.weight > 0.0 && reconnectable(p, x) && reconnectable(neighbour, x) {
+        if shares && x.weight > 0.0 && reconnectable(p, x) && reconnectable(neighbour, x) {
             let value = target_function(p, x);
             if value > 0.0 && candidate_visible(p, x, lane) {
                 let there = target_function(neighbour, x);

@@ -1,6 +1,7 @@
 // ReSTIR pass 5: shading. Each pixel's image value is what it estimated on its own
-// (emission at y1, next-event estimation there, or its whole path when it does not
-// resample) plus its reservoir's part: with RestirParams.shading = SHADING_SAMPLE its
+// (emission at y1, the smooth chain before its resampling vertex, or its whole path when
+// it does not resample) plus its reservoir's part, times the chain's throughput
+// (Primary.throughput, 1 without a chain): with RestirParams.shading = SHADING_SAMPLE its
 // sample, f(Y) V(y1, Y) W, with one shadow ray; with SHADING_EXPECTATION the expectation
 // of the frame's final resampling over its choice (Reservoir.expected, no ray). A sample
 // of kind PRIVATE can only be the pixel's own (nobody else can reconnect to it) and was
@@ -33,8 +34,10 @@ fn restir_shade(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_inv
         radiance = vec3<f32>(0.0);
     }
     let reservoir = reservoirs[pixel];
+    // The resampled part is the light reflected at the resampling vertex; behind a
+    // smooth chain it reaches the camera weighted by the chain's throughput.
     if (restir.shaded_parts & 2u) != 0u && (p.flags & PRIMARY_RESAMPLE) != 0u && restir.shading == SHADING_EXPECTATION {
-        radiance += reservoir.expected;
+        radiance += p.throughput * reservoir.expected;
     } else if (restir.shaded_parts & 2u) != 0u && (p.flags & PRIMARY_RESAMPLE) != 0u && reservoir.weight > 0.0 {
         let y = reservoir.sample;
         var seen = y.kind == KIND_PRIVATE;
@@ -42,7 +45,7 @@ fn restir_shade(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_inv
             seen = reconnectable(p, y) && candidate_visible(p, y, lane);
         }
         if seen {
-            radiance += integrand(p, y) * reservoir.weight;
+            radiance += p.throughput * integrand(p, y) * reservoir.weight;
         }
     }
     var invalid = base.w;

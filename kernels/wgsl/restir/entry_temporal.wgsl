@@ -19,8 +19,9 @@
 // 2022; with T = 0 this is the generalized balance heuristic):
 //   w_c = sum_j (1/S) M_c p̂_c(y_c) / (M_c p̂_c(y_c) + M_j p̂_j(y_c)) p̂_c(y_c) W_c
 //   w_j = (1/S) M_j p̂_j(y_j) / (M_c p̂_c(y_j) + M_j p̂_j(y_j)) p̂_c(y_j) W_j
-// with p̂_j evaluated at the source's previous primary hit (visibility included) and an
-// empty slot giving c its whole share. Each pair term depends on c and j only, the own
+// with p̂_j evaluated at the source's previous primary hit (visibility included; 0 for
+// a source reaching its resampling vertex with another path segment) and an empty slot
+// giving c its whole share. Each pair term depends on c and j only, the own
 // pair is always there and every drawing pattern gives each run member the expected count
 // T/n, so the merge stays unbiased whatever the sort did (as for the spatial selection).
 // One sample is kept in proportion to w: by inverse CDF with the temporal resampling
@@ -111,6 +112,12 @@ fn pair_terms(p: Primary, current: Reservoir, s: u32, share: f32, lane: u32) -> 
     terms.m = m_previous;
     let m_current = current.count;
     let previous_primary = previous_primaries[s];
+    if !same_segment(p, previous_primary) {
+        // Another path segment (reservoir.wgsl, same_segment): p̂ is 0 both ways, and c
+        // alone covers the pair.
+        terms.current_part = share * target_current * current.weight;
+        return terms;
+    }
     // The current sample's half: its target here is stored; there, evaluate it.
     if target_current > 0.0 {
         let there = target_at(previous_primary, current.sample, lane);

@@ -1,7 +1,8 @@
 // ReSTIR pass 4a: the temporal candidates. Each resampling pixel finds the previous
-// frame's pixel its primary hit reprojects to (RestirParams.previous_* camera) and keeps
-// it as its temporal source unless that pixel saw another object, faces another way
-// (normals beyond 25 degrees) or lies at another depth (10 %): a disocclusion. For the
+// frame's pixel its camera ray's hit reprojects to (RestirParams.previous_* camera) and
+// keeps it as its temporal source unless that pixel resampled at another object, with
+// another path segment (through another smooth chain), facing another way (normals
+// beyond 25 degrees) or at another depth (10 %): a disocclusion. For the
 // multiple-temporal-reservoir mode (paper Fig. 11: "sampling temporal reservoirs
 // similarly to spatial candidates"), it also writes the histogram input of the temporal
 // candidates: key = luminance of the source reservoir's own estimate p̂ W (its f(Y) W),
@@ -55,10 +56,12 @@ fn restir_temporal_keys(@builtin(global_invocation_id) id: vec3<u32>) {
     var object = OBJECT_ID_NONE;
     if restir.temporal != 0u && (p.flags & PRIMARY_RESAMPLE) != 0u {
         object = p.object_id;
-        let q = reproject(p.position);
+        // The point the pixel sees: its resampling vertex, or the smooth surface in front
+        // of it (Primary.camera_hit).
+        let q = reproject(p.camera_hit);
         if q != NO_SOURCE {
             let previous = previous_primaries[q];
-            if (previous.flags & PRIMARY_RESAMPLE) != 0u && previous.object_id == p.object_id
+            if (previous.flags & PRIMARY_RESAMPLE) != 0u && previous.object_id == p.object_id && same_segment(previous, p)
                 && dot(previous.normal, p.normal) >= 0.906 && abs(previous.depth - p.depth) <= 0.1 * p.depth {
                 source = q;
                 let reservoir = previous_reservoirs[q];

@@ -66,24 +66,41 @@ struct RestirParams {
     // SHADING_*: the resampled part as the kept sample or as the expectation of the
     // frame's final resampling (Reservoir.expected).
     shading: u32,
-    _pad0: u32,
+    // Smooth vertices (dielectrics, conductors below min_roughness) a camera path may
+    // pass through to the vertex it resamples at; 0: only a rough primary hit resamples.
+    specular_chain: u32,
     _pad1: u32,
     _pad2: u32,
 }
 
-// The G-buffer: what the camera ray of a pixel hit.
+// The G-buffer: the vertex a pixel resamples at. That is the camera ray's hit y1, or,
+// when y1 is smooth and RestirParams.specular_chain allows, the first rough vertex the
+// camera path reaches through smooth ones (restir/entry_candidates.wgsl): the pixel
+// then resamples the light that vertex reflects along the chain, and shading multiplies
+// by the chain's throughput.
 struct Primary {
     position: vec3<f32>,
     object_id: u32,
-    // Geometric normal, flipped towards the camera for two-sided materials.
+    // Geometric normal, flipped towards `wo` for two-sided materials.
     normal: vec3<f32>,
     material: u32,
-    // Unit direction towards the camera.
+    // Unit direction towards the previous vertex of the path (the camera, or the chain).
     wo: vec3<f32>,
     flags: u32,
     albedo: vec3<f32>,
-    // Distance from the camera.
+    // Length of the path from the camera to `position`.
     depth: f32,
+    // The chain's throughput: product of the BSDF sampling weights f cos / pdf of its
+    // smooth vertices (1 without a chain).
+    throughput: vec3<f32>,
+    // The number of the path segment that reached `position` (1: the camera ray). Pixels
+    // share candidates only with the same segment: a candidate's reflected radiance was
+    // estimated with the segments left after it (params.max_depth).
+    segment: u32,
+    // The camera ray's hit y1 (`position` without a chain): temporal reprojection
+    // follows the point the pixel sees.
+    camera_hit: vec3<f32>,
+    _pad: u32,
 }
 
 struct PathCandidate {
@@ -187,6 +204,14 @@ fn bsdf_density(p: Primary, x: PathCandidate) -> f32 {
     let frame = make_frame(p.normal);
     let pdf = bsdf_pdf(materials[p.material], to_local(frame, p.wo), to_local(frame, t.xyz));
     return pdf * geometry_factor(x, t.xyz, t.w);
+}
+
+// Whether pixels whose resampling vertices are `a` and `b` may share candidates: their
+// paths reach them with the same segment, so a candidate's reflected radiance, estimated
+// with the segments left after it, is the same integrand at both (reservoirs only ever
+// hold samples of their own segment, so this is a property of each sample too).
+fn same_segment(a: Primary, b: Primary) -> bool {
+    return a.segment == b.segment;
 }
 
 // Whether the pixel of `p` may reconnect to candidate `x`: both rough, x shareable,

@@ -101,9 +101,14 @@ pub(crate) struct CompareArgs {
     #[arg(long, value_enum, default_value_t = Shading::Expectation)]
     shading: Shading,
     /// A conductor at the primary hit resamples only from this GGX alpha up; smoother
-    /// ones path-trace on their own (1 sample per frame, no reuse).
+    /// ones are smooth vertices (see --specular-chain).
     #[arg(long, default_value_t = RestirSettings::default().min_roughness)]
     min_roughness: f32,
+    /// Smooth vertices (glass, conductors below --min-roughness) a pixel's path may pass
+    /// through to the rough vertex it resamples at, for every method alike; 0: pixels
+    /// whose primary hit is smooth path-trace on their own (1 sample per frame, no reuse).
+    #[arg(long, default_value_t = RestirSettings::default().specular_chain)]
+    specular_chain: u32,
     /// No reconnection to a vertex closer than this (scene units) to a primary hit;
     /// 0: 1e-3 of the scene's extent.
     #[arg(long, default_value_t = RestirSettings::default().min_distance)]
@@ -180,6 +185,7 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
         shaded_parts: args.shaded_parts,
         shading: args.shading,
         min_roughness: args.min_roughness,
+        specular_chain: args.specular_chain,
         min_distance: args.min_distance,
         ..RestirSettings::default()
     };
@@ -317,6 +323,7 @@ fn settings_record(
     put("temporal_candidates", restir.temporal_candidates.into());
     put("temporal_cap", f64::from(restir.temporal_cap).into());
     put("min_roughness", f64::from(restir.min_roughness).into());
+    put("specular_chain", restir.specular_chain.into());
     put("min_distance", f64::from(restir.min_distance).into());
     put("film", name(&|| clap::ValueEnum::to_possible_value(&film)).into());
     put("shaded_parts", name(&|| clap::ValueEnum::to_possible_value(&restir.shaded_parts)).into());

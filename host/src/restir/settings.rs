@@ -117,7 +117,7 @@ pub struct RestirSettings {
     /// resamples at the first rough surface behind it, the chain's throughput weighting
     /// the result (the primary surface replacement of RTXDI-style renderers, unbiased:
     /// `restir/entry_candidates.wgsl` derives it). 0: only a rough primary hit resamples
-    /// and every other pixel path-traces alone (the only behaviour before 2026-11-26).
+    /// and every other pixel path-traces alone (the only behaviour until 2026-11-25).
     /// At most 16; the scene's `max_depth` bounds the chain too. Default 4 (a mirror,
     /// a glass object in and out, glass seen in a mirror).
     pub specular_chain: u32,

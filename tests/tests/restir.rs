@@ -625,7 +625,8 @@ fn mirror_floor_short_paths_scene() -> Scene {
 /// of 3 segments every candidate of a segment-2 pixel reflects nothing (the segment after
 /// it is the last), so a reservoir of a segment-2 pixel holding a sample with reflected
 /// light took a segment-1 pixel's candidate. Checked after the spatial selection and
-/// after the temporal merge, over 6 frames of every method, with object masking off so
+/// after the temporal merge (own and four drawn previous reservoirs), over 6 frames of
+/// every method, with object masking off so
 /// that every block mixes both kinds of pixel. (The mixing is real: segment-1 samples
 /// with reflected light are checked to be there.) The bias such sharing adds is below
 /// what the statistical test next to it resolves: that test passes with the rule
@@ -640,7 +641,9 @@ fn pixels_share_candidates_only_at_the_same_segment() {
     let gpu_scene = GpuScene::build(&scene).unwrap();
     for method in [Method::Strata, Method::Restir, Method::RestirDisc] {
         let selection = SelectionSettings { masking: false, ..blocks_of_8() };
-        let restir = RestirSettings { method, selection, ..RestirSettings::default() };
+        // Four drawn temporal reservoirs besides the own one: the temporal histogram mixes
+        // segments as the spatial one does.
+        let restir = RestirSettings { method, selection, temporal_candidates: 4, ..RestirSettings::default() };
         let mut renderer =
             RestirRenderer::new(&mut backend, &gpu_scene, &settings(&scene, 11), restir, scene.extent()).unwrap();
         let (mut behind, mut reflecting) = (0usize, 0usize);
@@ -679,8 +682,9 @@ fn pixels_share_candidates_only_at_the_same_segment() {
 }
 
 /// Smooth chains on short paths stay unbiased: in the mirror-floor room with paths of 3
-/// segments (above), for every method with and without temporal reuse, object masking
-/// off so that blocks mix pixels resampling at segments 1 and 2.
+/// segments (above), for every method without temporal reuse and with it (own and four
+/// drawn previous reservoirs), object masking off so that blocks mix pixels resampling at
+/// segments 1 and 2.
 #[test]
 fn smooth_chains_on_short_paths_stay_unbiased() {
     let Some(mut backend) = strata_tests::vulkan_backend("smooth_chains_on_short_paths_stay_unbiased") else {
@@ -694,9 +698,15 @@ fn smooth_chains_on_short_paths_stay_unbiased() {
         let restir = RestirSettings { method, temporal: false, selection, ..RestirSettings::default() };
         let ours = restir_frames(&mut backend, &scene, restir, 1..9, 32);
         assert_unbiased(&format!("{}, 3 segments, without temporal reuse", method.name()), &ours, &reference);
-        let restir = RestirSettings { temporal: true, ..restir };
+        // With temporal reuse, four drawn previous reservoirs besides the own one (their
+        // histogram mixes segments too).
+        let restir = RestirSettings { temporal: true, temporal_candidates: 4, ..restir };
         let ours = restir_frames(&mut backend, &scene, restir, 1..97, 6);
-        assert_unbiased(&format!("{}, 3 segments, temporal reuse, frame 6", method.name()), &ours, &reference);
+        assert_unbiased(
+            &format!("{}, 3 segments, temporal reuse + 4 drawn, frame 6", method.name()),
+            &ours,
+            &reference,
+        );
     }
 }
 

@@ -109,15 +109,15 @@ fn pair_terms(p: Primary, current: Reservoir, s: u32, share: f32, lane: u32) -> 
         terms.current_part = share * target_current * current.weight;
         return terms;
     }
-    terms.m = m_previous;
     let m_current = current.count;
     let previous_primary = previous_primaries[s];
     if !same_segment(p, previous_primary) {
         // Another path segment (reservoir.wgsl, same_segment): p̂ is 0 both ways, and c
-        // alone covers the pair.
+        // alone covers the pair, which merges nothing and so adds no confidence M.
         terms.current_part = share * target_current * current.weight;
         return terms;
     }
+    terms.m = m_previous;
     // The current sample's half: its target here is stored; there, evaluate it.
     if target_current > 0.0 {
         let there = target_at(previous_primary, current.sample, lane);

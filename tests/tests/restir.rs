@@ -330,6 +330,12 @@ fn min_roughness_decides_which_conductors_resample() {
     assert!(loose > strict + total / 5, "{loose} pixels resample at 0.05, {strict} at 0.2");
 }
 
+/// A two-sided GGX conductor of alpha 0.01, below the default `min_roughness`: a smooth
+/// vertex that chains pass through.
+fn near_mirror() -> strata::scene::Material {
+    strata::scene::Material::RoughConductor { alpha: 0.01, eta: [0.2, 0.9, 1.1], k: [3.9, 2.4, 2.2], two_sided: true }
+}
+
 /// `specular_chain` lets pixels whose primary hit is smooth resample at the first rough
 /// vertex behind it: with the default scene's floor, ceiling and back wall a near-mirror
 /// conductor (alpha 0.01, below the default `min_roughness`) and its tall box glass, those
@@ -343,12 +349,7 @@ fn specular_chains_let_smooth_primary_hits_resample() {
         return;
     };
     let mut scene = default_scene();
-    scene.materials[0] = strata::scene::Material::RoughConductor {
-        alpha: 0.01,
-        eta: [0.2, 0.9, 1.1],
-        k: [3.9, 2.4, 2.2],
-        two_sided: true,
-    };
+    scene.materials[0] = near_mirror();
     scene.materials.push(strata::scene::Material::Dielectric { int_ior: 1.5, ext_ior: 1.0 });
     let glass = scene.materials.len() - 1;
     scene.shapes.iter_mut().filter(|shape| shape.name == "tall box").for_each(|shape| shape.material = glass);
@@ -608,12 +609,7 @@ fn glass_metal_and_environment_reuse_stays_unbiased() {
 /// segment 1 and its candidates bring one bounce more.
 fn mirror_floor_short_paths_scene() -> Scene {
     let mut scene = Scene { max_depth: 3, rr_depth: 3, ..default_scene() };
-    scene.materials.push(strata::scene::Material::RoughConductor {
-        alpha: 0.01,
-        eta: [0.2, 0.9, 1.1],
-        k: [3.9, 2.4, 2.2],
-        two_sided: true,
-    });
+    scene.materials.push(near_mirror());
     let mirror = scene.materials.len() - 1;
     scene.shapes.iter_mut().filter(|shape| shape.name == "floor").for_each(|shape| shape.material = mirror);
     scene

@@ -657,9 +657,9 @@ fn mirror_floor_short_paths_scene() -> Scene {
 /// it is the last), so a reservoir of a segment-2 pixel holding a sample with reflected
 /// light took a segment-1 pixel's candidate. Checked after the spatial selection and
 /// after the temporal merge (own and four drawn previous reservoirs), over 6 frames of
-/// every method, with object masking off so
-/// that every block mixes both kinds of pixel. (The mixing is real: segment-1 samples
-/// with reflected light are checked to be there.) The bias such sharing adds is below
+/// every method, with object masking off so that every block mixes both kinds of pixel.
+/// (The mixing is real: segment-1 samples with reflected light are checked to be there.)
+/// The bias such sharing adds is below
 /// what the statistical test next to it resolves: that test passes with the rule
 /// removed.
 #[test]

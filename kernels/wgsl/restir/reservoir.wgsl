@@ -22,7 +22,9 @@ const KIND_PRIVATE: u32 = 3u;
 
 // Primary.flags
 const PRIMARY_HIT: u32 = 1u;       // the camera ray hit a surface
-const PRIMARY_RESAMPLE: u32 = 2u;  // the resampling vertex (y1, or the first rough vertex behind a smooth chain) is rough enough to reconnect from: the pixel resamples
+// PRIMARY_RESAMPLE: the resampling vertex (y1, or the first rough vertex behind a smooth
+// chain) is rough enough to reconnect from: the pixel resamples
+const PRIMARY_RESAMPLE: u32 = 2u;
 
 // RestirParams.method
 const METHOD_STRATA: u32 = 0u;       // histogram + stratified selection, inverse-CDF resampling (ours)

@@ -5,7 +5,8 @@
 //! * `path_trace_128/{wgpu,interpreter}`: the same frame at 128 x 128 on lavapipe and on
 //!   the CPU interpreter (wall time: the interpreter has no timestamps), for their ratio.
 //! * `restir_frame_256/{method}`: one ReSTIR frame at 256 x 256 (all five passes, device
-//!   time summed), strata against the two baselines.
+//!   time summed), strata against the two baselines; each pass's mean time over the
+//!   benchmark's frames is printed to stderr.
 //! * `histogram_share_256/B{4,8,16,32}`: strata frames at each block size; the histogram
 //!   pass's share of the frame is printed to stderr (criterion measures the whole frame).
 //! * `histogram_share_simt_256/B{4,8,16,32}`: the same frames on the CPU interpreter
@@ -60,17 +61,20 @@ fn restir_frames(c: &mut Criterion, backend: &mut dyn Backend) {
         let restir = RestirSettings { method, shading, ..RestirSettings::default() };
         let mut renderer = RestirRenderer::new(backend, &gpu_scene, &render, restir, scene.extent()).expect("renderer");
         renderer.set_timed(true);
+        // The first frame builds the pipelines (seconds on a GPU driver); inside criterion's
+        // warm-up it leaves the GPU idle and too few frames to bring its clocks back up.
+        renderer.render_frame(backend, None).expect("first frame");
         let name = match shading {
             Shading::Sample => method.name().to_string(),
             Shading::Expectation => format!("{}/expectation", method.name()),
         };
-        group.bench_function(name, |b| {
+        let mut passes = PassTimes::default();
+        group.bench_function(&name, |b| {
             b.iter_custom(|n| {
-                (0..n)
-                    .map(|_| renderer.render_frame(backend, None).expect("frame").1.pass_times.iter().sum::<Duration>())
-                    .sum()
+                (0..n).map(|_| passes.add(renderer.render_frame(backend, None).expect("frame").1.pass_times)).sum()
             })
         });
+        passes.print(&name);
         renderer.destroy(backend).expect("destroy");
     }
     group.finish();
@@ -81,36 +85,55 @@ fn restir_frames(c: &mut Criterion, backend: &mut dyn Backend) {
         let restir = RestirSettings { selection, ..RestirSettings::default() };
         let mut renderer = RestirRenderer::new(backend, &gpu_scene, &render, restir, scene.extent()).expect("renderer");
         renderer.set_timed(true);
-        let mut passes = [Duration::ZERO; 5];
+        renderer.render_frame(backend, None).expect("first frame");
+        let mut passes = PassTimes::default();
         group.bench_function(format!("B{block_size}"), |b| {
             b.iter_custom(|n| {
-                (0..n)
-                    .map(|_| {
-                        let times = renderer.render_frame(backend, None).expect("frame").1.pass_times;
-                        for (total, t) in passes.iter_mut().zip(times) {
-                            *total += t;
-                        }
-                        times.iter().sum::<Duration>()
-                    })
-                    .sum()
+                (0..n).map(|_| passes.add(renderer.render_frame(backend, None).expect("frame").1.pass_times)).sum()
             })
         });
-        let total: Duration = passes.iter().sum();
-        // Nothing ran when a filter left this block size out.
-        if !total.is_zero() {
-            eprintln!(
-                "B{block_size}: histogram {:.1} % of the frame's device time (candidates {:.1} %, select {:.1} %, \
-             temporal {:.1} %, shade {:.1} %)",
-                100.0 * passes[1].as_secs_f64() / total.as_secs_f64(),
-                100.0 * passes[0].as_secs_f64() / total.as_secs_f64(),
-                100.0 * passes[2].as_secs_f64() / total.as_secs_f64(),
-                100.0 * passes[3].as_secs_f64() / total.as_secs_f64(),
-                100.0 * passes[4].as_secs_f64() / total.as_secs_f64(),
-            );
-        }
+        passes.print(&format!("B{block_size}"));
         renderer.destroy(backend).expect("destroy");
     }
     group.finish();
+}
+
+/// Device time per ReSTIR pass summed over a benchmark's frames (warm-up included), for
+/// the per-pass shares printed beside criterion's frame medians.
+#[derive(Default)]
+struct PassTimes {
+    frames: u32,
+    passes: [Duration; 5],
+}
+
+impl PassTimes {
+    /// Adds one frame's pass times and returns the frame's total.
+    fn add(&mut self, times: [Duration; 5]) -> Duration {
+        self.frames += 1;
+        for (total, t) in self.passes.iter_mut().zip(times) {
+            *total += t;
+        }
+        times.iter().sum()
+    }
+
+    /// One line to stderr: each pass's mean time and share of the frame. Nothing when a
+    /// filter left the benchmark out (no frames ran).
+    fn print(&self, name: &str) {
+        let total: Duration = self.passes.iter().sum();
+        if self.frames == 0 || total.is_zero() {
+            return;
+        }
+        let names = ["candidates", "histogram", "select", "temporal", "shade"];
+        let parts: Vec<String> = names
+            .iter()
+            .zip(self.passes)
+            .map(|(pass, t)| {
+                let ms = 1e3 * t.as_secs_f64() / f64::from(self.frames);
+                format!("{pass} {ms:.3} ms ({:.1} %)", 100.0 * t.as_secs_f64() / total.as_secs_f64())
+            })
+            .collect();
+        eprintln!("{name}: {} frames, mean per frame: {}", self.frames, parts.join(", "));
+    }
 }
 
 /// The histogram's share of a strata frame in SIMT issue slots (see the module doc).

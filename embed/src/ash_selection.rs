@@ -9,12 +9,12 @@ use crate::frame::{FrameId, FrameParams, frame_params, max_blocks};
 use crate::limits::{DeviceLimits, VULKAN_NAMES, check_limits};
 use crate::wgsl::{ModuleId, WgslModule, module};
 use ash::vk;
-use strata_kernels::Registry;
 use strata_kernels::blue_noise::BlueNoiseTables;
 use strata_kernels::embed_types::SelectionParams;
 use strata_kernels::selection::SelectionSettings;
 use strata_kernels::translate::{TranslateOptions, spirv};
 use strata_kernels::types::HistogramParams;
+use strata_kernels::{Executor, Registry};
 
 /// The engine's Vulkan objects the pass is created on (the device must be Vulkan 1.1 or
 /// newer; nothing has to be enabled beyond core features).
@@ -110,9 +110,10 @@ fn subgroup_shuffles(instance: &ash::Instance, physical_device: vk::PhysicalDevi
 impl AshSelection {
     /// Builds the pipelines (naga's SPIR-V) and the pass's own buffers for a `width` ×
     /// `height` image; fails, naming the setting or the device limit, when the settings
-    /// are out of range or the device cannot run the pass at this size. Uses the subgroup
-    /// histogram where compute shaders have subgroup shuffles. Frames belong to the
-    /// render of seed 0 until [`Self::set_seed`].
+    /// are out of range or the device cannot run the pass at this size. Uses the histogram
+    /// module [`crate::wgsl::histogram_module`] picks for the device's type (the subgroup
+    /// network on a GPU whose compute shaders have subgroup shuffles). Frames belong to
+    /// the render of seed 0 until [`Self::set_seed`].
     pub fn new(vulkan: AshDevice, settings: SelectionSettings, width: u32, height: u32) -> Result<Self, EmbedError> {
         crate::frame::grid(&settings, width, height)?;
         // SAFETY: valid handles from the engine.
@@ -125,10 +126,9 @@ impl AshSelection {
                 why: "naga's SPIR-V 1.3 needs Vulkan 1.1".into(),
             });
         }
-        let histogram_module = crate::wgsl::histogram_module(
-            settings.block_size,
-            subgroup_shuffles(vulkan.instance, vulkan.physical_device),
-        );
+        let executor = Executor::of_device(&format!("{:?}", properties.device_type), false);
+        let subgroups = subgroup_shuffles(vulkan.instance, vulkan.physical_device);
+        let histogram_module = crate::wgsl::histogram_module(settings.block_size, subgroups, executor);
         let limits = properties.limits;
         let blocks = max_blocks(&settings, width, height);
         check_limits(DeviceLimits::vulkan(&limits), &VULKAN_NAMES, histogram_module, width, height, blocks)?;

@@ -40,6 +40,9 @@ mod wgpu_selection;
 pub use ash_selection::{AshBindings, AshBufferSlice, AshBuffers, AshDevice, AshResampleBuffers, AshSelection};
 pub use binding_plan::{EngineBuffers, ResampleBuffers};
 pub use error::EmbedError;
+/// What runs the kernels (a GPU, a CPU driver such as lavapipe), for
+/// [`wgsl::histogram_module`]'s choice.
+pub use strata_kernels::Executor;
 /// The selection's settings and sampler variants: the paper's one settings struct, shared
 /// with strata's renderer and command line.
 pub use strata_kernels::selection::{SamplerVariant, SelectionSettings};

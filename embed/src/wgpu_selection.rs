@@ -7,6 +7,7 @@ use crate::error::EmbedError;
 use crate::frame::{FrameId, FrameParams, frame_params, max_blocks};
 use crate::limits::{DeviceLimits, WGPU_NAMES, check_limits};
 use crate::wgsl::{ModuleId, WgslModule, module};
+use strata_kernels::Executor;
 use strata_kernels::blue_noise::BlueNoiseTables;
 use strata_kernels::embed_types::SelectionParams;
 use strata_kernels::selection::SelectionSettings;
@@ -127,8 +128,9 @@ impl WgpuSelection {
     /// counters, the blue-noise tables: about 1.3 MiB + 16 bytes per pixel) for a
     /// `width` × `height` image. Fails, naming the setting or the device limit, when the
     /// settings are out of range or the device cannot run the pass at this size. Uses
-    /// the histogram module [`crate::wgsl::histogram_module`] picks (subgroups when the
-    /// device was created with `Features::SUBGROUP`).
+    /// the histogram module [`crate::wgsl::histogram_module`] picks for the device's type
+    /// (`Device::adapter_info`; subgroups when the device was created with
+    /// `Features::SUBGROUP`).
     /// Frames belong to the render of seed 0 until [`Self::set_seed`].
     pub fn new(
         device: &wgpu::Device,
@@ -137,8 +139,9 @@ impl WgpuSelection {
         height: u32,
     ) -> Result<Self, EmbedError> {
         crate::frame::grid(&settings, width, height)?;
-        let histogram_module =
-            crate::wgsl::histogram_module(settings.block_size, device.features().contains(wgpu::Features::SUBGROUP));
+        let executor = Executor::of_device(&format!("{:?}", device.adapter_info().device_type), false);
+        let subgroups = device.features().contains(wgpu::Features::SUBGROUP);
+        let histogram_module = crate::wgsl::histogram_module(settings.block_size, subgroups, executor);
         let limits = device.limits();
         let blocks = max_blocks(&settings, width, height);
         check_limits(DeviceLimits::wgpu(&limits), &WGPU_NAMES, histogram_module, width, height, blocks)?;

@@ -9,7 +9,7 @@
 //! [`crate::frame::frame_params`] of the frame.
 
 use crate::error::EmbedError;
-use strata_kernels::{BindingAccess, BindingKind, KernelId, Registry};
+use strata_kernels::{BindingAccess, BindingKind, Executor, KernelId, Registry};
 
 /// One of the pass's kernels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -48,11 +48,13 @@ impl ModuleId {
     }
 }
 
-/// The histogram module to run for `block_size` on a GPU with or without subgroup
+/// The histogram module to run for `block_size` on `executor` with or without subgroup
 /// shuffles: the choice strata's own renderer makes there ([`KernelId::fastest_histogram`];
-/// every choice gives the same output).
-pub fn histogram_module(block_size: u32, subgroups: bool) -> ModuleId {
-    match KernelId::fastest_histogram(block_size, subgroups, strata_kernels::Executor::Gpu) {
+/// every choice gives the same output). On a GPU the sorting network, on a CPU driver such
+/// as lavapipe ranking up to B = 16 (BENCHMARKS.md, block_sort).
+/// [`Executor::of_device`] tells them apart from the adapter's device type.
+pub fn histogram_module(block_size: u32, subgroups: bool, executor: Executor) -> ModuleId {
+    match KernelId::fastest_histogram(block_size, subgroups, executor) {
         KernelId::BlockHistogramRank => ModuleId::HistogramRank,
         KernelId::BlockHistogramSubgroup => ModuleId::HistogramSubgroup,
         _ => ModuleId::Histogram,

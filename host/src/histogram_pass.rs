@@ -29,9 +29,9 @@ pub enum HistogramVariant {
     /// Each element's position counted over its block (`block_histogram_rank`); runs
     /// everywhere, same outputs.
     Rank,
-    /// The fastest measured ([`KernelId::fastest_histogram`]): on a GPU ranking up to
-    /// B = 16 and the network at B = 32, on the interpreter the network (with subgroups
-    /// if the device has them).
+    /// The fastest measured ([`KernelId::fastest_histogram`]): on a GPU and on the
+    /// interpreter the network (with subgroups if the device has them), on a CPU driver
+    /// such as lavapipe ranking up to B = 16 and the network at B = 32.
     Auto,
 }
 
@@ -104,7 +104,7 @@ impl BlockHistogramPass {
             HistogramVariant::Rank => KernelId::BlockHistogramRank,
             HistogramVariant::Auto => {
                 let info = backend.info();
-                let executor = if info.is_interpreter() { Executor::Interpreter } else { Executor::Gpu };
+                let executor = Executor::of_device(&info.device_type, info.is_interpreter());
                 KernelId::fastest_histogram(grid.block_size, info.subgroup_sizes.is_some(), executor)
             }
         };

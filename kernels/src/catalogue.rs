@@ -53,12 +53,30 @@ pub enum KernelId {
 /// ([`KernelId::fastest_histogram`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Executor {
-    /// A GPU, or a driver that runs a workgroup's invocations side by side in SIMD
-    /// lanes (lavapipe).
+    /// A GPU: warps or wavefronts of lanes that issue one instruction together and wait
+    /// on memory far longer than on arithmetic.
     Gpu,
+    /// A Vulkan or GL driver on the CPU (lavapipe, llvmpipe, SwiftShader): a workgroup's
+    /// invocations side by side in SIMD lanes, with slow barriers.
+    CpuDriver,
     /// strata's CPU interpreter of naga IR, which runs a workgroup's invocations one
     /// after another for each instruction.
     Interpreter,
+}
+
+impl Executor {
+    /// The executor of a device of this type (`DeviceInfo::device_type`, as wgpu or
+    /// Vulkan name it: `Cpu`, `CPU`, `DiscreteGpu`, `INTEGRATED_GPU`, ...), or of strata's
+    /// interpreter.
+    pub fn of_device(device_type: &str, interpreter: bool) -> Executor {
+        if interpreter {
+            Executor::Interpreter
+        } else if device_type.eq_ignore_ascii_case("cpu") {
+            Executor::CpuDriver
+        } else {
+            Executor::Gpu
+        }
+    }
 }
 
 impl KernelId {
@@ -81,15 +99,20 @@ impl KernelId {
     ];
 
     /// The fastest block-histogram kernel for `block_size` on `executor`, with or without
-    /// subgroup shuffles (all three give the same output). On a GPU (and lavapipe, which
-    /// runs a workgroup's lanes as SIMD): ranking up to 16 × 16 blocks, the sorting
-    /// network at 32 × 32, where ranking's B² comparisons per candidate cost more. On
-    /// strata's interpreter, which pays every comparison lane by lane, the network at
-    /// every block size (ranking ties it at B = 4 and is 1.1×, 1.6× and 3.5× slower at
-    /// B = 8, 16, 32). BENCHMARKS.md, block_sort and interpreter. The one home of this
-    /// choice: the renderer's `HistogramVariant::Auto` and the embed pass both call it.
+    /// subgroup shuffles (all three give the same output). On a GPU the sorting network,
+    /// with subgroup shuffles where the device has them: on an H200 at B = 16 and 1M
+    /// candidates it takes 97.6 µs with shuffles and 150.7 µs without, ranking 248.7 µs,
+    /// since ranking compares every candidate with all B² slots of its block and the
+    /// network runs 36 compare-exchange stages; the SIMT issue-slot model agrees at every
+    /// B (ranking ties the network at B = 4 and costs 1.4× and 3.1× its slots at B = 8 and
+    /// 16). On a CPU driver (lavapipe), whose barriers are slow, ranking up to 16 × 16
+    /// blocks and the network at 32 × 32. On strata's interpreter, which pays every
+    /// comparison lane by lane, the network at every block size (ranking ties it at B = 4
+    /// and is 1.1×, 1.6× and 3.5× slower at B = 8, 16, 32). BENCHMARKS.md, block_sort,
+    /// render and interpreter. The one home of this choice: the renderer's
+    /// `HistogramVariant::Auto` and the embed pass both call it.
     pub fn fastest_histogram(block_size: u32, subgroups: bool, executor: Executor) -> KernelId {
-        if block_size <= 16 && executor == Executor::Gpu {
+        if block_size <= 16 && executor == Executor::CpuDriver {
             KernelId::BlockHistogramRank
         } else if subgroups {
             KernelId::BlockHistogramSubgroup
@@ -299,4 +322,31 @@ pub struct KernelSpec {
     /// Largest difference in ULPs allowed between backends for float outputs; `None`
     /// when every output is an integer or an ordering, compared bit for bit.
     pub float_ulp_bound: Option<u32>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Executor, KernelId};
+
+    #[test]
+    fn device_types_map_to_executors() {
+        // wgpu writes `Cpu`, ash (Vulkan's PhysicalDeviceType) `CPU`.
+        assert_eq!(Executor::of_device("Cpu", false), Executor::CpuDriver);
+        assert_eq!(Executor::of_device("CPU", false), Executor::CpuDriver);
+        assert_eq!(Executor::of_device("DiscreteGpu", false), Executor::Gpu);
+        assert_eq!(Executor::of_device("INTEGRATED_GPU", false), Executor::Gpu);
+        assert_eq!(Executor::of_device("Cpu", true), Executor::Interpreter);
+    }
+
+    #[test]
+    fn gpus_sort_with_the_network_and_cpu_drivers_rank_small_blocks() {
+        for block_size in [4, 8, 16, 32] {
+            assert_eq!(KernelId::fastest_histogram(block_size, true, Executor::Gpu), KernelId::BlockHistogramSubgroup);
+            assert_eq!(KernelId::fastest_histogram(block_size, false, Executor::Gpu), KernelId::BlockHistogram);
+            assert_eq!(KernelId::fastest_histogram(block_size, false, Executor::Interpreter), KernelId::BlockHistogram);
+            let cpu_driver =
+                if block_size <= 16 { KernelId::BlockHistogramRank } else { KernelId::BlockHistogramSubgroup };
+            assert_eq!(KernelId::fastest_histogram(block_size, true, Executor::CpuDriver), cpu_driver);
+        }
+    }
 }

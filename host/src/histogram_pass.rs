@@ -35,6 +35,13 @@ pub enum HistogramVariant {
     Auto,
 }
 
+/// The kernel [`HistogramVariant::Auto`] runs for `block_size` on this device
+/// ([`KernelId::fastest_histogram`] for its executor and subgroup support).
+pub fn auto_kernel(info: &strata_backends::DeviceInfo, block_size: u32) -> KernelId {
+    let executor = Executor::of_device(&info.device_type, info.is_interpreter());
+    KernelId::fastest_histogram(block_size, info.subgroup_sizes.is_some(), executor)
+}
+
 /// A failure of a host pass.
 #[derive(Debug, Error)]
 pub enum PassError {
@@ -102,11 +109,7 @@ impl BlockHistogramPass {
             HistogramVariant::Portable => KernelId::BlockHistogram,
             HistogramVariant::Subgroup => KernelId::BlockHistogramSubgroup,
             HistogramVariant::Rank => KernelId::BlockHistogramRank,
-            HistogramVariant::Auto => {
-                let info = backend.info();
-                let executor = Executor::of_device(&info.device_type, info.is_interpreter());
-                KernelId::fastest_histogram(grid.block_size, info.subgroup_sizes.is_some(), executor)
-            }
+            HistogramVariant::Auto => auto_kernel(backend.info(), grid.block_size),
         };
         let kernel = registry.get(id);
         backend.check_kernel(kernel)?;

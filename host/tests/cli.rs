@@ -255,4 +255,7 @@ fn a_second_run_into_the_same_folder_replaces_the_first_runs_files() {
     assert_eq!(record["width"], 8);
     assert!(record["command_line"].as_str().unwrap().contains("--reference-spp 2"), "{record}");
     assert!(record["backend"].as_str().unwrap().starts_with("cpu"), "{record}");
+    // The interpreter sorts with the network (ranking pays B² comparisons lane by lane).
+    let histogram = record["settings"]["histogram_kernel"].as_str();
+    assert!(matches!(histogram, Some("block_histogram" | "block_histogram_subgroup")), "{record}");
 }

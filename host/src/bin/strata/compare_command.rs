@@ -286,7 +286,7 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
         seeds: args.seeds,
         temporal: !args.accumulate,
         reference: reference_text,
-        settings: settings_record(&restir, &args, render.film),
+        settings: settings_record(&restir, &args, render.film, backend.info()),
         frame_ms: Vec::new(),
         seconds: 0.0,
     };
@@ -307,6 +307,7 @@ fn settings_record(
     restir: &RestirSettings,
     args: &CompareArgs,
     film: Film,
+    device: &strata_backends::DeviceInfo,
 ) -> serde_json::Map<String, serde_json::Value> {
     let s = &restir.selection;
     let mut map = serde_json::Map::new();
@@ -318,6 +319,9 @@ fn settings_record(
     put("candidates", s.candidates.into());
     put("masking", s.masking.into());
     put("block_shift", s.block_shift.into());
+    // Every histogram kernel gives the same output; which one ran depends on the device.
+    let histogram = strata::histogram_pass::auto_kernel(device, s.block_size);
+    put("histogram_kernel", histogram.spec().map(|spec| spec.name.to_string()).into());
     let name = |v: &dyn Fn() -> Option<clap::builder::PossibleValue>| v().map(|p| p.get_name().to_string());
     put("sampler", name(&|| clap::ValueEnum::to_possible_value(&s.sampler)).into());
     put("temporal_candidates", restir.temporal_candidates.into());

@@ -52,6 +52,7 @@ pub enum KernelId {
 /// What runs the kernels, for the choices that depend on it
 /// ([`KernelId::fastest_histogram`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Executor {
     /// A GPU: warps or wavefronts of lanes that issue one instruction together and wait
     /// on memory far longer than on arithmetic.
@@ -65,9 +66,11 @@ pub enum Executor {
 }
 
 impl Executor {
-    /// The executor of a device of this type (`DeviceInfo::device_type`, as wgpu or
-    /// Vulkan name it: `Cpu`, `CPU`, `DiscreteGpu`, `INTEGRATED_GPU`, ...), or of strata's
-    /// interpreter.
+    /// The executor of a device of this type (`DeviceInfo::device_type`: the `Debug`
+    /// name of `wgpu::DeviceType` or `ash::vk::PhysicalDeviceType`, e.g. `Cpu`, `CPU`,
+    /// `DiscreteGpu`, `INTEGRATED_GPU`), or of strata's interpreter. Only a device that
+    /// says it is a CPU counts as a CPU driver: a software renderer its driver reports as
+    /// `Other` gets the GPU's choice (every choice gives the same output).
     pub fn of_device(device_type: &str, interpreter: bool) -> Executor {
         if interpreter {
             Executor::Interpreter
@@ -335,6 +338,9 @@ mod tests {
         assert_eq!(Executor::of_device("CPU", false), Executor::CpuDriver);
         assert_eq!(Executor::of_device("DiscreteGpu", false), Executor::Gpu);
         assert_eq!(Executor::of_device("INTEGRATED_GPU", false), Executor::Gpu);
+        assert_eq!(Executor::of_device("IntegratedGpu", false), Executor::Gpu);
+        assert_eq!(Executor::of_device("VirtualGpu", false), Executor::Gpu);
+        assert_eq!(Executor::of_device("Other", false), Executor::Gpu);
         assert_eq!(Executor::of_device("Cpu", true), Executor::Interpreter);
     }
 

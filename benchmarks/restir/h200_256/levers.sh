@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Re-runs this folder's measurements: the references, then every lever's `strata compare`
-# (README.md here lists them), PARALLEL at a time (8 on the H200; 1 on lavapipe, where the
-# whole matrix takes about 30 h on 2 cores).
+# (README.md here lists them), PARALLEL at a time (8 on the H200, where it all took about
+# 6 minutes; 1 on lavapipe, where it would take roughly 15 h on a 2-core VM). Exits 1 when
+# a reference or a run failed (each has its .log beside its output).
 #
 #   benchmarks/restir/h200_256/levers.sh STRATA SCENES OUT [PARALLEL]
 #
@@ -26,7 +27,7 @@ scene_args() {
 before="--shading sample --film white --min-roughness 0.2 --specular-chain 0"
 pair="--seeds 32 --methods restir,strata"
 # NAME|SCENE|FLAGS, in the order they ran.
-jobs() {
+job_list() {
   for s in default cornell-box matpreview objects-grid veach-ajar; do
     echo "$s.T_before|$s|$before"
     echo "$s.T_defaults|$s|"
@@ -75,17 +76,23 @@ jobs() {
 }
 for s in default cornell-box matpreview objects-grid veach-ajar; do
   # shellcheck disable=SC2046 # the scene arguments are words
-  "$strata" render $(scene_args $s) --spp 4096 --out "$out/refs/$s" >"$out/refs/$s.log" 2>&1 &
+  if ! "$strata" render $(scene_args $s) --spp 4096 --backend wgpu --out "$out/refs/$s" >"$out/refs/$s.log" 2>&1; then
+    echo "reference $s FAILED (see $out/refs/$s.log)" >&2
+    exit 1
+  fi
 done
-wait
 run() {
   IFS='|' read -r name scene flags <<<"$1"
   seeds="--seeds 8"
   [[ $flags == *--seeds* ]] && seeds=""
   # shellcheck disable=SC2046,SC2086 # the arguments are words
   "$strata" compare $(scene_args "$scene") --frames 32 $seeds --reference "$out/refs/$scene/$scene.exr" \
-    --auto-crops 0 $flags --out "$out/$name" >"$out/$name.log" 2>&1 && echo "$name done" || echo "$name FAILED (see $out/$name.log)"
+    --backend wgpu --auto-crops 0 $flags --out "$out/$name" >"$out/$name.log" 2>&1 || {
+    echo "$name FAILED (see $out/$name.log)" >&2
+    return 1
+  }
+  echo "$name done"
 }
 export -f run scene_args
 export strata scenes out
-jobs | tr '\n' '\0' | xargs -0 -P "$parallel" -I{} bash -c 'run "$@"' _ {}
+job_list | tr '\n' '\0' | xargs -0 -P "$parallel" -I{} bash -c 'run "$@"' _ {} || exit 1

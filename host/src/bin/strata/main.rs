@@ -150,7 +150,8 @@ struct HistogramArgs {
 
 #[derive(Clone, Copy, clap::ValueEnum)]
 enum VariantArg {
-    /// The best for this device and block size (the ranking kernel up to B = 16).
+    /// The best for this device and block size (the network on a GPU and on the
+    /// interpreter, ranking up to B = 16 on a CPU driver such as lavapipe).
     Auto,
     /// The bitonic network through workgroup memory.
     Portable,

@@ -99,7 +99,7 @@ fn restir_frames(c: &mut Criterion, backend: &mut dyn Backend) {
 }
 
 /// Device time per ReSTIR pass summed over a benchmark's frames (warm-up included), for
-/// the per-pass shares printed beside criterion's frame medians.
+/// the per-pass times and shares printed beside criterion's frame times.
 #[derive(Default)]
 struct PassTimes {
     frames: u32,
@@ -191,16 +191,18 @@ fn histogram_share_simt(c: &mut Criterion) {
         let rank_alone = standalone(HistogramVariant::Rank).warp_issues as f64;
         let network_alone = standalone(HistogramVariant::Subgroup).warp_issues as f64;
         let per_frame = |n: u64| n as f64 / frames as f64;
-        let share = |issues: f64| 100.0 * issues / (issues + per_frame(rest.warp_issues));
+        // A histogram kernel's share of a frame made of it and the rest of the frame.
+        let histogram_share = |issues: f64| 100.0 * issues / (issues + per_frame(rest.warp_issues));
         eprintln!(
             "B{block_size}: histogram share of a frame's warp issues: ranking {:.1} % ({rank_alone:.3e}), \
              the subgroup network {:.1} % ({network_alone:.3e} on the generated image, {:.3e} in the frame); \
              a GPU runs {:?}",
-            share(rank_alone),
-            share(network_alone),
+            histogram_share(rank_alone),
+            histogram_share(network_alone),
             per_frame(network_in_frame.warp_issues),
             KernelId::fastest_histogram(block_size, true, Executor::Gpu),
         );
+        // The other passes' shares of a frame with the network.
         let frame = network_alone + per_frame(rest.warp_issues);
         let share = |issues: f64| 100.0 * issues / frame;
         let mut passes: Vec<_> = counts.iter().filter(|(id, _)| !is_histogram(id)).collect();

@@ -659,9 +659,8 @@ fn mirror_floor_short_paths_scene() -> Scene {
 /// after the temporal merge (own and four drawn previous reservoirs), over 6 frames of
 /// every method, with object masking off so that every block mixes both kinds of pixel.
 /// (The mixing is real: segment-1 samples with reflected light are checked to be there.)
-/// The bias such sharing adds is below
-/// what the statistical test next to it resolves: that test passes with the rule
-/// removed.
+/// The bias such sharing adds is below what the statistical test next to it resolves:
+/// that test passes with the rule removed.
 #[test]
 fn pixels_share_candidates_only_at_the_same_segment() {
     let Some(mut backend) = strata_tests::vulkan_backend("pixels_share_candidates_only_at_the_same_segment") else {

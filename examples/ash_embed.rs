@@ -199,8 +199,15 @@ fn run() -> Result<(), Error> {
     let outputs = engine.buffer((pixels * size_of::<ResampleOutput>()) as u64)?;
 
     let settings = SelectionSettings { block_shift: true, ..SelectionSettings::default() };
-    let vulkan =
-        AshDevice { instance: &engine.instance, physical_device: engine.physical_device, device: &engine.device };
+    let vulkan = AshDevice {
+        instance: &engine.instance,
+        physical_device: engine.physical_device,
+        device: &engine.device,
+        // This engine enabled core features only. One that enables
+        // shaderZeroInitializeWorkgroupMemory says so here, and the pass's pipelines
+        // leave zeroing workgroup memory to the driver (faster to build on some drivers).
+        shader_zero_initialize_workgroup_memory: false,
+    };
     let pass = AshSelection::new(vulkan, settings, WIDTH, HEIGHT)?;
     let bindings = pass.bind(&AshBuffers {
         candidates: candidate_buffer.slice(),

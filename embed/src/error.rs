@@ -31,6 +31,14 @@ pub enum EmbedError {
         /// What needs it.
         why: String,
     },
+    /// The engine's device description claims a feature its physical device lacks.
+    #[error("{field} is true, but the physical device does not support {feature}")]
+    UnsupportedFeature {
+        /// The field that claims it.
+        field: &'static str,
+        /// The feature as Vulkan spells it.
+        feature: &'static str,
+    },
     /// An engine buffer is smaller than the contract requires.
     #[error(
         "buffer `{buffer}` has {size} bytes from its offset, but a {width}x{height} image needs {needed} ({per_pixel} bytes per pixel)"

@@ -75,8 +75,10 @@ pub fn read_wgpu_buffer<T: bytemuck::Pod>(device: &wgpu::Device, queue: &wgpu::Q
 }
 
 /// A raw Vulkan device made through ash, as an embedding engine would own one: the
-/// first physical device with a compute queue, that queue, a command pool. `None` (with
-/// a note) without a Vulkan loader or device; a failure under `STRATA_REQUIRE_GPU=1`.
+/// first physical device with a compute queue, that queue, a command pool, and
+/// `shaderZeroInitializeWorkgroupMemory` where [`AshEngine::open`] was asked for it and
+/// the device has it. `None` (with a note) without a Vulkan loader or device; a failure
+/// under `STRATA_REQUIRE_GPU=1`.
 pub struct AshEngine {
     _entry: ash::Entry,
     /// The instance.
@@ -89,11 +91,35 @@ pub struct AshEngine {
     pub queue: ash::vk::Queue,
     /// A pool for one-shot command buffers.
     pub command_pool: ash::vk::CommandPool,
+    /// Whether `shaderZeroInitializeWorkgroupMemory` is enabled on the device.
+    pub zero_initializes_workgroup_memory: bool,
 }
 
 impl AshEngine {
-    /// Opens the device, or `None` (see the type's docs).
+    /// Opens the device with `shaderZeroInitializeWorkgroupMemory` enabled where the
+    /// device has it, as an engine that wants fast pipeline builds would, or `None` (see
+    /// the type's docs).
     pub fn open(test: &str) -> Option<Self> {
+        Self::open_with(test, true)
+    }
+
+    /// Opens the device with core features only (zeroing of workgroup memory left to the
+    /// shaders), or `None` (see the type's docs).
+    pub fn open_plain(test: &str) -> Option<Self> {
+        Self::open_with(test, false)
+    }
+
+    /// The device as the embeddable pass takes it.
+    pub fn embed_device(&self) -> strata_embed::AshDevice<'_> {
+        strata_embed::AshDevice {
+            instance: &self.instance,
+            physical_device: self.physical_device,
+            device: &self.device,
+            shader_zero_initialize_workgroup_memory: self.zero_initializes_workgroup_memory,
+        }
+    }
+
+    fn open_with(test: &str, zero_init_if_supported: bool) -> Option<Self> {
         use ash::vk;
         let fail = |why: String| -> Option<Self> {
             if gpu_required() {
@@ -129,14 +155,43 @@ impl AshEngine {
             let priorities = [1.0];
             let queues =
                 [vk::DeviceQueueCreateInfo::default().queue_family_index(family).queue_priorities(&priorities)];
+            let mut supported = vk::PhysicalDeviceZeroInitializeWorkgroupMemoryFeatures::default();
+            instance.get_physical_device_features2(
+                physical_device,
+                &mut vk::PhysicalDeviceFeatures2::default().push_next(&mut supported),
+            );
+            let extension = ash::khr::zero_initialize_workgroup_memory::NAME;
+            let has_extension = instance
+                .enumerate_device_extension_properties(physical_device)
+                .unwrap_or_default()
+                .iter()
+                .any(|e| e.extension_name_as_c_str() == Ok(extension));
+            let zero_init = zero_init_if_supported
+                && has_extension
+                && supported.shader_zero_initialize_workgroup_memory == vk::TRUE;
+            let mut enabled = vk::PhysicalDeviceZeroInitializeWorkgroupMemoryFeatures::default()
+                .shader_zero_initialize_workgroup_memory(true);
+            let extensions = [extension.as_ptr()];
+            let mut create = vk::DeviceCreateInfo::default().queue_create_infos(&queues);
+            if zero_init {
+                create = create.enabled_extension_names(&extensions).push_next(&mut enabled);
+            }
             let device = instance
-                .create_device(physical_device, &vk::DeviceCreateInfo::default().queue_create_infos(&queues), None)
+                .create_device(physical_device, &create, None)
                 .unwrap_or_else(|e| panic!("{test}: vkCreateDevice: {e:?}"));
             let queue = device.get_device_queue(family, 0);
             let command_pool = device
                 .create_command_pool(&vk::CommandPoolCreateInfo::default().queue_family_index(family), None)
                 .unwrap_or_else(|e| panic!("{test}: vkCreateCommandPool: {e:?}"));
-            Some(Self { _entry: entry, instance, physical_device, device, queue, command_pool })
+            Some(Self {
+                _entry: entry,
+                instance,
+                physical_device,
+                device,
+                queue,
+                command_pool,
+                zero_initializes_workgroup_memory: zero_init,
+            })
         }
     }
 

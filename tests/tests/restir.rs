@@ -256,33 +256,54 @@ fn every_method_converges_to_the_path_traced_reference() {
 /// by frame 6: the runs with the own reservoir alone cap it at 2, which binds from frame 3
 /// on (a merge capping M on one side of its MIS weights only was seen failing here: mean
 /// z² 359). Default settings otherwise: expectation shading (the kept sample's shading
-/// with temporal reuse is tested on the glass/metal/environment room).
-#[test]
-fn temporal_reuse_stays_unbiased() {
-    let Some(mut backend) = strata_tests::vulkan_backend("temporal_reuse_stays_unbiased") else {
+/// with temporal reuse is tested on the glass/metal/environment room). One test per
+/// method with drawn reservoirs, the longest runs here, so that they share the cores.
+fn temporal_reuse_stays_unbiased(test: &str, methods: &[Method], temporal_candidates: u32) {
+    let Some(mut backend) = strata_tests::vulkan_backend(test) else {
         assert!(!gpu_required());
         return;
     };
     let scene = default_scene();
     let reference = default_reference(&mut backend);
-    let default_cap = RestirSettings::default().temporal_cap;
-    for (temporal_candidates, temporal_cap, renders) in [(0, 2.0, 128), (4, default_cap, 512)] {
-        for method in [Method::Strata, Method::Restir, Method::RestirDisc] {
-            let restir = RestirSettings {
-                method,
-                selection: blocks_of_8(),
-                temporal_candidates,
-                temporal_cap,
-                ..RestirSettings::default()
-            };
-            let ours = restir_frames(&mut backend, &scene, restir, 1..renders + 1, 6);
-            let what = format!(
-                "{} with own + {temporal_candidates} drawn temporal reservoirs, cap {temporal_cap}, frame 6",
-                method.name()
-            );
-            assert_unbiased(&what, &ours, &reference);
-        }
+    let (temporal_cap, renders) =
+        if temporal_candidates == 0 { (2.0, 128) } else { (RestirSettings::default().temporal_cap, 512) };
+    for &method in methods {
+        let restir = RestirSettings {
+            method,
+            selection: blocks_of_8(),
+            temporal_candidates,
+            temporal_cap,
+            ..RestirSettings::default()
+        };
+        let ours = restir_frames(&mut backend, &scene, restir, 1..renders + 1, 6);
+        let what = format!(
+            "{} with own + {temporal_candidates} drawn temporal reservoirs, cap {temporal_cap}, frame 6",
+            method.name()
+        );
+        assert_unbiased(&what, &ours, &reference);
     }
+}
+
+#[test]
+fn temporal_reuse_stays_unbiased_with_the_own_reservoir() {
+    let methods = [Method::Strata, Method::Restir, Method::RestirDisc];
+    temporal_reuse_stays_unbiased("temporal_reuse_stays_unbiased_with_the_own_reservoir", &methods, 0);
+}
+
+#[test]
+fn temporal_reuse_stays_unbiased_with_drawn_reservoirs_restir() {
+    temporal_reuse_stays_unbiased("temporal_reuse_stays_unbiased_with_drawn_reservoirs_restir", &[Method::Restir], 4);
+}
+
+#[test]
+fn temporal_reuse_stays_unbiased_with_drawn_reservoirs_restir_disc() {
+    let test = "temporal_reuse_stays_unbiased_with_drawn_reservoirs_restir_disc";
+    temporal_reuse_stays_unbiased(test, &[Method::RestirDisc], 4);
+}
+
+#[test]
+fn temporal_reuse_stays_unbiased_with_drawn_reservoirs_strata() {
+    temporal_reuse_stays_unbiased("temporal_reuse_stays_unbiased_with_drawn_reservoirs_strata", &[Method::Strata], 4);
 }
 
 /// The `--shaded-parts` diagnostic: the base and the resampled part add up to the
@@ -595,46 +616,63 @@ fn glass_metal_environment_scene() -> Scene {
 /// map decide which pixels and candidates are reused, with and without temporal reuse,
 /// shading the kept sample or the final resampling's expectation, with smooth chains (the
 /// default) and without (expectation shading only); a 3 % bias is caught on the same scene.
-#[test]
-fn glass_metal_and_environment_reuse_stays_unbiased() {
-    let Some(mut backend) = strata_tests::vulkan_backend("glass_metal_and_environment_reuse_stays_unbiased") else {
+/// One test per method (they share the cores), all against one reference.
+fn glass_metal_and_environment_reuse_stays_unbiased(test: &str, method: Method) {
+    static REFERENCE: OnceLock<RegionStats> = OnceLock::new();
+    let Some(mut backend) = strata_tests::vulkan_backend(test) else {
         assert!(!gpu_required());
         return;
     };
     let scene = glass_metal_environment_scene();
-    let reference = reference(&mut backend, &scene, 2048);
+    let reference = REFERENCE.get_or_init(|| reference(&mut backend, &scene, 2048)).clone();
     let chains = RestirSettings::default().specular_chain;
     for (shading, specular_chain) in
         [(Shading::Sample, chains), (Shading::Expectation, chains), (Shading::Expectation, 0)]
     {
-        for method in [Method::Strata, Method::Restir, Method::RestirDisc] {
-            let restir = RestirSettings {
-                method,
-                shading,
-                specular_chain,
-                temporal: false,
-                selection: blocks_of_8(),
-                ..RestirSettings::default()
-            };
-            let ours = restir_frames(&mut backend, &scene, restir, 1..9, 32);
-            let what = format!(
-                "{} ({shading:?}, chain {specular_chain}) without temporal reuse, glass/metal/environment",
-                method.name()
-            );
-            assert_unbiased(&what, &ours, &reference);
-            if method == Method::Strata && shading == Shading::Sample {
-                let pooled = pooled_z(&ours.scaled(1.03), &reference);
-                assert!(pooled > 4.5, "a 3 % bias gives pooled z {pooled:.2} only");
-            }
-            let restir = RestirSettings { temporal: true, ..restir };
-            let ours = restir_frames(&mut backend, &scene, restir, 1..97, 6);
-            let what = format!(
-                "{} ({shading:?}, chain {specular_chain}) with temporal reuse, frame 6, glass/metal/environment",
-                method.name()
-            );
-            assert_unbiased(&what, &ours, &reference);
+        let restir = RestirSettings {
+            method,
+            shading,
+            specular_chain,
+            temporal: false,
+            selection: blocks_of_8(),
+            ..RestirSettings::default()
+        };
+        let ours = restir_frames(&mut backend, &scene, restir, 1..9, 32);
+        let what = format!(
+            "{} ({shading:?}, chain {specular_chain}) without temporal reuse, glass/metal/environment",
+            method.name()
+        );
+        assert_unbiased(&what, &ours, &reference);
+        if method == Method::Strata && shading == Shading::Sample {
+            let pooled = pooled_z(&ours.scaled(1.03), &reference);
+            assert!(pooled > 4.5, "a 3 % bias gives pooled z {pooled:.2} only");
         }
+        let restir = RestirSettings { temporal: true, ..restir };
+        let ours = restir_frames(&mut backend, &scene, restir, 1..97, 6);
+        let what = format!(
+            "{} ({shading:?}, chain {specular_chain}) with temporal reuse, frame 6, glass/metal/environment",
+            method.name()
+        );
+        assert_unbiased(&what, &ours, &reference);
     }
+}
+
+#[test]
+fn glass_metal_and_environment_reuse_stays_unbiased_restir() {
+    let test = "glass_metal_and_environment_reuse_stays_unbiased_restir";
+    glass_metal_and_environment_reuse_stays_unbiased(test, Method::Restir);
+}
+
+#[test]
+fn glass_metal_and_environment_reuse_stays_unbiased_restir_disc() {
+    let test = "glass_metal_and_environment_reuse_stays_unbiased_restir_disc";
+    glass_metal_and_environment_reuse_stays_unbiased(test, Method::RestirDisc);
+}
+
+#[test]
+fn glass_metal_and_environment_reuse_stays_unbiased_strata() {
+    let test = "glass_metal_and_environment_reuse_stays_unbiased_strata";
+    glass_metal_and_environment_reuse_stays_unbiased(test, Method::Strata);
 }
 
 /// The default room with a mirror floor (a GGX conductor of alpha 0.01, below the default

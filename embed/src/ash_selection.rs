@@ -16,8 +16,9 @@ use strata_kernels::translate::{TranslateOptions, WorkgroupZeroInit, spirv};
 use strata_kernels::types::HistogramParams;
 use strata_kernels::{Executor, Registry};
 
-/// The engine's Vulkan objects the pass is created on (the device must be Vulkan 1.1 or
-/// newer; nothing has to be enabled beyond core features).
+/// The engine's Vulkan objects the pass is created on (the instance created with
+/// `apiVersion` 1.1 or newer and a Vulkan 1.1 device; nothing has to be enabled beyond
+/// core features).
 #[derive(Clone, Copy)]
 pub struct AshDevice<'a> {
     /// The instance.
@@ -31,17 +32,33 @@ pub struct AshDevice<'a> {
     /// zeroed workgroup memory: with the feature the driver zeroes it, without it each
     /// pipeline carries code of its own that does (naga's polyfill), which some drivers
     /// compile far more slowly: on lavapipe the histogram pipeline took 600 ms to build
-    /// instead of 50 ms. `false` is always correct; `true` for a device that lacks the
-    /// feature is refused.
+    /// instead of 50 ms. `false` is always correct. `true` for a device that lacks the
+    /// feature is refused; `true` for one that has it but where the engine did not
+    /// enable it cannot be detected and makes the pipelines invalid usage.
     pub shader_zero_initialize_workgroup_memory: bool,
 }
 
-/// Whether the physical device has `shaderZeroInitializeWorkgroupMemory`.
-fn zero_initialize_workgroup_memory(instance: &ash::Instance, physical_device: vk::PhysicalDevice) -> bool {
+/// Whether the physical device has `shaderZeroInitializeWorkgroupMemory`: Vulkan 1.3, or
+/// the extension listed, and the feature reported.
+fn zero_initialize_workgroup_memory(
+    instance: &ash::Instance,
+    physical_device: vk::PhysicalDevice,
+    api_version: u32,
+) -> bool {
+    let extension = ash::khr::zero_initialize_workgroup_memory::NAME;
+    // SAFETY: valid instance and physical device handles from the engine.
+    let listed = unsafe { instance.enumerate_device_extension_properties(physical_device) }
+        .unwrap_or_default()
+        .iter()
+        .any(|e| e.extension_name_as_c_str() == Ok(extension));
+    if api_version < vk::API_VERSION_1_3 && !listed {
+        return false;
+    }
     let mut zero_init = vk::PhysicalDeviceZeroInitializeWorkgroupMemoryFeatures::default();
     let mut features = vk::PhysicalDeviceFeatures2::default().push_next(&mut zero_init);
-    // SAFETY: valid instance and physical device handles from the engine (Vulkan 1.1, checked
-    // before; a driver without the extension leaves the chained struct's field false).
+    // SAFETY: valid handles from the engine, whose instance is Vulkan 1.1 or newer (AshDevice's
+    // contract) on a device of 1.1 or newer (checked before); the chained struct is one the
+    // device knows (1.3, or its extension listed).
     unsafe { instance.get_physical_device_features2(physical_device, &mut features) };
     zero_init.shader_zero_initialize_workgroup_memory == vk::TRUE
 }
@@ -145,7 +162,7 @@ impl AshSelection {
             });
         }
         if vulkan.shader_zero_initialize_workgroup_memory
-            && !zero_initialize_workgroup_memory(vulkan.instance, vulkan.physical_device)
+            && !zero_initialize_workgroup_memory(vulkan.instance, vulkan.physical_device, properties.api_version)
         {
             return Err(EmbedError::UnsupportedFeature {
                 field: "AshDevice.shader_zero_initialize_workgroup_memory",

@@ -155,20 +155,24 @@ impl AshEngine {
             let priorities = [1.0];
             let queues =
                 [vk::DeviceQueueCreateInfo::default().queue_family_index(family).queue_priorities(&priorities)];
-            let mut supported = vk::PhysicalDeviceZeroInitializeWorkgroupMemoryFeatures::default();
-            instance.get_physical_device_features2(
-                physical_device,
-                &mut vk::PhysicalDeviceFeatures2::default().push_next(&mut supported),
-            );
+            // The feature through its extension (the instance is 1.2): asked for only where
+            // the device is 1.1 or newer and lists the extension.
             let extension = ash::khr::zero_initialize_workgroup_memory::NAME;
-            let has_extension = instance
-                .enumerate_device_extension_properties(physical_device)
-                .unwrap_or_default()
-                .iter()
-                .any(|e| e.extension_name_as_c_str() == Ok(extension));
-            let zero_init = zero_init_if_supported
-                && has_extension
-                && supported.shader_zero_initialize_workgroup_memory == vk::TRUE;
+            let has_extension = instance.get_physical_device_properties(physical_device).api_version
+                >= vk::API_VERSION_1_1
+                && instance
+                    .enumerate_device_extension_properties(physical_device)
+                    .unwrap_or_default()
+                    .iter()
+                    .any(|e| e.extension_name_as_c_str() == Ok(extension));
+            let mut supported = vk::PhysicalDeviceZeroInitializeWorkgroupMemoryFeatures::default();
+            if zero_init_if_supported && has_extension {
+                instance.get_physical_device_features2(
+                    physical_device,
+                    &mut vk::PhysicalDeviceFeatures2::default().push_next(&mut supported),
+                );
+            }
+            let zero_init = supported.shader_zero_initialize_workgroup_memory == vk::TRUE;
             let mut enabled = vk::PhysicalDeviceZeroInitializeWorkgroupMemoryFeatures::default()
                 .shader_zero_initialize_workgroup_memory(true);
             let extensions = [extension.as_ptr()];

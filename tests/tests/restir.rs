@@ -265,6 +265,8 @@ fn temporal_reuse_stays_unbiased(test: &str, methods: &[Method], temporal_candid
     };
     let scene = default_scene();
     let reference = default_reference(&mut backend);
+    // The own reservoir alone: cap 2, binding from frame 3; with drawn ones: the default cap
+    // and four times the renders (heavier tails, see above).
     let (temporal_cap, renders) =
         if temporal_candidates == 0 { (2.0, 128) } else { (RestirSettings::default().temporal_cap, 512) };
     for &method in methods {

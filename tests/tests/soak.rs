@@ -9,8 +9,9 @@
 //! renderers) alive instead of dropping them must raise the live allocations.
 //! The tests take turns: the resident set is the whole process's. Measured (lavapipe,
 //! 2026-11-25): 200 wgpu passes made, run and dropped move host memory by 0.3-1.3 MB,
-//! 200 ash passes by 0 (0.5-2.8 MB on 2026-11-26 with the device zeroing workgroup
-//! memory itself, which lets the 220 passes build in 16-17 s instead of 118); 200 frames
+//! 200 ash passes by 0 on a device with core features only (the ash test now runs on
+//! one that zeroes workgroup memory itself, where the 220 passes build in 16-17 s instead
+//! of 118, the objects made and destroyed being the same: 0.5-2.8 MB); 200 frames
 //! of each method by less than the tolerance. Each cycle submits work: lavapipe frees
 //! destroyed pipelines only at a later submission, so passes made and destroyed with no
 //! work in between grew host memory by megabytes each. Linux only (reads `/proc`);

@@ -5,6 +5,11 @@
 //! * `embed_720p/select_B{4,8,16,32}`: histogram + selection at 1280 × 720 per block size.
 //! * `embed_720p/select_resample_B16`: the same plus the resampling pass.
 //! * `embed_720p/empty_submit`: an empty submission and wait, the floor of the others.
+//! * `embed_build/ash_polyfill`, `embed_build/ash_native`: what making and destroying the
+//!   ash flavour's pass costs (its three pipelines and buffers) on a raw Vulkan device,
+//!   with `AshDevice::shader_zero_initialize_workgroup_memory` false (the pipelines zero
+//!   workgroup memory themselves) and true (the driver does; the device has the feature
+//!   enabled), side by side on the same device.
 //!
 //! Run: `cargo bench -p strata-benches --bench embed`.
 
@@ -109,5 +114,34 @@ fn embed(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, embed);
+/// `embed_build`: AshSelection::new + destroy on one device, zeroing workgroup memory in
+/// the shaders or leaving it to the driver. Each iteration ends with a submission: lavapipe
+/// frees destroyed pipelines only when its queue next does work (RELIABILITY.md).
+fn embed_build(c: &mut Criterion) {
+    let Some(engine) = strata_tests::AshEngine::open("embed_build bench") else {
+        return;
+    };
+    if !engine.zero_initializes_workgroup_memory {
+        eprintln!("embed_build bench: the device cannot zero workgroup memory itself");
+        return;
+    }
+    let mut group = c.benchmark_group("embed_build");
+    group.sample_size(10).measurement_time(Duration::from_secs(10));
+    for (name, native) in [("ash_polyfill", false), ("ash_native", true)] {
+        let vulkan =
+            strata_embed::AshDevice { shader_zero_initialize_workgroup_memory: native, ..engine.embed_device() };
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let pass =
+                    strata_embed::AshSelection::new(vulkan, SelectionSettings::default(), WIDTH, HEIGHT).expect("pass");
+                // SAFETY: nothing was recorded with the pass.
+                unsafe { pass.destroy() };
+                engine.submit(|_| {});
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, embed, embed_build);
 criterion_main!(benches);

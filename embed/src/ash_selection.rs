@@ -45,13 +45,15 @@ fn zero_initialize_workgroup_memory(
     physical_device: vk::PhysicalDevice,
     api_version: u32,
 ) -> bool {
-    let extension = ash::khr::zero_initialize_workgroup_memory::NAME;
-    // SAFETY: valid instance and physical device handles from the engine.
-    let listed = unsafe { instance.enumerate_device_extension_properties(physical_device) }
-        .unwrap_or_default()
-        .iter()
-        .any(|e| e.extension_name_as_c_str() == Ok(extension));
-    if api_version < vk::API_VERSION_1_3 && !listed {
+    let listed = || {
+        let extension = ash::khr::zero_initialize_workgroup_memory::NAME;
+        // SAFETY: valid instance and physical device handles from the engine.
+        unsafe { instance.enumerate_device_extension_properties(physical_device) }
+            .unwrap_or_default()
+            .iter()
+            .any(|e| e.extension_name_as_c_str() == Ok(extension))
+    };
+    if api_version < vk::API_VERSION_1_3 && !listed() {
         return false;
     }
     let mut zero_init = vk::PhysicalDeviceZeroInitializeWorkgroupMemoryFeatures::default();

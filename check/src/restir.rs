@@ -1,7 +1,8 @@
 //! Check of the five ReSTIR kernels. Like the path tracer they have no Rust mirror: the
 //! reference executor is the CPU interpreter running the same WGSL. Each case renders
 //! two frames (so the temporal merge has a history) of the default scene, or of the same
-//! room with a glass box, a rough-metal box and an environment, at sizes with partial
+//! room with a glass box, a rough-metal box and an environment (every fourth seed with a
+//! glossy wall resampled by random replay), at sizes with partial
 //! workgroups and blocks, on the interpreter, recording every pass's inputs and outputs
 //! (see [`super::replay`]). Each backend then runs each kernel's pass of the second
 //! frame alone on the interpreter's exact inputs, so a difference is that pass's own:
@@ -15,6 +16,7 @@ use std::sync::Arc;
 use strata::histogram_pass::PassError;
 use strata::render::{GpuScene, RenderSettings};
 use strata::restir::{Method, RestirRenderer, RestirSettings};
+use strata::scene::Material;
 use strata_backends::Backend;
 use strata_kernels::selection::{SamplerVariant, SelectionSettings};
 use strata_kernels::{KernelId, Registry};
@@ -22,9 +24,28 @@ use strata_kernels::{KernelId, Registry};
 /// Checks one of the ReSTIR kernels ([`KernelId::RestirCandidates`] and the four after it).
 pub struct RestirCheck(pub KernelId);
 
+/// Whether `case` resamples by random replay: the glass, metal and environment room with
+/// its left wall a glossy conductor (GGX alpha 0.03, below `min_roughness`) and
+/// `glossy_replay` on, every fourth seed from 1 (each method in turn over the full check's
+/// seeds; seed 1, restir, in the quick one), up to 64x48 pixels (every candidate a replay
+/// pixel weighs is a traced path: at 128x128 the interpreter's recording took 2.5 min).
+fn resamples_by_random_replay(case: &Case) -> bool {
+    case.family == 1 && case.seed % 4 == 1 && case.width * case.height <= 64 * 48
+}
+
 /// Renders two frames of `case` (so the temporal passes have a history).
 fn frame(backend: &mut dyn Backend, case: &Case) -> Result<(), PassError> {
-    let scene = super::path::scene(case);
+    let mut scene = super::path::scene(case);
+    if resamples_by_random_replay(case) {
+        scene.materials.push(Material::RoughConductor {
+            alpha: 0.03,
+            eta: [0.2, 0.9, 1.1],
+            k: [3.9, 2.4, 2.2],
+            two_sided: true,
+        });
+        let glossy = scene.materials.len() - 1;
+        scene.shapes.iter_mut().filter(|shape| shape.name == "left").for_each(|shape| shape.material = glossy);
+    }
     let gpu_scene = GpuScene::build(&scene)?;
     let render =
         RenderSettings { rr_depth: 2, ..RenderSettings::for_scene(&scene, case.width, case.height, case.seed as u32) };
@@ -44,6 +65,7 @@ fn frame(backend: &mut dyn Backend, case: &Case) -> Result<(), PassError> {
         },
         disc_radius: 4.0,
         temporal_candidates,
+        glossy_replay: resamples_by_random_replay(case),
         ..RestirSettings::default()
     };
     let mut renderer = RestirRenderer::new(backend, &gpu_scene, &render, settings, scene.extent())?;
@@ -94,18 +116,17 @@ impl KernelCheck for RestirCheck {
             for &(width, height) in sizes {
                 let family = (seed % 2) as u32;
                 let block_size = [4, 8, 16][(seed % 3) as usize];
-                cases.push(Case {
-                    label: format!(
-                        "{width}x{height} seed {seed} B{block_size} {} {}",
-                        ["strata T=4", "restir T=0", "restir-disc T=2"][(seed % 3) as usize],
-                        ["default scene", "glass, metal, environment"][family as usize]
-                    ),
-                    width,
-                    height,
-                    block_size,
-                    seed,
-                    family,
-                });
+                let mut case = Case { label: String::new(), width, height, block_size, seed, family };
+                case.label = format!(
+                    "{width}x{height} seed {seed} B{block_size} {} {}",
+                    ["strata T=4", "restir T=0", "restir-disc T=2"][(seed % 3) as usize],
+                    match (family, resamples_by_random_replay(&case)) {
+                        (0, _) => "default scene",
+                        (_, false) => "glass, metal, environment",
+                        (_, true) => "glass, metal, environment, glossy wall replayed",
+                    }
+                );
+                cases.push(case);
             }
         }
         cases

@@ -159,7 +159,7 @@ shader_struct!(
         shaded_parts,
         shading,
         specular_chain,
-        _pad1,
+        replay,
         _pad2,
     ]
 );

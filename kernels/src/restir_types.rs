@@ -11,11 +11,17 @@ pub const KIND_SURFACE: u32 = 1;
 pub const KIND_ENVIRONMENT: u32 = 2;
 /// `PathCandidate.kind`: a non-Lambertian x2, usable by its own pixel only.
 pub const KIND_PRIVATE: u32 = 3;
+/// `PathCandidate.kind`: the random numbers of the rest of a glossy vertex's path (the PCG
+/// state in `light`), shared with other replay pixels by random replay.
+pub const KIND_REPLAY: u32 = 4;
 
 /// `Primary.flags`: the camera ray hit a surface.
 pub const PRIMARY_HIT: u32 = 1;
 /// `Primary.flags`: the pixel resamples (its primary hit is rough enough).
 pub const PRIMARY_RESAMPLE: u32 = 2;
+/// `Primary.flags`: the pixel resamples by random replay at a glossy conductor
+/// (`RestirParams::replay`); it takes `KIND_REPLAY` candidates only.
+pub const PRIMARY_REPLAY: u32 = 4;
 
 /// `RestirParams.method`: histogram + antithetic selection, inverse-CDF resampling.
 pub const METHOD_STRATA: u32 = 0;
@@ -73,8 +79,9 @@ pub struct RestirParams {
     /// Smooth vertices a camera path may pass through to the vertex it resamples at (0:
     /// only a rough primary hit resamples).
     pub specular_chain: u32,
-    /// Padding.
-    pub _pad1: u32,
+    /// 1: a glossy conductor (GGX alpha below `min_roughness`) resamples at its own vertex
+    /// by random replay instead of passing as a smooth vertex of the chain.
+    pub replay: u32,
     /// Padding.
     pub _pad2: u32,
 }
@@ -114,15 +121,19 @@ pub struct Primary {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct PathCandidate {
-    /// x2, or the direction of an environment candidate.
+    /// x2, or the direction of an environment candidate; `KIND_REPLAY`: the vertex it
+    /// was drawn at.
     pub position: [f32; 3],
     /// `KIND_*`.
     pub kind: u32,
-    /// x2's geometric normal flipped towards the y1 that found it.
+    /// x2's geometric normal flipped towards the y1 that found it; `KIND_REPLAY`: the
+    /// vertex's direction towards the previous vertex.
     pub normal: [f32; 3],
-    /// x2's emissive triangle when seen from its emitting side, else `NO_LIGHT`.
+    /// x2's emissive triangle when seen from its emitting side, else `NO_LIGHT`;
+    /// `KIND_REPLAY`: the PCG state the rest of the path starts from.
     pub light: u32,
-    /// Radiance x2 reflects towards y1 (emission excluded).
+    /// Radiance x2 reflects towards y1 (emission excluded); `KIND_REPLAY`: the replayed
+    /// path's estimate at the vertex it was drawn at.
     pub reflected: [f32; 3],
     /// Unbiased contribution weight W for its own pixel (0 for none).
     pub weight: f32,

@@ -617,7 +617,8 @@ fn glass_metal_environment_scene() -> Scene {
 /// Every method stays unbiased where glass, glossy and rough metal and an environment
 /// map decide which pixels and candidates are reused, with and without temporal reuse,
 /// shading the kept sample or the final resampling's expectation, with smooth chains (the
-/// default) and without (expectation shading only); a 3 % bias is caught on the same scene.
+/// default) and without, with random replay at the alpha-0.03 wall and without; a 3 % bias
+/// is caught on the same scene.
 /// One test per method (they share the cores), all against one reference.
 fn glass_metal_and_environment_reuse_stays_unbiased(test: &str, method: Method) {
     static REFERENCE: OnceLock<RegionStats> = OnceLock::new();
@@ -628,20 +629,24 @@ fn glass_metal_and_environment_reuse_stays_unbiased(test: &str, method: Method) 
     let scene = glass_metal_environment_scene();
     let reference = REFERENCE.get_or_init(|| reference(&mut backend, &scene, 2048)).clone();
     let chains = RestirSettings::default().specular_chain;
-    for (shading, specular_chain) in
-        [(Shading::Sample, chains), (Shading::Expectation, chains), (Shading::Expectation, 0)]
-    {
+    for (shading, specular_chain, glossy_replay) in [
+        (Shading::Sample, chains, true),
+        (Shading::Expectation, chains, false),
+        (Shading::Expectation, chains, true),
+        (Shading::Expectation, 0, false),
+    ] {
         let restir = RestirSettings {
             method,
             shading,
             specular_chain,
+            glossy_replay,
             temporal: false,
             selection: blocks_of_8(),
             ..RestirSettings::default()
         };
         let ours = restir_frames(&mut backend, &scene, restir, 1..9, 32);
         let what = format!(
-            "{} ({shading:?}, chain {specular_chain}) without temporal reuse, glass/metal/environment",
+            "{} ({shading:?}, chain {specular_chain}, replay {glossy_replay}) without temporal reuse, glass/metal/environment",
             method.name()
         );
         assert_unbiased(&what, &ours, &reference);
@@ -652,7 +657,7 @@ fn glass_metal_and_environment_reuse_stays_unbiased(test: &str, method: Method) 
         let restir = RestirSettings { temporal: true, ..restir };
         let ours = restir_frames(&mut backend, &scene, restir, 1..97, 6);
         let what = format!(
-            "{} ({shading:?}, chain {specular_chain}) with temporal reuse, frame 6, glass/metal/environment",
+            "{} ({shading:?}, chain {specular_chain}, replay {glossy_replay}) with temporal reuse, frame 6, glass/metal/environment",
             method.name()
         );
         assert_unbiased(&what, &ours, &reference);

@@ -219,6 +219,7 @@ impl RestirRenderer {
             min_distance: self.min_distance,
             min_roughness: self.settings.min_roughness,
             specular_chain: self.settings.specular_chain,
+            replay: u32::from(self.settings.glossy_replay),
             previous_origin: previous.origin.into(),
             previous_tan_half_x: previous.tan_half_x,
             previous_forward: previous.forward.into(),

@@ -121,6 +121,15 @@ pub struct RestirSettings {
     /// At most 16; the scene's `max_depth` bounds the chain too. Default 4 (a mirror,
     /// a glass object in and out, glass seen in a mirror).
     pub specular_chain: u32,
+    /// Random replay at glossy conductors (ReSTIR PT's hybrid shift completed: reconnect
+    /// where the vertex is rough, replay where it is not). On: a conductor below
+    /// `min_roughness` resamples at its own vertex, its candidates being the random numbers
+    /// of the rest of its path, which other such pixels re-trace from their own vertex
+    /// (`restir/reservoir.wgsl`, "Random replay", derives why this is unbiased); each
+    /// candidate a pixel weighs costs one traced path instead of one shadow ray. Off: such
+    /// a conductor is a smooth vertex of `specular_chain` (or path-traces alone). Dielectrics
+    /// always go through the chain.
+    pub glossy_replay: bool,
     /// No reconnection to a vertex closer than this (scene units) to a primary hit
     /// (the geometry term is singular there). Default: 1e-3 of the scene's extent, set by
     /// the renderer when 0.
@@ -143,6 +152,7 @@ impl Default for RestirSettings {
             disc_radius: 30.0,
             min_roughness: 0.05,
             specular_chain: 4,
+            glossy_replay: false,
             min_distance: 0.0,
             shaded_parts: ShadedParts::All,
             shading: Shading::Expectation,

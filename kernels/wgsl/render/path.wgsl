@@ -94,9 +94,6 @@ fn trace_path_from(start: Ray, first_depth: u32, start_pdf: f32, start_specular:
 // `wo_world` by reflection or refraction, emission excluded: next-event estimation there
 // and one BSDF-sampled continuation, exactly as trace_path_from does at that vertex.
 fn scatter_from(surface: Surface, wo_world: vec3<f32>, depth: u32, lane: u32) -> PathSample {
-    if depth >= params.max_depth {
-        return PathSample(vec3<f32>(0.0), false);
-    }
     let material = materials[surface.material];
     let cos_out = dot(surface.normal, wo_world);
     var shading_normal = surface.normal;
@@ -106,12 +103,29 @@ fn scatter_from(surface: Surface, wo_world: vec3<f32>, depth: u32, lane: u32) ->
         }
         shading_normal = -shading_normal;
     }
-    let frame = make_frame(shading_normal);
+    return scatter_at(surface.position, shading_normal, material, albedo_at(material, surface.uv), wo_world, depth, lane);
+}
+
+// scatter_from at a point whose side is already settled: `normal` is the geometric normal
+// on the side the BSDF is evaluated from (flipped towards `wo_world` at the back of a
+// two-sided surface; ray offsets and shadow rays depend only on the line it spans).
+fn scatter_at(
+    position: vec3<f32>,
+    normal: vec3<f32>,
+    material: Material,
+    albedo: vec3<f32>,
+    wo_world: vec3<f32>,
+    depth: u32,
+    lane: u32,
+) -> PathSample {
+    if depth >= params.max_depth {
+        return PathSample(vec3<f32>(0.0), false);
+    }
+    let frame = make_frame(normal);
     let wo = to_local(frame, wo_world);
-    let albedo = albedo_at(material, surface.uv);
     var radiance = vec3<f32>(0.0);
     if (params.flags & FLAG_SAMPLE_LIGHTS) != 0u && !is_specular(material) {
-        radiance = direct_light(surface.position, surface.normal, frame, material, albedo, wo, lane);
+        radiance = direct_light(position, normal, frame, material, albedo, wo, lane);
     }
     let u = random2();
     let sample = bsdf_sample(material, albedo, wo, u, random());
@@ -119,7 +133,7 @@ fn scatter_from(surface: Surface, wo_world: vec3<f32>, depth: u32, lane: u32) ->
         return PathSample(radiance, false);
     }
     let direction = normalize(to_world(frame, sample.wi));
-    let ray = spawn_ray(surface.position, surface.normal, direction, INFINITY);
+    let ray = spawn_ray(position, normal, direction, INFINITY);
     let rest = trace_path_from(ray, depth + 1u, sample.pdf, sample.specular, lane);
     return PathSample(radiance + sample.weight * rest.radiance, rest.invalid);
 }

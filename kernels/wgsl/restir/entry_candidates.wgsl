@@ -8,8 +8,13 @@
 // for the histogram by the luminance of its own estimate f(Y) W (§4.1). `base_radiance`
 // holds what is not resampled: the emission y1 shows the camera.
 //
-// Smooth primary hits (a dielectric, a conductor below RestirParams.min_roughness) are
-// too sharp to reconnect from. With RestirParams.specular_chain > 0 the path goes on
+// A glossy conductor (GGX alpha below RestirParams.min_roughness) with RestirParams.replay
+// on resamples at its own vertex by random replay: its candidate is the random numbers of
+// the rest of its path (kind REPLAY, restir/reservoir.wgsl derives why that is unbiased),
+// and the key is the luminance of the estimate Ĉ(y, u) they give there.
+//
+// Other smooth primary hits (a dielectric; a conductor below min_roughness without replay)
+// are too sharp to reconnect from. With RestirParams.specular_chain > 0 the path goes on
 // through up to that many smooth vertices exactly as the path tracer would (BSDF
 // sampling, next-event estimation at glossy conductors, MIS-weighted emission, Russian
 // roulette; all of it into `base_radiance`, weighted by the throughput so far) and the
@@ -51,11 +56,11 @@ fn light_area_density(light: u32) -> f32 {
 
 // (p̂, RIS weight p̂ / (p_bsdf + p_light)) of `candidate` at `primary`, given the
 // density with which next-event estimation draws it; zero for no candidate.
-fn ris_weight(primary: Primary, candidate: PathCandidate, light_density: f32) -> vec2<f32> {
+fn ris_weight(primary: Primary, candidate: PathCandidate, light_density: f32, lane: u32) -> vec2<f32> {
     if candidate.kind == KIND_NONE {
         return vec2<f32>(0.0);
     }
-    let target_value = target_function(primary, candidate);
+    let target_value = target_function(primary, candidate, lane);
     let density = bsdf_density(primary, candidate) + light_density;
     if !(density > 0.0) {
         return vec2<f32>(target_value, 0.0);
@@ -164,8 +169,8 @@ fn draw_candidate(primary: Primary, surface: Surface, lane: u32) -> Drawn {
         }
     }
     // RIS over the two samples, balance heuristic: w = p̂ / (p_bsdf + p_light).
-    let bsdf_ris = ris_weight(primary, bsdf_candidate, bsdf_light_density);
-    let light_ris = ris_weight(primary, light_candidate, light_density);
+    let bsdf_ris = ris_weight(primary, bsdf_candidate, bsdf_light_density, lane);
+    let light_ris = ris_weight(primary, light_candidate, light_density, lane);
     let total = bsdf_ris.y + light_ris.y;
     var candidate = no_candidate();
     if total > 0.0 && total < INFINITY {
@@ -225,12 +230,24 @@ fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
             }
             let rough = material.kind == MATERIAL_DIFFUSE
                 || (material.kind == MATERIAL_CONDUCTOR && material.alpha >= restir.min_roughness);
+            let replay = restir.replay != 0u && material.kind == MATERIAL_CONDUCTOR && !rough;
             let front = material.kind == MATERIAL_DIELECTRIC || cos_out > 0.0 || material.two_sided != 0u;
             let albedo = albedo_at(material, surface.uv);
             primary = Primary(
                 surface.position, surface.object_id, normal, surface.material, wo_world, PRIMARY_HIT, albedo, length,
                 throughput, segment, camera_hit, 0u,
             );
+            if replay && front && segment < params.max_depth {
+                // A glossy conductor with random replay on: the candidate is the rest of
+                // the path's random numbers, u uniform (W = 1), and the estimate Ĉ(y, u)
+                // they give here (restir/reservoir.wgsl, "Random replay").
+                primary.flags |= PRIMARY_RESAMPLE | PRIMARY_REPLAY;
+                let seed = rng_state;
+                let own = replayed_sample(primary, seed, lane);
+                candidate = PathCandidate(primary.position, KIND_REPLAY, primary.wo, seed, own.radiance, 1.0);
+                invalid = invalid || own.invalid;
+                break;
+            }
             if rough && front && segment < params.max_depth {
                 primary.flags |= PRIMARY_RESAMPLE;
                 let drawn = draw_candidate(primary, surface, lane);
@@ -238,7 +255,7 @@ fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
                 invalid = invalid || drawn.invalid;
                 break;
             }
-            if rough || !front || chain >= restir.specular_chain || segment >= params.max_depth {
+            if rough || replay || !front || chain >= restir.specular_chain || segment >= params.max_depth {
                 // No resampling from here: the rest of the path, as the path tracer does it.
                 let rest = scatter_from(surface, wo_world, segment, lane);
                 base += throughput * rest.radiance;
@@ -301,7 +318,7 @@ fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
     var key = 0.0;
     if candidate.kind != KIND_NONE && candidate.weight > 0.0 && finite3(candidate.reflected) {
         // The luminance of the pixel's own one-sample estimate f(Y) W at its vertex.
-        key = target_function(primary, candidate) * candidate.weight;
+        key = target_function(primary, candidate, lane) * candidate.weight;
     } else {
         candidate = no_candidate();
     }

@@ -84,13 +84,16 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
     let positions = numbers.positions;
     let c = path_candidates[pixel];
     // p̂_i(x_c) W_c: the canonical candidate was found from y1, so it is visible.
-    let target_c = target_function(p, c);
+    let colour_c = integrand(p, c, lane);
+    let target_c = luminance(colour_c);
     let c_shareable = reconnectable(p, c);
     var weight_c = 0.0;
     // Per slot: resampling weight, target p̂ here, and the pixel whose candidate it is.
     var weights = vec4<f32>(0.0);
     var targets = vec4<f32>(0.0);
     var sources = vec4<u32>(pixel);
+    // Per slot f(x) here, for the expectation (a replayed candidate costs a traced path).
+    var colours = array<vec3<f32>, MAX_SELECTED>();
     for (var slot = 0u; slot < k; slot++) {
         let q = selected_pixel(id.x, id.y, pixel, p, slot, positions);
         if q == NO_PIXEL {
@@ -111,6 +114,7 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
                 weight_c += share * target_c * c.weight / f32(k);
                 weights[slot] = (1.0 - share) * target_c * c.weight / f32(k);
                 targets[slot] = target_c;
+                colours[slot] = colour_c;
             } else {
                 weight_c += target_c * c.weight / f32(k);
             }
@@ -121,7 +125,7 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
         if target_c > 0.0 {
             var target_neighbour_c = 0.0;
             if shares && c_shareable && reconnectable(neighbour, c) {
-                target_neighbour_c = target_function(neighbour, c);
+                target_neighbour_c = target_function(neighbour, c, lane);
                 if target_neighbour_c > 0.0 && !candidate_visible(neighbour, c, lane) {
                     target_neighbour_c = 0.0;
                 }
@@ -131,11 +135,13 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
         // The neighbour's half: x_j reconnected here, m_j = p̂_j / (p̂_i + p̂_j) at x_j
         // (p̂_j(x_j) > 0 and visible wherever W_j > 0).
         if shares && x.weight > 0.0 && reconnectable(p, x) && reconnectable(neighbour, x) {
-            let value = target_function(p, x);
+            let colour = integrand(p, x, lane);
+            let value = luminance(colour);
             if value > 0.0 && candidate_visible(p, x, lane) {
-                let there = target_function(neighbour, x);
+                let there = target_function(neighbour, x, lane);
                 weights[slot] = f32(k) * there / (value + f32(k) * there) * value * x.weight / f32(k);
                 targets[slot] = value;
+                colours[slot] = colour;
             }
         }
     }
@@ -183,15 +189,11 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
     // here (visible wherever its weight is positive, as p̂ required).
     var expected = vec3<f32>(0.0);
     if weight_c > 0.0 && target_c > 0.0 {
-        expected += weight_c / target_c * integrand(p, c);
+        expected += weight_c / target_c * colour_c;
     }
     for (var slot = 0u; slot < k; slot++) {
         if weights[slot] > 0.0 && targets[slot] > 0.0 {
-            var x = c;
-            if sources[slot] != pixel {
-                x = path_candidates[sources[slot]];
-            }
-            expected += weights[slot] / targets[slot] * integrand(p, x);
+            expected += weights[slot] / targets[slot] * colours[slot];
         }
     }
     result.expected = expected;

@@ -45,7 +45,7 @@ fn restir_shade(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_inv
             seen = reconnectable(p, y) && candidate_visible(p, y, lane);
         }
         if seen {
-            radiance += p.throughput * integrand(p, y) * reservoir.weight;
+            radiance += p.throughput * integrand(p, y, lane) * reservoir.weight;
         }
     }
     var invalid = base.w;

@@ -55,16 +55,21 @@
 
 const NO_SOURCE: u32 = 0xffffffffu;
 
-// p̂ of `y` at primary hit `p`: luminance of its contribution, visibility included.
-fn target_at(p: Primary, y: PathCandidate, lane: u32) -> f32 {
+// The contribution of `y` at primary hit `p`, visibility included.
+fn contribution_at(p: Primary, y: PathCandidate, lane: u32) -> vec3<f32> {
     if !reconnectable(p, y) {
-        return 0.0;
+        return vec3<f32>(0.0);
     }
-    let value = luminance(integrand(p, y));
-    if value > 0.0 && candidate_visible(p, y, lane) {
+    let value = integrand(p, y, lane);
+    if luminance(value) > 0.0 && candidate_visible(p, y, lane) {
         return value;
     }
-    return 0.0;
+    return vec3<f32>(0.0);
+}
+
+// p̂ of `y` at primary hit `p`: luminance of its contribution, visibility included.
+fn target_at(p: Primary, y: PathCandidate, lane: u32) -> f32 {
+    return luminance(contribution_at(p, y, lane));
 }
 
 // The previous frame's pixel whose reservoir drawn temporal slot `slot` of pixel (x, y)
@@ -87,16 +92,18 @@ fn drawn_source(x: u32, y: u32, pixel: u32, p: Primary, slot: u32, positions: ve
 
 // One pair (current c, previous reservoir of source s) of the merge, each pair sharing
 // `share`: c's half goes to `current_part`, the previous sample's resampling weight and
-// target here to `weight` and `target_here`, its capped M to `m`.
+// target here to `weight` and `target_here` (its contribution here to `colour_here`), its
+// capped M to `m`.
 struct PairTerms {
     current_part: f32,
     weight: f32,
     target_here: f32,
     m: f32,
+    colour_here: vec3<f32>,
 }
 
 fn pair_terms(p: Primary, current: Reservoir, s: u32, share: f32, lane: u32) -> PairTerms {
-    var terms = PairTerms(0.0, 0.0, 0.0, 0.0);
+    var terms = PairTerms(0.0, 0.0, 0.0, 0.0, vec3<f32>(0.0));
     var m_previous = 0.0;
     var previous = current;
     if s != NO_SOURCE {
@@ -126,11 +133,13 @@ fn pair_terms(p: Primary, current: Reservoir, s: u32, share: f32, lane: u32) -> 
     }
     // The previous sample shifted here.
     if previous.target_value > 0.0 {
-        let here = target_at(p, previous.sample, lane);
+        let colour = contribution_at(p, previous.sample, lane);
+        let here = luminance(colour);
         if here > 0.0 {
             let m = m_previous * previous.target_value / (m_current * here + m_previous * previous.target_value);
             terms.weight = share * m * here * previous.weight;
             terms.target_here = here;
+            terms.colour_here = colour;
         }
     }
     return terms;
@@ -165,6 +174,8 @@ fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
     var weights = vec4<f32>(0.0);
     var targets = vec4<f32>(0.0);
     var sources = vec4<u32>(NO_SOURCE);
+    // Per slot the previous sample's contribution here, for the expectation.
+    var colours = array<vec3<f32>, MAX_SELECTED>();
     for (var slot = 0u; slot < drawn; slot++) {
         let s = drawn_source(id.x, id.y, pixel, p, slot, positions);
         let terms = pair_terms(p, current, s, share, lane);
@@ -172,6 +183,7 @@ fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
         m_sum += terms.m;
         weights[slot] = terms.weight;
         targets[slot] = terms.target_here;
+        colours[slot] = terms.colour_here;
         sources[slot] = s;
     }
     var total = weight_current + own.weight;
@@ -192,14 +204,14 @@ fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
     // expectation: its MIS weight depends on which sample select kept.
     var expected = vec3<f32>(0.0);
     if weight_current > 0.0 && current.target_value > 0.0 {
-        expected += weight_current / current.target_value * integrand(p, current.sample);
+        expected += weight_current / current.target_value * integrand(p, current.sample, lane);
     }
     if own.weight > 0.0 && own.target_here > 0.0 {
-        expected += own.weight / own.target_here * integrand(p, previous_reservoirs[own_source].sample);
+        expected += own.weight / own.target_here * own.colour_here;
     }
     for (var slot = 0u; slot < drawn; slot++) {
         if weights[slot] > 0.0 && targets[slot] > 0.0 {
-            expected += weights[slot] / targets[slot] * integrand(p, previous_reservoirs[sources[slot]].sample);
+            expected += weights[slot] / targets[slot] * colours[slot];
         }
     }
     merged.expected = expected;

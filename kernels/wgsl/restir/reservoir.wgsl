@@ -12,6 +12,22 @@
 // PRIVATE). Surface candidates live in area measure at x2, environment candidates in
 // solid angle: the reconnection shift then has Jacobian 1.
 //
+// Random replay (RestirParams.replay, the other half of ReSTIR PT's hybrid shift, Lin et
+// al. 2022): a glossy conductor (GGX alpha below min_roughness) is too sharp to reconnect
+// from, and with replay on it resamples at its own vertex all the same. Its candidate
+// (kind REPLAY) is the random numbers of the rest of its path, a PCG state: the path
+// tracer's estimate from the vertex, Ĉ(y, u) = next-event estimation plus one
+// BSDF-sampled continuation and everything after it (render/path.wgsl, scatter_at), is a
+// deterministic function of the vertex y and the numbers u. Another replay pixel uses the
+// candidate by re-tracing its own path from its own vertex with the same numbers. The
+// candidates then live in primary sample space, where u is uniform (density 1): the
+// shift is the identity on u, its Jacobian 1, a pixel's own candidate has W = 1, and the
+// integrand is f_y(u) = Ĉ(y, u), whose integral over u is the radiance y reflects towards
+// the previous vertex (the path tracer is unbiased). p̂ is its luminance as for every
+// other kind, visibility included by the tracing. Replay pixels and reconnection pixels
+// share nothing (p̂ = 0 both ways), like pixels of different path segments, so each kind
+// of pixel resamples its own integral with the same GRIS weights.
+//
 // Bindings used with this fragment (group 0): 0-7 the scene (render/scene.wgsl) and
 //   8 uniform            RestirParams      the method and its settings
 
@@ -19,12 +35,18 @@ const KIND_NONE: u32 = 0u;
 const KIND_SURFACE: u32 = 1u;
 const KIND_ENVIRONMENT: u32 = 2u;
 const KIND_PRIVATE: u32 = 3u;
+// The random numbers of a path's rest (PathCandidate.light), shared with other replay
+// pixels by random replay.
+const KIND_REPLAY: u32 = 4u;
 
 // Primary.flags
 const PRIMARY_HIT: u32 = 1u;       // the camera ray hit a surface
 // PRIMARY_RESAMPLE: the resampling vertex (y1, or the first rough vertex behind a smooth
 // chain) is rough enough to reconnect from: the pixel resamples
 const PRIMARY_RESAMPLE: u32 = 2u;
+// PRIMARY_REPLAY: with PRIMARY_RESAMPLE, the vertex is a glossy conductor that resamples
+// by random replay (RestirParams.replay): it takes candidates of kind REPLAY only
+const PRIMARY_REPLAY: u32 = 4u;
 
 // RestirParams.method
 const METHOD_STRATA: u32 = 0u;       // histogram + stratified selection, inverse-CDF resampling (ours)
@@ -71,7 +93,9 @@ struct RestirParams {
     // Smooth vertices (dielectrics, conductors below min_roughness) a camera path may
     // pass through to the vertex it resamples at; 0: only a rough primary hit resamples.
     specular_chain: u32,
-    _pad1: u32,
+    // 1: a glossy conductor (GGX alpha below min_roughness, otherwise a smooth vertex of
+    // the chain) resamples at its own vertex by random replay (KIND_REPLAY above).
+    replay: u32,
     _pad2: u32,
 }
 
@@ -106,14 +130,17 @@ struct Primary {
 }
 
 struct PathCandidate {
-    // x2, or the direction of an environment candidate.
+    // x2, or the direction of an environment candidate; REPLAY: the vertex it was drawn at.
     position: vec3<f32>,
     kind: u32,
-    // x2's geometric normal, flipped towards the y1 that found it.
+    // x2's geometric normal, flipped towards the y1 that found it; REPLAY: the vertex's wo.
     normal: vec3<f32>,
-    // x2's emissive triangle when y1 sees its emitting side, else NO_LIGHT.
+    // x2's emissive triangle when y1 sees its emitting side, else NO_LIGHT; REPLAY: the
+    // PCG state the rest of the path starts from.
     light: u32,
-    // Radiance x2 reflects towards y1 (emission excluded), one-sample estimate.
+    // Radiance x2 reflects towards y1 (emission excluded), one-sample estimate; REPLAY:
+    // Ĉ(y, u) at the vertex it was drawn at (what a replay there gives, kept so that its
+    // own pixel need not trace it again).
     reflected: vec3<f32>,
     // Unbiased contribution weight W of the candidate for its own pixel (RIS over its
     // BSDF and light samples); 0 for none.
@@ -167,13 +194,47 @@ fn geometry_factor(x: PathCandidate, direction: vec3<f32>, distance: f32) -> f32
     return abs(dot(x.normal, direction)) / (distance * distance);
 }
 
+// Ĉ(p, u): the path tracer's estimate of the radiance resampling vertex `p` reflects
+// towards p.wo, with the random numbers of PCG state `seed`, traced from the vertex
+// (visibility included). The caller's own random stream is left where it was. A
+// traversal stack overflow gives nothing.
+fn replayed_sample(p: Primary, seed: u32, lane: u32) -> PathSample {
+    let saved = rng_state;
+    rng_state = seed;
+    let sample = scatter_at(p.position, p.normal, materials[p.material], p.albedo, p.wo, p.segment, lane);
+    rng_state = saved;
+    return sample;
+}
+
+// The contribution of replay candidate `x` to replay pixel `p`: Ĉ(p, u), read from the
+// candidate where `p` is the vertex it was drawn at (the replay is deterministic: same
+// vertex, same numbers, same path), re-traced otherwise.
+fn replayed(p: Primary, x: PathCandidate, lane: u32) -> vec3<f32> {
+    if all(p.position == x.position) && all(p.wo == x.normal) {
+        return x.reflected;
+    }
+    let sample = replayed_sample(p, x.light, lane);
+    if sample.invalid {
+        return vec3<f32>(0.0);
+    }
+    return sample.radiance;
+}
+
 // The contribution of candidate `x` to the pixel whose primary hit is `p`, in the
 // candidate's measure, visibility excluded: f(y1) cos (Le(x2) + Lr(x2)) |cos x2| / d².
 // Emission and reflection are both resampled: nothing of the first bounce is left to
-// the pixel alone but the emission it sees directly.
-fn integrand(p: Primary, x: PathCandidate) -> vec3<f32> {
+// the pixel alone but the emission it sees directly. A replay candidate's contribution
+// is the replayed path's (visibility included).
+fn integrand(p: Primary, x: PathCandidate, lane: u32) -> vec3<f32> {
     if x.kind == KIND_NONE || (p.flags & PRIMARY_RESAMPLE) == 0u {
         return vec3<f32>(0.0);
+    }
+    let replay_pixel = (p.flags & PRIMARY_REPLAY) != 0u;
+    if replay_pixel != (x.kind == KIND_REPLAY) {
+        return vec3<f32>(0.0);
+    }
+    if replay_pixel {
+        return replayed(p, x, lane);
     }
     let t = towards(p, x);
     let direction = t.xyz;
@@ -195,8 +256,8 @@ fn integrand(p: Primary, x: PathCandidate) -> vec3<f32> {
 }
 
 // p̂: the luminance of `integrand`.
-fn target_function(p: Primary, x: PathCandidate) -> f32 {
-    return luminance(integrand(p, x));
+fn target_function(p: Primary, x: PathCandidate, lane: u32) -> f32 {
+    return luminance(integrand(p, x, lane));
 }
 
 // Density with which the BSDF sampling at `p` finds candidate `x`, in the candidate's
@@ -218,9 +279,14 @@ fn same_segment(a: Primary, b: Primary) -> bool {
 
 // Whether the pixel of `p` may reconnect to candidate `x`: both rough, x shareable,
 // x2 far enough from y1 and seen from the side its reflected radiance was computed for.
+// A replay pixel takes replay candidates only, and every one of them (by replaying it).
 fn reconnectable(p: Primary, x: PathCandidate) -> bool {
     if (p.flags & PRIMARY_RESAMPLE) == 0u {
         return false;
+    }
+    let replay_pixel = (p.flags & PRIMARY_REPLAY) != 0u;
+    if replay_pixel || x.kind == KIND_REPLAY {
+        return replay_pixel && x.kind == KIND_REPLAY;
     }
     if x.kind == KIND_ENVIRONMENT {
         return true;
@@ -232,8 +298,11 @@ fn reconnectable(p: Primary, x: PathCandidate) -> bool {
     return length(to_primary) >= restir.min_distance && dot(x.normal, to_primary) > 0.0;
 }
 
-// Visibility between y1 and the candidate.
+// Visibility between y1 and the candidate (a replayed path carries its own).
 fn candidate_visible(p: Primary, x: PathCandidate, lane: u32) -> bool {
+    if x.kind == KIND_REPLAY {
+        return true;
+    }
     if x.kind == KIND_ENVIRONMENT {
         return unoccluded(p.position, p.normal, x.position, lane);
     }

@@ -109,6 +109,12 @@ pub(crate) struct CompareArgs {
     /// whose primary hit is smooth path-trace on their own (1 sample per frame, no reuse).
     #[arg(long, default_value_t = RestirSettings::default().specular_chain)]
     specular_chain: u32,
+    /// `true`: a conductor below --min-roughness resamples at its own vertex by random
+    /// replay (its candidates are the random numbers of the rest of its path, re-traced
+    /// by the pixels that reuse them), for every method alike; `false`: it is a smooth
+    /// vertex of --specular-chain.
+    #[arg(long, default_value_t = RestirSettings::default().glossy_replay, action = clap::ArgAction::Set)]
+    glossy_replay: bool,
     /// No reconnection to a vertex closer than this (scene units) to a primary hit;
     /// 0: 1e-3 of the scene's extent.
     #[arg(long, default_value_t = RestirSettings::default().min_distance)]
@@ -186,6 +192,7 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
         shading: args.shading,
         min_roughness: args.min_roughness,
         specular_chain: args.specular_chain,
+        glossy_replay: args.glossy_replay,
         min_distance: args.min_distance,
         ..RestirSettings::default()
     };
@@ -328,6 +335,7 @@ fn settings_record(
     put("temporal_cap", f64::from(restir.temporal_cap).into());
     put("min_roughness", f64::from(restir.min_roughness).into());
     put("specular_chain", restir.specular_chain.into());
+    put("glossy_replay", restir.glossy_replay.into());
     put("min_distance", f64::from(restir.min_distance).into());
     put("film", name(&|| clap::ValueEnum::to_possible_value(&film)).into());
     put("shaded_parts", name(&|| clap::ValueEnum::to_possible_value(&restir.shaded_parts)).into());

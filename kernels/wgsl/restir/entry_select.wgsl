@@ -93,7 +93,10 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
     var targets = vec4<f32>(0.0);
     var sources = vec4<u32>(pixel);
     // Per slot f(x) here, for the expectation (a replayed candidate costs a traced path).
-    var colours = array<vec3<f32>, MAX_SELECTED>();
+    // Written out element by element: naga turns the zero-value constructor
+    // `array<vec3<f32>, 4>()` into an HLSL cast `(float3[4])0` that glslang's HLSL front
+    // end rejects. MAX_SELECTED is 4.
+    var colours = array<vec3<f32>, MAX_SELECTED>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     for (var slot = 0u; slot < k; slot++) {
         let q = selected_pixel(id.x, id.y, pixel, p, slot, positions);
         if q == NO_PIXEL {

@@ -175,7 +175,10 @@ fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
     var targets = vec4<f32>(0.0);
     var sources = vec4<u32>(NO_SOURCE);
     // Per slot the previous sample's contribution here, for the expectation.
-    var colours = array<vec3<f32>, MAX_SELECTED>();
+    // Written out element by element: naga turns the zero-value constructor
+    // `array<vec3<f32>, 4>()` into an HLSL cast `(float3[4])0` that glslang's HLSL front
+    // end rejects. MAX_SELECTED is 4.
+    var colours = array<vec3<f32>, MAX_SELECTED>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     for (var slot = 0u; slot < drawn; slot++) {
         let s = drawn_source(id.x, id.y, pixel, p, slot, positions);
         let terms = pair_terms(p, current, s, share, lane);

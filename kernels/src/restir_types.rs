@@ -77,7 +77,7 @@ pub struct RestirParams {
     /// `SHADING_*`: the resampled part as the kept sample or as `Reservoir::expected`.
     pub shading: u32,
     /// Smooth vertices a camera path may pass through to the vertex it resamples at (0:
-    /// only a rough primary hit resamples).
+    /// only a rough primary hit resamples, or with `replay` a glossy conductor at it).
     pub specular_chain: u32,
     /// 1: a glossy conductor (GGX alpha below `min_roughness`) resamples at its own vertex
     /// by random replay instead of passing as a smooth vertex of the chain.

@@ -116,13 +116,15 @@ pub struct RestirSettings {
     /// pass through to find the vertex it resamples at: a pixel seeing a mirror or glass
     /// resamples at the first rough surface behind it, the chain's throughput weighting
     /// the result (the primary surface replacement of RTXDI-style renderers, unbiased:
-    /// `restir/entry_candidates.wgsl` derives it). 0: only a rough primary hit resamples
+    /// `restir/entry_candidates.wgsl` derives it). 0: only a rough primary hit resamples (or,
+    /// with `glossy_replay`, a glossy conductor at it)
     /// and every other pixel path-traces alone (the only behaviour until 2026-11-25).
     /// At most 16; the scene's `max_depth` bounds the chain too. Default 4 (a mirror,
     /// a glass object in and out, glass seen in a mirror).
     pub specular_chain: u32,
-    /// Random replay at glossy conductors (ReSTIR PT's hybrid shift completed: reconnect
-    /// where the vertex is rough, replay where it is not). On: a conductor below
+    /// Random replay at glossy conductors (ReSTIR PT's second shift beside reconnection;
+    /// not its hybrid within one path: a path here is reconnected at the vertex after its
+    /// resampling vertex or replayed whole). On: a conductor below
     /// `min_roughness` resamples at its own vertex, its candidates being the random numbers
     /// of the rest of its path, which other such pixels re-trace from their own vertex
     /// (`restir/reservoir.wgsl`, "Random replay", derives why this is unbiased); each

@@ -38,7 +38,8 @@
 //   13 storage, rw       array<Reservoir>      this frame's reservoir per pixel (M = 1)
 //   14 storage, read     array<u32>            blue_noise (BlueNoiseTables::packed)
 //
-// Dispatch: 8 x 8 pixels per workgroup. Shadow rays: up to 2K per pixel.
+// Dispatch: 8 x 8 pixels per workgroup. Shadow rays: up to 2K per pixel; a replay pixel
+// (reservoir.wgsl, "Random replay") traces up to 2K paths instead.
 
 @group(0) @binding(9) var<storage, read> primaries: array<Primary>;
 @group(0) @binding(10) var<storage, read> path_candidates: array<PathCandidate>;
@@ -107,8 +108,9 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
         let neighbour = primaries[q];
         let x = path_candidates[q];
         // Pixels reaching their resampling vertices with different segments share
-        // nothing (reservoir.wgsl, same_segment): p̂_j = 0 both ways.
-        let shares = same_segment(p, neighbour);
+        // nothing (reservoir.wgsl, may_share; nor do replay and reconnection pixels):
+        // p̂_j = 0 both ways.
+        let shares = may_share(p, neighbour);
         sources[slot] = q;
         if q == pixel {
             // The pixel's own candidate drawn again: both halves of the pair are c.

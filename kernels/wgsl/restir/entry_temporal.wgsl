@@ -41,7 +41,9 @@
 //   16 storage, read     array<u32>          temporal sources (restir_temporal_keys)
 //   17 storage, read     array<u32>          blue_noise (BlueNoiseTables::packed)
 //
-// Dispatch: 8 x 8 pixels per workgroup. Shadow rays: 2 per merged previous reservoir.
+// Dispatch: 8 x 8 pixels per workgroup. Shadow rays: 2 per merged previous reservoir; a
+// replay pixel traces 2 paths per merged reservoir instead, and one more for the
+// expectation when select kept another pixel's sample.
 
 @group(0) @binding(9) var<storage, read> primaries: array<Primary>;
 @group(0) @binding(10) var<storage, read> previous_primaries: array<Primary>;
@@ -118,8 +120,8 @@ fn pair_terms(p: Primary, current: Reservoir, s: u32, share: f32, lane: u32) -> 
     }
     let m_current = current.count;
     let previous_primary = previous_primaries[s];
-    if !same_segment(p, previous_primary) {
-        // Another path segment (reservoir.wgsl, same_segment): p̂ is 0 both ways, and c
+    if !may_share(p, previous_primary) {
+        // Another path segment or kind of shift (reservoir.wgsl, may_share): p̂ is 0 both ways, and c
         // alone covers the pair, which merges nothing and so adds no confidence M.
         terms.current_part = share * target_current * current.weight;
         return terms;

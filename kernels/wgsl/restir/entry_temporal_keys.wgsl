@@ -61,7 +61,7 @@ fn restir_temporal_keys(@builtin(global_invocation_id) id: vec3<u32>) {
         let q = reproject(p.camera_hit);
         if q != NO_SOURCE {
             let previous = previous_primaries[q];
-            if (previous.flags & PRIMARY_RESAMPLE) != 0u && previous.object_id == p.object_id && same_segment(previous, p)
+            if (previous.flags & PRIMARY_RESAMPLE) != 0u && previous.object_id == p.object_id && may_share(previous, p)
                 && dot(previous.normal, p.normal) >= 0.906 && abs(previous.depth - p.depth) <= 0.1 * p.depth {
                 source = q;
                 let reservoir = previous_reservoirs[q];

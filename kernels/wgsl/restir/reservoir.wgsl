@@ -91,7 +91,8 @@ struct RestirParams {
     // frame's final resampling (Reservoir.expected).
     shading: u32,
     // Smooth vertices (dielectrics, conductors below min_roughness) a camera path may
-    // pass through to the vertex it resamples at; 0: only a rough primary hit resamples.
+    // pass through to the vertex it resamples at; 0: only a rough primary hit resamples
+    // (or, with `replay`, a glossy conductor at it).
     specular_chain: u32,
     // 1: a glossy conductor (GGX alpha below min_roughness, otherwise a smooth vertex of
     // the chain) resamples at its own vertex by random replay (KIND_REPLAY above).
@@ -214,7 +215,9 @@ fn replayed(p: Primary, x: PathCandidate, lane: u32) -> vec3<f32> {
         return x.reflected;
     }
     let sample = replayed_sample(p, x.light, lane);
-    if sample.invalid {
+    // As the candidates pass drops a non-finite own estimate, so a replay gives nothing
+    // (an infinite value would turn a merge's total into NaN and empty the reservoir).
+    if sample.invalid || !finite3(sample.radiance) {
         return vec3<f32>(0.0);
     }
     return sample.radiance;
@@ -275,6 +278,14 @@ fn bsdf_density(p: Primary, x: PathCandidate) -> f32 {
 // hold samples of their own segment, so this is a property of each sample too).
 fn same_segment(a: Primary, b: Primary) -> bool {
     return a.segment == b.segment;
+}
+
+// Whether pixels whose resampling vertices are `a` and `b` resample the same kind of
+// integral and so may share candidates and histories: the same segment, and both
+// reconnection pixels or both replay pixels (p̂ is 0 across the kinds; a merge with the
+// other kind would merge nothing yet count its confidence M).
+fn may_share(a: Primary, b: Primary) -> bool {
+    return same_segment(a, b) && (a.flags & PRIMARY_REPLAY) == (b.flags & PRIMARY_REPLAY);
 }
 
 // Whether the pixel of `p` may reconnect to candidate `x`: both rough, x shareable,

@@ -5,8 +5,8 @@
 //               stratified positions of strata/selection.wgsl, run_member)
 //   restir      the same run at a uniformly random position
 //   restir-disc a uniformly random pixel of the disc of RestirParams.disc_radius pixels,
-//               kept only if it resamples, with the same path segment (reservoir.wgsl,
-//               same_segment), faces the same way (normals
+//               kept only if it resamples, with the same path segment and kind of
+//               shift (reservoir.wgsl, may_share), faces the same way (normals
 //               within 25 degrees) and lies at a similar depth (10 %)
 //
 // Needs from the kernel that includes it: `params`, `restir`, `primaries` (this frame's
@@ -27,7 +27,7 @@ fn disc_neighbour(x: u32, y: u32, p: Primary) -> u32 {
     }
     let q = u32(qy) * params.width + u32(qx);
     let n = primaries[q];
-    if (n.flags & PRIMARY_RESAMPLE) == 0u || !same_segment(n, p) || dot(n.normal, p.normal) < 0.906
+    if (n.flags & PRIMARY_RESAMPLE) == 0u || !may_share(n, p) || dot(n.normal, p.normal) < 0.906
         || abs(n.depth - p.depth) > 0.1 * p.depth {
         return NO_PIXEL;
     }

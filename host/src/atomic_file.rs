@@ -1,11 +1,20 @@
-//! Output files that are either complete or absent. Every file strata writes is first
-//! written under a hidden temporary name in the same folder (`.NAME.tmp-PID.EXT`, the
-//! extension kept because some encoders choose the format by it) and then renamed into
-//! place, which POSIX makes atomic within one file system. A run killed while writing
-//! leaves at most a hidden temporary file, never a truncated EXR, PNG or CSV under the
-//! final name that looks valid; the next run into the folder removes such leftovers
-//! ([`is_temporary`]).
+//! Output files that are either complete or absent: strata's one writer of files.
+//!
+//! Every encoder (EXR, PNG, CSV, SVG, JSON, HTML) makes its bytes in memory; [`write`]
+//! then puts them on the disk under a hidden temporary name in the same folder
+//! (`.NAME.tmp-PID.EXT`), forces them to the device (`fsync`, which is where a full disk
+//! or a failing device says so for data a write call had accepted into the page cache),
+//! checks that the file holds every byte, and only then renames it into place, which
+//! POSIX makes atomic within one file system. So:
+//! - a run killed while writing leaves at most a hidden temporary file, never a truncated
+//!   EXR, PNG or CSV under the final name that looks valid; the next run into the folder
+//!   removes such leftovers ([`is_temporary`]);
+//! - a full disk is an error naming the file, never a 0-byte file reported as written;
+//! - the target must be a regular file or absent: a rename would silently replace a
+//!   device node (`/dev/full`), a folder's entry of another kind or a symbolic link with
+//!   a regular file, so those are refused before anything is written.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The hidden temporary name `path` is written under before the rename.
@@ -23,79 +32,179 @@ pub fn is_temporary(name: &str) -> bool {
     name.starts_with('.') && name.contains(".tmp-")
 }
 
-/// Writes a file through `write`, which is given the temporary path to create, then
-/// renames it to `path`. On any error the temporary file is removed and `path` is left
-/// as it was.
-pub fn write_with<E>(path: &Path, write: impl FnOnce(&Path) -> Result<(), E>) -> Result<(), AtomicError<E>> {
-    let temporary = temporary_path(path);
-    if let Err(error) = write(&temporary) {
-        let _ = std::fs::remove_file(&temporary);
-        return Err(AtomicError::Write(error));
+/// Why a file cannot be written; the message names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum WriteError {
+    /// Something other than a regular file (a device, a folder, a socket, a symbolic
+    /// link) already has the name: replacing it is never what a user asked for.
+    #[error("{path}: is {kind}, not a regular file: strata writes only regular files and does not replace it")]
+    NotRegular {
+        /// The target.
+        path: String,
+        /// What is there ("a character device", "a folder", ...).
+        kind: &'static str,
+    },
+    /// Writing, syncing or renaming failed (a full disk, no permission, ...).
+    #[error("{path}: cannot write: {source}")]
+    Io {
+        /// The target.
+        path: String,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
+    /// The file on disk is shorter than what was written (a file system that accepted
+    /// the bytes and lost them).
+    #[error("{path}: cannot write: {written} of {expected} bytes reached the disk")]
+    Short {
+        /// The target.
+        path: String,
+        /// Bytes found on disk.
+        written: u64,
+        /// Bytes written.
+        expected: u64,
+    },
+}
+
+/// What kind of entry `metadata` describes, in words, if it is not a regular file.
+fn not_regular(metadata: &std::fs::Metadata) -> Option<&'static str> {
+    let kind = metadata.file_type();
+    if kind.is_file() {
+        return None;
     }
-    std::fs::rename(&temporary, path).map_err(|error| {
-        let _ = std::fs::remove_file(&temporary);
-        AtomicError::Rename(error)
-    })
-}
-
-/// Writes `bytes` to `path` through a temporary file; an error names `path`.
-pub fn write(path: &Path, bytes: impl AsRef<[u8]>) -> anyhow::Result<()> {
-    write_with(path, |temporary| std::fs::write(temporary, bytes.as_ref())).map_err(|error| {
-        anyhow::anyhow!(
-            "{}: cannot write: {}",
-            path.display(),
-            match error {
-                AtomicError::Write(e) | AtomicError::Rename(e) => e,
-            }
-        )
-    })
-}
-
-/// Why an atomic write failed.
-#[derive(Debug)]
-pub enum AtomicError<E> {
-    /// Writing the temporary file failed.
-    Write(E),
-    /// Renaming it into place failed.
-    Rename(std::io::Error),
-}
-
-impl<E: std::fmt::Display> std::fmt::Display for AtomicError<E> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            AtomicError::Write(error) => write!(f, "{error}"),
-            AtomicError::Rename(error) => write!(f, "cannot move the finished file into place: {error}"),
+    if kind.is_dir() {
+        return Some("a folder");
+    }
+    if kind.is_symlink() {
+        return Some("a symbolic link");
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_char_device() {
+            return Some("a character device");
+        }
+        if kind.is_block_device() {
+            return Some("a block device");
+        }
+        if kind.is_fifo() {
+            return Some("a named pipe");
+        }
+        if kind.is_socket() {
+            return Some("a socket");
         }
     }
+    Some("not a regular file")
+}
+
+/// Refuses `path` if something other than a regular file has its name (a missing file
+/// is fine: it is about to be created).
+pub fn check_target(path: &Path) -> Result<(), WriteError> {
+    match std::fs::symlink_metadata(path) {
+        Ok(metadata) => match not_regular(&metadata) {
+            Some(kind) => Err(WriteError::NotRegular { path: path.display().to_string(), kind }),
+            None => Ok(()),
+        },
+        Err(_) => Ok(()),
+    }
+}
+
+/// Writes `bytes` to `path`, complete or not at all (module documentation). On any error
+/// the temporary file is removed and `path` is left as it was.
+pub fn write(path: &Path, bytes: impl AsRef<[u8]>) -> Result<(), WriteError> {
+    let bytes = bytes.as_ref();
+    check_target(path)?;
+    let io = |source: std::io::Error| WriteError::Io { path: path.display().to_string(), source };
+    let temporary = temporary_path(path);
+    let written = (|| -> Result<(), WriteError> {
+        let mut file = std::fs::File::create(&temporary).map_err(io)?;
+        file.write_all(bytes).map_err(io)?;
+        file.sync_all().map_err(io)?;
+        let on_disk = file.metadata().map_err(io)?.len();
+        if on_disk != bytes.len() as u64 {
+            return Err(WriteError::Short {
+                path: path.display().to_string(),
+                written: on_disk,
+                expected: bytes.len() as u64,
+            });
+        }
+        // Checked again: something may have taken the name while the bytes were written.
+        check_target(path)?;
+        std::fs::rename(&temporary, path).map_err(io)
+    })();
+    if written.is_err() {
+        let _ = std::fs::remove_file(&temporary);
+    }
+    written
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    #[test]
-    fn a_file_appears_whole_or_not_at_all() {
-        let folder = std::env::temp_dir().join(format!("strata-atomic-{}", std::process::id()));
+    fn scratch(name: &str) -> PathBuf {
+        let folder = std::env::temp_dir().join(format!("strata-atomic-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&folder);
         std::fs::create_dir_all(&folder).unwrap();
+        folder
+    }
+
+    fn names(folder: &Path) -> Vec<String> {
+        let mut names: Vec<String> =
+            std::fs::read_dir(folder).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        names.sort();
+        names
+    }
+
+    #[test]
+    fn a_file_appears_whole_and_its_temporary_is_gone() {
+        let folder = scratch("whole");
         let path = folder.join("errors.csv");
         write(&path, "a,b\n").unwrap();
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "a,b\n");
-        // A writer that fails half-way leaves neither the file nor its temporary.
-        let failed = write_with(&folder.join("image.png"), |temporary| {
-            std::fs::write(temporary, b"half")?;
-            Err(std::io::Error::other("killed"))
-        });
-        assert!(failed.is_err());
-        let names: Vec<String> = std::fs::read_dir(&folder)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .collect();
-        assert_eq!(names, ["errors.csv"]);
+        write(&path, "c\n").unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "c\n");
+        assert_eq!(names(&folder), ["errors.csv"]);
         let temporary = temporary_path(&folder.join("strata_frame001.png"));
         let name = temporary.file_name().unwrap().to_string_lossy().into_owned();
         assert!(name.starts_with(".strata_frame001.tmp-") && name.ends_with(".png") && is_temporary(&name));
         assert!(!is_temporary("strata_frame001.png"));
+        std::fs::remove_dir_all(&folder).unwrap();
+    }
+
+    #[test]
+    fn what_is_not_a_regular_file_is_never_replaced() {
+        let folder = scratch("irregular");
+        std::fs::create_dir(folder.join("a-folder.png")).unwrap();
+        let message = write(&folder.join("a-folder.png"), b"x").unwrap_err().to_string();
+        assert!(message.contains("a-folder.png: is a folder"), "{message}");
+        #[cfg(unix)]
+        {
+            std::fs::write(folder.join("target.csv"), b"kept").unwrap();
+            std::os::unix::fs::symlink(folder.join("target.csv"), folder.join("link.csv")).unwrap();
+            let message = write(&folder.join("link.csv"), b"x").unwrap_err().to_string();
+            assert!(message.contains("link.csv: is a symbolic link"), "{message}");
+            assert_eq!(std::fs::read(folder.join("target.csv")).unwrap(), b"kept");
+            let full = Path::new("/dev/full");
+            if full.exists() {
+                let message = write(full, b"x").unwrap_err().to_string();
+                assert!(message.contains("/dev/full: is a character device"), "{message}");
+                assert!(std::fs::symlink_metadata(full).unwrap().file_type().is_file().eq(&false));
+            }
+        }
+        // Nothing was left behind.
+        assert!(names(&folder).iter().all(|n| !is_temporary(n)), "{:?}", names(&folder));
+        std::fs::remove_dir_all(&folder).unwrap();
+    }
+
+    #[test]
+    fn a_failed_write_leaves_the_old_file_and_no_temporary() {
+        let folder = scratch("failed");
+        let path = folder.join("run.json");
+        write(&path, "old").unwrap();
+        // A folder in the temporary's place makes creating it fail.
+        std::fs::create_dir(temporary_path(&path)).unwrap();
+        assert!(write(&path, "new").is_err());
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "old");
         std::fs::remove_dir_all(&folder).unwrap();
     }
 }

@@ -4,9 +4,11 @@
 //! line every [`PLAIN_LINE_EVERY`] and a last one when the work ends, so a log still
 //! shows that the run is alive and how far it got.
 //!
-//! The estimate of the whole work is also said once, in words, as soon as the first
-//! step has been timed (see [`Progress::inc`]), so a run that will take many minutes
-//! says so before it takes them.
+//! The estimate of the whole work is also said once, in words, as soon as a step after
+//! the first has been timed (see [`Progress::set`]), so a run that will take many minutes
+//! says so before it takes them. The first step is left out of every estimate: it carries
+//! the one-off costs (pipeline compilation, the first dispatch), which on a fresh machine
+//! made it 100 times slower than the rest (a three-minute run announced as six hours).
 
 use std::io::IsTerminal;
 use std::time::{Duration, Instant};
@@ -26,6 +28,9 @@ pub struct Progress {
     position: u64,
     started: Instant,
     last_plain_line: Instant,
+    /// When the first step ended and how many steps were done then: the estimates
+    /// extrapolate from there.
+    warmed: Option<(Instant, u64)>,
     announced: bool,
     bar: Option<indicatif::ProgressBar>,
 }
@@ -47,7 +52,17 @@ impl Progress {
             bar
         });
         let now = Instant::now();
-        Progress { label, unit, total, position: 0, started: now, last_plain_line: now, announced: false, bar }
+        Progress {
+            label,
+            unit,
+            total,
+            position: 0,
+            started: now,
+            last_plain_line: now,
+            warmed: None,
+            announced: false,
+            bar,
+        }
     }
 
     /// Sets the number of steps done.
@@ -56,13 +71,18 @@ impl Progress {
         if let Some(bar) = &self.bar {
             bar.set_position(self.position);
         }
-        let elapsed = self.started.elapsed();
-        if !self.announced && self.position > 0 {
+        let now = Instant::now();
+        let elapsed = now - self.started;
+        if self.warmed.is_none() && self.position > 0 {
+            self.warmed = Some((now, self.position));
+        }
+        let left = self.estimated_left(now);
+        if let (false, Some(left)) = (self.announced, left) {
             self.announced = true;
-            let estimate = self.estimated_total(elapsed);
+            let estimate = elapsed + left;
             if estimate >= ANNOUNCE_FROM {
                 self.say(&format!(
-                    "{}: {} {} estimated to take {} (from the first {})",
+                    "{}: {} {} estimated to take {} (from the {} after the first)",
                     self.label,
                     self.total,
                     self.unit,
@@ -72,16 +92,15 @@ impl Progress {
             }
         }
         if self.bar.is_none() && self.last_plain_line.elapsed() >= PLAIN_LINE_EVERY && self.position < self.total {
-            self.last_plain_line = Instant::now();
-            let left = self.estimated_total(elapsed).saturating_sub(elapsed);
+            self.last_plain_line = now;
+            let left = left.map_or_else(|| "an unknown time".to_string(), |l| format!("about {}", words(l)));
             eprintln!(
-                "{}: {}/{} {}, {} elapsed, about {} left",
+                "{}: {}/{} {}, {} elapsed, {left} left",
                 self.label,
                 self.position,
                 self.total,
                 self.unit,
-                words(elapsed),
-                words(left)
+                words(elapsed)
             );
         }
     }
@@ -103,12 +122,12 @@ impl Progress {
         elapsed
     }
 
-    /// The whole work's duration extrapolated from the steps done so far.
-    fn estimated_total(&self, elapsed: Duration) -> Duration {
-        if self.position == 0 {
-            return Duration::ZERO;
-        }
-        elapsed.mul_f64(self.total as f64 / self.position as f64)
+    /// The time the steps not yet done will take, at the rate of the steps done after
+    /// the first (module documentation); `None` until such a step is done.
+    fn estimated_left(&self, now: Instant) -> Option<Duration> {
+        let (warm, warm_position) = self.warmed?;
+        let timed = self.position.checked_sub(warm_position).filter(|&steps| steps > 0)?;
+        Some((now - warm).mul_f64((self.total - self.position) as f64 / timed as f64))
     }
 
     /// A line that stays above the bar.
@@ -143,10 +162,16 @@ mod tests {
     }
 
     #[test]
-    fn the_estimate_extrapolates_the_steps_done() {
+    fn the_estimate_leaves_out_the_first_step() {
         let mut progress = Progress::new("test", 10, "frames");
-        assert_eq!(progress.estimated_total(Duration::from_secs(3)), Duration::ZERO);
-        progress.position = 2;
-        assert_eq!(progress.estimated_total(Duration::from_secs(3)), Duration::from_secs(15));
+        let start = progress.started;
+        assert_eq!(progress.estimated_left(start + Duration::from_secs(100)), None);
+        // The first step took 100 s (compilation); the next two took 1 s each: the
+        // seven left take 7 s, not 7 × 34 s.
+        progress.position = 1;
+        progress.warmed = Some((start + Duration::from_secs(100), 1));
+        assert_eq!(progress.estimated_left(start + Duration::from_secs(100)), None);
+        progress.position = 3;
+        assert_eq!(progress.estimated_left(start + Duration::from_secs(102)), Some(Duration::from_secs(7)));
     }
 }

@@ -49,7 +49,7 @@ impl RgbImage {
     /// would make every RelMSE NaN.
     pub fn read_exr(path: &Path) -> Result<RgbImage, ImageError> {
         let error = |message: String| ImageError { path: path.display().to_string(), message };
-        let bytes = std::fs::read(path).map_err(|e| error(e.to_string()))?;
+        let bytes = crate::scene::read_capped(path).map_err(|e| error(e.to_string()))?;
         let exr = crate::scene::decode_rgb_exr(path, &bytes).map_err(|e| match e {
             crate::scene::SceneError::Image { message, .. } => error(message),
             other => error(other.to_string()),
@@ -90,37 +90,67 @@ impl RgbImage {
         }
     }
 
+    /// The float32 RGB EXR file of the image, in memory.
+    pub fn exr_bytes(&self) -> Result<Vec<u8>, String> {
+        use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
+        let width = self.width as usize;
+        let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+            let p = self.pixels[y * width + x];
+            (p[0], p[1], p[2])
+        });
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        Image::from_channels((width, self.height as usize), channels)
+            .write()
+            .to_buffered(&mut bytes)
+            .map_err(|e| e.to_string())?;
+        Ok(bytes.into_inner())
+    }
+
+    /// The 8-bit sRGB PNG file of the image (radiance × `exposure`, clamped to [0, 1],
+    /// sRGB-encoded), in memory.
+    pub fn png_bytes(&self, exposure: f32) -> Result<Vec<u8>, String> {
+        let pixels: Vec<u8> = self.pixels.iter().flat_map(|p| p.map(|c| linear_to_srgb8(c * exposure))).collect();
+        encode_png(&pixels, self.width, self.height, image::ExtendedColorType::Rgb8)
+    }
+
     /// Writes a float32 RGB EXR, complete or not at all ([`crate::atomic_file`]).
     pub fn write_exr(&self, path: &Path) -> Result<(), ImageError> {
         self.check_finite(path)?;
-        let width = self.width as usize;
-        crate::atomic_file::write_with(path, |temporary| {
-            exr::prelude::write_rgb_file(temporary, width, self.height as usize, |x, y| {
-                let p = self.pixels[y * width + x];
-                (p[0], p[1], p[2])
-            })
-        })
-        .map_err(|e| ImageError { path: path.display().to_string(), message: e.to_string() })
+        let error = |message: String| ImageError { path: path.display().to_string(), message };
+        let bytes = self.exr_bytes().map_err(error)?;
+        crate::atomic_file::write(path, bytes).map_err(|e| without_path(path, e))
     }
 
     /// Writes an 8-bit sRGB PNG: radiance × `exposure`, clamped to [0, 1], sRGB-encoded;
-    /// complete or not at all.
+    /// complete or not at all. `exposure` must be finite and positive (a NaN or negative
+    /// one would write a black picture, an infinite one a white one).
     pub fn write_png(&self, path: &Path, exposure: f32) -> Result<(), ImageError> {
         self.check_finite(path)?;
-        let bytes: Vec<u8> =
-            self.pixels.iter().flat_map(|p| p.map(|c| linear_to_srgb8(c * exposure))).collect::<Vec<_>>();
-        crate::atomic_file::write_with(path, |temporary| {
-            image::save_buffer_with_format(
-                temporary,
-                &bytes,
-                self.width,
-                self.height,
-                image::ExtendedColorType::Rgb8,
-                image::ImageFormat::Png,
-            )
-        })
-        .map_err(|e| ImageError { path: path.display().to_string(), message: e.to_string() })
+        let error = |message: String| ImageError { path: path.display().to_string(), message };
+        if !(exposure.is_finite() && exposure > 0.0) {
+            return Err(error(format!("exposure {exposure}: must be finite and positive")));
+        }
+        let bytes = self.png_bytes(exposure).map_err(error)?;
+        crate::atomic_file::write(path, bytes).map_err(|e| without_path(path, e))
     }
+}
+
+/// A PNG file of 8-bit `pixels` in memory.
+pub fn encode_png(pixels: &[u8], width: u32, height: u32, colour: image::ExtendedColorType) -> Result<Vec<u8>, String> {
+    use image::ImageEncoder;
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut bytes)
+        .write_image(pixels, width, height, colour)
+        .map_err(|e| e.to_string())?;
+    Ok(bytes)
+}
+
+/// An [`ImageError`] of a failed [`crate::atomic_file::write`] (whose message names the
+/// file already).
+fn without_path(path: &Path, error: crate::atomic_file::WriteError) -> ImageError {
+    let text = error.to_string();
+    let prefix = format!("{}: ", path.display());
+    ImageError { path: path.display().to_string(), message: text.strip_prefix(&prefix).unwrap_or(&text).to_string() }
 }
 
 /// sRGB OETF of a linear value, clamped to [0, 1] and rounded to 8 bits (NaN gives 0).

@@ -2,7 +2,7 @@
 """Render small Mitsuba 3 reference images of the shared test scenes.
 
 For every entry of REFERENCES below, the scene's Mitsuba XML (generated from the
-authoritative scene.json, see ../shared/scenes/CONVENTIONS.md) is loaded with only the
+authoritative scene.json, see scenes/CONVENTIONS.md) is loaded with only the
 film resolution changed (same aspect ratio, same camera, integrator, box filter,
 `independent` sampler), and rendered in PASSES independent passes with seeds
 SEED0, SEED0+1, ... Each pass uses spp / PASSES samples per pixel. Written per entry:
@@ -17,7 +17,7 @@ Regenerate (from the repository root):
   pip install mitsuba==3.9.1 numpy
   python3 tests/references/make_references.py
 
-Options: --scenes-dir (default ../shared/scenes relative to the repository root),
+Options: --scenes-dir (default scenes relative to the repository root),
 --out (default tests/references/), --only NAME [NAME ...], --spp-scale F (multiply
 every spp, e.g. 0.01 for a quick smoke test), --passes N, --seed0 S.
 """

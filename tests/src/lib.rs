@@ -5,6 +5,12 @@ pub mod wgsl_fuzz;
 use strata_backends::wgpu_backend::{WgpuApi, WgpuBackend, WgpuOptions};
 use strata_backends::{BackendError, GPU_REQUIRED_VARIABLE, gpu_required};
 
+/// The test scenes committed in the repository (`scenes/`: the shared JSON + PLY scenes
+/// with their licences), so that a clone alone passes its tests.
+pub fn scenes_folder() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes")
+}
+
 /// The wgpu Vulkan backend with validation on, or `None` (with a note on stderr) when
 /// the machine has no Vulkan device. Under `STRATA_REQUIRE_GPU=1` a missing device
 /// fails the test instead.

@@ -77,7 +77,7 @@ fn bad_geometry_and_rays_are_named() {
 /// plane and a dense mesh) hit what obvhs hits. Rays with an unbounded tmax (1e30) once
 /// made every box count as hit (limit + 1 == limit) and half the rays missed on lavapipe.
 fn scene_camera_rays_agree_with_obvhs(backend: &mut dyn Backend) {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/scenes/matpreview/scene.json");
+    let path = strata_tests::scenes_folder().join("matpreview/scene.json");
     let scene = strata::scene::Scene::load(&path).unwrap();
     let (soup, _) = scene.triangles_with_ids();
     let frame = strata::scene::CameraFrame::new(&scene.camera).unwrap();

@@ -24,7 +24,7 @@ use strata::scene::{Camera, Environment, Material, Scene, Shape};
 use strata_backends::{Backend, gpu_required};
 
 fn shared_scene(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/scenes").join(name)
+    strata_tests::scenes_folder().join(name)
 }
 
 fn reference(name: &str) -> (RgbImage, RgbImage) {
@@ -327,6 +327,7 @@ fn furnace(material: Material, radiance: f32) -> Scene {
             scale: 1.0,
             to_world: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
         }),
+        warnings: Vec::new(),
     }
 }
 

@@ -5,14 +5,14 @@ use std::path::{Path, PathBuf};
 use strata::scene::{Material, Scene, SceneError, read_ply};
 
 fn shared_scenes() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/scenes")
+    strata_tests::scenes_folder()
 }
 
 #[test]
 fn every_shared_scene_loads_with_object_ids_and_emitters() {
     let root = shared_scenes();
     if !root.exists() {
-        panic!("{} is missing: the shared scenes must sit beside the checkout", root.display());
+        panic!("{} is missing: the test scenes are part of the repository", root.display());
     }
     for (name, shapes, emitters, environment) in [
         ("cornell-box", 8, 1, false),

@@ -6,7 +6,7 @@
 #
 #   benchmarks/restir/h200_256/levers.sh STRATA SCENES OUT [PARALLEL]
 #
-# STRATA: a release `strata` binary; SCENES: the shared scenes' folder (../shared/scenes);
+# STRATA: a release `strata` binary; SCENES: the shared scenes' folder (scenes);
 # OUT: where the references and one folder per run go.
 set -euo pipefail
 if [ $# -lt 3 ]; then

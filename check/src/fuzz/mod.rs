@@ -79,9 +79,10 @@ pub fn findings_folder() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/fuzz")
 }
 
-/// The shared scenes beside the checkout (`../shared/scenes`), if they are there.
+/// The test scenes committed in the repository (`scenes/`, copies of the shared scenes
+/// with their licences), if the checkout has them.
 pub fn shared_scenes() -> Option<PathBuf> {
-    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/scenes");
+    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
     folder.is_dir().then_some(folder)
 }
 

@@ -74,6 +74,9 @@ pub fn run_comparison(
                     let (image, stats) = renderer.render_frame(backend, camera)?;
                     let render_time = started.elapsed();
                     let reference = references.get(frame as usize).unwrap_or(&references[0]);
+                    let name = format!("{} frame {}, seed {seed}", method.name(), frame + 1);
+                    super::image_checks::check_frame(&image, reference, &name)
+                        .map_err(|e| PassError::Input(e.to_string()))?;
                     if stats.invalid_pixels > 0 {
                         return Err(PassError::Input(format!(
                             "{}: frame {frame}, seed {seed}: {} pixels had invalid samples",
@@ -182,8 +185,12 @@ fn ratio_of(
         errors.iter().filter(|e| e.method == m && e.frame == frame).filter_map(|e| Some((e.seed, value(e)?))).collect()
     };
     let (ours, theirs) = (of(method), of(baseline));
-    let ratios: Vec<f64> =
-        ours.iter().filter_map(|(seed, a)| theirs.iter().find(|(s, _)| s == seed).map(|(_, b)| a / b)).collect();
+    // A pair whose baseline error is 0 has no ratio (only an image equal to its
+    // reference scores 0): it is left out rather than averaged as infinity.
+    let ratios: Vec<f64> = ours
+        .iter()
+        .filter_map(|(seed, a)| theirs.iter().find(|(s, b)| s == seed && *b > 0.0).map(|(_, b)| a / b))
+        .collect();
     (!ratios.is_empty()).then(|| MeanInterval::of(&ratios))
 }
 
@@ -205,13 +212,61 @@ pub fn relmse_ratio_over_frames(errors: &[FrameError], method: Method, baseline:
         run.iter().map(|&(frame, _)| frame).eq(frames.iter().copied()).then(|| run.iter().map(|&(_, v)| v).sum())
     };
     let seeds: BTreeSet<u32> = errors.iter().map(|e| e.seed).collect();
-    let ratios: Vec<f64> =
-        seeds.iter().filter_map(|&seed| Some(summed(method, seed)? / summed(baseline, seed)?)).collect();
+    let ratios: Vec<f64> = seeds
+        .iter()
+        .filter_map(|&seed| Some(summed(method, seed)? / summed(baseline, seed).filter(|&b| b > 0.0)?))
+        .collect();
     (!ratios.is_empty()).then(|| MeanInterval::of(&ratios))
 }
 
 /// Reads the CSV [`errors_csv`] writes; an error names the line and what is wrong.
+/// Besides each line's own fields, the rows together must be what a comparison writes:
+/// at least one row, each (method, frame, seed) once, every method measured at the same
+/// (frame, seed) pairs, and errors above 0 (a ratio to an error of 0 cannot be
+/// computed, and only an image equal to its reference has one).
 pub fn parse_errors_csv(text: &str) -> Result<Vec<FrameError>, String> {
+    let rows = parse_rows(text)?;
+    check_rows(&rows)?;
+    Ok(rows.into_iter().map(|(_, error)| error).collect())
+}
+
+/// The rows as a whole: [`parse_errors_csv`]'s rules across lines.
+fn check_rows(rows: &[(usize, FrameError)]) -> Result<(), String> {
+    use std::collections::{BTreeMap, BTreeSet};
+    if rows.is_empty() {
+        return Err("no measurements: the file has its header and no rows".into());
+    }
+    let mut lines: BTreeMap<(Method, u32, u32), usize> = BTreeMap::new();
+    for &(line, e) in rows {
+        if let Some(first) = lines.insert((e.method, e.frame, e.seed), line) {
+            return Err(format!(
+                "line {line}: {} frame {}, seed {} is measured again (first on line {first})",
+                e.method.name(),
+                e.frame + 1,
+                e.seed
+            ));
+        }
+    }
+    let methods: BTreeSet<Method> = rows.iter().map(|(_, e)| e.method).collect();
+    for &(line, e) in rows {
+        for &other in &methods {
+            if !lines.contains_key(&(other, e.frame, e.seed)) {
+                return Err(format!(
+                    "{} has no row for frame {}, seed {} (line {line} has {}'s): every method must be measured at the \
+                     same frames and seeds",
+                    other.name(),
+                    e.frame + 1,
+                    e.seed,
+                    e.method.name()
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Each line's fields, with its line number.
+fn parse_rows(text: &str) -> Result<Vec<(usize, FrameError)>, String> {
     let mut lines = text.lines();
     let columns = match lines.next().map(str::trim) {
         Some(CSV_HEADER) => 7,
@@ -228,29 +283,32 @@ pub fn parse_errors_csv(text: &str) -> Result<Vec<FrameError>, String> {
         let method = <Method as clap::ValueEnum>::from_str(fields[0], false)
             .map_err(|_| format!("line {number}: unknown method `{}`", fields[0]))?;
         let int = |i: usize| fields[i].parse::<u32>().map_err(|e| format!("line {number}, field {}: {e}", i + 1));
-        // Errors are finite and non-negative: anything else is a damaged file, not a
-        // measurement to average.
+        // Errors are finite and positive: anything else is a damaged file, not a
+        // measurement to average or divide by.
         let float = |i: usize| match fields[i].parse::<f64>() {
-            Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
-            Ok(v) => Err(format!("line {number}, field {}: {v} is not an error (finite, 0 or more)", i + 1)),
+            Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+            Ok(v) => Err(format!("line {number}, field {}: {v} is not an error (finite, above 0)", i + 1)),
             Err(e) => Err(format!("line {number}, field {}: {e}", i + 1)),
         };
         let frame = int(1)?;
         if frame == 0 {
             return Err(format!("line {number}: frames are counted from 1"));
         }
-        errors.push(FrameError {
-            method,
-            frame: frame - 1,
-            seed: int(2)?,
-            relmse: float(3)?,
-            prelmse: float(4)?,
-            mse: float(5)?,
-            relmse_luminance: match fields.get(6) {
-                None | Some(&"") => None,
-                Some(_) => Some(float(6)?),
+        errors.push((
+            number,
+            FrameError {
+                method,
+                frame: frame - 1,
+                seed: int(2)?,
+                relmse: float(3)?,
+                prelmse: float(4)?,
+                mse: float(5)?,
+                relmse_luminance: match fields.get(6) {
+                    None | Some(&"") => None,
+                    Some(_) => Some(float(6)?),
+                },
             },
-        });
+        ));
     }
     Ok(errors)
 }

@@ -212,9 +212,34 @@ impl MeanInterval {
     }
 }
 
+impl MeanInterval {
+    /// `mean ± half-width` with `decimals` decimals; with fewer than two samples, where
+    /// no interval exists, `mean (1 seed: no interval)`; and `n/a` for a mean that could
+    /// not be computed. Printed summaries never show NaN or infinity.
+    pub fn fixed(&self, decimals: usize) -> String {
+        self.text(|v| format!("{v:.decimals$}"))
+    }
+
+    /// The text of the interval with `number` formatting each value ([`MeanInterval::fixed`]).
+    fn text(&self, number: impl Fn(f64) -> String) -> String {
+        if self.count == 0 || !self.mean.is_finite() {
+            return "n/a".to_string();
+        }
+        if !self.half_width.is_finite() {
+            let seeds = if self.count == 1 { "1 seed" } else { "seeds" };
+            return format!("{} ({seeds}: no interval)", number(self.mean));
+        }
+        format!("{} ± {}", number(self.mean), number(self.half_width))
+    }
+}
+
 impl std::fmt::Display for MeanInterval {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{:.4e} ± {:.1e}", self.mean, self.half_width)
+        if self.half_width.is_finite() && self.mean.is_finite() && self.count > 0 {
+            write!(f, "{:.4e} ± {:.1e}", self.mean, self.half_width)
+        } else {
+            write!(f, "{}", self.text(|v| format!("{v:.4e}")))
+        }
     }
 }
 
@@ -310,5 +335,10 @@ mod tests {
         let sd = (5.0f64 / 3.0).sqrt();
         assert!((interval.half_width - 3.182 * sd / 2.0).abs() < 1e-9);
         assert!(MeanInterval::of(&[1.0]).half_width.is_infinite());
+        // What is printed never says NaN or inf.
+        assert_eq!(MeanInterval::of(&[0.5]).fixed(3), "0.500 (1 seed: no interval)");
+        assert_eq!(MeanInterval::of(&[0.5]).to_string(), "5.0000e-1 (1 seed: no interval)");
+        assert_eq!(MeanInterval::of(&[]).fixed(3), "n/a");
+        assert_eq!(MeanInterval::of(&[1.0, 3.0]).fixed(1), "2.0 ± 12.7");
     }
 }

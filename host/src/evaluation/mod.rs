@@ -1,5 +1,5 @@
 //! Evaluation of the renderer: [`compare`] renders every method from the same seeds
-//! against a reference, [`metrics`] and [`variance`] measure the images (with and
+//! against a reference ([`image_checks`] says what an image must be to be scored), [`metrics`] and [`variance`] measure the images (with and
 //! without the reference), [`plot`] draws RelMSE and ratios over frames, [`summary`]
 //! makes the ratio and variance tables, [`crops`] picks close-ups, [`page`] writes
 //! `report.html`, [`record`] says what ran where, [`output_folder`] keeps one run per
@@ -8,6 +8,7 @@
 
 pub mod compare;
 pub mod crops;
+pub mod image_checks;
 pub mod metrics;
 pub mod output_folder;
 pub mod page;

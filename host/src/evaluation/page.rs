@@ -147,11 +147,10 @@ impl Page<'_> {
         let mut html = String::from("<section id=\"headline\">\n<h2>Over the whole run</h2>\n<div class=\"ratios\">\n");
         for w in &self.whole_run {
             html += &format!(
-                "<div class=\"ratio\"><div class=\"big\">{:.3} <small>± {:.3}</small></div>\
+                "<div class=\"ratio\"><div class=\"big\">{}</div>\
                  <div>{} ÷ {} RelMSE, frames 1–{}</div><div class=\"note\">per seed, summed over frames; mean and \
                  95 % interval over {} seeds (below 1: strata better)</div></div>\n",
-                w.ratio.mean,
-                w.ratio.half_width,
+                headline_ratio(&w.ratio),
                 method_label(Method::Strata),
                 method_label(w.baseline),
                 self.record.frames,
@@ -387,6 +386,20 @@ table.crops td, table.crops th { padding: 0.3em; vertical-align: top; text-align
 dl { display: grid; grid-template-columns: max-content 1fr; gap: 0.2em 1em; } dt { font-weight: 600; }
 dd { margin: 0; font-family: ui-monospace, monospace; font-size: 0.9em; overflow-wrap: anywhere; }
 ";
+
+/// The headline's big number: `mean <small>± half-width</small>`, or the mean alone
+/// (with why) where no interval exists; never NaN or infinity.
+fn headline_ratio(ratio: &crate::evaluation::metrics::MeanInterval) -> String {
+    if ratio.count >= 2 && ratio.mean.is_finite() && ratio.half_width.is_finite() {
+        format!("{:.3} <small>± {:.3}</small>", ratio.mean, ratio.half_width)
+    } else {
+        let text = ratio.fixed(3);
+        match text.split_once(' ') {
+            Some((mean, why)) => format!("{mean} <small>{why}</small>"),
+            None => text,
+        }
+    }
+}
 
 #[cfg(test)]
 mod tests {

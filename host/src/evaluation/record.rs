@@ -38,6 +38,8 @@ pub struct RunRecord {
     pub reference: String,
     /// The settings every method shared, by name.
     pub settings: serde_json::Map<String, serde_json::Value>,
+    /// The scene loader's warnings (what it left out or replaced, naming file and line).
+    pub warnings: Vec<String>,
     /// Per method: mean wall time of one frame in milliseconds (rendering only, on
     /// `backend`; not the measuring or writing).
     pub frame_ms: Vec<MethodTime>,
@@ -83,6 +85,9 @@ impl RunRecord {
         ];
         let settings: Vec<String> = self.settings.iter().map(|(k, v)| format!("{k} = {v}")).collect();
         lines.push(("settings".to_string(), settings.join(", ")));
+        if !self.warnings.is_empty() {
+            lines.push((format!("scene warnings ({})", self.warnings.len()), self.warnings.join("; ")));
+        }
         let times: Vec<String> = self.frame_ms.iter().map(|t| format!("{} {:.1} ms", t.method, t.frame_ms)).collect();
         lines.push(("time per frame".to_string(), times.join(", ")));
         lines.push(("whole run".to_string(), crate::progress::words(std::time::Duration::from_secs_f64(self.seconds))));
@@ -90,13 +95,37 @@ impl RunRecord {
     }
 }
 
-/// This process's command line, each argument quoted for a POSIX shell where it needs it.
+/// This process's command line, each argument quoted for a POSIX shell where it needs
+/// it. Arguments need not be UTF-8 (a path on Linux is any bytes but NUL): such an
+/// argument is written in the `$'...'` quoting of bash, zsh and POSIX 2024 shells, with
+/// every byte that is not printable ASCII as `\xHH`, so the line still reproduces the run.
 pub fn command_line() -> String {
-    let mut args = std::env::args();
-    let program = args
-        .next()
-        .map(|p| std::path::Path::new(&p).file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or(p));
-    program.into_iter().chain(args).map(|a| shell_quote(&a)).collect::<Vec<_>>().join(" ")
+    let mut args = std::env::args_os();
+    let program = args.next().map(|p| {
+        let path = std::path::PathBuf::from(&p);
+        path.file_name().map(std::ffi::OsStr::to_os_string).unwrap_or(p)
+    });
+    program.into_iter().chain(args).map(|a| shell_quote_os(&a)).collect::<Vec<_>>().join(" ")
+}
+
+/// `argument` as one word of a POSIX shell command, whatever its bytes.
+fn shell_quote_os(argument: &std::ffi::OsStr) -> String {
+    if let Some(text) = argument.to_str() {
+        return shell_quote(text);
+    }
+    let bytes = argument.as_encoded_bytes();
+    let mut quoted = String::from("$'");
+    for &byte in bytes {
+        match byte {
+            b'\\' | b'\'' => {
+                quoted.push('\\');
+                quoted.push(byte as char);
+            }
+            0x20..=0x7e => quoted.push(byte as char),
+            _ => quoted.push_str(&format!("\\x{byte:02x}")),
+        }
+    }
+    quoted + "'"
 }
 
 /// `text` as one word of a POSIX shell command.
@@ -121,6 +150,15 @@ mod tests {
         assert_eq!(shell_quote("a b"), "'a b'");
         assert_eq!(shell_quote("it's"), "'it'\\''s'");
         assert_eq!(shell_quote(""), "''");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn arguments_that_are_not_utf8_are_quoted_byte_for_byte() {
+        use std::os::unix::ffi::OsStrExt;
+        let argument = std::ffi::OsStr::from_bytes(b"out/bad\xff it's\\");
+        assert_eq!(shell_quote_os(argument), "$'out/bad\\xff it\\'s\\\\'");
+        assert_eq!(shell_quote_os(std::ffi::OsStr::new("a b")), "'a b'");
     }
 
     #[test]

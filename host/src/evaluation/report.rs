@@ -213,7 +213,7 @@ pub fn run_and_report(
 
 /// Writes `text` to `path`, complete or not at all; an error names the file.
 fn write(path: &Path, text: String) -> Result<()> {
-    crate::atomic_file::write(path, text)
+    Ok(crate::atomic_file::write(path, text)?)
 }
 
 /// Writes one seed-1 frame of a method: EXR and PNG, and its RelMSE map as EXR and

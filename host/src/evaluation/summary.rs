@@ -58,7 +58,7 @@ type RatioOf = fn(&[FrameError], Method, Method, u32) -> Option<MeanInterval>;
 
 /// `mean ± half-width` to 3 decimals, or empty.
 fn ratio_cell(ratio: Option<MeanInterval>) -> String {
-    ratio.map(|r| format!("{:.3} ± {:.3}", r.mean, r.half_width)).unwrap_or_default()
+    ratio.map(|r| r.fixed(3)).unwrap_or_default()
 }
 
 /// The baselines among `methods` that strata can be compared with.
@@ -122,10 +122,9 @@ pub fn whole_run_lines(errors: &[FrameError], frames: u32) -> Vec<String> {
         .iter()
         .map(|w| {
             format!(
-                "strata ÷ {} over frames 1-{frames} (per seed, RelMSE summed over the frames): {:.4} ± {:.4} ({} seeds)",
+                "strata ÷ {} over frames 1-{frames} (per seed, RelMSE summed over the frames): {} ({} seeds)",
                 w.baseline.name(),
-                w.ratio.mean,
-                w.ratio.half_width,
+                w.ratio.fixed(4),
                 w.ratio.count
             )
         })
@@ -186,7 +185,10 @@ pub fn variance_tables(
             for baseline in [Method::Restir, Method::RestirDisc] {
                 if method == Method::Strata && methods.contains(&baseline) {
                     let r = variance_ratio(&images(method, f), &images(baseline, f), &reference(f))?;
-                    ratios += &format!(",{:.4},{:.4}", r.mean, r.half_width);
+                    // A ratio that cannot be computed (a baseline without variance) is
+                    // an empty field, never NaN.
+                    let field = |v: f64| if v.is_finite() { format!("{v:.4}") } else { String::new() };
+                    ratios += &format!(",{},{}", field(r.mean), field(r.half_width));
                 } else {
                     ratios += ",,";
                 }
@@ -222,7 +224,7 @@ fn variance_table(
             .iter()
             .map(|&f| {
                 let r = variance_ratio(&images(Method::Strata, f), &images(baseline, f), &reference(f))?;
-                Ok(format!("{:.3} ± {:.3}", r.mean, r.half_width))
+                Ok(r.fixed(3))
             })
             .collect::<Result<Vec<String>>>()?;
         rows.push(Row { label: format!("÷ {}{suffix}", baseline.name()), cells, is_ratio: true });

@@ -4,7 +4,7 @@ use crate::histogram_pass::PassError;
 use strata_kernels::selection::SelectionSettings;
 
 /// How each pixel chooses the K candidates it resamples.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, clap::ValueEnum)]
 pub enum Method {
     /// The paper: the block's candidates clustered by object id and sorted by luminance,
     /// K taken by the sampler variant's pattern (antithetic by default), resampled by

@@ -111,7 +111,8 @@ impl CameraPath {
     /// (`keyframes[2].frame`), a non-finite coordinate (`keyframes[1].origin[0]`), a target
     /// equal to its origin (`keyframes[0].target`).
     pub fn load(path: &Path) -> Result<CameraPath, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
+        let text =
+            crate::scene::read_text_capped(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
         let deserializer = &mut serde_json::Deserializer::from_str(&text);
         let file: CameraPathFile = serde_path_to_error::deserialize(deserializer).map_err(|error| {
             SceneError::Json { path: path.into(), field: error.path().to_string(), message: error.inner().to_string() }

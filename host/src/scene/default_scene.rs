@@ -88,6 +88,7 @@ pub fn default_scene() -> Scene {
         shapes,
         textures: Vec::new(),
         environment: None,
+        warnings: Vec::new(),
     }
 }
 

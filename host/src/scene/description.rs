@@ -44,9 +44,10 @@ pub struct Integrator {
     pub hide_emitters: bool,
 }
 
-/// Diffuse reflectance: a constant, a checkerboard or an sRGB texture.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(untagged)]
+/// Diffuse reflectance: a constant, a checkerboard or an sRGB texture. Read by its shape
+/// (an array, an object with `checkerboard`, an object with `texture`), each object form
+/// refusing fields it does not know, as every other object of the file does.
+#[derive(Clone, Debug, PartialEq)]
 pub enum Reflectance {
     /// Constant linear RGB.
     Constant([f32; 3]),
@@ -60,18 +61,64 @@ pub enum Reflectance {
         /// File relative to the scene folder.
         texture: PathBuf,
         /// Whether the file is sRGB-encoded.
-        #[serde(default)]
         srgb: bool,
         /// Filter (`bilinear`).
-        #[serde(default)]
         filter: Option<String>,
         /// Wrap mode (`repeat`).
-        #[serde(default)]
         wrap: Option<String>,
         /// UV scale.
-        #[serde(default)]
         uv_scale: Option<[f32; 2]>,
     },
+}
+
+/// The object form `{"checkerboard": {...}}`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CheckerboardForm {
+    checkerboard: Checkerboard,
+}
+
+/// The object form `{"texture": "file.png", ...}`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TextureForm {
+    texture: PathBuf,
+    #[serde(default)]
+    srgb: bool,
+    #[serde(default)]
+    filter: Option<String>,
+    #[serde(default)]
+    wrap: Option<String>,
+    #[serde(default)]
+    uv_scale: Option<[f32; 2]>,
+}
+
+impl<'de> Deserialize<'de> for Reflectance {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        use serde_json::Value;
+        let value = Value::deserialize(deserializer)?;
+        let is_object_with = |key: &str| value.as_object().is_some_and(|o| o.contains_key(key));
+        let reflectance = if value.is_array() {
+            serde_json::from_value::<[f32; 3]>(value).map(Reflectance::Constant)
+        } else if is_object_with("checkerboard") {
+            serde_json::from_value::<CheckerboardForm>(value)
+                .map(|form| Reflectance::Checkerboard { checkerboard: form.checkerboard })
+        } else if is_object_with("texture") {
+            serde_json::from_value::<TextureForm>(value).map(|form| Reflectance::Texture {
+                texture: form.texture,
+                srgb: form.srgb,
+                filter: form.filter,
+                wrap: form.wrap,
+                uv_scale: form.uv_scale,
+            })
+        } else {
+            return Err(D::Error::custom(
+                "expected [r, g, b], {\"checkerboard\": {...}} or {\"texture\": \"file.png\", ...}",
+            ));
+        };
+        reflectance.map_err(D::Error::custom)
+    }
 }
 
 /// Checkerboard parameters (CONVENTIONS.md).
@@ -191,12 +238,19 @@ pub struct SceneDescription {
     pub environment: Option<EnvironmentDescription>,
 }
 
-/// Parses `text` (the contents of `path`), naming the field at fault on error.
+/// Parses `text` (the contents of `path`), naming the field at fault on error. Nothing
+/// but white space may follow the scene's object.
 pub(super) fn parse(path: &Path, text: &str) -> Result<SceneDescription, SceneError> {
     let deserializer = &mut serde_json::Deserializer::from_str(text);
-    serde_path_to_error::deserialize(deserializer).map_err(|error| SceneError::Json {
+    let description = serde_path_to_error::deserialize(&mut *deserializer).map_err(|error| SceneError::Json {
         path: path.into(),
         field: error.path().to_string(),
         message: error.inner().to_string(),
-    })
+    })?;
+    deserializer.end().map_err(|error| SceneError::Json {
+        path: path.into(),
+        field: "(after the scene)".into(),
+        message: format!("{error}: nothing may follow the scene's closing brace"),
+    })?;
+    Ok(description)
 }

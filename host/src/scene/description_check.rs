@@ -20,6 +20,9 @@ enum Rule {
     NonNegative,
     /// Finite and > 0.
     Positive,
+    /// A reflectance: in [0, 1] (above 1 a surface would reflect more light than
+    /// arrives, creating energy).
+    Reflectance,
 }
 
 impl Rule {
@@ -28,6 +31,7 @@ impl Rule {
             Rule::Finite => value.is_finite(),
             Rule::NonNegative => value.is_finite() && value >= 0.0,
             Rule::Positive => value.is_finite() && value > 0.0,
+            Rule::Reflectance => (0.0..=1.0).contains(&value),
         }
     }
 
@@ -36,6 +40,7 @@ impl Rule {
             Rule::Finite => "must be finite",
             Rule::NonNegative => "must be finite and ≥ 0",
             Rule::Positive => "must be finite and > 0",
+            Rule::Reflectance => "each must lie in [0, 1] (a reflectance above 1 creates energy)",
         }
     }
 }
@@ -50,6 +55,26 @@ pub(super) fn check(path: &Path, description: &SceneDescription) -> Result<(), S
             None => Ok(()),
         }
     };
+    // Fields the format has but the renderer implements for one value only: any other
+    // value is refused, never rendered as if the field were absent.
+    let integrator = &description.integrator;
+    if integrator.kind != "path" {
+        return Err(error("integrator.type".into(), format!("`{}`: only `path` is implemented", integrator.kind)));
+    }
+    if integrator.hide_emitters {
+        return Err(error(
+            "integrator.hide_emitters".into(),
+            "true: emitters seen directly by the camera cannot be hidden; only false is implemented".into(),
+        ));
+    }
+    for (index, shape) in description.shapes.iter().enumerate() {
+        if let Some(normals) = shape.normals.as_deref().filter(|n| *n != "face") {
+            return Err(error(
+                format!("shapes[{index}].normals"),
+                format!("`{normals}`: only `face` (geometric normals) is implemented"),
+            ));
+        }
+    }
     let camera = &description.camera;
     numbers("camera.origin".into(), &camera.origin, Rule::Finite)?;
     numbers("camera.target".into(), &camera.target, Rule::Finite)?;
@@ -86,10 +111,10 @@ pub(super) fn check(path: &Path, description: &SceneDescription) -> Result<(), S
         let field = |what: &str| format!("materials.{name}.{what}");
         match material {
             MaterialDescription::Diffuse { reflectance, .. } => match reflectance {
-                Reflectance::Constant(c) => numbers(field("reflectance"), c, Rule::NonNegative)?,
+                Reflectance::Constant(c) => numbers(field("reflectance"), c, Rule::Reflectance)?,
                 Reflectance::Checkerboard { checkerboard } => {
-                    numbers(field("reflectance.checkerboard.color0"), &checkerboard.color0, Rule::NonNegative)?;
-                    numbers(field("reflectance.checkerboard.color1"), &checkerboard.color1, Rule::NonNegative)?;
+                    numbers(field("reflectance.checkerboard.color0"), &checkerboard.color0, Rule::Reflectance)?;
+                    numbers(field("reflectance.checkerboard.color1"), &checkerboard.color1, Rule::Reflectance)?;
                     numbers(field("reflectance.checkerboard.uv_scale"), &checkerboard.uv_scale, Rule::Finite)?;
                 }
                 Reflectance::Texture { uv_scale, .. } => {

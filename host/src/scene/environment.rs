@@ -26,7 +26,7 @@ impl Environment {
     /// Loads `file` (RGB, half or float samples), refusing negative or non-finite
     /// radiance with the pixel named, and a `to_world` that is not a rotation.
     pub fn load(file: &Path, scale: f32, to_world: Option<[[f32; 4]; 4]>) -> Result<Environment, SceneError> {
-        let bytes = std::fs::read(file).map_err(|source| SceneError::Io { path: file.into(), source })?;
+        let bytes = crate::scene::read_capped(file).map_err(|source| SceneError::Io { path: file.into(), source })?;
         Environment::from_exr_bytes(file, &bytes, scale, to_world)
     }
 

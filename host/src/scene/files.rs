@@ -20,8 +20,46 @@ pub struct DiskFiles;
 
 impl FileSource for DiskFiles {
     fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
-        std::fs::read(path)
+        read_capped(path)
     }
+}
+
+/// The most bytes strata reads from one input file (a scene, mesh, texture, environment
+/// map, reference image, camera path or CSV): 1 GiB, above any of the shared scenes'
+/// files by a wide margin. A larger file, or an endless one such as `/dev/zero`, is an
+/// error naming it, never read until memory runs out.
+pub const MAX_INPUT_FILE_BYTES: u64 = 1 << 30;
+
+/// The whole contents of `path`, at most [`MAX_INPUT_FILE_BYTES`]: a regular file's
+/// size is checked before anything is read; anything else (a device, a pipe) is read up
+/// to the limit and refused beyond it.
+pub fn read_capped(path: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let too_large = || {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("larger than the {} MiB an input file may have", MAX_INPUT_FILE_BYTES >> 20),
+        )
+    };
+    let file = std::fs::File::open(path)?;
+    let metadata = file.metadata()?;
+    if metadata.is_dir() {
+        return Err(std::io::Error::new(std::io::ErrorKind::InvalidInput, "is a folder, not a file"));
+    }
+    if metadata.is_file() && metadata.len() > MAX_INPUT_FILE_BYTES {
+        return Err(too_large());
+    }
+    let mut bytes = Vec::new();
+    file.take(MAX_INPUT_FILE_BYTES + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > MAX_INPUT_FILE_BYTES {
+        return Err(too_large());
+    }
+    Ok(bytes)
+}
+
+/// [`read_capped`] as UTF-8 text.
+pub fn read_text_capped(path: &Path) -> std::io::Result<String> {
+    String::from_utf8(read_capped(path)?).map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
 }
 
 /// Files held in memory, by path; a path not in the map is "not found", unless a

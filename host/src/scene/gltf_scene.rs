@@ -56,7 +56,7 @@ use std::path::Path;
 
 /// Loads a glTF 2.0 file (`.gltf` or `.glb`) as a scene (module documentation).
 pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
+    let bytes = crate::scene::read_capped(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
     load_gltf_from(path, &bytes, &DiskFiles)
 }
 
@@ -72,10 +72,27 @@ pub(super) fn json_error(path: &Path, field: impl Into<String>, message: impl In
     SceneError::Json { path: path.into(), field: field.into(), message: message.into() }
 }
 
+/// Refuses a document that is not glTF 2.x (`asset.version` "1.0" is a different format
+/// whose fields the loader would misread).
+fn check_version(path: &Path, raw: &serde_json::Value) -> Result<(), SceneError> {
+    let version = raw.pointer("/asset/version");
+    match version.and_then(serde_json::Value::as_str) {
+        Some(text) if text.split_once('.').is_some_and(|(major, _)| major == "2") => Ok(()),
+        Some(text) => Err(json_error(path, "asset.version", format!("`{text}`: only glTF 2.x is read"))),
+        None => Err(json_error(path, "asset.version", "missing: a glTF 2.0 document names its version")),
+    }
+}
+
+/// How far from 1 the length of a node's rotation quaternion may be (exporters write
+/// unit quaternions rounded to a few decimals); beyond it the rotation is an error,
+/// since glam would turn a zero quaternion into no rotation at all.
+const QUATERNION_LENGTH_TOLERANCE: f32 = 1e-2;
+
 /// Loads the document in `bytes`, read from `path`.
 fn load_bytes(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene, SceneError> {
     check_glb_header(path, bytes)?;
     let raw = raw_json(bytes).map_err(|message| json_error(path, "(document)", message))?;
+    check_version(path, &raw)?;
     check_position_accessors(path, &raw)?;
     let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(bytes).map_err(|e| document_error(path, e))?;
     let folder = path.parent().unwrap_or(Path::new("."));
@@ -170,8 +187,8 @@ fn load_buffers(
 struct MaterialInfo {
     /// Emitted radiance, if any.
     emission: Option<[f32; 3]>,
-    /// Texture coordinate set of the colour texture (0 without one).
-    tex_coord: u32,
+    /// Texture coordinate set of the colour texture, if the material has one.
+    tex_coord: Option<u32>,
 }
 
 /// The conversion's state.
@@ -216,25 +233,22 @@ impl Loader<'_> {
         let pbr = material.pbr_metallic_roughness();
         let [r, g, b, _] = pbr.base_color_factor();
         let (metallic, roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
-        if [r, g, b, metallic, roughness].iter().any(|c| !c.is_finite() || *c < 0.0)
-            || metallic > 1.0
-            || roughness > 1.0
-        {
+        if ![r, g, b, metallic, roughness].iter().all(|c| (0.0..=1.0).contains(c)) {
             return Err(self.error(
                 format!("{field}.pbrMetallicRoughness"),
                 format!(
-                    "base colour {:?}, metallic {metallic}, roughness {roughness}: must be finite and ≥ 0 \
-                     (metallic and roughness ≤ 1)",
+                    "base colour {:?}, metallic {metallic}, roughness {roughness}: each must lie in [0, 1] (a base \
+                     colour above 1 creates energy)",
                     [r, g, b]
                 ),
             ));
         }
         let two_sided = material.double_sided();
-        let mut tex_coord = 0;
+        let mut tex_coord = None;
         let bsdf = if metallic >= 0.5 {
             metal([r, g, b], (roughness * roughness).max(MIN_ALPHA), two_sided)
         } else if let Some(info) = pbr.base_color_texture() {
-            tex_coord = info.tex_coord();
+            tex_coord = Some(info.tex_coord());
             let texture = self.texture(info.texture().source(), [r, g, b])?;
             Material::Diffuse { albedo: Albedo::Texture { texture, uv_scale: [1.0, 1.0] }, two_sided }
         } else {
@@ -328,6 +342,15 @@ impl Loader<'_> {
             if std::mem::replace(&mut reached[node.index()], true) {
                 return Err(self.error(field, "the node is reached twice: the node hierarchy must be a tree"));
             }
+            if let gltf::scene::Transform::Decomposed { rotation, .. } = node.transform() {
+                let length = rotation.iter().map(|c| c * c).sum::<f32>().sqrt();
+                if !((length - 1.0).abs() <= QUATERNION_LENGTH_TOLERANCE) {
+                    return Err(self.error(
+                        format!("{field}.rotation"),
+                        format!("{rotation:?} has length {length}: a rotation is a unit quaternion"),
+                    ));
+                }
+            }
             let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
             if !world.is_finite() {
                 return Err(self.error(field, format!("the world transform is not finite: {world:?}")));
@@ -391,7 +414,8 @@ impl Loader<'_> {
         let material = primitive.material();
         let material_index = self.material_index(&material);
         let info = material.index().and_then(|i| self.material_info.get(i));
-        let (emission, tex_coord) = info.map_or((None, 0), |i| (i.emission, i.tex_coord));
+        let (emission, textured_with) = info.map_or((None, None), |i| (i.emission, i.tex_coord));
+        let tex_coord = textured_with.unwrap_or(0);
         let buffers = &self.buffers;
         let reader = primitive.reader(|b| buffers.get(b.index()).map(|data| data.0.as_slice()));
         let outside = |accessor: &Accessor| {
@@ -440,6 +464,17 @@ impl Loader<'_> {
                 let what = format!("TEXCOORD_{tex_coord}");
                 self.check_accessor(&accessor, &what, Dimensions::Vec2, &[DataType::F32, DataType::U8, DataType::U16])?;
                 Some(reader.read_tex_coords(tex_coord).ok_or_else(|| outside(&accessor))?.into_f32().collect())
+            }
+            // A textured material needs the coordinates it names: without them every
+            // texel lookup would be a guess.
+            None if textured_with.is_some() => {
+                return Err(self.error(
+                    format!("{field}.attributes"),
+                    format!(
+                        "no TEXCOORD_{tex_coord}, which the base colour texture of material `{}` reads",
+                        material.name().map_or_else(|| format!("materials[{:?}]", material.index()), String::from)
+                    ),
+                ));
             }
             None => None,
         };

@@ -175,6 +175,7 @@ pub(super) fn assemble_scene(
         shapes,
         textures,
         environment: None,
+        warnings: Vec::new(),
     })
 }
 

@@ -47,7 +47,7 @@ pub use environment::Environment;
 pub use exr_decode::{
     MAX_BLOCK_BYTES, MAX_BLOCK_BYTES_PER_FILE_BYTE, MAX_EXR_TEXELS, MAX_TEXELS_PER_FILE_BYTE, RgbExr, decode_rgb_exr,
 };
-pub use files::{DiskFiles, FileSource, MemoryFiles};
+pub use files::{DiskFiles, FileSource, MAX_INPUT_FILE_BYTES, MemoryFiles, read_capped, read_text_capped};
 pub use gltf_scene::{load_gltf, load_gltf_from};
 pub use material::{Albedo, Material};
 pub use obj_scene::{load_obj, load_obj_from};
@@ -139,6 +139,10 @@ pub struct Scene {
     pub textures: Vec<Texture>,
     /// The environment map.
     pub environment: Option<Environment>,
+    /// What the loader left out or replaced and said so (an OBJ face of two vertices, a
+    /// material name no library defines, a missing material library): each names the
+    /// file and line; the command line prints them once and the run record keeps them.
+    pub warnings: Vec<String>,
 }
 
 impl Scene {
@@ -213,6 +217,7 @@ impl Scene {
             shapes,
             textures,
             environment,
+            warnings: Vec::new(),
         })
     }
 

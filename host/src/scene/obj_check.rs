@@ -2,7 +2,8 @@
 //! check itself: a face index of 0 or beyond the vertices, texture coordinates or normals
 //! that exist (`tobj` computes `index × 3` unchecked, which overflows on huge indices), and a
 //! colour statement (`Ka`, `Kd`, `Ks`, `Ke`) with fewer than three numbers (`tobj` unwraps
-//! it). Each is an error naming the line.
+//! it). Each is an error naming the line. Also found here, for warnings naming the line:
+//! faces of fewer than three vertices and the `usemtl` statements.
 
 /// The first face (or line, or point) of `text` with a vertex, texture or normal index
 /// that is 0 or lies outside the elements declared so far (relative, negative indices)
@@ -50,6 +51,39 @@ pub(super) fn bad_face_index(text: &str) -> Option<(usize, String)> {
     None
 }
 
+/// The lines (1-based) of faces with fewer than three vertices: not surfaces, which
+/// `tobj` drops without a word.
+pub(super) fn short_faces(text: &str) -> Vec<usize> {
+    text.lines()
+        .enumerate()
+        .filter(|(_, line)| {
+            let mut words = line.split_whitespace();
+            words.next() == Some("f") && words.count() < 3
+        })
+        .map(|(number, _)| number + 1)
+        .collect()
+}
+
+/// Every `usemtl` statement: its line (1-based) and the material it names.
+pub(super) fn material_uses(text: &str) -> Vec<(usize, String)> {
+    text.lines()
+        .enumerate()
+        .filter_map(|(number, line)| {
+            let rest = line.trim_start().strip_prefix("usemtl")?;
+            rest.starts_with(char::is_whitespace).then(|| (number + 1, rest.trim().to_string()))
+        })
+        .collect()
+}
+
+/// One warning for many lines: `line N` or `line N (and M more)`.
+pub(super) fn lines_text(lines: &[usize]) -> String {
+    match lines {
+        [] => String::new(),
+        [line] => format!("line {line}"),
+        [line, rest @ ..] => format!("line {line} (and {} more)", rest.len()),
+    }
+}
+
 /// The first colour statement of the MTL `text` with fewer than three numbers: its line
 /// number and statement.
 pub(super) fn short_colour(text: &str) -> Option<(usize, String)> {
@@ -75,5 +109,8 @@ mod tests {
         assert!(bad_face_index("f -1 1 1\nv 0 0 0\n").is_some(), "relative to what is declared before");
         assert_eq!(short_colour("newmtl a\nKd 1 1 1\n"), None);
         assert_eq!(short_colour("newmtl a\nKe 1\n").unwrap().0, 2);
+        assert_eq!(short_faces("v 0 0 0\nf 1 1\nf 1 1 1\nf 1\n"), [2, 4]);
+        assert_eq!(material_uses("usemtl a b\nusemtlx\n  usemtl c\n"), [(1, "a b".into()), (3, "c".into())]);
+        assert_eq!(lines_text(&[4, 9, 12]), "line 4 (and 2 more)");
     }
 }

@@ -46,7 +46,7 @@ use std::path::{Path, PathBuf};
 /// Loads an OBJ file and the MTL libraries it names (relative to its folder) as a scene
 /// (module documentation).
 pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
+    let bytes = crate::scene::read_capped(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
     load_obj_from(path, &bytes, &DiskFiles)
 }
 
@@ -64,6 +64,8 @@ fn obj_error(path: &Path, element: impl Into<String>, message: impl Into<String>
 /// Loads the OBJ in `bytes`, read from `path`.
 fn load_bytes(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene, SceneError> {
     let folder = path.parent().unwrap_or(Path::new("."));
+    let warnings = RefCell::new(Vec::new());
+    let library_missing = std::cell::Cell::new(false);
     let library_error = RefCell::new(None);
     let library_of = RefCell::new(HashMap::new());
     let load_library = |relative: &Path| {
@@ -72,11 +74,12 @@ fn load_bytes(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene
             Ok(text) => text,
             Err(error) => {
                 if error.kind() == std::io::ErrorKind::NotFound {
-                    eprintln!(
-                        "notice: {}: material library {} not found; its materials are grey diffuse {DEFAULT_GREY}",
+                    library_missing.set(true);
+                    warnings.borrow_mut().push(format!(
+                        "{}: material library {} not found; its materials are grey diffuse {DEFAULT_GREY}",
                         path.display(),
                         library.display()
-                    );
+                    ));
                 } else {
                     *library_error.borrow_mut() = Some(SceneError::Io { path: library.clone(), source: error });
                 }
@@ -99,8 +102,19 @@ fn load_bytes(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene
         }
         loaded
     };
-    if let Some((line, problem)) = obj_check::bad_face_index(&String::from_utf8_lossy(bytes)) {
+    let text = String::from_utf8_lossy(bytes);
+    if let Some((line, problem)) = obj_check::bad_face_index(&text) {
         return Err(obj_error(path, format!("line {line}"), problem));
+    }
+    let short_faces = obj_check::short_faces(&text);
+    if !short_faces.is_empty() {
+        warnings.borrow_mut().push(format!(
+            "{}: {}: {} with fewer than 3 vertices {} not a surface; left out",
+            path.display(),
+            obj_check::lines_text(&short_faces),
+            if short_faces.len() == 1 { "a face".to_string() } else { format!("{} faces", short_faces.len()) },
+            if short_faces.len() == 1 { "is" } else { "are" }
+        ));
     }
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
     let (models, materials) = tobj::load_obj_buf(&mut &bytes[..], &options, load_library)
@@ -109,6 +123,28 @@ fn load_bytes(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene
         return Err(error);
     }
     let library_of = library_of.into_inner();
+    let mut warnings = warnings.into_inner();
+    // A `usemtl` naming no material of a library that was found: its faces get the
+    // default material, said once per name. (A missing library was said above.)
+    let defined: Vec<&str> = materials.iter().flatten().map(|m| m.name.as_str()).collect();
+    let mut unknown: Vec<(String, Vec<usize>)> = Vec::new();
+    for (line, name) in obj_check::material_uses(&text) {
+        if defined.contains(&name.as_str()) {
+            continue;
+        }
+        match unknown.iter_mut().find(|(n, _)| *n == name) {
+            Some((_, lines)) => lines.push(line),
+            None => unknown.push((name, vec![line])),
+        }
+    }
+    for (name, lines) in unknown.into_iter().filter(|_| !library_missing.get()) {
+        warnings.push(format!(
+            "{}: {}: `usemtl {name}` names no material of the scene's libraries; its faces are grey diffuse \
+             {DEFAULT_GREY}",
+            path.display(),
+            obj_check::lines_text(&lines)
+        ));
+    }
     let mut converter = MaterialConverter { files, textures: Vec::new(), texture_cache: HashMap::new() };
     let mut scene_materials = Vec::new();
     let mut names = Vec::new();
@@ -159,8 +195,10 @@ fn load_bytes(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene
         return Err(obj_error(path, "faces", "the file has no triangles"));
     }
     let name = path.file_stem().map_or_else(|| path.display().to_string(), |s| s.to_string_lossy().into_owned());
-    assemble_scene(name, None, (scene_materials, names), shapes, converter.textures)
-        .map_err(|message| obj_error(path, "(scene)", message))
+    let mut scene = assemble_scene(name, None, (scene_materials, names), shapes, converter.textures)
+        .map_err(|message| obj_error(path, "(scene)", message))?;
+    scene.warnings = warnings;
+    Ok(scene)
 }
 
 /// Turns MTL materials into the renderer's, loading their textures.
@@ -189,27 +227,39 @@ impl MaterialConverter<'_> {
                 _ => Err(obj_error(library, element(statement), format!("`{text}` is not a finite number"))),
             }
         };
-        let colour = |statement: &str, value: Option<[f32; 3]>| -> Result<Option<[f32; 3]>, SceneError> {
+        // Kd and Ks are reflectances: above 1 a surface would reflect more light than
+        // arrives (creating energy).
+        let reflectance = |statement: &str, value: Option<[f32; 3]>| -> Result<Option<[f32; 3]>, SceneError> {
             match value {
-                Some(c) if c.iter().any(|x| !x.is_finite() || *x < 0.0) => {
-                    Err(obj_error(library, element(statement), format!("{c:?} must be finite and ≥ 0")))
-                }
+                Some(c) if !c.iter().all(|x| (0.0..=1.0).contains(x)) => Err(obj_error(
+                    library,
+                    element(statement),
+                    format!("{c:?}: each must lie in [0, 1] (a reflectance above 1 creates energy)"),
+                )),
                 other => Ok(other),
             }
         };
-        let scalar = |statement: &str, value: Option<f32>, least: f32| -> Result<Option<f32>, SceneError> {
+        /// What a scalar statement must be.
+        #[derive(Clone, Copy)]
+        enum Least {
+            Zero,
+            Positive,
+        }
+        let scalar = |statement: &str, value: Option<f32>, least: Least| -> Result<Option<f32>, SceneError> {
+            let (holds, rule) = match least {
+                Least::Zero => (value.is_none_or(|v| v.is_finite() && v >= 0.0), "must be finite and ≥ 0"),
+                Least::Positive => (value.is_none_or(|v| v.is_finite() && v > 0.0), "must be finite and positive"),
+            };
             match value {
-                Some(v) if !(v.is_finite() && v >= least) => {
-                    Err(obj_error(library, element(statement), format!("{v} must be finite and ≥ {least}")))
-                }
+                Some(v) if !holds => Err(obj_error(library, element(statement), format!("{v} {rule}"))),
                 other => Ok(other),
             }
         };
-        let dissolve = scalar("d", material.dissolve, 0.0)?;
-        let optical_density = scalar("Ni", material.optical_density, f32::MIN_POSITIVE)?;
-        let shininess = scalar("Ns", material.shininess, 0.0)?;
-        let kd = colour("Kd", material.diffuse)?;
-        let ks = colour("Ks", material.specular)?;
+        let dissolve = scalar("d", material.dissolve, Least::Zero)?;
+        let optical_density = scalar("Ni", material.optical_density, Least::Positive)?;
+        let shininess = scalar("Ns", material.shininess, Least::Zero)?;
+        let kd = reflectance("Kd", material.diffuse)?;
+        let ks = reflectance("Ks", material.specular)?;
         let radiance = emission(material.emissive.unwrap_or([0.0; 3]))
             .map_err(|message| obj_error(library, element("Ke"), message))?;
         let transparent =

@@ -90,7 +90,7 @@ fn ply_error(path: &Path, element: impl Into<String>, message: impl Into<String>
 
 /// Reads a binary little-endian PLY triangle mesh from the file `path`.
 pub fn read_ply(path: &Path) -> Result<PlyMesh, SceneError> {
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
+    let bytes = crate::scene::read_capped(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
     parse_ply(path, &bytes)
 }
 

@@ -37,7 +37,7 @@ impl Texture {
 
     /// Loads a PNG (or another format the `image` crate decodes here).
     pub fn load(path: &Path, srgb: bool) -> Result<Texture, SceneError> {
-        let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
+        let bytes = crate::scene::read_capped(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
         Texture::decode(path, &bytes, srgb)
     }
 

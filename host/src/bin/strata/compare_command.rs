@@ -8,6 +8,7 @@ use std::time::Instant;
 use strata::backend_choice::{BackendChoice, open_backend};
 use strata::evaluation::compare::Comparison;
 use strata::evaluation::crops::{self, Crop};
+use strata::evaluation::image_checks::check_reference;
 use strata::evaluation::output_folder;
 use strata::evaluation::record::{self, RunRecord};
 use strata::evaluation::report::{ReportOptions, run_and_report};
@@ -124,8 +125,8 @@ pub(crate) struct CompareArgs {
     /// path-traced (`--reference-spp` each) and `--reference` is refused.
     #[arg(long, default_value = "static")]
     camera_path: String,
-    /// Exposure of the PNG previews.
-    #[arg(long, default_value_t = 1.0)]
+    /// Exposure of the PNG previews: finite and positive.
+    #[arg(long, default_value_t = 1.0, value_parser = super::finite_positive)]
     exposure: f32,
     /// Backend to run on.
     #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
@@ -164,6 +165,15 @@ fn default_reference_spp(backend: &dyn strata_backends::Backend) -> u32 {
 }
 
 pub(crate) fn compare(args: CompareArgs) -> Result<()> {
+    let mut size = None;
+    compare_sized(&args, &mut size).map_err(|e| match size {
+        Some((width, height)) => super::name_the_size(e, width, height),
+        None => e,
+    })
+}
+
+/// [`compare`], which says the image size in `size` once it is known.
+fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()> {
     let started = Instant::now();
     let date = record::now_rfc3339();
     let (scene, render) = scene_and_settings(&args.scene, args.width, args.height)?;
@@ -173,6 +183,9 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
     // Read before any long work, and before the output folder is cleared (the file may
     // lie in it).
     let given_reference = args.reference.as_deref().map(RgbImage::read_exr).transpose()?;
+    if let (Some(image), Some(path)) = (&given_reference, &args.reference) {
+        check_reference(image, &path.display().to_string())?;
+    }
     let film = match (args.pixel_centres, args.film) {
         (true, _) => Film::Centres,
         (false, Some(film)) => film,
@@ -182,6 +195,11 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
     let render = RenderSettings { film, ..render };
     if args.frames == 0 || args.seeds == 0 {
         bail!("--frames and --seeds must be at least 1");
+    }
+    for (index, method) in args.methods.iter().enumerate() {
+        if args.methods[..index].contains(method) {
+            bail!("--methods: `{}` is named twice; name each method once", method.name());
+        }
     }
     let restir = RestirSettings {
         selection: args.selection,
@@ -202,7 +220,8 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
     let mut backend = open_backend(args.backend)?;
     println!("backend: {}", backend.info().summary());
     let reference_spp = args.reference_spp.unwrap_or_else(|| default_reference_spp(backend.as_ref()));
-    let render = sized_to_backend(&args, render, backend.as_ref(), reference_spp);
+    let render = sized_to_backend(args, render, backend.as_ref(), reference_spp);
+    *size = Some((render.camera.width, render.camera.height));
     for crop in &args.crop {
         crops::check_inside(crop, render.camera.width, render.camera.height)?;
     }
@@ -250,6 +269,7 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
                 ..render.clone()
             };
             let image = strata::render::render(backend.as_mut(), &gpu_scene, &settings, reference_spp, |_| {})?;
+            check_reference(&image, &format!("the path-traced reference of frame {}", frame + 1))?;
             image.write_exr(&args.out.join(format!("reference_frame{:03}.exr", frame + 1)))?;
             references.push(image);
             progress.inc(1);
@@ -293,7 +313,8 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
         seeds: args.seeds,
         temporal: !args.accumulate,
         reference: reference_text,
-        settings: settings_record(&restir, &args, render.film, backend.info()),
+        settings: settings_record(&restir, args, render.film, backend.info()),
+        warnings: scene.warnings.clone(),
         frame_ms: Vec::new(),
         seconds: 0.0,
     };
@@ -363,6 +384,7 @@ fn rendered_reference(
     let mut progress = Progress::new("reference", u64::from(spp), "spp");
     let image = strata::render::render(backend, gpu_scene, &settings, spp, |done| progress.set(u64::from(done)))?;
     progress.finish();
+    check_reference(&image, "the path-traced reference")?;
     image.write_exr(&args.out.join("reference.exr"))?;
     Ok(image)
 }

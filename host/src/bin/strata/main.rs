@@ -2,6 +2,16 @@
 
 mod compare_command;
 
+/// `--exposure` and other scales: a finite, positive number (NaN or a negative exposure
+/// would write black pictures, an infinite one white ones).
+pub(crate) fn finite_positive(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(value) if value.is_finite() && value > 0.0 => Ok(value),
+        Ok(value) => Err(format!("{value} must be finite and positive")),
+        Err(error) => Err(error.to_string()),
+    }
+}
+
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -109,8 +119,8 @@ struct RenderArgs {
     /// Turn Russian roulette off.
     #[arg(long)]
     no_russian_roulette: bool,
-    /// Exposure of the PNG preview (the EXR is never scaled).
-    #[arg(long, default_value_t = 1.0)]
+    /// Exposure of the PNG preview (the EXR is never scaled): finite and positive.
+    #[arg(long, default_value_t = 1.0, value_parser = finite_positive)]
     exposure: f32,
     /// Backend to run on.
     #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
@@ -191,12 +201,19 @@ pub(crate) fn scene_and_settings(
         Some(path) => load_scene_file(path)?,
         None => default_scene(),
     };
+    // Said once here; `compare` also keeps them in its run record.
+    for warning in &scene.warnings {
+        eprintln!("warning: {warning}");
+    }
     let width = width.unwrap_or(scene.camera.width);
     let height = height.unwrap_or(scene.camera.height);
     // Said before a backend opens or a reference starts rendering.
     for (flag, value) in [("--width", width), ("--height", height)] {
         if value == 0 {
             bail!("{flag} 0: the image must be at least 1x1 pixels");
+        }
+        if value > strata::scene::MAX_IMAGE_SIDE {
+            bail!("{flag} {value}: each side of the image must be at most {}", strata::scene::MAX_IMAGE_SIDE);
         }
     }
     let settings = RenderSettings::for_scene(&scene, width, height, 1);
@@ -230,7 +247,7 @@ fn plot(args: PlotArgs) -> Result<()> {
     let labels = if args.labels.is_empty() { default_labels(&args.csv) } else { args.labels.clone() };
     let mut runs = Vec::new();
     for (path, label) in args.csv.iter().zip(labels) {
-        let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
+        let text = strata::scene::read_text_capped(path).with_context(|| format!("{}: cannot read", path.display()))?;
         let errors = compare::parse_errors_csv(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
         runs.push((label, errors));
     }
@@ -280,8 +297,27 @@ fn plot(args: PlotArgs) -> Result<()> {
 }
 
 fn metrics(args: MetricsArgs) -> Result<()> {
+    // The map's names are checked before anything is read or measured.
+    let map_png = args.map.as_ref().map(|map| map.with_extension("png"));
+    if let Some(map) = &args.map {
+        if !map.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
+            bail!(
+                "--map {}: the error map is an EXR file and its false-colour picture a PNG beside it; give a name \
+                 ending in .exr",
+                map.display()
+            );
+        }
+        for output in [map, map_png.as_ref().expect("set with map")] {
+            for (flag, input) in [("the image", &args.image), ("the reference", &args.reference)] {
+                if same_file(output, input) {
+                    bail!("--map {}: would overwrite {flag} {}", map.display(), input.display());
+                }
+            }
+        }
+    }
     let image = RgbImage::read_exr(&args.image)?;
     let reference = RgbImage::read_exr(&args.reference)?;
+    strata::evaluation::image_checks::check_reference(&reference, &args.reference.display().to_string())?;
     let context = || format!("{} against {}", args.image.display(), args.reference.display());
     println!("mse            {:.6e}", metrics::mse(&image, &reference).with_context(context)?);
     println!("relmse         {:.6e}", metrics::relmse(&image, &reference).with_context(context)?);
@@ -296,7 +332,7 @@ fn metrics(args: MetricsArgs) -> Result<()> {
         let map_image =
             RgbImage { width: image.width, height: image.height, pixels: map.iter().map(|&e| [e as f32; 3]).collect() };
         map_image.write_exr(path)?;
-        let png = path.with_extension("png");
+        let png = map_png.expect("set with map");
         metrics::false_colour(&map, image.width, image.height).write_png(&png, 1.0)?;
         println!("wrote {} and {}", path.display(), png.display());
     }
@@ -332,10 +368,18 @@ fn render(args: RenderArgs) -> Result<()> {
     std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create the folder", args.out.display()))?;
     let mut progress = strata::progress::Progress::new("render", u64::from(args.spp), "spp");
     let started = Instant::now();
-    let image = strata::render::render(backend.as_mut(), &gpu_scene, &settings, args.spp, |done| {
-        progress.set(u64::from(done))
-    })?;
+    let image =
+        strata::render::render(backend.as_mut(), &gpu_scene, &settings, args.spp, |done| progress.set(u64::from(done)))
+            .map_err(|e| name_the_size(e.into(), settings.camera.width, settings.camera.height))?;
     progress.finish();
+    if strata::evaluation::image_checks::is_black(&image) {
+        bail!(
+            "the rendered image is black everywhere ({}x{} pixels of 0): the camera sees no light (is it inside a \
+             closed object, pointed away from the scene, or is the scene unlit?); nothing written",
+            image.width,
+            image.height
+        );
+    }
     let seconds = started.elapsed().as_secs_f64();
     let stem = args.scene.as_ref().and_then(|p| scene_stem(p)).unwrap_or_else(|| "default".into());
     let exr = args.out.join(format!("{stem}.exr"));
@@ -354,6 +398,38 @@ fn render(args: RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// `error` with the image size named first where the device refused a buffer as too
+/// large (the message otherwise names only an internal kernel binding).
+pub(crate) fn name_the_size(error: anyhow::Error, width: u32, height: u32) -> anyhow::Error {
+    use strata::histogram_pass::PassError;
+    use strata_backends::BackendError;
+    let limit = |b: &BackendError| matches!(b, BackendError::LimitExceeded { .. });
+    let too_large = error.chain().any(|cause| {
+        cause.downcast_ref::<BackendError>().is_some_and(limit)
+            || cause.downcast_ref::<PassError>().is_some_and(|p| matches!(p, PassError::Backend(b) if limit(b)))
+    });
+    if too_large {
+        error.context(format!(
+            "--width {width} --height {height}: {} pixels are too many for this device; choose a smaller image",
+            u64::from(width) * u64::from(height)
+        ))
+    } else {
+        error
+    }
+}
+
+/// Whether `a` and `b` name the same file: the same path, or the same file on disk
+/// (through links, `..` or another spelling).
+fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
+    if a == b {
+        return true;
+    }
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
 /// `cornell-box` for `.../cornell-box/scene.json`, else the file stem.
 pub(crate) fn scene_stem(path: &std::path::Path) -> Option<String> {
     let stem = path.file_stem()?.to_string_lossy().into_owned();
@@ -366,6 +442,9 @@ pub(crate) fn scene_stem(path: &std::path::Path) -> Option<String> {
 
 fn histogram(args: HistogramArgs) -> Result<()> {
     let grid = BlockGrid::new(args.width, args.height, args.block_size)?;
+    if args.objects == 0 {
+        bail!("--objects 0: the generated image needs at least one object id");
+    }
     if !(0.0..=1.0).contains(&args.awkward) {
         bail!("--awkward {}: must be a share between 0 and 1", args.awkward);
     }

@@ -74,13 +74,12 @@ pub(super) fn write(figure: &Figure, stem: &Path) -> Result<Vec<PathBuf>> {
     let (svg_path, png_path) = (with_suffix(stem, ".svg"), with_suffix(stem, ".png"));
     let document = svg(figure).with_context(|| format!("{}: cannot write", svg_path.display()))?;
     crate::atomic_file::write(&svg_path, document)?;
-    png(figure)
+    let bytes = png(figure)
         .and_then(|image| {
-            crate::atomic_file::write_with(&png_path, |temporary| {
-                image.save_with_format(temporary, image::ImageFormat::Png)
-            })
-            .map_err(|e| anyhow!("{e}"))
+            crate::rgb_image::encode_png(image.as_raw(), image.width(), image.height(), image::ExtendedColorType::Rgb8)
+                .map_err(|e| anyhow!(e))
         })
         .with_context(|| format!("{}: cannot write", png_path.display()))?;
+    crate::atomic_file::write(&png_path, bytes)?;
     Ok(vec![svg_path, png_path])
 }

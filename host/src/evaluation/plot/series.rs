@@ -48,14 +48,26 @@ pub(super) fn frame_count(errors: &[FrameError]) -> u32 {
     errors.iter().map(|e| e.frame.saturating_add(1)).max().unwrap_or(0)
 }
 
+/// The 0-based frames below `frames` that `errors` hold a row of, in order. Plots walk
+/// these, never 0..frames: the work follows the rows, whatever the frame numbers.
+fn frames_present(errors: &[FrameError], frames: u32) -> std::collections::BTreeSet<u32> {
+    errors.iter().map(|e| e.frame).filter(|&f| f < frames).collect()
+}
+
 /// `method`'s RelMSE over seeds at frames 1..=`frames`; only positive finite means.
 pub(super) fn relmse_points(errors: &[FrameError], method: Method, frames: u32) -> Vec<Point> {
-    (0..frames).filter_map(|f| point(f, relmse_over_seeds(errors, method, f)).filter(|p| p.mean > 0.0)).collect()
+    frames_present(errors, frames)
+        .into_iter()
+        .filter_map(|f| point(f, relmse_over_seeds(errors, method, f)).filter(|p| p.mean > 0.0))
+        .collect()
 }
 
 /// strata ÷ `baseline`, paired per seed, at frames 1..=`frames`; only finite means.
 pub(super) fn ratio_points(errors: &[FrameError], baseline: Method, frames: u32) -> Vec<Point> {
-    (0..frames).filter_map(|f| point(f, relmse_ratio(errors, Method::Strata, baseline, f)?)).collect()
+    frames_present(errors, frames)
+        .into_iter()
+        .filter_map(|f| point(f, relmse_ratio(errors, Method::Strata, baseline, f)?))
+        .collect()
 }
 
 /// The point of 0-based `frame`, if its mean can be drawn; its band if the half-width is

@@ -1,0 +1,136 @@
+//! What an image must be before it is scored, in one place: a reference (read from a
+//! file or path-traced) and every rendered frame pass these checks before any error
+//! metric is computed from them, so that a number in `errors.csv`, the summary or the
+//! report is never computed from an image that cannot mean anything.
+//!
+//! - A reference is finite, non-negative (radiance; a negative pixel makes the paper's
+//!   RelMSE, (f − ref)² / (ref + 1e-4), negative or huge) and not black everywhere (a
+//!   camera that sees no light: every error would be 0 and every ratio 0 / 0).
+//! - A frame is finite and, where its reference is not black, not black everywhere
+//!   either: a renderer that lost every sample (a radiance that overflowed to infinity
+//!   and was zeroed as a non-finite sample) must not be scored as a plausible error.
+
+use crate::rgb_image::RgbImage;
+
+/// Why an image cannot be scored; the message names the image and the pixel.
+#[derive(Debug, thiserror::Error)]
+pub enum ImageCheckError {
+    /// A NaN or infinite channel.
+    #[error("{name}: pixel ({x}, {y}) is {value:?}: an image with non-finite values cannot be measured")]
+    NonFinite {
+        /// The image, in words ("the reference", "strata frame 3, seed 1").
+        name: String,
+        /// Column.
+        x: u32,
+        /// Row.
+        y: u32,
+        /// The pixel.
+        value: [f32; 3],
+    },
+    /// A negative channel in a reference.
+    #[error("{name}: pixel ({x}, {y}) is {value:?}: a reference is radiance, never negative")]
+    Negative {
+        /// The image.
+        name: String,
+        /// Column.
+        x: u32,
+        /// Row.
+        y: u32,
+        /// The pixel.
+        value: [f32; 3],
+    },
+    /// A reference that is 0 everywhere.
+    #[error(
+        "{name} is black everywhere ({width}x{height} pixels of 0): the camera sees no light (is it inside a closed \
+         object, pointed away from the scene, or is the scene unlit?), so there is no error to measure"
+    )]
+    BlackReference {
+        /// The image.
+        name: String,
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+    },
+    /// A frame that is 0 everywhere while its reference is not.
+    #[error(
+        "{name} is black everywhere while its reference is not: the renderer lost every sample (a radiance that \
+         overflows single-precision floats?); it is not scored"
+    )]
+    BlackFrame {
+        /// The image.
+        name: String,
+    },
+}
+
+/// The first pixel with a channel that fails `bad`, as (x, y, pixel).
+fn first_pixel(image: &RgbImage, bad: impl Fn(f32) -> bool) -> Option<(u32, u32, [f32; 3])> {
+    let index = image.pixels.iter().position(|p| p.iter().any(|&c| bad(c)))?;
+    let width = image.width.max(1) as usize;
+    Some(((index % width) as u32, (index / width) as u32, image.pixels[index]))
+}
+
+/// Whether every channel of every pixel is exactly 0.
+pub fn is_black(image: &RgbImage) -> bool {
+    image.pixels.iter().all(|p| p.iter().all(|&c| c == 0.0))
+}
+
+/// Refuses a reference that is not finite, has a negative pixel or is black everywhere;
+/// `name` says which image it is in the message ("the reference", a file name).
+pub fn check_reference(image: &RgbImage, name: &str) -> Result<(), ImageCheckError> {
+    if let Some((x, y, value)) = first_pixel(image, |c| !c.is_finite()) {
+        return Err(ImageCheckError::NonFinite { name: name.into(), x, y, value });
+    }
+    if let Some((x, y, value)) = first_pixel(image, |c| c < 0.0) {
+        return Err(ImageCheckError::Negative { name: name.into(), x, y, value });
+    }
+    if is_black(image) {
+        return Err(ImageCheckError::BlackReference { name: name.into(), width: image.width, height: image.height });
+    }
+    Ok(())
+}
+
+/// Refuses a rendered frame that is not finite, or black everywhere against a
+/// `reference` that is not.
+pub fn check_frame(image: &RgbImage, reference: &RgbImage, name: &str) -> Result<(), ImageCheckError> {
+    if let Some((x, y, value)) = first_pixel(image, |c| !c.is_finite()) {
+        return Err(ImageCheckError::NonFinite { name: name.into(), x, y, value });
+    }
+    if is_black(image) && !is_black(reference) {
+        return Err(ImageCheckError::BlackFrame { name: name.into() });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(pixels: Vec<[f32; 3]>) -> RgbImage {
+        RgbImage { width: 2, height: (pixels.len() / 2) as u32, pixels }
+    }
+
+    #[test]
+    fn references_must_be_finite_non_negative_and_lit() {
+        let lit = image(vec![[0.0; 3], [0.5; 3], [0.0; 3], [0.0; 3]]);
+        assert!(check_reference(&lit, "r").is_ok());
+        let negative = image(vec![[0.0; 3], [0.5; 3], [0.0, -1e-3, 0.0], [0.0; 3]]);
+        let message = check_reference(&negative, "ref.exr").unwrap_err().to_string();
+        assert!(message.starts_with("ref.exr: pixel (0, 1)") && message.contains("never negative"), "{message}");
+        let nan = image(vec![[0.0; 3], [f32::NAN, 0.0, 0.0], [0.0; 3], [0.0; 3]]);
+        assert!(check_reference(&nan, "r").unwrap_err().to_string().contains("pixel (1, 0)"));
+        let black = image(vec![[0.0; 3]; 4]);
+        assert!(check_reference(&black, "the reference").unwrap_err().to_string().contains("black everywhere"));
+    }
+
+    #[test]
+    fn frames_must_be_finite_and_not_black_where_the_reference_is_lit() {
+        let lit = image(vec![[0.0; 3], [0.5; 3], [0.0; 3], [0.0; 3]]);
+        let black = image(vec![[0.0; 3]; 4]);
+        assert!(check_frame(&lit, &lit, "f").is_ok());
+        assert!(matches!(check_frame(&black, &lit, "f"), Err(ImageCheckError::BlackFrame { .. })));
+        assert!(check_frame(&black, &black, "f").is_ok());
+        let infinite = image(vec![[0.0; 3], [0.5; 3], [0.0; 3], [0.0, 0.0, f32::INFINITY]]);
+        assert!(matches!(check_frame(&infinite, &lit, "f"), Err(ImageCheckError::NonFinite { x: 1, y: 1, .. })));
+    }
+}

@@ -1,5 +1,6 @@
 //! Shaders written the way outside projects write them (`tests/data/corpus/`, written
-//! here): overrides in `@workgroup_size` and in expressions, a uniform struct of seven
+//! here): overrides in `@workgroup_size` and in expressions, workgroup arrays sized by
+//! override expressions (overrides without defaults), a uniform struct of seven
 //! f32, read-only runtime arrays of structs read through `arrayLength`,
 //! `distance`/`normalize`/`exp`/`log`/`pow` in loops, atomics on storage and workgroup
 //! memory, 2-D and 3-D dispatches, `select` on vectors, u32 wrap-around and signed
@@ -390,4 +391,45 @@ fn a_3d_dispatch_with_wrapping_integers_and_vector_select_agrees_everywhere() {
         assert_eq!(&words[4 * index as usize..4 * index as usize + 4], &want, "voxel {index}");
     }
     check(case);
+}
+
+/// The scan of `scan_override.wgsl` at `wg` lanes × `items` words per lane over `groups`
+/// workgroups, and the exact result (each workgroup's tile scanned on its own).
+fn scan_case(wg: u32, items: u32, groups: u32) -> (Case, Vec<u32>) {
+    let mut rng = Rng(41 + u64::from(wg));
+    let words = (wg * items * groups) as usize;
+    let input: Vec<u32> = (0..words).map(|_| rng.next()).collect();
+    let mut exact = Vec::with_capacity(words);
+    for tile in input.chunks((wg * items) as usize) {
+        let mut sum = 0u32;
+        exact.extend(tile.iter().map(|x| {
+            sum = sum.wrapping_add(*x);
+            sum
+        }));
+    }
+    let case = Case {
+        file: "scan_override.wgsl",
+        entry: "main",
+        overrides: vec![("WG".into(), f64::from(wg)), ("ITEMS".into(), f64::from(items))],
+        workgroups: [groups, 1, 1],
+        inputs: vec![(0, bytes(&input)), (1, vec![0; words * 4])],
+        bounds: Vec::new(),
+        normalise: None,
+    };
+    (case, exact)
+}
+
+#[test]
+fn workgroup_arrays_sized_by_overrides_scan_exactly_everywhere() {
+    for (wg, items, groups) in [(64, 4, 8), (48, 3, 5)] {
+        let (case, exact) = scan_case(wg, items, groups);
+        // The interpreter alone against the exact scan: with no GPU the check below
+        // compares it only with itself.
+        let cpu = named_slots(&["cpu".to_string()]).unwrap();
+        let (kernel, runs, _) = run_case(&case, &cpu);
+        assert_eq!(kernel.workgroup_memory_bytes(), u64::from(4 * (2 * wg + wg * items)));
+        let output = &runs[0].outputs.as_ref().expect("the interpreter ran")[0];
+        assert!(output.bytes == bytes(&exact), "wg {wg}, items {items}: the interpreter's scan is not exact");
+        check(scan_case(wg, items, groups).0);
+    }
 }

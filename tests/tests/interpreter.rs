@@ -417,6 +417,41 @@ fn main() {
 }
 
 #[test]
+fn an_array_whose_override_has_no_value_is_refused_by_name_not_run_as_zeros() {
+    let source = r#"
+override N: u32;
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+var<workgroup> staged: array<u32, N * 2u>;
+@compute @workgroup_size(4)
+fn main(@builtin(local_invocation_index) i: u32) {
+    staged[i] = input[i] + 1u;
+    workgroupBarrier();
+    output[i] = staged[3u - i];
+}
+"#;
+    let overrides = [("N".to_string(), 2.0)];
+    let kernel = Kernel::from_wgsl_with_overrides("staged.wgsl", source.into(), "main", false, &overrides).unwrap();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    // With N given, the array has 4 words and the kernel runs (it once read zeros).
+    assert_eq!(run_words(&mut cpu, &kernel, &[10, 20, 30, 40], 4, 1), [41, 31, 21, 11]);
+    // Without a value for the size's override (a module the overrides were never
+    // applied to): an error naming the variable and its line, never zeros.
+    let mut unapplied =
+        Kernel::from_wgsl_with_overrides("staged.wgsl", source.into(), "main", false, &overrides).unwrap();
+    for (_, item) in unapplied.module.overrides.iter_mut() {
+        item.init = None;
+    }
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let input = upload(&mut cpu, "input", &[1u32; 4]).unwrap();
+    let output = cpu.create_buffer("output", 16).unwrap();
+    let error = cpu.dispatch(&unapplied, &[Bind::new(0, input), Bind::new(1, output)], [1, 1, 1]).unwrap_err();
+    let message = error.to_string();
+    assert!(message.contains("`staged`") && message.contains("value is not known"), "{message}");
+    assert!(message.contains("(WGSL line 5)"), "{message}");
+}
+
+#[test]
 fn barrier_in_nonuniform_control_flow_error_names_line_and_function() {
     // The barrier is in a small function, which the interpreter inlines into its caller:
     // the error must still name the barrier's own line and function.

@@ -509,7 +509,18 @@ pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> 
             let line = lines_of.line(module.global_variables.get_span(handle));
             words_of(module, inner).map_err(|what| unsupported(&what, line))?;
         }
-        let words = words_of(module, inner).unwrap_or(0);
+        // Workgroup and private variables take room in the interpreter's own memory: a
+        // type it cannot size is an error naming the variable, never a variable of no
+        // words whose loads read 0 (how an override-sized workgroup array once ran).
+        let words = match (variable.space, words_of(module, inner)) {
+            (_, Ok(words)) => words,
+            (naga::AddressSpace::Uniform | naga::AddressSpace::Storage { .. }, Err(_)) => 0,
+            (_, Err(what)) => {
+                let line = lines_of.line(module.global_variables.get_span(handle));
+                let name = variable.name.as_deref().unwrap_or("(unnamed)");
+                return Err(unsupported(&format!("{what} (`{name}`)"), line));
+            }
+        };
         let entry = match variable.space {
             naga::AddressSpace::Uniform | naga::AddressSpace::Storage { .. } => {
                 let binding = variable.binding.as_ref().map_or(u32::MAX, |b| b.binding);

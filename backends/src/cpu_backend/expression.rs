@@ -9,8 +9,8 @@ use super::constant::{compose_offsets, literal};
 use super::decode::{Compiler, Scope};
 use super::insn::{BinOp, Insn, Reg, UnOp};
 use super::layout::{
-    Place, Words, byte_addressed, component_step, component_words, element_step, is_half, is_wide, member_step,
-    scalar_shape, shape,
+    Place, Words, array_length, byte_addressed, component_step, component_words, element_step, is_half, is_wide,
+    member_step, scalar_shape, shape,
 };
 use super::math_call::{put, slice};
 use super::matrix::column_words;
@@ -110,21 +110,25 @@ impl Compiler<'_> {
                         // Pointers into buffers count bytes, others register words.
                         let bytes = byte_addressed(*space);
                         match module.types[*pointee].inner {
-                            TypeInner::Array { base: element, size: naga::ArraySize::Constant(n), stride } => {
-                                Ok(Insn::PtrIndex {
+                            TypeInner::Array { base: element, size, stride } => match array_length(module, size) {
+                                Ok(Some(n)) => Ok(Insn::PtrIndex {
                                     dst,
                                     base: base_reg,
                                     index: index_reg,
-                                    count: n.get(),
+                                    count: n,
                                     stride: element_step(module, element, stride, bytes),
-                                })
-                            }
-                            TypeInner::Array { base: element, stride, .. } => Ok(Insn::PtrIndexRt {
-                                dst,
-                                base: base_reg,
-                                index: index_reg,
-                                stride: element_step(module, element, stride, bytes),
-                            }),
+                                }),
+                                // Runtime-sized arrays live only in buffers, whose length
+                                // the instruction reads at run time.
+                                Ok(None) if bytes => Ok(Insn::PtrIndexRt {
+                                    dst,
+                                    base: base_reg,
+                                    index: index_reg,
+                                    stride: element_step(module, element, stride, bytes),
+                                }),
+                                Ok(None) => Err(format!("a runtime-sized array in {space:?} memory")),
+                                Err(what) => Err(what),
+                            },
                             TypeInner::Vector { size, scalar } => Ok(Insn::PtrIndex {
                                 dst,
                                 base: base_reg,
@@ -157,17 +161,18 @@ impl Compiler<'_> {
                         stride: component_words(*scalar),
                         len: component_words(*scalar),
                     }),
-                    TypeInner::Array { base: element, size: naga::ArraySize::Constant(n), stride } => {
-                        Ok(Insn::Extract {
+                    TypeInner::Array { base: element, size, stride } => match array_length(module, *size) {
+                        Ok(Some(n)) => Ok(Insn::Extract {
                             dst,
                             base: base_reg,
                             index: index_reg,
-                            count: n.get(),
+                            count: n,
                             stride: element_step(module, *element, *stride, false),
                             len,
-                        })
-                    }
-                    TypeInner::Array { .. } => Err("indexing a runtime-sized array value".to_string()),
+                        }),
+                        Ok(None) => Err("indexing a runtime-sized array value".to_string()),
+                        Err(what) => Err(what),
+                    },
                     TypeInner::Matrix { columns, rows, .. } => Ok(Insn::Extract {
                         dst,
                         base: base_reg,
@@ -486,10 +491,11 @@ impl Compiler<'_> {
                 Ok((true, index * component_step(*scalar, byte_addressed(*space))))
             }
             TypeInner::Vector { scalar, .. } => Ok((false, index * component_words(*scalar))),
-            TypeInner::Array { base: element, size: naga::ArraySize::Constant(_), stride } => {
-                Ok((false, index * element_step(module, *element, *stride, false)))
-            }
-            TypeInner::Array { .. } => Err("indexing a runtime-sized array value".to_string()),
+            TypeInner::Array { base: element, size, stride } => match array_length(module, *size) {
+                Ok(Some(_)) => Ok((false, index * element_step(module, *element, *stride, false))),
+                Ok(None) => Err("indexing a runtime-sized array value".to_string()),
+                Err(what) => Err(what),
+            },
             inner @ TypeInner::Struct { .. } => Ok((false, member_step(module, inner, index, false))),
             TypeInner::Matrix { rows, .. } => Ok((false, index * column_words(*rows) as u32)),
             other => Err(format!("indexing {other:?}")),

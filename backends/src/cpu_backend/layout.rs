@@ -12,6 +12,29 @@ use smallvec::SmallVec;
 /// Word offset of a value in the frame's register file.
 pub(super) type Reg = u32;
 
+/// The element count of an array of size `size`: `Some(n)` for a fixed count, `None`
+/// for a runtime-sized array. An array sized by an override expression
+/// (`array<u32, WG * 2u>`) stays `Pending` in naga's type arena after the overrides are
+/// applied (`process_overrides` evaluates each override's initialiser, not the types),
+/// so its count is resolved here from the override's value, as naga's own back ends do;
+/// an override without a value is an error naming it, never an array of no elements.
+pub(super) fn array_length(module: &Module, size: naga::ArraySize) -> Result<Option<u32>, String> {
+    match size.resolve(module.to_ctx()) {
+        Ok(naga::proc::IndexableLength::Known(n)) => Ok(Some(n)),
+        Ok(naga::proc::IndexableLength::Dynamic) => Ok(None),
+        Err(error) => {
+            let name = match size {
+                naga::ArraySize::Pending(handle) => module.overrides[handle]
+                    .name
+                    .clone()
+                    .map_or_else(|| "an override expression".into(), |n| format!("override `{n}`")),
+                _ => "its size".into(),
+            };
+            Err(format!("an array sized by {name} whose value is not known ({error})"))
+        }
+    }
+}
+
 /// Words of a value of type `inner` (bool and every 32-bit scalar: one word; 64-bit
 /// integers: two, the low word first).
 pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String> {
@@ -32,10 +55,12 @@ pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String
         }
         // Register layout of composites holding f16: a word per f16, members and
         // elements one after the other (naga's 2-byte layout is used in buffers only).
-        TypeInner::Array { base, size, .. } if contains_f16(module, &module.types[base].inner) => match size {
-            naga::ArraySize::Constant(n) => n.get() * words_of(module, &module.types[base].inner)?,
-            _ => return Err("runtime-sized arrays as values".into()),
-        },
+        TypeInner::Array { base, size, .. } if contains_f16(module, &module.types[base].inner) => {
+            match array_length(module, size)? {
+                Some(n) => n * words_of(module, &module.types[base].inner)?,
+                None => return Err("runtime-sized arrays as values".into()),
+            }
+        }
         TypeInner::Struct { ref members, .. } if contains_f16(module, inner) => {
             let mut words = 0;
             for member in members {
@@ -46,9 +71,9 @@ pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String
         TypeInner::Array { base, size, stride } => {
             // The element type must be supported too.
             words_of(module, &module.types[base].inner)?;
-            match size {
-                naga::ArraySize::Constant(n) => n.get() * stride / 4,
-                _ => return Err("runtime-sized arrays as values".into()),
+            match array_length(module, size)? {
+                Some(n) => n * stride / 4,
+                None => return Err("runtime-sized arrays as values".into()),
             }
         }
         TypeInner::Struct { span, .. } => span / 4,
@@ -139,9 +164,11 @@ pub(super) fn load_plan(module: &Module, inner: &TypeInner, memory: u32, reg: u3
         TypeInner::Vector { size, .. } => {
             out.extend((0..size as u32).map(|i| Piece::Half { memory: memory + 2 * i, reg: reg + i }))
         }
-        TypeInner::Array { base, size: naga::ArraySize::Constant(n), stride } => {
+        TypeInner::Array { base, size, stride } => {
+            // Only values of known size are loaded (words_of refuses the others first).
+            let n = array_length(module, size).ok().flatten().unwrap_or(0);
             let words = words_of(module, &module.types[base].inner).unwrap_or(0);
-            for i in 0..n.get() {
+            for i in 0..n {
                 load_plan(module, &module.types[base].inner, memory + i * stride, reg + i * words, out);
             }
         }

@@ -117,7 +117,7 @@ impl<'de> Deserialize<'de> for Reflectance {
                 "expected [r, g, b], {\"checkerboard\": {...}} or {\"texture\": \"file.png\", ...}",
             ));
         };
-        reflectance.map_err(D::Error::custom)
+        reflectance.map_err(|e| D::Error::custom(format!("reflectance: {e}")))
     }
 }
 

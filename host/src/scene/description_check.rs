@@ -20,6 +20,8 @@ enum Rule {
     NonNegative,
     /// Finite and > 0.
     Positive,
+    /// An emitted radiance: in [0, [`super::MAX_RADIANCE`]].
+    Radiance,
     /// A reflectance: in [0, 1] (above 1 a surface would reflect more light than
     /// arrives, creating energy).
     Reflectance,
@@ -31,6 +33,7 @@ impl Rule {
             Rule::Finite => value.is_finite(),
             Rule::NonNegative => value.is_finite() && value >= 0.0,
             Rule::Positive => value.is_finite() && value > 0.0,
+            Rule::Radiance => (0.0..=super::MAX_RADIANCE).contains(&value),
             Rule::Reflectance => (0.0..=1.0).contains(&value),
         }
     }
@@ -40,6 +43,7 @@ impl Rule {
             Rule::Finite => "must be finite",
             Rule::NonNegative => "must be finite and ≥ 0",
             Rule::Positive => "must be finite and > 0",
+            Rule::Radiance => "each must lie in [0, 1e20] (sums of brighter samples overflow single precision)",
             Rule::Reflectance => "each must lie in [0, 1] (a reflectance above 1 creates energy)",
         }
     }
@@ -132,7 +136,7 @@ pub(super) fn check(path: &Path, description: &SceneDescription) -> Result<(), S
     }
     for (index, shape) in description.shapes.iter().enumerate() {
         if let Some(emitter) = &shape.emitter {
-            numbers(format!("shapes[{index}].emitter.radiance"), &emitter.radiance, Rule::NonNegative)?;
+            numbers(format!("shapes[{index}].emitter.radiance"), &emitter.radiance, Rule::Radiance)?;
         }
     }
     if let Some(environment) = &description.environment {

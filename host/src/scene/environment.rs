@@ -58,6 +58,14 @@ impl Environment {
                 message: format!("environment scale {scale} must be finite and non-negative"),
             });
         }
+        let brightest = texels.iter().flatten().fold(0.0f32, |a, &b| a.max(b));
+        if f64::from(brightest) * f64::from(scale) > f64::from(super::MAX_RADIANCE) {
+            return Err(error(format!(
+                "radiance {brightest:e} × scale {scale} is above the {:e} a scene may emit (sums of such samples \
+                 overflow single-precision floats)",
+                super::MAX_RADIANCE
+            )));
+        }
         let rotation = match to_world {
             Some(m) => [[m[0][0], m[0][1], m[0][2]], [m[1][0], m[1][1], m[1][2]], [m[2][0], m[2][1], m[2][2]]],
             None => [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],

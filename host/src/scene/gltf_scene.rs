@@ -344,7 +344,7 @@ impl Loader<'_> {
             }
             if let gltf::scene::Transform::Decomposed { rotation, .. } = node.transform() {
                 let length = rotation.iter().map(|c| c * c).sum::<f32>().sqrt();
-                if !((length - 1.0).abs() <= QUATERNION_LENGTH_TOLERANCE) {
+                if (length - 1.0).abs().is_nan() || (length - 1.0).abs() > QUATERNION_LENGTH_TOLERANCE {
                     return Err(self.error(
                         format!("{field}.rotation"),
                         format!("{rotation:?} has length {length}: a rotation is a unit quaternion"),

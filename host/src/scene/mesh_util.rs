@@ -214,8 +214,8 @@ pub(super) fn tinted(mut texture: Texture, factor: [f32; 3]) -> Texture {
 /// `Some(radiance)` if any channel is positive; an error message if one is negative or not
 /// finite.
 pub(super) fn emission(radiance: [f32; 3]) -> Result<Option<[f32; 3]>, String> {
-    if radiance.iter().any(|c| !c.is_finite() || *c < 0.0) {
-        return Err(format!("emitted radiance {radiance:?} must be finite and non-negative"));
+    if radiance.iter().any(|c| !c.is_finite() || *c < 0.0 || *c > super::MAX_RADIANCE) {
+        return Err(format!("emitted radiance {radiance:?} must lie in [0, {:e}]", super::MAX_RADIANCE));
     }
     Ok(radiance.iter().any(|&c| c > 0.0).then_some(radiance))
 }

@@ -57,6 +57,12 @@ pub use texture::{MAX_TEXTURE_BYTES, Texture, srgb_to_linear};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
+/// The largest radiance an emitter or an environment texel (times its scale) may have:
+/// 10²⁰, far above any physical light in the scenes' units, and low enough that the sums
+/// of billions of such samples stay finite in single precision (10³⁸). A larger one
+/// would render as infinity or, where a kernel drops non-finite samples, as black.
+pub const MAX_RADIANCE: f32 = 1e20;
+
 /// A scene file or mesh that cannot be loaded.
 #[derive(Debug, Error)]
 pub enum SceneError {

@@ -252,7 +252,7 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
         vec![image]
     } else if cameras.is_empty() {
         let rendered = Instant::now();
-        let image = rendered_reference(&args, reference_spp, backend.as_mut(), &gpu_scene, &render)?;
+        let image = rendered_reference(args, reference_spp, backend.as_mut(), &gpu_scene, &render)?;
         reference_text =
             format!("path-traced, {reference_spp} spp, in {}", strata::progress::words(rendered.elapsed()));
         vec![image]

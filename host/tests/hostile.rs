@@ -1,0 +1,730 @@
+//! The `strata` binary against a careless or hostile user (issue 38, RELIABILITY.md
+//! "Hostile input"): one test per class of defect found by ~390 runs of the release
+//! binary. Every refusal is one `error:` line naming the file, field or value, exit status
+//! 1 (2 for the argument parser), no panic and no backtrace although `RUST_BACKTRACE=1` is
+//! set, and no file written half or under a wrong name. Runs on the CPU interpreter
+//! (`--backend cpu`) at a few pixels, so it needs no device.
+//!
+//! `STRATA_HOSTILE_BINARY=PATH` runs the suite against another build of `strata` (how
+//! each test was seen failing before its fix: against the binary of 47d7e0e).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use strata::rgb_image::RgbImage;
+
+/// The binary under test.
+fn binary() -> PathBuf {
+    std::env::var_os("STRATA_HOSTILE_BINARY").map_or_else(|| PathBuf::from(env!("CARGO_BIN_EXE_strata")), PathBuf::from)
+}
+
+/// A fresh, empty folder for one test.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("strata-hostile-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("a scratch folder");
+    dir
+}
+
+/// `strata` with `args`, a backtrace asked for, and Mesa kept quiet.
+fn command(args: &[&std::ffi::OsStr]) -> Command {
+    let mut command = Command::new(binary());
+    command
+        .args(args)
+        .env("RUST_BACKTRACE", "1")
+        .env("RUST_LIB_BACKTRACE", "1")
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir());
+    command
+}
+
+/// Runs `strata ARGS` to the end.
+fn strata<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
+    let args: Vec<&std::ffi::OsStr> = args.iter().map(AsRef::as_ref).collect();
+    command(&args).output().expect("the strata binary runs")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// Asserts a refusal: exit status `code`, no panic or backtrace, every one of `names` in
+/// standard error, and (for our own errors, status 1) exactly one line there that is not
+/// a warning.
+fn assert_refused_with(output: &Output, code: i32, names: &[&str]) {
+    let stderr = text(&output.stderr);
+    assert_eq!(output.status.code(), Some(code), "expected a refusal (status {code}); stderr:\n{stderr}");
+    assert!(!stderr.contains("panicked") && !stderr.contains("stack backtrace"), "a panic:\n{stderr}");
+    for name in names {
+        assert!(stderr.contains(name), "the error does not name `{name}`:\n{stderr}");
+    }
+    if code == 1 {
+        let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty() && !l.starts_with("warning:")).collect();
+        let errors: Vec<&&str> = lines.iter().filter(|l| l.starts_with("error: ")).collect();
+        assert_eq!(errors.len(), 1, "not one error line:\n{stderr}");
+    }
+}
+
+fn assert_refused(output: &Output, names: &[&str]) {
+    assert_refused_with(output, 1, names);
+}
+
+fn assert_succeeded(output: &Output) {
+    assert!(output.status.success(), "failed:\n{}\n{}", text(&output.stdout), text(&output.stderr));
+}
+
+/// Every file under `folder` (recursively), with its size.
+fn files(folder: &Path) -> Vec<(PathBuf, u64)> {
+    let mut found = Vec::new();
+    let Ok(entries) = std::fs::read_dir(folder) else { return found };
+    for entry in entries.map(Result::unwrap) {
+        let path = entry.path();
+        if path.is_dir() {
+            found.extend(files(&path));
+        } else {
+            found.push((path.clone(), std::fs::symlink_metadata(&path).unwrap().len()));
+        }
+    }
+    found
+}
+
+/// The committed Cornell box copied into `folder/name` with `edit` applied to its JSON;
+/// returns the scene file.
+fn cornell_box(folder: &Path, name: &str, edit: impl FnOnce(&mut serde_json::Value)) -> PathBuf {
+    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/cornell-box");
+    let target = folder.join(name);
+    std::fs::create_dir_all(target.join("meshes")).unwrap();
+    for entry in std::fs::read_dir(source.join("meshes")).unwrap().map(Result::unwrap) {
+        std::fs::copy(entry.path(), target.join("meshes").join(entry.file_name())).unwrap();
+    }
+    let mut scene: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(source.join("scene.json")).unwrap()).unwrap();
+    edit(&mut scene);
+    let file = target.join("scene.json");
+    std::fs::write(&file, serde_json::to_string_pretty(&scene).unwrap()).unwrap();
+    file
+}
+
+/// A small `compare` on the interpreter: `WxH`, frames, seeds, 4-spp reference.
+fn compare_args(size: u32, frames: u32, seeds: u32) -> Vec<String> {
+    let size = size.to_string();
+    [
+        "compare",
+        "--backend",
+        "cpu",
+        "--width",
+        &size,
+        "--height",
+        &size,
+        "--frames",
+        &frames.to_string(),
+        "--seeds",
+        &seeds.to_string(),
+        "--reference-spp",
+        "4",
+        "--auto-crops",
+        "0",
+    ]
+    .map(String::from)
+    .to_vec()
+}
+
+/// A small `render` on the interpreter.
+fn render_args(size: u32) -> Vec<String> {
+    let size = size.to_string();
+    ["render", "--backend", "cpu", "--width", &size, "--height", &size, "--spp", "1"].map(String::from).to_vec()
+}
+
+fn with<S: AsRef<std::ffi::OsStr>>(mut args: Vec<std::ffi::OsString>, more: &[S]) -> Vec<std::ffi::OsString> {
+    args.extend(more.iter().map(|s| s.as_ref().to_os_string()));
+    args
+}
+
+fn os(args: Vec<String>) -> Vec<std::ffi::OsString> {
+    args.into_iter().map(Into::into).collect()
+}
+
+/// A uniform image written as EXR.
+fn write_exr(path: &Path, width: u32, height: u32, value: [f32; 3]) {
+    RgbImage { width, height, pixels: vec![value; (width * height) as usize] }.write_exr(path).unwrap();
+}
+
+// 1. Paths need not be UTF-8: every command takes them, and the run record quotes them.
+#[cfg(unix)]
+#[test]
+fn paths_that_are_not_utf8_are_taken_by_every_command() {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = scratch("non-utf8");
+    let scene_folder = std::ffi::OsStr::from_bytes(b"scene-\xff");
+    let scene = cornell_box(&dir, scene_folder.to_str().unwrap_or("x"), |_| {});
+    let scene = {
+        let odd = dir.join(scene_folder);
+        std::fs::rename(scene.parent().unwrap(), &odd).unwrap();
+        odd.join("scene.json")
+    };
+    let out = dir.join(std::ffi::OsStr::from_bytes(b"out-\xfe"));
+    let output = strata(&with(os(compare_args(8, 1, 2)), &[scene.as_os_str(), "--out".as_ref(), out.as_os_str()]));
+    assert_succeeded(&output);
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    let line = record["command_line"].as_str().unwrap();
+    assert!(line.contains("$'") && line.contains("\\xff") && line.contains("\\xfe"), "{line}");
+    let render_out = dir.join(std::ffi::OsStr::from_bytes(b"render-\xfd"));
+    assert_succeeded(&strata(&with(
+        os(render_args(8)),
+        &[scene.as_os_str(), "--out".as_ref(), render_out.as_os_str()],
+    )));
+    assert!(render_out.join("cornell-box.exr").is_file() || files(&render_out).len() == 2, "{:?}", files(&render_out));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Runs `script` (sh) in a new mount namespace where `mount` is a tmpfs of `kib` KiB,
+/// or `None` (with the reason) where this machine cannot make one.
+fn in_small_tmpfs(mount: &Path, kib: u64, script: &str) -> Option<String> {
+    let full = format!("mount -t tmpfs -o size={kib}k tmpfs '{}' || exit 97\n{script}", mount.display());
+    let output = Command::new("unshare")
+        .args(["-rm", "sh", "-c", &full])
+        .env("RUST_BACKTRACE", "1")
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output();
+    match output {
+        Ok(output) if output.status.code() != Some(97) => {
+            Some(text(&output.stdout) + &text(&output.stderr) + &format!("\nstatus {:?}\n", output.status.code()))
+        }
+        Ok(output) => {
+            eprintln!("SKIPPED: no tmpfs could be mounted in a user namespace: {}", text(&output.stderr));
+            None
+        }
+        Err(error) => {
+            eprintln!("SKIPPED: `unshare` cannot run here ({error}): the full-disk test needs a small tmpfs");
+            None
+        }
+    }
+}
+
+// 2. A full disk: an error naming the file, and no file half-written (a 0-byte PNG was
+// reported as written).
+#[test]
+fn a_full_disk_is_an_error_and_leaves_no_half_written_file() {
+    let dir = scratch("full-disk");
+    // The sizes of this render's EXR and PNG on a disk with room.
+    let roomy = dir.join("roomy");
+    assert_succeeded(&strata(&with(os(render_args(64)), &["--out".as_ref(), roomy.as_os_str()])));
+    let size = |name: &str| std::fs::metadata(roomy.join(name)).unwrap().len();
+    let (exr, png) = (size("default.exr"), size("default.png"));
+    assert!(png > 4096, "the PNG must need more than the one spare page: {png} bytes");
+    // A disk with room for the EXR and one page more: the PNG cannot fit.
+    let kib = exr.div_ceil(4096) * 4 + 4;
+    let mount = dir.join("tiny");
+    std::fs::create_dir_all(&mount).unwrap();
+    let script = format!(
+        "'{}' render --backend cpu --width 64 --height 64 --spp 1 --out '{}'; echo \"exit $?\"; ls -la '{}'",
+        binary().display(),
+        mount.display(),
+        mount.display()
+    );
+    let Some(report) = in_small_tmpfs(&mount, kib, &script) else { return };
+    assert!(report.contains("exit 1"), "the render must fail on a full disk:\n{report}");
+    assert!(report.contains("error: ") && report.contains("default.png: cannot write"), "{report}");
+    assert!(!report.contains("panicked"), "{report}");
+    // The EXR is whole; no PNG and no temporary file is left.
+    assert!(report.contains(&format!(" {exr} ")) && report.contains("default.exr"), "{report}");
+    assert!(!report.contains("default.png\n") && !report.contains(".tmp-"), "{report}");
+
+    // `metrics --map` likewise: its EXR map fits, its PNG does not.
+    let image = roomy.join("default.exr");
+    let reference = dir.join("grey.exr");
+    write_exr(&reference, 64, 64, [0.25; 3]);
+    let map = roomy.join("map.exr");
+    assert_succeeded(&strata(&[
+        "metrics".as_ref(),
+        image.as_os_str(),
+        reference.as_os_str(),
+        "--map".as_ref(),
+        map.as_os_str(),
+    ]));
+    let (map_exr, map_png) = (size("map.exr"), size("map.png"));
+    assert!(map_png > 4096, "the map's PNG must need more than the one spare page: {map_png} bytes");
+    let kib = map_exr.div_ceil(4096) * 4 + 4;
+    let script = format!(
+        "'{bin}' metrics '{image}' '{reference}' --map '{mount}/map.exr'; echo \"exit $?\"; ls -la '{mount}'",
+        bin = binary().display(),
+        image = image.display(),
+        reference = reference.display(),
+        mount = mount.display()
+    );
+    let Some(report) = in_small_tmpfs(&mount, kib, &script) else { return };
+    assert!(report.contains("exit 1") && report.contains("map.png: cannot write"), "{report}");
+    assert!(!report.contains("map.png\n") && !report.contains(".tmp-"), "{report}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// 3. An output name taken by something that is not a regular file is left alone.
+#[cfg(unix)]
+#[test]
+fn outputs_never_replace_devices_links_pipes_or_folders() {
+    let dir = scratch("not-regular");
+    let image = dir.join("image.exr");
+    write_exr(&image, 4, 4, [0.5; 3]);
+    let link = dir.join("full.exr");
+    std::os::unix::fs::symlink("/dev/full", &link).unwrap();
+    let output =
+        strata(&["metrics".as_ref(), image.as_os_str(), image.as_os_str(), "--map".as_ref(), link.as_os_str()]);
+    assert_refused(&output, &["full.exr", "not a regular file"]);
+    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+    assert!(!std::fs::metadata("/dev/full").unwrap().is_file(), "/dev/full was replaced");
+    let pipe = dir.join("pipe.exr");
+    assert!(Command::new("mkfifo").arg(&pipe).status().unwrap().success());
+    let output =
+        strata(&["metrics".as_ref(), image.as_os_str(), image.as_os_str(), "--map".as_ref(), pipe.as_os_str()]);
+    assert_refused(&output, &["pipe.exr", "named pipe"]);
+    // A folder where `render` would write its PNG.
+    let out = dir.join("render");
+    std::fs::create_dir_all(out.join("default.png")).unwrap();
+    let output = strata(&with(os(render_args(4)), &["--out".as_ref(), out.as_os_str()]));
+    assert_refused(&output, &["default.png", "a folder"]);
+    assert!(out.join("default.png").is_dir());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// 4. `metrics --map` writes an EXR and a PNG beside it, never over each other or an input.
+#[test]
+fn the_error_map_never_overwrites_itself_or_an_input() {
+    let dir = scratch("map-names");
+    let (image, reference) = (dir.join("image.exr"), dir.join("reference.exr"));
+    write_exr(&image, 4, 4, [0.5; 3]);
+    write_exr(&reference, 4, 4, [0.25; 3]);
+    let before = std::fs::read(&image).unwrap();
+    let metrics = |map: &Path| {
+        strata(&["metrics".as_ref(), image.as_os_str(), reference.as_os_str(), "--map".as_ref(), map.as_os_str()])
+    };
+    assert_refused(&metrics(&dir.join("map.png")), &["--map", "map.png", ".exr"]);
+    assert!(!dir.join("map.png").exists());
+    assert_refused(&metrics(&image), &["--map", "would overwrite the image"]);
+    assert_refused(&metrics(&dir.join("./reference.exr")), &["--map", "would overwrite the reference"]);
+    assert_eq!(std::fs::read(&image).unwrap(), before);
+    let output = metrics(&dir.join("map.exr"));
+    assert_succeeded(&output);
+    assert!(RgbImage::read_exr(&dir.join("map.exr")).is_ok(), "the map is an EXR");
+    assert!(std::fs::read(dir.join("map.png")).unwrap().starts_with(b"\x89PNG"), "the picture is a PNG");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// 5. Radiance that overflows single precision: refused, never scored as black frames.
+#[test]
+fn radiance_that_overflows_is_refused_before_anything_is_scored() {
+    let dir = scratch("overflow");
+    let scene = cornell_box(&dir, "bright", |scene| {
+        scene["environment"] = serde_json::json!({"file": "sky.exr", "scale": 1.0});
+    });
+    write_exr(&scene.parent().unwrap().join("sky.exr"), 8, 4, [3e38; 3]);
+    let out = dir.join("out");
+    let output = strata(&with(os(compare_args(8, 2, 2)), &[scene.as_os_str(), "--out".as_ref(), out.as_os_str()]));
+    assert_refused(&output, &[]);
+    assert!(!text(&output.stdout).contains("÷ restir"), "a summary was printed:\n{}", text(&output.stdout));
+    assert!(!out.join("errors.csv").exists() && !out.join("summary.txt").exists());
+    let output = strata(&with(os(render_args(8)), &[scene.as_os_str(), "--out".as_ref(), out.as_os_str()]));
+    assert_refused(&output, &[]);
+    // An emitter likewise.
+    let scene = cornell_box(&dir, "bright-light", |scene| {
+        for shape in scene["shapes"].as_array_mut().unwrap() {
+            if shape.get("emitter").is_some() {
+                shape["emitter"]["radiance"] = serde_json::json!([3e38, 3e38, 3e38]);
+            }
+        }
+    });
+    let output = strata(&with(os(compare_args(8, 2, 2)), &[scene.as_os_str(), "--out".as_ref(), out.as_os_str()]));
+    assert_refused(&output, &[]);
+    assert!(!out.join("errors.csv").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// 6. A camera that sees nothing: no RelMSE 0, no `NaN ± inf`, no black image written.
+#[test]
+fn a_camera_that_sees_no_light_is_refused() {
+    let dir = scratch("blind");
+    // Turned around, out of the open side of the box into an unlit world.
+    let scene = cornell_box(&dir, "blind", |scene| {
+        scene["camera"]["target"] = serde_json::json!([278, 273, -801]);
+    });
+    let out = dir.join("out");
+    let output = strata(&with(os(compare_args(8, 2, 2)), &[scene.as_os_str(), "--out".as_ref(), out.as_os_str()]));
+    assert_refused(&output, &["black everywhere"]);
+    assert!(!text(&output.stdout).contains("NaN") && !out.join("errors.csv").exists());
+    let output = strata(&with(os(render_args(8)), &[scene.as_os_str(), "--out".as_ref(), out.as_os_str()]));
+    assert_refused(&output, &["black everywhere"]);
+    assert!(!out.join("scene.exr").exists() && !out.join("blind.exr").exists(), "{:?}", files(&out));
+    // A dolly that leaves the box behind: the later frames' references are black.
+    let scene = cornell_box(&dir, "away", |_| {});
+    let output = strata(&with(
+        os(compare_args(8, 3, 2)),
+        &[scene.as_os_str(), "--camera-path".as_ref(), "dolly:-1e6".as_ref(), "--out".as_ref(), out.as_os_str()],
+    ));
+    assert_refused(&output, &["black everywhere"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// 7. An exposure that would write black or white pictures.
+#[test]
+fn exposures_that_are_not_finite_and_positive_are_refused() {
+    let dir = scratch("exposure");
+    for value in ["NaN", "-1", "0", "inf", "1e39"] {
+        let out = dir.join(value);
+        let exposure = format!("--exposure={value}");
+        let output = strata(&with(os(render_args(4)), &[exposure.as_str(), "--out", out.to_str().unwrap()]));
+        assert_refused_with(&output, 2, &["--exposure", "finite and positive"]);
+        let output = strata(&with(os(compare_args(4, 1, 2)), &[exposure.as_str(), "--out", out.to_str().unwrap()]));
+        assert_refused_with(&output, 2, &["--exposure"]);
+        assert!(files(&out).is_empty(), "{value}: {:?}", files(&out));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// 8. A reference with negative pixels gives negative or huge RelMSE: refused.
+#[test]
+fn references_with_negative_pixels_are_refused() {
+    let dir = scratch("negative");
+    let (image, reference) = (dir.join("image.exr"), dir.join("reference.exr"));
+    write_exr(&image, 8, 8, [0.5; 3]);
+    let mut pixels = vec![[0.25f32; 3]; 64];
+    pixels[8 * 2 + 3] = [0.25, -0.5, 0.25];
+    RgbImage { width: 8, height: 8, pixels }.write_exr(&reference).unwrap();
+    let output = strata(&["metrics".as_ref(), image.as_os_str(), reference.as_os_str()]);
+    assert_refused(&output, &["reference.exr", "pixel (3, 2)", "negative"]);
+    assert!(!text(&output.stdout).contains("relmse"), "{}", text(&output.stdout));
+    let out = dir.join("out");
+    let output = strata(&with(
+        os(compare_args(8, 1, 2)),
+        &["--reference".as_ref(), reference.as_os_str(), "--out".as_ref(), out.as_os_str()],
+    ));
+    assert_refused(&output, &["reference.exr", "pixel (3, 2)"]);
+    assert!(!out.join("errors.csv").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// 9. A method named twice.
+#[test]
+fn a_method_named_twice_is_refused() {
+    let dir = scratch("twice");
+    let output = strata(&with(
+        os(compare_args(4, 1, 2)),
+        &["--methods", "strata,restir,strata", "--out", dir.to_str().unwrap()],
+    ));
+    assert_refused(&output, &["--methods", "`strata` is named twice"]);
+    assert!(files(&dir).is_empty());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A CSV of `rows` (method, frame, seed, relmse) in the format `compare` writes.
+fn csv(rows: &[(&str, u64, u32, f64)]) -> String {
+    let mut text = String::from("method,frame,seed,relmse,prelmse,mse,relmse_luminance\n");
+    for (method, frame, seed, relmse) in rows {
+        text += &format!("{method},{frame},{seed},{relmse},{relmse},{relmse},{relmse}\n");
+    }
+    text
+}
+
+/// `strata plot CSV --out STEM` with a deadline: a hang is a failure, not a stuck suite.
+fn plot_within(csv_text: &str, dir: &Path, name: &str, deadline: std::time::Duration) -> Output {
+    let file = dir.join(format!("{name}.csv"));
+    std::fs::write(&file, csv_text).unwrap();
+    let stem = dir.join(name);
+    let mut child = command(&["plot".as_ref(), file.as_os_str(), "--out".as_ref(), stem.as_os_str()])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if started.elapsed() > deadline {
+            let _ = child.kill();
+            panic!("`strata plot` of {name}.csv still ran after {deadline:?}");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    child.wait_with_output().unwrap()
+}
+
+// 10. The work of `plot` follows the rows, not the largest frame number.
+#[test]
+fn plot_time_does_not_grow_with_the_frame_number() {
+    let dir = scratch("plot-frames");
+    let rows =
+        [("strata", 1, 1, 0.5), ("strata", 4294967295, 1, 0.25), ("restir", 1, 1, 1.0), ("restir", 4294967295, 1, 0.5)];
+    let output = plot_within(&csv(&rows), &dir, "far", std::time::Duration::from_secs(60));
+    assert_succeeded(&output);
+    assert!(!text(&output.stdout).contains("NaN") && !text(&output.stdout).contains("inf"), "{}", text(&output.stdout));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// 11. CSVs that cannot give a number: refused, naming the line.
+#[test]
+fn plot_refuses_csvs_whose_numbers_cannot_be_computed() {
+    let dir = scratch("plot-csv");
+    let second = std::time::Duration::from_secs(60);
+    let cases: [(&str, String, &[&str]); 4] = [
+        ("header-only", csv(&[]), &["header-only.csv", "no measurements"]),
+        (
+            "duplicate",
+            csv(&[("strata", 1, 1, 0.5), ("restir", 1, 1, 1.0), ("strata", 1, 1, 0.7)]),
+            &["duplicate.csv", "line 4", "first on line 2"],
+        ),
+        (
+            "missing",
+            csv(&[("strata", 1, 1, 0.5), ("strata", 1, 2, 0.5), ("restir", 1, 1, 1.0)]),
+            &["missing.csv", "restir has no row for frame 1, seed 2"],
+        ),
+        ("zero", csv(&[("strata", 1, 1, 0.5), ("restir", 1, 1, 0.0)]), &["zero.csv", "line 3", "above 0"]),
+    ];
+    for (name, text_of_csv, names) in cases {
+        let output = plot_within(&text_of_csv, &dir, name, second);
+        assert_refused(&output, names);
+        assert!(!dir.join(format!("{name}.svg")).exists(), "{name}: a plot was written");
+    }
+    // One seed: a ratio without an interval says so, never `± inf`.
+    let output = plot_within(&csv(&[("strata", 1, 1, 0.5), ("restir", 1, 1, 1.0)]), &dir, "one-seed", second);
+    assert_succeeded(&output);
+    let stdout = text(&output.stdout);
+    assert!(
+        stdout.contains("0.5000 (1 seed: no interval)") && !stdout.contains("inf") && !stdout.contains("NaN"),
+        "{stdout}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// 12. Scene JSON: values the renderer does not implement and text after the scene.
+#[test]
+fn scene_fields_the_renderer_does_not_implement_are_refused_by_name() {
+    let dir = scratch("scene-json");
+    type Edit = fn(&mut serde_json::Value);
+    let cases: [(&str, Edit, &[&str]); 5] = [
+        ("hide", |s| s["integrator"]["hide_emitters"] = true.into(), &["integrator.hide_emitters", "true"]),
+        ("volpath", |s| s["integrator"]["type"] = "volpath".into(), &["integrator.type", "`volpath`"]),
+        ("normals", |s| s["shapes"][0]["normals"] = "vertex".into(), &["shapes[0].normals", "`vertex`"]),
+        (
+            "checker-field",
+            |s| {
+                let first = s["materials"].as_object().unwrap().keys().next().unwrap().clone();
+                s["materials"][&first]["reflectance"] = serde_json::json!({
+                    "checkerboard": {"color0": [0.1, 0.1, 0.1], "color1": [0.5, 0.5, 0.5], "uv_scale": [4, 4]},
+                    "scale": 2
+                });
+            },
+            &["reflectance", "unknown field `scale`"],
+        ),
+        ("extra", |s| s["camera"]["aperture"] = 0.5.into(), &["camera", "unknown field `aperture`"]),
+    ];
+    for (name, edit, names) in cases {
+        let scene = cornell_box(&dir, name, edit);
+        let output =
+            strata(&with(os(render_args(4)), &[scene.as_os_str(), "--out".as_ref(), dir.join("out").as_os_str()]));
+        assert_refused(&output, &[&["scene.json"][..], names].concat());
+    }
+    let scene = cornell_box(&dir, "trailing", |_| {});
+    let mut contents = std::fs::read_to_string(&scene).unwrap();
+    contents += "\n{\"name\": \"a second scene\"}";
+    std::fs::write(&scene, contents).unwrap();
+    let output = strata(&with(os(render_args(4)), &[scene.as_os_str(), "--out".as_ref(), dir.join("out").as_os_str()]));
+    assert_refused(&output, &["scene.json", "trailing"]);
+    assert!(files(&dir.join("out")).is_empty());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// An OBJ room: a floor and a light above it (`Ke`), with `extra` OBJ lines and the MTL
+/// library `mtl` (None: the library is not written).
+fn obj_scene(dir: &Path, name: &str, extra: &str, mtl: Option<&str>) -> PathBuf {
+    let obj = format!(
+        "mtllib room.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nv -0.2 1 -0.2\nv 0.2 1 -0.2\nv 0.2 1 0.2\nv -0.2 1 0.2\n\
+         o floor\nusemtl floor\nf 1 4 3 2\no light\nusemtl lamp\nf 5 6 7 8\n{extra}"
+    );
+    let folder = dir.join(name);
+    std::fs::create_dir_all(&folder).unwrap();
+    std::fs::write(folder.join("room.obj"), obj).unwrap();
+    if let Some(mtl) = mtl {
+        std::fs::write(folder.join("room.mtl"), mtl).unwrap();
+    }
+    folder.join("room.obj")
+}
+
+const ROOM_MTL: &str = "newmtl floor\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n";
+
+// 13. OBJ faces of fewer than 3 vertices and unknown materials: a warning naming file
+// and line, said once, kept in the run record.
+#[test]
+fn obj_short_faces_and_unknown_materials_are_warned_about_once() {
+    let dir = scratch("obj-warnings");
+    let extra = "o bits\nusemtl nosuch\nf 1 2\nf 2 3\nf 1 2 3\nusemtl nosuch\nf 3 4 1\n";
+    let scene = obj_scene(&dir, "room", extra, Some(ROOM_MTL));
+    let out = dir.join("out");
+    let output = strata(&with(os(compare_args(8, 1, 2)), &[scene.as_os_str(), "--out".as_ref(), out.as_os_str()]));
+    assert_succeeded(&output);
+    let stderr = text(&output.stderr);
+    let warnings: Vec<&str> = stderr.lines().filter(|l| l.starts_with("warning:")).collect();
+    assert_eq!(warnings.len(), 2, "{stderr}");
+    assert!(
+        warnings.iter().any(|w| w.contains("room.obj: line 18 (and 1 more): 2 faces with fewer than 3")),
+        "{stderr}"
+    );
+    assert!(warnings.iter().any(|w| w.contains("room.obj: line 17 (and 1 more): `usemtl nosuch`")), "{stderr}");
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    assert_eq!(record["warnings"].as_array().map(Vec::len), Some(2), "{record}");
+    assert!(std::fs::read_to_string(out.join("summary.txt")).unwrap().contains("scene warnings (2)"));
+    // A missing library is one warning, not one per material it would have defined.
+    let scene = obj_scene(&dir, "no-library", "", None);
+    let output = strata(&with(os(render_args(8)), &[scene.as_os_str(), "--out".as_ref(), out.as_os_str()]));
+    let stderr = text(&output.stderr);
+    assert_eq!(stderr.lines().filter(|l| l.starts_with("warning:")).count(), 1, "{stderr}");
+    assert!(stderr.contains("material library") && stderr.contains("room.mtl"), "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// 14. A reflectance above 1 creates energy.
+#[test]
+fn reflectances_above_one_are_refused() {
+    let dir = scratch("reflectance");
+    let scene = cornell_box(&dir, "json", |scene| {
+        let first = scene["materials"].as_object().unwrap().keys().next().unwrap().clone();
+        scene["materials"][&first]["reflectance"] = serde_json::json!([2, 2, 2]);
+    });
+    let out = dir.join("out");
+    let output = strata(&with(os(render_args(4)), &[scene.as_os_str(), "--out".as_ref(), out.as_os_str()]));
+    assert_refused(&output, &["scene.json", "reflectance", "[0, 1]"]);
+    let scene = obj_scene(&dir, "mtl", "", Some(&ROOM_MTL.replace("Kd 0.5 0.5 0.5", "Kd 5 5 5")));
+    let output = strata(&with(os(render_args(4)), &[scene.as_os_str(), "--out".as_ref(), out.as_os_str()]));
+    assert_refused(&output, &["room.mtl", "Kd", "[0, 1]"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A glTF document of one textured triangle seen by a camera, with `edit` applied.
+fn gltf_scene(dir: &Path, name: &str, edit: impl FnOnce(&mut serde_json::Value)) -> PathBuf {
+    let folder = dir.join(name);
+    std::fs::create_dir_all(&folder).unwrap();
+    let positions: [[f32; 3]; 3] = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]];
+    let uvs: [[f32; 2]; 3] = [[0.0, 0.0], [1.0, 0.0], [0.5, 1.0]];
+    let mut bytes: Vec<u8> = positions.iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
+    bytes.extend(uvs.iter().flatten().flat_map(|c| c.to_le_bytes()));
+    std::fs::write(folder.join("triangle.bin"), &bytes).unwrap();
+    let png = strata::rgb_image::encode_png(&[200, 100, 50, 255], 1, 1, image::ExtendedColorType::Rgba8).unwrap();
+    std::fs::write(folder.join("texture.png"), png).unwrap();
+    let mut document = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 1]}],
+        "nodes": [
+            {"mesh": 0, "rotation": [0, 0, 0, 1]},
+            {"camera": 0, "translation": [0, 0, 3]}
+        ],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.01}}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "material": 0}]}],
+        "materials": [{
+            "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0},
+            "emissiveFactor": [1, 1, 1]
+        }],
+        "textures": [{"source": 0}],
+        "images": [{"uri": "texture.png"}],
+        "buffers": [{"uri": "triangle.bin", "byteLength": 60}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 24}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}
+        ]
+    });
+    edit(&mut document);
+    let file = folder.join("scene.gltf");
+    std::fs::write(&file, serde_json::to_string_pretty(&document).unwrap()).unwrap();
+    file
+}
+
+// 15. glTF: another version, a rotation that is no rotation, a texture without the
+// coordinates it names.
+#[test]
+fn gltf_documents_that_say_something_else_are_refused() {
+    let dir = scratch("gltf");
+    let out = dir.join("out");
+    let render =
+        |scene: &Path| strata(&with(os(render_args(4)), &[scene.as_os_str(), "--out".as_ref(), out.as_os_str()]));
+    assert_succeeded(&render(&gltf_scene(&dir, "good", |_| {})));
+    type Edit = fn(&mut serde_json::Value);
+    let cases: [(&str, Edit, &[&str]); 3] = [
+        ("version", |d| d["asset"]["version"] = "1.0".into(), &["asset.version", "`1.0`"]),
+        (
+            "quaternion",
+            |d| d["nodes"][0]["rotation"] = serde_json::json!([0, 0, 0, 0]),
+            &["nodes[0].rotation", "unit quaternion"],
+        ),
+        (
+            "texcoord",
+            |d| {
+                d["meshes"][0]["primitives"][0]["attributes"] = serde_json::json!({"POSITION": 0});
+            },
+            &["meshes[0].primitives[0]", "TEXCOORD_0"],
+        ),
+    ];
+    for (name, edit, names) in cases {
+        let output = render(&gltf_scene(&dir, name, edit));
+        assert_refused(&output, &[&["scene.gltf"][..], names].concat());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// 16. A generated image with no objects.
+#[test]
+fn a_histogram_of_no_objects_is_refused() {
+    let output = strata(&["histogram", "--backend", "cpu", "--objects", "0", "--width", "32", "--height", "32"]);
+    assert_refused(&output, &["--objects 0"]);
+}
+
+// 17. Messages that name the wrong thing; inputs that never end.
+#[test]
+fn messages_name_what_the_user_gave() {
+    let dir = scratch("messages");
+    let scene = obj_scene(&dir, "nan", "", Some(&ROOM_MTL.replace("Kd 0.5 0.5 0.5", "Kd 0.5 0.5 0.5\nNi nan")));
+    let output = strata(&with(os(render_args(4)), &[scene.as_os_str(), "--out".as_ref(), dir.join("out").as_os_str()]));
+    assert_refused(&output, &["room.mtl", "Ni", "positive"]);
+    assert!(!text(&output.stderr).contains("0.0000"), "{}", text(&output.stderr));
+    for flag in ["--width", "--height"] {
+        let output = strata(&[
+            "render",
+            "--backend",
+            "cpu",
+            flag,
+            "100000",
+            "--spp",
+            "1",
+            "--out",
+            dir.join("out").to_str().unwrap(),
+        ]);
+        assert_refused(&output, &[&format!("{flag} 100000"), "16384"]);
+    }
+    #[cfg(unix)]
+    {
+        // A scene "file" that never ends is read up to the input limit, then refused.
+        let endless = dir.join("endless.json");
+        std::os::unix::fs::symlink("/dev/zero", &endless).unwrap();
+        let output = strata(&["render".as_ref(), "--backend".as_ref(), "cpu".as_ref(), endless.as_os_str()]);
+        assert_refused(&output, &["endless.json", "larger than"]);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// Across classes: nothing printed or written says NaN or inf, with one seed too.
+#[test]
+fn no_summary_report_or_record_says_nan_or_inf() {
+    let dir = scratch("no-nan");
+    let out = dir.join("out");
+    let output = strata(&with(os(compare_args(8, 2, 1)), &["--out".as_ref(), out.as_os_str()]));
+    assert_succeeded(&output);
+    let stdout = text(&output.stdout);
+    for (name, contents) in [
+        ("stdout", stdout.clone()),
+        ("summary.txt", std::fs::read_to_string(out.join("summary.txt")).unwrap()),
+        ("run.json", std::fs::read_to_string(out.join("run.json")).unwrap()),
+        ("report.html", std::fs::read_to_string(out.join("report.html")).unwrap()),
+    ] {
+        for word in ["NaN", "inf"] {
+            let found = contents.split(|c: char| !c.is_alphanumeric()).any(|w| w == word);
+            assert!(!found, "{name} says `{word}`:\n{contents}");
+        }
+    }
+    assert!(stdout.contains("(1 seed: no interval)"), "{stdout}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -2,7 +2,7 @@
 //! SPIR-V of the same WGSL kernels, recording into the engine's command buffer with the
 //! engine's buffers.
 
-use crate::binding_plan::{BindingPlan, EngineBuffers, OwnBuffers, ResampleBuffers, Resource};
+use crate::binding_plan::{BindingPlan, EngineBuffers, OwnBuffers, PassBuffer, ResampleBuffers, Resource};
 use crate::contract::check_size;
 use crate::error::EmbedError;
 use crate::frame::{FrameId, FrameParams, frame_params, max_blocks};
@@ -10,10 +10,8 @@ use crate::limits::{DeviceLimits, VULKAN_NAMES, check_limits};
 use crate::wgsl::{ModuleId, WgslModule, module};
 use ash::vk;
 use strata_kernels::blue_noise::BlueNoiseTables;
-use strata_kernels::embed_types::SelectionParams;
 use strata_kernels::selection::SelectionSettings;
 use strata_kernels::translate::{TranslateOptions, WorkgroupZeroInit, spirv};
-use strata_kernels::types::HistogramParams;
 use strata_kernels::{Executor, Registry};
 
 /// The engine's Vulkan objects the pass is created on (the instance created with
@@ -195,17 +193,22 @@ impl AshSelection {
         let uniform = vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC;
         let local = vk::MemoryPropertyFlags::DEVICE_LOCAL;
-        let histogram_params = created.buffer(&memory, size_of::<HistogramParams>() as u64, uniform, local, None)?;
-        let selection_params = created.buffer(&memory, size_of::<SelectionParams>() as u64, uniform, local, None)?;
-        let sorted_pixels = created.buffer(&memory, pixels * 4, storage, local, None)?;
-        let spans = created.buffer(&memory, pixels * 12, storage, local, None)?;
-        let block_stats = created.buffer(&memory, blocks * 12, storage, local, None)?;
         let host = vk::MemoryPropertyFlags::HOST_VISIBLE | vk::MemoryPropertyFlags::HOST_COHERENT;
         let packed = BlueNoiseTables::new().packed();
-        let bytes: &[u8] = bytemuck::cast_slice(&packed);
-        let blue_noise =
-            created.buffer(&memory, bytes.len() as u64, vk::BufferUsageFlags::STORAGE_BUFFER, host, Some(bytes))?;
-        let unused_payloads = created.buffer(&memory, 4, vk::BufferUsageFlags::STORAGE_BUFFER, local, None)?;
+        let own = OwnBuffers::make(pixels, blocks, |own, size| match own {
+            PassBuffer::BlueNoise => created.buffer(
+                &memory,
+                size,
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+                host,
+                Some(bytemuck::cast_slice(&packed)),
+            ),
+            PassBuffer::HistogramParams | PassBuffer::SelectionParams => {
+                created.buffer(&memory, size, uniform, local, None)
+            }
+            PassBuffer::Payloads => created.buffer(&memory, size, vk::BufferUsageFlags::STORAGE_BUFFER, local, None),
+            _ => created.buffer(&memory, size, storage, local, None),
+        })?;
         created.keep();
         Ok(Self {
             device,
@@ -218,15 +221,7 @@ impl AshSelection {
             histogram,
             select,
             resample,
-            own: OwnBuffers {
-                histogram_params,
-                selection_params,
-                sorted_pixels,
-                spans,
-                block_stats,
-                blue_noise,
-                unused_payloads,
-            },
+            own,
         })
     }
 

@@ -21,7 +21,7 @@ pub struct FrameParams {
 }
 
 /// The image's grid, checked (the settings are validated first).
-pub(crate) fn grid(settings: &SelectionSettings, width: u32, height: u32) -> Result<BlockGrid, EmbedError> {
+pub fn grid(settings: &SelectionSettings, width: u32, height: u32) -> Result<BlockGrid, EmbedError> {
     settings.validate()?;
     BlockGrid::new(width, height, settings.block_size).map_err(|error| EmbedError::ImageSize {
         width,
@@ -40,7 +40,7 @@ pub fn grid_shift(settings: &SelectionSettings, frame: u32, seed: u32) -> (u32, 
 }
 
 /// Most blocks any frame's grid has (a shifted grid has up to one more row and column).
-pub(crate) fn max_blocks(settings: &SelectionSettings, width: u32, height: u32) -> u64 {
+pub fn max_blocks(settings: &SelectionSettings, width: u32, height: u32) -> u64 {
     match grid(settings, width, height) {
         Ok(grid) if settings.block_shift => u64::from(grid.max_shifted_block_count()),
         Ok(grid) => u64::from(grid.block_count()),

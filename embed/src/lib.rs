@@ -38,7 +38,7 @@ mod wgpu_selection;
 
 #[cfg(feature = "ash")]
 pub use ash_selection::{AshBindings, AshBufferSlice, AshBuffers, AshDevice, AshResampleBuffers, AshSelection};
-pub use binding_plan::{EngineBuffers, ResampleBuffers};
+pub use binding_plan::{EngineBuffers, PassBuffer, ResampleBuffers, SizeRule, Stage, Writer};
 pub use error::EmbedError;
 /// What runs the kernels (a GPU, a CPU driver such as lavapipe), for
 /// [`wgsl::histogram_module`]'s choice.

@@ -1,7 +1,7 @@
 //! [`WgpuSelection`]: the pass on an engine's own `wgpu::Device`, recording into the
 //! engine's command encoder with the engine's buffers.
 
-use crate::binding_plan::{BindingPlan, EngineBuffers, OwnBuffers, ResampleBuffers, Resource};
+use crate::binding_plan::{BindingPlan, EngineBuffers, OwnBuffers, PassBuffer, ResampleBuffers, Resource};
 use crate::contract::{BufferRole, check_size};
 use crate::error::EmbedError;
 use crate::frame::{FrameId, FrameParams, frame_params, max_blocks};
@@ -9,9 +9,7 @@ use crate::limits::{DeviceLimits, WGPU_NAMES, check_limits};
 use crate::wgsl::{ModuleId, WgslModule, module};
 use strata_kernels::Executor;
 use strata_kernels::blue_noise::BlueNoiseTables;
-use strata_kernels::embed_types::SelectionParams;
 use strata_kernels::selection::SelectionSettings;
-use strata_kernels::types::HistogramParams;
 use wgpu::util::DeviceExt;
 
 /// An engine buffer bound to the pass: the buffer and the byte offset where its records
@@ -160,6 +158,20 @@ impl WgpuSelection {
             };
             let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
             let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+            let own = OwnBuffers::make(pixels, blocks, |own, size| -> Result<wgpu::Buffer, ()> {
+                let label = format!("strata {}", own.name());
+                Ok(match own {
+                    PassBuffer::BlueNoise => device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some(&label),
+                        contents: bytemuck::cast_slice(&tables.packed()),
+                        usage: wgpu::BufferUsages::STORAGE,
+                    }),
+                    PassBuffer::HistogramParams | PassBuffer::SelectionParams => buffer(&label, size, uniform),
+                    PassBuffer::Payloads => buffer(&label, size, wgpu::BufferUsages::STORAGE),
+                    _ => buffer(&label, size, storage),
+                })
+            })
+            .expect("wgpu reports buffer errors through the error scope");
             Self {
                 settings,
                 seed: 0,
@@ -170,19 +182,7 @@ impl WgpuSelection {
                 histogram: pipeline(device, &histogram_module),
                 select: pipeline(device, &select_module),
                 resample: pipeline(device, &resample_module),
-                own: OwnBuffers {
-                    histogram_params: buffer("strata histogram params", size_of::<HistogramParams>() as u64, uniform),
-                    selection_params: buffer("strata selection params", size_of::<SelectionParams>() as u64, uniform),
-                    sorted_pixels: buffer("strata sorted pixels", pixels * 4, storage),
-                    spans: buffer("strata cluster spans", pixels * 12, storage),
-                    block_stats: buffer("strata block stats", blocks * 12, storage),
-                    blue_noise: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some("strata blue noise"),
-                        contents: bytemuck::cast_slice(&tables.packed()),
-                        usage: wgpu::BufferUsages::STORAGE,
-                    }),
-                    unused_payloads: buffer("strata unused payloads", 4, wgpu::BufferUsages::STORAGE),
-                },
+                own,
             }
         })
     }

@@ -37,7 +37,8 @@ impl ModuleId {
         ModuleId::Resample,
     ];
 
-    pub(crate) fn kernel(self) -> KernelId {
+    /// The registry kernel of the module.
+    pub fn kernel(self) -> KernelId {
         match self {
             ModuleId::Histogram => KernelId::BlockHistogram,
             ModuleId::HistogramSubgroup => KernelId::BlockHistogramSubgroup,

@@ -12,7 +12,10 @@
 //! - a full disk is an error naming the file, never a 0-byte file reported as written;
 //! - the target must be a regular file or absent: a rename would silently replace a
 //!   device node (`/dev/full`), a folder's entry of another kind or a symbolic link with
-//!   a regular file, so those are refused before anything is written.
+//!   a regular file, so those are refused before anything is written;
+//! - the target must not be a file the process read as an input ([`note_input`], which
+//!   every loader's read calls): an error map, a frame or a render never replaces a
+//!   reference, a texture or an environment map of the same name.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -43,6 +46,12 @@ pub enum WriteError {
         path: String,
         /// What is there ("a character device", "a folder", ...).
         kind: &'static str,
+    },
+    /// The target is a file this process read as an input.
+    #[error("{path}: is an input of this run; an output never replaces one (choose another output name or folder)")]
+    Input {
+        /// The target.
+        path: String,
     },
     /// Writing, syncing or renaming failed (a full disk, no permission, ...).
     #[error("{path}: cannot write: {source}")]
@@ -96,13 +105,32 @@ fn not_regular(metadata: &std::fs::Metadata) -> Option<&'static str> {
     Some("not a regular file")
 }
 
+/// The files this process read as inputs ([`note_input`]): an output never replaces one.
+static INPUTS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// Records that `path` was read as an input (a scene, mesh, texture, environment map,
+/// reference, CSV), so that no output of this process replaces it.
+pub fn note_input(path: &Path) {
+    if let Ok(canonical) = path.canonicalize() {
+        INPUTS.lock().unwrap_or_else(std::sync::PoisonError::into_inner).push(canonical);
+    }
+}
+
 /// Refuses `path` if something other than a regular file has its name (a missing file
-/// is fine: it is about to be created).
+/// is fine: it is about to be created), or if it is a file this process read as an input.
 pub fn check_target(path: &Path) -> Result<(), WriteError> {
     match std::fs::symlink_metadata(path) {
         Ok(metadata) => match not_regular(&metadata) {
             Some(kind) => Err(WriteError::NotRegular { path: path.display().to_string(), kind }),
-            None => Ok(()),
+            None => {
+                let canonical = path.canonicalize().ok();
+                let inputs = INPUTS.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+                if canonical.is_some_and(|c| inputs.contains(&c)) {
+                    Err(WriteError::Input { path: path.display().to_string() })
+                } else {
+                    Ok(())
+                }
+            }
         },
         Err(_) => Ok(()),
     }

@@ -7,7 +7,7 @@ use strata_kernels::types::{BlockStats, Candidate, ClusterSpan};
 use strata_kernels::{BlockGrid, Executor, GridError, Kernel, KernelError, KernelId, Registry};
 use thiserror::Error;
 
-/// Slots one workgroup sorts (`SLOTS` in `block_sort.wgsl`).
+/// Slots one workgroup sorts (`SLOTS` in `strata/histogram.wgsl`).
 pub const SLOTS_PER_WORKGROUP: u32 = strata_kernels::types::HISTOGRAM_SLOTS_PER_WORKGROUP;
 
 /// Workgroups of a dispatch over `grid`, in rows of at most the backend's limit.

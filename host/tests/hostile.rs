@@ -172,7 +172,11 @@ fn paths_that_are_not_utf8_are_taken_by_every_command() {
         os(render_args(8)),
         &[scene.as_os_str(), "--out".as_ref(), render_out.as_os_str()],
     )));
-    assert!(render_out.join("cornell-box.exr").is_file() || files(&render_out).len() == 2, "{:?}", files(&render_out));
+    // Named after the scene's folder, its bytes kept.
+    let mut stem = scene_folder.to_os_string();
+    stem.push(".exr");
+    assert!(render_out.join(&stem).is_file(), "{:?}", files(&render_out));
+    assert_eq!(files(&render_out).len(), 2, "{:?}", files(&render_out));
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -349,9 +353,15 @@ fn a_camera_that_sees_no_light_is_refused() {
     let output = strata(&with(os(compare_args(8, 2, 2)), &[scene.as_os_str(), "--out".as_ref(), out.as_os_str()]));
     assert_refused(&output, &["black everywhere"]);
     assert!(!text(&output.stdout).contains("NaN") && !out.join("errors.csv").exists());
+    // `render` writes what it rendered (a black image can be what was asked for) and
+    // says so in a warning.
     let output = strata(&with(os(render_args(8)), &[scene.as_os_str(), "--out".as_ref(), out.as_os_str()]));
-    assert_refused(&output, &["black everywhere"]);
-    assert!(!out.join("scene.exr").exists() && !out.join("blind.exr").exists(), "{:?}", files(&out));
+    assert_succeeded(&output);
+    assert!(
+        text(&output.stderr).contains("warning: the rendered image is black everywhere"),
+        "{}",
+        text(&output.stderr)
+    );
     // A dolly that leaves the box behind: the later frames' references are black.
     let scene = cornell_box(&dir, "away", |_| {});
     let output = strata(&with(
@@ -460,7 +470,7 @@ fn plot_time_does_not_grow_with_the_frame_number() {
 fn plot_refuses_csvs_whose_numbers_cannot_be_computed() {
     let dir = scratch("plot-csv");
     let second = std::time::Duration::from_secs(60);
-    let cases: [(&str, String, &[&str]); 4] = [
+    let cases: [(&str, String, &[&str]); 3] = [
         ("header-only", csv(&[]), &["header-only.csv", "no measurements"]),
         (
             "duplicate",
@@ -472,13 +482,17 @@ fn plot_refuses_csvs_whose_numbers_cannot_be_computed() {
             csv(&[("strata", 1, 1, 0.5), ("strata", 1, 2, 0.5), ("restir", 1, 1, 1.0)]),
             &["missing.csv", "restir has no row for frame 1, seed 2"],
         ),
-        ("zero", csv(&[("strata", 1, 1, 0.5), ("restir", 1, 1, 0.0)]), &["zero.csv", "line 3", "above 0"]),
     ];
     for (name, text_of_csv, names) in cases {
         let output = plot_within(&text_of_csv, &dir, name, second);
         assert_refused(&output, names);
         assert!(!dir.join(format!("{name}.svg")).exists(), "{name}: a plot was written");
     }
+    // A baseline of error 0 (an image equal to its reference): no ratio, and it says so.
+    let output = plot_within(&csv(&[("strata", 1, 1, 0.5), ("restir", 1, 1, 0.0)]), &dir, "zero", second);
+    assert_succeeded(&output);
+    let stdout = text(&output.stdout);
+    assert!(stdout.contains("cannot be computed (restir's RelMSE is 0") && !stdout.contains("inf"), "{stdout}");
     // One seed: a ratio without an interval says so, never `± inf`.
     let output = plot_within(&csv(&[("strata", 1, 1, 0.5), ("restir", 1, 1, 1.0)]), &dir, "one-seed", second);
     assert_succeeded(&output);
@@ -508,10 +522,35 @@ fn scene_fields_the_renderer_does_not_implement_are_refused_by_name() {
                     "scale": 2
                 });
             },
-            &["reflectance", "unknown field `scale`"],
+            &["unknown field `scale`", "expected one of `checkerboard`"],
         ),
         ("extra", |s| s["camera"]["aperture"] = 0.5.into(), &["camera", "unknown field `aperture`"]),
     ];
+    // A key given twice (serde_json's values cannot hold one: edited as text).
+    let scene = cornell_box(&dir, "twice", |s| {
+        let first = s["materials"].as_object().unwrap().keys().next().unwrap().clone();
+        s["materials"][&first]["reflectance"] = serde_json::json!({"texture": "a.png", "srgb": true});
+    });
+    let original = std::fs::read_to_string(&scene).unwrap();
+    for (from, to, names) in [
+        (
+            "\"texture\": \"a.png\"",
+            "\"texture\": \"a.png\", \"texture\": \"b.png\"",
+            ["scene.json", "duplicate field `texture`"],
+        ),
+        (
+            "\"materials\": {",
+            "\"materials\": {\"white\": {\"type\": \"black\"},",
+            ["scene.json", "`white` is defined twice"],
+        ),
+    ] {
+        let twice = original.replacen(from, to, 1);
+        assert_ne!(twice, original, "{from}");
+        std::fs::write(&scene, twice).unwrap();
+        let output =
+            strata(&with(os(render_args(4)), &[scene.as_os_str(), "--out".as_ref(), dir.join("out").as_os_str()]));
+        assert_refused(&output, &names);
+    }
     for (name, edit, names) in cases {
         let scene = cornell_box(&dir, name, edit);
         let output =
@@ -569,11 +608,33 @@ fn obj_short_faces_and_unknown_materials_are_warned_about_once() {
     assert_eq!(record["warnings"].as_array().map(Vec::len), Some(2), "{record}");
     assert!(std::fs::read_to_string(out.join("summary.txt")).unwrap().contains("scene warnings (2)"));
     // A missing library is one warning, not one per material it would have defined.
+    // (Without its library the lamp has no `Ke`: the scene has no light, which is refused
+    // after the one warning.)
     let scene = obj_scene(&dir, "no-library", "", None);
     let output = strata(&with(os(render_args(8)), &[scene.as_os_str(), "--out".as_ref(), out.as_os_str()]));
+    assert_refused(&output, &["has no light"]);
     let stderr = text(&output.stderr);
-    assert_eq!(stderr.lines().filter(|l| l.starts_with("warning:")).count(), 1, "{stderr}");
-    assert!(stderr.contains("material library") && stderr.contains("room.mtl"), "{stderr}");
+    let warnings: Vec<&str> = stderr.lines().filter(|l| l.starts_with("warning:")).collect();
+    assert_eq!(warnings.len(), 1, "{stderr}");
+    assert!(warnings[0].contains("material library") && warnings[0].contains("room.mtl"), "{stderr}");
+    // Indented statements and a `usemtl` before its library: what tobj does is what is said.
+    let scene = obj_scene(&dir, "indented", "  usemtl floor\nf 1 2 3\n", Some(ROOM_MTL));
+    let output = strata(&with(os(render_args(8)), &[scene.as_os_str(), "--out".as_ref(), out.as_os_str()]));
+    assert_succeeded(&output);
+    assert!(!text(&output.stderr).contains("warning:"), "an indented usemtl is a usemtl:\n{}", text(&output.stderr));
+    let folder = dir.join("early");
+    std::fs::create_dir_all(&folder).unwrap();
+    std::fs::write(folder.join("room.mtl"), ROOM_MTL).unwrap();
+    let room = std::fs::read_to_string(dir.join("room/room.obj")).unwrap();
+    let early = format!("usemtl floor\nf 1 2 3\n{}", room.replace("mtllib room.mtl\n", "mtllib room.mtl\n"));
+    std::fs::write(folder.join("room.obj"), early).unwrap();
+    let output =
+        strata(&with(os(render_args(8)), &[folder.join("room.obj").as_os_str(), "--out".as_ref(), out.as_os_str()]));
+    let stderr = text(&output.stderr);
+    assert!(
+        stderr.contains("room.obj: line 1: `usemtl floor` names no material of the libraries loaded before it"),
+        "{stderr}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -701,7 +762,7 @@ fn messages_name_what_the_user_gave() {
         let endless = dir.join("endless.json");
         std::os::unix::fs::symlink("/dev/zero", &endless).unwrap();
         let output = strata(&["render".as_ref(), "--backend".as_ref(), "cpu".as_ref(), endless.as_os_str()]);
-        assert_refused(&output, &["endless.json", "larger than"]);
+        assert_refused(&output, &["endless.json", "not a regular file"]);
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -726,5 +787,69 @@ fn no_summary_report_or_record_says_nan_or_inf() {
         }
     }
     assert!(stdout.contains("(1 seed: no interval)"), "{stdout}");
+    // serde_json writes a NaN as null: every time in the record is a number.
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    assert!(record["seconds"].is_f64(), "{record}");
+    for time in record["frame_ms"].as_array().unwrap() {
+        assert!(time["frame_ms"].is_f64(), "{record}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// 2 (a variant that needs no privileges): a file-size limit (RLIMIT_FSIZE, `ulimit -f`)
+// that the plot's SVG fits and its PNG does not; and standard output on a full device.
+#[cfg(unix)]
+#[test]
+fn a_write_cut_short_by_a_size_limit_is_an_error_and_leaves_no_file() {
+    let dir = scratch("size-limit");
+    let rows = [("strata", 1, 1, 0.5), ("restir", 1, 1, 1.0), ("strata", 2, 1, 0.4), ("restir", 2, 1, 0.9)];
+    let file = dir.join("errors.csv");
+    std::fs::write(&file, csv(&rows)).unwrap();
+    assert_succeeded(&strata(&["plot".as_ref(), file.as_os_str(), "--out".as_ref(), dir.join("roomy").as_os_str()]));
+    let size = |name: &str| std::fs::metadata(dir.join(name)).unwrap().len();
+    let (svg, png) = (size("roomy.svg"), size("roomy.png"));
+    assert!(svg + 2048 < png, "the PNG ({png} bytes) must be larger than the SVG ({svg} bytes)");
+    // `ulimit -f` counts 512-byte blocks in dash (1024 in bash): a limit between the sizes.
+    let blocks = (svg + 1024) / 512;
+    let limited = dir.join("limited");
+    let script = format!(
+        "trap '' XFSZ; ulimit -f {blocks}; exec '{}' plot '{}' --out '{}'",
+        binary().display(),
+        file.display(),
+        limited.display()
+    );
+    let output = Command::new("sh").args(["-c", &script]).env("RUST_BACKTRACE", "1").output().unwrap();
+    assert_refused(&output, &["limited.png", "cannot write"]);
+    let left: Vec<String> =
+        files(&dir).iter().map(|(p, _)| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+    assert!(left.contains(&"limited.svg".to_string()), "{left:?}");
+    assert!(!left.iter().any(|n| n == "limited.png" || n.contains(".tmp-")), "{left:?}");
+    // Standard output on a full device: one line, no panic.
+    let script = format!(
+        "exec '{}' plot '{}' --out '{}' > /dev/full",
+        binary().display(),
+        file.display(),
+        dir.join("again").display()
+    );
+    let output = Command::new("sh").args(["-c", &script]).env("RUST_BACKTRACE", "1").output().unwrap();
+    assert_refused(&output, &["standard out", "cannot write"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// 4 (another variant): an output never replaces a file the run read, whatever the names.
+#[test]
+fn an_output_never_replaces_an_input_of_the_run() {
+    let dir = scratch("input-output");
+    // The render of studio/scene.json is named studio.exr: the scene's environment map.
+    let scene = cornell_box(&dir, "studio", |scene| {
+        scene["environment"] = serde_json::json!({"file": "studio.exr", "scale": 1.0});
+    });
+    let folder = scene.parent().unwrap().to_path_buf();
+    write_exr(&folder.join("studio.exr"), 8, 4, [0.5; 3]);
+    let before = std::fs::read(folder.join("studio.exr")).unwrap();
+    let output = strata(&with(os(render_args(4)), &[scene.as_os_str(), "--out".as_ref(), folder.as_os_str()]));
+    assert_refused(&output, &["studio.exr", "input of this run"]);
+    assert_eq!(std::fs::read(folder.join("studio.exr")).unwrap(), before);
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -104,6 +104,12 @@ pub fn hlsl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, K
 
 /// Metal Shading Language 2.3.
 pub fn msl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, KernelError> {
+    msl_version(kernel, options, (2, 3))
+}
+
+/// Metal Shading Language of `version` (major, minor): buffers at `[[buffer(binding)]]`,
+/// the array-sizes buffer at 30.
+pub fn msl_version(kernel: &Kernel, options: TranslateOptions, version: (u8, u8)) -> Result<Translation, KernelError> {
     use naga::back::msl;
     let mut resources = msl::BindingMap::default();
     for binding in &kernel.bindings {
@@ -122,7 +128,7 @@ pub fn msl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, Ke
         msl::EntryPointResources { resources, immediates_buffer: None, sizes_buffer: Some(30) },
     );
     let msl_options = msl::Options {
-        lang_version: (2, 3),
+        lang_version: version,
         per_entry_point_map,
         fake_missing_bindings: false,
         zero_initialize_workgroup_memory: options.zero_init_in_source(),

@@ -4,7 +4,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
-/// Slots one workgroup of the histogram kernel sorts (`SLOTS` in `block_sort.wgsl`):
+/// Slots one workgroup of the histogram kernel sorts (`SLOTS` in `strata/histogram.wgsl`):
 /// 1024 / B² whole blocks per workgroup.
 pub const HISTOGRAM_SLOTS_PER_WORKGROUP: u32 = 1024;
 

@@ -115,6 +115,11 @@ impl AshEngine {
         Self::open_with(test, false)
     }
 
+    /// The loader's `vkGetInstanceProcAddr`, as a C engine hands it to `strata_vk_create`.
+    pub fn get_instance_proc_addr(&self) -> ash::vk::PFN_vkGetInstanceProcAddr {
+        self._entry.static_fn().get_instance_proc_addr
+    }
+
     /// The device as the embeddable pass takes it.
     pub fn embed_device(&self) -> strata_embed::AshDevice<'_> {
         strata_embed::AshDevice {

@@ -28,6 +28,10 @@
 //!   1 GiB writes `hang-`/`huge-<hash>` and exits 2 or 3 at once. Commit the files: the
 //!   `fuzz_regressions` test runs each of them again.
 //!
+//! * `cargo xtask export --out DIR`: the kernel package for engines outside Rust
+//!   (`strata_export`: translations, manifest.json, strata.h, strata_frame.h,
+//!   strata_vk.h, the blue-noise tables, a README per API).
+//!
 //! * `cargo xtask validate`: `strata render`, `strata compare` (temporal and
 //!   accumulated, wgpu and ash), both embed examples and `xtask check` under
 //!   `VK_LAYER_KHRONOS_validation` with synchronization validation; fails on any error or
@@ -85,6 +89,14 @@ enum Command {
     /// Run render, compare, the embed examples and the check under the Vulkan validation
     /// layer with synchronization validation; fail on any error or warning.
     Validate,
+    /// Write the kernel package for engines outside Rust: every kernel of the embeddable
+    /// pass in SPIR-V, HLSL, MSL, GLSL and WGSL, manifest.json, the C headers and the
+    /// blue-noise tables (strata-export).
+    Export {
+        /// The package's folder: new, empty, or an earlier package (replaced whole).
+        #[arg(long)]
+        out: PathBuf,
+    },
 }
 
 /// `cargo xtask run`'s arguments.
@@ -137,6 +149,11 @@ fn main() {
         Command::Check { full, kernel } => check(full, &kernel),
         Command::Validate => validate::validate(),
         Command::Fuzz(args) => fuzz::fuzz(args),
+        Command::Export { out } => strata_export::export(&out)
+            .map(|exported| {
+                println!("wrote the kernel package {} ({} files)", exported.folder.display(), exported.files.len())
+            })
+            .map_err(Into::into),
         Command::Run(args) => {
             let RunArgs { shader, entry, workgroups, buffers, sizes, overrides, backend, ulp, abs, reference, out } =
                 *args;

@@ -75,12 +75,11 @@ pub fn run_comparison(
                     let render_time = started.elapsed();
                     let reference = references.get(frame as usize).unwrap_or(&references[0]);
                     let name = format!("{} frame {}, seed {seed}", method.name(), frame + 1);
-                    super::image_checks::check_frame(&image, reference, &name)
-                        .map_err(|e| PassError::Input(e.to_string()))?;
+                    super::image_checks::check_frame(&image, &name).map_err(|e| PassError::Input(e.to_string()))?;
                     if stats.invalid_pixels > 0 {
                         return Err(PassError::Input(format!(
-                            "{}: frame {frame}, seed {seed}: {} pixels had invalid samples",
-                            method.name(),
+                            "{name}: {} pixels had invalid samples (a radiance that overflows, or a traversal \
+                             stack overflow); not scored",
                             stats.invalid_pixels
                         )));
                     }
@@ -181,16 +180,20 @@ fn ratio_of(
     frame: u32,
     value: impl Fn(&FrameError) -> Option<f64>,
 ) -> Option<MeanInterval> {
-    let of = |m: Method| -> Vec<(u32, f64)> {
-        errors.iter().filter(|e| e.method == m && e.frame == frame).filter_map(|e| Some((e.seed, value(e)?))).collect()
-    };
-    let (ours, theirs) = (of(method), of(baseline));
+    let ours: Vec<(u32, f64)> = errors
+        .iter()
+        .filter(|e| e.method == method && e.frame == frame)
+        .filter_map(|e| Some((e.seed, value(e)?)))
+        .collect();
+    let theirs: std::collections::HashMap<u32, f64> = errors
+        .iter()
+        .filter(|e| e.method == baseline && e.frame == frame)
+        .filter_map(|e| Some((e.seed, value(e)?)))
+        .collect();
     // A pair whose baseline error is 0 has no ratio (only an image equal to its
     // reference scores 0): it is left out rather than averaged as infinity.
-    let ratios: Vec<f64> = ours
-        .iter()
-        .filter_map(|(seed, a)| theirs.iter().find(|(s, b)| s == seed && *b > 0.0).map(|(_, b)| a / b))
-        .collect();
+    let ratios: Vec<f64> =
+        ours.iter().filter_map(|(seed, a)| theirs.get(seed).filter(|&&b| b > 0.0).map(|b| a / b)).collect();
     (!ratios.is_empty()).then(|| MeanInterval::of(&ratios))
 }
 
@@ -201,17 +204,21 @@ fn ratio_of(
 /// lacks one of them, or has one twice, for either method is left out. The ratio of sums
 /// is the per-frame ratios weighted by the baseline's error at each frame.
 pub fn relmse_ratio_over_frames(errors: &[FrameError], method: Method, baseline: Method) -> Option<MeanInterval> {
-    use std::collections::BTreeSet;
+    use std::collections::{BTreeMap, BTreeSet};
     let frames: BTreeSet<u32> =
         errors.iter().filter(|e| e.method == method || e.method == baseline).map(|e| e.frame).collect();
+    // Each run's (frame, RelMSE) pairs, grouped in one pass over the rows.
+    let mut runs: BTreeMap<(Method, u32), Vec<(u32, f64)>> = BTreeMap::new();
+    for e in errors.iter().filter(|e| e.method == method || e.method == baseline) {
+        runs.entry((e.method, e.seed)).or_default().push((e.frame, e.relmse));
+    }
     // One run's RelMSE summed over the frames, if it has each of them exactly once.
     let summed = |m: Method, seed: u32| -> Option<f64> {
-        let mut run: Vec<(u32, f64)> =
-            errors.iter().filter(|e| e.method == m && e.seed == seed).map(|e| (e.frame, e.relmse)).collect();
+        let mut run = runs.get(&(m, seed))?.clone();
         run.sort_by_key(|&(frame, _)| frame);
         run.iter().map(|&(frame, _)| frame).eq(frames.iter().copied()).then(|| run.iter().map(|&(_, v)| v).sum())
     };
-    let seeds: BTreeSet<u32> = errors.iter().map(|e| e.seed).collect();
+    let seeds: BTreeSet<u32> = runs.keys().map(|&(_, seed)| seed).collect();
     let ratios: Vec<f64> = seeds
         .iter()
         .filter_map(|&seed| Some(summed(method, seed)? / summed(baseline, seed).filter(|&b| b > 0.0)?))
@@ -219,11 +226,20 @@ pub fn relmse_ratio_over_frames(errors: &[FrameError], method: Method, baseline:
     (!ratios.is_empty()).then(|| MeanInterval::of(&ratios))
 }
 
+/// The rows grouped by frame, in frame order (one pass; what per-frame statistics over
+/// many frames walk, instead of every row per frame).
+pub fn by_frame(errors: &[FrameError]) -> std::collections::BTreeMap<u32, Vec<FrameError>> {
+    let mut frames: std::collections::BTreeMap<u32, Vec<FrameError>> = std::collections::BTreeMap::new();
+    for e in errors {
+        frames.entry(e.frame).or_default().push(*e);
+    }
+    frames
+}
+
 /// Reads the CSV [`errors_csv`] writes; an error names the line and what is wrong.
 /// Besides each line's own fields, the rows together must be what a comparison writes:
 /// at least one row, each (method, frame, seed) once, every method measured at the same
-/// (frame, seed) pairs, and errors above 0 (a ratio to an error of 0 cannot be
-/// computed, and only an image equal to its reference has one).
+/// (frame, seed) pairs, and errors finite and 0 or more.
 pub fn parse_errors_csv(text: &str) -> Result<Vec<FrameError>, String> {
     let rows = parse_rows(text)?;
     check_rows(&rows)?;
@@ -283,11 +299,12 @@ fn parse_rows(text: &str) -> Result<Vec<(usize, FrameError)>, String> {
         let method = <Method as clap::ValueEnum>::from_str(fields[0], false)
             .map_err(|_| format!("line {number}: unknown method `{}`", fields[0]))?;
         let int = |i: usize| fields[i].parse::<u32>().map_err(|e| format!("line {number}, field {}: {e}", i + 1));
-        // Errors are finite and positive: anything else is a damaged file, not a
-        // measurement to average or divide by.
+        // Errors are finite and non-negative: anything else is a damaged file, not a
+        // measurement to average. (0 is an image equal to its reference: no ratio to
+        // it exists, and the summaries say so.)
         let float = |i: usize| match fields[i].parse::<f64>() {
-            Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-            Ok(v) => Err(format!("line {number}, field {}: {v} is not an error (finite, above 0)", i + 1)),
+            Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+            Ok(v) => Err(format!("line {number}, field {}: {v} is not an error (finite, 0 or more)", i + 1)),
             Err(e) => Err(format!("line {number}, field {}: {e}", i + 1)),
         };
         let frame = int(1)?;

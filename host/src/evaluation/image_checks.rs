@@ -6,9 +6,10 @@
 //! - A reference is finite, non-negative (radiance; a negative pixel makes the paper's
 //!   RelMSE, (f − ref)² / (ref + 1e-4), negative or huge) and not black everywhere (a
 //!   camera that sees no light: every error would be 0 and every ratio 0 / 0).
-//! - A frame is finite and, where its reference is not black, not black everywhere
-//!   either: a renderer that lost every sample (a radiance that overflowed to infinity
-//!   and was zeroed as a non-finite sample) must not be scored as a plausible error.
+//! - A frame is finite. A frame black everywhere where its reference is not is scored
+//!   but said ([`black_against`]: at a few pixels and one sample per frame it can
+//!   happen; a renderer that lost every sample to overflow flags those samples as
+//!   invalid, which the comparison refuses, so black alone is not an error).
 
 use crate::rgb_image::RgbImage;
 
@@ -52,15 +53,6 @@ pub enum ImageCheckError {
         /// Height.
         height: u32,
     },
-    /// A frame that is 0 everywhere while its reference is not.
-    #[error(
-        "{name} is black everywhere while its reference is not: the renderer lost every sample (a radiance that \
-         overflows single-precision floats?); it is not scored"
-    )]
-    BlackFrame {
-        /// The image.
-        name: String,
-    },
 }
 
 /// The first pixel with a channel that fails `bad`, as (x, y, pixel).
@@ -90,16 +82,17 @@ pub fn check_reference(image: &RgbImage, name: &str) -> Result<(), ImageCheckErr
     Ok(())
 }
 
-/// Refuses a rendered frame that is not finite, or black everywhere against a
-/// `reference` that is not.
-pub fn check_frame(image: &RgbImage, reference: &RgbImage, name: &str) -> Result<(), ImageCheckError> {
-    if let Some((x, y, value)) = first_pixel(image, |c| !c.is_finite()) {
-        return Err(ImageCheckError::NonFinite { name: name.into(), x, y, value });
+/// Refuses a rendered frame that is not finite.
+pub fn check_frame(image: &RgbImage, name: &str) -> Result<(), ImageCheckError> {
+    match first_pixel(image, |c| !c.is_finite()) {
+        Some((x, y, value)) => Err(ImageCheckError::NonFinite { name: name.into(), x, y, value }),
+        None => Ok(()),
     }
-    if is_black(image) && !is_black(reference) {
-        return Err(ImageCheckError::BlackFrame { name: name.into() });
-    }
-    Ok(())
+}
+
+/// Whether `image` is black everywhere while `reference` is not (worth a warning).
+pub fn black_against(image: &RgbImage, reference: &RgbImage) -> bool {
+    is_black(image) && !is_black(reference)
 }
 
 #[cfg(test)]
@@ -124,13 +117,12 @@ mod tests {
     }
 
     #[test]
-    fn frames_must_be_finite_and_not_black_where_the_reference_is_lit() {
+    fn frames_must_be_finite_and_black_ones_are_told_apart() {
         let lit = image(vec![[0.0; 3], [0.5; 3], [0.0; 3], [0.0; 3]]);
         let black = image(vec![[0.0; 3]; 4]);
-        assert!(check_frame(&lit, &lit, "f").is_ok());
-        assert!(matches!(check_frame(&black, &lit, "f"), Err(ImageCheckError::BlackFrame { .. })));
-        assert!(check_frame(&black, &black, "f").is_ok());
+        assert!(check_frame(&lit, "f").is_ok() && check_frame(&black, "f").is_ok());
+        assert!(black_against(&black, &lit) && !black_against(&black, &black) && !black_against(&lit, &lit));
         let infinite = image(vec![[0.0; 3], [0.5; 3], [0.0; 3], [0.0, 0.0, f32::INFINITY]]);
-        assert!(matches!(check_frame(&infinite, &lit, "f"), Err(ImageCheckError::NonFinite { x: 1, y: 1, .. })));
+        assert!(matches!(check_frame(&infinite, "f"), Err(ImageCheckError::NonFinite { x: 1, y: 1, .. })));
     }
 }

@@ -103,7 +103,15 @@ pub fn prepare(folder: &Path, keep: Option<&Path>) -> Result<(FolderLock, Vec<St
         let name = entry.file_name().to_string_lossy().into_owned();
         let path = entry.path();
         let leftover = crate::atomic_file::is_temporary(&name);
-        if !(is_run_output(&name) || leftover) || !entry.file_type().is_ok_and(|t| t.is_file()) {
+        if !(is_run_output(&name) || leftover) {
+            continue;
+        }
+        // A folder, link or device under a name the run writes would fail the run at its
+        // end (the writer never replaces one): said now, before any work.
+        if is_run_output(&name) && !entry.file_type().is_ok_and(|t| t.is_file()) {
+            crate::atomic_file::check_target(&path)?;
+        }
+        if !entry.file_type().is_ok_and(|t| t.is_file()) {
             continue;
         }
         if keep.is_some() && path.canonicalize().ok() == keep {

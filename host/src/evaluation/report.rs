@@ -77,6 +77,8 @@ pub fn run_and_report(
     let mut seed_images: SeedImages = HashMap::new();
     let mut written: HashMap<(Method, u32), Written> = HashMap::new();
     let mut render_time: HashMap<Method, (Duration, u32)> = HashMap::new();
+    // Frames black everywhere where their reference is not: scored, and said once.
+    let mut black_frames: Vec<String> = Vec::new();
     let errors = run_comparison(
         backend,
         gpu_scene,
@@ -86,6 +88,10 @@ pub fn run_and_report(
         references,
         |method, seed, frame, image, took| {
             progress.inc(1);
+            let reference = references.get(frame as usize).unwrap_or(&references[0]);
+            if super::image_checks::black_against(image, reference) {
+                black_frames.push(format!("{} frame {}, seed {seed}", method.name(), frame + 1));
+            }
             let time = render_time.entry(method).or_default();
             time.0 += took;
             time.1 += 1;
@@ -96,7 +102,6 @@ pub fn run_and_report(
                 seed_images.entry((method, frame)).or_default().push(image.clone());
             }
             if seed == 1 {
-                let reference = references.get(frame as usize).unwrap_or(&references[0]);
                 match write_frame(out, method, frame, image, reference, options.exposure) {
                     Ok(w) => {
                         written.insert((method, frame), w);
@@ -153,6 +158,18 @@ pub fn run_and_report(
 
     // The record.
     let mut record = options.record.clone();
+    if let Some(first) = black_frames.first() {
+        let warning = format!(
+            "{first}{} black everywhere while the reference is not (scored as rendered: at a few pixels and one \
+             sample per frame this happens; otherwise look at the scene's light)",
+            match black_frames.len() {
+                1 => " is".to_string(),
+                n => format!(" and {} more frames are", n - 1),
+            }
+        );
+        eprintln!("warning: {warning}");
+        record.warnings.push(warning);
+    }
     record.frame_ms = options
         .methods
         .iter()

@@ -116,17 +116,28 @@ pub fn whole_run_ratios(errors: &[FrameError]) -> Vec<WholeRunRatio> {
         .collect()
 }
 
-/// The sentence `strata compare` and `strata plot` print for each [`WholeRunRatio`].
+/// The sentence `strata compare` and `strata plot` print for each baseline the errors
+/// hold beside strata: its [`WholeRunRatio`], or why it cannot be computed (the
+/// baseline's RelMSE is 0 in every seed: its images equal the reference).
 pub fn whole_run_lines(errors: &[FrameError], frames: u32) -> Vec<String> {
-    whole_run_ratios(errors)
-        .iter()
-        .map(|w| {
-            format!(
-                "strata ÷ {} over frames 1-{frames} (per seed, RelMSE summed over the frames): {} ({} seeds)",
-                w.baseline.name(),
-                w.ratio.fixed(4),
-                w.ratio.count
-            )
+    let has = |m: Method| errors.iter().any(|e| e.method == m);
+    let ratios = whole_run_ratios(errors);
+    [Method::Restir, Method::RestirDisc]
+        .into_iter()
+        .filter(|&baseline| has(Method::Strata) && has(baseline))
+        .map(|baseline| {
+            let head = format!(
+                "strata ÷ {} over frames 1-{frames} (per seed, RelMSE summed over the frames)",
+                baseline.name()
+            );
+            match ratios.iter().find(|w| w.baseline == baseline) {
+                Some(w) if w.ratio.count >= 2 => format!("{head}: {} ({} seeds)", w.ratio.fixed(4), w.ratio.count),
+                Some(w) => format!("{head}: {}", w.ratio.fixed(4)),
+                None => format!(
+                    "{head}: cannot be computed ({}'s RelMSE is 0 in every seed: its images equal the reference)",
+                    baseline.name()
+                ),
+            }
         })
         .collect()
 }

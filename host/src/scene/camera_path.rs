@@ -170,7 +170,10 @@ impl CameraPath {
 ///
 /// A number that is not finite, an orbit about a zero `base.up` or a dolly of a base
 /// whose origin equals its target is an error naming `spec` and the field.
-pub fn parse_camera_path(spec: &str, base: &Camera) -> Result<CameraPath, SceneError> {
+pub fn parse_camera_path(spec: impl AsRef<std::ffi::OsStr>, base: &Camera) -> Result<CameraPath, SceneError> {
+    let spec = spec.as_ref();
+    // A path that is not UTF-8 names a keyframe file; the keywords are ASCII.
+    let Some(spec) = spec.to_str() else { return CameraPath::load(Path::new(spec)) };
     let error =
         |field: &str, message: String| SceneError::Json { path: PathBuf::from(spec), field: field.into(), message };
     let number = |field: &str, text: &str, unit: &str| -> Result<f32, SceneError> {

@@ -71,54 +71,96 @@ pub enum Reflectance {
     },
 }
 
-/// The object form `{"checkerboard": {...}}`.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct CheckerboardForm {
-    checkerboard: Checkerboard,
-}
-
-/// The object form `{"texture": "file.png", ...}`.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct TextureForm {
-    texture: PathBuf,
-    #[serde(default)]
-    srgb: bool,
-    #[serde(default)]
-    filter: Option<String>,
-    #[serde(default)]
-    wrap: Option<String>,
-    #[serde(default)]
-    uv_scale: Option<[f32; 2]>,
-}
-
 impl<'de> Deserialize<'de> for Reflectance {
     fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        use serde::de::Error;
-        use serde_json::Value;
-        let value = Value::deserialize(deserializer)?;
-        let is_object_with = |key: &str| value.as_object().is_some_and(|o| o.contains_key(key));
-        let reflectance = if value.is_array() {
-            serde_json::from_value::<[f32; 3]>(value).map(Reflectance::Constant)
-        } else if is_object_with("checkerboard") {
-            serde_json::from_value::<CheckerboardForm>(value)
-                .map(|form| Reflectance::Checkerboard { checkerboard: form.checkerboard })
-        } else if is_object_with("texture") {
-            serde_json::from_value::<TextureForm>(value).map(|form| Reflectance::Texture {
-                texture: form.texture,
-                srgb: form.srgb,
-                filter: form.filter,
-                wrap: form.wrap,
-                uv_scale: form.uv_scale,
-            })
-        } else {
-            return Err(D::Error::custom(
-                "expected [r, g, b], {\"checkerboard\": {...}} or {\"texture\": \"file.png\", ...}",
-            ));
-        };
-        reflectance.map_err(|e| D::Error::custom(format!("reflectance: {e}")))
+        deserializer.deserialize_any(ReflectanceVisitor)
     }
+}
+
+/// Reads a [`Reflectance`] by its shape, field by field (so that an error names the
+/// field, and a field given twice or unknown is refused).
+struct ReflectanceVisitor;
+
+/// The fields of the object forms.
+const REFLECTANCE_FIELDS: &[&str] = &["checkerboard", "texture", "srgb", "filter", "wrap", "uv_scale"];
+
+impl<'de> serde::de::Visitor<'de> for ReflectanceVisitor {
+    type Value = Reflectance;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("[r, g, b], {\"checkerboard\": {...}} or {\"texture\": \"file.png\", ...}")
+    }
+
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Reflectance, A::Error> {
+        use serde::de::Error;
+        let mut rgb = [0.0f32; 3];
+        for (i, c) in rgb.iter_mut().enumerate() {
+            *c = seq.next_element()?.ok_or_else(|| A::Error::invalid_length(i, &"three numbers"))?;
+        }
+        if seq.next_element::<serde::de::IgnoredAny>()?.is_some() {
+            return Err(A::Error::invalid_length(4, &"three numbers"));
+        }
+        Ok(Reflectance::Constant(rgb))
+    }
+
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Reflectance, A::Error> {
+        use serde::de::Error;
+        let mut checkerboard: Option<Checkerboard> = None;
+        let mut texture: Option<PathBuf> = None;
+        let (mut srgb, mut filter, mut wrap, mut uv_scale) = (None, None, None, None);
+        let mut seen: Vec<String> = Vec::new();
+        while let Some(key) = map.next_key::<String>()? {
+            if seen.contains(&key) {
+                return Err(A::Error::custom(format!("duplicate field `{key}`")));
+            }
+            match key.as_str() {
+                "checkerboard" => checkerboard = Some(map.next_value()?),
+                "texture" => texture = Some(map.next_value()?),
+                "srgb" => srgb = Some(map.next_value::<bool>()?),
+                "filter" => filter = map.next_value::<Option<String>>()?,
+                "wrap" => wrap = map.next_value::<Option<String>>()?,
+                "uv_scale" => uv_scale = map.next_value::<Option<[f32; 2]>>()?,
+                other => return Err(A::Error::unknown_field(other, REFLECTANCE_FIELDS)),
+            }
+            seen.push(key);
+        }
+        match (checkerboard, texture) {
+            (Some(checkerboard), None) if seen.len() == 1 => Ok(Reflectance::Checkerboard { checkerboard }),
+            (Some(_), _) => Err(A::Error::custom("a checkerboard takes no other field beside it")),
+            (None, Some(texture)) => {
+                Ok(Reflectance::Texture { texture, srgb: srgb.unwrap_or(false), filter, wrap, uv_scale })
+            }
+            (None, None) => Err(A::Error::custom("expected `checkerboard` or `texture`")),
+        }
+    }
+}
+
+/// Reads a map whose keys must be distinct (serde's maps keep the last of two equal
+/// keys without a word): `materials`, where a name defined twice is an error.
+fn distinct_keys<'de, D, V>(deserializer: D) -> Result<BTreeMap<String, V>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    V: Deserialize<'de>,
+{
+    struct Visitor<V>(std::marker::PhantomData<V>);
+    impl<'de, V: Deserialize<'de>> serde::de::Visitor<'de> for Visitor<V> {
+        type Value = BTreeMap<String, V>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("an object of materials by name")
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
+            let mut out = BTreeMap::new();
+            while let Some(key) = map.next_key::<String>()? {
+                if out.contains_key(&key) {
+                    return Err(serde::de::Error::custom(format!("`{key}` is defined twice")));
+                }
+                let value = map.next_value()?;
+                out.insert(key, value);
+            }
+            Ok(out)
+        }
+    }
+    deserializer.deserialize_map(Visitor(std::marker::PhantomData))
 }
 
 /// Checkerboard parameters (CONVENTIONS.md).
@@ -229,7 +271,8 @@ pub struct SceneDescription {
     pub camera: Camera,
     /// Integrator.
     pub integrator: Integrator,
-    /// Materials by name.
+    /// Materials by name (each name once).
+    #[serde(deserialize_with = "distinct_keys")]
     pub materials: BTreeMap<String, MaterialDescription>,
     /// Shapes.
     pub shapes: Vec<ShapeDescription>,

@@ -24,35 +24,40 @@ impl FileSource for DiskFiles {
     }
 }
 
-/// The most bytes strata reads from one input file (a scene, mesh, texture, environment
-/// map, reference image, camera path or CSV): 1 GiB, above any of the shared scenes'
-/// files by a wide margin. A larger file, or an endless one such as `/dev/zero`, is an
-/// error naming it, never read until memory runs out.
+/// The most bytes strata reads from an input that is not a regular file (a device, a
+/// pipe): 1 GiB, above any of the shared scenes' files by a wide margin. An endless one
+/// such as `/dev/zero` is an error naming it, never read until memory runs out. A regular
+/// file is read whole: its size is known before reading.
 pub const MAX_INPUT_FILE_BYTES: u64 = 1 << 30;
 
-/// The whole contents of `path`, at most [`MAX_INPUT_FILE_BYTES`]: a regular file's
-/// size is checked before anything is read; anything else (a device, a pipe) is read up
-/// to the limit and refused beyond it.
+/// The whole contents of `path`: a regular file as it is, anything else (a device, a
+/// pipe) up to [`MAX_INPUT_FILE_BYTES`] and refused beyond it. Every file read is noted
+/// as an input of the run ([`crate::atomic_file::note_input`]).
 pub fn read_capped(path: &Path) -> std::io::Result<Vec<u8>> {
     use std::io::Read;
-    let too_large = || {
-        std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            format!("larger than the {} MiB an input file may have", MAX_INPUT_FILE_BYTES >> 20),
-        )
-    };
     let file = std::fs::File::open(path)?;
     let metadata = file.metadata()?;
     if metadata.is_dir() {
         return Err(std::io::Error::new(std::io::ErrorKind::InvalidInput, "is a folder, not a file"));
     }
-    if metadata.is_file() && metadata.len() > MAX_INPUT_FILE_BYTES {
-        return Err(too_large());
-    }
+    // No output of this run may replace what it reads.
+    crate::atomic_file::note_input(path);
     let mut bytes = Vec::new();
+    if metadata.is_file() {
+        // A regular file's size is what the user handed over: read as it is.
+        bytes.reserve_exact(usize::try_from(metadata.len()).unwrap_or(0));
+        (&file).read_to_end(&mut bytes)?;
+        return Ok(bytes);
+    }
     file.take(MAX_INPUT_FILE_BYTES + 1).read_to_end(&mut bytes)?;
     if bytes.len() as u64 > MAX_INPUT_FILE_BYTES {
-        return Err(too_large());
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!(
+                "not a regular file, and more than the {} MiB read from a device or pipe",
+                MAX_INPUT_FILE_BYTES >> 20
+            ),
+        ));
     }
     Ok(bytes)
 }

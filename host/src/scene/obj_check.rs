@@ -64,15 +64,43 @@ pub(super) fn short_faces(text: &str) -> Vec<usize> {
         .collect()
 }
 
-/// Every `usemtl` statement: its line (1-based) and the material it names.
-pub(super) fn material_uses(text: &str) -> Vec<(usize, String)> {
+/// A statement about materials, in file order.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(super) enum MaterialStatement {
+    /// `mtllib FILE`: the library's file name as written.
+    Library(String),
+    /// `usemtl NAME`.
+    Use(String),
+}
+
+/// Every `mtllib` and `usemtl` statement: its line (1-based) and what it names, read
+/// as `tobj` reads them once [`without_indentation`] is applied (the name is everything
+/// after the first space, trimmed).
+pub(super) fn material_statements(text: &str) -> Vec<(usize, MaterialStatement)> {
     text.lines()
         .enumerate()
         .filter_map(|(number, line)| {
-            let rest = line.trim_start().strip_prefix("usemtl")?;
-            rest.starts_with(char::is_whitespace).then(|| (number + 1, rest.trim().to_string()))
+            let line = line.trim_start();
+            let (keyword, rest) = line.split_once(' ').unwrap_or((line, ""));
+            let name = rest.trim().to_string();
+            match keyword {
+                "mtllib" => Some((number + 1, MaterialStatement::Library(name))),
+                "usemtl" => Some((number + 1, MaterialStatement::Use(name))),
+                _ => None,
+            }
         })
         .collect()
+}
+
+/// `text` with every line's leading white space removed: `tobj` finds a statement's
+/// keyword past indentation but reads its argument from the untrimmed line, so an
+/// indented `usemtl red` would name the material "usemtl red".
+pub(super) fn without_indentation(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for line in text.split_inclusive('\n') {
+        out.push_str(line.trim_start_matches([' ', '\t']));
+    }
+    out
 }
 
 /// One warning for many lines: `line N` or `line N (and M more)`.
@@ -110,7 +138,15 @@ mod tests {
         assert_eq!(short_colour("newmtl a\nKd 1 1 1\n"), None);
         assert_eq!(short_colour("newmtl a\nKe 1\n").unwrap().0, 2);
         assert_eq!(short_faces("v 0 0 0\nf 1 1\nf 1 1 1\nf 1\n"), [2, 4]);
-        assert_eq!(material_uses("usemtl a b\nusemtlx\n  usemtl c\n"), [(1, "a b".into()), (3, "c".into())]);
+        assert_eq!(
+            material_statements("usemtl a b\nusemtlx\n  usemtl c\nmtllib x y.mtl\n"),
+            [
+                (1, MaterialStatement::Use("a b".into())),
+                (3, MaterialStatement::Use("c".into())),
+                (4, MaterialStatement::Library("x y.mtl".into()))
+            ]
+        );
+        assert_eq!(without_indentation("  usemtl c\n\tf 1 2 3\nv 1 2 3"), "usemtl c\nf 1 2 3\nv 1 2 3");
         assert_eq!(lines_text(&[4, 9, 12]), "line 4 (and 2 more)");
     }
 }

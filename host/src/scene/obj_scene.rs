@@ -117,7 +117,11 @@ fn load_bytes(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene
         ));
     }
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
-    let (models, materials) = tobj::load_obj_buf(&mut &bytes[..], &options, load_library)
+    // tobj reads statements' arguments from untrimmed lines: indentation removed first
+    // (UTF-8 only; other bytes go to tobj as they are, which refuses them).
+    let unindented = std::str::from_utf8(bytes).ok().map(obj_check::without_indentation);
+    let parsed: &[u8] = unindented.as_ref().map_or(bytes, |t| t.as_bytes());
+    let (models, materials) = tobj::load_obj_buf(&mut &parsed[..], &options, load_library)
         .map_err(|e| obj_error(path, "(file)", format!("not a valid OBJ file: {e}")))?;
     if let Some(error) = library_error.into_inner() {
         return Err(error);
@@ -126,21 +130,29 @@ fn load_bytes(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene
     let mut warnings = warnings.into_inner();
     // A `usemtl` naming no material of a library that was found: its faces get the
     // default material, said once per name. (A missing library was said above.)
-    let defined: Vec<&str> = materials.iter().flatten().map(|m| m.name.as_str()).collect();
+    // A `usemtl` whose name no library loaded *before it* defines gets the default
+    // material (tobj resolves names line by line), said once per name.
+    let mut known: Vec<&str> = Vec::new();
     let mut unknown: Vec<(String, Vec<usize>)> = Vec::new();
-    for (line, name) in obj_check::material_uses(&text) {
-        if defined.contains(&name.as_str()) {
-            continue;
-        }
-        match unknown.iter_mut().find(|(n, _)| *n == name) {
-            Some((_, lines)) => lines.push(line),
-            None => unknown.push((name, vec![line])),
+    for (line, statement) in obj_check::material_statements(&text) {
+        match statement {
+            obj_check::MaterialStatement::Library(file) => {
+                let library = folder.join(&file);
+                known.extend(library_of.iter().filter(|(_, l)| **l == library).map(|(name, _)| name.as_str()));
+            }
+            obj_check::MaterialStatement::Use(name) if !known.contains(&name.as_str()) => {
+                match unknown.iter_mut().find(|(n, _)| *n == name) {
+                    Some((_, lines)) => lines.push(line),
+                    None => unknown.push((name, vec![line])),
+                }
+            }
+            obj_check::MaterialStatement::Use(_) => {}
         }
     }
     for (name, lines) in unknown.into_iter().filter(|_| !library_missing.get()) {
         warnings.push(format!(
-            "{}: {}: `usemtl {name}` names no material of the scene's libraries; its faces are grey diffuse \
-             {DEFAULT_GREY}",
+            "{}: {}: `usemtl {name}` names no material of the libraries loaded before it; its faces are grey \
+             diffuse {DEFAULT_GREY}",
             path.display(),
             obj_check::lines_text(&lines)
         ));

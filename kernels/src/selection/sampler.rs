@@ -54,6 +54,18 @@ impl SamplerVariant {
         }
     }
 
+    /// The variant's name, as the command line's `--sampler` and the export's
+    /// `manifest.json` spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            SamplerVariant::Random => "random",
+            SamplerVariant::Heitz => "heitz",
+            SamplerVariant::RandomOffset => "random-offset",
+            SamplerVariant::RandomOffsetBlueNoise => "random-offset-blue-noise",
+            SamplerVariant::Antithetic => "antithetic",
+        }
+    }
+
     /// The variant whose [`Self::id`] is `id`, if any.
     pub fn from_id(id: u32) -> Option<Self> {
         Self::ALL.into_iter().find(|variant| variant.id() == id)
@@ -81,3 +93,17 @@ pub const SAMPLER_RANDOM_OFFSET: u32 = 2;
 pub const SAMPLER_RANDOM_OFFSET_BLUE_NOISE: u32 = 3;
 /// WGSL `SAMPLER_ANTITHETIC`.
 pub const SAMPLER_ANTITHETIC: u32 = 4;
+
+#[cfg(all(test, feature = "clap"))]
+mod tests {
+    use super::*;
+
+    /// The names are the command line's.
+    #[test]
+    fn names_are_the_command_lines() {
+        for variant in SamplerVariant::ALL {
+            let clap_name = clap::ValueEnum::to_possible_value(&variant).unwrap().get_name().to_string();
+            assert_eq!(variant.name(), clap_name);
+        }
+    }
+}

@@ -181,6 +181,10 @@ fn draw_candidate(primary: Primary, surface: Surface, lane: u32) -> Drawn {
             candidate = bsdf_candidate;
             candidate.weight = total / bsdf_ris.x;
         }
+    } else if total != 0.0 {
+        // Infinite or NaN: a radiance that overflowed. Flagged, so that the frame is
+        // refused rather than scored with the sample silently dropped.
+        invalid = true;
     }
     return Drawn(candidate, invalid);
 }
@@ -320,6 +324,9 @@ fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
         // The luminance of the pixel's own one-sample estimate f(Y) W at its vertex.
         key = target_function(primary, candidate, lane) * candidate.weight;
     } else {
+        // A drawn candidate whose radiance overflowed is an invalid sample, not an
+        // absent one.
+        invalid = invalid || (candidate.kind != KIND_NONE && !finite3(candidate.reflected));
         candidate = no_candidate();
     }
     if invalid || !finite3(base) || !finite3(primary.throughput) {

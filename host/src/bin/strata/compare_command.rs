@@ -124,7 +124,7 @@ pub(crate) struct CompareArgs {
     /// a keyframe JSON file. A moving camera needs a reference per frame: they are
     /// path-traced (`--reference-spp` each) and `--reference` is refused.
     #[arg(long, default_value = "static")]
-    camera_path: String,
+    camera_path: std::ffi::OsString,
     /// Exposure of the PNG previews: finite and positive.
     #[arg(long, default_value_t = 1.0, value_parser = super::finite_positive)]
     exposure: f32,
@@ -235,11 +235,14 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
         bail!(
             "--accumulate with --camera-path {}: accumulated frames would average different viewpoints and be \
              measured against one frame's reference; accumulate with a static camera, or use temporal reuse",
-            args.camera_path
+            args.camera_path.to_string_lossy()
         );
     }
     if !cameras.is_empty() && args.reference.is_some() {
-        bail!("--reference: a moving camera (--camera-path {}) needs a reference per frame", args.camera_path);
+        bail!(
+            "--reference: a moving camera (--camera-path {}) needs a reference per frame",
+            args.camera_path.to_string_lossy()
+        );
     }
     // Held until the report is written: a second run into the folder is refused meanwhile.
     let (_lock, removed) = output_folder::prepare(&args.out, args.reference.as_deref())?;
@@ -277,7 +280,7 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
         progress.finish();
         reference_text = format!(
             "path-traced per frame ({}), {reference_spp} spp each, in {}",
-            args.camera_path,
+            args.camera_path.to_string_lossy(),
             strata::progress::words(rendered.elapsed())
         );
         references
@@ -306,7 +309,11 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
         version: env!("CARGO_PKG_VERSION").to_string(),
         git_revision: record::GIT_REVISION.to_string(),
         date,
-        scene: args.scene.as_ref().and_then(|p| scene_stem(p)).unwrap_or_else(|| "default scene".into()),
+        scene: args
+            .scene
+            .as_ref()
+            .and_then(|p| scene_stem(p))
+            .map_or_else(|| "default scene".into(), |s| s.to_string_lossy().into_owned()),
         width: render.camera.width,
         height: render.camera.height,
         frames: args.frames,
@@ -361,7 +368,7 @@ fn settings_record(
     put("film", name(&|| clap::ValueEnum::to_possible_value(&film)).into());
     put("shaded_parts", name(&|| clap::ValueEnum::to_possible_value(&restir.shaded_parts)).into());
     put("shading", name(&|| clap::ValueEnum::to_possible_value(&restir.shading)).into());
-    put("camera_path", args.camera_path.clone().into());
+    put("camera_path", args.camera_path.to_string_lossy().into_owned().into());
     map
 }
 

@@ -7,8 +7,8 @@ mod compare_command;
 pub(crate) fn finite_positive(text: &str) -> Result<f32, String> {
     match text.trim().parse::<f32>() {
         Ok(value) if value.is_finite() && value > 0.0 => Ok(value),
-        Ok(value) => Err(format!("{value} must be finite and positive")),
-        Err(error) => Err(error.to_string()),
+        Ok(_) => Err(format!("{text}: must be finite and positive (and within single precision)")),
+        Err(error) => Err(format!("{text}: {error}")),
     }
 }
 
@@ -175,6 +175,7 @@ enum VariantArg {
 /// is one line on standard error and exit status 1, with no backtrace whatever
 /// `RUST_BACKTRACE` says. Panics, which are bugs, keep theirs.
 fn main() -> std::process::ExitCode {
+    quiet_output_failures();
     let result = match Cli::parse().command {
         Command::Histogram(args) => histogram(args),
         Command::Render(args) => render(args),
@@ -189,6 +190,37 @@ fn main() -> std::process::ExitCode {
             std::process::ExitCode::FAILURE
         }
     }
+}
+
+/// Standard output or error that cannot be written (a full disk behind `> FILE`,
+/// `/dev/full`, a pipe whose reader has gone, as in `strata plot ... | head -1`) ends the
+/// run with one line and status 1 (141, silently, for a closed pipe, as a shell's
+/// SIGPIPE would), instead of the standard library's panic and backtrace. Other panics,
+/// which are bugs, keep theirs.
+fn quiet_output_failures() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let payload = info.payload();
+        let message = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or_default();
+        if let Some(rest) = message.strip_prefix("failed printing to ") {
+            if message.contains("Broken pipe") {
+                std::process::exit(141);
+            }
+            use std::io::Write;
+            let (stream, why) = rest.split_once(": ").unwrap_or((rest, ""));
+            let _ = writeln!(
+                std::io::stderr(),
+                "error: standard {}: cannot write: {why}",
+                stream.trim_start_matches("std")
+            );
+            std::process::exit(1);
+        }
+        default(info);
+    }));
 }
 
 /// The scene file (or the built-in scene) and its render settings at the requested size.
@@ -315,9 +347,32 @@ fn metrics(args: MetricsArgs) -> Result<()> {
             }
         }
     }
+    if let (Some(map), Some(png)) = (&args.map, &map_png) {
+        strata::atomic_file::check_target(map)?;
+        strata::atomic_file::check_target(png)?;
+    }
     let image = RgbImage::read_exr(&args.image)?;
     let reference = RgbImage::read_exr(&args.reference)?;
     strata::evaluation::image_checks::check_reference(&reference, &args.reference.display().to_string())?;
+    // The map is made before anything is printed: a map that single precision cannot hold
+    // is an error, not a half-done command.
+    let map = match &args.map {
+        Some(path) => {
+            let map = metrics::error_map(&image, &reference, args.map_metric)?;
+            if let Some(i) = map.iter().position(|&e| !(e as f32).is_finite()) {
+                bail!(
+                    "--map {}: the error at pixel ({}, {}) is {:e}, beyond single precision (the images differ by \
+                     more than an EXR can hold)",
+                    path.display(),
+                    i % image.width as usize,
+                    i / image.width as usize,
+                    map[i]
+                );
+            }
+            Some(map)
+        }
+        None => None,
+    };
     let context = || format!("{} against {}", args.image.display(), args.reference.display());
     println!("mse            {:.6e}", metrics::mse(&image, &reference).with_context(context)?);
     println!("relmse         {:.6e}", metrics::relmse(&image, &reference).with_context(context)?);
@@ -327,8 +382,7 @@ fn metrics(args: MetricsArgs) -> Result<()> {
     let (m, r) = (image.mean(), reference.mean());
     println!("mean image     ({:.5}, {:.5}, {:.5})", m[0], m[1], m[2]);
     println!("mean reference ({:.5}, {:.5}, {:.5})", r[0], r[1], r[2]);
-    if let Some(path) = &args.map {
-        let map = metrics::error_map(&image, &reference, args.map_metric)?;
+    if let (Some(path), Some(map)) = (&args.map, map) {
         let map_image =
             RgbImage { width: image.width, height: image.height, pixels: map.iter().map(|&e| [e as f32; 3]).collect() };
         map_image.write_exr(path)?;
@@ -366,6 +420,11 @@ fn render(args: RenderArgs) -> Result<()> {
         settings.max_depth
     );
     std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create the folder", args.out.display()))?;
+    let stem = args.scene.as_ref().and_then(|p| scene_stem(p)).unwrap_or_else(|| "default".into());
+    let (exr, png) = (args.out.join(with_extension(&stem, "exr")), args.out.join(with_extension(&stem, "png")));
+    // Said before the samples take their time: the writer refuses these names anyway.
+    strata::atomic_file::check_target(&exr)?;
+    strata::atomic_file::check_target(&png)?;
     let mut progress = strata::progress::Progress::new("render", u64::from(args.spp), "spp");
     let started = Instant::now();
     let image =
@@ -373,17 +432,13 @@ fn render(args: RenderArgs) -> Result<()> {
             .map_err(|e| name_the_size(e.into(), settings.camera.width, settings.camera.height))?;
     progress.finish();
     if strata::evaluation::image_checks::is_black(&image) {
-        bail!(
-            "the rendered image is black everywhere ({}x{} pixels of 0): the camera sees no light (is it inside a \
-             closed object, pointed away from the scene, or is the scene unlit?); nothing written",
-            image.width,
-            image.height
+        eprintln!(
+            "warning: the rendered image is black everywhere ({}x{} pixels of 0): does the camera see any light (is \
+             it inside a closed object, pointed away from the scene, or is the scene unlit)?",
+            image.width, image.height
         );
     }
     let seconds = started.elapsed().as_secs_f64();
-    let stem = args.scene.as_ref().and_then(|p| scene_stem(p)).unwrap_or_else(|| "default".into());
-    let exr = args.out.join(format!("{stem}.exr"));
-    let png = args.out.join(format!("{stem}.png"));
     image.write_exr(&exr)?;
     image.write_png(&png, args.exposure)?;
     let mean = image.mean();
@@ -430,14 +485,24 @@ fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
     }
 }
 
-/// `cornell-box` for `.../cornell-box/scene.json`, else the file stem.
-pub(crate) fn scene_stem(path: &std::path::Path) -> Option<String> {
-    let stem = path.file_stem()?.to_string_lossy().into_owned();
-    if let Some(variant) = stem.strip_prefix("scene") {
-        let folder = path.parent()?.file_name()?.to_string_lossy().into_owned();
-        return Some(format!("{folder}{variant}"));
+/// `cornell-box` for `.../cornell-box/scene.json`, else the file stem; the bytes of the
+/// path kept (a file name need not be UTF-8).
+pub(crate) fn scene_stem(path: &std::path::Path) -> Option<std::ffi::OsString> {
+    let stem = path.file_stem()?;
+    if let Some(variant) = stem.to_str().and_then(|s| s.strip_prefix("scene")) {
+        let mut name = path.parent()?.file_name()?.to_os_string();
+        name.push(variant);
+        return Some(name);
     }
-    Some(stem)
+    Some(stem.to_os_string())
+}
+
+/// `stem.extension` without reading `stem` as text.
+fn with_extension(stem: &std::ffi::OsStr, extension: &str) -> std::ffi::OsString {
+    let mut name = stem.to_os_string();
+    name.push(".");
+    name.push(extension);
+    name
 }
 
 fn histogram(args: HistogramArgs) -> Result<()> {

@@ -4,7 +4,7 @@
 //! on a log axis) are left out, and the line has a gap there.
 
 use super::style::Dash;
-use crate::evaluation::compare::{FrameError, relmse_over_seeds, relmse_ratio};
+use crate::evaluation::compare::{FrameError, by_frame, relmse_over_seeds, relmse_ratio};
 use crate::evaluation::metrics::MeanInterval;
 use crate::restir::Method;
 
@@ -48,25 +48,21 @@ pub(super) fn frame_count(errors: &[FrameError]) -> u32 {
     errors.iter().map(|e| e.frame.saturating_add(1)).max().unwrap_or(0)
 }
 
-/// The 0-based frames below `frames` that `errors` hold a row of, in order. Plots walk
-/// these, never 0..frames: the work follows the rows, whatever the frame numbers.
-fn frames_present(errors: &[FrameError], frames: u32) -> std::collections::BTreeSet<u32> {
-    errors.iter().map(|e| e.frame).filter(|&f| f < frames).collect()
-}
-
 /// `method`'s RelMSE over seeds at frames 1..=`frames`; only positive finite means.
+/// Plots walk the frames the rows hold, each over its own rows ([`by_frame`]): the work
+/// follows the rows, whatever the frame numbers.
 pub(super) fn relmse_points(errors: &[FrameError], method: Method, frames: u32) -> Vec<Point> {
-    frames_present(errors, frames)
-        .into_iter()
-        .filter_map(|f| point(f, relmse_over_seeds(errors, method, f)).filter(|p| p.mean > 0.0))
+    by_frame(errors)
+        .range(..frames)
+        .filter_map(|(&f, rows)| point(f, relmse_over_seeds(rows, method, f)).filter(|p| p.mean > 0.0))
         .collect()
 }
 
 /// strata ÷ `baseline`, paired per seed, at frames 1..=`frames`; only finite means.
 pub(super) fn ratio_points(errors: &[FrameError], baseline: Method, frames: u32) -> Vec<Point> {
-    frames_present(errors, frames)
-        .into_iter()
-        .filter_map(|f| point(f, relmse_ratio(errors, Method::Strata, baseline, f)?))
+    by_frame(errors)
+        .range(..frames)
+        .filter_map(|(&f, rows)| point(f, relmse_ratio(rows, Method::Strata, baseline, f)?))
         .collect()
 }
 

@@ -1,0 +1,556 @@
+//! # strata-vk: the stratified selection for engines in C and C++
+//!
+//! The pass of [`strata_embed::AshSelection`] (histogram, stratified selection,
+//! resampling; Salaün et al., SIGGRAPH 2025) behind a C ABI, on the engine's own Vulkan
+//! objects: the engine hands over its `VkInstance`, `VkPhysicalDevice`, `VkDevice` and
+//! `vkGetInstanceProcAddr`, binds its own `VkBuffer`s and records into its own
+//! `VkCommandBuffer`s. Its header, `strata_vk.h`, is generated from this file by
+//! cbindgen (`cargo xtask export`); `strata_frame.h` and `strata.h` of the same package
+//! declare the settings and the buffers' records.
+//!
+//! Every function returns a [`StrataStatus`] and, where the caller passes a
+//! [`StrataError`], fills it with the status and a one-line message naming the argument,
+//! field, buffer or device limit at fault. Nothing unwinds across the boundary: a panic
+//! inside the pass (a bug) is caught and reported as [`StrataStatus::Internal`]. A null
+//! pointer, a handle that is not one of this library's (checked by a tag), or bindings
+//! of another pass are refused with [`StrataStatus::InvalidArgument`].
+
+use ash::vk::{self, Handle};
+use std::ffi::c_char;
+use strata_embed::{AshBindings, AshBufferSlice, AshBuffers, AshDevice, AshResampleBuffers, AshSelection, EmbedError};
+use strata_embed::{SamplerVariant, SelectionSettings};
+
+/// `VkInstance` (from `vulkan.h`).
+pub type VkInstance = vk::Instance;
+/// `VkPhysicalDevice` (from `vulkan.h`).
+pub type VkPhysicalDevice = vk::PhysicalDevice;
+/// `VkDevice` (from `vulkan.h`).
+pub type VkDevice = vk::Device;
+/// `VkBuffer` (from `vulkan.h`).
+pub type VkBuffer = vk::Buffer;
+/// `VkCommandBuffer` (from `vulkan.h`).
+pub type VkCommandBuffer = vk::CommandBuffer;
+/// `PFN_vkGetInstanceProcAddr` (from `vulkan.h`); may be null only to be refused.
+#[allow(non_camel_case_types)]
+pub type PFN_vkGetInstanceProcAddr =
+    Option<unsafe extern "system" fn(instance: vk::Instance, name: *const c_char) -> vk::PFN_vkVoidFunction>;
+
+/// What a call returned.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StrataStatus {
+    /// Done.
+    Ok = 0,
+    /// A null pointer, a handle that is not this library's, bindings of another pass,
+    /// an inconsistent buffer set.
+    InvalidArgument = 1,
+    /// A selection setting out of range (the message names the field).
+    Settings = 2,
+    /// An image of 0 pixels or more than 2^32 - 1.
+    ImageSize = 3,
+    /// An engine buffer too small or bound at an unaligned offset (the message names it).
+    Buffer = 4,
+    /// The device cannot run the pass (a limit, a feature, its Vulkan version).
+    Device = 5,
+    /// A Vulkan call failed (the message names the call and its VkResult).
+    Vulkan = 6,
+    /// A bug of this library: a panic caught at the boundary.
+    Internal = 7,
+}
+
+/// Bytes of [`StrataError::message`], its terminating NUL included.
+pub const STRATA_ERROR_MESSAGE_BYTES: usize = 512;
+
+/// A call's status and, unless it is `STRATA_STATUS_OK`, a one-line NUL-terminated
+/// message (UTF-8, cut at a character boundary to fit).
+#[repr(C)]
+pub struct StrataError {
+    /// The status the call returned.
+    pub status: StrataStatus,
+    /// What went wrong, naming the argument, field, buffer or limit.
+    pub message: [c_char; STRATA_ERROR_MESSAGE_BYTES],
+}
+
+/// The selection's settings: the C twin of `StrataSelectionSettings` in `strata_frame.h`
+/// (declared there, not in `strata_vk.h`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct StrataSelectionSettings {
+    /// B: 4, 8, 16 or 32.
+    pub block_size: u32,
+    /// K: 1 to 4.
+    pub candidates: u32,
+    /// A `StrataSampler` (`strata.h`).
+    pub sampler: u32,
+    /// 1: object masking; 0: none.
+    pub masking: u32,
+    /// 1: block shifting; 0: none.
+    pub block_shift: u32,
+}
+
+/// The engine's Vulkan objects the pass is made on: an instance of `apiVersion` 1.1 or
+/// newer and a device of Vulkan 1.1 or newer with a compute queue; nothing needs enabling
+/// beyond core features.
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub struct StrataVkDevice {
+    /// The loader's (or the instance's) `vkGetInstanceProcAddr`: every other function
+    /// is looked up through it.
+    pub get_instance_proc_addr: PFN_vkGetInstanceProcAddr,
+    /// The instance.
+    pub instance: VkInstance,
+    /// The physical device behind `device`.
+    pub physical_device: VkPhysicalDevice,
+    /// The logical device.
+    pub device: VkDevice,
+    /// 1 if the engine enabled `shaderZeroInitializeWorkgroupMemory` on `device` (the
+    /// driver then zeroes workgroup memory; pipelines build faster on some drivers); 0 is
+    /// always correct.
+    pub shader_zero_initialize_workgroup_memory: u32,
+}
+
+/// A range of an engine buffer (created with `VK_BUFFER_USAGE_STORAGE_BUFFER_BIT`):
+/// records start at `offset`, a multiple of `minStorageBufferOffsetAlignment`, and `size`
+/// bytes from it may be used.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct StrataVkBufferSlice {
+    /// The buffer; `VK_NULL_HANDLE` where a buffer is optional and not given.
+    pub buffer: VkBuffer,
+    /// Byte offset of the first record.
+    pub offset: u64,
+    /// Bytes from `offset`.
+    pub size: u64,
+}
+
+/// The engine's buffers (the contract of `strata.h`: one record per pixel, row-major).
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct StrataVkBuffers {
+    /// `StrataCandidate` per pixel, written by the engine before the selection.
+    pub candidates: StrataVkBufferSlice,
+    /// `uint32_t` payload per pixel, or `VK_NULL_HANDLE`: a pixel's payload is its index.
+    pub payloads: StrataVkBufferSlice,
+    /// `StrataSelectedCandidates` per pixel, written by the pass.
+    pub selections: StrataVkBufferSlice,
+    /// `StrataResampleInput` per pixel, written by the engine after the selection; or
+    /// `VK_NULL_HANDLE` (with `resampled`) when the engine resamples on its own.
+    pub resample_inputs: StrataVkBufferSlice,
+    /// `StrataResampleOutput` per pixel, written by the pass's resampling; or
+    /// `VK_NULL_HANDLE` with `resample_inputs`.
+    pub resampled: StrataVkBufferSlice,
+}
+
+/// Tags of the two handle kinds, checked on every call.
+const PASS_TAG: u64 = 0x5354_5241_5441_5041; // "STRATAPA"
+const BINDINGS_TAG: u64 = 0x5354_5241_5441_4249; // "STRATABI"
+
+/// A pass made by [`strata_vk_create`] (opaque to C).
+pub struct StrataVkPass {
+    tag: u64,
+    // Kept for the pass's lifetime: the device's functions were loaded through it.
+    _instance: ash::Instance,
+    selection: AshSelection,
+}
+
+/// Descriptor sets of one set of engine buffers, made by [`strata_vk_bind`] (opaque).
+pub struct StrataVkBindings {
+    tag: u64,
+    owner: *const StrataVkPass,
+    bindings: AshBindings,
+}
+
+/// Why a call failed.
+struct Failure {
+    status: StrataStatus,
+    message: String,
+}
+
+fn invalid(message: impl Into<String>) -> Failure {
+    Failure { status: StrataStatus::InvalidArgument, message: message.into() }
+}
+
+impl From<EmbedError> for Failure {
+    fn from(error: EmbedError) -> Self {
+        let status = match &error {
+            EmbedError::Setting(_) => StrataStatus::Settings,
+            EmbedError::ImageSize { .. } => StrataStatus::ImageSize,
+            EmbedError::BufferTooSmall { .. } | EmbedError::BufferOffset { .. } | EmbedError::BufferUsage { .. } => {
+                StrataStatus::Buffer
+            }
+            EmbedError::DeviceLimit { .. } | EmbedError::UnsupportedFeature { .. } => StrataStatus::Device,
+            EmbedError::NoResampleBuffers => StrataStatus::InvalidArgument,
+            EmbedError::Api { .. } => StrataStatus::Vulkan,
+            _ => StrataStatus::Internal,
+        };
+        Failure { status, message: error.to_string() }
+    }
+}
+
+/// Writes `status` and `message` into `error` (if not null).
+///
+/// # Safety
+/// `error` is null or points to a writable `StrataError`.
+unsafe fn report(error: *mut StrataError, status: StrataStatus, message: &str) {
+    // SAFETY: per this function's contract.
+    let Some(error) = (unsafe { error.as_mut() }) else { return };
+    error.status = status;
+    let mut end = message.len().min(STRATA_ERROR_MESSAGE_BYTES - 1);
+    while !message.is_char_boundary(end) {
+        end -= 1;
+    }
+    for (slot, &byte) in error.message.iter_mut().zip(&message.as_bytes()[..end]) {
+        *slot = byte as c_char;
+    }
+    error.message[end] = 0;
+}
+
+/// Runs `call`, catching panics, and reports its outcome through `error`.
+///
+/// # Safety
+/// `error` is null or points to a writable `StrataError`.
+unsafe fn guarded(error: *mut StrataError, call: impl FnOnce() -> Result<(), Failure>) -> StrataStatus {
+    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(call)).unwrap_or_else(|payload| {
+        let what = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown panic".into());
+        Err(Failure { status: StrataStatus::Internal, message: format!("internal error (a bug of strata-vk): {what}") })
+    });
+    let (status, message) = match outcome {
+        Ok(()) => (StrataStatus::Ok, String::new()),
+        Err(failure) => (failure.status, failure.message),
+    };
+    // SAFETY: per this function's contract.
+    unsafe { report(error, status, &message) };
+    status
+}
+
+/// The pass behind `pass`, if it is one of ours.
+///
+/// # Safety
+/// `pass` is null or points to memory that may be read as a `StrataVkPass`'s tag.
+unsafe fn pass_of<'a>(pass: *mut StrataVkPass, argument: &str) -> Result<&'a mut StrataVkPass, Failure> {
+    // SAFETY: per this function's contract; the tag is checked before anything else is used.
+    match unsafe { pass.as_mut() } {
+        None => Err(invalid(format!("{argument} is NULL"))),
+        Some(pass) if pass.tag != PASS_TAG => {
+            Err(invalid(format!("{argument} is not a pass made by strata_vk_create")))
+        }
+        Some(pass) => Ok(pass),
+    }
+}
+
+/// The bindings behind `bindings`, if they are ours and belong to `pass`.
+///
+/// # Safety
+/// As [`pass_of`], for `StrataVkBindings`.
+unsafe fn bindings_of<'a>(
+    bindings: *const StrataVkBindings,
+    pass: *const StrataVkPass,
+) -> Result<&'a StrataVkBindings, Failure> {
+    // SAFETY: per this function's contract.
+    match unsafe { bindings.as_ref() } {
+        None => Err(invalid("bindings is NULL")),
+        Some(b) if b.tag != BINDINGS_TAG => Err(invalid("bindings is not made by strata_vk_bind")),
+        Some(b) if b.owner != pass => Err(invalid("bindings were made by another pass")),
+        Some(b) => Ok(b),
+    }
+}
+
+fn settings_of(settings: &StrataSelectionSettings) -> Result<SelectionSettings, Failure> {
+    let flag = |name: &str, value: u32| match value {
+        0 => Ok(false),
+        1 => Ok(true),
+        _ => Err(Failure { status: StrataStatus::Settings, message: format!("{name} = {value}: must be 0 or 1") }),
+    };
+    let sampler = SamplerVariant::from_id(settings.sampler).ok_or_else(|| Failure {
+        status: StrataStatus::Settings,
+        message: format!("sampler = {}: must be a StrataSampler (0 to 4)", settings.sampler),
+    })?;
+    let settings = SelectionSettings {
+        block_size: settings.block_size,
+        candidates: settings.candidates,
+        masking: flag("masking", settings.masking)?,
+        block_shift: flag("block_shift", settings.block_shift)?,
+        sampler,
+    };
+    settings.validate().map_err(|e| Failure { status: StrataStatus::Settings, message: e.to_string() })?;
+    Ok(settings)
+}
+
+/// Makes the pass for a `width` × `height` image on the engine's device: its pipelines
+/// (naga's SPIR-V of the kernels; the histogram kernel chosen for the device) and its own
+/// buffers (about 1.3 MiB + 16 bytes per pixel). On success `*pass` holds it; destroy it
+/// with [`strata_vk_destroy`].
+///
+/// # Safety
+/// `device`, `settings` and `pass` are null (refused) or valid; `device` holds valid
+/// handles of a live instance and device; `error` is null or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn strata_vk_create(
+    device: *const StrataVkDevice,
+    settings: *const StrataSelectionSettings,
+    width: u32,
+    height: u32,
+    pass: *mut *mut StrataVkPass,
+    error: *mut StrataError,
+) -> StrataStatus {
+    // SAFETY: per this function's contract.
+    unsafe {
+        guarded(error, || {
+            let out = pass.as_mut().ok_or_else(|| invalid("pass (the result pointer) is NULL"))?;
+            *out = std::ptr::null_mut();
+            let device = device.as_ref().ok_or_else(|| invalid("device is NULL"))?;
+            let settings = settings_of(settings.as_ref().ok_or_else(|| invalid("settings is NULL"))?)?;
+            let get_instance_proc_addr =
+                device.get_instance_proc_addr.ok_or_else(|| invalid("device->get_instance_proc_addr is NULL"))?;
+            for (name, null) in [
+                ("device->instance", device.instance.is_null()),
+                ("device->physical_device", device.physical_device.is_null()),
+                ("device->device", device.device.is_null()),
+            ] {
+                if null {
+                    return Err(invalid(format!("{name} is VK_NULL_HANDLE")));
+                }
+            }
+            let zero_init = match device.shader_zero_initialize_workgroup_memory {
+                0 => false,
+                1 => true,
+                other => {
+                    return Err(invalid(format!(
+                        "device->shader_zero_initialize_workgroup_memory = {other}: must be 0 or 1"
+                    )));
+                }
+            };
+            let static_fn = ash::StaticFn { get_instance_proc_addr };
+            let instance = ash::Instance::load(&static_fn, device.instance);
+            let logical = ash::Device::load(instance.fp_v1_0(), device.device);
+            let vulkan = AshDevice {
+                instance: &instance,
+                physical_device: device.physical_device,
+                device: &logical,
+                shader_zero_initialize_workgroup_memory: zero_init,
+            };
+            let selection = AshSelection::new(vulkan, settings, width, height)?;
+            *out = Box::into_raw(Box::new(StrataVkPass { tag: PASS_TAG, _instance: instance, selection }));
+            Ok(())
+        })
+    }
+}
+
+/// Starts an independent render: the frames recorded from now on belong to `seed`
+/// (0 until the first call).
+///
+/// # Safety
+/// `pass` is null (refused) or a pass of this library; `error` is null or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn strata_vk_set_seed(
+    pass: *mut StrataVkPass,
+    seed: u32,
+    error: *mut StrataError,
+) -> StrataStatus {
+    // SAFETY: per this function's contract.
+    unsafe {
+        guarded(error, || {
+            pass_of(pass, "pass")?.selection.set_seed(seed);
+            Ok(())
+        })
+    }
+}
+
+/// The engine's buffer slice, checked where it is required.
+fn slice(slice: &StrataVkBufferSlice, name: &str, required: bool) -> Result<Option<AshBufferSlice>, Failure> {
+    if slice.buffer.is_null() {
+        return if required { Err(invalid(format!("buffers->{name}.buffer is VK_NULL_HANDLE"))) } else { Ok(None) };
+    }
+    Ok(Some(AshBufferSlice { buffer: slice.buffer, offset: slice.offset, size: slice.size }))
+}
+
+/// Checks the engine's buffers against the contract (sizes for the pass's image, offset
+/// alignment) and writes their descriptor sets; on success `*bindings` holds them, to be
+/// freed by [`strata_vk_destroy_bindings`].
+///
+/// # Safety
+/// `pass` is a pass of this library; `buffers` and `bindings` are null (refused) or
+/// valid; the buffers stay alive while the bindings are used; `error` is null or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn strata_vk_bind(
+    pass: *mut StrataVkPass,
+    buffers: *const StrataVkBuffers,
+    bindings: *mut *mut StrataVkBindings,
+    error: *mut StrataError,
+) -> StrataStatus {
+    // SAFETY: per this function's contract.
+    unsafe {
+        guarded(error, || {
+            let out = bindings.as_mut().ok_or_else(|| invalid("bindings (the result pointer) is NULL"))?;
+            *out = std::ptr::null_mut();
+            let owner = pass_of(pass, "pass")?;
+            let buffers = buffers.as_ref().ok_or_else(|| invalid("buffers is NULL"))?;
+            let resample = match (
+                slice(&buffers.resample_inputs, "resample_inputs", false)?,
+                slice(&buffers.resampled, "resampled", false)?,
+            ) {
+                (Some(inputs), Some(outputs)) => Some(AshResampleBuffers { inputs, outputs }),
+                (None, None) => None,
+                _ => {
+                    return Err(invalid(
+                        "buffers->resample_inputs and buffers->resampled: give both (the pass resamples) or neither",
+                    ));
+                }
+            };
+            let ash_buffers = AshBuffers {
+                candidates: slice(&buffers.candidates, "candidates", true)?.expect("required"),
+                payloads: slice(&buffers.payloads, "payloads", false)?,
+                selections: slice(&buffers.selections, "selections", true)?.expect("required"),
+                resample,
+            };
+            let made = owner.selection.bind(&ash_buffers)?;
+            *out = Box::into_raw(Box::new(StrataVkBindings { tag: BINDINGS_TAG, owner: pass, bindings: made }));
+            Ok(())
+        })
+    }
+}
+
+/// Records frame `frame`'s uniform updates, histogram and selection into the engine's
+/// command buffer, with the barriers the pass needs (from the engine's earlier shader and
+/// transfer writes, between its dispatches, and to the engine's later reads).
+///
+/// # Safety
+/// `command_buffer` is recording, outside a render pass, on a queue with compute, of the
+/// pass's device; `bindings` come from this pass; `error` is null or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn strata_vk_record_selection(
+    pass: *mut StrataVkPass,
+    bindings: *const StrataVkBindings,
+    command_buffer: VkCommandBuffer,
+    frame: u32,
+    error: *mut StrataError,
+) -> StrataStatus {
+    // SAFETY: per this function's contract.
+    unsafe {
+        guarded(error, || {
+            let owner = pass_of(pass, "pass")?;
+            let bindings = bindings_of(bindings, pass)?;
+            if command_buffer.is_null() {
+                return Err(invalid("command_buffer is NULL"));
+            }
+            owner.selection.record_selection(command_buffer, &bindings.bindings, frame)?;
+            Ok(())
+        })
+    }
+}
+
+/// Records the resampling of the engine's `resample_inputs` (after the selection, in the
+/// same or an earlier submission).
+///
+/// # Safety
+/// As [`strata_vk_record_selection`].
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn strata_vk_record_resampling(
+    pass: *mut StrataVkPass,
+    bindings: *const StrataVkBindings,
+    command_buffer: VkCommandBuffer,
+    error: *mut StrataError,
+) -> StrataStatus {
+    // SAFETY: per this function's contract.
+    unsafe {
+        guarded(error, || {
+            let owner = pass_of(pass, "pass")?;
+            let bindings = bindings_of(bindings, pass)?;
+            if command_buffer.is_null() {
+                return Err(invalid("command_buffer is NULL"));
+            }
+            owner.selection.record_resampling(command_buffer, &bindings.bindings)?;
+            Ok(())
+        })
+    }
+}
+
+/// Frees the descriptor sets of `bindings` (null: nothing). Their tag is cleared, so a
+/// second call with the same pointer is refused rather than freeing twice only while the
+/// memory is not reused.
+///
+/// # Safety
+/// No pending command buffer uses them; `bindings` come from `pass`; `error` is null or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn strata_vk_destroy_bindings(
+    pass: *mut StrataVkPass,
+    bindings: *mut StrataVkBindings,
+    error: *mut StrataError,
+) -> StrataStatus {
+    // SAFETY: per this function's contract.
+    unsafe {
+        guarded(error, || {
+            if bindings.is_null() {
+                return Ok(());
+            }
+            let owner = pass_of(pass, "pass")?;
+            bindings_of(bindings, pass)?;
+            (*bindings).tag = 0;
+            let boxed = Box::from_raw(bindings);
+            owner.selection.destroy_bindings(boxed.bindings);
+            Ok(())
+        })
+    }
+}
+
+/// Destroys the pass's pipelines and buffers (null: nothing).
+///
+/// # Safety
+/// No pending command buffer uses the pass; its bindings were destroyed first; `error`
+/// is null or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn strata_vk_destroy(pass: *mut StrataVkPass, error: *mut StrataError) -> StrataStatus {
+    // SAFETY: per this function's contract.
+    unsafe {
+        guarded(error, || {
+            if pass.is_null() {
+                return Ok(());
+            }
+            pass_of(pass, "pass")?;
+            (*pass).tag = 0;
+            let boxed = Box::from_raw(pass);
+            boxed.selection.destroy();
+            Ok(())
+        })
+    }
+}
+
+/// The library's version, `MAJOR.MINOR.PATCH` (static, NUL-terminated).
+#[unsafe(no_mangle)]
+pub extern "C" fn strata_vk_version() -> *const c_char {
+    concat!(env!("CARGO_PKG_VERSION"), "\0").as_ptr().cast()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn messages_are_cut_at_a_character_boundary_and_terminated() {
+        let mut error = StrataError { status: StrataStatus::Ok, message: [1; STRATA_ERROR_MESSAGE_BYTES] };
+        let long = "é".repeat(STRATA_ERROR_MESSAGE_BYTES);
+        // SAFETY: a valid, writable error.
+        unsafe { report(&mut error, StrataStatus::Buffer, &long) };
+        let end = error.message.iter().position(|&c| c == 0).expect("terminated");
+        let bytes: Vec<u8> = error.message[..end].iter().map(|&c| c as u8).collect();
+        let text = String::from_utf8(bytes).expect("whole characters");
+        assert!(end < STRATA_ERROR_MESSAGE_BYTES && text.chars().all(|c| c == 'é') && text.len() == end);
+        assert_eq!(error.status, StrataStatus::Buffer);
+    }
+
+    #[test]
+    fn a_panic_inside_a_call_is_a_status_not_an_unwind() {
+        let mut error = StrataError { status: StrataStatus::Ok, message: [0; STRATA_ERROR_MESSAGE_BYTES] };
+        // SAFETY: a valid, writable error.
+        let status = unsafe { guarded(&mut error, || panic!("a bug")) };
+        assert_eq!(status, StrataStatus::Internal);
+        let end = error.message.iter().position(|&c| c == 0).unwrap();
+        let text: String = error.message[..end].iter().map(|&c| c as u8 as char).collect();
+        assert!(text.contains("a bug"), "{text}");
+    }
+}

@@ -1,0 +1,230 @@
+//! `strata.h`: the C11 declarations of the pass's records and constants, generated from
+//! the same Rust twins that strata's layout and constant tests check against naga's
+//! reflection of the WGSL (`strata_kernels::layout::ShaderStruct`,
+//! `strata_kernels::constants::SHARED`): each struct's fields in the twin's order with
+//! the C type of the WGSL member's type, a `_Static_assert` on the struct's size and on
+//! every field's offset (the twin's), the constants as `STRATA_` macros, the sampler
+//! variants as an enum, and the kernels' workgroup sizes. The doc comments are the Rust
+//! twins' own, read from their source.
+
+use crate::ExportError;
+use strata_kernels::constants::ConstantValue;
+use strata_kernels::layout::ShaderStruct;
+use strata_kernels::selection::SamplerVariant;
+
+/// The Rust sources of the twins, whose `///` comments become the header's comments.
+const TWIN_SOURCES: [&str; 2] =
+    [include_str!("../../kernels/src/types.rs"), include_str!("../../kernels/src/embed_types.rs")];
+
+/// The doc comment above the item whose line (trimmed) starts with `start` in the twins'
+/// sources: `pub struct Name ` for a struct, `pub field:` after that struct's line for a
+/// field.
+fn doc_above(start: &str, after: Option<&str>) -> Option<String> {
+    for source in TWIN_SOURCES {
+        let lines: Vec<&str> = source.lines().collect();
+        let from = match after {
+            Some(anchor) => match lines.iter().position(|l| l.trim_start().starts_with(anchor)) {
+                Some(line) => line,
+                None => continue,
+            },
+            None => 0,
+        };
+        let Some(at) = lines[from..].iter().position(|l| l.trim_start().starts_with(start)).map(|i| i + from) else {
+            continue;
+        };
+        let mut doc: Vec<&str> = Vec::new();
+        for line in lines[..at].iter().rev() {
+            let line = line.trim_start();
+            if let Some(text) = line.strip_prefix("///") {
+                doc.push(text.strip_prefix(' ').unwrap_or(text));
+            } else if line.starts_with("#[") {
+                continue;
+            } else {
+                break;
+            }
+        }
+        doc.reverse();
+        return (!doc.is_empty()).then(|| doc.join(" "));
+    }
+    None
+}
+
+/// WGSL constants whose names need their context in C (and whose Rust twins carry it).
+const RENAMED: [(&str, &str); 1] = [("SLOTS", "HISTOGRAM_SLOTS_PER_WORKGROUP")];
+
+/// The Rust twin's name of the WGSL constant `name`.
+fn rust_name(name: &str) -> &str {
+    RENAMED.iter().find(|(wgsl, _)| *wgsl == name).map_or(name, |(_, rust)| rust)
+}
+
+/// The C macro of the WGSL constant `name`: `STRATA_` and its Rust twin's name.
+pub fn c_name(name: &str) -> String {
+    format!("STRATA_{}", rust_name(name))
+}
+
+/// `text` as a C comment indented by `indent`, wrapped at about 96 columns.
+fn comment(text: &str, indent: &str) -> String {
+    let mut lines = vec![String::new()];
+    for word in text.split_whitespace() {
+        let word = word.replace("*/", "* /").replace('`', "").replace("[", "").replace("]", "");
+        let line = lines.last_mut().expect("one line");
+        if !line.is_empty() && line.len() + word.len() > 88 {
+            lines.push(word);
+        } else {
+            if !line.is_empty() {
+                line.push(' ');
+            }
+            line.push_str(&word);
+        }
+    }
+    match lines.as_slice() {
+        [one] if one.len() < 86 => format!("{indent}/* {one} */\n"),
+        _ => {
+            let body: String = lines.iter().map(|l| format!("{indent} * {l}\n")).collect();
+            format!("{indent}/*\n{body}{indent} */\n")
+        }
+    }
+}
+
+/// The C declarator of a field named `name` of WGSL type `wgsl` (`u32`, `f32`, `i32`,
+/// `array<u32, 4>`, `vec3<f32>`).
+fn c_declarator(wgsl: &str, name: &str) -> Result<String, ExportError> {
+    let scalar = |t: &str| match t.trim() {
+        "u32" => Some("uint32_t"),
+        "i32" => Some("int32_t"),
+        "f32" => Some("float"),
+        _ => None,
+    };
+    if let Some(c) = scalar(wgsl) {
+        return Ok(format!("{c} {name}"));
+    }
+    let inner = |prefix: &str| wgsl.strip_prefix(prefix).and_then(|rest| rest.strip_suffix('>'));
+    if let Some(args) = inner("array<")
+        && let Some((element, count)) = args.rsplit_once(',')
+        && let (Some(c), Ok(count)) = (scalar(element), count.trim().parse::<u32>())
+    {
+        return Ok(format!("{c} {name}[{count}]"));
+    }
+    for (prefix, count) in [("vec2<", 2), ("vec3<", 3), ("vec4<", 4)] {
+        if let Some(c) = inner(prefix).and_then(scalar) {
+            return Ok(format!("{c} {name}[{count}]"));
+        }
+    }
+    Err(ExportError::Header(format!("field `{name}`: no C type for WGSL `{wgsl}`")))
+}
+
+/// A struct of the header with its layout.
+pub struct HeaderStruct {
+    /// The manifest's entry (name, size, fields with offsets and WGSL types).
+    pub entry: crate::manifest::StructEntry,
+}
+
+impl HeaderStruct {
+    /// The struct `T` with its WGSL types from `kernel`.
+    pub fn of<T: ShaderStruct>(kernel: &strata_kernels::Kernel) -> HeaderStruct {
+        HeaderStruct { entry: crate::manifest::struct_entry::<T>(kernel) }
+    }
+}
+
+/// The header's text.
+pub fn header(
+    structs: &[HeaderStruct],
+    constants: &[(String, ConstantValue)],
+    workgroup_sizes: &[(String, [u32; 3])],
+    version: &str,
+) -> Result<String, ExportError> {
+    let mut h = String::new();
+    h += &format!(
+        "/*\n * strata.h: the records and constants of strata {version}'s stratified selection pass (Salaün et al.,\n \
+         * SIGGRAPH 2025) for C11 and C++.\n *\n * Generated by `cargo xtask export` from the Rust twins of the kernels' WGSL \
+         structs (checked\n * against naga's layout by strata's tests); do not edit. Each struct's layout is the WGSL's\n \
+         * (std430 / std140-compatible: 4-byte fields, no implicit padding); the _Static_asserts below fail\n \
+         * the build where a compiler lays one out otherwise. manifest.json says which buffer holds which.\n */\n"
+    );
+    h += "#ifndef STRATA_H\n#define STRATA_H\n\n#include <stddef.h>\n#include <stdint.h>\n\n";
+    h += "/* C11's _Static_assert, C++'s static_assert. */\n#ifdef __cplusplus\n#define STRATA_STATIC_ASSERT \
+          static_assert\n#else\n#define STRATA_STATIC_ASSERT _Static_assert\n#endif\n\n";
+    h += "#ifdef __cplusplus\nextern \"C\" {\n#endif\n\n";
+    h += "/* Constants the kernels and the host share (WGSL names with STRATA_ in front). */\n";
+    for (name, value) in constants {
+        // The sampler ids are the enum below.
+        if name.starts_with("SAMPLER_") {
+            continue;
+        }
+        let doc = doc_above(&format!("pub const {}:", rust_name(name)), None);
+        let text = match *value {
+            ConstantValue::U32(v) => format!("{v}u"),
+            ConstantValue::F32(v) => format!("{v:?}f"),
+        };
+        if let Some(doc) = doc {
+            h += &comment(&doc, "");
+        }
+        h += &format!("#define {} {text}\n", c_name(name));
+    }
+    h += "\n/* Workgroup sizes (x, y, z) of the kernels, from naga's reflection. */\n";
+    for (kernel, size) in workgroup_sizes {
+        let upper = kernel.strip_prefix("strata_").unwrap_or(kernel).to_uppercase();
+        for (axis, value) in ["X", "Y", "Z"].iter().zip(size) {
+            h += &format!("#define STRATA_{upper}_WORKGROUP_SIZE_{axis} {value}u\n");
+        }
+    }
+    h += "\n/* The sampler variants (StrataSelectionParams.sampler; paper Table 2). */\ntypedef enum StrataSampler {\n";
+    for variant in SamplerVariant::ALL {
+        let name = variant.name().to_uppercase().replace('-', "_");
+        h += &format!("    STRATA_SAMPLER_{name} = {},\n", variant.id());
+    }
+    h += "} StrataSampler;\n\n";
+    for s in structs {
+        let entry = &s.entry;
+        if let Some(doc) = doc_above(&format!("pub struct {} ", entry.name), None) {
+            h += &comment(&doc, "");
+        }
+        h += &format!("typedef struct Strata{} {{\n", entry.name);
+        for field in &entry.fields {
+            if let Some(doc) = doc_above(&format!("pub {}:", field.name), Some(&format!("pub struct {} ", entry.name)))
+            {
+                h += &comment(&doc, "    ");
+            }
+            h += &format!("    {};\n", c_declarator(&field.wgsl_type, field.name)?);
+        }
+        h += &format!("}} Strata{};\n\n", entry.name);
+    }
+    h += "/* The layouts, as the Rust twins and naga have them. */\n";
+    for s in structs {
+        let e = &s.entry;
+        h += &format!(
+            "STRATA_STATIC_ASSERT(sizeof(Strata{0}) == {1}, \"Strata{0} must be {1} bytes\");\n",
+            e.name, e.size
+        );
+        for field in &e.fields {
+            h += &format!(
+                "STRATA_STATIC_ASSERT(offsetof(Strata{0}, {1}) == {2}, \"Strata{0}.{1} must lie at byte {2}\");\n",
+                e.name, field.name, field.offset
+            );
+        }
+    }
+    h += "\n#ifdef __cplusplus\n}\n#endif\n\n#endif /* STRATA_H */\n";
+    Ok(h)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn twins_docs_are_found_for_structs_and_fields() {
+        assert!(doc_above("pub struct Candidate ", None).is_some_and(|d| !d.is_empty()));
+        assert!(doc_above("pub key:", Some("pub struct Candidate ")).is_some());
+        // In the second source file too.
+        assert!(doc_above("pub run_length:", Some("pub struct SelectedCandidates ")).is_some());
+        assert!(doc_above("pub const OBJECT_ID_NONE:", None).is_some());
+    }
+
+    #[test]
+    fn wgsl_types_become_c_declarators() {
+        assert_eq!(c_declarator("u32", "width").unwrap(), "uint32_t width");
+        assert_eq!(c_declarator("array<u32, 4>", "payloads").unwrap(), "uint32_t payloads[4]");
+        assert_eq!(c_declarator("vec3<f32>", "origin").unwrap(), "float origin[3]");
+        assert!(c_declarator("mat4x4<f32>", "m").is_err());
+    }
+}

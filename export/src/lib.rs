@@ -1,0 +1,272 @@
+//! # strata-export: the kernel package for engines outside Rust
+//!
+//! [`export`] writes a self-contained, versioned folder with everything an engine in C,
+//! C++ or any language needs to run strata's stratified selection pass (Salaün et al.,
+//! SIGGRAPH 2025) on its own GPU API, without Rust:
+//!
+//! | path | what |
+//! |---|---|
+//! | `README.md` | per API (Vulkan, D3D12, Metal) how to bind, record and synchronise; what the engine writes when; what is tested where |
+//! | `manifest.json` | per kernel: entry points, workgroup size, features, per binding its set/binding, HLSL register and space, MSL buffer index, element type and stride; the buffers' size rules and writers; the structs' layouts; the constants; the dispatch formulas ([`manifest`]) |
+//! | `include/strata.h` | the records and constants as C11, generated from the Rust twins, with `_Static_assert` on every size and offset ([`c_header`]) |
+//! | `include/strata_frame.h` | the per-frame uniforms and dispatch sizes in plain C, as `strata-embed` computes them |
+//! | `include/strata_vk.h` | the C ABI of the `strata-vk` library (cbindgen, [`abi_header`]) |
+//! | `kernels/{spirv,hlsl,msl,glsl,wgsl}/` | every kernel in every language ([`translations`]) |
+//! | `data/blue_noise.bin` | the blue-noise tables, uploaded once |
+//!
+//! `cargo xtask export --out DIR` runs it. The folder is written next to `DIR` first and
+//! moved into place whole; an existing `DIR` is replaced only if it is an earlier package.
+
+pub mod abi_header;
+pub mod c_header;
+pub mod manifest;
+pub mod translations;
+
+use std::path::{Path, PathBuf};
+use strata_embed::wgsl::ModuleId;
+use strata_embed::{PassBuffer, Stage};
+use strata_kernels::constants::{ConstantValue, SHARED, module_constants};
+use strata_kernels::embed_types::{ResampleInput, ResampleOutput, SelectedCandidates, SelectionParams};
+use strata_kernels::selection::SamplerVariant;
+use strata_kernels::types::{BlockStats, Candidate, ClusterSpan, HistogramParams};
+use strata_kernels::{KernelId, Registry};
+
+/// Why the package could not be written; each message is one line naming what is wrong.
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    /// The output folder cannot be used.
+    #[error("--out {path}: {why}")]
+    Out {
+        /// The folder.
+        path: String,
+        /// What is wrong with it.
+        why: String,
+    },
+    /// A file could not be written.
+    #[error("{path}: cannot write: {source}")]
+    Write {
+        /// The file.
+        path: String,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// A kernel could not be translated (a bug: the message names kernel and language).
+    #[error("translation: {0}")]
+    Translation(String),
+    /// A header could not be generated.
+    #[error("header: {0}")]
+    Header(String),
+    /// A kernel failed to load.
+    #[error(transparent)]
+    Kernel(#[from] strata_kernels::KernelError),
+}
+
+/// The file that marks a folder as a package (and holds its manifest).
+pub const MANIFEST: &str = "manifest.json";
+
+/// What [`export`] wrote.
+#[derive(Debug)]
+pub struct Exported {
+    /// The package's folder.
+    pub folder: PathBuf,
+    /// Its files, relative to it.
+    pub files: Vec<String>,
+}
+
+/// The kernels the package carries, in run order (the three histogram variants first).
+pub const MODULES: [ModuleId; 5] = ModuleId::ALL;
+
+/// The structs the package declares, each with a kernel whose IR has it.
+fn structs(registry: &Registry) -> Vec<c_header::HeaderStruct> {
+    use c_header::HeaderStruct;
+    let histogram = registry.get(KernelId::BlockHistogram);
+    let select = registry.get(KernelId::StrataSelect);
+    let resample = registry.get(KernelId::StrataResample);
+    vec![
+        HeaderStruct::of::<Candidate>(histogram),
+        HeaderStruct::of::<ClusterSpan>(histogram),
+        HeaderStruct::of::<BlockStats>(histogram),
+        HeaderStruct::of::<HistogramParams>(histogram),
+        HeaderStruct::of::<SelectionParams>(select),
+        HeaderStruct::of::<SelectedCandidates>(select),
+        HeaderStruct::of::<ResampleInput>(resample),
+        HeaderStruct::of::<ResampleOutput>(resample),
+    ]
+}
+
+/// The shared constants the exported kernels use (names from naga's IR, values checked
+/// against [`SHARED`] by strata's constant test), in [`SHARED`]'s order.
+fn constants(registry: &Registry) -> Vec<(String, ConstantValue)> {
+    let used: Vec<String> = MODULES
+        .iter()
+        .flat_map(|&id| module_constants(&registry.get(id.kernel()).module))
+        .map(|(name, _)| name)
+        .collect();
+    SHARED.iter().filter(|(name, _)| used.iter().any(|u| u == name)).map(|&(n, v)| (n.to_string(), v)).collect()
+}
+
+/// Writes the package into `out` (module documentation).
+pub fn export(out: &Path) -> Result<Exported, ExportError> {
+    let out_error = |why: String| ExportError::Out { path: out.display().to_string(), why };
+    check_out(out).map_err(out_error)?;
+    let registry = Registry::shared()?;
+    let version = env!("CARGO_PKG_VERSION");
+    let mut files: Vec<(String, Vec<u8>)> = Vec::new();
+    let mut kernels = Vec::new();
+    let mut workgroup_sizes = Vec::new();
+    for module in MODULES {
+        let kernel = registry.get(module.kernel());
+        let translated = translations::translate(kernel)?;
+        let entry = manifest::kernel_entry(module, kernel, &translated);
+        files.push((entry.files.spirv.clone(), bytemuck::cast_slice(&translated.spirv).to_vec()));
+        files.push((entry.files.hlsl.clone(), translated.hlsl.text.clone().into_bytes()));
+        files.push((entry.files.msl.clone(), translated.msl.text.clone().into_bytes()));
+        files.push((entry.files.glsl.clone(), translated.glsl.clone().into_bytes()));
+        files.push((entry.files.wgsl.clone(), translated.wgsl.clone().into_bytes()));
+        workgroup_sizes.push((kernel.name().to_string(), kernel.workgroup_size));
+        kernels.push(entry);
+    }
+    let structs = structs(registry);
+    let constants = constants(registry);
+    let packed = strata_kernels::blue_noise::BlueNoiseTables::new().packed();
+    let blue_noise: Vec<u8> = packed.iter().flat_map(|w| w.to_le_bytes()).collect();
+    let manifest = manifest::Manifest {
+        schema_version: manifest::SCHEMA_VERSION,
+        strata_version: version.to_string(),
+        description: "strata's stratified selection pass (Salaün et al., SIGGRAPH 2025, §4): per B x B block a histogram \
+                      of the engine's candidates by object and luminance, then K stratified candidates per pixel and an \
+                      optional resampling"
+            .into(),
+        buffers: PassBuffer::ALL.iter().map(|&b| manifest::buffer_entry(b)).collect(),
+        structs: structs.iter().map(|s| manifest_struct(&s.entry)).collect(),
+        constants: constants
+            .iter()
+            .map(|(name, value)| manifest::ConstantEntry {
+                name: name.clone(),
+                c_name: if name.starts_with("SAMPLER_") {
+                    name.replacen("SAMPLER_", "STRATA_SAMPLER_", 1)
+                } else {
+                    c_header::c_name(name)
+                },
+                wgsl_type: match value {
+                    ConstantValue::U32(_) => "u32",
+                    ConstantValue::F32(_) => "f32",
+                },
+                value: match *value {
+                    ConstantValue::U32(v) => v.into(),
+                    ConstantValue::F32(v) => serde_json::Number::from_f64(f64::from(v)).map_or(0.into(), Into::into),
+                },
+            })
+            .collect(),
+        samplers: SamplerVariant::ALL.iter().map(|v| manifest::SamplerEntry { name: v.name(), id: v.id() }).collect(),
+        blue_noise: manifest::BlueNoiseEntry {
+            file: "data/blue_noise.bin".into(),
+            bytes: blue_noise.len() as u64,
+            sobol_offset: strata_kernels::blue_noise::PACKED_SOBOL,
+            scrambling_offset: strata_kernels::blue_noise::PACKED_SCRAMBLING,
+            ranking_offset: strata_kernels::blue_noise::PACKED_RANKING,
+            origin: "Heitz et al. 2019, 'A Low-Discrepancy Sampler that Distributes Monte Carlo Errors as a Blue Noise \
+                     in Screen Space', 256-spp tables (crate blue-noise-sampler, MIT)"
+                .into(),
+        },
+        frame: manifest::FrameEntry {
+            sequence: vec![
+                "the engine writes candidates (and payloads) for the frame".into(),
+                "update histogram_params and selection_params (strata_frame_params)".into(),
+                "barrier: transfer and shader writes -> uniform and storage reads of compute".into(),
+                "dispatch one histogram kernel (histogram_workgroups)".into(),
+                "barrier: compute writes -> compute reads".into(),
+                "dispatch strata_select (pixel_workgroups)".into(),
+                "barrier: compute writes -> the engine's reads of selections".into(),
+                "optional: the engine writes resample_inputs; barrier; dispatch strata_resample (pixel_workgroups); \
+                 barrier before the engine reads resampled"
+                    .into(),
+            ],
+            functions: "include/strata_frame.h: strata_frame_params, strata_max_blocks, strata_grid_shift".into(),
+        },
+        kernels,
+    };
+    let json = serde_json::to_string_pretty(&manifest).map_err(|e| ExportError::Header(e.to_string()))? + "\n";
+    files.push((MANIFEST.into(), json.into_bytes()));
+    files.push(("data/blue_noise.bin".into(), blue_noise));
+    files.push((
+        "include/strata.h".into(),
+        c_header::header(&structs, &constants, &workgroup_sizes, version)?.into_bytes(),
+    ));
+    files.push(("include/strata_frame.h".into(), include_bytes!("../package/strata_frame.h").to_vec()));
+    files.push(("include/strata_vk.h".into(), abi_header::header(version)?.into_bytes()));
+    files.push(("README.md".into(), include_bytes!("../package/README.md").to_vec()));
+    let _ = Stage::ALL;
+    write_package(out, &files)?;
+    Ok(Exported { folder: out.to_path_buf(), files: files.into_iter().map(|(name, _)| name).collect() })
+}
+
+/// The manifest's copy of a header struct.
+fn manifest_struct(entry: &manifest::StructEntry) -> manifest::StructEntry {
+    manifest::StructEntry {
+        name: entry.name,
+        size: entry.size,
+        fields: entry
+            .fields
+            .iter()
+            .map(|f| manifest::FieldEntry {
+                name: f.name,
+                offset: f.offset,
+                size: f.size,
+                wgsl_type: f.wgsl_type.clone(),
+            })
+            .collect(),
+    }
+}
+
+/// Whether `out` may be written: absent, an empty folder, or an earlier package (a
+/// folder with a [`MANIFEST`] of this schema's kind). Anything else is refused: the
+/// export never deletes a user's files.
+fn check_out(out: &Path) -> Result<(), String> {
+    if out.as_os_str().is_empty() {
+        return Err("an empty path".into());
+    }
+    let Ok(metadata) = std::fs::symlink_metadata(out) else { return Ok(()) };
+    if !metadata.is_dir() {
+        return Err("exists and is not a folder".into());
+    }
+    let entries: Vec<_> = std::fs::read_dir(out).map_err(|e| e.to_string())?.collect();
+    if entries.is_empty() {
+        return Ok(());
+    }
+    let manifest = std::fs::read_to_string(out.join(MANIFEST)).unwrap_or_default();
+    if manifest.contains("\"schema_version\"") && manifest.contains("\"strata_version\"") {
+        return Ok(());
+    }
+    Err("is a folder with other files in it (not an earlier strata package): choose an empty or new folder".into())
+}
+
+/// Writes `files` into a temporary sibling of `out`, then moves it into place (removing
+/// an earlier package there), so `out` is a whole package or untouched.
+fn write_package(out: &Path, files: &[(String, Vec<u8>)]) -> Result<(), ExportError> {
+    let name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "package".into());
+    let temporary = out.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
+    let write = |path: &Path, bytes: &[u8]| -> Result<(), ExportError> {
+        let failed = |source| ExportError::Write { path: path.display().to_string(), source };
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent).map_err(failed)?;
+        }
+        std::fs::write(path, bytes).map_err(failed)
+    };
+    let _ = std::fs::remove_dir_all(&temporary);
+    let result = (|| {
+        for (relative, bytes) in files {
+            write(&temporary.join(relative), bytes)?;
+        }
+        if out.exists() {
+            std::fs::remove_dir_all(out)
+                .map_err(|source| ExportError::Write { path: out.display().to_string(), source })?;
+        }
+        std::fs::rename(&temporary, out)
+            .map_err(|source| ExportError::Write { path: out.display().to_string(), source })
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_dir_all(&temporary);
+    }
+    result
+}

@@ -1,0 +1,500 @@
+//! The kernel package for engines outside Rust (`strata-export`) and the C program that
+//! uses it (`examples/c/`), as an engine developer in C would: the package exported, the
+//! C program built with `cc -std=c11 -Wall -Wextra -Werror` against the package's headers,
+//! the system Vulkan headers, Jansson and the `strata_vk` library, then run by both routes
+//! (the package alone; the C ABI) over several frames. Every route's selections and
+//! resampling results must equal the wgpu flavour of `strata-embed` bit for bit, for every
+//! K and two sampler variants (and every histogram kernel, by route 1). The manifest is
+//! checked against naga's reflection of every kernel, and the check is shown to fail with
+//! one binding number of the manifest changed and with one field offset of `strata.h`
+//! changed.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use strata_embed::contract::{Candidate, ResampleInput, ResampleOutput, SelectedCandidates};
+use strata_embed::wgsl::{ModuleId, module};
+use strata_embed::{SamplerVariant, SelectionSettings, WgpuBuffers, WgpuResampleBuffers, WgpuSelection};
+use strata_tests::{engine_device, read_wgpu_buffer};
+use wgpu::util::DeviceExt;
+
+const WIDTH: u32 = 45;
+const HEIGHT: u32 = 29;
+const FRAMES: u32 = 4;
+const SEED: u32 = 7;
+
+/// The workspace's root.
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// A fresh folder under the workspace's target.
+fn scratch(name: &str) -> PathBuf {
+    let folder = root().join("target/export-c-test").join(format!("{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&folder);
+    std::fs::create_dir_all(&folder).unwrap();
+    folder
+}
+
+/// The engine's inputs: candidates over a few objects with some invalid keys, payloads,
+/// resampling weights.
+fn inputs() -> (Vec<Candidate>, Vec<u32>, Vec<ResampleInput>) {
+    let pixels = WIDTH * HEIGHT;
+    let candidates = (0..pixels)
+        .map(|p| {
+            let key = if p % 37 == 5 { f32::NAN } else { ((p * 7919) % 113) as f32 * 0.05 };
+            Candidate { key, object_id: if p % 53 == 0 { u32::MAX } else { (p % WIDTH) / 11 + 4 * (p / WIDTH / 8) } }
+        })
+        .collect();
+    let payloads = (0..pixels).map(|p| p.wrapping_mul(2_654_435_761) >> 7).collect();
+    let resample = (0..pixels)
+        .map(|p| ResampleInput {
+            weights: [1.0 + (p % 5) as f32, 0.5 * (p % 3) as f32, 2.0, 0.25],
+            targets: [1.0, 2.0, 3.0, 4.0],
+            canonical_weight: 0.75,
+            canonical_target: 0.5,
+            canonical_payload: p,
+            _pad: 0,
+        })
+        .collect();
+    (candidates, payloads, resample)
+}
+
+/// One run's per-frame outputs.
+type Frames = Vec<(Vec<SelectedCandidates>, Vec<ResampleOutput>)>;
+
+/// Frames 0..FRAMES of the wgpu flavour for `settings`.
+fn wgpu_frames(device: &wgpu::Device, queue: &wgpu::Queue, settings: SelectionSettings) -> Frames {
+    let (candidates, payloads, resample) = inputs();
+    let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+    let init =
+        |contents: &[u8]| device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents, usage });
+    let pixels = (WIDTH * HEIGHT) as usize;
+    let candidates = init(bytemuck::cast_slice(&candidates));
+    let payloads = init(bytemuck::cast_slice(&payloads));
+    let selections = init(&vec![0; pixels * size_of::<SelectedCandidates>()]);
+    let weights = init(bytemuck::cast_slice(&resample));
+    let outputs = init(&vec![0; pixels * size_of::<ResampleOutput>()]);
+    let mut pass = WgpuSelection::new(device, settings, WIDTH, HEIGHT).unwrap();
+    pass.set_seed(SEED);
+    let bindings = pass
+        .bind(
+            device,
+            &WgpuBuffers {
+                candidates: (&candidates).into(),
+                payloads: Some((&payloads).into()),
+                selections: (&selections).into(),
+                resample: Some(WgpuResampleBuffers { inputs: (&weights).into(), outputs: (&outputs).into() }),
+            },
+        )
+        .unwrap();
+    (0..FRAMES)
+        .map(|frame| {
+            let mut encoder = device.create_command_encoder(&Default::default());
+            pass.encode_selection(queue, &mut encoder, &bindings, frame).unwrap();
+            pass.encode_resampling(&mut encoder, &bindings).unwrap();
+            queue.submit([encoder.finish()]);
+            (read_wgpu_buffer(device, queue, &selections), read_wgpu_buffer(device, queue, &outputs))
+        })
+        .collect()
+}
+
+/// The shared library `strata_vk`, built by cargo beside the test binaries.
+fn library_folder() -> PathBuf {
+    let deps = std::env::current_exe().unwrap().parent().unwrap().to_path_buf();
+    for folder in [deps.clone(), deps.join("..")] {
+        if folder.join("libstrata_vk.so").exists() {
+            return folder;
+        }
+    }
+    panic!("libstrata_vk.so is not in {} (cargo builds it with the workspace)", deps.display());
+}
+
+/// Builds the C program against `package`'s headers; the compiler's output on failure.
+fn build_c(package: &Path, out: &Path) -> Result<PathBuf, String> {
+    let program = out.join("strata_c");
+    let sources =
+        ["main.c", "engine.c", "route_package.c", "route_library.c"].map(|f| root().join("examples/c").join(f));
+    let library = library_folder();
+    let output = Command::new("cc")
+        .args(["-std=c11", "-Wall", "-Wextra", "-Werror", "-O1", "-I"])
+        .arg(package.join("include"))
+        .args(&sources)
+        .arg("-o")
+        .arg(&program)
+        .args(["-lvulkan", "-ljansson", "-L"])
+        .arg(&library)
+        .arg("-lstrata_vk")
+        .arg(format!("-Wl,-rpath,{}", library.display()))
+        .output()
+        .map_err(|e| format!("cc cannot run: {e} (install gcc)"))?;
+    if !output.status.success() {
+        return Err(String::from_utf8_lossy(&output.stderr).into_owned());
+    }
+    Ok(program)
+}
+
+/// Writes the engine's input files into `folder`.
+fn write_inputs(folder: &Path) {
+    let (candidates, payloads, resample) = inputs();
+    std::fs::write(folder.join("candidates.bin"), bytemuck::cast_slice(&candidates)).unwrap();
+    std::fs::write(folder.join("payloads.bin"), bytemuck::cast_slice(&payloads)).unwrap();
+    std::fs::write(folder.join("resample_inputs.bin"), bytemuck::cast_slice(&resample)).unwrap();
+}
+
+/// Runs the C program's `route` with `settings`; its frames, or its message.
+fn run_c(
+    program: &Path,
+    route: &str,
+    package: &Path,
+    histogram: &str,
+    settings: SelectionSettings,
+    folder: &Path,
+) -> Result<Frames, String> {
+    let out = folder.join(format!("{route}-{histogram}-{}-{}", settings.candidates, settings.sampler.name()));
+    std::fs::create_dir_all(&out).unwrap();
+    let number = |v: u32| v.to_string();
+    let output = Command::new(program)
+        .args([route, folder.to_str().unwrap(), out.to_str().unwrap()])
+        .args(["--package", package.to_str().unwrap(), "--histogram", histogram])
+        .args(["--width", &number(WIDTH), "--height", &number(HEIGHT), "--frames", &number(FRAMES)])
+        .args(["--seed", &number(SEED), "--block-size", &number(settings.block_size)])
+        .args(["--candidates", &number(settings.candidates), "--sampler", &number(settings.sampler.id())])
+        .args([
+            "--masking",
+            &number(u32::from(settings.masking)),
+            "--block-shift",
+            &number(u32::from(settings.block_shift)),
+        ])
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap();
+    if !output.status.success() {
+        return Err(String::from_utf8_lossy(&output.stderr).into_owned());
+    }
+    Ok((0..FRAMES)
+        .map(|frame| {
+            let read = |name: &str| std::fs::read(out.join(format!("{name}_{frame}.bin"))).unwrap();
+            (bytemuck::pod_collect_to_vec(&read("selections")), bytemuck::pod_collect_to_vec(&read("resampled")))
+        })
+        .collect())
+}
+
+/// The first frame and pixel where `got` and `want` differ, in words.
+fn first_difference(got: &Frames, want: &Frames) -> Option<String> {
+    for (frame, ((gs, gr), (ws, wr))) in got.iter().zip(want).enumerate() {
+        if let Some(p) = (0..ws.len()).find(|&p| bytemuck::bytes_of(&gs[p]) != bytemuck::bytes_of(&ws[p])) {
+            return Some(format!("frame {frame}, pixel {p}: selection {:?} against {:?}", gs[p], ws[p]));
+        }
+        if let Some(p) = (0..wr.len()).find(|&p| bytemuck::bytes_of(&gr[p]) != bytemuck::bytes_of(&wr[p])) {
+            return Some(format!("frame {frame}, pixel {p}: resampled {:?} against {:?}", gr[p], wr[p]));
+        }
+    }
+    (got.len() != want.len()).then(|| format!("{} frames against {}", got.len(), want.len()))
+}
+
+#[test]
+fn both_c_routes_equal_the_rust_pass_bit_for_bit() {
+    let Some((device, queue)) = engine_device("both_c_routes_equal_the_rust_pass_bit_for_bit", None) else {
+        return;
+    };
+    let folder = scratch("routes");
+    let package = folder.join("package");
+    strata_export::export(&package).unwrap();
+    let program = build_c(&package, &folder).unwrap_or_else(|e| panic!("the C program does not build:\n{e}"));
+    write_inputs(&folder);
+    let mut runs = 0;
+    for sampler in [SamplerVariant::Antithetic, SamplerVariant::Random] {
+        for candidates in 1..=4 {
+            let settings =
+                SelectionSettings { block_size: 8, candidates, sampler, block_shift: true, ..Default::default() };
+            let want = wgpu_frames(&device, &queue, settings);
+            let library = run_c(&program, "library", &package, "block_histogram", settings, &folder).unwrap();
+            assert_eq!(first_difference(&library, &want), None, "route 2 (library), K = {candidates}, {sampler:?}");
+            // Route 1 with each histogram kernel in turn (they give the same output).
+            let histogram =
+                ["block_histogram", "block_histogram_rank", "block_histogram_subgroup"][candidates as usize % 3];
+            let package_route = run_c(&program, "package", &package, histogram, settings, &folder).unwrap();
+            assert_eq!(
+                first_difference(&package_route, &want),
+                None,
+                "route 1 ({histogram}), K = {candidates}, {sampler:?}"
+            );
+            runs += 2;
+        }
+    }
+    assert_eq!(runs, 16);
+    let _ = std::fs::remove_dir_all(&folder);
+}
+
+#[test]
+fn a_wrong_binding_number_in_the_manifest_or_offset_in_the_header_is_caught() {
+    let Some((device, queue)) =
+        engine_device("a_wrong_binding_number_in_the_manifest_or_offset_in_the_header_is_caught", None)
+    else {
+        return;
+    };
+    let folder = scratch("broken");
+    let package = folder.join("package");
+    strata_export::export(&package).unwrap();
+    let program = build_c(&package, &folder).unwrap();
+    write_inputs(&folder);
+    let settings = SelectionSettings { block_size: 8, candidates: 4, ..Default::default() };
+    let want = wgpu_frames(&device, &queue, settings);
+    assert_eq!(
+        first_difference(&run_c(&program, "package", &package, "block_histogram", settings, &folder).unwrap(), &want),
+        None
+    );
+    // strata_select's `sorted_pixels` and `spans` swap binding numbers in the manifest.
+    let manifest_path = package.join("manifest.json");
+    let original = std::fs::read_to_string(&manifest_path).unwrap();
+    let mut manifest: serde_json::Value = serde_json::from_str(&original).unwrap();
+    let select = manifest["kernels"].as_array_mut().unwrap().iter_mut().find(|k| k["name"] == "strata_select").unwrap();
+    let bindings = select["bindings"].as_array_mut().unwrap();
+    let number = |name: &str| bindings.iter().position(|b| b["name"] == name).unwrap();
+    let (a, b) = (number("sorted_pixels"), number("spans"));
+    let (binding_a, binding_b) = (bindings[a]["binding"].clone(), bindings[b]["binding"].clone());
+    bindings[a]["binding"] = binding_b;
+    bindings[b]["binding"] = binding_a;
+    std::fs::write(&manifest_path, serde_json::to_string_pretty(&manifest).unwrap()).unwrap();
+    match run_c(&program, "package", &package, "block_histogram", settings, &folder) {
+        Ok(frames) => assert!(first_difference(&frames, &want).is_some(), "a swapped binding went unnoticed"),
+        Err(message) => eprintln!("the swapped binding failed the run: {message}"),
+    }
+    std::fs::write(&manifest_path, original).unwrap();
+    // A field of StrataSelectedCandidates moved in strata.h: the build fails on its assert.
+    let header_path = package.join("include/strata.h");
+    let header = std::fs::read_to_string(&header_path).unwrap();
+    let moved = header.replacen("    uint32_t run_length;\n", "    uint32_t spare;\n    uint32_t run_length;\n", 1);
+    assert_ne!(moved, header, "the header declares StrataSelectedCandidates.run_length");
+    std::fs::write(&header_path, moved).unwrap();
+    let error = build_c(&package, &folder).expect_err("a moved field must not build");
+    assert!(error.contains("StrataSelectedCandidates"), "{error}");
+    let _ = std::fs::remove_dir_all(&folder);
+}
+
+#[test]
+fn the_manifest_is_naga_s_reflection_of_every_kernel() {
+    let folder = scratch("manifest");
+    let package = folder.join("package");
+    let exported = strata_export::export(&package).unwrap();
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(package.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(manifest["schema_version"], 1);
+    let kernels = manifest["kernels"].as_array().unwrap();
+    assert_eq!(kernels.len(), ModuleId::ALL.len());
+    for id in ModuleId::ALL {
+        let reflected = module(id).unwrap();
+        let kernel = kernels.iter().find(|k| k["entry_point"]["wgsl"] == reflected.entry_point.as_str()).unwrap();
+        assert_eq!(kernel["workgroup_size"], serde_json::json!(reflected.workgroup_size), "{id:?}");
+        assert_eq!(kernel["workgroup_memory_bytes"], reflected.workgroup_memory_bytes, "{id:?}");
+        assert_eq!(kernel["required_features"].as_array().unwrap().is_empty(), !reflected.needs_subgroups, "{id:?}");
+        let bindings = kernel["bindings"].as_array().unwrap();
+        assert_eq!(bindings.len(), reflected.bindings.len(), "{id:?}");
+        for (entry, binding) in bindings.iter().zip(&reflected.bindings) {
+            let what = format!("{id:?} `{}`", binding.name);
+            assert_eq!(entry["name"], binding.name.as_str(), "{what}");
+            assert_eq!(
+                (entry["set"].as_u64(), entry["binding"].as_u64()),
+                (Some(0), Some(u64::from(binding.binding))),
+                "{what}"
+            );
+            assert_eq!(entry["descriptor_type"] == "uniform_buffer", binding.uniform, "{what}");
+            assert_eq!(entry["access"] == "read_write", binding.writable, "{what}");
+            assert_eq!(entry["element"], binding.element.as_str(), "{what}");
+            assert_eq!(entry["stride"], binding.stride, "{what}");
+            assert_eq!(entry["msl_buffer"], binding.binding, "{what}");
+            let register = entry["hlsl"]["register"].as_str().unwrap();
+            let class = if binding.uniform {
+                'b'
+            } else if binding.writable {
+                'u'
+            } else {
+                't'
+            };
+            assert!(register.starts_with(class), "{what}: {register}");
+            // Every file the entry names exists, and the HLSL declares the register.
+            let hlsl = std::fs::read_to_string(package.join(kernel["files"]["hlsl"].as_str().unwrap())).unwrap();
+            assert!(hlsl.contains(&format!("register({register}")), "{what}: {register} not in the HLSL");
+            let glsl = std::fs::read_to_string(package.join(kernel["files"]["glsl"].as_str().unwrap())).unwrap();
+            assert!(glsl.contains(&format!("set = 0, binding = {})", binding.binding)), "{what}: GLSL has no set");
+        }
+        let spirv = std::fs::read(package.join(kernel["files"]["spirv"].as_str().unwrap())).unwrap();
+        assert_eq!(&spirv[..4], &0x0723_0203u32.to_le_bytes(), "{id:?}: not SPIR-V");
+    }
+    // The buffers cover every binding, and every struct's size is its Rust twin's.
+    let buffers: Vec<&str> =
+        manifest["buffers"].as_array().unwrap().iter().map(|b| b["name"].as_str().unwrap()).collect();
+    for kernel in kernels {
+        for binding in kernel["bindings"].as_array().unwrap() {
+            assert!(buffers.contains(&binding["buffer"].as_str().unwrap()), "{binding}");
+        }
+    }
+    let size = |name: &str| {
+        manifest["structs"].as_array().unwrap().iter().find(|s| s["name"] == name).unwrap()["size"].clone()
+    };
+    assert_eq!(size("SelectedCandidates"), size_of::<SelectedCandidates>());
+    assert_eq!(size("ResampleInput"), size_of::<ResampleInput>());
+    assert!(exported.files.iter().any(|f| f == "data/blue_noise.bin"));
+    let _ = std::fs::remove_dir_all(&folder);
+}
+
+#[test]
+fn the_headers_compile_as_strict_c11_and_cpp() {
+    let folder = scratch("headers");
+    let package = folder.join("package");
+    strata_export::export(&package).unwrap();
+    let source = folder.join("headers.c");
+    std::fs::write(
+        &source,
+        "#include \"strata_vk.h\"\nint main(void) { return (int)sizeof(StrataFrameParams) == 0; }\n",
+    )
+    .unwrap();
+    for (compiler, standard) in [("cc", "-std=c11"), ("c++", "-std=c++17")] {
+        let mut command = Command::new(compiler);
+        command.arg(standard).args(["-Wall", "-Wextra", "-Werror", "-fsyntax-only", "-I"]).arg(package.join("include"));
+        if compiler == "c++" {
+            command.args(["-x", "c++"]);
+        }
+        let output = command.arg(&source).output().unwrap_or_else(|e| panic!("{compiler}: {e}"));
+        assert!(output.status.success(), "{compiler} {standard}:\n{}", String::from_utf8_lossy(&output.stderr));
+    }
+    let _ = std::fs::remove_dir_all(&folder);
+}
+
+#[test]
+fn the_export_refuses_a_folder_that_is_not_a_package() {
+    let folder = scratch("refuse");
+    std::fs::write(folder.join("notes.txt"), "the user's").unwrap();
+    let message = strata_export::export(&folder).unwrap_err().to_string();
+    assert!(message.contains("--out") && message.contains("other files"), "{message}");
+    assert!(folder.join("notes.txt").exists());
+    let file = folder.join("notes.txt");
+    let message = strata_export::export(&file).unwrap_err().to_string();
+    assert!(message.contains("not a folder"), "{message}");
+    // An earlier package is replaced whole.
+    let package = folder.join("package");
+    strata_export::export(&package).unwrap();
+    strata_export::export(&package).unwrap();
+    assert!(package.join("manifest.json").is_file());
+    let _ = std::fs::remove_dir_all(&folder);
+}
+
+/// Frame parameters of `strata_frame.h` against `strata_embed::frame::frame_params` for
+/// many settings, sizes, frames, seeds and workgroup limits, byte for byte.
+#[test]
+fn strata_frame_h_computes_what_frame_rs_does() {
+    use strata_embed::frame::{FrameId, frame_params};
+    let folder = scratch("frame");
+    let package = folder.join("package");
+    strata_export::export(&package).unwrap();
+    let source = folder.join("frame.c");
+    std::fs::write(
+        &source,
+        r#"#include <stdio.h>
+#include "strata_frame.h"
+int main(void) {
+    unsigned b, k, s, m, bs, w, h, f, seed, id, mw;
+    while (scanf("%u %u %u %u %u %u %u %u %u %u %u", &b, &k, &s, &m, &bs, &w, &h, &f, &seed, &id, &mw) == 11) {
+        StrataSelectionSettings settings = {b, k, s, m, bs};
+        StrataFrameParams p;
+        char message[128];
+        if (strata_frame_params(&settings, w, h, f, seed, id, mw, &p, message, sizeof message)) {
+            printf("error\n");
+            continue;
+        }
+        const unsigned char *bytes = (const unsigned char *)&p;
+        for (size_t i = 0; i < sizeof p; i++) printf("%02x", bytes[i]);
+        printf(" %llu\n", (unsigned long long)strata_max_blocks(&settings, w, h));
+    }
+    return 0;
+}
+"#,
+    )
+    .unwrap();
+    let program = folder.join("frame");
+    let built = Command::new("cc")
+        .args(["-std=c11", "-Wall", "-Wextra", "-Werror", "-I"])
+        .arg(package.join("include"))
+        .arg(&source)
+        .arg("-o")
+        .arg(&program)
+        .output()
+        .unwrap();
+    assert!(built.status.success(), "{}", String::from_utf8_lossy(&built.stderr));
+    // Cases: every block size, K, sampler and flag, sizes from 1 pixel to 4096 wide, frames
+    // and seeds from a generator, workgroup limits from 1 up.
+    let mut state = 0x2545_f491_u64;
+    let mut next = |range: u32| {
+        state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+        ((state >> 33) as u32) % range
+    };
+    let mut cases = Vec::new();
+    for case in 0..600u32 {
+        let settings = SelectionSettings {
+            block_size: [4, 8, 16, 32][case as usize % 4],
+            candidates: 1 + case / 4 % 4,
+            masking: case % 3 == 0,
+            block_shift: case % 2 == 1,
+            sampler: SamplerVariant::ALL[case as usize % 5],
+        };
+        let (width, height) = match case % 5 {
+            0 => (1, 1),
+            1 => (1 + next(4096), 1 + next(8)),
+            _ => (1 + next(700), 1 + next(500)),
+        };
+        let id = FrameId { frame: next(u32::MAX), seed: next(u32::MAX), identity_payload: case % 7 == 0 };
+        let max_workgroups = [1, 3, 65535, 8][case as usize % 4];
+        cases.push((settings, width, height, id, max_workgroups));
+    }
+    let input: String = cases
+        .iter()
+        .map(|(s, w, h, id, mw)| {
+            format!(
+                "{} {} {} {} {} {w} {h} {} {} {} {mw}\n",
+                s.block_size,
+                s.candidates,
+                s.sampler.id(),
+                u32::from(s.masking),
+                u32::from(s.block_shift),
+                id.frame,
+                id.seed,
+                u32::from(id.identity_payload)
+            )
+        })
+        .collect();
+    let mut child = Command::new(&program)
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    use std::io::Write;
+    child.stdin.take().unwrap().write_all(input.as_bytes()).unwrap();
+    let output = child.wait_with_output().unwrap();
+    let lines: Vec<String> = String::from_utf8(output.stdout).unwrap().lines().map(String::from).collect();
+    assert_eq!(lines.len(), cases.len());
+    for ((settings, width, height, id, max_workgroups), line) in cases.iter().zip(&lines) {
+        let params = frame_params(settings, *width, *height, *id, *max_workgroups).unwrap();
+        let mut bytes = bytemuck::bytes_of(&params.histogram).to_vec();
+        bytes.extend_from_slice(bytemuck::bytes_of(&params.selection));
+        bytes.extend(params.histogram_workgroups.iter().chain(&params.pixel_workgroups).flat_map(|w| w.to_le_bytes()));
+        let hex: String = bytes.iter().map(|b| format!("{b:02x}")).collect();
+        let blocks = strata_embed::frame::max_blocks(settings, *width, *height);
+        assert_eq!(line, &format!("{hex} {blocks}"), "{settings:?} {width}x{height} {id:?} max {max_workgroups}");
+    }
+    // Bad settings are refused by both, naming the field in C as in Rust.
+    let refused = Command::new(&program)
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .and_then(|mut child| {
+            child
+                .stdin
+                .take()
+                .unwrap()
+                .write_all(b"12 4 4 1 0 8 8 0 0 0 1\n4 5 4 1 0 8 8 0 0 0 1\n4 4 9 1 0 8 8 0 0 0 1\n")?;
+            child.wait_with_output()
+        })
+        .unwrap();
+    assert_eq!(String::from_utf8_lossy(&refused.stdout), "error\nerror\nerror\n");
+    let _ = std::fs::remove_dir_all(&folder);
+}

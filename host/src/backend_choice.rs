@@ -8,9 +8,10 @@ use strata_backends::{Backend, BackendError};
 /// Backends the command line can be asked for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum BackendChoice {
-    /// The best available: wgpu on Vulkan.
+    /// The best available: wgpu on the platform's API (Vulkan on Linux, Metal on macOS,
+    /// DX12 or Vulkan on Windows), else the CPU interpreter.
     Auto,
-    /// wgpu on Vulkan.
+    /// wgpu on the platform's API (Vulkan, Metal or DX12).
     Wgpu,
     /// wgpu on OpenGL (no subgroups).
     WgpuGl,
@@ -24,7 +25,7 @@ pub enum BackendChoice {
 /// with a one-line notice on stderr, when no Vulkan adapter exists.
 pub fn open_backend(choice: BackendChoice) -> Result<Box<dyn Backend>, BackendError> {
     let api = match choice {
-        BackendChoice::Auto | BackendChoice::Wgpu => WgpuApi::Vulkan,
+        BackendChoice::Auto | BackendChoice::Wgpu => WgpuApi::Primary,
         BackendChoice::WgpuGl => WgpuApi::Gl,
         BackendChoice::Ash => return Ok(Box::new(AshBackend::new(AshOptions::default())?)),
         BackendChoice::Cpu => return Ok(Box::new(CpuBackend::new(CpuOptions::default())?)),

@@ -1,4 +1,5 @@
-//! The [`Backend`] on wgpu: Vulkan (lavapipe on machines without a GPU) or GL.
+//! The [`Backend`] on wgpu: the platform's own API (Vulkan on Linux, lavapipe on
+//! machines without a GPU; Metal on macOS; DX12, else Vulkan, on Windows) or GL.
 
 mod buffers;
 mod errors;
@@ -17,6 +18,9 @@ use strata_kernels::Kernel;
 /// Which wgpu backend to open.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum WgpuApi {
+    /// The platform's primary API: Vulkan, Metal or DX12, whichever the build has and
+    /// the machine offers (wgpu's `Backends::PRIMARY`).
+    Primary,
     /// Vulkan (lavapipe counts).
     Vulkan,
     /// OpenGL / GLES through EGL.
@@ -55,11 +59,13 @@ impl WgpuBackend {
     /// Opens the first adapter of `options.api`.
     pub fn new(options: WgpuOptions) -> Result<Self, BackendError> {
         let backend_name = match options.api {
+            WgpuApi::Primary => "wgpu",
             WgpuApi::Vulkan => "wgpu-vulkan",
             WgpuApi::Gl => "wgpu-gl",
         };
         let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
         descriptor.backends = match options.api {
+            WgpuApi::Primary => wgpu::Backends::PRIMARY,
             WgpuApi::Vulkan => wgpu::Backends::VULKAN,
             WgpuApi::Gl => wgpu::Backends::GL,
         };
@@ -98,8 +104,17 @@ impl WgpuBackend {
         }))
         .map_err(|e| BackendError::DeviceCreation { backend: backend_name.into(), reason: e.to_string() })?;
 
-        let errors = ErrorSink::install(&device, backend_name);
         let adapter_info = adapter.get_info();
+        // The API the adapter runs on names the backend (`wgpu-vulkan`, `wgpu-metal`,
+        // `wgpu-dx12`, `wgpu-gl`).
+        let backend_name: &'static str = match adapter_info.backend {
+            wgpu::Backend::Vulkan => "wgpu-vulkan",
+            wgpu::Backend::Metal => "wgpu-metal",
+            wgpu::Backend::Dx12 => "wgpu-dx12",
+            wgpu::Backend::Gl => "wgpu-gl",
+            _ => backend_name,
+        };
+        let errors = ErrorSink::install(&device, backend_name);
         let info = DeviceInfo {
             backend: backend_name.into(),
             adapter: adapter_info.name.clone(),

@@ -32,6 +32,7 @@ pub mod registry;
 pub mod render_types;
 pub mod restir_types;
 pub mod selection;
+pub mod slang;
 pub mod source;
 pub mod trace_types;
 pub mod translate;

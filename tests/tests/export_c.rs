@@ -320,6 +320,44 @@ fn the_manifest_is_naga_s_reflection_of_every_kernel() {
         }
         let spirv = std::fs::read(package.join(kernel["files"]["spirv"].as_str().unwrap())).unwrap();
         assert_eq!(&spirv[..4], &0x0723_0203u32.to_le_bytes(), "{id:?}: not SPIR-V");
+        // The GLSL for Vulkan compiles with glslang as such (`-V`), sets and all; the SPIR-V
+        // passes spirv-val for Vulkan 1.1.
+        let glsl = package.join(kernel["files"]["glsl"].as_str().unwrap());
+        let compiled = folder.join(format!("{}.glsl.spv", reflected.entry_point));
+        for (tool, args) in [
+            (
+                "glslangValidator",
+                vec![
+                    "-V".into(),
+                    "--target-env".into(),
+                    "vulkan1.1".into(),
+                    "-S".into(),
+                    "comp".into(),
+                    glsl.clone().into_os_string(),
+                    "-o".into(),
+                    compiled.into_os_string(),
+                ],
+            ),
+            (
+                "spirv-val",
+                vec![
+                    "--target-env".into(),
+                    "vulkan1.1".into(),
+                    package.join(kernel["files"]["spirv"].as_str().unwrap()).into_os_string(),
+                ],
+            ),
+        ] {
+            let args: Vec<std::ffi::OsString> = args;
+            match strata_kernels::glslang::run_tool(tool, &args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>()) {
+                Ok(()) => {}
+                Err(strata_kernels::glslang::ToolError::Missing(tool))
+                    if std::env::var_os("STRATA_REQUIRE_VALIDATORS").is_none() =>
+                {
+                    eprintln!("SKIPPED {tool} of {id:?}: not installed");
+                }
+                Err(error) => panic!("{id:?}: {error}"),
+            }
+        }
     }
     // The buffers cover every binding, and every struct's size is its Rust twin's.
     let buffers: Vec<&str> =
@@ -496,5 +534,56 @@ int main(void) {
         })
         .unwrap();
     assert_eq!(String::from_utf8_lossy(&refused.stdout), "error\nerror\nerror\n");
+    let _ = std::fs::remove_dir_all(&folder);
+}
+
+/// The package's HLSL, as exported, compiled by a second front end (Slang, not the
+/// glslang whose HLSL bugs strata works around) and run through route 1 in place of
+/// naga's SPIR-V: the same outputs as the Rust pass, bit for bit.
+#[test]
+fn the_exported_hlsl_compiled_by_slang_equals_the_rust_pass() {
+    let Some((device, queue)) = engine_device("the_exported_hlsl_compiled_by_slang_equals_the_rust_pass", None) else {
+        return;
+    };
+    let folder = scratch("slang");
+    let package = folder.join("package");
+    strata_export::export(&package).unwrap();
+    let manifest_path = package.join("manifest.json");
+    let mut manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&manifest_path).unwrap()).unwrap();
+    for kernel in manifest["kernels"].as_array_mut().unwrap() {
+        let hlsl = package.join(kernel["files"]["hlsl"].as_str().unwrap());
+        let entry = kernel["entry_point"]["hlsl"].as_str().unwrap().to_string();
+        let words = match strata_kernels::slang::compile_hlsl(&hlsl, &entry) {
+            Ok(words) => words,
+            Err(strata_kernels::glslang::ToolError::Missing(what))
+                if std::env::var_os("STRATA_REQUIRE_VALIDATORS").is_none() =>
+            {
+                eprintln!("SKIPPED: {what} (STRATA_REQUIRE_VALIDATORS=1 makes this a failure)");
+                return;
+            }
+            Err(error) => panic!("{}: {error}", kernel["name"]),
+        };
+        std::fs::write(package.join(kernel["files"]["spirv"].as_str().unwrap()), bytemuck::cast_slice(&words)).unwrap();
+        kernel["entry_point"]["spirv"] = entry.into();
+    }
+    std::fs::write(&manifest_path, serde_json::to_string_pretty(&manifest).unwrap()).unwrap();
+    let program = build_c(&package, &folder).unwrap();
+    write_inputs(&folder);
+    let histograms = ["block_histogram", "block_histogram_rank", "block_histogram_subgroup"];
+    for (candidates, sampler) in [
+        (1, SamplerVariant::Antithetic),
+        (2, SamplerVariant::Antithetic),
+        (3, SamplerVariant::Random),
+        (4, SamplerVariant::Antithetic),
+    ] {
+        let settings =
+            SelectionSettings { block_size: 8, candidates, sampler, block_shift: true, ..Default::default() };
+        let want = wgpu_frames(&device, &queue, settings);
+        let histogram = histograms[candidates as usize % 3];
+        let got = run_c(&program, "package", &package, histogram, settings, &folder)
+            .unwrap_or_else(|e| panic!("Slang's SPIR-V of {histogram}: {e}"));
+        assert_eq!(first_difference(&got, &want), None, "Slang's SPIR-V, {histogram}, K = {candidates}, {sampler:?}");
+    }
     let _ = std::fs::remove_dir_all(&folder);
 }

@@ -30,6 +30,9 @@ pub enum SpirvSource {
     GlslangFromGlsl,
     /// glslang's compilation of naga's HLSL output.
     GlslangFromHlsl,
+    /// Slang's compilation of naga's HLSL output (a second HLSL front end;
+    /// `strata_kernels::slang`).
+    SlangFromHlsl,
 }
 
 impl SpirvSource {
@@ -39,6 +42,7 @@ impl SpirvSource {
             SpirvSource::Naga => "ash",
             SpirvSource::GlslangFromGlsl => "ash-glsl",
             SpirvSource::GlslangFromHlsl => "ash-hlsl",
+            SpirvSource::SlangFromHlsl => "ash-slang",
         }
     }
 }
@@ -82,7 +86,14 @@ pub struct AshBackend {
 impl AshBackend {
     /// Opens the best Vulkan device: a discrete GPU first, a CPU device (lavapipe) last.
     pub fn new(options: AshOptions) -> Result<Self, BackendError> {
-        if options.source != SpirvSource::Naga {
+        if options.source == SpirvSource::SlangFromHlsl {
+            if let Err(error) = strata_kernels::slang::tool() {
+                return Err(BackendError::NoAdapter {
+                    backend: options.source.name().into(),
+                    reason: error.to_string(),
+                });
+            }
+        } else if options.source != SpirvSource::Naga {
             let probe = std::process::Command::new("glslangValidator").arg("--version").output();
             if !probe.is_ok_and(|out| out.status.success()) {
                 return Err(BackendError::NoAdapter {

@@ -48,6 +48,7 @@ impl PipelineCache {
             }
             SpirvSource::GlslangFromGlsl => GlslangInput::Glsl,
             SpirvSource::GlslangFromHlsl => GlslangInput::Hlsl,
+            SpirvSource::SlangFromHlsl => return self.slang(kernel),
         };
         // One folder per compilation: threads of one process compile kernels of the same
         // name (every external kernel is named after its entry point, often `main`), and
@@ -62,6 +63,30 @@ impl PipelineCache {
             operation: format!("glslang compilation of `{}`", kernel.name()),
             message: error.to_string(),
         })
+    }
+
+    /// naga's HLSL of `kernel` (workgroup memory zeroed in the shader, as exported)
+    /// compiled by Slang.
+    fn slang(&self, kernel: &Kernel) -> Result<(Vec<u32>, String), BackendError> {
+        let failed = |message: String| BackendError::Validation {
+            backend: self.source.name().into(),
+            operation: format!("Slang compilation of `{}`", kernel.name()),
+            message,
+        };
+        let translation =
+            translate::hlsl(kernel, TranslateOptions { workgroup_zero_init: WorkgroupZeroInit::Polyfill })?;
+        static COMPILATIONS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let n = COMPILATIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!("strata-slang-{}-{n}", std::process::id()));
+        let file = dir.join(format!("{}.hlsl", kernel.name()));
+        let result = std::fs::create_dir_all(&dir)
+            .and_then(|()| std::fs::write(&file, &translation.text))
+            .map_err(|e| failed(format!("{}: {e}", file.display())))
+            .and_then(|()| {
+                strata_kernels::slang::compile_hlsl(&file, &translation.entry_point).map_err(|e| failed(e.to_string()))
+            });
+        let _ = std::fs::remove_dir_all(&dir);
+        Ok((result?, translation.entry_point))
     }
 
     pub(super) fn get_or_create(

@@ -12,8 +12,13 @@
 //! [`StrataError`], fills it with the status and a one-line message naming the argument,
 //! field, buffer or device limit at fault. Nothing unwinds across the boundary: a panic
 //! inside the pass (a bug) is caught and reported as [`StrataStatus::Internal`]. A null
-//! pointer, a handle that is not one of this library's (checked by a tag), or bindings
-//! of another pass are refused with [`StrataStatus::InvalidArgument`].
+//! pointer, a handle that is not a live one of this library's (every handle is looked up
+//! in a table of live handles before it is touched, so a destroyed or foreign pointer is
+//! never read), bindings of another pass, or a pass destroyed while its bindings live are
+//! refused with [`StrataStatus::InvalidArgument`].
+//!
+//! Threads: calls on different passes may run concurrently; calls on one pass (and its
+//! bindings) must not (the engine synchronises them, as it does its command buffers).
 
 use ash::vk::{self, Handle};
 use std::ffi::c_char;
@@ -141,13 +146,25 @@ pub struct StrataVkBuffers {
     pub resampled: StrataVkBufferSlice,
 }
 
-/// Tags of the two handle kinds, checked on every call.
-const PASS_TAG: u64 = 0x5354_5241_5441_5041; // "STRATAPA"
-const BINDINGS_TAG: u64 = 0x5354_5241_5441_4249; // "STRATABI"
+/// A live handle: a pass (with how many of its bindings live) or bindings (with their
+/// pass).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Live {
+    Pass { bindings: usize },
+    Bindings { owner: usize },
+}
+
+/// Every live handle, by address: a pointer handed in is dereferenced only if it is here
+/// with the right kind.
+static LIVE: std::sync::Mutex<Vec<(usize, Live)>> = std::sync::Mutex::new(Vec::new());
+
+/// The table of live handles (a panic elsewhere never leaves it unusable).
+fn live() -> std::sync::MutexGuard<'static, Vec<(usize, Live)>> {
+    LIVE.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
 
 /// A pass made by [`strata_vk_create`] (opaque to C).
 pub struct StrataVkPass {
-    tag: u64,
     // Kept for the pass's lifetime: the device's functions were loaded through it.
     _instance: ash::Instance,
     selection: AshSelection,
@@ -155,8 +172,6 @@ pub struct StrataVkPass {
 
 /// Descriptor sets of one set of engine buffers, made by [`strata_vk_bind`] (opaque).
 pub struct StrataVkBindings {
-    tag: u64,
-    owner: *const StrataVkPass,
     bindings: AshBindings,
 }
 
@@ -192,17 +207,23 @@ impl From<EmbedError> for Failure {
 /// # Safety
 /// `error` is null or points to a writable `StrataError`.
 unsafe fn report(error: *mut StrataError, status: StrataStatus, message: &str) {
-    // SAFETY: per this function's contract.
-    let Some(error) = (unsafe { error.as_mut() }) else { return };
-    error.status = status;
+    if error.is_null() {
+        return;
+    }
     let mut end = message.len().min(STRATA_ERROR_MESSAGE_BYTES - 1);
     while !message.is_char_boundary(end) {
         end -= 1;
     }
-    for (slot, &byte) in error.message.iter_mut().zip(&message.as_bytes()[..end]) {
-        *slot = byte as c_char;
+    // SAFETY: per this function's contract; written through raw pointers, never reading
+    // what the caller's struct held (its status may be any bits).
+    unsafe {
+        std::ptr::addr_of_mut!((*error).status).write(status);
+        let text = std::ptr::addr_of_mut!((*error).message).cast::<c_char>();
+        for (i, &byte) in message.as_bytes()[..end].iter().enumerate() {
+            text.add(i).write(byte as c_char);
+        }
+        text.add(end).write(0);
     }
-    error.message[end] = 0;
 }
 
 /// Runs `call`, catching panics, and reports its outcome through `error`.
@@ -227,36 +248,40 @@ unsafe fn guarded(error: *mut StrataError, call: impl FnOnce() -> Result<(), Fai
     status
 }
 
-/// The pass behind `pass`, if it is one of ours.
+/// The live pass behind `pass`.
 ///
 /// # Safety
-/// `pass` is null or points to memory that may be read as a `StrataVkPass`'s tag.
+/// Only a live pass of this library is dereferenced (the table of live handles is asked
+/// first); the caller does not use it from two threads at once.
 unsafe fn pass_of<'a>(pass: *mut StrataVkPass, argument: &str) -> Result<&'a mut StrataVkPass, Failure> {
-    // SAFETY: per this function's contract; the tag is checked before anything else is used.
-    match unsafe { pass.as_mut() } {
-        None => Err(invalid(format!("{argument} is NULL"))),
-        Some(pass) if pass.tag != PASS_TAG => {
-            Err(invalid(format!("{argument} is not a pass made by strata_vk_create")))
-        }
-        Some(pass) => Ok(pass),
+    if pass.is_null() {
+        return Err(invalid(format!("{argument} is NULL")));
     }
+    if !live().iter().any(|&(address, kind)| address == pass as usize && matches!(kind, Live::Pass { .. })) {
+        return Err(invalid(format!("{argument} is not a live pass made by strata_vk_create")));
+    }
+    // SAFETY: a live pass: made by strata_vk_create and not yet destroyed.
+    Ok(unsafe { &mut *pass })
 }
 
-/// The bindings behind `bindings`, if they are ours and belong to `pass`.
+/// The live bindings behind `bindings`, made by `pass`.
 ///
 /// # Safety
-/// As [`pass_of`], for `StrataVkBindings`.
+/// As [`pass_of`].
 unsafe fn bindings_of<'a>(
     bindings: *const StrataVkBindings,
     pass: *const StrataVkPass,
 ) -> Result<&'a StrataVkBindings, Failure> {
-    // SAFETY: per this function's contract.
-    match unsafe { bindings.as_ref() } {
-        None => Err(invalid("bindings is NULL")),
-        Some(b) if b.tag != BINDINGS_TAG => Err(invalid("bindings is not made by strata_vk_bind")),
-        Some(b) if b.owner != pass => Err(invalid("bindings were made by another pass")),
-        Some(b) => Ok(b),
+    if bindings.is_null() {
+        return Err(invalid("bindings is NULL"));
     }
+    match live().iter().find(|&&(address, _)| address == bindings as usize).map(|&(_, kind)| kind) {
+        Some(Live::Bindings { owner }) if owner == pass as usize => {}
+        Some(Live::Bindings { .. }) => return Err(invalid("bindings were made by another pass")),
+        _ => return Err(invalid("bindings is not live bindings made by strata_vk_bind")),
+    }
+    // SAFETY: live bindings: made by strata_vk_bind and not yet destroyed.
+    Ok(unsafe { &*bindings })
 }
 
 fn settings_of(settings: &StrataSelectionSettings) -> Result<SelectionSettings, Failure> {
@@ -334,7 +359,9 @@ pub unsafe extern "C" fn strata_vk_create(
                 shader_zero_initialize_workgroup_memory: zero_init,
             };
             let selection = AshSelection::new(vulkan, settings, width, height)?;
-            *out = Box::into_raw(Box::new(StrataVkPass { tag: PASS_TAG, _instance: instance, selection }));
+            let made = Box::into_raw(Box::new(StrataVkPass { _instance: instance, selection }));
+            live().push((made as usize, Live::Pass { bindings: 0 }));
+            *out = made;
             Ok(())
         })
     }
@@ -407,8 +434,14 @@ pub unsafe extern "C" fn strata_vk_bind(
                 selections: slice(&buffers.selections, "selections", true)?.expect("required"),
                 resample,
             };
-            let made = owner.selection.bind(&ash_buffers)?;
-            *out = Box::into_raw(Box::new(StrataVkBindings { tag: BINDINGS_TAG, owner: pass, bindings: made }));
+            let made = Box::into_raw(Box::new(StrataVkBindings { bindings: owner.selection.bind(&ash_buffers)? }));
+            let mut table = live();
+            table.push((made as usize, Live::Bindings { owner: pass as usize }));
+            if let Some((_, Live::Pass { bindings })) = table.iter_mut().find(|(address, _)| *address == pass as usize)
+            {
+                *bindings += 1;
+            }
+            *out = made;
             Ok(())
         })
     }
@@ -469,9 +502,8 @@ pub unsafe extern "C" fn strata_vk_record_resampling(
     }
 }
 
-/// Frees the descriptor sets of `bindings` (null: nothing). Their tag is cleared, so a
-/// second call with the same pointer is refused rather than freeing twice only while the
-/// memory is not reused.
+/// Frees the descriptor sets of `bindings` (null: nothing); a second call with the same
+/// pointer is refused (it is no longer live).
 ///
 /// # Safety
 /// No pending command buffer uses them; `bindings` come from `pass`; `error` is null or
@@ -490,7 +522,13 @@ pub unsafe extern "C" fn strata_vk_destroy_bindings(
             }
             let owner = pass_of(pass, "pass")?;
             bindings_of(bindings, pass)?;
-            (*bindings).tag = 0;
+            let mut table = live();
+            table.retain(|&(address, _)| address != bindings as usize);
+            if let Some((_, Live::Pass { bindings })) = table.iter_mut().find(|(address, _)| *address == pass as usize)
+            {
+                *bindings -= 1;
+            }
+            drop(table);
             let boxed = Box::from_raw(bindings);
             owner.selection.destroy_bindings(boxed.bindings);
             Ok(())
@@ -498,11 +536,11 @@ pub unsafe extern "C" fn strata_vk_destroy_bindings(
     }
 }
 
-/// Destroys the pass's pipelines and buffers (null: nothing).
+/// Destroys the pass's pipelines and buffers (null: nothing). Refused while bindings of
+/// the pass live (destroy them first: they hold the pass's descriptor sets).
 ///
 /// # Safety
-/// No pending command buffer uses the pass; its bindings were destroyed first; `error`
-/// is null or writable.
+/// No pending command buffer uses the pass; `error` is null or writable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn strata_vk_destroy(pass: *mut StrataVkPass, error: *mut StrataError) -> StrataStatus {
     // SAFETY: per this function's contract.
@@ -512,7 +550,16 @@ pub unsafe extern "C" fn strata_vk_destroy(pass: *mut StrataVkPass, error: *mut 
                 return Ok(());
             }
             pass_of(pass, "pass")?;
-            (*pass).tag = 0;
+            let mut table = live();
+            if let Some((_, Live::Pass { bindings })) = table.iter().find(|(address, _)| *address == pass as usize)
+                && *bindings > 0
+            {
+                return Err(invalid(format!(
+                    "{bindings} bindings of this pass are still live: destroy them first (strata_vk_destroy_bindings)"
+                )));
+            }
+            table.retain(|&(address, _)| address != pass as usize);
+            drop(table);
             let boxed = Box::from_raw(pass);
             boxed.selection.destroy();
             Ok(())

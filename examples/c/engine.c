@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-void fail(const char *what, ...) {
+_Noreturn void fail(const char *what, ...) {
     va_list arguments;
     va_start(arguments, what);
     fprintf(stderr, "error: ");
@@ -42,17 +42,22 @@ void engine_open(Engine *engine) {
     if (count == 0) {
         fail("no Vulkan device (install a driver, e.g. Mesa's lavapipe: mesa-vulkan-drivers)");
     }
-    VkPhysicalDevice devices[16];
-    if (count > 16) {
-        count = 16;
+    VkPhysicalDevice *devices = calloc(count, sizeof *devices);
+    if (devices == NULL) {
+        fail("out of memory listing %u Vulkan devices", count);
     }
     check_vk(vkEnumeratePhysicalDevices(engine->instance, &count, devices), "vkEnumeratePhysicalDevices");
     for (uint32_t d = 0; d < count && engine->physical_device == VK_NULL_HANDLE; d++) {
+        VkPhysicalDeviceProperties device_properties;
+        vkGetPhysicalDeviceProperties(devices[d], &device_properties);
+        if (device_properties.apiVersion < VK_API_VERSION_1_1) {
+            continue; /* the kernels' SPIR-V 1.3 needs Vulkan 1.1 */
+        }
         uint32_t families = 0;
         vkGetPhysicalDeviceQueueFamilyProperties(devices[d], &families, NULL);
-        VkQueueFamilyProperties properties[16];
-        if (families > 16) {
-            families = 16;
+        VkQueueFamilyProperties *properties = calloc(families, sizeof *properties);
+        if (properties == NULL) {
+            fail("out of memory listing %u queue families", families);
         }
         vkGetPhysicalDeviceQueueFamilyProperties(devices[d], &families, properties);
         for (uint32_t f = 0; f < families; f++) {
@@ -62,9 +67,11 @@ void engine_open(Engine *engine) {
                 break;
             }
         }
+        free(properties);
     }
+    free(devices);
     if (engine->physical_device == VK_NULL_HANDLE) {
-        fail("no Vulkan device with a compute queue");
+        fail("no Vulkan 1.1 device with a compute queue");
     }
     VkPhysicalDeviceProperties properties;
     vkGetPhysicalDeviceProperties(engine->physical_device, &properties);

@@ -31,8 +31,11 @@ typedef struct Buffer {
     void *mapped;
 } Buffer;
 
-/* Prints "error: WHAT" and exits with status 1. */
-void fail(const char *what, ...);
+/* Prints "error: WHAT" (printf-style) and exits with status 1. */
+#if defined(__GNUC__)
+__attribute__((format(printf, 1, 2)))
+#endif
+_Noreturn void fail(const char *what, ...);
 
 /* Exits with a message naming `call` unless `result` is VK_SUCCESS. */
 void check_vk(VkResult result, const char *call);

@@ -81,6 +81,9 @@ int main(int argc, char **argv) {
     if (strata_check_settings(&run.settings, message, sizeof message)) {
         fail("settings: %s", message);
     }
+    if (run.width == 0 || run.height == 0) {
+        fail("--width %u --height %u: the image needs at least one pixel", run.width, run.height);
+    }
     Engine engine;
     engine_open(&engine);
     if (strcmp(argv[1], "package") == 0) {

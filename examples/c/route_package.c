@@ -87,13 +87,44 @@ static VkDescriptorType descriptor_type(json_t *binding) {
     return VK_DESCRIPTOR_TYPE_MAX_ENUM;
 }
 
+/* Exits naming the kernel unless the device has every feature it requires. */
+static void check_features(Engine *engine, const Kernel *kernel) {
+    size_t index;
+    json_t *feature;
+    json_array_foreach(json_object_get(kernel->entry, "required_features"), index, feature) {
+        const char *name = json_string_value(feature);
+        if (name != NULL && strcmp(name, "subgroups") == 0) {
+            VkPhysicalDeviceSubgroupProperties subgroup = {0};
+            subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
+            VkPhysicalDeviceProperties2 properties = {0};
+            properties.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+            properties.pNext = &subgroup;
+            vkGetPhysicalDeviceProperties2(engine->physical_device, &properties);
+            VkSubgroupFeatureFlags needed = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_SHUFFLE_BIT;
+            if (!(subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) ||
+                (subgroup.supportedOperations & needed) != needed) {
+                fail("kernel `%s` needs subgroup shuffles in compute shaders, which this device lacks: run "
+                     "block_histogram or block_histogram_rank",
+                     text_of(kernel->entry, "name"));
+            }
+        } else {
+            fail("kernel `%s` requires feature `%s`, which this engine does not know",
+                 text_of(kernel->entry, "name"), name != NULL ? name : "?");
+        }
+    }
+}
+
 /* The pipeline of `kernel` from its SPIR-V file and bindings. */
 static void kernel_create(Engine *engine, const char *package, Kernel *kernel) {
+    check_features(engine, kernel);
     char path[4096];
     json_t *files = json_object_get(kernel->entry, "files");
     snprintf(path, sizeof path, "%s/%s", package, text_of(files, "spirv"));
     size_t size = 0;
     uint32_t *words = file_read(path, &size);
+    if (size < 20 || size % 4 != 0 || words[0] != 0x07230203u) {
+        fail("%s: not a SPIR-V module", path);
+    }
     VkShaderModuleCreateInfo module_info = {0};
     module_info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
     module_info.codeSize = size;
@@ -244,6 +275,7 @@ void route_package(Engine *engine, const Run *run) {
     EngineBuffers engine_buffers = engine_buffers_create(engine, run);
     uint32_t identity_payload = engine_buffers.payloads.buffer == VK_NULL_HANDLE;
     NamedBuffer buffers[MAX_BUFFERS];
+    memset(buffers, 0, sizeof buffers);
     size_t buffer_count = 0;
     size_t index;
     json_t *entry;

@@ -99,13 +99,16 @@ static inline void strata_grid_shift(const StrataSelectionSettings *settings, ui
 static inline uint32_t strata_div_ceil(uint32_t a, uint32_t b) { return a / b + (a % b != 0u ? 1u : 0u); }
 
 /* Blocks of the largest grid any frame has: with block shifting one more row and column
- * (what the block_stats buffer must hold, STRATA_BLOCK_STATS_BYTES each). */
+ * (what the block_stats buffer must hold, sizeof(StrataBlockStats) each); 0 for settings
+ * or an image strata_frame_params refuses. */
 static inline uint64_t strata_max_blocks(const StrataSelectionSettings *settings, uint32_t width, uint32_t height) {
-    uint32_t b = settings->block_size;
-    if (settings->block_shift) {
-        return (uint64_t)strata_div_ceil(width + b - 1u, b) * (uint64_t)strata_div_ceil(height + b - 1u, b);
+    if (strata_check_settings(settings, NULL, 0) || width == 0u || height == 0u ||
+        (uint64_t)width * (uint64_t)height > 0xffffffffull) {
+        return 0u;
     }
-    return (uint64_t)strata_div_ceil(width, b) * (uint64_t)strata_div_ceil(height, b);
+    uint64_t b = settings->block_size;
+    uint64_t extra = settings->block_shift ? b - 1u : 0u;
+    return ((width + extra + b - 1u) / b) * ((height + extra + b - 1u) / b);
 }
 
 /* Everything one frame's dispatches need. */

@@ -185,6 +185,7 @@ pub fn export(out: &Path) -> Result<Exported, ExportError> {
             functions: "include/strata_frame.h: strata_frame_params, strata_max_blocks, strata_grid_shift".into(),
         },
         kernels,
+        dispatch_variables: manifest::DISPATCH_VARIABLES.to_vec(),
     };
     let json = serde_json::to_string_pretty(&manifest).map_err(|e| ExportError::Header(e.to_string()))? + "\n";
     files.push((MANIFEST.into(), json.into_bytes()));
@@ -219,54 +220,86 @@ fn manifest_struct(entry: &manifest::StructEntry) -> manifest::StructEntry {
     }
 }
 
-/// Whether `out` may be written: absent, an empty folder, or an earlier package (a
-/// folder with a [`MANIFEST`] of this schema's kind). Anything else is refused: the
-/// export never deletes a user's files.
+/// The entries of a package's folder: an existing folder with anything else in it is not
+/// replaced.
+const PACKAGE_ENTRIES: [&str; 5] = ["README.md", MANIFEST, "include", "kernels", "data"];
+
+/// Whether `out` may be written: a path ending in a folder's own name, absent, an empty
+/// folder, or an earlier package (a folder holding only a package's entries and a
+/// [`MANIFEST`] of this schema's kind). Anything else is refused: the export never
+/// deletes a user's files.
 fn check_out(out: &Path) -> Result<(), String> {
-    if out.as_os_str().is_empty() {
-        return Err("an empty path".into());
+    if !matches!(out.components().next_back(), Some(std::path::Component::Normal(_))) {
+        return Err("give the package folder's own name (not `.`, `..` or a root)".into());
     }
     let Ok(metadata) = std::fs::symlink_metadata(out) else { return Ok(()) };
     if !metadata.is_dir() {
         return Err("exists and is not a folder".into());
     }
-    let entries: Vec<_> = std::fs::read_dir(out).map_err(|e| e.to_string())?.collect();
+    let mut entries = Vec::new();
+    for entry in std::fs::read_dir(out).map_err(|e| e.to_string())? {
+        entries.push(entry.map_err(|e| e.to_string())?.file_name().to_string_lossy().into_owned());
+    }
     if entries.is_empty() {
         return Ok(());
     }
     let manifest = std::fs::read_to_string(out.join(MANIFEST)).unwrap_or_default();
-    if manifest.contains("\"schema_version\"") && manifest.contains("\"strata_version\"") {
-        return Ok(());
+    if !(manifest.contains("\"schema_version\"") && manifest.contains("\"strata_version\"")) {
+        return Err(
+            "is a folder with other files in it (not an earlier strata package): choose an empty or new folder".into(),
+        );
     }
-    Err("is a folder with other files in it (not an earlier strata package): choose an empty or new folder".into())
+    if let Some(foreign) = entries.iter().find(|e| !PACKAGE_ENTRIES.contains(&e.as_str())) {
+        return Err(format!(
+            "is an earlier package with `{foreign}` added to it, which the export would delete: move it out, or \
+             choose another folder"
+        ));
+    }
+    Ok(())
 }
 
-/// Writes `files` into a temporary sibling of `out`, then moves it into place (removing
-/// an earlier package there), so `out` is a whole package or untouched.
+/// Writes `files` into a temporary sibling of `out`, then swaps it into place (an earlier
+/// package there is renamed aside, then removed), so `out` is a whole package, new or
+/// old, at every moment.
 fn write_package(out: &Path, files: &[(String, Vec<u8>)]) -> Result<(), ExportError> {
     let name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "package".into());
     let temporary = out.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
-    let write = |path: &Path, bytes: &[u8]| -> Result<(), ExportError> {
-        let failed = |source| ExportError::Write { path: path.display().to_string(), source };
-        if let Some(parent) = path.parent() {
-            std::fs::create_dir_all(parent).map_err(failed)?;
-        }
-        std::fs::write(path, bytes).map_err(failed)
+    let aside = out.with_file_name(format!(".{name}.old-{}", std::process::id()));
+    let failed = |path: &Path| {
+        let path = path.display().to_string();
+        move |source| ExportError::Write { path, source }
     };
     let _ = std::fs::remove_dir_all(&temporary);
-    let result = (|| {
-        for (relative, bytes) in files {
-            write(&temporary.join(relative), bytes)?;
+    let written = files.iter().try_for_each(|(relative, bytes)| {
+        let path = temporary.join(relative);
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent).map_err(failed(parent))?;
         }
-        if out.exists() {
-            std::fs::remove_dir_all(out)
-                .map_err(|source| ExportError::Write { path: out.display().to_string(), source })?;
-        }
-        std::fs::rename(&temporary, out)
-            .map_err(|source| ExportError::Write { path: out.display().to_string(), source })
-    })();
-    if result.is_err() {
+        std::fs::write(&path, bytes).map_err(failed(&path))
+    });
+    if let Err(error) = written {
         let _ = std::fs::remove_dir_all(&temporary);
+        return Err(error);
     }
-    result
+    // Checked again just before anything is moved: the folder may have changed.
+    if let Err(why) = check_out(out) {
+        let _ = std::fs::remove_dir_all(&temporary);
+        return Err(ExportError::Out { path: out.display().to_string(), why });
+    }
+    let earlier = out.exists();
+    if earlier && let Err(source) = std::fs::rename(out, &aside) {
+        let _ = std::fs::remove_dir_all(&temporary);
+        return Err(ExportError::Write { path: out.display().to_string(), source });
+    }
+    if let Err(source) = std::fs::rename(&temporary, out) {
+        if earlier {
+            let _ = std::fs::rename(&aside, out);
+        }
+        let _ = std::fs::remove_dir_all(&temporary);
+        return Err(ExportError::Write { path: out.display().to_string(), source });
+    }
+    if earlier {
+        let _ = std::fs::remove_dir_all(&aside);
+    }
+    Ok(())
 }

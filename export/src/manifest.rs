@@ -39,7 +39,20 @@ pub struct Manifest {
     pub blue_noise: BlueNoiseEntry,
     /// How a frame runs.
     pub frame: FrameEntry,
+    /// The variables of the kernels' `dispatch` formulas, each with its definition.
+    pub dispatch_variables: Vec<(&'static str, &'static str)>,
 }
+
+/// The variables the dispatch formulas use.
+pub const DISPATCH_VARIABLES: [(&str, &str); 7] = [
+    ("width, height", "the image's size in pixels"),
+    ("B", "the block size (StrataSelectionSettings.block_size)"),
+    ("shift_x, shift_y", "the frame's block-grid shift (strata_grid_shift; 0 without block shifting)"),
+    ("blocks_x, blocks_y", "ceil((width + shift_x) / B), ceil((height + shift_y) / B)"),
+    ("blocks_per_workgroup", "STRATA_HISTOGRAM_SLOTS_PER_WORKGROUP / (B * B)"),
+    ("groups", "ceil(blocks_x * blocks_y / blocks_per_workgroup): the histogram's workgroups in all"),
+    ("max_workgroups", "the device's smallest maxComputeWorkGroupCount component (at least 1)"),
+];
 
 /// One kernel.
 #[derive(Serialize)]
@@ -58,9 +71,12 @@ pub struct KernelEntry {
     pub workgroup_size: [u32; 3],
     /// Workgroup memory the kernel uses, in bytes.
     pub workgroup_memory_bytes: u64,
-    /// Device features beyond core Vulkan 1.1 / SM 6.0 / MSL 2.1 / GLSL 4.50.
+    /// Device features beyond core Vulkan 1.1 / SM 6.0 / MSL 2.1 / GLSL 4.50: `subgroups`
+    /// (Vulkan: subgroup basic and shuffle operations in compute shaders; HLSL: wave
+    /// intrinsics; MSL: SIMD-group functions).
     pub required_features: Vec<&'static str>,
-    /// Workgroups of its dispatch, as formulas (`strata_frame_params` computes them).
+    /// Workgroups of its dispatch (x, y, z), as formulas of the variables of
+    /// [`Manifest::dispatch_variables`] (`strata_frame_params` computes them).
     pub dispatch: [String; 3],
     /// The uniform it reads, by struct name.
     pub uniform: String,
@@ -142,9 +158,10 @@ pub struct BufferEntry {
     /// uniforms, from `strata_frame_params`), `host_once` (after creating it: the
     /// blue-noise tables), `pass` (a kernel).
     pub written_by: &'static str,
-    /// Whether the engine may leave it out (`payloads`: then a pixel's payload is its
+    /// Whether the engine may leave it out: `payloads` (then a pixel's payload is its
     /// index, `SelectionParams.identity_payload` is 1 and any storage buffer of at least 4
-    /// bytes is bound in its place).
+    /// bytes is bound in its place), and `resample_inputs` with `resampled` together (then
+    /// `strata_resample` is not run).
     pub optional: bool,
     /// Its smallest size.
     pub size: SizeEntry,
@@ -260,7 +277,7 @@ pub fn buffer_entry(buffer: PassBuffer) -> BufferEntry {
             Writer::HostOnce => "host_once",
             Writer::Pass => "pass",
         },
-        optional: buffer == PassBuffer::Payloads,
+        optional: matches!(buffer, PassBuffer::Payloads | PassBuffer::ResampleInputs | PassBuffer::Resampled),
         size: SizeEntry { rule, bytes, formula },
     }
 }
@@ -303,8 +320,8 @@ pub fn kernel_entry(module: ModuleId, kernel: &Kernel, translated: &Translated) 
     let [x, y, _] = kernel.workgroup_size;
     let dispatch = match stage {
         Stage::Histogram => [
-            "min(ceil(blocks_x * blocks_y / (1024 / (B * B))), max_workgroups)".to_string(),
-            "ceil(ceil(blocks_x * blocks_y / (1024 / (B * B))) / dispatch_x)".to_string(),
+            "min(groups, max_workgroups)".to_string(),
+            "ceil(groups / min(groups, max_workgroups))".to_string(),
             "1".to_string(),
         ],
         Stage::Select | Stage::Resample => [format!("ceil(width / {x})"), format!("ceil(height / {y})"), "1".into()],
@@ -334,13 +351,7 @@ pub fn kernel_entry(module: ModuleId, kernel: &Kernel, translated: &Translated) 
         },
         workgroup_size: kernel.workgroup_size,
         workgroup_memory_bytes: kernel.workgroup_memory_bytes(),
-        required_features: if kernel.spec.features.subgroup {
-            vec![
-                "subgroups (Vulkan: subgroup basic and shuffle in compute; HLSL: wave intrinsics; MSL: SIMD-group functions)",
-            ]
-        } else {
-            Vec::new()
-        },
+        required_features: if kernel.spec.features.subgroup { vec!["subgroups"] } else { Vec::new() },
         dispatch,
         uniform: kernel
             .bindings
@@ -348,10 +359,7 @@ pub fn kernel_entry(module: ModuleId, kernel: &Kernel, translated: &Translated) 
             .find(|b| b.kind == BindingKind::Uniform)
             .map(|b| b.element.type_name.clone())
             .unwrap_or_default(),
-        msl_sizes_buffer: MslSizes {
-            buffer: MSL_SIZES_BUFFER,
-            sized_bindings: bindings.iter().filter(|b| b.runtime_sized).map(|b| b.name.clone()).collect(),
-        },
+        msl_sizes_buffer: MslSizes { buffer: MSL_SIZES_BUFFER, sized_bindings: translated.msl_sized_bindings.clone() },
         bindings,
         name,
     }

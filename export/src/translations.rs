@@ -26,6 +26,9 @@ pub struct Translated {
     pub wgsl: String,
     /// Each binding's HLSL register (`b0`, `t1`, `u6`) and space, by WGSL name.
     pub hlsl_registers: Vec<(String, String, u32)>,
+    /// The bindings whose sizes naga's MSL reads from the sizes buffer, in the order of
+    /// its members (`_mslBufferSizes { uint sizeN; ... }`, N the global's handle).
+    pub msl_sized_bindings: Vec<String>,
 }
 
 /// Translates `kernel`. Workgroup memory is zeroed by naga's code in the shader (every
@@ -34,11 +37,30 @@ pub fn translate(kernel: &Kernel) -> Result<Translated, ExportError> {
     let options = TranslateOptions { workgroup_zero_init: WorkgroupZeroInit::Polyfill };
     let failed = |error: strata_kernels::KernelError| ExportError::Translation(error.to_string());
     let spirv = strata_kernels::translate::spirv(kernel, options).map_err(failed)?.words;
-    let hlsl = strata_kernels::translate::hlsl(kernel, options).map_err(failed)?;
+    let mut hlsl = strata_kernels::translate::hlsl(kernel, options).map_err(failed)?;
+    hlsl.text = explicit_spaces(kernel, &hlsl.text)?;
     let msl = strata_kernels::translate::msl_version(kernel, options, (2, 1)).map_err(failed)?;
     let glsl = vulkan_glsl(kernel, &strata_kernels::translate::glsl(kernel, options).map_err(failed)?.text)?;
     let hlsl_registers = hlsl_registers(kernel, &hlsl.text)?;
-    Ok(Translated { spirv, hlsl, msl, glsl, wgsl: kernel.source.text.clone(), hlsl_registers })
+    let msl_sized_bindings = msl_sized_bindings(kernel, &msl.text)?;
+    Ok(Translated { spirv, hlsl, msl, glsl, wgsl: kernel.source.text.clone(), hlsl_registers, msl_sized_bindings })
+}
+
+/// The order of the members of naga's MSL sizes buffer, read from the MSL the package
+/// ships: member `sizeN` holds the byte size of global variable N.
+fn msl_sized_bindings(kernel: &Kernel, text: &str) -> Result<Vec<String>, ExportError> {
+    let Some(start) = text.find("struct _mslBufferSizes {") else { return Ok(Vec::new()) };
+    let body = &text[start..text[start..].find("};").map_or(text.len(), |end| start + end)];
+    let globals: Vec<&naga::GlobalVariable> = kernel.module.global_variables.iter().map(|(_, g)| g).collect();
+    body.lines()
+        .filter_map(|line| line.trim().strip_prefix("uint size").and_then(|rest| rest.strip_suffix(';')))
+        .map(|index| {
+            let name = index.parse::<usize>().ok().and_then(|i| globals.get(i)).and_then(|g| g.name.clone());
+            name.ok_or_else(|| {
+                ExportError::Translation(format!("{}: MSL sizes member `size{index}` names no global", kernel.name()))
+            })
+        })
+        .collect()
 }
 
 /// naga's GLSL (written for OpenGL: `layout(..., binding = b)`) with each binding's
@@ -67,6 +89,29 @@ fn vulkan_glsl(kernel: &Kernel, text: &str) -> Result<String, ExportError> {
         )));
     }
     Ok(out)
+}
+
+/// naga's HLSL with every binding's register space written out (`register(u6)` →
+/// `register(u6, space0)`; naga leaves space 0 implicit), so that a D3D12 root signature
+/// can be read off the file as well as off the manifest.
+fn explicit_spaces(kernel: &Kernel, text: &str) -> Result<String, ExportError> {
+    let mut text = text.to_string();
+    for binding in &kernel.bindings {
+        let marker = format!("{} : register(", binding.name);
+        let Some(start) = text.find(&marker) else {
+            return Err(ExportError::Translation(format!(
+                "{}: no HLSL register for `{}`",
+                kernel.name(),
+                binding.name
+            )));
+        };
+        let open = start + marker.len();
+        let close = open + text[open..].find(')').unwrap_or(0);
+        if !text[open..close].contains(',') {
+            text.insert_str(close, &format!(", space{}", binding.group));
+        }
+    }
+    Ok(text)
 }
 
 /// Each binding's register and space as naga's HLSL declares it (`... name :

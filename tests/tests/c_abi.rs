@@ -115,10 +115,13 @@ fn bad_arguments_are_status_codes_with_messages() {
     let (status, text, _) = bind(pass, &half);
     assert_eq!(status, StrataStatus::InvalidArgument);
     assert!(text.contains("resample_inputs and buffers->resampled"), "{text}");
-    // A handle that is not a pass: a tag check, not a crash.
-    let mut not_a_pass = [0u64; 8];
+    // A handle that is not a pass: looked up among the live handles, never read.
+    let mut not_a_pass = [0u8; 1];
     let (status, text, _) = bind(not_a_pass.as_mut_ptr().cast(), &good_buffers);
-    assert_eq!((status, text.as_str()), (StrataStatus::InvalidArgument, "pass is not a pass made by strata_vk_create"));
+    assert_eq!(
+        (status, text.as_str()),
+        (StrataStatus::InvalidArgument, "pass is not a live pass made by strata_vk_create")
+    );
     let (status, text, bindings) = bind(pass, &good_buffers);
     assert_eq!(status, StrataStatus::Ok, "{text}");
     // Bindings of another pass, and bindings passed as a pass.
@@ -135,10 +138,18 @@ fn bad_arguments_are_status_codes_with_messages() {
     // SAFETY: as above.
     let status = unsafe { strata_vk_record_resampling(pass, bindings, vk::CommandBuffer::null(), &mut error) };
     assert_eq!((status, message(&error).as_str()), (StrataStatus::InvalidArgument, "command_buffer is NULL"));
+    // A pass is not destroyed under its live bindings.
+    // SAFETY: the pass is live; the call refuses.
+    let status = unsafe { strata_vk_destroy(pass, &mut error) };
+    assert_eq!(status, StrataStatus::InvalidArgument);
+    assert!(message(&error).contains("1 bindings of this pass are still live"), "{}", message(&error));
     // Teardown, and null handles to the destroyers are nothing.
-    // SAFETY: nothing was submitted; each handle is destroyed once.
+    // SAFETY: nothing was submitted; each handle is destroyed once, and the second
+    // destruction of the bindings is refused without touching them.
     unsafe {
         assert_eq!(strata_vk_destroy_bindings(pass, bindings, &mut error), StrataStatus::Ok);
+        assert_eq!(strata_vk_destroy_bindings(pass, bindings, &mut error), StrataStatus::InvalidArgument);
+        assert!(message(&error).contains("not live bindings"), "{}", message(&error));
         assert_eq!(strata_vk_destroy_bindings(pass, std::ptr::null_mut(), &mut error), StrataStatus::Ok);
         assert_eq!(strata_vk_destroy(pass, &mut error), StrataStatus::Ok);
         assert_eq!(strata_vk_destroy(other, &mut error), StrataStatus::Ok);

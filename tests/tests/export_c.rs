@@ -62,8 +62,19 @@ fn inputs() -> (Vec<Candidate>, Vec<u32>, Vec<ResampleInput>) {
 /// One run's per-frame outputs.
 type Frames = Vec<(Vec<SelectedCandidates>, Vec<ResampleOutput>)>;
 
-/// Frames 0..FRAMES of the wgpu flavour for `settings`.
+/// Frames 0..FRAMES of the wgpu flavour for `settings`, with the engine's payloads.
 fn wgpu_frames(device: &wgpu::Device, queue: &wgpu::Queue, settings: SelectionSettings) -> Frames {
+    wgpu_frames_with(device, queue, settings, true)
+}
+
+/// [`wgpu_frames`], with or without a payloads buffer (without: a pixel's payload is its
+/// index).
+fn wgpu_frames_with(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    settings: SelectionSettings,
+    with_payloads: bool,
+) -> Frames {
     let (candidates, payloads, resample) = inputs();
     let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
     let init =
@@ -81,7 +92,7 @@ fn wgpu_frames(device: &wgpu::Device, queue: &wgpu::Queue, settings: SelectionSe
             device,
             &WgpuBuffers {
                 candidates: (&candidates).into(),
-                payloads: Some((&payloads).into()),
+                payloads: with_payloads.then(|| (&payloads).into()),
                 selections: (&selections).into(),
                 resample: Some(WgpuResampleBuffers { inputs: (&weights).into(), outputs: (&outputs).into() }),
             },
@@ -135,9 +146,16 @@ fn build_c(package: &Path, out: &Path) -> Result<PathBuf, String> {
 
 /// Writes the engine's input files into `folder`.
 fn write_inputs(folder: &Path) {
+    write_inputs_with(folder, true);
+}
+
+/// [`write_inputs`], with or without `payloads.bin`.
+fn write_inputs_with(folder: &Path, with_payloads: bool) {
     let (candidates, payloads, resample) = inputs();
     std::fs::write(folder.join("candidates.bin"), bytemuck::cast_slice(&candidates)).unwrap();
-    std::fs::write(folder.join("payloads.bin"), bytemuck::cast_slice(&payloads)).unwrap();
+    if with_payloads {
+        std::fs::write(folder.join("payloads.bin"), bytemuck::cast_slice(&payloads)).unwrap();
+    }
     std::fs::write(folder.join("resample_inputs.bin"), bytemuck::cast_slice(&resample)).unwrap();
 }
 
@@ -223,6 +241,16 @@ fn both_c_routes_equal_the_rust_pass_bit_for_bit() {
         }
     }
     assert_eq!(runs, 16);
+    // Without a payloads buffer (a pixel's payload is its index), by both routes.
+    let bare = folder.join("no-payloads");
+    std::fs::create_dir_all(&bare).unwrap();
+    write_inputs_with(&bare, false);
+    let settings = SelectionSettings { block_size: 16, candidates: 4, ..Default::default() };
+    let want = wgpu_frames_with(&device, &queue, settings, false);
+    for route in ["library", "package"] {
+        let got = run_c(&program, route, &package, "block_histogram", settings, &bare).unwrap();
+        assert_eq!(first_difference(&got, &want), None, "route {route} without payloads");
+    }
     let _ = std::fs::remove_dir_all(&folder);
 }
 
@@ -256,10 +284,9 @@ fn a_wrong_binding_number_in_the_manifest_or_offset_in_the_header_is_caught() {
     bindings[a]["binding"] = binding_b;
     bindings[b]["binding"] = binding_a;
     std::fs::write(&manifest_path, serde_json::to_string_pretty(&manifest).unwrap()).unwrap();
-    match run_c(&program, "package", &package, "block_histogram", settings, &folder) {
-        Ok(frames) => assert!(first_difference(&frames, &want).is_some(), "a swapped binding went unnoticed"),
-        Err(message) => eprintln!("the swapped binding failed the run: {message}"),
-    }
+    let swapped = run_c(&program, "package", &package, "block_histogram", settings, &folder)
+        .expect("a swapped binding of two storage buffers still runs (the sizes fit): only its outputs are wrong");
+    assert!(first_difference(&swapped, &want).is_some(), "a swapped binding went unnoticed");
     std::fs::write(&manifest_path, original).unwrap();
     // A field of StrataSelectedCandidates moved in strata.h: the build fails on its assert.
     let header_path = package.join("include/strata.h");
@@ -314,12 +341,38 @@ fn the_manifest_is_naga_s_reflection_of_every_kernel() {
             assert!(register.starts_with(class), "{what}: {register}");
             // Every file the entry names exists, and the HLSL declares the register.
             let hlsl = std::fs::read_to_string(package.join(kernel["files"]["hlsl"].as_str().unwrap())).unwrap();
-            assert!(hlsl.contains(&format!("register({register}")), "{what}: {register} not in the HLSL");
+            let declared = format!("{} : register({register}, space0)", binding.name);
+            assert!(hlsl.contains(&declared), "{what}: `{declared}` not in the HLSL");
+            let metal = std::fs::read_to_string(package.join(kernel["files"]["msl"].as_str().unwrap())).unwrap();
+            let parameter = format!("{} [[buffer({})]]", binding.name, binding.binding);
+            assert!(metal.contains(&parameter), "{what}: `{parameter}` not in the MSL");
             let glsl = std::fs::read_to_string(package.join(kernel["files"]["glsl"].as_str().unwrap())).unwrap();
             assert!(glsl.contains(&format!("set = 0, binding = {})", binding.binding)), "{what}: GLSL has no set");
         }
         let spirv = std::fs::read(package.join(kernel["files"]["spirv"].as_str().unwrap())).unwrap();
         assert_eq!(&spirv[..4], &0x0723_0203u32.to_le_bytes(), "{id:?}: not SPIR-V");
+        // The MSL sizes buffer's members, read from the .metal file (`sizeN`: global N of
+        // the kernel's module), in the manifest's order.
+        let metal = std::fs::read_to_string(package.join(kernel["files"]["msl"].as_str().unwrap())).unwrap();
+        let registry_kernel = strata_kernels::Registry::shared().unwrap().get(id.kernel());
+        let globals: Vec<String> =
+            registry_kernel.module.global_variables.iter().map(|(_, g)| g.name.clone().unwrap_or_default()).collect();
+        let members: Vec<String> = metal
+            .split("struct _mslBufferSizes {")
+            .nth(1)
+            .map(|body| body.split("};").next().unwrap_or(""))
+            .unwrap_or("")
+            .lines()
+            .filter_map(|l| l.trim().strip_prefix("uint size")?.strip_suffix(';')?.parse::<usize>().ok())
+            .map(|i| globals[i].clone())
+            .collect();
+        let listed: Vec<String> = kernel["msl_sizes_buffer"]["sized_bindings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_str().unwrap().to_string())
+            .collect();
+        assert_eq!(listed, members, "{id:?}: the MSL sizes buffer's order");
         // The GLSL for Vulkan compiles with glslang as such (`-V`), sets and all; the SPIR-V
         // passes spirv-val for Vulkan 1.1.
         let glsl = package.join(kernel["files"]["glsl"].as_str().unwrap());
@@ -367,6 +420,28 @@ fn the_manifest_is_naga_s_reflection_of_every_kernel() {
             assert!(buffers.contains(&binding["buffer"].as_str().unwrap()), "{binding}");
         }
     }
+    // Every struct's field offsets and size as naga lays the WGSL struct out.
+    for entry in manifest["structs"].as_array().unwrap() {
+        let name = entry["name"].as_str().unwrap();
+        let registry = strata_kernels::Registry::shared().unwrap();
+        let (module, handle) = registry
+            .kernels()
+            .iter()
+            .find_map(|k| {
+                k.module.types.iter().find(|(_, t)| t.name.as_deref() == Some(name)).map(|(h, _)| (&k.module, h))
+            })
+            .unwrap_or_else(|| panic!("no kernel declares {name}"));
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(module.to_ctx()).unwrap();
+        assert_eq!(entry["size"], layouter[handle].size, "{name}");
+        let naga::TypeInner::Struct { members, .. } = &module.types[handle].inner else { panic!("{name}") };
+        let fields = entry["fields"].as_array().unwrap();
+        assert_eq!(fields.len(), members.len(), "{name}");
+        for (field, member) in fields.iter().zip(members) {
+            assert_eq!(field["name"], member.name.as_deref().unwrap(), "{name}");
+            assert_eq!(field["offset"], member.offset, "{name}.{}", field["name"]);
+        }
+    }
     let size = |name: &str| {
         manifest["structs"].as_array().unwrap().iter().find(|s| s["name"] == name).unwrap()["size"].clone()
     };
@@ -409,11 +484,17 @@ fn the_export_refuses_a_folder_that_is_not_a_package() {
     let file = folder.join("notes.txt");
     let message = strata_export::export(&file).unwrap_err().to_string();
     assert!(message.contains("not a folder"), "{message}");
-    // An earlier package is replaced whole.
+    // An earlier package is replaced whole; one with a file of the user's added is not.
     let package = folder.join("package");
     strata_export::export(&package).unwrap();
     strata_export::export(&package).unwrap();
     assert!(package.join("manifest.json").is_file());
+    std::fs::write(package.join("CMakeLists.txt"), "the user's").unwrap();
+    let message = strata_export::export(&package).unwrap_err().to_string();
+    assert!(message.contains("`CMakeLists.txt` added to it"), "{message}");
+    assert!(package.join("CMakeLists.txt").exists() && package.join("manifest.json").exists());
+    let message = strata_export::export(&package.join("..")).unwrap_err().to_string();
+    assert!(message.contains("own name"), "{message}");
     let _ = std::fs::remove_dir_all(&folder);
 }
 

@@ -186,6 +186,8 @@ pub fn export(out: &Path) -> Result<Exported, ExportError> {
         },
         kernels,
         dispatch_variables: manifest::DISPATCH_VARIABLES.to_vec(),
+        choosing_the_histogram: manifest::CHOOSING_THE_HISTOGRAM.to_vec(),
+        device_requirements: device_requirements(registry),
     };
     let json = serde_json::to_string_pretty(&manifest).map_err(|e| ExportError::Header(e.to_string()))? + "\n";
     files.push((MANIFEST.into(), json.into_bytes()));
@@ -200,6 +202,32 @@ pub fn export(out: &Path) -> Result<Exported, ExportError> {
     let _ = Stage::ALL;
     write_package(out, &files)?;
     Ok(Exported { folder: out.to_path_buf(), files: files.into_iter().map(|(name, _)| name).collect() })
+}
+
+/// What the device must offer (`strata_embed`'s `check_limits`, as formulas).
+fn device_requirements(registry: &Registry) -> Vec<(&'static str, String)> {
+    let kernels: Vec<&strata_kernels::Kernel> = MODULES.iter().map(|&m| registry.get(m.kernel())).collect();
+    let storage = kernels
+        .iter()
+        .map(|k| k.bindings.iter().filter(|b| b.kind != strata_kernels::BindingKind::Uniform).count())
+        .max();
+    let shared = kernels.iter().map(|k| k.workgroup_memory_bytes()).max();
+    let invocations = kernels.iter().map(|k| k.invocations()).max();
+    let size_x = kernels.iter().map(|k| k.workgroup_size[0]).max();
+    let size_y = kernels.iter().map(|k| k.workgroup_size[1]).max();
+    let largest: Vec<String> = PassBuffer::ALL
+        .iter()
+        .filter(|b| !matches!(b.size_rule(), strata_embed::SizeRule::Fixed(_)))
+        .map(|&b| manifest::buffer_entry(b).size.formula)
+        .collect();
+    vec![
+        ("maxPerStageDescriptorStorageBuffers", format!(">= {}", storage.unwrap_or(0))),
+        ("maxComputeSharedMemorySize", format!(">= {} (the kernel run's workgroup_memory_bytes)", shared.unwrap_or(0))),
+        ("maxComputeWorkGroupInvocations", format!(">= {}", invocations.unwrap_or(0))),
+        ("maxComputeWorkGroupSize", format!(">= ({}, {}, 1)", size_x.unwrap_or(0), size_y.unwrap_or(0))),
+        ("maxComputeWorkGroupCount", "every component >= max(ceil(width / 8), ceil(height / 8))".into()),
+        ("maxStorageBufferRange", format!(">= the largest of {}", largest.join(", "))),
+    ]
 }
 
 /// The manifest's copy of a header struct.

@@ -41,7 +41,20 @@ pub struct Manifest {
     pub frame: FrameEntry,
     /// The variables of the kernels' `dispatch` formulas, each with its definition.
     pub dispatch_variables: Vec<(&'static str, &'static str)>,
+    /// Which histogram kernel to run where (all three give the same output), as
+    /// `strata_kernels::KernelId::fastest_histogram` chooses for strata's own passes.
+    pub choosing_the_histogram: Vec<&'static str>,
+    /// What the device must offer for a `width` × `height` image, as the Rust passes check
+    /// before they make anything (Vulkan's limit names).
+    pub device_requirements: Vec<(&'static str, String)>,
 }
+
+/// [`Manifest::choosing_the_histogram`], the rule of `KernelId::fastest_histogram`.
+pub const CHOOSING_THE_HISTOGRAM: [&str; 3] = [
+    "a CPU driver (VK_PHYSICAL_DEVICE_TYPE_CPU, e.g. lavapipe) with B <= 16: block_histogram_rank",
+    "otherwise, a device with subgroup basic and shuffle operations in compute: block_histogram_subgroup",
+    "otherwise: block_histogram",
+];
 
 /// The variables the dispatch formulas use.
 pub const DISPATCH_VARIABLES: [(&str, &str); 7] = [

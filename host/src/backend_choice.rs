@@ -21,6 +21,18 @@ pub enum BackendChoice {
     Cpu,
 }
 
+/// Opens the requested backend as [`open_backend`] does, without the notice of a
+/// fall-back (for a helper's second device: the user was told once already).
+pub fn open_backend_quietly(choice: BackendChoice) -> Result<Box<dyn Backend>, BackendError> {
+    match choice {
+        BackendChoice::Auto => match WgpuBackend::new(WgpuOptions { api: WgpuApi::Primary, ..Default::default() }) {
+            Ok(backend) => Ok(Box::new(backend)),
+            Err(_) => Ok(Box::new(CpuBackend::new(CpuOptions::default())?)),
+        },
+        other => open_backend(other),
+    }
+}
+
 /// Opens the requested backend. `Auto` falls back to the CPU interpreter of naga IR,
 /// with a one-line notice on stderr, when no Vulkan adapter exists.
 pub fn open_backend(choice: BackendChoice) -> Result<Box<dyn Backend>, BackendError> {

@@ -219,6 +219,12 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
     let gpu_scene = GpuScene::build(&scene)?;
     let mut backend = open_backend(args.backend)?;
     println!("backend: {}", backend.info().summary());
+    // While the reference renders, a second device builds and runs the methods' kernels
+    // once at 8x8: a CPU driver compiles each kernel at its first dispatch (lavapipe took 93
+    // of the first run's 144 s for the ReSTIR kernels, on one core), and its shader cache
+    // then serves the methods' own first frames.
+    let warm_up = (!backend.info().is_interpreter())
+        .then(|| warm_up_kernels(args.backend, scene.clone(), args.methods.clone(), restir));
     let reference_spp = args.reference_spp.unwrap_or_else(|| default_reference_spp(backend.as_ref()));
     let render = sized_to_backend(args, render, backend.as_ref(), reference_spp);
     *size = Some((render.camera.width, render.camera.height));
@@ -295,6 +301,10 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
             render.camera.height
         );
     }
+    if let Some(warm_up) = warm_up {
+        // Joined before the methods run, so that no kernel is compiled twice at once.
+        let _ = warm_up.join();
+    }
     let comparison = Comparison {
         methods: args.methods.clone(),
         frames: args.frames,
@@ -370,6 +380,34 @@ fn settings_record(
     put("shading", name(&|| clap::ValueEnum::to_possible_value(&restir.shading)).into());
     put("camera_path", args.camera_path.to_string_lossy().into_owned().into());
     map
+}
+
+/// Builds and runs every kernel the methods use, once each at 8x8 on a device of its own,
+/// on another thread; anything failing there is left for the real run to report.
+fn warm_up_kernels(
+    choice: strata::backend_choice::BackendChoice,
+    scene: strata::scene::Scene,
+    methods: Vec<Method>,
+    restir: RestirSettings,
+) -> std::thread::JoinHandle<()> {
+    std::thread::spawn(move || {
+        let run = || -> Result<()> {
+            let mut backend = strata::backend_choice::open_backend_quietly(choice)?;
+            let gpu_scene = GpuScene::build(&scene)?;
+            let mut render = RenderSettings::for_scene(&scene, 8, 8, 1);
+            render.seed = 1;
+            for method in methods {
+                let settings = RestirSettings { method, ..restir };
+                let mut renderer =
+                    strata::restir::RestirRenderer::new(backend.as_mut(), &gpu_scene, &render, settings, scene.extent())?;
+                let frame = renderer.render_frame(backend.as_mut(), None);
+                renderer.destroy(backend.as_mut())?;
+                frame?;
+            }
+            Ok(())
+        };
+        let _ = run();
+    })
 }
 
 /// The reference path-traced at `spp` and written to the output folder.

@@ -398,8 +398,13 @@ fn warm_up_kernels(
             render.seed = 1;
             for method in methods {
                 let settings = RestirSettings { method, ..restir };
-                let mut renderer =
-                    strata::restir::RestirRenderer::new(backend.as_mut(), &gpu_scene, &render, settings, scene.extent())?;
+                let mut renderer = strata::restir::RestirRenderer::new(
+                    backend.as_mut(),
+                    &gpu_scene,
+                    &render,
+                    settings,
+                    scene.extent(),
+                )?;
                 let frame = renderer.render_frame(backend.as_mut(), None);
                 renderer.destroy(backend.as_mut())?;
                 frame?;

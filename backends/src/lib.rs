@@ -8,6 +8,26 @@
 //! Every failure is a [`BackendError`]: no adapter, a missing feature, a limit the device
 //! cannot meet, a binding that does not fit the kernel, a validation error, a lost
 //! device. None of them panics.
+//!
+//! ```
+//! use strata_backends::backend::{download, upload};
+//! use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
+//! use strata_backends::{Backend, Bind};
+//! use strata_kernels::Kernel;
+//!
+//! // Any WGSL compute shader, on the CPU interpreter (no device needed); a
+//! // `WgpuBackend` or `AshBackend` runs it the same way on a GPU.
+//! let source = "@group(0) @binding(0) var<storage, read_write> data: array<u32>;
+//!     @compute @workgroup_size(4) fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+//!         data[id.x] = data[id.x] * 2u + 1u;
+//!     }";
+//! let kernel = Kernel::from_wgsl("double.wgsl", source.into(), "main", false)?;
+//! let mut cpu = CpuBackend::new(CpuOptions::default())?;
+//! let data = upload(&mut cpu, "data", &[1u32, 2, 3, 4])?;
+//! cpu.dispatch(&kernel, &[Bind::new(0, data)], [1, 1, 1])?;
+//! assert_eq!(download::<u32>(&mut cpu, data)?, [3, 5, 7, 9]);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 pub mod ash_backend;
 pub mod backend;

@@ -19,6 +19,22 @@
 //!
 //! Threads: calls on different passes may run concurrently; calls on one pass (and its
 //! bindings) must not (the engine synchronises them, as it does its command buffers).
+//!
+//! From Rust, as C calls it (a pass needs a live Vulkan device: see `examples/c/` and
+//! `tests/tests/c_abi.rs`):
+//!
+//! ```
+//! use strata_vk::*;
+//! let mut error = StrataError { status: StrataStatus::Ok, message: [0; STRATA_ERROR_MESSAGE_BYTES] };
+//! let mut pass = std::ptr::null_mut();
+//! // SAFETY: null pointers are refused, never read.
+//! let status = unsafe { strata_vk_create(std::ptr::null(), std::ptr::null(), 16, 16, &mut pass, &mut error) };
+//! assert_eq!(status, StrataStatus::InvalidArgument);
+//! // SAFETY: a static NUL-terminated string.
+//! let version = unsafe { std::ffi::CStr::from_ptr(strata_vk_version()) };
+//! assert_eq!(version.to_str()?, env!("CARGO_PKG_VERSION"));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use ash::vk::{self, Handle};
 use std::ffi::c_char;

@@ -23,6 +23,21 @@
 //!
 //! Examples that run: `cargo run -p strata-embed --example wgpu_embed` and
 //! `--example ash_embed`.
+//!
+//! What one frame needs, without a device: the uniforms and dispatch sizes (the same
+//! numbers the C header `strata_frame.h` of the export package computes).
+//!
+//! ```
+//! use strata_embed::SelectionSettings;
+//! use strata_embed::frame::{FrameId, frame_params};
+//!
+//! let settings = SelectionSettings { block_shift: true, ..SelectionSettings::default() };
+//! let id = FrameId { frame: 3, seed: 7, identity_payload: true };
+//! let params = frame_params(&settings, 1920, 1080, id, 65535)?;
+//! assert_eq!(params.pixel_workgroups, [240, 135, 1]);
+//! assert!(params.histogram.shift_x < 16 && params.histogram.block_size == 16);
+//! # Ok::<(), strata_embed::EmbedError>(())
+//! ```
 
 mod binding_plan;
 pub mod contract;

@@ -16,15 +16,15 @@
 //! Given the pool and the selected multiset S, resampling gives
 //! E[Y | S] = (1/K) Σ_{j∈S} w_j · f(x_j)/p̂(x_j) = (1/K) Σ_{j∈S} f(x_j)/p(x_j),
 //! provided p̂ > 0 wherever f ≠ 0. Writing c_i for how often candidate i is in S,
-//! E[Y | pool] = (1/K) Σ_i E[c_i] · f(x_i)/p(x_i). If **every candidate's expected
+//! E\[Y | pool\] = (1/K) Σ_i E\[c_i\] · f(x_i)/p(x_i). If **every candidate's expected
 //! selection count is K/n whatever the pool's order**, this is (1/n) Σ_i f(x_i)/p(x_i),
 //! the plain pool average, whose expectation is ∫ f. Two conditions matter:
 //!
 //! 1. The pattern's positions must cover [0, 1) uniformly: each of K positions is
 //!    uniform on its own interval of length 1/K and the intervals tile [0, 1) (random
 //!    offset: [j/K, (j+1)/K); antithetic: [0, ¼), (¼, ½], [½, ¾), (¾, 1]). Then
-//!    E[c_i] = K · (1/n) for every index i, duplicates counted when n < K.
-//!    [`expected_counts`] computes E[c_i] exactly (piecewise-linear positions, integrated
+//!    E\[c_i\] = K · (1/n) for every index i, duplicates counted when n < K.
+//!    [`expected_counts`] computes E\[c_i\] exactly (piecewise-linear positions, integrated
 //!    over u), and the tests check it equals K/n.
 //! 2. The resampling weights must not depend on which subset was drawn: w_j is a function
 //!    of candidate j alone and the normalisation is the fixed 1/K. (A weight that looked at

@@ -16,6 +16,16 @@
 //!
 //! `cargo xtask export --out DIR` runs it. The folder is written next to `DIR` first and
 //! moved into place whole; an existing `DIR` is replaced only if it is an earlier package.
+//!
+//! ```
+//! let out = std::env::temp_dir().join(format!("strata-doc-package-{}", std::process::id()));
+//! let package = strata_export::export(&out)?;
+//! assert!(package.files.iter().any(|f| f == "include/strata.h"));
+//! let manifest: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("manifest.json"))?)?;
+//! assert_eq!(manifest["schema_version"], 1);
+//! # std::fs::remove_dir_all(&out)?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 pub mod abi_header;
 pub mod c_header;

@@ -1,6 +1,6 @@
 //! Output files that are either complete or absent: strata's one writer of files.
 //!
-//! Every encoder (EXR, PNG, CSV, SVG, JSON, HTML) makes its bytes in memory; [`write`]
+//! Every encoder (EXR, PNG, CSV, SVG, JSON, HTML) makes its bytes in memory; [`write()`]
 //! then puts them on the disk under a hidden temporary name in the same folder
 //! (`.NAME.tmp-PID.EXT`), forces them to the device (`fsync`, which is where a full disk
 //! or a failing device says so for data a write call had accepted into the page cache),

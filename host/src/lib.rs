@@ -2,6 +2,23 @@
 //! inputs, and the `strata` command line (in `main.rs`).
 //!
 //! [`Backend`]: strata_backends::Backend
+//!
+//! ```
+//! use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
+//! use strata::synthetic::{CandidateMix, candidate_image};
+//! use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
+//! use strata_kernels::BlockGrid;
+//!
+//! // The paper's block histogram (§4.1) as a pass, on the interpreter here.
+//! let mut backend = CpuBackend::new(CpuOptions::default())?;
+//! let grid = BlockGrid::new(32, 16, 16)?;
+//! let candidates = candidate_image(32, 16, 1, CandidateMix::default());
+//! let pass = BlockHistogramPass::new(&mut backend, HistogramVariant::Auto, grid)?;
+//! let output = pass.run(&mut backend, &candidates)?;
+//! assert_eq!(output, strata_kernels::reference::block_histogram::block_histogram(grid, &candidates));
+//! pass.destroy(&mut backend)?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 pub mod atomic_file;
 pub mod backend_choice;

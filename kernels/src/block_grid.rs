@@ -184,9 +184,7 @@ impl BlockGrid {
 /// The block-grid shift of frame `frame` of render `seed` when the grid moves every frame
 /// (the paper's limitations section): a hash of both, in 0..B per axis.
 pub fn frame_shift(block_size: u32, frame: u32, seed: u32) -> (u32, u32) {
-    let h = crate::reference::stratified_selection::selection_hash(
-        frame ^ crate::reference::stratified_selection::selection_hash(seed ^ 0xb10c),
-    );
+    let h = crate::hash::selection_hash(frame ^ crate::hash::selection_hash(seed ^ 0xb10c));
     (h % block_size, (h >> 16) % block_size)
 }
 

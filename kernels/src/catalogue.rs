@@ -44,7 +44,7 @@ pub enum KernelId {
     StrataSelect,
     /// Embedding: inverse-CDF resampling of the engine's weights (paper §4.2).
     StrataResample,
-    /// A kernel from outside the registry ([`Kernel::from_wgsl`]), keyed by a hash of its
+    /// A kernel from outside the registry ([`Kernel::from_wgsl`](crate::Kernel::from_wgsl)), keyed by a hash of its
     /// source and entry point so that backends can cache its pipeline.
     External(u64),
 }

@@ -1,5 +1,24 @@
 //! strata's compute kernels, written once in WGSL.
 //!
+//! ```
+//! use strata_kernels::{BlockGrid, KernelId, Registry};
+//! use strata_kernels::reference::block_histogram::block_histogram;
+//! use strata_kernels::types::Candidate;
+//!
+//! // Every kernel, parsed and validated by naga, with what its IR says.
+//! let registry = Registry::shared()?;
+//! let histogram = registry.get(KernelId::BlockHistogram);
+//! assert_eq!(histogram.workgroup_size, [64, 1, 1]);
+//! assert!(histogram.bindings.iter().any(|b| b.name == "candidates"));
+//! // Its plain-Rust statement: one 16 x 16 block, two objects.
+//! let grid = BlockGrid::new(16, 16, 16)?;
+//! let candidates: Vec<Candidate> =
+//!     (0..256).map(|p| Candidate { key: (p % 7) as f32, object_id: p / 128 }).collect();
+//! let output = block_histogram(grid, &candidates);
+//! assert_eq!(output.stats[0].clusters, 2);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
 //! * [`catalogue`]: every kernel the project ships, as declared (fragments, entry point,
 //!   features, float tolerance); [`registry`]: each parsed and validated by naga, with
 //!   its workgroup size and bindings read from naga's IR.
@@ -8,7 +27,7 @@
 //!   host, checked against naga's layout by [`layout`].
 //! * [`translate`]: naga's SPIR-V, HLSL, MSL and GLSL back ends with the options every
 //!   backend of the project uses.
-//! * [`reference`]: plain-Rust statements of what each kernel computes, the oracle of
+//! * [`reference`](mod@reference): plain-Rust statements of what each kernel computes, the oracle of
 //!   the tests.
 //! * [`selection`]: the paper's stratified selection on the host (§4.2): the settings
 //!   struct every user shares, the sampler variants and the table of position patterns.
@@ -25,6 +44,7 @@ pub mod constants;
 pub mod embed_types;
 pub mod error;
 pub mod glslang;
+pub mod hash;
 pub mod integer_division;
 pub mod layout;
 pub mod reference;

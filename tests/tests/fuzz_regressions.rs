@@ -1,7 +1,7 @@
 //! The loaders' fuzz harness under `cargo test`: every committed finding
 //! (`tests/data/fuzz/<target>/`) gives an error now, not a panic, a hang or a huge
 //! allocation; and a short fixed-seed campaign of every target (from the seeds written in
-//! code, so that it runs the same without `../shared`) finds nothing. The long campaigns
+//! code, so that it runs the same with or without the scene files) finds nothing. The long campaigns
 //! are `cargo xtask fuzz`; RELIABILITY.md has their figures.
 
 use std::time::{Duration, Instant};

@@ -1,4 +1,4 @@
-//! Loading the shared test scenes (`../shared/scenes`, JSON + PLY) and refusing bad ones
+//! Loading the test scenes committed under `scenes/` (JSON + PLY) and refusing bad ones
 //! with errors that name the file and the field or element.
 
 use std::path::{Path, PathBuf};

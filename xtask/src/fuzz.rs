@@ -35,7 +35,7 @@ pub struct FuzzArgs {
     /// Leave out the shared scenes' files as seeds (only seeds written in code).
     #[arg(long)]
     no_shared: bool,
-    /// Write each target's distinct outcomes to DIR/<target>.txt.
+    /// Write each target's distinct outcomes to `DIR/<target>.txt`.
     #[arg(long)]
     outcomes: Option<PathBuf>,
 }

@@ -2,27 +2,27 @@
 //! kernels on the CPU. It is the reference executor of the cross-backend check and the
 //! command line's fallback when no GPU adapter exists.
 //!
-//! Each kernel is compiled once into a register bytecode ([`insn`], compiled by
-//! [`decode`] and [`expression`]): instructions whose operands are word offsets in the
+//! Each kernel is compiled once into a register bytecode (`insn`, compiled by
+//! `decode` and `expression`): instructions whose operands are word offsets in the
 //! frame's register file, small callees inlined, fields and bitcasts aliasing their
-//! source's registers, compile-time values in a register template. [`interp`] runs it;
-//! [`memory`] is the pointer model (offsets in bytes into bound buffers, in register
+//! source's registers, compile-time values in a register template. `interp` runs it;
+//! `memory` is the pointer model (offsets in bytes into bound buffers, in register
 //! words elsewhere). Workgroups run in parallel on the machine's cores;
-//! the invocations of a workgroup run together from barrier to barrier ([`exec`]), each
+//! the invocations of a workgroup run together from barrier to barrier (`exec`), each
 //! a resumable stack of frames, so every invocation reaches a barrier before any passes
 //! it; those at the same place run as one group, each instruction decoded once for the
-//! whole group ([`interp`]). Each dispatch is counted ([`counts`]): instructions, and
+//! whole group (`interp`). Each dispatch is counted (`counts`): instructions, and
 //! the issue slots a 32-wide SIMT GPU would spend on the same groups, by kernel. A
 //! barrier or subgroup operation reached in non-uniform control flow is an error
 //! naming the line and function. Subgroup operations run with a configurable subgroup
 //! size (1, 8, 32, ...).
 //!
-//! Semantics follow WGSL, not Rust ([`arith`]): wrapping integers, division and remainder
+//! Semantics follow WGSL, not Rust (`arith`): wrapping integers, division and remainder
 //! by zero as WGSL defines them, masked shifts, saturating float→int conversion, IEEE
 //! f32 without contraction. Out-of-bounds indices are clamped (naga's `Restrict` policy);
 //! out-of-bounds memory words read as 0 and are not written.
 //!
-//! Supported today: 32-bit scalars, bool, 64-bit integers ([`wide`]: two words, low
+//! Supported today: 32-bit scalars, bool, 64-bit integers (`wide`: two words, low
 //! first, as the storage layout has them; arithmetic, comparisons, bit operations,
 //! shifts, conversions, `abs`/`min`/`max`/`clamp`/`sign`), f16 (held in a register
 //! word as the f32 of equal value, every operation computed in f32 and rounded to

@@ -1,5 +1,5 @@
 //! Small valid files written in code, the seeds every target starts from without
-//! `../shared`: binary PLY meshes, PNG textures, RGB EXR images (each compression the
+//! the scene files: binary PLY meshes, PNG textures, RGB EXR images (each compression the
 //! `exr` crate writes).
 
 use exr::prelude::{Compression, Encoding, Image, Layer, LayerAttributes, SpecificChannels, WritableImage};

@@ -217,7 +217,7 @@ pub struct Campaign {
     /// One allocation over this many bytes is a finding (0: unchecked); needs the
     /// [`super::GuardedAllocator`] as the process's global allocator.
     pub allocation_limit: usize,
-    /// The shared scenes (`../shared/scenes`), whose small files join the seeds.
+    /// The committed test scenes (`scenes/`), whose small files join the seeds.
     pub shared_scenes: Option<PathBuf>,
     /// Print a progress line this often.
     pub progress: Option<Duration>,
@@ -321,8 +321,9 @@ fn report_running_and_exit(kind: &str, what: String, status: i32) -> ! {
     std::process::exit(status)
 }
 
-/// Called by [`super::GuardedAllocator`] on an allocation over the limit.
-pub(super) fn report_huge_allocation(size: usize) {
+/// Called by [`super::GuardedAllocator`] on an allocation over the limit (registered
+/// with [`super::alloc::on_huge_allocation`] when a campaign starts).
+fn report_huge_allocation(size: usize) {
     let backtrace = std::backtrace::Backtrace::force_capture().to_string();
     let ours: Vec<&str> = backtrace.lines().filter(|l| l.contains(" at ") && !l.contains("/rustc/")).take(8).collect();
     eprintln!("fuzz: where the allocation was made:\n{}", ours.join("\n"));
@@ -349,6 +350,7 @@ pub fn run_campaign(target: &dyn Target, campaign: &Campaign) -> CampaignReport 
     let stop = AtomicBool::new(false);
     let hang_ms = campaign.hang_after.as_millis() as u64;
     let started = Instant::now();
+    super::alloc::on_huge_allocation(report_huge_allocation);
     let previous_limit = super::alloc::set_allocation_limit(0);
     std::thread::scope(|scope| {
         scope.spawn(|| {

@@ -146,7 +146,7 @@ mod tests {
     #[test]
     fn arguments_are_quoted_only_where_a_shell_needs_it() {
         assert_eq!(shell_quote("--width"), "--width");
-        assert_eq!(shell_quote("../shared/scenes/a.json"), "../shared/scenes/a.json");
+        assert_eq!(shell_quote("scenes/cornell-box/scene.json"), "scenes/cornell-box/scene.json");
         assert_eq!(shell_quote("a b"), "'a b'");
         assert_eq!(shell_quote("it's"), "'it'\\''s'");
         assert_eq!(shell_quote(""), "''");

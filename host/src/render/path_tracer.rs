@@ -292,7 +292,7 @@ const PROGRESS_EVERY: std::time::Duration = std::time::Duration::from_millis(250
 
 /// Renders `samples` samples per pixel of `scene`; `progress` is called with the samples
 /// the device has finished: after the first (which carries the kernel's compilation, so
-/// that estimates can leave it out) and then at most every [`PROGRESS_EVERY`] (a submitted
+/// that estimates can leave it out) and then at most every 250 ms (a submitted
 /// dispatch is not a finished one: counting submissions told a fresh machine 9 minutes
 /// for a 28-second reference).
 pub fn render(

@@ -1,4 +1,4 @@
-//! The JSON scene description of `../shared/scenes/*/scene.json`, as serde types.
+//! The JSON scene description of `scenes/*/scene.json` (the shared test scenes), as serde types.
 
 use super::SceneError;
 use serde::Deserialize;

@@ -5,9 +5,13 @@
 //! that name the glTF field. Found by the loaders' fuzzer (RELIABILITY.md).
 
 use super::SceneError;
-use super::gltf_scene::json_error;
 use gltf::Document;
 use std::path::Path;
+
+/// A glTF error: `field` is the JSON path of the problem.
+pub(super) fn json_error(path: &Path, field: impl Into<String>, message: impl Into<String>) -> SceneError {
+    SceneError::Json { path: path.into(), field: field.into(), message: message.into() }
+}
 
 /// Refuses an accessor whose declared elements cannot fit in its buffer view (before any
 /// of them is read or allocated): `count` elements of `stride` bytes from `byteOffset` must

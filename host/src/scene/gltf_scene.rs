@@ -38,7 +38,9 @@
 //! read through the loader's [`FileSource`].
 
 use super::files::{self, DiskFiles, FileSource};
-use super::gltf_check::{check_accessor_sizes, check_glb_header, check_position_accessors, document_error, raw_json};
+use super::gltf_check::{
+    check_accessor_sizes, check_glb_header, check_position_accessors, document_error, json_error, raw_json,
+};
 use super::mesh_util::{
     DEFAULT_IMAGE_SIDE, MIN_ALPHA, assemble_scene, bounds, checked_triangles, default_material, emission,
     far_clip_beyond, metal, tinted, without_panic,
@@ -65,11 +67,6 @@ pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
 pub fn load_gltf_from(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene, SceneError> {
     without_panic(|| load_bytes(path, bytes, files))
         .unwrap_or_else(|message| Err(json_error(path, "(document)", message)))
-}
-
-/// A glTF error: `field` is the JSON path of the problem.
-pub(super) fn json_error(path: &Path, field: impl Into<String>, message: impl Into<String>) -> SceneError {
-    SceneError::Json { path: path.into(), field: field.into(), message: message.into() }
 }
 
 /// Refuses a document that is not glTF 2.x (`asset.version` "1.0" is a different format

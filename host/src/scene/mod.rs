@@ -1,4 +1,4 @@
-//! Scenes: the JSON + PLY description of the shared test scenes (`../shared/scenes`,
+//! Scenes: the JSON + PLY description of the shared test scenes (`scenes/`,
 //! every formula in their CONVENTIONS.md), loaded into triangles with object ids (the
 //! paper's masking key, §4.3), materials, emitters, a camera and an environment. glTF 2.0
 //! (`.gltf`, `.glb`) and Wavefront OBJ + MTL files load into the same [`Scene`]

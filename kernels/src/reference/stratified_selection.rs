@@ -14,12 +14,7 @@ use crate::selection::patterns::BELOW_ONE;
 use crate::selection::{MAX_SELECTED, Pattern, SamplerVariant};
 use crate::types::{Candidate, ClusterSpan, OBJECT_ID_NONE};
 
-/// PCG hash (Jarzynski and Olano 2020), WGSL `selection_hash`.
-pub fn selection_hash(v: u32) -> u32 {
-    let state = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
-    let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277_803_737);
-    (word >> 22) ^ word
-}
+pub use crate::hash::selection_hash;
 
 fn unit_float(bits: u32) -> f32 {
     (bits >> 8) as f32 * (1.0 / 16_777_216.0)

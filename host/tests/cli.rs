@@ -259,3 +259,29 @@ fn a_second_run_into_the_same_folder_replaces_the_first_runs_files() {
     let histogram = record["settings"]["histogram_kernel"].as_str();
     assert!(matches!(histogram, Some("block_histogram" | "block_histogram_subgroup")), "{record}");
 }
+
+/// `docs/cli.md` is every subcommand's `--help`, so the flag reference and the command
+/// line never disagree. `STRATA_BLESS=1` rewrites the file from the binary.
+#[test]
+fn the_flag_reference_is_the_commands_help() {
+    let mut reference = String::from(
+        "# Every flag of `strata`\n\n[← README](../README.md)\n\nThe `--help` of each command, generated from the argument types: \
+         `STRATA_BLESS=1 cargo test -p strata --test cli` rewrites this file, and the test fails when it differs \
+         from the binary.\n",
+    );
+    for command in ["compare", "render", "metrics", "plot", "histogram"] {
+        let output = Command::new(env!("CARGO_BIN_EXE_strata")).args([command, "--help"]).output().unwrap();
+        assert!(output.status.success(), "{command} --help");
+        let help = text(&output.stdout);
+        reference += &format!("\n## strata {command}\n\n```text\n{}\n```\n", help.trim_end());
+    }
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/cli.md");
+    if std::env::var_os("STRATA_BLESS").is_some() {
+        std::fs::write(&path, &reference).unwrap();
+    }
+    let committed = std::fs::read_to_string(&path).unwrap_or_default();
+    assert!(
+        committed == reference,
+        "docs/cli.md is not the commands' --help: run STRATA_BLESS=1 cargo test -p strata --test cli"
+    );
+}

@@ -43,3 +43,55 @@ fn nothing_reads_the_folder_beside_the_checkout() {
     assert!(offenders.is_empty(), "files that read ../shared: {offenders:?}");
     assert!(root.join("scenes/cornell-box/scene.json").is_file(), "the test scenes are committed");
 }
+
+/// GitHub's anchor of a heading: lower case, punctuation dropped, spaces as hyphens.
+fn anchor(heading: &str) -> String {
+    heading
+        .trim()
+        .to_lowercase()
+        .chars()
+        .filter(|c| c.is_alphanumeric() || *c == '-' || *c == '_' || *c == ' ')
+        .map(|c| if c == ' ' { '-' } else { c })
+        .collect()
+}
+
+/// Every relative link of README.md and docs/*.md names a file that exists, and every
+/// `#anchor` a heading of its file: the README's map of moved sections works.
+#[test]
+fn the_readme_and_docs_links_resolve() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut pages = vec![root.join("README.md"), root.join("BENCHMARKS.md")];
+    for entry in std::fs::read_dir(root.join("docs")).unwrap().filter_map(Result::ok) {
+        if entry.path().extension().is_some_and(|e| e == "md") {
+            pages.push(entry.path());
+        }
+    }
+    let mut checked = 0;
+    for page in &pages {
+        let text = std::fs::read_to_string(page).unwrap();
+        for piece in text.split("](").skip(1) {
+            let target = piece.split(')').next().unwrap_or("");
+            if target.starts_with("http") || target.is_empty() {
+                continue;
+            }
+            let (file, fragment) = target.split_once('#').unwrap_or((target, ""));
+            let linked = if file.is_empty() { page.clone() } else { page.parent().unwrap().join(file) };
+            assert!(linked.exists(), "{}: link to {target}: no such file", page.display());
+            if !fragment.is_empty() {
+                let headings: Vec<String> = std::fs::read_to_string(&linked)
+                    .unwrap()
+                    .lines()
+                    .filter_map(|l| l.trim_start_matches('#').strip_prefix(' ').filter(|_| l.starts_with('#')))
+                    .map(anchor)
+                    .collect();
+                assert!(
+                    headings.iter().any(|h| h == fragment),
+                    "{}: link to {target}: no such heading",
+                    page.display()
+                );
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked > 20, "only {checked} links checked");
+}

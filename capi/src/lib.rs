@@ -463,6 +463,30 @@ pub unsafe extern "C" fn strata_vk_bind(
     }
 }
 
+/// Checks a recording call's handles and command buffer, then records with `record`.
+///
+/// # Safety
+/// As [`strata_vk_record_selection`].
+unsafe fn recording(
+    pass: *mut StrataVkPass,
+    bindings: *const StrataVkBindings,
+    command_buffer: VkCommandBuffer,
+    error: *mut StrataError,
+    record: impl FnOnce(&AshSelection, &AshBindings) -> Result<(), EmbedError>,
+) -> StrataStatus {
+    // SAFETY: per this function's contract.
+    unsafe {
+        guarded(error, || {
+            let owner = pass_of(pass, "pass")?;
+            let bindings = bindings_of(bindings, pass)?;
+            if command_buffer.is_null() {
+                return Err(invalid("command_buffer is NULL"));
+            }
+            Ok(record(&owner.selection, &bindings.bindings)?)
+        })
+    }
+}
+
 /// Records frame `frame`'s uniform updates, histogram and selection into the engine's
 /// command buffer, with the barriers the pass needs (from the engine's earlier shader and
 /// transfer writes, between its dispatches, and to the engine's later reads).
@@ -478,16 +502,10 @@ pub unsafe extern "C" fn strata_vk_record_selection(
     frame: u32,
     error: *mut StrataError,
 ) -> StrataStatus {
-    // SAFETY: per this function's contract.
+    // SAFETY: per this function's contract; the command buffer is checked non-null first.
     unsafe {
-        guarded(error, || {
-            let owner = pass_of(pass, "pass")?;
-            let bindings = bindings_of(bindings, pass)?;
-            if command_buffer.is_null() {
-                return Err(invalid("command_buffer is NULL"));
-            }
-            owner.selection.record_selection(command_buffer, &bindings.bindings, frame)?;
-            Ok(())
+        recording(pass, bindings, command_buffer, error, |selection, bound| {
+            selection.record_selection(command_buffer, bound, frame)
         })
     }
 }
@@ -504,16 +522,10 @@ pub unsafe extern "C" fn strata_vk_record_resampling(
     command_buffer: VkCommandBuffer,
     error: *mut StrataError,
 ) -> StrataStatus {
-    // SAFETY: per this function's contract.
+    // SAFETY: as above.
     unsafe {
-        guarded(error, || {
-            let owner = pass_of(pass, "pass")?;
-            let bindings = bindings_of(bindings, pass)?;
-            if command_buffer.is_null() {
-                return Err(invalid("command_buffer is NULL"));
-            }
-            owner.selection.record_resampling(command_buffer, &bindings.bindings)?;
-            Ok(())
+        recording(pass, bindings, command_buffer, error, |selection, bound| {
+            selection.record_resampling(command_buffer, bound)
         })
     }
 }

@@ -294,3 +294,70 @@ impl Drop for AshEngine {
         }
     }
 }
+
+/// The engine's inputs of one run of the embeddable pass.
+pub struct EmbedInputs<'a> {
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// One candidate per pixel.
+    pub candidates: &'a [strata_embed::contract::Candidate],
+    /// One payload per pixel, or `None` (a pixel's payload is its index).
+    pub payloads: Option<&'a [u32]>,
+    /// One resampling input per pixel.
+    pub resample: &'a [strata_embed::contract::ResampleInput],
+}
+
+/// Each frame's selections and resampling results.
+pub type EmbedFrames =
+    Vec<(Vec<strata_embed::contract::SelectedCandidates>, Vec<strata_embed::contract::ResampleOutput>)>;
+
+/// Frames `0..frames` of `strata_embed`'s wgpu flavour over `inputs`, with `settings` and
+/// render `seed`: what every other route to the pass (ash, the C ABI, the C program from
+/// the kernel package) must equal bit for bit.
+pub fn wgpu_embed_frames(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    settings: strata_embed::SelectionSettings,
+    seed: u32,
+    inputs: &EmbedInputs,
+    frames: u32,
+) -> EmbedFrames {
+    use strata_embed::contract::{ResampleOutput, SelectedCandidates};
+    use wgpu::util::DeviceExt;
+    let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+    let init =
+        |contents: &[u8]| device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents, usage });
+    let pixels = (inputs.width * inputs.height) as usize;
+    let candidates = init(bytemuck::cast_slice(inputs.candidates));
+    let payloads = inputs.payloads.map(|p| init(bytemuck::cast_slice(p)));
+    let selections = init(&vec![0; pixels * size_of::<SelectedCandidates>()]);
+    let weights = init(bytemuck::cast_slice(inputs.resample));
+    let outputs = init(&vec![0; pixels * size_of::<ResampleOutput>()]);
+    let mut pass = strata_embed::WgpuSelection::new(device, settings, inputs.width, inputs.height).unwrap();
+    pass.set_seed(seed);
+    let bindings = pass
+        .bind(
+            device,
+            &strata_embed::WgpuBuffers {
+                candidates: (&candidates).into(),
+                payloads: payloads.as_ref().map(Into::into),
+                selections: (&selections).into(),
+                resample: Some(strata_embed::WgpuResampleBuffers {
+                    inputs: (&weights).into(),
+                    outputs: (&outputs).into(),
+                }),
+            },
+        )
+        .unwrap();
+    (0..frames)
+        .map(|frame| {
+            let mut encoder = device.create_command_encoder(&Default::default());
+            pass.encode_selection(queue, &mut encoder, &bindings, frame).unwrap();
+            pass.encode_resampling(&mut encoder, &bindings).unwrap();
+            queue.submit([encoder.finish()]);
+            (read_wgpu_buffer(device, queue, &selections), read_wgpu_buffer(device, queue, &outputs))
+        })
+        .collect()
+}

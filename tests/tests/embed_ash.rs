@@ -5,12 +5,8 @@
 //! errors naming the buffer.
 
 use strata_embed::contract::{Candidate, ResampleInput, ResampleOutput, SelectedCandidates};
-use strata_embed::{
-    AshBufferSlice, AshBuffers, AshResampleBuffers, AshSelection, SelectionSettings, WgpuBuffers, WgpuResampleBuffers,
-    WgpuSelection,
-};
-use strata_tests::{AshEngine, engine_device, read_wgpu_buffer};
-use wgpu::util::DeviceExt;
+use strata_embed::{AshBufferSlice, AshBuffers, AshResampleBuffers, AshSelection, SelectionSettings};
+use strata_tests::{AshEngine, EmbedInputs, engine_device, wgpu_embed_frames};
 
 const WIDTH: u32 = 50;
 const HEIGHT: u32 = 27;
@@ -42,39 +38,14 @@ fn settings() -> SelectionSettings {
 fn wgpu_frames() -> Option<Frames> {
     let (device, queue) = engine_device("ash_flavour_matches_wgpu_flavour", None)?;
     let (candidates, payloads, resample) = inputs();
-    let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
-    let init =
-        |contents: &[u8]| device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents, usage });
-    let pixels = (WIDTH * HEIGHT) as usize;
-    let candidates = init(bytemuck::cast_slice(&candidates));
-    let payloads = init(bytemuck::cast_slice(&payloads));
-    let selections = init(&vec![0; pixels * size_of::<SelectedCandidates>()]);
-    let weights = init(bytemuck::cast_slice(&resample));
-    let outputs = init(&vec![0; pixels * size_of::<ResampleOutput>()]);
-    let mut pass = WgpuSelection::new(&device, settings(), WIDTH, HEIGHT).unwrap();
-    pass.set_seed(9);
-    let bindings = pass
-        .bind(
-            &device,
-            &WgpuBuffers {
-                candidates: (&candidates).into(),
-                payloads: Some((&payloads).into()),
-                selections: (&selections).into(),
-                resample: Some(WgpuResampleBuffers { inputs: (&weights).into(), outputs: (&outputs).into() }),
-            },
-        )
-        .unwrap();
-    Some(
-        (0..4)
-            .map(|frame| {
-                let mut encoder = device.create_command_encoder(&Default::default());
-                pass.encode_selection(&queue, &mut encoder, &bindings, frame).unwrap();
-                pass.encode_resampling(&mut encoder, &bindings).unwrap();
-                queue.submit([encoder.finish()]);
-                (read_wgpu_buffer(&device, &queue, &selections), read_wgpu_buffer(&device, &queue, &outputs))
-            })
-            .collect(),
-    )
+    let inputs = EmbedInputs {
+        width: WIDTH,
+        height: HEIGHT,
+        candidates: &candidates,
+        payloads: Some(&payloads),
+        resample: &resample,
+    };
+    Some(wgpu_embed_frames(&device, &queue, settings(), 9, &inputs, 4))
 }
 
 type Frames = Vec<(Vec<SelectedCandidates>, Vec<ResampleOutput>)>;

@@ -13,9 +13,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use strata_embed::contract::{Candidate, ResampleInput, ResampleOutput, SelectedCandidates};
 use strata_embed::wgsl::{ModuleId, module};
-use strata_embed::{SamplerVariant, SelectionSettings, WgpuBuffers, WgpuResampleBuffers, WgpuSelection};
-use strata_tests::{engine_device, read_wgpu_buffer};
-use wgpu::util::DeviceExt;
+use strata_embed::{SamplerVariant, SelectionSettings};
+use strata_tests::{EmbedInputs, engine_device, wgpu_embed_frames};
 
 const WIDTH: u32 = 45;
 const HEIGHT: u32 = 29;
@@ -76,37 +75,14 @@ fn wgpu_frames_with(
     with_payloads: bool,
 ) -> Frames {
     let (candidates, payloads, resample) = inputs();
-    let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
-    let init =
-        |contents: &[u8]| device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents, usage });
-    let pixels = (WIDTH * HEIGHT) as usize;
-    let candidates = init(bytemuck::cast_slice(&candidates));
-    let payloads = init(bytemuck::cast_slice(&payloads));
-    let selections = init(&vec![0; pixels * size_of::<SelectedCandidates>()]);
-    let weights = init(bytemuck::cast_slice(&resample));
-    let outputs = init(&vec![0; pixels * size_of::<ResampleOutput>()]);
-    let mut pass = WgpuSelection::new(device, settings, WIDTH, HEIGHT).unwrap();
-    pass.set_seed(SEED);
-    let bindings = pass
-        .bind(
-            device,
-            &WgpuBuffers {
-                candidates: (&candidates).into(),
-                payloads: with_payloads.then(|| (&payloads).into()),
-                selections: (&selections).into(),
-                resample: Some(WgpuResampleBuffers { inputs: (&weights).into(), outputs: (&outputs).into() }),
-            },
-        )
-        .unwrap();
-    (0..FRAMES)
-        .map(|frame| {
-            let mut encoder = device.create_command_encoder(&Default::default());
-            pass.encode_selection(queue, &mut encoder, &bindings, frame).unwrap();
-            pass.encode_resampling(&mut encoder, &bindings).unwrap();
-            queue.submit([encoder.finish()]);
-            (read_wgpu_buffer(device, queue, &selections), read_wgpu_buffer(device, queue, &outputs))
-        })
-        .collect()
+    let inputs = EmbedInputs {
+        width: WIDTH,
+        height: HEIGHT,
+        candidates: &candidates,
+        payloads: with_payloads.then_some(payloads.as_slice()),
+        resample: &resample,
+    };
+    wgpu_embed_frames(device, queue, settings, SEED, &inputs, FRAMES)
 }
 
 /// The shared library `strata_vk`, built by cargo beside the test binaries.

@@ -4,7 +4,7 @@
 use crate::error::EmbedError;
 use strata_kernels::embed_types::SelectionParams;
 use strata_kernels::selection::SelectionSettings;
-use strata_kernels::types::{HISTOGRAM_SLOTS_PER_WORKGROUP, HistogramParams};
+use strata_kernels::types::HistogramParams;
 use strata_kernels::{BlockGrid, KernelId, Registry};
 
 /// Everything one frame's dispatches need.
@@ -83,10 +83,8 @@ pub fn frame_params(
         height,
         why: e.to_string(),
     })?;
-    let blocks_per_workgroup = HISTOGRAM_SLOTS_PER_WORKGROUP / (settings.block_size * settings.block_size);
-    let total = grid.block_count().div_ceil(blocks_per_workgroup);
-    let x = total.min(max_workgroups.max(1));
-    let histogram_workgroups = [x, total.div_ceil(x), 1];
+    let histogram_workgroups = grid.histogram_workgroups(max_workgroups);
+    let x = histogram_workgroups[0];
     let selection = SelectionParams {
         width,
         height,

@@ -10,13 +10,10 @@ use thiserror::Error;
 /// Slots one workgroup sorts (`SLOTS` in `strata/histogram.wgsl`).
 pub const SLOTS_PER_WORKGROUP: u32 = strata_kernels::types::HISTOGRAM_SLOTS_PER_WORKGROUP;
 
-/// Workgroups of a dispatch over `grid`, in rows of at most the backend's limit.
+/// Workgroups of a dispatch over `grid`, in rows of at most the backend's limit
+/// ([`BlockGrid::histogram_workgroups`]).
 fn workgroups_of(backend: &dyn Backend, grid: BlockGrid) -> [u32; 3] {
-    let block_area = grid.block_size * grid.block_size;
-    let total = grid.block_count().div_ceil(SLOTS_PER_WORKGROUP / block_area);
-    let max = backend.info().limits.max_workgroups_per_dimension.max(1);
-    let x = total.min(max);
-    [x, total.div_ceil(x), 1]
+    grid.histogram_workgroups(backend.info().limits.max_workgroups_per_dimension)
 }
 
 /// Which entry point of the histogram kernel to run.

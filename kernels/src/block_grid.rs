@@ -123,6 +123,18 @@ impl BlockGrid {
         (self.width + extra).div_ceil(self.block_size) * (self.height + extra).div_ceil(self.block_size)
     }
 
+    /// Workgroups of the histogram dispatch over this grid: `1024 / B²` whole blocks per
+    /// workgroup, laid out in rows of at most `max_workgroups` (the device's
+    /// per-dimension limit; 0 counts as 1). The one statement of this formula: the
+    /// renderer's pass, the embeddable pass and (in C) the export's `strata_frame.h` give
+    /// the same numbers.
+    pub fn histogram_workgroups(&self, max_workgroups: u32) -> [u32; 3] {
+        let blocks_per_workgroup = crate::types::HISTOGRAM_SLOTS_PER_WORKGROUP / (self.block_size * self.block_size);
+        let total = self.block_count().div_ceil(blocks_per_workgroup);
+        let x = total.min(max_workgroups.max(1));
+        [x, total.div_ceil(x), 1]
+    }
+
     /// The `HistogramParams` of a dispatch over this grid with `workgroups_x` workgroups
     /// per row of the dispatch grid; `masking` false puts every candidate with an object id
     /// in one cluster per block (paper §4.3 without object masking).

@@ -98,5 +98,62 @@ pub fn compile_hlsl(hlsl: &Path, entry: &str) -> Result<Vec<u32>, ToolError> {
     if bytes.len() % 4 != 0 || bytes.len() < 20 {
         return Err(ToolError::Failed(format!("{}: not a SPIR-V file", output.display())));
     }
-    Ok(bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect())
+    let words: Vec<u32> = bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect();
+    Ok(with_unknown_source_language(words))
+}
+
+/// SPIR-V's `OpSource` opcode.
+const OP_SOURCE: u32 = 3;
+/// The `SourceLanguage` value `Unknown`.
+const SOURCE_LANGUAGE_UNKNOWN: u32 = 0;
+
+/// Rewrites the language operand of every `OpSource` instruction to `Unknown`.
+///
+/// Why: Slang labels its modules with source language 11 (Slang), newer than the
+/// SPIR-V tools inside Debian's Vulkan validation layer, which then reject the whole
+/// module as invalid ("Invalid source language operand: 11"). `OpSource` is debug
+/// information only, so the rewrite changes no behaviour. Words that do not parse as
+/// instructions are returned as they came, for the driver to judge.
+pub fn with_unknown_source_language(mut words: Vec<u32>) -> Vec<u32> {
+    const HEADER_WORDS: usize = 5;
+    let mut at = HEADER_WORDS;
+    while at < words.len() {
+        let word_count = (words[at] >> 16) as usize;
+        let opcode = words[at] & 0xffff;
+        if word_count == 0 || at + word_count > words.len() {
+            break;
+        }
+        if opcode == OP_SOURCE && word_count >= 2 {
+            words[at + 1] = SOURCE_LANGUAGE_UNKNOWN;
+        }
+        at += word_count;
+    }
+    words
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_the_language_of_op_source_is_rewritten() {
+        const MAGIC: u32 = 0x0723_0203;
+        const SLANG_LANGUAGE: u32 = 11;
+        let op_capability_shader = [(2 << 16) | 17, 1];
+        let op_source_slang = [(3 << 16) | OP_SOURCE, SLANG_LANGUAGE, 1];
+        let mut words = vec![MAGIC, 0x0001_0300, 0, 100, 0];
+        words.extend(op_capability_shader);
+        words.extend(op_source_slang);
+        let rewritten = with_unknown_source_language(words.clone());
+        assert_eq!(rewritten[..7], words[..7], "header and OpCapability untouched");
+        assert_eq!(rewritten[7], words[7], "OpSource keeps its opcode and length");
+        assert_eq!(rewritten[8], SOURCE_LANGUAGE_UNKNOWN);
+        assert_eq!(rewritten[9], 1, "the version operand stays");
+    }
+
+    #[test]
+    fn a_truncated_module_comes_back_unchanged() {
+        let words = vec![0x0723_0203, 0x0001_0300, 0, 100, 0, (9 << 16) | OP_SOURCE, 11];
+        assert_eq!(with_unknown_source_language(words.clone()), words);
+    }
 }

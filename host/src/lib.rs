@@ -1,35 +1,28 @@
-//! strata's host: the passes that drive the kernels on any [`Backend`], synthetic
-//! inputs, and the `strata` command line (in `main.rs`).
+//! strata's evaluation and command line: `compare`, `metrics`, plots, the report page
+//! and the `strata` binary (in `main.rs`), over the product crate [`strata_render`],
+//! whose modules are re-exported here under their own names (`strata::scene`,
+//! `strata::restir`, ...) so that a program can use either crate's paths.
 //!
-//! [`Backend`]: strata_backends::Backend
+//! An engine that renders depends on `strata-render` alone: this crate adds the
+//! plotting, font, progress and time-formatting dependencies that only an evaluation
+//! needs.
 //!
 //! ```
-//! use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
-//! use strata::synthetic::{CandidateMix, candidate_image};
-//! use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
-//! use strata_kernels::BlockGrid;
+//! use strata::evaluation::metrics::relmse;
+//! use strata::rgb_image::RgbImage;
 //!
-//! // The paper's block histogram (§4.1) as a pass, on the interpreter here.
-//! let mut backend = CpuBackend::new(CpuOptions::default())?;
-//! let grid = BlockGrid::new(32, 16, 16)?;
-//! let candidates = candidate_image(32, 16, 1, CandidateMix::default());
-//! let pass = BlockHistogramPass::new(&mut backend, HistogramVariant::Auto, grid)?;
-//! let output = pass.run(&mut backend, &candidates)?;
-//! assert_eq!(output, strata_kernels::reference::block_histogram::block_histogram(grid, &candidates));
-//! pass.destroy(&mut backend)?;
+//! // Relative MSE of an image against its reference (the paper's error measure, §6).
+//! let reference = RgbImage { width: 4, height: 4, pixels: vec![[1.0, 0.5, 0.25]; 16] };
+//! let image = RgbImage { pixels: vec![[1.1, 0.5, 0.25]; 16], ..reference.clone() };
+//! let error = relmse(&image, &reference)?;
+//! assert!(error > 0.0 && error < 0.02);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-pub mod atomic_file;
-pub mod backend_choice;
 pub mod evaluation;
-pub mod histogram_pass;
 pub mod progress;
-pub mod render;
-pub mod restir;
-pub mod rgb_image;
-pub mod scene;
-pub mod synthetic;
-pub mod trace_pass;
 
-pub use histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};
+pub use strata_render::{
+    BlockHistogramPass, HistogramVariant, PassError, atomic_file, backend_choice, histogram_pass, render, restir,
+    rgb_image, scene, synthetic, trace_pass,
+};

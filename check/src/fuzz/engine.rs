@@ -38,7 +38,7 @@ pub enum Verdict {
     /// A bug: a panic that escaped, a panic in our own code (contained or not), or a
     /// loaded scene that breaks the oracle.
     Crash {
-        /// What kind and where, e.g. `panic at host/src/scene/ply.rs:120`.
+        /// What kind and where, e.g. `panic at render/src/scene/ply.rs:120`.
         signature: String,
         /// The message.
         message: String,
@@ -226,7 +226,7 @@ pub struct Campaign {
 /// A finding of a campaign: its kind and where, how often, and the first input's file.
 #[derive(Clone, Debug)]
 pub struct Finding {
-    /// e.g. `panic at host/src/scene/ply.rs:120`, or a contained panic's location.
+    /// e.g. `panic at render/src/scene/ply.rs:120`, or a contained panic's location.
     pub signature: String,
     /// The first message.
     pub message: String,

@@ -4,7 +4,8 @@ use crate::histogram_pass::PassError;
 use strata_kernels::selection::SelectionSettings;
 
 /// How each pixel chooses the K candidates it resamples.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Method {
     /// The paper: the block's candidates clustered by object id and sorted by luminance,
     /// K taken by the sampler variant's pattern (antithetic by default), resampled by
@@ -37,7 +38,8 @@ impl Method {
 
 /// Which parts of a pixel's estimate the shading pass writes: a diagnostic that splits
 /// the error into what resampling acts on and what it does not.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum ShadedParts {
     /// Everything: the image (default).
     #[default]
@@ -63,7 +65,8 @@ impl ShadedParts {
 }
 
 /// What the shading pass adds for the resampled part of a pixel.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Shading {
     /// The kept sample, f(Y) V W, with one shadow ray (the paper's; the default before
     /// 2026-11-25 and in the measurements made before).

@@ -6,7 +6,8 @@ use strata_backends::wgpu_backend::{WgpuApi, WgpuBackend, WgpuOptions};
 use strata_backends::{Backend, BackendError};
 
 /// Backends the command line can be asked for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum BackendChoice {
     /// The best available: wgpu on the platform's API (Vulkan on Linux, Metal on macOS,
     /// DX12 or Vulkan on Windows), else the CPU interpreter.

@@ -13,7 +13,8 @@ use strata_kernels::render_types::{
 use strata_kernels::{Kernel, KernelId, Registry};
 
 /// How light is found (all three estimate the same image).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum LightSampling {
     /// Next-event estimation and BSDF sampling, combined by the power heuristic.
     #[default]
@@ -26,7 +27,8 @@ pub enum LightSampling {
 }
 
 /// Where in its pixel each camera ray starts.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Film {
     /// Successive samples (frames, for ReSTIR) of a pixel take successive points of its
     /// own R2 sequence from a random start (the default): each sample alone is a uniform

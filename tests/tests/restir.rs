@@ -246,6 +246,40 @@ fn every_method_converges_to_the_path_traced_reference() {
     }
 }
 
+/// `--disc-radius` is a public setting: restir-disc stays unbiased with a disc of 2
+/// pixels (few neighbours, most of them rejected by the normal and depth tests) and one
+/// wider than the image (most draws land outside it and leave the slot empty), without
+/// temporal reuse (every frame scored) and with it (the own reservoir and 4 drawn from the
+/// disc, frame 6).
+#[test]
+fn restir_disc_stays_unbiased_for_any_disc_radius() {
+    let test = "restir_disc_stays_unbiased_for_any_disc_radius";
+    let Some(mut backend) = strata_tests::vulkan_backend(test) else {
+        assert!(!gpu_required());
+        return;
+    };
+    let scene = default_scene();
+    let reference = default_reference(&mut backend);
+    for disc_radius in [2.0, 1000.0] {
+        let restir = RestirSettings {
+            method: Method::RestirDisc,
+            disc_radius,
+            temporal: false,
+            selection: blocks_of_8(),
+            ..RestirSettings::default()
+        };
+        let accumulated = restir_frames(&mut backend, &scene, restir, 1..9, 64);
+        assert_unbiased(
+            &format!("restir-disc, disc radius {disc_radius}, no temporal reuse"),
+            &accumulated,
+            &reference,
+        );
+        let temporal = RestirSettings { temporal: true, temporal_candidates: 4, ..restir };
+        let frame_6 = restir_frames(&mut backend, &scene, temporal, 1..257, 6);
+        assert_unbiased(&format!("restir-disc, disc radius {disc_radius}, temporal, frame 6"), &frame_6, &reference);
+    }
+}
+
 /// With temporal reuse every method stays unbiased at frame 6 of independent renders: with
 /// the reprojected previous reservoir alone (128 renders), then with four more drawn like
 /// spatial candidates (Fig. 11: strata from the temporal histogram, restir uniformly from
@@ -525,7 +559,7 @@ fn bad_restir_settings_are_errors_naming_the_value() {
     let scene = default_scene();
     let gpu_scene = GpuScene::build(&scene).unwrap();
     let render = settings(&scene, 1);
-    let cases: [(RestirSettings, &str); 7] = [
+    let cases: [(RestirSettings, &str); 9] = [
         (
             RestirSettings {
                 selection: SelectionSettings { block_size: 12, ..Default::default() },
@@ -545,6 +579,8 @@ fn bad_restir_settings_are_errors_naming_the_value() {
         (RestirSettings { temporal_cap: 0.5, ..Default::default() }, "temporal cap 0.5"),
         (RestirSettings { temporal_candidates: 5, ..Default::default() }, "temporal candidates 5"),
         (RestirSettings { specular_chain: 17, ..Default::default() }, "specular chain 17"),
+        (RestirSettings { disc_radius: f32::NAN, ..Default::default() }, "disc radius NaN"),
+        (RestirSettings { disc_radius: 1e9, ..Default::default() }, "disc radius 1000000000"),
     ];
     for (restir, expected) in cases {
         let error = RestirRenderer::new(&mut backend, &gpu_scene, &render, restir, 1.0).err().unwrap().to_string();

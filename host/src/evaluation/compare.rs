@@ -39,11 +39,10 @@ pub struct Comparison {
     pub frames: u32,
     /// Seeds (independent renders per method).
     pub seeds: Vec<u32>,
-    /// Settings shared by every method (its `method` field is replaced).
+    /// Settings shared by every method (its `method` field is replaced). Without
+    /// temporal reuse (`temporal` false) the frames are accumulated: frame f's image is
+    /// the mean of frames 0..=f (Fig. 5 / 10).
     pub restir: RestirSettings,
-    /// Average the frames instead of showing each (the accumulation mode): frame f's
-    /// image is then the mean of frames 0..=f.
-    pub accumulate: bool,
     /// The camera of each frame (empty: the render settings' camera throughout).
     pub cameras: Vec<Camera>,
 }
@@ -83,7 +82,7 @@ pub fn run_comparison(
                             stats.invalid_pixels
                         )));
                     }
-                    let shown = if comparison.accumulate {
+                    let shown = if !comparison.restir.temporal {
                         let total = match sum.take() {
                             None => image,
                             Some(mut total) => {

@@ -16,4 +16,6 @@ pub use sampler::{
     SAMPLER_ANTITHETIC, SAMPLER_HEITZ, SAMPLER_RANDOM, SAMPLER_RANDOM_OFFSET, SAMPLER_RANDOM_OFFSET_BLUE_NOISE,
     SamplerVariant,
 };
+#[cfg(feature = "clap")]
+pub use settings::block_size_parser;
 pub use settings::{SelectionSettings, SettingError};

@@ -11,6 +11,7 @@ use super::patterns::{Pattern, StratifiedPattern};
 /// position is uniform on [0, 1) over independent renders.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize), serde(rename_all = "kebab-case"))]
 pub enum SamplerVariant {
     /// Uncorrelated slots (Table 2's "ReSTIR"): K independent white-noise positions per
     /// pixel and frame, and a white-noise resampling number; no stratification within or
@@ -104,6 +105,16 @@ mod tests {
         for variant in SamplerVariant::ALL {
             let clap_name = clap::ValueEnum::to_possible_value(&variant).unwrap().get_name().to_string();
             assert_eq!(variant.name(), clap_name);
+        }
+    }
+
+    /// The run record's names are the command line's.
+    #[cfg(feature = "serde")]
+    #[test]
+    fn record_names_are_the_command_lines() {
+        for variant in SamplerVariant::ALL {
+            let record = serde_json::to_value(variant).unwrap();
+            assert_eq!(record, serde_json::Value::from(variant.name()));
         }
     }
 }

@@ -6,6 +6,7 @@
 use super::SamplerVariant;
 use super::patterns::MAX_SELECTED;
 use crate::block_grid::BlockGrid;
+use crate::types::BLOCK_SIZES;
 use thiserror::Error;
 
 /// A setting out of range, naming the field, its value and what it may be.
@@ -17,15 +18,35 @@ pub struct SettingError {
     /// Its value.
     pub value: String,
     /// What it may be.
-    pub expected: &'static str,
+    pub expected: String,
+}
+
+/// The command line's parser of a block size: one of [`BLOCK_SIZES`], which `--help`
+/// lists (the one list of block sizes; `strata compare` and `strata histogram` use it).
+#[cfg(feature = "clap")]
+pub fn block_size_parser() -> impl clap::builder::TypedValueParser<Value = u32> {
+    // clap's possible values borrow `'static` text: four short strings, made once per
+    // command-line parse.
+    let names = BLOCK_SIZES.map(|size| &*Box::leak(size.to_string().into_boxed_str()));
+    clap::builder::TypedValueParser::map(clap::builder::PossibleValuesParser::new(names), |text: String| {
+        text.parse::<u32>().expect("a listed block size")
+    })
+}
+
+/// `4, 8, 16 or 32`: [`BLOCK_SIZES`] in words.
+fn block_sizes_in_words() -> String {
+    let names: Vec<String> = BLOCK_SIZES.iter().map(u32::to_string).collect();
+    let (last, first) = names.split_last().expect("at least one block size");
+    format!("{} or {last}", first.join(", "))
 }
 
 /// The stratified selection's settings; `Default` is the paper's (§5.1: 16 × 16 blocks,
 /// object masking, four antithetic candidates, temporal blue noise).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "clap", derive(clap::Args))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct SelectionSettings {
-    /// Block size B: candidates are sorted per B x B block of pixels (4, 8, 16 or 32).
+    /// Block size B: candidates are sorted per B x B block of pixels.
     ///
     /// Larger blocks give each cluster more candidates, hence finer strata and less
     /// noise, but join less similar pixels and cost more sorting (paper Table 1: the
@@ -33,10 +54,7 @@ pub struct SelectionSettings {
     /// blocky low-frequency error, 32 degrades slightly). Default 16.
     #[cfg_attr(
         feature = "clap",
-        arg(long, default_value_t = 16, value_parser = clap::builder::TypedValueParser::map(
-            clap::builder::PossibleValuesParser::new(["4", "8", "16", "32"]),
-            |text: String| text.parse::<u32>().expect("a listed block size"),
-        ))
+        arg(long, default_value_t = SelectionSettings::default().block_size, value_parser = block_size_parser())
     )]
     pub block_size: u32,
     /// K: candidates selected per pixel besides its own (1 to 4).
@@ -45,7 +63,7 @@ pub struct SelectionSettings {
     /// its shadow rays (two in strata's renderer). The antithetic pattern mirrors its
     /// slots in pairs for K = 4 and 2, and one pair plus an offset slot for K = 3.
     /// Default 4 (the paper's).
-    #[cfg_attr(feature = "clap", arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=4)))]
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = SelectionSettings::default().candidates, value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_SELECTED))))]
     pub candidates: u32,
     /// Object masking (§4.3; on unless --no-masking): candidates cluster by object id
     /// within a block, so a pixel draws only from pixels that see the same object.
@@ -84,14 +102,14 @@ impl SelectionSettings {
             return Err(SettingError {
                 field: "block_size",
                 value: self.block_size.to_string(),
-                expected: "a power of two from 4 to 32 (4, 8, 16 or 32)",
+                expected: block_sizes_in_words(),
             });
         }
         if !(1..=MAX_SELECTED).contains(&self.candidates) {
             return Err(SettingError {
                 field: "candidates",
                 value: self.candidates.to_string(),
-                expected: "1, 2, 3 or 4",
+                expected: format!("1 to {MAX_SELECTED}"),
             });
         }
         Ok(())
@@ -105,7 +123,7 @@ mod tests {
     #[test]
     fn validate_names_the_field() {
         let error = SelectionSettings { block_size: 12, ..Default::default() }.validate().unwrap_err();
-        assert_eq!(error.to_string(), "block_size = 12: must be a power of two from 4 to 32 (4, 8, 16 or 32)");
+        assert_eq!(error.to_string(), "block_size = 12: must be 4, 8, 16 or 32");
         let error = SelectionSettings { candidates: 0, ..Default::default() }.validate().unwrap_err();
         assert_eq!(error.field, "candidates");
         for sampler in SamplerVariant::ALL {

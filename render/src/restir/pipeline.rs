@@ -2,7 +2,7 @@
 //! buffers (two G-buffers and two reservoir buffers alternate for temporal reuse), and
 //! the five passes dispatched in order.
 
-use super::{Method, RestirSettings, Shading};
+use super::RestirSettings;
 use crate::histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};
 use crate::render::{GpuScene, RenderSettings, SceneBuffers};
 use crate::rgb_image::RgbImage;
@@ -12,10 +12,7 @@ use strata_backends::{Backend, BackendError, Bind, BufferId};
 use strata_kernels::block_grid::frame_shift;
 use strata_kernels::blue_noise::BlueNoiseTables;
 use strata_kernels::render_types::{FLAG_HIT_LIGHTS, FLAG_SAMPLE_LIGHTS, RenderParams};
-use strata_kernels::restir_types::{
-    METHOD_RESTIR, METHOD_RESTIR_DISC, METHOD_STRATA, PathCandidate, Primary, Reservoir, RestirParams,
-    SHADING_EXPECTATION, SHADING_SAMPLE,
-};
+use strata_kernels::restir_types::{PathCandidate, Primary, Reservoir, RestirParams};
 use strata_kernels::types::Candidate;
 use strata_kernels::{BlockGrid, Kernel, KernelId, Registry};
 
@@ -206,33 +203,15 @@ impl RestirRenderer {
         backend.write_buffer(self.render_params, 0, bytemuck::bytes_of(&params))?;
         let previous = self.previous_camera.unwrap_or(frame_camera);
         let restir = RestirParams {
-            method: match self.settings.method {
-                Method::Strata => METHOD_STRATA,
-                Method::Restir => METHOD_RESTIR,
-                Method::RestirDisc => METHOD_RESTIR_DISC,
-            },
-            candidates: selection.candidates,
-            sampler: selection.sampler.id(),
             temporal: u32::from(self.settings.temporal && self.frame > 0),
-            temporal_cap: self.settings.temporal_cap,
-            disc_radius: self.settings.disc_radius,
             min_distance: self.min_distance,
-            min_roughness: self.settings.min_roughness,
-            specular_chain: self.settings.specular_chain,
-            replay: u32::from(self.settings.glossy_replay),
             previous_origin: previous.origin.into(),
             previous_tan_half_x: previous.tan_half_x,
             previous_forward: previous.forward.into(),
             previous_tan_half_y: previous.tan_half_y,
             previous_right: previous.right.into(),
-            temporal_candidates: self.settings.temporal_candidates,
             previous_up: previous.up.into(),
-            shaded_parts: self.settings.shaded_parts.bits(),
-            shading: match self.settings.shading {
-                Shading::Sample => SHADING_SAMPLE,
-                Shading::Expectation => SHADING_EXPECTATION,
-            },
-            ..RestirParams::default()
+            ..self.settings.uniform()
         };
         backend.write_buffer(self.restir_params, 0, bytemuck::bytes_of(&restir))?;
         let (width, height) = (camera.width, camera.height);

@@ -1,11 +1,16 @@
 //! What a ReSTIR render does, one documented setting per field.
 
 use crate::histogram_pass::PassError;
+use strata_kernels::restir_types::{
+    METHOD_RESTIR, METHOD_RESTIR_DISC, METHOD_STRATA, RestirParams, SHADING_EXPECTATION, SHADING_SAMPLE,
+};
 use strata_kernels::selection::SelectionSettings;
 
 /// How each pixel chooses the K candidates it resamples.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[derive(serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Method {
     /// The paper: the block's candidates clustered by object id and sorted by luminance,
     /// K taken by the sampler variant's pattern (antithetic by default), resampled by
@@ -40,6 +45,8 @@ impl Method {
 /// the error into what resampling acts on and what it does not.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[derive(serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum ShadedParts {
     /// Everything: the image (default).
     #[default]
@@ -67,6 +74,8 @@ impl ShadedParts {
 /// What the shading pass adds for the resampled part of a pixel.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[derive(serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Shading {
     /// The kept sample, f(Y) V W, with one shadow ray (the paper's; the default before
     /// 2026-11-25 and in the measurements made before).
@@ -84,65 +93,101 @@ pub enum Shading {
 }
 
 /// Settings of a ReSTIR render; the defaults are the paper's (§5.1).
-#[derive(Clone, Copy, Debug, PartialEq)]
+///
+/// The one declaration of each setting: the field docs are the command line's `--help`
+/// (`strata compare` flattens this struct; with the `clap` feature), the field names
+/// the run record's keys (serde), [`RestirSettings::check`] their one validation and
+/// [`RestirSettings::uniform`] what the kernels read of them.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct RestirSettings {
-    /// Candidate selection. Default: strata.
+    /// Candidate selection. Default: strata. (Not a flag: `strata compare` runs the
+    /// methods it is given side by side.)
+    #[cfg_attr(feature = "clap", arg(skip))]
+    #[serde(skip)]
     pub method: Method,
     /// The histogram and the selection (§4.1-4.3): block size, K (the candidates every
     /// method resamples per pixel besides its own), object masking, block shifting and
     /// strata's sampler variant. The baselines use K, and restir the histogram; the
     /// sampler variant is strata's alone. Default: the paper's.
+    #[cfg_attr(feature = "clap", command(flatten))]
+    #[serde(flatten)]
     pub selection: SelectionSettings,
-    /// Merge each frame's reservoir with the previous frame's (temporal reuse). Off: each
-    /// frame stands alone (the accumulation mode of Fig. 5 / 10). Default on.
+    /// Temporal reuse, on unless --accumulate: each frame's reservoir merges with the
+    /// previous frame's. Off, each frame stands alone and frames are accumulated instead
+    /// (Fig. 5 / 10).
+    #[cfg_attr(feature = "clap", arg(long = "accumulate", action = clap::ArgAction::SetFalse))]
     pub temporal: bool,
-    /// T, previous reservoirs drawn per pixel (0 to 4) and merged besides the pixel's own
-    /// reprojected one. 0: standard temporal reuse. 1-4: the paper's Fig. 11, temporal
-    /// reservoirs drawn like spatial candidates: strata from a histogram of the block's
-    /// reprojected reservoirs at stratified positions (sampler dimensions 2 and 3),
-    /// restir uniformly from the same cluster, restir-disc from a disc; each costs 2
-    /// shadow rays and lets disoccluded pixels use their neighbours' histories. Default 0.
+    /// Previous reservoirs drawn per pixel like spatial candidates (the paper's Fig. 11),
+    /// 0 to 4, merged besides the pixel's own reprojected one.
+    ///
+    /// 0: standard temporal reuse. 1-4: strata draws them from a histogram of the
+    /// block's reprojected reservoirs at stratified positions (sampler dimensions 2 and
+    /// 3), restir uniformly from the same cluster, restir-disc from a disc; each costs 2
+    /// shadow rays and lets disoccluded pixels use their neighbours' histories.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = RestirSettings::default().temporal_candidates))]
     pub temporal_candidates: u32,
-    /// Cap of the previous reservoir's M before a merge; beyond it the history decays as
-    /// an exponential moving average. Higher: more reuse, slower reaction. Default 20.
+    /// Cap of the previous reservoir's M before a temporal merge (the paper's 20): lower
+    /// reacts faster and lets a rare bright sample fade sooner, higher reuses more.
+    ///
+    /// Beyond the cap the history decays as an exponential moving average.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = RestirSettings::default().temporal_cap))]
     pub temporal_cap: f32,
-    /// Neighbourhood radius in pixels of `restir-disc`. Default 30.
+    /// Neighbourhood radius in pixels of `restir-disc`'s candidates.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = RestirSettings::default().disc_radius))]
     pub disc_radius: f32,
-    /// A conductor at the primary hit resamples only from this GGX alpha up (smoother ones
-    /// path-trace on their own: reconnecting through a near-mirror lobe is noisy). Default
-    /// 0.05: glossy surfaces down to alpha 0.05 resample (BENCHMARKS.md, "Glossy primary
-    /// hits resample": with temporal reuse every method's error halves on veach-ajar, whose
-    /// floor has alpha 0.1, and falls 2–3 % on objects-grid; the previous default 0.2,
-    /// ReSTIR PT's rule, left such surfaces to path-trace alone).
+    /// A conductor at the primary hit resamples only from this GGX alpha up; smoother
+    /// ones are smooth vertices (see --specular-chain).
+    ///
+    /// Reconnecting through a near-mirror lobe is noisy. 0.05 lets glossy surfaces down
+    /// to alpha 0.05 resample (BENCHMARKS.md, "Glossy primary hits resample": with
+    /// temporal reuse every method's error halves on veach-ajar, whose floor has alpha
+    /// 0.1, and falls 2-3 % on objects-grid; the previous default 0.2, ReSTIR PT's rule,
+    /// left such surfaces to path-trace alone).
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = RestirSettings::default().min_roughness))]
     pub min_roughness: f32,
-    /// Smooth vertices (dielectrics, conductors below `min_roughness`) a camera path may
-    /// pass through to find the vertex it resamples at: a pixel seeing a mirror or glass
-    /// resamples at the first rough surface behind it, the chain's throughput weighting
-    /// the result (the primary surface replacement of RTXDI-style renderers, unbiased:
-    /// `restir/entry_candidates.wgsl` derives it). 0: only a rough primary hit resamples (or,
-    /// with `glossy_replay`, a glossy conductor at it)
-    /// and every other pixel path-traces alone (the only behaviour until 2026-11-25).
-    /// At most 16; the scene's `max_depth` bounds the chain too. Default 4 (a mirror,
-    /// a glass object in and out, glass seen in a mirror).
+    /// Smooth vertices (glass, conductors below --min-roughness) a pixel's path may pass
+    /// through to the rough vertex it resamples at, for every method alike; 0: pixels
+    /// whose primary hit is smooth path-trace on their own (1 sample per frame, no reuse).
+    ///
+    /// A pixel seeing a mirror or glass resamples at the first rough surface behind it,
+    /// the chain's throughput weighting the result (the primary surface replacement of
+    /// RTXDI-style renderers, unbiased: `restir/entry_candidates.wgsl` derives it). At
+    /// most 16; the scene's `max_depth` bounds the chain too. The default 4 covers a
+    /// mirror, a glass object in and out, glass seen in a mirror.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = RestirSettings::default().specular_chain))]
     pub specular_chain: u32,
-    /// Random replay at glossy conductors (ReSTIR PT's second shift beside reconnection;
-    /// not its hybrid within one path: a path here is reconnected at the vertex after its
-    /// resampling vertex or replayed whole). On: a conductor below
-    /// `min_roughness` resamples at its own vertex, its candidates being the random numbers
-    /// of the rest of its path, which other such pixels re-trace from their own vertex
-    /// (`restir/reservoir.wgsl`, "Random replay", derives why this is unbiased); each
-    /// candidate a pixel weighs costs one traced path instead of one shadow ray. Off: such
-    /// a conductor is a smooth vertex of `specular_chain` (or path-traces alone). Dielectrics
-    /// always go through the chain.
+    /// `true`: a conductor below --min-roughness resamples at its own vertex by random
+    /// replay (its candidates are the random numbers of the rest of its path, re-traced
+    /// by the pixels that reuse them), for every method alike; `false`: it is a smooth
+    /// vertex of --specular-chain.
+    ///
+    /// ReSTIR PT's second shift beside reconnection (not its hybrid within one path: a
+    /// path here is reconnected at the vertex after its resampling vertex or replayed
+    /// whole; `restir/reservoir.wgsl`, "Random replay", derives why this is unbiased).
+    /// Each candidate a pixel weighs costs one traced path instead of one shadow ray.
+    /// Dielectrics always go through the chain.
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, default_value_t = RestirSettings::default().glossy_replay, action = clap::ArgAction::Set)
+    )]
     pub glossy_replay: bool,
-    /// No reconnection to a vertex closer than this (scene units) to a primary hit
-    /// (the geometry term is singular there). Default: 1e-3 of the scene's extent, set by
-    /// the renderer when 0.
+    /// No reconnection to a vertex closer than this (scene units) to a primary hit;
+    /// 0: 1e-3 of the scene's extent.
+    ///
+    /// The geometry term is singular there.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = RestirSettings::default().min_distance))]
     pub min_distance: f32,
-    /// Which parts of the estimate the frame shows (a diagnostic). Default: all.
+    /// Which parts of each pixel's estimate the frames show (a diagnostic: `base` is what
+    /// no selection touches, `resampled` the reservoir's sample; read their variance over
+    /// seeds, since each part alone is biased against the reference).
+    #[cfg_attr(feature = "clap", arg(long, value_enum, default_value_t = RestirSettings::default().shaded_parts))]
     pub shaded_parts: ShadedParts,
-    /// The resampled part as the kept sample or as the final resampling's expectation.
-    /// Default: the expectation.
+    /// The resampled part of each pixel, for every method alike: the expectation of the
+    /// frame's final resampling over its choice (every candidate's colour, no ray;
+    /// unbiased), or the kept sample f(Y) V W with one shadow ray (the paper's, and the
+    /// default before 2026-11-25).
+    #[cfg_attr(feature = "clap", arg(long, value_enum, default_value_t = RestirSettings::default().shading))]
     pub shading: Shading,
 }
 
@@ -166,6 +211,36 @@ impl Default for RestirSettings {
 }
 
 impl RestirSettings {
+    /// The kernels' uniform as these settings fill it: everything but what changes frame
+    /// by frame (`temporal`, on from the second frame; the previous camera) and what the
+    /// renderer resolves against the scene (`min_distance` when 0), which the renderer
+    /// sets over it.
+    pub fn uniform(&self) -> RestirParams {
+        RestirParams {
+            method: match self.method {
+                Method::Strata => METHOD_STRATA,
+                Method::Restir => METHOD_RESTIR,
+                Method::RestirDisc => METHOD_RESTIR_DISC,
+            },
+            candidates: self.selection.candidates,
+            sampler: self.selection.sampler.id(),
+            temporal: u32::from(self.temporal),
+            temporal_cap: self.temporal_cap,
+            disc_radius: self.disc_radius,
+            min_distance: self.min_distance,
+            min_roughness: self.min_roughness,
+            specular_chain: self.specular_chain,
+            replay: u32::from(self.glossy_replay),
+            temporal_candidates: self.temporal_candidates,
+            shaded_parts: self.shaded_parts.bits(),
+            shading: match self.shading {
+                Shading::Sample => SHADING_SAMPLE,
+                Shading::Expectation => SHADING_EXPECTATION,
+            },
+            ..RestirParams::default()
+        }
+    }
+
     /// Refuses settings the kernels cannot run, naming the field and value.
     pub fn check(&self) -> Result<(), PassError> {
         self.selection.validate().map_err(|error| PassError::Input(error.to_string()))?;
@@ -175,8 +250,11 @@ impl RestirSettings {
         if !(self.temporal_cap >= 1.0 && self.temporal_cap.is_finite()) {
             return Err(PassError::Input(format!("temporal cap {}: must be at least 1", self.temporal_cap)));
         }
-        if !(self.disc_radius > 0.0 && self.disc_radius.is_finite()) {
-            return Err(PassError::Input(format!("disc radius {}: must be positive", self.disc_radius)));
+        if !(self.disc_radius > 0.0 && self.disc_radius <= MAX_DISC_RADIUS) {
+            return Err(PassError::Input(format!(
+                "disc radius {}: must be positive and at most {MAX_DISC_RADIUS} pixels",
+                self.disc_radius
+            )));
         }
         if !(self.min_distance >= 0.0 && self.min_distance.is_finite()) {
             return Err(PassError::Input(format!(
@@ -200,6 +278,90 @@ impl RestirSettings {
     }
 }
 
+/// The largest [`RestirSettings::disc_radius`]: the widest image side the command line
+/// accepts, so that every offset the disc draws stays an integer the kernels can hold.
+pub const MAX_DISC_RADIUS: f32 = 16384.0;
+
 /// The longest smooth chain [`RestirSettings::specular_chain`] accepts (a path has at most
 /// the scene's `max_depth` segments anyway).
 pub const MAX_SPECULAR_CHAIN: u32 = 16;
+
+#[cfg(all(test, feature = "clap"))]
+mod tests {
+    use super::*;
+    use clap::{Parser, ValueEnum};
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        restir: RestirSettings,
+    }
+
+    /// The command line's defaults are `Default`'s, and every flag reaches its field.
+    #[test]
+    fn command_line_defaults_are_the_defaults_and_each_flag_lands_in_its_field() {
+        assert_eq!(Cli::try_parse_from(["strata"]).unwrap().restir, RestirSettings::default());
+        let moved = Cli::try_parse_from([
+            "strata",
+            "--block-size",
+            "8",
+            "--accumulate",
+            "--temporal-candidates",
+            "2",
+            "--temporal-cap",
+            "7",
+            "--disc-radius",
+            "12",
+            "--min-roughness",
+            "0.2",
+            "--specular-chain",
+            "1",
+            "--glossy-replay",
+            "true",
+            "--min-distance",
+            "0.01",
+            "--shaded-parts",
+            "base",
+            "--shading",
+            "sample",
+        ])
+        .unwrap()
+        .restir;
+        let want = RestirSettings {
+            selection: SelectionSettings { block_size: 8, ..SelectionSettings::default() },
+            temporal: false,
+            temporal_candidates: 2,
+            temporal_cap: 7.0,
+            disc_radius: 12.0,
+            min_roughness: 0.2,
+            specular_chain: 1,
+            glossy_replay: true,
+            min_distance: 0.01,
+            shaded_parts: ShadedParts::Base,
+            shading: Shading::Sample,
+            ..RestirSettings::default()
+        };
+        assert_eq!(moved, want);
+    }
+
+    /// The run record names each field as the struct does and each choice as the
+    /// command line does.
+    #[test]
+    fn the_record_uses_the_field_names_and_the_command_lines_values() {
+        let record = serde_json::to_value(RestirSettings::default()).unwrap();
+        let keys: Vec<&str> = record.as_object().unwrap().keys().map(String::as_str).collect();
+        for field in ["block_size", "candidates", "masking", "block_shift", "sampler", "temporal", "shading"] {
+            assert!(keys.contains(&field), "{field} missing from {keys:?}");
+        }
+        assert!(!keys.contains(&"method"), "the method is the comparison's, not a shared setting");
+        fn same_names<T: ValueEnum + serde::Serialize>() {
+            for value in T::value_variants() {
+                let clap_name = value.to_possible_value().unwrap().get_name().to_string();
+                assert_eq!(serde_json::to_value(value).unwrap(), serde_json::Value::from(clap_name));
+            }
+        }
+        same_names::<Method>();
+        same_names::<ShadedParts>();
+        same_names::<Shading>();
+    }
+}

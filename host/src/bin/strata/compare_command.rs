@@ -14,10 +14,9 @@ use strata::evaluation::record::{self, RunRecord};
 use strata::evaluation::report::{ReportOptions, run_and_report};
 use strata::progress::Progress;
 use strata::render::{Film, GpuScene, RenderSettings};
-use strata::restir::{Method, RestirSettings, ShadedParts, Shading};
+use strata::restir::{Method, RestirSettings};
 use strata::rgb_image::RgbImage;
 use strata::scene::parse_camera_path;
-use strata_kernels::selection::SelectionSettings;
 
 use super::{scene_and_settings, scene_stem};
 
@@ -60,21 +59,10 @@ pub(crate) struct CompareArgs {
     /// Image height [default: the scene camera's; half of it on the CPU interpreter].
     #[arg(long)]
     height: Option<u32>,
-    /// The histogram and the selection (§4.1-4.3), shared by every method except where
-    /// a field says otherwise.
+    /// The ReSTIR settings every method shares (the selection's among them): declared,
+    /// documented and validated once, in `strata::restir::RestirSettings`.
     #[command(flatten)]
-    selection: SelectionSettings,
-    /// No temporal reuse: frames are accumulated instead (Fig. 5 / 10).
-    #[arg(long)]
-    accumulate: bool,
-    /// Cap of the previous reservoir's M before a temporal merge (the paper's 20): lower
-    /// reacts faster and lets a rare bright sample fade sooner, higher reuses more.
-    #[arg(long, default_value_t = RestirSettings::default().temporal_cap)]
-    temporal_cap: f32,
-    /// Previous reservoirs drawn per pixel like spatial candidates (the paper's Fig. 11),
-    /// 0 to 4, merged besides the pixel's own reprojected one.
-    #[arg(long, default_value_t = 0)]
-    temporal_candidates: u32,
+    restir: RestirSettings,
     /// Camera rays through pixel centres, no film jitter, for the methods and the
     /// rendered reference alike (a diagnostic: without jitter a pixel's history sees the
     /// same primary hit every frame).
@@ -90,36 +78,6 @@ pub(crate) struct CompareArgs {
     /// `--pixel-centres` removes the jitter instead.
     #[arg(long, value_enum, conflicts_with = "pixel_centres")]
     film: Option<Film>,
-    /// Which parts of each pixel's estimate the frames show (a diagnostic: `base` is what
-    /// no selection touches, `resampled` the reservoir's sample; read their variance over
-    /// seeds, since each part alone is biased against the reference).
-    #[arg(long, value_enum, default_value_t = ShadedParts::All)]
-    shaded_parts: ShadedParts,
-    /// The resampled part of each pixel, for every method alike: the expectation of the
-    /// frame's final resampling over its choice (every candidate's colour, no ray;
-    /// unbiased), or the kept sample f(Y) V W with one shadow ray (the paper's, and the
-    /// default before 2026-11-25).
-    #[arg(long, value_enum, default_value_t = Shading::Expectation)]
-    shading: Shading,
-    /// A conductor at the primary hit resamples only from this GGX alpha up; smoother
-    /// ones are smooth vertices (see --specular-chain).
-    #[arg(long, default_value_t = RestirSettings::default().min_roughness)]
-    min_roughness: f32,
-    /// Smooth vertices (glass, conductors below --min-roughness) a pixel's path may pass
-    /// through to the rough vertex it resamples at, for every method alike; 0: pixels
-    /// whose primary hit is smooth path-trace on their own (1 sample per frame, no reuse).
-    #[arg(long, default_value_t = RestirSettings::default().specular_chain)]
-    specular_chain: u32,
-    /// `true`: a conductor below --min-roughness resamples at its own vertex by random
-    /// replay (its candidates are the random numbers of the rest of its path, re-traced
-    /// by the pixels that reuse them), for every method alike; `false`: it is a smooth
-    /// vertex of --specular-chain.
-    #[arg(long, default_value_t = RestirSettings::default().glossy_replay, action = clap::ArgAction::Set)]
-    glossy_replay: bool,
-    /// No reconnection to a vertex closer than this (scene units) to a primary hit;
-    /// 0: 1e-3 of the scene's extent.
-    #[arg(long, default_value_t = RestirSettings::default().min_distance)]
-    min_distance: f32,
     /// Camera motion: `static`, `orbit:DEGREES_PER_FRAME`, `dolly:DISTANCE_PER_FRAME` or
     /// a keyframe JSON file. A moving camera needs a reference per frame: they are
     /// path-traced (`--reference-spp` each) and `--reference` is refused.
@@ -189,7 +147,7 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
     let film = match (args.pixel_centres, args.film) {
         (true, _) => Film::Centres,
         (false, Some(film)) => film,
-        (false, None) if args.accumulate => Film::Stratified,
+        (false, None) if !args.restir.temporal => Film::Stratified,
         (false, None) => Film::White,
     };
     let render = RenderSettings { film, ..render };
@@ -201,19 +159,7 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
             bail!("--methods: `{}` is named twice; name each method once", method.name());
         }
     }
-    let restir = RestirSettings {
-        selection: args.selection,
-        temporal: !args.accumulate,
-        temporal_candidates: args.temporal_candidates,
-        temporal_cap: args.temporal_cap,
-        shaded_parts: args.shaded_parts,
-        shading: args.shading,
-        min_roughness: args.min_roughness,
-        specular_chain: args.specular_chain,
-        glossy_replay: args.glossy_replay,
-        min_distance: args.min_distance,
-        ..RestirSettings::default()
-    };
+    let restir = args.restir;
     // Refused settings are said before the reference takes its minutes.
     restir.check()?;
     let gpu_scene = GpuScene::build(&scene)?;
@@ -237,7 +183,7 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
     } else {
         (0..args.frames).map(|f| camera_path.camera_at(&render.camera, f)).collect()
     };
-    if !camera_path.is_static() && args.accumulate {
+    if !camera_path.is_static() && !args.restir.temporal {
         bail!(
             "--accumulate with --camera-path {}: accumulated frames would average different viewpoints and be \
              measured against one frame's reference; accumulate with a static camera, or use temporal reuse",
@@ -310,7 +256,6 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
         frames: args.frames,
         seeds: (1..=args.seeds).collect(),
         restir,
-        accumulate: args.accumulate,
         cameras,
     };
     let record = RunRecord {
@@ -328,7 +273,7 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
         height: render.camera.height,
         frames: args.frames,
         seeds: args.seeds,
-        temporal: !args.accumulate,
+        temporal: args.restir.temporal,
         reference: reference_text,
         settings: settings_record(&restir, args, render.film, backend.info()),
         warnings: scene.warnings.clone(),
@@ -354,30 +299,18 @@ fn settings_record(
     film: Film,
     device: &strata_backends::DeviceInfo,
 ) -> serde_json::Map<String, serde_json::Value> {
-    let s = &restir.selection;
-    let mut map = serde_json::Map::new();
+    let mut map = match serde_json::to_value(restir) {
+        Ok(serde_json::Value::Object(map)) => map,
+        _ => unreachable!("RestirSettings serialises to an object"),
+    };
     let mut put = |name: &str, value: serde_json::Value| {
         map.insert(name.to_string(), value);
     };
     put("methods", args.methods.iter().map(|m| m.name()).collect::<Vec<_>>().join(",").into());
-    put("block_size", s.block_size.into());
-    put("candidates", s.candidates.into());
-    put("masking", s.masking.into());
-    put("block_shift", s.block_shift.into());
     // Every histogram kernel gives the same output; which one ran depends on the device.
-    let histogram = strata::histogram_pass::auto_kernel(device, s.block_size);
+    let histogram = strata::histogram_pass::auto_kernel(device, restir.selection.block_size);
     put("histogram_kernel", histogram.spec().map(|spec| spec.name.to_string()).into());
-    let name = |v: &dyn Fn() -> Option<clap::builder::PossibleValue>| v().map(|p| p.get_name().to_string());
-    put("sampler", name(&|| clap::ValueEnum::to_possible_value(&s.sampler)).into());
-    put("temporal_candidates", restir.temporal_candidates.into());
-    put("temporal_cap", f64::from(restir.temporal_cap).into());
-    put("min_roughness", f64::from(restir.min_roughness).into());
-    put("specular_chain", restir.specular_chain.into());
-    put("glossy_replay", restir.glossy_replay.into());
-    put("min_distance", f64::from(restir.min_distance).into());
-    put("film", name(&|| clap::ValueEnum::to_possible_value(&film)).into());
-    put("shaded_parts", name(&|| clap::ValueEnum::to_possible_value(&restir.shaded_parts)).into());
-    put("shading", name(&|| clap::ValueEnum::to_possible_value(&restir.shading)).into());
+    put("film", clap::ValueEnum::to_possible_value(&film).map(|p| p.get_name().to_string()).into());
     put("camera_path", args.camera_path.to_string_lossy().into_owned().into());
     map
 }

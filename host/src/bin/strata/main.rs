@@ -26,6 +26,7 @@ use strata::scene::{Scene, default_scene, load_scene_file};
 use strata::synthetic::{CandidateMix, candidate_image};
 use strata_kernels::BlockGrid;
 use strata_kernels::reference::block_histogram::block_histogram;
+use strata_kernels::selection::{SelectionSettings, block_size_parser};
 
 /// strata: histogram-stratified ReSTIR.
 #[derive(Parser)]
@@ -135,8 +136,8 @@ struct HistogramArgs {
     /// Image height in pixels.
     #[arg(long, default_value_t = 1080)]
     height: u32,
-    /// Block size B (blocks are B x B): 4, 8, 16 or 32.
-    #[arg(long, default_value_t = 16)]
+    /// Block size B (blocks are B x B).
+    #[arg(long, default_value_t = SelectionSettings::default().block_size, value_parser = block_size_parser())]
     block_size: u32,
     /// Seed of the generated candidates.
     #[arg(long, default_value_t = 1)]

@@ -54,12 +54,13 @@ pub enum WriteError {
         path: String,
     },
     /// Writing, syncing or renaming failed (a full disk, no permission, ...).
-    #[error("{path}: cannot write: {source}")]
+    #[error("{path}: cannot write: {error}")]
     Io {
         /// The target.
         path: String,
-        /// The operating system's error.
-        source: std::io::Error,
+        /// The operating system's error (in the message, not a `source`: a chain of
+        /// causes printed after it would say it twice).
+        error: std::io::Error,
     },
     /// The file on disk is shorter than what was written (a file system that accepted
     /// the bytes and lost them).
@@ -139,30 +140,57 @@ pub fn check_target(path: &Path) -> Result<(), WriteError> {
 /// Writes `bytes` to `path`, complete or not at all (module documentation). On any error
 /// the temporary file is removed and `path` is left as it was.
 pub fn write(path: &Path, bytes: impl AsRef<[u8]>) -> Result<(), WriteError> {
-    let bytes = bytes.as_ref();
-    check_target(path)?;
-    let io = |source: std::io::Error| WriteError::Io { path: path.display().to_string(), source };
-    let temporary = temporary_path(path);
-    let written = (|| -> Result<(), WriteError> {
-        let mut file = std::fs::File::create(&temporary).map_err(io)?;
-        file.write_all(bytes).map_err(io)?;
-        file.sync_all().map_err(io)?;
-        let on_disk = file.metadata().map_err(io)?.len();
-        if on_disk != bytes.len() as u64 {
-            return Err(WriteError::Short {
-                path: path.display().to_string(),
-                written: on_disk,
-                expected: bytes.len() as u64,
-            });
-        }
-        // Checked again: something may have taken the name while the bytes were written.
+    write_set(&[(path, bytes.as_ref())])
+}
+
+/// Writes several files as one: every target is checked, then every file is written under
+/// its temporary name and synced, and only when all of them are complete are they renamed
+/// into place. So a full disk, a size limit or a refused target on the last file leaves
+/// none of them (a plot's SVG never stands without its PNG); the earlier files of those
+/// names stay as they were.
+pub fn write_set(files: &[(&Path, &[u8])]) -> Result<(), WriteError> {
+    for (path, _) in files {
         check_target(path)?;
-        std::fs::rename(&temporary, path).map_err(io)
-    })();
-    if written.is_err() {
-        let _ = std::fs::remove_file(&temporary);
     }
-    written
+    let mut staged: Vec<PathBuf> = Vec::new();
+    let result = (|| -> Result<(), WriteError> {
+        for (path, bytes) in files {
+            staged.push(temporary_path(path));
+            stage(path, bytes)?;
+        }
+        for (path, _) in files {
+            // Checked again: something may have taken the name while the bytes were written.
+            check_target(path)?;
+        }
+        for (path, _) in files {
+            let io = |error: std::io::Error| WriteError::Io { path: path.display().to_string(), error };
+            std::fs::rename(temporary_path(path), path).map_err(io)?;
+        }
+        Ok(())
+    })();
+    if result.is_err() {
+        for temporary in staged {
+            let _ = std::fs::remove_file(temporary);
+        }
+    }
+    result
+}
+
+/// Writes `bytes` under `path`'s temporary name, synced and checked for length.
+fn stage(path: &Path, bytes: &[u8]) -> Result<(), WriteError> {
+    let io = |error: std::io::Error| WriteError::Io { path: path.display().to_string(), error };
+    let mut file = std::fs::File::create(temporary_path(path)).map_err(io)?;
+    file.write_all(bytes).map_err(io)?;
+    file.sync_all().map_err(io)?;
+    let on_disk = file.metadata().map_err(io)?.len();
+    if on_disk != bytes.len() as u64 {
+        return Err(WriteError::Short {
+            path: path.display().to_string(),
+            written: on_disk,
+            expected: bytes.len() as u64,
+        });
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -233,6 +261,26 @@ mod tests {
         std::fs::create_dir(temporary_path(&path)).unwrap();
         assert!(write(&path, "new").is_err());
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "old");
+        std::fs::remove_dir_all(&folder).unwrap();
+    }
+
+    #[test]
+    fn a_set_is_written_whole_or_not_at_all() {
+        let folder = scratch("set");
+        let (svg, png) = (folder.join("plot.svg"), folder.join("plot.png"));
+        write_set(&[(&svg, b"svg 1"), (&png, b"png 1")]).unwrap();
+        // The second file's temporary cannot be created: neither file changes.
+        std::fs::create_dir(temporary_path(&png)).unwrap();
+        assert!(write_set(&[(&svg, b"svg 2"), (&png, b"png 2")]).is_err());
+        assert_eq!(std::fs::read(&svg).unwrap(), b"svg 1");
+        assert_eq!(std::fs::read(&png).unwrap(), b"png 1");
+        std::fs::remove_dir(temporary_path(&png)).unwrap();
+        assert_eq!(names(&folder), ["plot.png", "plot.svg"]);
+        // A refused target anywhere in the set: nothing is written.
+        let link = folder.join("new.svg");
+        std::fs::create_dir(folder.join("new.png")).unwrap();
+        assert!(write_set(&[(&link, b"x"), (&folder.join("new.png"), b"y")]).is_err());
+        assert!(!link.exists());
         std::fs::remove_dir_all(&folder).unwrap();
     }
 }

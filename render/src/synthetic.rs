@@ -34,9 +34,12 @@ pub fn candidate_image(width: u32, height: u32, seed: u64, mix: CandidateMix) ->
     for y in 0..height {
         for x in 0..width {
             let region = (x / cell + 3 * (y / cell)) as usize % offsets.len();
-            let mut object_id = (offsets[region] * 7919 + 13) % 1_000_003;
+            // Object k gets id (7919 k + 13) mod 1,000,003 (spread over the id range;
+            // in 64 bits, so that any `objects` is taken).
+            let id_of = |object: u32, offset: u64| ((u64::from(object) * 7919 + offset) % 1_000_003) as u32;
+            let mut object_id = id_of(offsets[region], 13);
             if rng.random_bool(0.1) {
-                object_id = rng.random_range(0..objects) * 7919 % 1_000_003;
+                object_id = id_of(rng.random_range(0..objects), 0);
             }
             let level = rng.random_range(0..mix.key_levels.max(1));
             let mut key = level as f32 * 0.25;

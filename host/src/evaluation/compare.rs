@@ -301,10 +301,20 @@ fn parse_rows(text: &str) -> Result<Vec<(usize, FrameError)>, String> {
         // Errors are finite and non-negative: anything else is a damaged file, not a
         // measurement to average. (0 is an image equal to its reference: no ratio to
         // it exists, and the summaries say so.)
+        // A subnormal error (below 2.2e-308) is no RelMSE strata writes either: its
+        // reciprocal overflows, so no ratio or log axis could show it.
         let float = |i: usize| match fields[i].parse::<f64>() {
-            Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
-            Ok(v) => Err(format!("line {number}, field {}: {v} is not an error (finite, 0 or more)", i + 1)),
-            Err(e) => Err(format!("line {number}, field {}: {e}", i + 1)),
+            Ok(v) if v == 0.0 || (v.is_normal() && v > 0.0) => Ok(v),
+            Ok(v) if v.is_finite() && v > 0.0 => Err(format!(
+                "line {number}, field {}: `{}` is below the smallest normal number ({:e}): not an error strata writes",
+                i + 1,
+                fields[i],
+                f64::MIN_POSITIVE
+            )),
+            Ok(_) => {
+                Err(format!("line {number}, field {}: `{}` is not an error (finite, 0 or more)", i + 1, fields[i]))
+            }
+            Err(e) => Err(format!("line {number}, field {}: `{}`: {e}", i + 1, fields[i])),
         };
         let frame = int(1)?;
         if frame == 0 {

@@ -11,7 +11,7 @@
 //!   happen; a renderer that lost every sample to overflow flags those samples as
 //!   invalid, which the comparison refuses, so black alone is not an error).
 
-use crate::rgb_image::RgbImage;
+use crate::rgb_image::{RgbImage, linear_to_srgb8};
 
 /// Why an image cannot be scored; the message names the image and the pixel.
 #[derive(Debug, thiserror::Error)]
@@ -95,9 +95,35 @@ pub fn black_against(image: &RgbImage, reference: &RgbImage) -> bool {
     is_black(image) && !is_black(reference)
 }
 
+/// A warning when `image` has light but its 8-bit preview at `exposure` is black
+/// everywhere (an `--exposure` so small that the brightest pixel maps below one step):
+/// the PNG would look like a failed render while the EXR holds the image.
+pub fn black_preview(image: &RgbImage, exposure: f32) -> Option<String> {
+    if is_black(image) {
+        return None;
+    }
+    let brightest = image.pixels.iter().flat_map(|p| p.iter().copied()).fold(0.0f32, f32::max);
+    let all_zero = image.pixels.iter().all(|p| p.iter().all(|&c| linear_to_srgb8(c * exposure) == 0));
+    all_zero.then(|| {
+        format!(
+            "--exposure {exposure:e}: the PNG previews are black (the brightest pixel, {brightest:e}, maps below one \
+             8-bit step); the EXR images hold the render: raise --exposure"
+        )
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_preview_black_at_its_exposure_is_warned_about() {
+        let image = RgbImage { width: 2, height: 1, pixels: vec![[0.0; 3], [0.5, 0.25, 1.0]] };
+        assert!(black_preview(&image, 1.0).is_none());
+        let warning = black_preview(&image, 1e-6).expect("a black preview");
+        assert!(warning.contains("--exposure 1e-6") && warning.contains("1e0"), "{warning}");
+        assert!(black_preview(&RgbImage { pixels: vec![[0.0; 3]; 2], ..image }, 1e-6).is_none(), "black is black");
+    }
 
     fn image(pixels: Vec<[f32; 3]>) -> RgbImage {
         RgbImage { width: 2, height: (pixels.len() / 2) as u32, pixels }

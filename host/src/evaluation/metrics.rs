@@ -215,9 +215,10 @@ impl MeanInterval {
 impl MeanInterval {
     /// `mean ± half-width` with `decimals` decimals; with fewer than two samples, where
     /// no interval exists, `mean (1 seed: no interval)`; and `n/a` for a mean that could
-    /// not be computed. Printed summaries never show NaN or infinity.
+    /// not be computed. Printed summaries never show NaN or infinity. A value of a million
+    /// or more is written in scientific notation (`5.0000e299`, not 300 digits).
     pub fn fixed(&self, decimals: usize) -> String {
-        self.text(|v| format!("{v:.decimals$}"))
+        self.text(|v| if v.abs() >= 1e6 { format!("{v:.decimals$e}") } else { format!("{v:.decimals$}") })
     }
 
     /// The text of the interval with `number` formatting each value ([`MeanInterval::fixed`]).
@@ -340,5 +341,6 @@ mod tests {
         assert_eq!(MeanInterval::of(&[0.5]).to_string(), "5.0000e-1 (1 seed: no interval)");
         assert_eq!(MeanInterval::of(&[]).fixed(3), "n/a");
         assert_eq!(MeanInterval::of(&[1.0, 3.0]).fixed(1), "2.0 ± 12.7");
+        assert_eq!(MeanInterval::of(&[5e299]).fixed(4), "5.0000e299 (1 seed: no interval)");
     }
 }

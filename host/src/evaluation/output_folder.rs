@@ -90,33 +90,50 @@ pub fn is_run_output(name: &str) -> bool {
 
 /// Creates `folder` if needed, takes its [`lock`] and removes the files an earlier run
 /// wrote there and temporary files a killed run left ([`crate::atomic_file`]), except
-/// `keep` (an input of this run). Returns the lock, to hold until the run has written
-/// everything, and the names removed.
+/// `keep` (the reference this run reads, which may be an earlier run's `reference.exr`).
+/// Returns the lock, to hold until the run has written everything, and the names removed.
+///
+/// Everything is checked before anything is removed: an entry under a name the run
+/// writes that is not a regular file (the writer would refuse it at the end), or that is
+/// an input of this run (a scene, mesh, texture or camera path named `run.json`,
+/// `summary.txt`, ...: removing it and writing the run's file there would destroy it), is
+/// refused while the earlier run's files are all still there.
 pub fn prepare(folder: &Path, keep: Option<&Path>) -> Result<(FolderLock, Vec<String>)> {
     std::fs::create_dir_all(folder).with_context(|| format!("{}: cannot create the folder", folder.display()))?;
     let lock = lock(folder)?;
     let keep: Option<PathBuf> = keep.and_then(|k| k.canonicalize().ok());
-    let mut removed = Vec::new();
+    let mut doomed = Vec::new();
     let entries = std::fs::read_dir(folder).with_context(|| format!("{}: cannot list the folder", folder.display()))?;
     for entry in entries {
         let entry = entry.with_context(|| format!("{}: cannot list the folder", folder.display()))?;
         let name = entry.file_name().to_string_lossy().into_owned();
         let path = entry.path();
-        let leftover = crate::atomic_file::is_temporary(&name);
-        if !(is_run_output(&name) || leftover) {
+        let output = is_run_output(&name);
+        if !(output || crate::atomic_file::is_temporary(&name)) {
             continue;
         }
-        // A folder, link or device under a name the run writes would fail the run at its
-        // end (the writer never replaces one): said now, before any work.
-        if is_run_output(&name) && !entry.file_type().is_ok_and(|t| t.is_file()) {
+        let regular = entry.file_type().is_ok_and(|t| t.is_file());
+        let kept = regular && keep.is_some() && path.canonicalize().ok() == keep;
+        if kept && name == "reference.exr" {
+            // The run reads it and, given a reference, writes no file of that name.
+            continue;
+        }
+        if kept {
+            bail!(
+                "--reference {}: this run writes a file of that name into --out {}; copy the reference elsewhere                  or choose another --out",
+                path.display(),
+                folder.display()
+            );
+        }
+        if output {
             crate::atomic_file::check_target(&path)?;
         }
-        if !entry.file_type().is_ok_and(|t| t.is_file()) {
-            continue;
+        if regular {
+            doomed.push((name, path));
         }
-        if keep.is_some() && path.canonicalize().ok() == keep {
-            continue;
-        }
+    }
+    let mut removed = Vec::new();
+    for (name, path) in doomed {
         std::fs::remove_file(&path)
             .with_context(|| format!("{}: cannot remove this file of an earlier run", path.display()))?;
         removed.push(name);
@@ -177,6 +194,38 @@ mod tests {
         let (_lock, removed) = prepare(&folder, None).unwrap();
         assert_eq!(removed, ["reference.exr"]);
         drop(_lock);
+        std::fs::remove_dir_all(&folder).unwrap();
+    }
+
+    /// An input of the run under a name the run writes, or a link there, is refused
+    /// before any earlier file is removed.
+    #[test]
+    fn nothing_is_removed_when_an_entry_would_be_refused() {
+        let folder = std::env::temp_dir().join(format!("strata-output-folder-refused-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&folder);
+        std::fs::create_dir_all(&folder).unwrap();
+        for name in ["errors.csv", "report.html", "summary.txt", "strata_frame001.exr"] {
+            std::fs::write(folder.join(name), b"x").unwrap();
+        }
+        // A scene file named like the run's record, read as an input.
+        std::fs::write(folder.join("run.json"), b"{}").unwrap();
+        crate::atomic_file::note_input(&folder.join("run.json"));
+        let refused = prepare(&folder, None).unwrap_err().to_string();
+        assert!(refused.contains("run.json") && refused.contains("input"), "{refused}");
+        // A reference named like a frame the run writes.
+        std::fs::remove_file(folder.join("run.json")).unwrap();
+        let refused = prepare(&folder, Some(&folder.join("strata_frame001.exr"))).unwrap_err().to_string();
+        assert!(refused.contains("--reference"), "{refused}");
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink("/nonexistent", folder.join("variance.csv")).unwrap();
+            let refused = prepare(&folder, None).unwrap_err().to_string();
+            assert!(refused.contains("symbolic link"), "{refused}");
+            std::fs::remove_file(folder.join("variance.csv")).unwrap();
+        }
+        for name in ["errors.csv", "report.html", "summary.txt", "strata_frame001.exr"] {
+            assert!(folder.join(name).exists(), "{name} was removed by a refused run");
+        }
         std::fs::remove_dir_all(&folder).unwrap();
     }
 }

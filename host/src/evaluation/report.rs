@@ -124,10 +124,17 @@ pub fn run_and_report(
     let mode = if options.record.temporal { "temporal reuse" } else { "accumulated frames" };
     let title =
         format!("{} {}x{}, {} seeds, {mode}", options.record.scene, render.camera.width, render.camera.height, seeds);
-    super::plot::write_relmse_plot(&errors, &options.methods, frames, &title, &out.join("relmse"))?;
+    let plotted = super::plot::write_relmse_and_ratio_plots(
+        &errors,
+        &options.methods,
+        frames,
+        &title,
+        &out.join("relmse"),
+        &out.join("relmse_ratio"),
+    )?;
     let mut plots =
         vec![("relmse.svg".to_string(), "RelMSE against frame: mean and 95 % interval over seeds".to_string())];
-    if super::plot::write_ratio_plot(&errors, frames, &title, &out.join("relmse_ratio"))? {
+    if plotted.contains(&out.join("relmse_ratio.svg")) {
         plots.push((
             "relmse_ratio.svg".to_string(),
             "strata ÷ each baseline against frame: paired per seed, mean and 95 % interval".to_string(),
@@ -167,6 +174,10 @@ pub fn run_and_report(
                 n => format!(" and {} more frames are", n - 1),
             }
         );
+        eprintln!("warning: {warning}");
+        record.warnings.push(warning);
+    }
+    if let Some(warning) = super::image_checks::black_preview(&references[0], options.exposure) {
         eprintln!("warning: {warning}");
         record.warnings.push(warning);
     }

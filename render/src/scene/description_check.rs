@@ -43,7 +43,9 @@ impl Rule {
             Rule::Finite => "must be finite",
             Rule::NonNegative => "must be finite and ≥ 0",
             Rule::Positive => "must be finite and > 0",
-            Rule::Radiance => "each must lie in [0, 1e20] (sums of brighter samples overflow single precision)",
+            Rule::Radiance => {
+                "each must lie in [0, 1e15] (the squared errors of brighter light overflow single precision)"
+            }
             Rule::Reflectance => "each must lie in [0, 1] (a reflectance above 1 creates energy)",
         }
     }
@@ -72,6 +74,14 @@ pub(super) fn check(path: &Path, description: &SceneDescription) -> Result<(), S
         ));
     }
     for (index, shape) in description.shapes.iter().enumerate() {
+        // Ids name shapes in messages, warnings and object ids: two shapes of one id
+        // could not be told apart.
+        if let Some(first) = description.shapes[..index].iter().position(|earlier| earlier.id == shape.id) {
+            return Err(error(
+                format!("shapes[{index}].id"),
+                format!("`{}`: shapes[{first}] has this id already; each shape's id must be its own", shape.id),
+            ));
+        }
         if let Some(normals) = shape.normals.as_deref().filter(|n| *n != "face") {
             return Err(error(
                 format!("shapes[{index}].normals"),
@@ -224,6 +234,7 @@ mod tests {
                 ),
                 "environment.to_world",
             ),
+            (scene(CAMERA, MATERIAL, &format!("{SHAPE}, {SHAPE}"), "null"), "shapes[1].id"),
         ];
         for (text, field) in cases {
             let message = verdict(&text);

@@ -33,9 +33,13 @@ pub const MAX_INPUT_FILE_BYTES: u64 = 1 << 30;
 /// The whole contents of `path`: a regular file as it is, anything else (a device, a
 /// pipe) up to [`MAX_INPUT_FILE_BYTES`] and refused beyond it. Every file read is noted
 /// as an input of the run ([`crate::atomic_file::note_input`]).
+///
+/// A named pipe is opened without waiting for a writer ([`open_without_waiting`]): one
+/// that nobody writes to reads as empty (and its loader names it), where a plain `open`
+/// would wait forever.
 pub fn read_capped(path: &Path) -> std::io::Result<Vec<u8>> {
     use std::io::Read;
-    let file = std::fs::File::open(path)?;
+    let file = open_without_waiting(path)?;
     let metadata = file.metadata()?;
     if metadata.is_dir() {
         return Err(std::io::Error::new(std::io::ErrorKind::InvalidInput, "is a folder, not a file"));
@@ -49,7 +53,7 @@ pub fn read_capped(path: &Path) -> std::io::Result<Vec<u8>> {
         (&file).read_to_end(&mut bytes)?;
         return Ok(bytes);
     }
-    file.take(MAX_INPUT_FILE_BYTES + 1).read_to_end(&mut bytes)?;
+    read_waiting_for_writers(file, &mut bytes)?;
     if bytes.len() as u64 > MAX_INPUT_FILE_BYTES {
         return Err(std::io::Error::new(
             std::io::ErrorKind::InvalidData,
@@ -60,6 +64,38 @@ pub fn read_capped(path: &Path) -> std::io::Result<Vec<u8>> {
         ));
     }
     Ok(bytes)
+}
+
+/// Opens `path` for reading; on Unix with `O_NONBLOCK`, so that opening a named pipe
+/// returns at once instead of waiting for a writer to appear (for a regular file or a
+/// device the flag changes nothing that [`read_capped`] does).
+fn open_without_waiting(path: &Path) -> std::io::Result<std::fs::File> {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    options.open(path)
+}
+
+/// Reads a device or pipe opened by [`open_without_waiting`] to its end, at most one byte
+/// beyond [`MAX_INPUT_FILE_BYTES`]: a pipe with a writer that has not written yet says
+/// "would block", and is waited for in short sleeps; one without a writer ends at once.
+fn read_waiting_for_writers(file: std::fs::File, bytes: &mut Vec<u8>) -> std::io::Result<()> {
+    use std::io::Read;
+    let mut limited = file.take(MAX_INPUT_FILE_BYTES + 1);
+    loop {
+        match limited.read_to_end(bytes) {
+            Ok(_) => return Ok(()),
+            Err(error) if error.kind() == std::io::ErrorKind::WouldBlock => {
+                std::thread::sleep(std::time::Duration::from_millis(10));
+            }
+            Err(error) if error.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(error) => return Err(error),
+        }
+    }
 }
 
 /// [`read_capped`] as UTF-8 text.

@@ -70,13 +70,33 @@ pub fn load_gltf_from(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Resu
 }
 
 /// Refuses a document that is not glTF 2.x (`asset.version` "1.0" is a different format
-/// whose fields the loader would misread).
+/// whose fields the loader would misread; a version must be `MAJOR.MINOR` in digits), or
+/// one whose `asset.minVersion` asks for more than the 2.0 this loader reads.
 fn check_version(path: &Path, raw: &serde_json::Value) -> Result<(), SceneError> {
-    let version = raw.pointer("/asset/version");
-    match version.and_then(serde_json::Value::as_str) {
-        Some(text) if text.split_once('.').is_some_and(|(major, _)| major == "2") => Ok(()),
-        Some(text) => Err(json_error(path, "asset.version", format!("`{text}`: only glTF 2.x is read"))),
-        None => Err(json_error(path, "asset.version", "missing: a glTF 2.0 document names its version")),
+    /// `MAJOR.MINOR` in digits, as the glTF schema's pattern `^[0-9]+\.[0-9]+$` says.
+    fn major_minor(text: &str) -> Option<(u64, u64)> {
+        let (major, minor) = text.split_once('.')?;
+        let digits = |t: &str| !t.is_empty() && t.bytes().all(|b| b.is_ascii_digit());
+        if !(digits(major) && digits(minor)) {
+            return None;
+        }
+        Some((major.parse().ok()?, minor.parse().ok()?))
+    }
+    match raw.pointer("/asset/version").and_then(serde_json::Value::as_str) {
+        Some(text) if major_minor(text).is_some_and(|(major, _)| major == 2) => {}
+        Some(text) => return Err(json_error(path, "asset.version", format!("`{text}`: only glTF 2.x is read"))),
+        None => return Err(json_error(path, "asset.version", "missing: a glTF 2.0 document names its version")),
+    }
+    match raw.pointer("/asset/minVersion") {
+        None => Ok(()),
+        Some(value) => match value.as_str().and_then(major_minor) {
+            Some((2, 0)) => Ok(()),
+            _ => Err(json_error(
+                path,
+                "asset.minVersion",
+                format!("{value}: this loader reads glTF 2.0, and the document needs a later version"),
+            )),
+        },
     }
 }
 
@@ -228,15 +248,15 @@ impl Loader<'_> {
         let index = material.index().unwrap_or(self.materials.len());
         let field = format!("materials[{index}]");
         let pbr = material.pbr_metallic_roughness();
-        let [r, g, b, _] = pbr.base_color_factor();
+        let [r, g, b, alpha] = pbr.base_color_factor();
         let (metallic, roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
-        if ![r, g, b, metallic, roughness].iter().all(|c| (0.0..=1.0).contains(c)) {
+        if ![r, g, b, alpha, metallic, roughness].iter().all(|c| (0.0..=1.0).contains(c)) {
             return Err(self.error(
                 format!("{field}.pbrMetallicRoughness"),
                 format!(
                     "base colour {:?}, metallic {metallic}, roughness {roughness}: each must lie in [0, 1] (a base \
                      colour above 1 creates energy)",
-                    [r, g, b]
+                    [r, g, b, alpha]
                 ),
             ));
         }

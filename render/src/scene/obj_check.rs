@@ -74,7 +74,7 @@ pub(super) enum MaterialStatement {
 }
 
 /// Every `mtllib` and `usemtl` statement: its line (1-based) and what it names, read
-/// as `tobj` reads them once [`without_indentation`] is applied (the name is everything
+/// as `tobj` reads them once [`prepared_for_tobj`] is applied (the name is everything
 /// after the first space, trimmed).
 pub(super) fn material_statements(text: &str) -> Vec<(usize, MaterialStatement)> {
     text.lines()
@@ -92,13 +92,20 @@ pub(super) fn material_statements(text: &str) -> Vec<(usize, MaterialStatement)>
         .collect()
 }
 
-/// `text` with every line's leading white space removed: `tobj` finds a statement's
-/// keyword past indentation but reads its argument from the untrimmed line, so an
-/// indented `usemtl red` would name the material "usemtl red".
-pub(super) fn without_indentation(text: &str) -> String {
+/// `text` as `tobj` should read it: every line's leading white space removed (`tobj`
+/// finds a statement's keyword past indentation but reads its argument from the untrimmed
+/// line, so an indented `usemtl red` would name the material "usemtl red"), and a face
+/// without any vertex emptied (`tobj` refuses the whole file for it, "invalid polygon",
+/// where it drops shorter faces; [`short_faces`] warns of both). Lines keep their numbers.
+pub(super) fn prepared_for_tobj(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     for line in text.split_inclusive('\n') {
-        out.push_str(line.trim_start_matches([' ', '\t']));
+        let unindented = line.trim_start_matches([' ', '\t']);
+        if unindented.split_whitespace().eq(["f"]) {
+            out.push_str(&line[line.trim_end_matches(['\r', '\n']).len()..]);
+        } else {
+            out.push_str(unindented);
+        }
     }
     out
 }
@@ -146,7 +153,8 @@ mod tests {
                 (4, MaterialStatement::Library("x y.mtl".into()))
             ]
         );
-        assert_eq!(without_indentation("  usemtl c\n\tf 1 2 3\nv 1 2 3"), "usemtl c\nf 1 2 3\nv 1 2 3");
+        assert_eq!(prepared_for_tobj("  usemtl c\n\tf 1 2 3\nv 1 2 3"), "usemtl c\nf 1 2 3\nv 1 2 3");
+        assert_eq!(prepared_for_tobj("v 1 2 3\n  f \r\nf\nf 1 1 1"), "v 1 2 3\n\r\n\nf 1 1 1");
         assert_eq!(lines_text(&[4, 9, 12]), "line 4 (and 2 more)");
     }
 }

@@ -68,6 +68,8 @@ fn load_bytes(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene
     let library_missing = std::cell::Cell::new(false);
     let library_error = RefCell::new(None);
     let library_of = RefCell::new(HashMap::new());
+    let text = String::from_utf8_lossy(bytes);
+    let statements = obj_check::material_statements(&text);
     let load_library = |relative: &Path| {
         let library = folder.join(relative);
         let text = match files.read(&library) {
@@ -75,9 +77,15 @@ fn load_bytes(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene
             Err(error) => {
                 if error.kind() == std::io::ErrorKind::NotFound {
                     library_missing.set(true);
+                    let lines: Vec<usize> = statements
+                        .iter()
+                        .filter(|(_, s)| *s == obj_check::MaterialStatement::Library(relative.display().to_string()))
+                        .map(|(line, _)| *line)
+                        .collect();
                     warnings.borrow_mut().push(format!(
-                        "{}: material library {} not found; its materials are grey diffuse {DEFAULT_GREY}",
+                        "{}: {}: material library {} not found; its materials are grey diffuse {DEFAULT_GREY}",
                         path.display(),
+                        obj_check::lines_text(&lines),
                         library.display()
                     ));
                 } else {
@@ -102,7 +110,6 @@ fn load_bytes(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene
         }
         loaded
     };
-    let text = String::from_utf8_lossy(bytes);
     if let Some((line, problem)) = obj_check::bad_face_index(&text) {
         return Err(obj_error(path, format!("line {line}"), problem));
     }
@@ -117,9 +124,11 @@ fn load_bytes(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene
         ));
     }
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
-    // tobj reads statements' arguments from untrimmed lines: indentation removed first
-    // (UTF-8 only; other bytes go to tobj as they are, which refuses them).
-    let unindented = std::str::from_utf8(bytes).ok().map(obj_check::without_indentation);
+    // tobj reads statements' arguments from untrimmed lines: indentation removed first,
+    // and faces without a vertex (which tobj refuses as a whole file, where shorter faces
+    // it drops) emptied: left out with the short faces' warning (UTF-8 only; other bytes
+    // go to tobj as they are, which refuses them).
+    let unindented = std::str::from_utf8(bytes).ok().map(obj_check::prepared_for_tobj);
     let parsed: &[u8] = unindented.as_ref().map_or(bytes, |t| t.as_bytes());
     let (models, materials) = tobj::load_obj_buf(&mut &parsed[..], &options, load_library)
         .map_err(|e| obj_error(path, "(file)", format!("not a valid OBJ file: {e}")))?;
@@ -134,7 +143,7 @@ fn load_bytes(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene
     // material (tobj resolves names line by line), said once per name.
     let mut known: Vec<&str> = Vec::new();
     let mut unknown: Vec<(String, Vec<usize>)> = Vec::new();
-    for (line, statement) in obj_check::material_statements(&text) {
+    for (line, statement) in statements.iter().cloned() {
         match statement {
             obj_check::MaterialStatement::Library(file) => {
                 let library = folder.join(&file);
@@ -267,23 +276,30 @@ impl MaterialConverter<'_> {
                 other => Ok(other),
             }
         };
-        let dissolve = scalar("d", material.dissolve, Least::Zero)?;
+        // Fractions: d and Tr (opacity and transparency), Pm and Pr (the PBR extension's
+        // metallic and roughness), all read whatever the material becomes.
+        let fraction = |statement: &str, value: Option<f32>| -> Result<Option<f32>, SceneError> {
+            match value {
+                Some(v) if !(0.0..=1.0).contains(&v) => {
+                    Err(obj_error(library, element(statement), format!("{v} must lie in [0, 1]")))
+                }
+                other => Ok(other),
+            }
+        };
+        let dissolve = fraction("d", material.dissolve)?;
+        let transparency = fraction("Tr", number("Tr")?)?;
+        let metallic = fraction("Pm", number("Pm")?)?;
+        let roughness = fraction("Pr", number("Pr")?)?;
         let optical_density = scalar("Ni", material.optical_density, Least::Positive)?;
         let shininess = scalar("Ns", material.shininess, Least::Zero)?;
         let kd = reflectance("Kd", material.diffuse)?;
         let ks = reflectance("Ks", material.specular)?;
         let radiance = emission(material.emissive.unwrap_or([0.0; 3]))
             .map_err(|message| obj_error(library, element("Ke"), message))?;
-        let transparent =
-            dissolve.is_some_and(|d| d < 1.0) || number("Tr")?.is_some_and(|transparency| transparency > 0.0);
+        let transparent = dissolve.is_some_and(|d| d < 1.0) || transparency.is_some_and(|t| t > 0.0);
         let illum = material.illumination_model;
-        let bsdf = if let Some(metallic) = number("Pm")?
-            && metallic >= 0.5
-        {
-            let roughness = number("Pr")?.unwrap_or(1.0);
-            if !(0.0..=1.0).contains(&roughness) {
-                return Err(obj_error(library, element("Pr"), format!("{roughness} must lie in [0, 1]")));
-            }
+        let bsdf = if metallic.is_some_and(|m| m >= 0.5) {
+            let roughness = roughness.unwrap_or(1.0);
             metal(kd.unwrap_or([DEFAULT_GREY; 3]), (roughness * roughness).max(MIN_ALPHA), true)
         } else if transparent || matches!(illum, Some(4 | 6 | 7 | 9)) {
             let int_ior = optical_density.unwrap_or(1.5);

@@ -159,6 +159,11 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
             bail!("--methods: `{}` is named twice; name each method once", method.name());
         }
     }
+    for (index, crop) in args.crop.iter().enumerate() {
+        if args.crop[..index].contains(crop) {
+            bail!("--crop {crop}: given twice; give each close-up once");
+        }
+    }
     let restir = args.restir;
     // Refused settings are said before the reference takes its minutes.
     restir.check()?;

@@ -14,7 +14,7 @@ pub(crate) fn finite_positive(text: &str) -> Result<f32, String> {
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 use strata::backend_choice::{BackendChoice, open_backend};
 use strata::evaluation::metrics::{self, Metric};
@@ -177,6 +177,7 @@ enum VariantArg {
 /// `RUST_BACKTRACE` says. Panics, which are bugs, keep theirs.
 fn main() -> std::process::ExitCode {
     quiet_output_failures();
+    write_limits_are_errors();
     let result = match Cli::parse().command {
         Command::Histogram(args) => histogram(args),
         Command::Render(args) => render(args),
@@ -190,6 +191,19 @@ fn main() -> std::process::ExitCode {
             eprintln!("error: {error:#}");
             std::process::ExitCode::FAILURE
         }
+    }
+}
+
+/// A file-size limit (`ulimit -f`) reached while writing would kill the process by
+/// SIGXFSZ before it could say anything, leaving the writer's temporary file behind.
+/// Ignored, the write fails with "File too large" instead, which the one writer
+/// (`atomic_file`) reports naming the file, removing its temporary.
+fn write_limits_are_errors() {
+    #[cfg(unix)]
+    // SAFETY: `signal` with `SIG_IGN` installs no handler code; it is called once, before
+    // any other thread exists.
+    unsafe {
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
     }
 }
 
@@ -277,6 +291,20 @@ fn plot(args: PlotArgs) -> Result<()> {
             args.csv.len()
         );
     }
+    for (index, label) in args.labels.iter().enumerate() {
+        if args.labels[..index].contains(label) {
+            bail!("--label `{label}`: given twice; the legend could not tell the runs apart");
+        }
+    }
+    let same_file = |a: &PathBuf, b: &PathBuf| match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => a == b,
+    };
+    for (index, path) in args.csv.iter().enumerate() {
+        if let Some(earlier) = args.csv[..index].iter().find(|earlier| same_file(earlier, path)) {
+            bail!("{}: the same CSV as {}; give each run once", path.display(), earlier.display());
+        }
+    }
     let labels = if args.labels.is_empty() { default_labels(&args.csv) } else { args.labels.clone() };
     let mut runs = Vec::new();
     for (path, label) in args.csv.iter().zip(labels) {
@@ -303,18 +331,9 @@ fn plot(args: PlotArgs) -> Result<()> {
             }
         }
         let frames = frames_of(errors);
-        let with = |suffix: &str| {
-            let mut name = stem.as_os_str().to_owned();
-            name.push(suffix);
-            PathBuf::from(name)
-        };
-        plot::write_relmse_plot(errors, &methods, frames, &title, &stem)?;
-        let mut written = vec![with(".svg"), with(".png")];
-        let ratio = with("_ratio");
-        if plot::write_ratio_plot(errors, frames, &title, &ratio)? {
-            written.extend([with("_ratio.svg"), with("_ratio.png")]);
-        }
-        written
+        let mut ratio = stem.as_os_str().to_owned();
+        ratio.push("_ratio");
+        plot::write_relmse_and_ratio_plots(errors, &methods, frames, &title, &stem, Path::new(&ratio))?
     };
     println!("wrote {}", written.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "));
     for (label, errors) in &runs {
@@ -442,6 +461,9 @@ fn render(args: RenderArgs) -> Result<()> {
     let seconds = started.elapsed().as_secs_f64();
     image.write_exr(&exr)?;
     image.write_png(&png, args.exposure)?;
+    if let Some(warning) = strata::evaluation::image_checks::black_preview(&image, args.exposure) {
+        eprintln!("warning: {}: {warning}", png.display());
+    }
     let mean = image.mean();
     println!(
         "rendered in {seconds:.1} s ({:.1} ms per sample per pixel); mean radiance ({:.4}, {:.4}, {:.4})",

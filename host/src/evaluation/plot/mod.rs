@@ -22,5 +22,5 @@ mod style;
 #[cfg(test)]
 mod tests;
 
-pub use plots::{relmse_svg, write_overlay_plots, write_ratio_plot, write_relmse_plot};
+pub use plots::{relmse_svg, write_overlay_plots, write_ratio_plot, write_relmse_and_ratio_plots, write_relmse_plot};
 pub use style::method_colour;

@@ -69,17 +69,29 @@ pub(super) fn png(figure: &Figure) -> Result<image::RgbImage> {
     Ok(image::imageops::resize(&large, small_width, small_height, image::imageops::FilterType::Triangle))
 }
 
-/// Writes `{stem}.svg` and `{stem}.png`; returns their paths. An error names the file.
-pub(super) fn write(figure: &Figure, stem: &Path) -> Result<Vec<PathBuf>> {
+/// The files of `figure`: `{stem}.svg` and `{stem}.png`, encoded in memory. An error
+/// names the file.
+pub(super) fn encode(figure: &Figure, stem: &Path) -> Result<Vec<(PathBuf, Vec<u8>)>> {
     let (svg_path, png_path) = (with_suffix(stem, ".svg"), with_suffix(stem, ".png"));
     let document = svg(figure).with_context(|| format!("{}: cannot write", svg_path.display()))?;
-    crate::atomic_file::write(&svg_path, document)?;
     let bytes = png(figure)
         .and_then(|image| {
             crate::rgb_image::encode_png(image.as_raw(), image.width(), image.height(), image::ExtendedColorType::Rgb8)
                 .map_err(|e| anyhow!(e))
         })
         .with_context(|| format!("{}: cannot write", png_path.display()))?;
-    crate::atomic_file::write(&png_path, bytes)?;
-    Ok(vec![svg_path, png_path])
+    Ok(vec![(svg_path, document.into_bytes()), (png_path, bytes)])
+}
+
+/// Writes `files` as one set ([`crate::atomic_file::write_set`]: all of them or none);
+/// returns their paths.
+pub(super) fn write_files(files: &[(PathBuf, Vec<u8>)]) -> Result<Vec<PathBuf>> {
+    let set: Vec<(&Path, &[u8])> = files.iter().map(|(path, bytes)| (path.as_path(), bytes.as_slice())).collect();
+    crate::atomic_file::write_set(&set)?;
+    Ok(files.iter().map(|(path, _)| path.clone()).collect())
+}
+
+/// Writes `{stem}.svg` and `{stem}.png`, both or neither; returns their paths.
+pub(super) fn write(figure: &Figure, stem: &Path) -> Result<Vec<PathBuf>> {
+    write_files(&encode(figure, stem)?)
 }

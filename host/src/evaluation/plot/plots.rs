@@ -105,11 +105,30 @@ pub fn write_overlay_plots(runs: &[(String, Vec<FrameError>)], title: &str, stem
         ratios.extend(ratio_series(errors, frames, &format!("{label}: "), dash));
     }
     let figure = Figure { series: relmse, ..relmse_figure(&[], &[], frames, title) };
-    let mut written = output::write(&figure, &with_suffix(stem, "_relmse"))?;
+    let mut files = output::encode(&figure, &with_suffix(stem, "_relmse"))?;
     if !ratios.is_empty() {
-        written.extend(output::write(&ratio_figure(ratios, frames, title), &with_suffix(stem, "_ratio"))?);
+        files.extend(output::encode(&ratio_figure(ratios, frames, title), &with_suffix(stem, "_ratio"))?);
     }
-    Ok(written)
+    output::write_files(&files)
+}
+
+/// [`write_relmse_plot`] at `stem` and [`write_ratio_plot`] at `ratio_stem`, written as
+/// one set: all four files or none (a full disk or a refused name on the last leaves no
+/// plot half-made). Returns the paths written.
+pub fn write_relmse_and_ratio_plots(
+    errors: &[FrameError],
+    methods: &[Method],
+    frames: u32,
+    title: &str,
+    stem: &Path,
+    ratio_stem: &Path,
+) -> Result<Vec<PathBuf>> {
+    let mut files = output::encode(&relmse_figure(errors, methods, frames, title), stem)?;
+    let series = ratio_series(errors, frames, "", Dash::SOLID);
+    if !series.is_empty() {
+        files.extend(output::encode(&ratio_figure(series, frames, title), ratio_stem)?);
+    }
+    output::write_files(&files)
 }
 
 /// The RelMSE plot of [`write_relmse_plot`] as an SVG document, for callers that write

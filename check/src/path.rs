@@ -14,7 +14,7 @@ use super::{Case, CheckConfig, Compare, KernelCheck, Output};
 use std::sync::Arc;
 use strata::histogram_pass::PassError;
 use strata::render::{GpuScene, RenderSettings, render};
-use strata::scene::{Environment, Material, Scene, default_scene};
+use strata::scene::{Material, Scene, default_scene};
 use strata_backends::Backend;
 use strata_kernels::{KernelId, Registry};
 
@@ -41,15 +41,7 @@ pub(super) fn scene(case: &Case) -> Scene {
                 shape.material = count - 1;
             }
         }
-        let (width, height) = (8u32, 4u32);
-        scene.environment = Some(Environment {
-            file: "generated".into(),
-            width,
-            height,
-            texels: (0..width * height).map(|i| [0.1 + (i % 5) as f32 * 0.3, 0.5, 0.2 + (i % 3) as f32]).collect(),
-            scale: 1.0,
-            to_world: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
-        });
+        scene.environment = Some(crate::fuzz::build::generated_environment(1.0));
     }
     scene
 }

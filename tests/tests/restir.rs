@@ -624,7 +624,7 @@ fn temporal_reuse_with_a_moving_camera_stays_unbiased() {
 /// vertex, resampled behind or path-traced alone like the glass), and an environment map
 /// shining in through the open front (candidates reconnected by direction).
 fn glass_metal_environment_scene() -> Scene {
-    use strata::scene::{Environment, Material};
+    use strata::scene::Material;
     let mut scene = default_scene();
     let metal = |alpha| Material::RoughConductor { alpha, eta: [0.2, 0.9, 1.1], k: [3.9, 2.4, 2.2], two_sided: true };
     scene.materials.extend([Material::Dielectric { int_ior: 1.5, ext_ior: 1.0 }, metal(0.3), metal(0.1), metal(0.03)]);
@@ -638,15 +638,7 @@ fn glass_metal_environment_scene() -> Scene {
             _ => {}
         }
     }
-    let (width, height) = (8u32, 4u32);
-    scene.environment = Some(Environment {
-        file: "generated".into(),
-        width,
-        height,
-        texels: (0..width * height).map(|i| [0.1 + (i % 5) as f32 * 0.3, 0.5, 0.2 + (i % 3) as f32]).collect(),
-        scale: 2.0,
-        to_world: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
-    });
+    scene.environment = Some(strata_check::fuzz::build::generated_environment(2.0));
     scene
 }
 

@@ -6,6 +6,7 @@ use glam::Vec3;
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 use strata::scene::{Albedo, CameraFrame, Material, Scene, SceneError, load_scene_file, srgb_to_linear};
+use strata_check::fuzz::build::base64;
 
 /// A fresh folder under the system's temporary folder.
 fn temp_folder(name: &str) -> PathBuf {
@@ -19,18 +20,6 @@ fn write(dir: &Path, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
     let path = dir.join(name);
     std::fs::write(&path, bytes).unwrap();
     path
-}
-
-fn base64(bytes: &[u8]) -> String {
-    const ALPHABET: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::new();
-    for chunk in bytes.chunks(3) {
-        let n = chunk.iter().enumerate().fold(0u32, |n, (i, &b)| n | u32::from(b) << (16 - 8 * i));
-        for i in 0..4 {
-            out.push(if i <= chunk.len() { ALPHABET[(n >> (18 - 6 * i) & 63) as usize] as char } else { '=' });
-        }
-    }
-    out
 }
 
 /// A PNG of `width` × 1 RGBA pixels.

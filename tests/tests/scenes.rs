@@ -51,25 +51,9 @@ fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
     path
 }
 
+/// A binary PLY of `vertices` and `faces` (the fixtures' one writer).
 fn ply(vertices: &[[f32; 3]], faces: &[[i32; 3]]) -> Vec<u8> {
-    let mut bytes = format!(
-        "ply\nformat binary_little_endian 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
-        vertices.len(),
-        faces.len()
-    )
-    .into_bytes();
-    for v in vertices {
-        for c in v {
-            bytes.extend(c.to_le_bytes());
-        }
-    }
-    for f in faces {
-        bytes.push(3);
-        for i in f {
-            bytes.extend(i.to_le_bytes());
-        }
-    }
-    bytes
+    strata_check::fuzz::build::ply(vertices, None, faces)
 }
 
 #[test]

@@ -123,3 +123,31 @@ pub fn files_in(folder: &std::path::Path, extension: &str, largest: u64) -> Vec<
     paths.sort();
     paths.into_iter().filter_map(|p| std::fs::read(p).ok()).collect()
 }
+
+/// Standard base64 with padding (the `data:` URIs of glTF buffers and images).
+pub fn base64(bytes: &[u8]) -> String {
+    const ALPHABET: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::new();
+    for chunk in bytes.chunks(3) {
+        let n = chunk.iter().enumerate().fold(0u32, |n, (i, &b)| n | u32::from(b) << (16 - 8 * i));
+        for i in 0..4 {
+            out.push(if i <= chunk.len() { ALPHABET[(n >> (18 - 6 * i) & 63) as usize] as char } else { '=' });
+        }
+    }
+    out
+}
+
+/// A small generated environment map (8 x 4 texels of varied colours) at `scale`: the
+/// environment light of the glass/metal rooms that the cross-backend check and the
+/// unbiasedness tests render.
+pub fn generated_environment(scale: f32) -> strata::scene::Environment {
+    let (width, height) = (8u32, 4u32);
+    strata::scene::Environment {
+        file: "generated".into(),
+        width,
+        height,
+        texels: (0..width * height).map(|i| [0.1 + (i % 5) as f32 * 0.3, 0.5, 0.2 + (i % 3) as f32]).collect(),
+        scale,
+        to_world: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+    }
+}

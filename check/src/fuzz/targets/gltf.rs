@@ -112,7 +112,7 @@ impl Builder {
 
     /// `document` with this buffer as a `data:` URI.
     fn gltf(self, mut document: Value) -> Vec<u8> {
-        let uri = format!("data:application/octet-stream;base64,{}", base64(&self.bytes));
+        let uri = format!("data:application/octet-stream;base64,{}", build::base64(&self.bytes));
         document["buffers"] = json!([{"byteLength": self.bytes.len(), "uri": uri}]);
         document["bufferViews"] = Value::Array(self.views);
         document["accessors"] = Value::Array(self.accessors);
@@ -126,19 +126,6 @@ impl Builder {
         document["accessors"] = Value::Array(self.accessors);
         glb(&serde_json::to_vec(&document).expect("JSON"), Some(&self.bytes))
     }
-}
-
-/// Standard base64 with padding.
-fn base64(bytes: &[u8]) -> String {
-    const ALPHABET: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::new();
-    for chunk in bytes.chunks(3) {
-        let n = chunk.iter().enumerate().fold(0u32, |n, (i, &b)| n | u32::from(b) << (16 - 8 * i));
-        for i in 0..4 {
-            out.push(if i <= chunk.len() { ALPHABET[(n >> (18 - 6 * i) & 63) as usize] as char } else { '=' });
-        }
-    }
-    out
 }
 
 /// A GLB container of `json` and an optional binary chunk (chunks padded to 4 bytes).
@@ -347,7 +334,7 @@ impl Target for Gltf {
  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": {}}}{indices}, "mode": {mode}, "material": 0}}]}}],
  "cameras": [{{"type": "perspective", "perspective": {{"yfov": {}, "znear": {}, "zfar": {}}}}}],
  "nodes": [{{"mesh": 0{transform}}}, {{"camera": 0, "translation": [0, 0, {}]}}]}}"#,
-            base64(&buffer),
+            build::base64(&buffer),
             views.join(", "),
             accessors.join(", "),
             factor(u)?,

@@ -2,17 +2,18 @@
 //! SPIR-V of the same WGSL kernels, recording into the engine's command buffer with the
 //! engine's buffers.
 
+use crate::ash_objects::{Created, OwnBuffer, Pipeline, descriptor_type, destroy_pipeline, vk_error};
 use crate::binding_plan::{BindingPlan, EngineBuffers, OwnBuffers, PassBuffer, ResampleBuffers, Resource};
 use crate::contract::check_size;
 use crate::error::EmbedError;
 use crate::frame::{FrameId, FrameParams, frame_params, max_blocks};
 use crate::limits::{DeviceLimits, VULKAN_NAMES, check_limits};
-use crate::wgsl::{ModuleId, WgslModule, module};
+use crate::wgsl::{ModuleId, module};
 use ash::vk;
+use strata_kernels::Executor;
 use strata_kernels::blue_noise::BlueNoiseTables;
 use strata_kernels::selection::SelectionSettings;
-use strata_kernels::translate::{TranslateOptions, WorkgroupZeroInit, spirv};
-use strata_kernels::{Executor, Registry};
+use strata_kernels::translate::{TranslateOptions, WorkgroupZeroInit};
 
 /// The engine's Vulkan objects the pass is created on (the instance created with
 /// `apiVersion` 1.1 or newer and a Vulkan 1.1 device; nothing has to be enabled beyond
@@ -92,19 +93,6 @@ pub struct AshBindings {
     identity_payload: bool,
 }
 
-struct Pipeline {
-    pipeline: vk::Pipeline,
-    layout: vk::PipelineLayout,
-    set_layout: vk::DescriptorSetLayout,
-    module: WgslModule,
-}
-
-struct OwnBuffer {
-    buffer: vk::Buffer,
-    memory: vk::DeviceMemory,
-    size: u64,
-}
-
 /// The stratified selection on an engine's Vulkan device (see [`crate::WgpuSelection`]
 /// for the frame's sequence; here the uniforms are written inside the command buffer with
 /// `vkCmdUpdateBuffer`, so several frames may be recorded into one submission).
@@ -125,10 +113,6 @@ pub struct AshSelection {
     select: Pipeline,
     resample: Pipeline,
     own: OwnBuffers<OwnBuffer>,
-}
-
-fn vk_error(operation: &str, result: vk::Result) -> EmbedError {
-    EmbedError::Api { api: "Vulkan", operation: operation.into(), message: format!("{result:?}") }
 }
 
 /// Whether compute shaders may use subgroup shuffles (Vulkan 1.1 subgroup properties).
@@ -449,167 +433,6 @@ impl AshSelection {
             }
             for pipeline in [&self.histogram, &self.select, &self.resample] {
                 destroy_pipeline(&self.device, pipeline);
-            }
-        }
-    }
-}
-
-/// The descriptor type of binding `binding` of `module`.
-fn descriptor_type(module: &WgslModule, binding: u32) -> vk::DescriptorType {
-    match module.bindings.iter().find(|b| b.binding == binding) {
-        Some(b) if b.uniform => vk::DescriptorType::UNIFORM_BUFFER,
-        _ => vk::DescriptorType::STORAGE_BUFFER,
-    }
-}
-
-/// # Safety
-/// The pipeline must be unused.
-unsafe fn destroy_pipeline(device: &ash::Device, pipeline: &Pipeline) {
-    // SAFETY: per the function's contract.
-    unsafe {
-        device.destroy_pipeline(pipeline.pipeline, None);
-        device.destroy_pipeline_layout(pipeline.layout, None);
-        device.destroy_descriptor_set_layout(pipeline.set_layout, None);
-    }
-}
-
-/// Objects made so far by [`AshSelection::new`], destroyed if it fails half-way.
-struct Created<'a> {
-    device: &'a ash::Device,
-    /// How the pipelines' SPIR-V zeroes workgroup memory.
-    translate: TranslateOptions,
-    pipelines: Vec<(vk::Pipeline, vk::PipelineLayout, vk::DescriptorSetLayout)>,
-    buffers: Vec<(vk::Buffer, vk::DeviceMemory)>,
-}
-
-impl Created<'_> {
-    fn pipeline(&mut self, module: &WgslModule) -> Result<Pipeline, EmbedError> {
-        let kernel = Registry::shared()?.get(module.id.kernel());
-        let code = spirv(kernel, self.translate)?;
-        let layout_bindings: Vec<_> = module
-            .bindings
-            .iter()
-            .map(|b| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(b.binding)
-                    .descriptor_type(descriptor_type(module, b.binding))
-                    .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::COMPUTE)
-            })
-            .collect();
-        let device = self.device;
-        let operation = format!("creating the `{}` pipeline", module.entry_point);
-        // SAFETY: valid device; every object is destroyed by `Drop` on failure or by
-        // AshSelection::destroy.
-        unsafe {
-            let set_layout = device
-                .create_descriptor_set_layout(
-                    &vk::DescriptorSetLayoutCreateInfo::default().bindings(&layout_bindings),
-                    None,
-                )
-                .map_err(|e| vk_error(&operation, e))?;
-            let layouts = [set_layout];
-            let layout = match device
-                .create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts), None)
-            {
-                Ok(layout) => layout,
-                Err(e) => {
-                    device.destroy_descriptor_set_layout(set_layout, None);
-                    return Err(vk_error(&operation, e));
-                }
-            };
-            self.pipelines.push((vk::Pipeline::null(), layout, set_layout));
-            let shader = device
-                .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&code.words), None)
-                .map_err(|e| vk_error(&operation, e))?;
-            let entry = std::ffi::CString::new(code.entry_point).expect("entry points have no NUL");
-            let stage = vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::COMPUTE)
-                .module(shader)
-                .name(&entry);
-            let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout);
-            let result = device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None);
-            device.destroy_shader_module(shader, None);
-            let pipeline = result.map_err(|(_, e)| vk_error(&operation, e))?[0];
-            self.pipelines.last_mut().expect("pushed above").0 = pipeline;
-            Ok(Pipeline { pipeline, layout, set_layout, module: module.clone() })
-        }
-    }
-
-    fn buffer(
-        &mut self,
-        memory: &vk::PhysicalDeviceMemoryProperties,
-        size: u64,
-        usage: vk::BufferUsageFlags,
-        preferred: vk::MemoryPropertyFlags,
-        contents: Option<&[u8]>,
-    ) -> Result<OwnBuffer, EmbedError> {
-        let device = self.device;
-        let info = vk::BufferCreateInfo::default().size(size).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
-        // SAFETY: valid device; objects are recorded for cleanup right after creation.
-        unsafe {
-            let buffer = device.create_buffer(&info, None).map_err(|e| vk_error("creating a buffer", e))?;
-            let requirements = device.get_buffer_memory_requirements(buffer);
-            let candidates = (0..memory.memory_type_count).filter(|&i| requirements.memory_type_bits & (1 << i) != 0);
-            let flags = |i: u32| memory.memory_types[i as usize].property_flags;
-            let required = if contents.is_some() {
-                vk::MemoryPropertyFlags::HOST_VISIBLE | vk::MemoryPropertyFlags::HOST_COHERENT
-            } else {
-                vk::MemoryPropertyFlags::empty()
-            };
-            let chosen = candidates
-                .clone()
-                .find(|&i| flags(i).contains(preferred | required))
-                .or_else(|| candidates.clone().find(|&i| flags(i).contains(required)));
-            let Some(type_index) = chosen else {
-                device.destroy_buffer(buffer, None);
-                return Err(EmbedError::Api {
-                    api: "Vulkan",
-                    operation: "allocating buffer memory".into(),
-                    message: format!("no memory type with {required:?} for a buffer of usage {usage:?}"),
-                });
-            };
-            let allocate =
-                vk::MemoryAllocateInfo::default().allocation_size(requirements.size).memory_type_index(type_index);
-            let memory = match device.allocate_memory(&allocate, None) {
-                Ok(memory) => memory,
-                Err(e) => {
-                    device.destroy_buffer(buffer, None);
-                    return Err(vk_error("allocating buffer memory", e));
-                }
-            };
-            self.buffers.push((buffer, memory));
-            device.bind_buffer_memory(buffer, memory, 0).map_err(|e| vk_error("binding buffer memory", e))?;
-            if let Some(bytes) = contents {
-                let mapped = device
-                    .map_memory(memory, 0, size, vk::MemoryMapFlags::empty())
-                    .map_err(|e| vk_error("mapping buffer memory", e))?;
-                std::ptr::copy_nonoverlapping(bytes.as_ptr(), mapped.cast::<u8>(), bytes.len());
-                device.unmap_memory(memory);
-            }
-            Ok(OwnBuffer { buffer, memory, size })
-        }
-    }
-
-    /// Everything succeeded: ownership passes to the AshSelection.
-    fn keep(mut self) {
-        self.pipelines.clear();
-        self.buffers.clear();
-    }
-}
-
-impl Drop for Created<'_> {
-    fn drop(&mut self) {
-        // SAFETY: these objects were never used by a command buffer.
-        unsafe {
-            for &(pipeline, layout, set_layout) in &self.pipelines {
-                self.device.destroy_pipeline(pipeline, None);
-                self.device.destroy_pipeline_layout(layout, None);
-                self.device.destroy_descriptor_set_layout(set_layout, None);
-            }
-            for &(buffer, memory) in &self.buffers {
-                self.device.destroy_buffer(buffer, None);
-                self.device.free_memory(memory, None);
             }
         }
     }

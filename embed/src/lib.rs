@@ -47,6 +47,8 @@ mod limits;
 pub mod wgsl;
 
 #[cfg(feature = "ash")]
+mod ash_objects;
+#[cfg(feature = "ash")]
 mod ash_selection;
 #[cfg(feature = "wgpu")]
 mod wgpu_selection;

@@ -56,9 +56,9 @@ static inline int strata_check_settings(const StrataSelectionSettings *settings,
     uint32_t value = 0;
     if (settings->block_size != 4u && settings->block_size != 8u && settings->block_size != 16u &&
         settings->block_size != 32u) {
-        field = "block_size", value = settings->block_size, expected = "a power of two from 4 to 32 (4, 8, 16 or 32)";
+        field = "block_size", value = settings->block_size, expected = "4, 8, 16 or 32";
     } else if (settings->candidates < 1u || settings->candidates > STRATA_MAX_SELECTED) {
-        field = "candidates", value = settings->candidates, expected = "1, 2, 3 or 4";
+        field = "candidates", value = settings->candidates, expected = "1 to 4";
     } else if (settings->sampler > STRATA_SAMPLER_ANTITHETIC) {
         field = "sampler", value = settings->sampler, expected = "a StrataSampler (0 to 4)";
     } else if (settings->masking > 1u) {

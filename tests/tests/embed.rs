@@ -539,7 +539,7 @@ fn bad_configurations_are_named_errors() {
     let new = |settings: SelectionSettings, w, h| WgpuSelection::new(&device, settings, w, h);
     expect_error(
         new(SelectionSettings { block_size: 12, ..Default::default() }, 8, 8),
-        &["block_size = 12", "power of two"],
+        &["block_size = 12", "4, 8, 16 or 32"],
     );
     expect_error(new(SelectionSettings { block_size: 64, ..Default::default() }, 8, 8), &["block_size = 64"]);
     expect_error(new(SelectionSettings { candidates: 5, ..Default::default() }, 8, 8), &["candidates = 5"]);

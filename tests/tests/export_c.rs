@@ -494,7 +494,7 @@ int main(void) {
         StrataFrameParams p;
         char message[128];
         if (strata_frame_params(&settings, w, h, f, seed, id, mw, &p, message, sizeof message)) {
-            printf("error\n");
+            printf("error %s\n", message);
             continue;
         }
         const unsigned char *bytes = (const unsigned char *)&p;
@@ -590,7 +590,15 @@ int main(void) {
             child.wait_with_output()
         })
         .unwrap();
-    assert_eq!(String::from_utf8_lossy(&refused.stdout), "error\nerror\nerror\n");
+    // The messages are Rust's own (`SelectionSettings::validate`) where Rust has the field.
+    let rust = |settings: SelectionSettings| format!("error {}", settings.validate().unwrap_err());
+    let expected = [
+        rust(SelectionSettings { block_size: 12, ..SelectionSettings::default() }),
+        rust(SelectionSettings { block_size: 4, candidates: 5, ..SelectionSettings::default() }),
+        "error sampler = 9: must be a StrataSampler (0 to 4)".to_string(),
+    ];
+    let said: Vec<&str> = std::str::from_utf8(&refused.stdout).unwrap().lines().collect();
+    assert_eq!(said, expected);
     let _ = std::fs::remove_dir_all(&folder);
 }
 

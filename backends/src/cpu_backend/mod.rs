@@ -39,12 +39,14 @@
 //! `reflect`, `refract`, `faceForward`, `dot4I8Packed`/`dot4U8Packed`). Anything else is
 //! an error naming the construct and its WGSL line, never a panic.
 
+mod access;
 mod arith;
 mod constant;
 mod counts;
 mod decode;
 mod error;
 mod exec;
+mod execute;
 mod expression;
 mod insn;
 mod interp;

@@ -28,6 +28,9 @@ pub struct FrameError {
     /// The paper's RelMSE of luminance ([`metrics::relmse_luminance`]): the part of the
     /// error that is not colour noise. `None` when read from a CSV written before it.
     pub relmse_luminance: Option<f64>,
+    /// Mean LDR-FLIP of the frame's preview against the reference's ([`super::flip`]).
+    /// `None` when read from a CSV written before it or computed by a build without FLIP.
+    pub flip: Option<f64>,
 }
 
 /// What to compare.
@@ -45,6 +48,8 @@ pub struct Comparison {
     pub restir: RestirSettings,
     /// The camera of each frame (empty: the render settings' camera throughout).
     pub cameras: Vec<Camera>,
+    /// The exposure of the previews, at which FLIP compares what a person sees.
+    pub exposure: f32,
 }
 
 /// Renders every method × seed × frame of `comparison` and measures each frame against
@@ -113,6 +118,8 @@ pub fn run_comparison(
                         prelmse: measure(metrics::prelmse(&shown, reference))?,
                         mse: measure(metrics::mse(&shown, reference))?,
                         relmse_luminance: Some(measure(metrics::relmse_luminance(&shown, reference))?),
+                        flip: super::flip::mean_flip(&shown, reference, comparison.exposure)
+                            .map_err(|e| PassError::Input(e.to_string()))?,
                     });
                     on_frame(method, seed, frame, &shown, render_time);
                 }
@@ -126,18 +133,21 @@ pub fn run_comparison(
 }
 
 /// The CSV header [`errors_csv`] writes.
-const CSV_HEADER: &str = "method,frame,seed,relmse,prelmse,mse,relmse_luminance";
+const CSV_HEADER: &str = "method,frame,seed,relmse,prelmse,mse,relmse_luminance,flip";
+/// The header of CSVs written before the FLIP column (still read).
+const CSV_HEADER_WITHOUT_FLIP: &str = "method,frame,seed,relmse,prelmse,mse,relmse_luminance";
 /// The header of CSVs written before the luminance column (still read).
 const CSV_HEADER_WITHOUT_LUMINANCE: &str = "method,frame,seed,relmse,prelmse,mse";
 
-/// The CSV of `errors`: method, frame, seed, relmse, prelmse, mse, relmse_luminance
-/// (frames 1-based; an unknown luminance RelMSE is an empty field).
+/// The CSV of `errors`: method, frame, seed, relmse, prelmse, mse, relmse_luminance,
+/// flip (frames 1-based; an unknown value is an empty field).
 pub fn errors_csv(errors: &[FrameError]) -> String {
     let mut csv = format!("{CSV_HEADER}\n");
     for e in errors {
-        let luminance = e.relmse_luminance.map(|v| format!("{v:.6e}")).unwrap_or_default();
+        let optional = |value: Option<f64>| value.map(|v| format!("{v:.6e}")).unwrap_or_default();
+        let (luminance, flip) = (optional(e.relmse_luminance), optional(e.flip));
         csv.push_str(&format!(
-            "{},{},{},{:.6e},{:.6e},{:.6e},{luminance}\n",
+            "{},{},{},{:.6e},{:.6e},{:.6e},{luminance},{flip}\n",
             e.method.name(),
             e.frame + 1,
             e.seed,
@@ -169,6 +179,19 @@ pub fn luminance_relmse_ratio(
     frame: u32,
 ) -> Option<MeanInterval> {
     ratio_of(errors, method, baseline, frame, |e| e.relmse_luminance)
+}
+
+/// FLIP of `method` at `frame` over seeds; `None` when no row has one.
+pub fn flip_over_seeds(errors: &[FrameError], method: Method, frame: u32) -> Option<MeanInterval> {
+    let values: Vec<f64> =
+        errors.iter().filter(|e| e.method == method && e.frame == frame).filter_map(|e| e.flip).collect();
+    (!values.is_empty()).then(|| MeanInterval::of(&values))
+}
+
+/// Per seed, the ratio of `method`'s FLIP to `baseline`'s at `frame` (paired, as
+/// [`relmse_ratio`]).
+pub fn flip_ratio(errors: &[FrameError], method: Method, baseline: Method, frame: u32) -> Option<MeanInterval> {
+    ratio_of(errors, method, baseline, frame, |e| e.flip)
 }
 
 /// Per seed, `value(method) / value(baseline)` at `frame`, with mean and interval.
@@ -284,7 +307,8 @@ fn check_rows(rows: &[(usize, FrameError)]) -> Result<(), String> {
 fn parse_rows(text: &str) -> Result<Vec<(usize, FrameError)>, String> {
     let mut lines = text.lines();
     let columns = match lines.next().map(str::trim) {
-        Some(CSV_HEADER) => 7,
+        Some(CSV_HEADER) => 8,
+        Some(CSV_HEADER_WITHOUT_FLIP) => 7,
         Some(CSV_HEADER_WITHOUT_LUMINANCE) => 6,
         _ => return Err(format!("line 1: expected the header `{CSV_HEADER}`")),
     };
@@ -333,6 +357,10 @@ fn parse_rows(text: &str) -> Result<Vec<(usize, FrameError)>, String> {
                     None | Some(&"") => None,
                     Some(_) => Some(float(6)?),
                 },
+                flip: match fields.get(7) {
+                    None | Some(&"") => None,
+                    Some(_) => Some(float(7)?),
+                },
             },
         ));
     }
@@ -353,9 +381,13 @@ mod tests {
             prelmse: 0.25,
             mse: 1e-3,
             relmse_luminance,
+            flip: None,
         };
-        let errors = vec![error(7, Some(0.125)), error(8, None)];
+        let errors = vec![error(7, Some(0.125)), error(8, None), FrameError { flip: Some(0.0625), ..error(9, None) }];
         assert_eq!(parse_errors_csv(&errors_csv(&errors)).unwrap(), errors);
+        // CSVs written before the FLIP column still read.
+        let without_flip = "method,frame,seed,relmse,prelmse,mse,relmse_luminance\nrestir-disc,3,8,0.5,0.25,1e-3,\n";
+        assert_eq!(parse_errors_csv(without_flip).unwrap(), vec![error(8, None)]);
         // CSVs written before the luminance column still read.
         let old = "method,frame,seed,relmse,prelmse,mse\nrestir-disc,3,8,0.5,0.25,1e-3\n";
         assert_eq!(parse_errors_csv(old).unwrap(), vec![error(8, None)]);
@@ -381,6 +413,7 @@ mod tests {
             prelmse: relmse,
             mse: relmse,
             relmse_luminance: None,
+            flip: None,
         };
         // Seed s: restir has RelMSE 3 and 1 at frames 0 and 1; strata 1 and 1, so the
         // pooled ratio is 2/4 for every seed, while the per-frame ratios are 1/3 and 1.

@@ -66,6 +66,9 @@ pub enum MetricError {
     /// Two methods' seed counts differ.
     #[error("{0} seeds against {1}: the methods must run from the same seeds")]
     SeedCounts(usize, usize),
+    /// The exposure of a tone-mapped metric (FLIP) is not finite and positive.
+    #[error("exposure {0}: must be finite and positive")]
+    Exposure(f32),
 }
 
 /// Both images have the same, non-zero size and only finite values.

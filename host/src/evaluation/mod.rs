@@ -8,6 +8,7 @@
 
 pub mod compare;
 pub mod crops;
+pub mod flip;
 pub mod image_checks;
 pub mod metrics;
 pub mod output_folder;

@@ -153,6 +153,10 @@ pub fn run_and_report(
     for line in summary::whole_run_lines(&errors, frames) {
         text += &format!("{line}\n");
     }
+    if let Some(flip) = summary::flip_table(&errors, &options.methods, &shown) {
+        text += &flip.to_text();
+        tables.push(flip);
+    }
     if seeds >= 3 {
         let (variance, csv) = summary::variance_tables(&options.methods, &shown, &seed_images, references)?;
         write(&out.join("variance.csv"), csv)?;

@@ -4,7 +4,10 @@
 //! out; [`Table::to_text`] prints them (stdout, `summary.txt`) and the report page
 //! writes the same tables as HTML, so the two never disagree.
 
-use super::compare::{FrameError, luminance_relmse_ratio, relmse_over_seeds, relmse_ratio, relmse_ratio_over_frames};
+use super::compare::{
+    FrameError, flip_over_seeds, flip_ratio, luminance_relmse_ratio, relmse_over_seeds, relmse_ratio,
+    relmse_ratio_over_frames,
+};
 use super::metrics::{self, MeanInterval};
 use crate::restir::Method;
 use crate::rgb_image::RgbImage;
@@ -95,6 +98,36 @@ pub fn relmse_table(errors: &[FrameError], methods: &[Method], shown: &[u32], ti
         }
     }
     Table { title: title.to_string(), columns: frame_columns("method", shown), rows }
+}
+
+/// FLIP of each method at the shown frames (mean ± 95 % CI over seeds), then strata ÷
+/// each baseline, paired per seed; `None` when the errors hold no FLIP (a CSV written
+/// before it, a build without it).
+pub fn flip_table(errors: &[FrameError], methods: &[Method], shown: &[u32]) -> Option<Table> {
+    if !errors.iter().any(|e| e.flip.is_some()) {
+        return None;
+    }
+    let mut rows: Vec<Row> = methods
+        .iter()
+        .map(|&m| Row {
+            label: m.name().to_string(),
+            cells: shown
+                .iter()
+                .map(|&f| flip_over_seeds(errors, m, f).map(|v| v.fixed(4)).unwrap_or_default())
+                .collect(),
+            is_ratio: false,
+        })
+        .collect();
+    for baseline in baselines(methods) {
+        rows.push(Row {
+            label: format!("÷ {}", baseline.name()),
+            cells: shown.iter().map(|&f| ratio_cell(flip_ratio(errors, Method::Strata, baseline, f))).collect(),
+            is_ratio: true,
+        });
+    }
+    let title = "FLIP of the previews (LDR-FLIP at the report's exposure, 67 pixels per degree; 0 = identical, lower \
+                 is better), mean ± 95% CI over seeds:";
+    Some(Table { title: title.to_string(), columns: frame_columns("method", shown), rows })
 }
 
 /// strata ÷ one baseline over a whole run.
@@ -260,6 +293,7 @@ mod tests {
                         prelmse: relmse,
                         mse: relmse,
                         relmse_luminance: Some(relmse),
+                        flip: None,
                     });
                 }
             }

@@ -37,6 +37,7 @@ impl Target for ErrorsCsv {
                         prelmse: 0.25,
                         mse: 1e-3,
                         relmse_luminance: (frame != 1).then_some(0.125),
+                        flip: None,
                     });
                 }
             }

@@ -262,6 +262,7 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
         seeds: (1..=args.seeds).collect(),
         restir,
         cameras,
+        exposure: args.exposure,
     };
     let record = RunRecord {
         command_line: record::command_line(),

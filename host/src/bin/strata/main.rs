@@ -89,6 +89,10 @@ struct MetricsArgs {
     /// Metric of the error map.
     #[arg(long, value_enum, default_value_t = Metric::Relmse)]
     map_metric: Metric,
+    /// Exposure of the tone mapping FLIP compares at (as `compare`'s previews):
+    /// finite and positive.
+    #[arg(long, default_value_t = 1.0, value_parser = finite_positive)]
+    exposure: f32,
 }
 
 #[derive(clap::Args)]
@@ -399,6 +403,10 @@ fn metrics(args: MetricsArgs) -> Result<()> {
     println!("relmse-common  {:.6e}", metrics::relmse_common(&image, &reference).with_context(context)?);
     println!("prelmse        {:.6e}", metrics::prelmse(&image, &reference).with_context(context)?);
     println!("relmse-luma    {:.6e}", metrics::relmse_luminance(&image, &reference).with_context(context)?);
+    match strata::evaluation::flip::mean_flip(&image, &reference, args.exposure).with_context(context)? {
+        Some(flip) => println!("flip           {flip:.6e}  (LDR-FLIP at --exposure {})", args.exposure),
+        None => println!("flip           not computed (a build without the `flip` feature)"),
+    }
     let (m, r) = (image.mean(), reference.mean());
     println!("mean image     ({:.5}, {:.5}, {:.5})", m[0], m[1], m[2]);
     println!("mean reference ({:.5}, {:.5}, {:.5})", r[0], r[1], r[2]);

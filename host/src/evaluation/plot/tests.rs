@@ -23,6 +23,7 @@ fn rows(methods: &[Method], frames: u32, seeds: u32) -> Vec<FrameError> {
                     prelmse: 0.0,
                     mse: 0.0,
                     relmse_luminance: None,
+                    flip: None,
                 });
             }
         }

@@ -31,6 +31,10 @@ pub struct FrameError {
     /// Mean LDR-FLIP of the frame's preview against the reference's ([`super::flip`]).
     /// `None` when read from a CSV written before it or computed by a build without FLIP.
     pub flip: Option<f64>,
+    /// The block-edge contrast of the frame's error on the selection's block grid
+    /// ([`super::block_structure`]): 0 without block structure. `None` when it cannot be
+    /// computed (no block edge inside the image) or was not measured.
+    pub block_edge: Option<f64>,
 }
 
 /// What to compare.
@@ -120,6 +124,11 @@ pub fn run_comparison(
                         relmse_luminance: Some(measure(metrics::relmse_luminance(&shown, reference))?),
                         flip: super::flip::mean_flip(&shown, reference, comparison.exposure)
                             .map_err(|e| PassError::Input(e.to_string()))?,
+                        block_edge: super::block_structure::block_edge_contrast(
+                            &shown,
+                            reference,
+                            comparison.restir.selection.block_size,
+                        ),
                     });
                     on_frame(method, seed, frame, &shown, render_time);
                 }
@@ -133,21 +142,20 @@ pub fn run_comparison(
 }
 
 /// The CSV header [`errors_csv`] writes.
-const CSV_HEADER: &str = "method,frame,seed,relmse,prelmse,mse,relmse_luminance,flip";
-/// The header of CSVs written before the FLIP column (still read).
-const CSV_HEADER_WITHOUT_FLIP: &str = "method,frame,seed,relmse,prelmse,mse,relmse_luminance";
-/// The header of CSVs written before the luminance column (still read).
-const CSV_HEADER_WITHOUT_LUMINANCE: &str = "method,frame,seed,relmse,prelmse,mse";
+const CSV_HEADER: &str = "method,frame,seed,relmse,prelmse,mse,relmse_luminance,flip,block_edge";
+/// How many of [`CSV_HEADER`]'s columns CSVs written before the later ones have (still
+/// read): without the block-edge contrast, without FLIP, without the luminance RelMSE.
+const EARLIER_COLUMNS: [usize; 3] = [8, 7, 6];
 
 /// The CSV of `errors`: method, frame, seed, relmse, prelmse, mse, relmse_luminance,
-/// flip (frames 1-based; an unknown value is an empty field).
+/// flip, block_edge (frames 1-based; an unknown value is an empty field).
 pub fn errors_csv(errors: &[FrameError]) -> String {
     let mut csv = format!("{CSV_HEADER}\n");
     for e in errors {
         let optional = |value: Option<f64>| value.map(|v| format!("{v:.6e}")).unwrap_or_default();
-        let (luminance, flip) = (optional(e.relmse_luminance), optional(e.flip));
+        let (luminance, flip, block_edge) = (optional(e.relmse_luminance), optional(e.flip), optional(e.block_edge));
         csv.push_str(&format!(
-            "{},{},{},{:.6e},{:.6e},{:.6e},{luminance},{flip}\n",
+            "{},{},{},{:.6e},{:.6e},{:.6e},{luminance},{flip},{block_edge}\n",
             e.method.name(),
             e.frame + 1,
             e.seed,
@@ -306,11 +314,11 @@ fn check_rows(rows: &[(usize, FrameError)]) -> Result<(), String> {
 /// Each line's fields, with its line number.
 fn parse_rows(text: &str) -> Result<Vec<(usize, FrameError)>, String> {
     let mut lines = text.lines();
-    let columns = match lines.next().map(str::trim) {
-        Some(CSV_HEADER) => 8,
-        Some(CSV_HEADER_WITHOUT_FLIP) => 7,
-        Some(CSV_HEADER_WITHOUT_LUMINANCE) => 6,
-        _ => return Err(format!("line 1: expected the header `{CSV_HEADER}`")),
+    let header = lines.next().map(str::trim).unwrap_or_default();
+    let all: Vec<&str> = CSV_HEADER.split(',').collect();
+    let columns = match std::iter::once(all.len()).chain(EARLIER_COLUMNS).find(|&n| header == all[..n].join(",")) {
+        Some(columns) => columns,
+        None => return Err(format!("line 1: expected the header `{CSV_HEADER}`")),
     };
     let mut errors = Vec::new();
     for (index, line) in lines.enumerate().filter(|(_, l)| !l.trim().is_empty()) {
@@ -361,6 +369,12 @@ fn parse_rows(text: &str) -> Result<Vec<(usize, FrameError)>, String> {
                     None | Some(&"") => None,
                     Some(_) => Some(float(7)?),
                 },
+                block_edge: match fields.get(8) {
+                    None | Some(&"") => None,
+                    Some(text) => Some(text.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
+                        format!("line {number}, field 9: `{text}` is not a block-edge contrast (a finite number)")
+                    })?),
+                },
             },
         ));
     }
@@ -382,8 +396,13 @@ mod tests {
             mse: 1e-3,
             relmse_luminance,
             flip: None,
+            block_edge: None,
         };
-        let errors = vec![error(7, Some(0.125)), error(8, None), FrameError { flip: Some(0.0625), ..error(9, None) }];
+        let errors = vec![
+            error(7, Some(0.125)),
+            error(8, None),
+            FrameError { flip: Some(0.0625), block_edge: Some(-0.25), ..error(9, None) },
+        ];
         assert_eq!(parse_errors_csv(&errors_csv(&errors)).unwrap(), errors);
         // CSVs written before the FLIP column still read.
         let without_flip = "method,frame,seed,relmse,prelmse,mse,relmse_luminance\nrestir-disc,3,8,0.5,0.25,1e-3,\n";
@@ -414,6 +433,7 @@ mod tests {
             mse: relmse,
             relmse_luminance: None,
             flip: None,
+            block_edge: None,
         };
         // Seed s: restir has RelMSE 3 and 1 at frames 0 and 1; strata 1 and 1, so the
         // pooled ratio is 2/4 for every seed, while the per-frame ratios are 1/3 and 1.

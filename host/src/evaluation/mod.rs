@@ -6,6 +6,7 @@
 //! folder, and [`report`] runs a whole comparison from a plain options struct. It runs the renderer and the command line runs it, so it is
 //! a module of the host crate rather than a crate below it.
 
+pub mod block_structure;
 pub mod compare;
 pub mod crops;
 pub mod flip;

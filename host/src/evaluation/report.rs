@@ -157,6 +157,11 @@ pub fn run_and_report(
         text += &flip.to_text();
         tables.push(flip);
     }
+    let block_size = comparison.restir.selection.block_size;
+    if let Some(blocks) = summary::block_edge_table(&errors, &options.methods, &shown, block_size) {
+        text += &blocks.to_text();
+        tables.push(blocks);
+    }
     if seeds >= 3 {
         let (variance, csv) = summary::variance_tables(&options.methods, &shown, &seed_images, references)?;
         write(&out.join("variance.csv"), csv)?;

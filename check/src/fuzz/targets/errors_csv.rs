@@ -38,6 +38,7 @@ impl Target for ErrorsCsv {
                         mse: 1e-3,
                         relmse_luminance: (frame != 1).then_some(0.125),
                         flip: None,
+                        block_edge: None,
                     });
                 }
             }

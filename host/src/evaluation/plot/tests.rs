@@ -24,6 +24,7 @@ fn rows(methods: &[Method], frames: u32, seeds: u32) -> Vec<FrameError> {
                     mse: 0.0,
                     relmse_luminance: None,
                     flip: None,
+                    block_edge: None,
                 });
             }
         }

@@ -9,6 +9,7 @@ use crate::restir::{Method, RestirRenderer, RestirSettings};
 use crate::rgb_image::RgbImage;
 use crate::scene::Camera;
 use strata_backends::Backend;
+use strata_kernels::block_grid::frame_shift;
 
 /// One frame's errors against the reference.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -72,6 +73,7 @@ pub fn run_comparison(
     for &method in &comparison.methods {
         for &seed in &comparison.seeds {
             let settings = RestirSettings { method, ..comparison.restir };
+            let selection = settings.selection;
             let render = RenderSettings { seed, ..render.clone() };
             let mut renderer = RestirRenderer::new(backend, scene, &render, settings, scene_extent)?;
             let mut sum: Option<RgbImage> = None;
@@ -127,7 +129,12 @@ pub fn run_comparison(
                         block_edge: super::block_structure::block_edge_contrast(
                             &shown,
                             reference,
-                            comparison.restir.selection.block_size,
+                            selection.block_size,
+                            if selection.block_shift && method.uses_histogram() {
+                                frame_shift(selection.block_size, frame, seed)
+                            } else {
+                                (0, 0)
+                            },
                         ),
                     });
                     on_frame(method, seed, frame, &shown, render_time);

@@ -34,7 +34,7 @@ pub const MAX_INPUT_FILE_BYTES: u64 = 1 << 30;
 /// pipe) up to [`MAX_INPUT_FILE_BYTES`] and refused beyond it. Every file read is noted
 /// as an input of the run ([`crate::atomic_file::note_input`]).
 ///
-/// A named pipe is opened without waiting for a writer ([`open_without_waiting`]): one
+/// A named pipe is opened without waiting for a writer (`O_NONBLOCK`): one
 /// that nobody writes to reads as empty (and its loader names it), where a plain `open`
 /// would wait forever.
 pub fn read_capped(path: &Path) -> std::io::Result<Vec<u8>> {

@@ -24,6 +24,7 @@ mod report;
 mod restir;
 pub mod run_kernel;
 mod selection;
+mod svgf;
 mod trace;
 
 pub use backends::{BackendSlot, backend_slots};
@@ -92,6 +93,11 @@ pub fn kernel_checks() -> Vec<Box<dyn KernelCheck>> {
         Box::new(restir::RestirCheck(KernelId::RestirTemporalKeys)),
         Box::new(restir::RestirCheck(KernelId::RestirTemporal)),
         Box::new(restir::RestirCheck(KernelId::RestirShade)),
+        Box::new(restir::RestirCheck(KernelId::RestirGuide)),
+        Box::new(svgf::SvgfCheck(KernelId::SvgfTemporal)),
+        Box::new(svgf::SvgfCheck(KernelId::SvgfVariance)),
+        Box::new(svgf::SvgfCheck(KernelId::SvgfAtrous)),
+        Box::new(svgf::SvgfCheck(KernelId::SvgfModulate)),
         Box::new(selection::SelectionCheck(KernelId::StrataSelect)),
         Box::new(selection::SelectionCheck(KernelId::StrataResample)),
     ]

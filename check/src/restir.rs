@@ -1,4 +1,4 @@
-//! Check of the five ReSTIR kernels. Like the path tracer they have no Rust mirror: the
+//! Check of the ReSTIR kernels (the five passes and the denoiser's guide). Like the path tracer they have no Rust mirror: the
 //! reference executor is the CPU interpreter running the same WGSL. Each case renders
 //! two frames (so the temporal merge has a history) of the default scene, or of the same
 //! room with a glass box, a rough-metal box and an environment (every fourth seed with a
@@ -21,7 +21,7 @@ use strata_backends::Backend;
 use strata_kernels::selection::{SamplerVariant, SelectionSettings};
 use strata_kernels::{KernelId, Registry};
 
-/// Checks one of the ReSTIR kernels ([`KernelId::RestirCandidates`] and the four after it).
+/// Checks one of the ReSTIR kernels ([`KernelId::RestirCandidates`] and the five after it).
 pub struct RestirCheck(pub KernelId);
 
 /// Whether `case` resamples by random replay: the glass, metal and environment room with
@@ -70,6 +70,7 @@ fn frame(backend: &mut dyn Backend, case: &Case) -> Result<(), PassError> {
     };
     let mut renderer = RestirRenderer::new(backend, &gpu_scene, &render, settings, scene.extent())?;
     let result = (|| {
+        renderer.enable_guides(backend)?;
         renderer.render_frame(backend, None)?;
         renderer.render_frame(backend, None).map(drop)
     })();
@@ -77,13 +78,15 @@ fn frame(backend: &mut dyn Backend, case: &Case) -> Result<(), PassError> {
     result
 }
 
-/// The five ReSTIR kernels, recorded together from one chain.
-const RESTIR_KERNELS: [KernelId; 5] = [
+/// The ReSTIR kernels (the five passes and the denoiser's guide), recorded together
+/// from one chain.
+const RESTIR_KERNELS: [KernelId; 6] = [
     KernelId::RestirCandidates,
     KernelId::RestirSelect,
     KernelId::RestirTemporalKeys,
     KernelId::RestirTemporal,
     KernelId::RestirShade,
+    KernelId::RestirGuide,
 ];
 
 /// The interpreter's two-frame chain of `case`, recorded once per case.

@@ -23,6 +23,6 @@ pub mod evaluation;
 pub mod progress;
 
 pub use strata_render::{
-    BlockHistogramPass, HistogramVariant, PassError, atomic_file, backend_choice, histogram_pass, render, restir,
-    rgb_image, scene, synthetic, trace_pass,
+    BlockHistogramPass, HistogramVariant, PassError, atomic_file, backend_choice, denoise, histogram_pass, render,
+    restir, rgb_image, scene, synthetic, trace_pass,
 };

@@ -39,6 +39,18 @@ pub enum KernelId {
     RestirTemporal,
     /// ReSTIR pass 5: shading of the reservoirs' samples with one shadow ray.
     RestirShade,
+    /// ReSTIR pass 6 (with a denoiser): the denoiser's guide (albedo, depth, normal,
+    /// object, motion) from the G-buffer.
+    RestirGuide,
+    /// SVGF pass 1 (Schied et al. 2017, §4.1): temporal accumulation of the demodulated
+    /// colour and of its luminance moments through the motion vectors.
+    SvgfTemporal,
+    /// SVGF pass 2 (§4.2): per-pixel luminance variance, spatial for short histories.
+    SvgfVariance,
+    /// SVGF pass 3 (§4.3): one level of the edge-avoiding à-trous wavelet filter.
+    SvgfAtrous,
+    /// SVGF pass 4: the filtered illumination times the albedo again.
+    SvgfModulate,
     /// Embedding: K payload indices per pixel from its cluster's run at the stratified
     /// positions of the chosen sampler variant (paper §4.2, Fig. 3, Table 2).
     StrataSelect,
@@ -84,7 +96,7 @@ impl Executor {
 
 impl KernelId {
     /// Every registry kernel.
-    pub const ALL: [KernelId; 14] = [
+    pub const ALL: [KernelId; 19] = [
         KernelId::BlockHistogram,
         KernelId::BlockHistogramSubgroup,
         KernelId::BlockHistogramRank,
@@ -97,6 +109,11 @@ impl KernelId {
         KernelId::RestirTemporalKeys,
         KernelId::RestirTemporal,
         KernelId::RestirShade,
+        KernelId::RestirGuide,
+        KernelId::SvgfTemporal,
+        KernelId::SvgfVariance,
+        KernelId::SvgfAtrous,
+        KernelId::SvgfModulate,
         KernelId::StrataSelect,
         KernelId::StrataResample,
     ];
@@ -175,6 +192,20 @@ impl KernelId {
             // map's gradient (up to ~8500 ULP, 5e-4 relative, in the glass, metal and
             // environment room at 128²). 16384 ULP is 2e-3 relative.
             float_ulp_bound: Some(16384),
+        };
+        // An SVGF pass: the guide, what the passes share, then its entry point.
+        let svgf = |name: &'static str, pass: Fragment| KernelSpec {
+            name: name.into(),
+            fragments: vec![fragment!("denoise/guide.wgsl"), fragment!("denoise/svgf.wgsl"), pass],
+            entry_point: name.into(),
+            features: KernelFeatures::empty(),
+            // Checked against the Rust reference (reference/svgf.rs) on generated
+            // guides: at most 12 ULP on llvmpipe, every path, 80 cases (exp(), whose
+            // rounding the weighted sums carry). A GPU's exp() may be off by 3 + 2|x|
+            // ULP (43 at x = 20, where a weight is already below 1e-8), sqrt and
+            // divisions by a few, and products may be fused into multiply-adds: 256
+            // ULP, 3e-5 relative.
+            float_ulp_bound: Some(256),
         };
         Some(match self {
             KernelId::BlockHistogram => KernelSpec {
@@ -259,6 +290,13 @@ impl KernelId {
                     .concat(),
             ),
             KernelId::RestirShade => restir("restir_shade", &[fragment!("restir/entry_shade.wgsl")]),
+            KernelId::RestirGuide => {
+                restir("restir_guide", &[fragment!("denoise/guide.wgsl"), fragment!("restir/entry_guide.wgsl")])
+            }
+            KernelId::SvgfTemporal => svgf("svgf_temporal", fragment!("denoise/entry_temporal.wgsl")),
+            KernelId::SvgfVariance => svgf("svgf_variance", fragment!("denoise/entry_variance.wgsl")),
+            KernelId::SvgfAtrous => svgf("svgf_atrous", fragment!("denoise/entry_atrous.wgsl")),
+            KernelId::SvgfModulate => svgf("svgf_modulate", fragment!("denoise/entry_modulate.wgsl")),
             KernelId::StrataSelect => KernelSpec {
                 name: "strata_select".into(),
                 fragments: [

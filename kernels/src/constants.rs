@@ -8,7 +8,7 @@
 //! fails it, so a new constant is classified when it is written.
 
 use crate::blue_noise::{OPTIMISED_DIMENSIONS, PACKED_RANKING, PACKED_SCRAMBLING, PACKED_SOBOL, TILE_SIZE};
-use crate::{embed_types, render_types, restir_types, selection, trace_types, types};
+use crate::{denoise_types, embed_types, render_types, restir_types, selection, trace_types, types};
 
 /// A constant's value, as WGSL types it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -74,6 +74,8 @@ pub const SHARED: &[(&str, ConstantValue)] = {
         ("MISS", U32(trace_types::MISS)),
         ("STACK_OVERFLOW", U32(trace_types::STACK_OVERFLOW)),
         ("TRACE_STACK_DEPTH", U32(trace_types::TRACE_STACK_DEPTH)),
+        ("MIN_ALBEDO", F32(denoise_types::MIN_ALBEDO)),
+        ("SHORT_HISTORY", F32(denoise_types::SHORT_HISTORY)),
     ]
 };
 

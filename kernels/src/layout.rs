@@ -4,6 +4,7 @@
 //! read garbage without any error. [`check_struct`] compares the host struct's size and
 //! every field's name, offset and size with naga's layout of the WGSL struct.
 
+use crate::denoise_types::{DenoiseGuide, DenoiseParams};
 use crate::embed_types::{ResampleInput, ResampleOutput, SelectedCandidates, SelectionParams};
 use crate::render_types::{EmissiveTriangle, GpuMaterial, RenderParams, TriangleInfo};
 use crate::restir_types::{PathCandidate, Primary, Reservoir, RestirParams};
@@ -167,6 +168,25 @@ shader_struct!(
     Primary,
     "Primary",
     [position, object_id, normal, material, wo, flags, albedo, depth, throughput, segment, camera_hit, _pad]
+);
+shader_struct!(DenoiseGuide, "DenoiseGuide", [albedo, depth, normal, mesh, motion, _pad]);
+shader_struct!(
+    DenoiseParams,
+    "DenoiseParams",
+    [
+        width,
+        height,
+        history,
+        step,
+        alpha_colour,
+        alpha_moments,
+        sigma_luminance,
+        sigma_depth,
+        normal_power_log2,
+        max_history,
+        depth_tolerance,
+        normal_tolerance
+    ]
 );
 shader_struct!(PathCandidate, "PathCandidate", [position, kind, normal, light, reflected, weight]);
 shader_struct!(Reservoir, "Reservoir", [sample, weight, count, target_value, _pad, expected, _pad_expected]);

@@ -41,6 +41,7 @@ pub mod block_grid;
 pub mod blue_noise;
 pub mod catalogue;
 pub mod constants;
+pub mod denoise_types;
 pub mod embed_types;
 pub mod error;
 pub mod glslang;

@@ -4,3 +4,4 @@ pub mod block_histogram;
 pub mod bvh_trace;
 pub mod camera_rays;
 pub mod stratified_selection;
+pub mod svgf;

@@ -355,6 +355,29 @@ mod tests {
             }
             if matches!(
                 kernel.id,
+                KernelId::SvgfTemporal | KernelId::SvgfVariance | KernelId::SvgfAtrous | KernelId::SvgfModulate
+            ) {
+                use crate::denoise_types::{DenoiseGuide, DenoiseParams};
+                for result in [check_struct::<DenoiseGuide>(module), check_struct::<DenoiseParams>(module)] {
+                    result.unwrap_or_else(|e| panic!("{}: {e}", kernel.name()));
+                }
+                continue;
+            }
+            if kernel.id == KernelId::RestirGuide {
+                use crate::denoise_types::DenoiseGuide;
+                use crate::restir_types::{Primary, RestirParams};
+                for result in [
+                    check_struct::<crate::render_types::RenderParams>(module),
+                    check_struct::<RestirParams>(module),
+                    check_struct::<Primary>(module),
+                    check_struct::<DenoiseGuide>(module),
+                ] {
+                    result.unwrap_or_else(|e| panic!("{}: {e}", kernel.name()));
+                }
+                continue;
+            }
+            if matches!(
+                kernel.id,
                 KernelId::RestirCandidates
                     | KernelId::RestirSelect
                     | KernelId::RestirTemporalKeys

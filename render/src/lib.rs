@@ -24,6 +24,7 @@
 
 pub mod atomic_file;
 pub mod backend_choice;
+pub mod denoise;
 pub mod histogram_pass;
 pub mod render;
 pub mod restir;

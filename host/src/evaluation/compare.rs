@@ -2,6 +2,7 @@
 //! measured against a reference, with a CSV of every measurement and a summary of
 //! mean ± 95 % confidence interval over seeds.
 
+use crate::denoise::{Denoiser, SvgfDenoiser, SvgfSettings};
 use crate::evaluation::metrics::{self, MeanInterval};
 use crate::histogram_pass::PassError;
 use crate::render::{GpuScene, RenderSettings};
@@ -9,6 +10,7 @@ use crate::restir::{Method, RestirRenderer, RestirSettings};
 use crate::rgb_image::RgbImage;
 use crate::scene::Camera;
 use strata_backends::Backend;
+use strata_backends::backend::download;
 use strata_kernels::block_grid::frame_shift;
 
 /// One frame's errors against the reference.
@@ -55,11 +57,60 @@ pub struct Comparison {
     pub cameras: Vec<Camera>,
     /// The exposure of the previews, at which FLIP compares what a person sees.
     pub exposure: f32,
+    /// The denoiser whose output is measured too (`--denoise`); `None`: raw frames only.
+    pub denoise: Option<Denoiser>,
+}
+
+/// Every frame's errors: as rendered (shown: accumulated without temporal reuse) and,
+/// with a denoiser, after it.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ComparisonErrors {
+    /// The frames as rendered (`errors.csv`).
+    pub raw: Vec<FrameError>,
+    /// The same frames denoised (`errors_denoised.csv`); empty without a denoiser.
+    pub denoised: Vec<FrameError>,
+}
+
+/// One frame's [`FrameError`] against `reference`.
+fn measure(
+    method: Method,
+    frame: u32,
+    seed: u32,
+    image: &RgbImage,
+    reference: &RgbImage,
+    comparison: &Comparison,
+) -> Result<FrameError, PassError> {
+    let selection = comparison.restir.selection;
+    let measure = |e: Result<f64, metrics::MetricError>| e.map_err(|e| PassError::Input(e.to_string()));
+    Ok(FrameError {
+        method,
+        frame,
+        seed,
+        relmse: measure(metrics::relmse(image, reference))?,
+        prelmse: measure(metrics::prelmse(image, reference))?,
+        mse: measure(metrics::mse(image, reference))?,
+        relmse_luminance: Some(measure(metrics::relmse_luminance(image, reference))?),
+        flip: super::flip::mean_flip(image, reference, comparison.exposure)
+            .map_err(|e| PassError::Input(e.to_string()))?,
+        block_edge: super::block_structure::block_edge_contrast(
+            image,
+            reference,
+            selection.block_size,
+            if selection.block_shift && method.uses_histogram() {
+                frame_shift(selection.block_size, frame, seed)
+            } else {
+                (0, 0)
+            },
+        ),
+    })
 }
 
 /// Renders every method × seed × frame of `comparison` and measures each frame against
 /// its reference (`references[frame]`, or `references[0]` for every frame); `on_frame`
-/// sees every image (method, seed, frame, image, the wall time of rendering it).
+/// sees every image (method, seed, frame, image, the denoised image with a denoiser, the
+/// wall time of rendering it). The denoiser filters each frame as rendered, its history
+/// carried from frame to frame (also without temporal reuse, where the raw image scored
+/// is the mean of the frames so far).
 pub fn run_comparison(
     backend: &mut dyn Backend,
     scene: &GpuScene,
@@ -67,17 +118,22 @@ pub fn run_comparison(
     scene_extent: f32,
     comparison: &Comparison,
     references: &[RgbImage],
-    mut on_frame: impl FnMut(Method, u32, u32, &RgbImage, std::time::Duration),
-) -> Result<Vec<FrameError>, PassError> {
-    let mut errors = Vec::new();
+    mut on_frame: impl FnMut(Method, u32, u32, &RgbImage, Option<&RgbImage>, std::time::Duration),
+) -> Result<ComparisonErrors, PassError> {
+    let mut errors = ComparisonErrors::default();
     for &method in &comparison.methods {
         for &seed in &comparison.seeds {
             let settings = RestirSettings { method, ..comparison.restir };
-            let selection = settings.selection;
             let render = RenderSettings { seed, ..render.clone() };
             let mut renderer = RestirRenderer::new(backend, scene, &render, settings, scene_extent)?;
+            let mut denoiser = None;
             let mut sum: Option<RgbImage> = None;
             let result = (|| {
+                if let Some(Denoiser::Svgf) = comparison.denoise {
+                    renderer.enable_guides(backend)?;
+                    let (width, height) = (render.camera.width, render.camera.height);
+                    denoiser = Some(SvgfDenoiser::new(backend, width, height, SvgfSettings::default())?);
+                }
                 for frame in 0..comparison.frames {
                     let camera = comparison.cameras.get(frame as usize);
                     let started = std::time::Instant::now();
@@ -93,6 +149,23 @@ pub fn run_comparison(
                             stats.invalid_pixels
                         )));
                     }
+                    let denoised = match (&mut denoiser, renderer.denoiser_inputs()) {
+                        (Some(denoiser), Some(inputs)) => {
+                            let output =
+                                denoiser.denoise(backend, inputs.colour, inputs.guides, inputs.previous_guides)?;
+                            let pixels: Vec<[f32; 4]> = download(backend, output)?;
+                            let denoised = RgbImage {
+                                width: image.width,
+                                height: image.height,
+                                pixels: pixels.iter().map(|p| [p[0], p[1], p[2]]).collect(),
+                            };
+                            super::image_checks::check_frame(&denoised, &format!("{name}, denoised"))
+                                .map_err(|e| PassError::Input(e.to_string()))?;
+                            errors.denoised.push(measure(method, frame, seed, &denoised, reference, comparison)?);
+                            Some(denoised)
+                        }
+                        _ => None,
+                    };
                     let shown = if !comparison.restir.temporal {
                         let total = match sum.take() {
                             None => image,
@@ -115,32 +188,14 @@ pub fn run_comparison(
                     } else {
                         image
                     };
-                    let measure = |e: Result<f64, metrics::MetricError>| e.map_err(|e| PassError::Input(e.to_string()));
-                    errors.push(FrameError {
-                        method,
-                        frame,
-                        seed,
-                        relmse: measure(metrics::relmse(&shown, reference))?,
-                        prelmse: measure(metrics::prelmse(&shown, reference))?,
-                        mse: measure(metrics::mse(&shown, reference))?,
-                        relmse_luminance: Some(measure(metrics::relmse_luminance(&shown, reference))?),
-                        flip: super::flip::mean_flip(&shown, reference, comparison.exposure)
-                            .map_err(|e| PassError::Input(e.to_string()))?,
-                        block_edge: super::block_structure::block_edge_contrast(
-                            &shown,
-                            reference,
-                            selection.block_size,
-                            if selection.block_shift && method.uses_histogram() {
-                                frame_shift(selection.block_size, frame, seed)
-                            } else {
-                                (0, 0)
-                            },
-                        ),
-                    });
-                    on_frame(method, seed, frame, &shown, render_time);
+                    errors.raw.push(measure(method, frame, seed, &shown, reference, comparison)?);
+                    on_frame(method, seed, frame, &shown, denoised.as_ref(), render_time);
                 }
                 Ok(())
             })();
+            if let Some(denoiser) = denoiser {
+                denoiser.destroy(backend)?;
+            }
             renderer.destroy(backend)?;
             result?;
         }

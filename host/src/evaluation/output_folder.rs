@@ -68,8 +68,15 @@ pub fn lock(folder: &Path) -> Result<FolderLock> {
 /// the report page and its plots and colour bar, the reference and every method's frame
 /// images and error maps.
 pub fn is_run_output(name: &str) -> bool {
-    const FIXED: [&str; 6] =
-        ["errors.csv", "variance.csv", "summary.txt", "run.json", "report.html", "relmse_colourbar.png"];
+    const FIXED: [&str; 7] = [
+        "errors.csv",
+        "errors_denoised.csv",
+        "variance.csv",
+        "summary.txt",
+        "run.json",
+        "report.html",
+        "relmse_colourbar.png",
+    ];
     if FIXED.contains(&name) {
         return true;
     }
@@ -81,9 +88,11 @@ pub fn is_run_output(name: &str) -> bool {
     if stem == "relmse" || stem == "relmse_ratio" || stem == "reference" {
         return true;
     }
-    // reference_frameNNN, METHOD_frameNNN, METHOD_frameNNN_relmse.
+    // reference_frameNNN, METHOD_frameNNN, METHOD_frameNNN_relmse, and the same of
+    // METHOD_denoised.
     let stem = stem.strip_suffix("_relmse").unwrap_or(stem);
     let Some((prefix, frame)) = stem.rsplit_once("_frame") else { return false };
+    let prefix = prefix.strip_suffix("_denoised").unwrap_or(prefix);
     let methods = ["reference", "strata", "restir", "restir-disc"];
     methods.contains(&prefix) && !frame.is_empty() && frame.bytes().all(|b| b.is_ascii_digit())
 }

@@ -79,14 +79,14 @@ pub fn run_and_report(
     let mut render_time: HashMap<Method, (Duration, u32)> = HashMap::new();
     // Frames black everywhere where their reference is not: scored, and said once.
     let mut black_frames: Vec<String> = Vec::new();
-    let errors = run_comparison(
+    let measured = run_comparison(
         backend,
         gpu_scene,
         render,
         extent,
         comparison,
         references,
-        |method, seed, frame, image, took| {
+        |method, seed, frame, image, denoised, took| {
             progress.inc(1);
             let reference = references.get(frame as usize).unwrap_or(&references[0]);
             if super::image_checks::black_against(image, reference) {
@@ -102,7 +102,7 @@ pub fn run_and_report(
                 seed_images.entry((method, frame)).or_default().push(image.clone());
             }
             if seed == 1 {
-                match write_frame(out, method, frame, image, reference, options.exposure) {
+                match write_frame(out, method.name(), frame, image, reference, options.exposure) {
                     Ok(w) => {
                         written.insert((method, frame), w);
                     }
@@ -110,15 +110,25 @@ pub fn run_and_report(
                         write_error.get_or_insert(error);
                     }
                 }
+                if let Some(denoised) = denoised {
+                    let name = format!("{}_denoised", method.name());
+                    if let Err(error) = write_frame(out, &name, frame, denoised, reference, options.exposure) {
+                        write_error.get_or_insert(error);
+                    }
+                }
             }
         },
     )?;
+    let errors = measured.raw;
     progress.finish();
     if let Some(error) = write_error {
         return Err(error);
     }
     let compare_seconds = compared.elapsed().as_secs_f64();
     write(&out.join("errors.csv"), errors_csv(&errors))?;
+    if !measured.denoised.is_empty() {
+        write(&out.join("errors_denoised.csv"), errors_csv(&measured.denoised))?;
+    }
 
     // Plots.
     let mode = if options.record.temporal { "temporal reuse" } else { "accumulated frames" };
@@ -161,6 +171,26 @@ pub fn run_and_report(
     if let Some(blocks) = summary::block_edge_table(&errors, &options.methods, &shown, block_size) {
         text += &blocks.to_text();
         tables.push(blocks);
+    }
+    if !measured.denoised.is_empty() {
+        let denoised = &measured.denoised;
+        let heading = "After SVGF denoising (each method's frames as rendered, filtered alike): RelMSE, mean ± 95% CI \
+                       over seeds:";
+        let relmse = summary::relmse_table(denoised, &options.methods, &shown, heading);
+        text += &relmse.to_text();
+        tables.push(relmse);
+        for line in summary::whole_run_lines(denoised, frames) {
+            text += &format!("after SVGF, {line}\n");
+        }
+        let more = [
+            summary::flip_table(denoised, &options.methods, &shown),
+            summary::block_edge_table(denoised, &options.methods, &shown, block_size),
+        ];
+        for mut table in more.into_iter().flatten() {
+            table.title = format!("After SVGF denoising: {}", table.title);
+            text += &table.to_text();
+            tables.push(table);
+        }
     }
     if seeds >= 3 {
         let (variance, csv) = summary::variance_tables(&options.methods, &shown, &seed_images, references)?;
@@ -257,13 +287,13 @@ fn write(path: &Path, text: String) -> Result<()> {
 /// false-colour PNG.
 fn write_frame(
     out: &Path,
-    method: Method,
+    name: &str,
     frame: u32,
     image: &RgbImage,
     reference: &RgbImage,
     exposure: f32,
 ) -> Result<Written> {
-    let stem = format!("{}_frame{:03}", method.name(), frame + 1);
+    let stem = format!("{name}_frame{:03}", frame + 1);
     image.write_exr(&out.join(format!("{stem}.exr")))?;
     image.write_png(&out.join(format!("{stem}.png")), exposure)?;
     let map = metrics::error_map(image, reference, Metric::Relmse)?;

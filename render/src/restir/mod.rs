@@ -7,11 +7,11 @@
 //! One frame is five kernels (`kernels/wgsl/restir/`): candidates (G-buffer, each pixel's
 //! own estimate, one path candidate per pixel), the block histogram (strata and restir
 //! only), selection + resampling with the pixel's canonical candidate, temporal reuse
-//! and shading. See [`RestirRenderer`] for the buffers; the selection itself (§4.1-4.3)
+//! and shading (and, for a denoiser, its guide). See [`RestirRenderer`] for the buffers; the selection itself (§4.1-4.3)
 //! lives in the kernels' `strata/` folder and [`strata_kernels::selection`].
 
 mod pipeline;
 mod settings;
 
-pub use pipeline::{FrameBuffers, FrameStats, RestirRenderer};
+pub use pipeline::{DenoiserInputs, FrameBuffers, FrameStats, RestirRenderer};
 pub use settings::{MAX_SPECULAR_CHAIN, Method, RestirSettings, ShadedParts, Shading};

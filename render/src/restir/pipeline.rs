@@ -11,6 +11,7 @@ use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, BackendError, Bind, BufferId};
 use strata_kernels::block_grid::frame_shift;
 use strata_kernels::blue_noise::BlueNoiseTables;
+use strata_kernels::denoise_types::DenoiseGuide;
 use strata_kernels::render_types::{FLAG_HIT_LIGHTS, FLAG_SAMPLE_LIGHTS, RenderParams};
 use strata_kernels::restir_types::{PathCandidate, Primary, Reservoir, RestirParams};
 use strata_kernels::types::Candidate;
@@ -81,6 +82,20 @@ pub struct RestirRenderer {
     previous_camera: Option<CameraFrame>,
     min_distance: f32,
     timed: bool,
+    /// With a denoiser ([`RestirRenderer::enable_guides`]): `restir_guide` and this
+    /// frame's and the previous frame's guides, alternating like the G-buffers.
+    guides: Option<(&'static Kernel, [BufferId; 2])>,
+}
+
+/// What a denoiser reads of the last frame ([`RestirRenderer::denoiser_inputs`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DenoiserInputs {
+    /// The frame's colour (`vec4<f32>` per pixel: rgb, invalid flag).
+    pub colour: BufferId,
+    /// Its `DenoiseGuide`s.
+    pub guides: BufferId,
+    /// The previous frame's `DenoiseGuide`s (this frame's on the first frame).
+    pub previous_guides: BufferId,
 }
 
 impl RestirRenderer {
@@ -159,6 +174,7 @@ impl RestirRenderer {
             previous_camera: None,
             min_distance: if settings.min_distance > 0.0 { settings.min_distance } else { 1e-3 * scene_extent },
             timed: false,
+            guides: None,
         };
         Ok(renderer)
     }
@@ -166,6 +182,32 @@ impl RestirRenderer {
     /// Time every pass with timestamp queries (each dispatch then waits for the device).
     pub fn set_timed(&mut self, timed: bool) {
         self.timed = timed;
+    }
+
+    /// From the next frame on, also write a denoiser's guide (pass 6, `restir_guide`):
+    /// see [`RestirRenderer::denoiser_inputs`].
+    pub fn enable_guides(&mut self, backend: &mut dyn Backend) -> Result<(), PassError> {
+        if self.guides.is_some() {
+            return Ok(());
+        }
+        let kernel = Registry::shared()?.get(KernelId::RestirGuide);
+        backend.check_kernel(kernel)?;
+        let (width, height) = (self.render.camera.width, self.render.camera.height);
+        let bytes = u64::from(width) * u64::from(height) * size_of::<DenoiseGuide>() as u64;
+        let buffers = [backend.create_buffer("guides A", bytes)?, backend.create_buffer("guides B", bytes)?];
+        self.guides = Some((kernel, buffers));
+        Ok(())
+    }
+
+    /// The last frame's colour and guides, for a denoiser; `None` before
+    /// [`RestirRenderer::enable_guides`] or before a frame with guides.
+    pub fn denoiser_inputs(&self) -> Option<DenoiserInputs> {
+        let (_, guides) = self.guides?;
+        if self.frame == 0 {
+            return None;
+        }
+        let last = ((self.frame + 1) % 2) as usize;
+        Some(DenoiserInputs { colour: self.frame_out, guides: guides[last], previous_guides: guides[1 - last] })
     }
 
     /// Frames rendered so far.
@@ -340,6 +382,13 @@ impl RestirRenderer {
                 ],
             )?,
         )?;
+        if let Some((guide_kernel, guides)) = self.guides {
+            run(
+                backend,
+                guide_kernel,
+                &with(guide_kernel, &[("primaries", self.primaries[current]), ("guides_out", guides[current])])?,
+            )?;
+        }
         let pixels: Vec<[f32; 4]> = download(backend, self.frame_out)?;
         self.frame += 1;
         self.previous_camera = Some(frame_camera);
@@ -404,7 +453,12 @@ impl RestirRenderer {
             self.blue_noise,
             self.frame_out,
         ];
-        buffers.into_iter().try_for_each(|b| backend.destroy_buffer(b)).map_err(|e: BackendError| e.into())
+        let guides = self.guides.map(|(_, guides)| guides).into_iter().flatten();
+        buffers
+            .into_iter()
+            .chain(guides)
+            .try_for_each(|b| backend.destroy_buffer(b))
+            .map_err(|e: BackendError| e.into())
     }
 }
 

@@ -6,6 +6,7 @@ use anyhow::{Result, bail};
 use std::path::PathBuf;
 use std::time::Instant;
 use strata::backend_choice::{BackendChoice, open_backend};
+use strata::denoise::Denoiser;
 use strata::evaluation::compare::Comparison;
 use strata::evaluation::crops::{self, Crop};
 use strata::evaluation::image_checks::check_reference;
@@ -86,6 +87,12 @@ pub(crate) struct CompareArgs {
     /// Exposure of the PNG previews: finite and positive.
     #[arg(long, default_value_t = 1.0, value_parser = super::finite_positive)]
     exposure: f32,
+    /// Also measure every frame after a denoiser: `svgf` (Schied et al. 2017, with the
+    /// paper's settings), applied alike to every method's frames as rendered, its history
+    /// reprojected from frame to frame. Writes `errors_denoised.csv`, the denoised
+    /// previews and the same tables for them.
+    #[arg(long, value_enum)]
+    denoise: Option<Denoiser>,
     /// Backend to run on.
     #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
     backend: BackendChoice,
@@ -263,6 +270,7 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
         restir,
         cameras,
         exposure: args.exposure,
+        denoise: args.denoise,
     };
     let record = RunRecord {
         command_line: record::command_line(),

@@ -1,0 +1,118 @@
+// SVGF, what its passes share (Schied et al. 2017, "Spatiotemporal Variance-Guided
+// Filtering: Real-Time Reconstruction for Path-Traced Global Illumination"): the
+// settings, and the edge-stopping functions of §4.2-4.3, written here from the paper.
+//
+//   temporal (entry_temporal.wgsl)  colour / albedo accumulated with its reprojected
+//                                   history, and the first two moments of its luminance
+//   variance (entry_variance.wgsl)  per pixel the luminance variance: from the moments,
+//                                   or spatially where the history is short
+//   à-trous  (entry_atrous.wgsl)    five levels of the edge-avoiding wavelet filter,
+//                                   taps 1, 2, 4, 8, 16 pixels apart; the first level's
+//                                   output is the next frame's history
+//   modulate (entry_modulate.wgsl)  times the albedo again
+//
+// Every pass: 8 x 8 pixels per workgroup, one invocation per pixel, binding 0 the
+// DenoiseParams below, buffers indexed y * width + x.
+
+struct DenoiseParams {
+    width: u32,
+    height: u32,
+    // 1: the history buffers hold the previous frame's (0: the first frame, or a cut).
+    history: u32,
+    // À-trous: the distance in pixels between this level's taps (2^level).
+    step: u32,
+    // Weight of the new frame in the exponential moving averages of colour and of the
+    // moments (SVGF: 0.2 both); a history shorter than 1/alpha frames is averaged
+    // uniformly instead.
+    alpha_colour: f32,
+    alpha_moments: f32,
+    // σ_l of the luminance weight, in standard deviations (SVGF: 4).
+    sigma_luminance: f32,
+    // σ_z of the depth weight, in units of the depth's local slope (SVGF: 1).
+    sigma_depth: f32,
+    // The normal weight is max(0, n·n')^(2^normal_power_log2) (SVGF: 128, i.e. 7),
+    // computed by squaring: the same on every backend, where pow() is not.
+    normal_power_log2: u32,
+    // History lengths stop growing here (frames).
+    max_history: f32,
+    // Reprojection: a previous pixel shows the same surface if it saw the same object,
+    // at a depth within this fraction of the current one...
+    depth_tolerance: f32,
+    // ...with normals whose cosine is at least this.
+    normal_tolerance: f32,
+}
+
+@group(0) @binding(0) var<uniform> params: DenoiseParams;
+
+// Albedo components at or below this are not divided out (a black or nearly black
+// surface: its colour is its emission, which dividing would blow up).
+const MIN_ALBEDO: f32 = 1e-3;
+// Histories shorter than this many frames get their variance from their neighbours
+// (§4.2).
+const SHORT_HISTORY: f32 = 4.0;
+// No pixel (outside the image).
+const NO_PIXEL: u32 = 0xffffffffu;
+
+fn pixel_of(x: u32, y: u32) -> u32 {
+    return y * params.width + x;
+}
+
+fn has_surface(g: DenoiseGuide) -> bool {
+    return g.depth > 0.0;
+}
+
+// What the colour is divided by and multiplied by again.
+fn demodulation(albedo: vec3<f32>) -> vec3<f32> {
+    return select(vec3<f32>(1.0), albedo, albedo > vec3<f32>(MIN_ALBEDO));
+}
+
+// Rec. 709 luminance.
+fn luminance(c: vec3<f32>) -> f32 {
+    return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+}
+
+// w_n (§4.3): max(0, n·n')^(2^normal_power_log2).
+fn normal_weight(a: vec3<f32>, b: vec3<f32>) -> f32 {
+    var w = max(a.x * b.x + a.y * b.y + a.z * b.z, 0.0);
+    for (var i = 0u; i < params.normal_power_log2; i++) {
+        w = w * w;
+    }
+    return w;
+}
+
+// The pixel at (x, y), or NO_PIXEL outside the image.
+fn pixel_at(x: i32, y: i32) -> u32 {
+    if x < 0 || y < 0 || x >= i32(params.width) || y >= i32(params.height) {
+        return NO_PIXEL;
+    }
+    return pixel_of(u32(x), u32(y));
+}
+
+// The depth's slope at (x, y) along each axis: the smaller of the differences to the two
+// neighbours with a surface (so that a silhouette next to the pixel does not count as
+// slope), 0 where neither has one. Stands in for SVGF's screen-space derivative.
+fn depth_slope(x: i32, y: i32, depth: f32) -> vec2<f32> {
+    var slope = vec2<f32>(0.0);
+    for (var axis = 0; axis < 2; axis++) {
+        var smallest = -1.0;
+        for (var side = -1; side <= 1; side += 2) {
+            let q = pixel_at(x + select(0, side, axis == 0), y + select(0, side, axis == 1));
+            if q != NO_PIXEL && has_surface(guides[q]) {
+                let d = abs(guides[q].depth - depth);
+                if smallest < 0.0 || d < smallest {
+                    smallest = d;
+                }
+            }
+        }
+        slope[axis] = max(smallest, 0.0);
+    }
+    return slope;
+}
+
+// The exponent of w_z (§4.3): |z - z'| over σ_z times the depth's change along the offset
+// predicted by its slope, plus a thousandth of the depth (SVGF's ε, made relative so
+// that it means the same at any scene scale).
+fn depth_distance(depth: f32, other: f32, slope: vec2<f32>, offset: vec2<f32>) -> f32 {
+    let expected = params.sigma_depth * (abs(slope.x * offset.x) + abs(slope.y * offset.y)) + 1e-3 * depth;
+    return abs(depth - other) / expected;
+}

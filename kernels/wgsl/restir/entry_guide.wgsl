@@ -1,0 +1,61 @@
+// ReSTIR pass 6 (only when a denoiser runs): the denoiser's guide (denoise/guide.wgsl)
+// from the G-buffer, what an engine's G-buffer pass would give it. The surface is the
+// pixel's resampling vertex (through a smooth chain, the first rough vertex behind it,
+// as engines substitute the surface seen in a mirror), its albedo the vertex's times the
+// chain's throughput; the motion vector follows the camera ray's first hit from the
+// previous frame's camera (RestirParams.previous_*) to this one's, both without the
+// sub-pixel jitter. Pixels whose camera ray hit nothing get depth 0.
+//
+// Bindings (group 0): 0-7 the scene, 8 RestirParams, and
+//   9  storage, read     array<Primary>        this frame's G-buffer
+//   10 storage, rw       array<DenoiseGuide>   the denoiser's guide
+//
+// Dispatch: 8 x 8 pixels per workgroup.
+
+@group(0) @binding(9) var<storage, read> primaries: array<Primary>;
+@group(0) @binding(10) var<storage, read_write> guides_out: array<DenoiseGuide>;
+
+// Where `point` lands on a camera's film in pixels (x right, y down; pixel centres at
+// integer + 0.5), and its depth along the camera's axis in z.
+fn image_position(
+    point: vec3<f32>,
+    origin: vec3<f32>,
+    forward: vec3<f32>,
+    right: vec3<f32>,
+    up: vec3<f32>,
+    tan_half_x: f32,
+    tan_half_y: f32,
+) -> vec3<f32> {
+    let d = point - origin;
+    let z = dot(d, forward);
+    let sx = dot(d, right) / (z * tan_half_x);
+    let sy = dot(d, up) / (z * tan_half_y);
+    return vec3<f32>((sx + 1.0) * 0.5 * f32(params.width), (1.0 - sy) * 0.5 * f32(params.height), z);
+}
+
+@compute @workgroup_size(8, 8)
+fn restir_guide(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= params.width || id.y >= params.height {
+        return;
+    }
+    let pixel = id.y * params.width + id.x;
+    let p = primaries[pixel];
+    if (p.flags & PRIMARY_HIT) == 0u {
+        guides_out[pixel] = DenoiseGuide(vec3<f32>(1.0), 0.0, vec3<f32>(0.0, 0.0, 1.0), OBJECT_ID_NONE, vec2<f32>(0.0), vec2<u32>(0u));
+        return;
+    }
+    let now = image_position(
+        p.camera_hit, params.camera_origin, params.camera_forward, params.camera_right, params.camera_up,
+        params.tan_half_x, params.tan_half_y,
+    );
+    let before = image_position(
+        p.camera_hit, restir.previous_origin, restir.previous_forward, restir.previous_right, restir.previous_up,
+        restir.previous_tan_half_x, restir.previous_tan_half_y,
+    );
+    // Behind the previous camera: a motion that leaves the image, so no history.
+    var motion = vec2<f32>(-1e30);
+    if before.z > 0.0 && now.z > 0.0 {
+        motion = before.xy - now.xy;
+    }
+    guides_out[pixel] = DenoiseGuide(p.albedo * p.throughput, p.depth, p.normal, p.object_id, motion, vec2<u32>(0u));
+}

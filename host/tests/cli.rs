@@ -124,7 +124,7 @@ fn bad_compare_arguments_are_refused_before_anything_renders() {
         assert!(names.iter().all(|name| stderr.contains(name)), "{arguments:?}: {stderr}");
         assert!(!out.join("reference.exr").exists(), "{arguments:?} rendered a reference");
     }
-    let cases: [(&[&str], &[&str]); 8] = [
+    let cases: [(&[&str], &[&str]); 10] = [
         (&["--width", "0"], &["--width 0"]),
         (&["--temporal-cap", "0"], &["temporal cap 0"]),
         (&["--accumulate", "--camera-path", "orbit:2"], &["--accumulate", "--camera-path orbit:2"]),
@@ -133,6 +133,8 @@ fn bad_compare_arguments_are_refused_before_anything_renders() {
         (&["--temporal-candidates", "9"], &["temporal candidates 9"]),
         (&["--specular-chain", "99"], &["specular chain 99"]),
         (&["--frames", "0"], &["--frames"]),
+        (&["--frames", "4294967295"], &["--frames 4294967295", "at most 100000"]),
+        (&["--seeds", "20000"], &["--seeds 20000", "at most 10000"]),
     ];
     for (arguments, names) in cases {
         let output = strata_without_vulkan(&[&["compare", "--out", out_str(&out)][..], arguments].concat());

@@ -21,6 +21,11 @@ use strata::scene::parse_camera_path;
 
 use super::{scene_and_settings, scene_stem};
 
+/// The most frames per seed a comparison takes (about a day at 256 x 256 on lavapipe).
+const MAX_FRAMES: u32 = 100_000;
+/// The most seeds a comparison takes.
+const MAX_SEEDS: u32 = 10_000;
+
 #[derive(clap::Args)]
 pub(crate) struct CompareArgs {
     /// Scene file; the built-in default scene when left out.
@@ -160,6 +165,13 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
     let render = RenderSettings { film, ..render };
     if args.frames == 0 || args.seeds == 0 {
         bail!("--frames and --seeds must be at least 1");
+    }
+    // Every frame's measurements are kept (and written to errors.csv): a count no run
+    // could finish would only fill the memory first.
+    for (flag, value, most) in [("--frames", args.frames, MAX_FRAMES), ("--seeds", args.seeds, MAX_SEEDS)] {
+        if value > most {
+            bail!("{flag} {value}: at most {most} (each frame of each seed is rendered and measured)");
+        }
     }
     for (index, method) in args.methods.iter().enumerate() {
         if args.methods[..index].contains(method) {
@@ -326,6 +338,7 @@ fn settings_record(
     put("histogram_kernel", histogram.spec().map(|spec| spec.name.to_string()).into());
     put("film", clap::ValueEnum::to_possible_value(&film).map(|p| p.get_name().to_string()).into());
     put("camera_path", args.camera_path.to_string_lossy().into_owned().into());
+    put("denoise", args.denoise.map(|d| d.name()).into());
     map
 }
 

@@ -28,6 +28,10 @@ pub struct SvgfDenoiser {
     output: BufferId,
     /// Frames denoised since creation or [`SvgfDenoiser::reset`].
     frame: u32,
+    /// Time every pass with timestamp queries ([`SvgfDenoiser::set_timed`]).
+    timed: bool,
+    /// The device time of the last frame's passes (zero unless timed).
+    last_time: std::time::Duration,
 }
 
 impl SvgfDenoiser {
@@ -65,7 +69,20 @@ impl SvgfDenoiser {
             levels,
             output,
             frame: 0,
+            timed: false,
+            last_time: std::time::Duration::ZERO,
         })
+    }
+
+    /// Time every pass with timestamp queries (each dispatch then waits for the device),
+    /// when the backend has them: see [`SvgfDenoiser::last_time`].
+    pub fn set_timed(&mut self, timed: bool) {
+        self.timed = timed;
+    }
+
+    /// The device time of the last frame's passes, summed; zero unless timed.
+    pub fn last_time(&self) -> std::time::Duration {
+        self.last_time
     }
 
     /// The next frame starts without history (a camera cut).
@@ -90,11 +107,13 @@ impl SvgfDenoiser {
         let (current, previous) = ((self.frame % 2) as usize, ((self.frame + 1) % 2) as usize);
         let [temporal, variance, atrous, modulate] = self.kernels;
         let groups = [self.width.div_ceil(8), self.height.div_ceil(8), 1];
+        let timed = self.timed && backend.info().timestamps;
+        let mut time = std::time::Duration::ZERO;
         // Binds each of `buffers` to the kernel's binding of that name.
-        let dispatch = |backend: &mut dyn Backend,
-                        kernel: &Kernel,
-                        params: BufferId,
-                        buffers: &[(&str, BufferId)]|
+        let mut dispatch = |backend: &mut dyn Backend,
+                            kernel: &Kernel,
+                            params: BufferId,
+                            buffers: &[(&str, BufferId)]|
          -> Result<(), PassError> {
             let mut binds = vec![Bind::new(0, params)];
             for &(name, buffer) in buffers {
@@ -102,6 +121,10 @@ impl SvgfDenoiser {
                     .binding_named(name)
                     .ok_or_else(|| PassError::Input(format!("kernel {}: no binding named {name}", kernel.name())))?;
                 binds.push(Bind::new(info.binding, buffer));
+            }
+            if timed {
+                time += backend.dispatch_timed(kernel, &binds, groups)?;
+                return Ok(());
             }
             Ok(backend.dispatch(kernel, &binds, groups)?)
         };
@@ -155,6 +178,7 @@ impl SvgfDenoiser {
             self.params[0],
             &[("colour", colour), ("guides", guides), ("filtered", input), ("denoised", self.output)],
         )?;
+        self.last_time = time;
         self.frame += 1;
         Ok(self.output)
     }

@@ -3,7 +3,9 @@
 // surface was in the previous frame (its motion vector) by bilinear taps that each must
 // show the same surface (same object, depth within depth_tolerance, normal within
 // normal_tolerance); the valid taps' weights are renormalised, and with none the history
-// starts again. Also the first two moments of the illumination's luminance, averaged the
+// starts again (SVGF then searches a 3 x 3 neighbourhood for a matching pixel; left out
+// here: such a pixel is at a disocclusion or an edge, where a new history is the safe
+// choice). Also the first two moments of the illumination's luminance, averaged the
 // same way, for the variance (§4.2). Pixels without a surface pass their colour through.
 //
 // Bindings (group 0):

@@ -161,7 +161,8 @@ fn inputs(kernel: KernelId, case: &Case) -> Inputs {
         })
         .collect();
     let level = if kernel == KernelId::SvgfAtrous { (case.seed % 5) as u32 } else { 0 };
-    let settings = strata::denoise::SvgfSettings::default();
+    // Object edges on for about half the cases (the seed's parity).
+    let settings = strata::denoise::SvgfSettings { object_edges: case.seed % 2 == 1, ..Default::default() };
     let params = settings.params(width, height, level, case.family != 3);
     Inputs {
         params,

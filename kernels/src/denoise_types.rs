@@ -53,6 +53,14 @@ pub struct DenoiseParams {
     pub depth_tolerance: f32,
     /// Reprojection's least cosine between normals.
     pub normal_tolerance: f32,
+    /// 1: the spatial filters also stop at object boundaries.
+    pub object_edges: u32,
+    /// Padding (a uniform is a multiple of 16 bytes).
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+    /// Padding.
+    pub _pad2: u32,
 }
 
 /// Albedo components at or below this are not divided out (WGSL `MIN_ALBEDO`).

@@ -185,7 +185,11 @@ shader_struct!(
         normal_power_log2,
         max_history,
         depth_tolerance,
-        normal_tolerance
+        normal_tolerance,
+        object_edges,
+        _pad0,
+        _pad1,
+        _pad2
     ]
 );
 shader_struct!(PathCandidate, "PathCandidate", [position, kind, normal, light, reflected, weight]);

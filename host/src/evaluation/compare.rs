@@ -2,7 +2,7 @@
 //! measured against a reference, with a CSV of every measurement and a summary of
 //! mean ± 95 % confidence interval over seeds.
 
-use crate::denoise::{Denoiser, SvgfDenoiser, SvgfSettings};
+use crate::denoise::{Denoiser, SvgfDenoiser};
 use crate::evaluation::metrics::{self, MeanInterval};
 use crate::histogram_pass::PassError;
 use crate::render::{GpuScene, RenderSettings};
@@ -129,10 +129,10 @@ pub fn run_comparison(
             let mut denoiser = None;
             let mut sum: Option<RgbImage> = None;
             let result = (|| {
-                if let Some(Denoiser::Svgf) = comparison.denoise {
+                if let Some(chosen) = comparison.denoise {
                     renderer.enable_guides(backend)?;
                     let (width, height) = (render.camera.width, render.camera.height);
-                    denoiser = Some(SvgfDenoiser::new(backend, width, height, SvgfSettings::default())?);
+                    denoiser = Some(SvgfDenoiser::new(backend, width, height, chosen.settings())?);
                 }
                 for frame in 0..comparison.frames {
                     let camera = comparison.cameras.get(frame as usize);

@@ -59,6 +59,10 @@ fn depth_slope(params: &DenoiseParams, guides: &[DenoiseGuide], x: i32, y: i32, 
     slope
 }
 
+fn object_weight(params: &DenoiseParams, a: &DenoiseGuide, b: &DenoiseGuide) -> f32 {
+    if params.object_edges != 0 && a.mesh != b.mesh { 0.0 } else { 1.0 }
+}
+
 fn depth_distance(params: &DenoiseParams, depth: f32, other: f32, slope: [f32; 2], offset: [f32; 2]) -> f32 {
     let expected = params.sigma_depth * ((slope[0] * offset[0]).abs() + (slope[1] * offset[1]).abs()) + 1e-3 * depth;
     (depth - other).abs() / expected
@@ -198,7 +202,9 @@ pub fn variance(
                     let other = integrated[q];
                     let exponent = depth_distance(params, g.depth, guides[q].depth, slope, [dx as f32, dy as f32])
                         + (l - luminance(rgb(other))).abs() / params.sigma_luminance;
-                    let w = normal_weight(params, g.normal, guides[q].normal) * (-exponent).exp();
+                    let w = object_weight(params, g, &guides[q])
+                        * normal_weight(params, g.normal, guides[q].normal)
+                        * (-exponent).exp();
                     weight_sum += w;
                     add_weighted(&mut illumination, w, &other[..3]);
                     add_weighted(&mut moment, w, &moments[q]);
@@ -265,6 +271,7 @@ pub fn atrous(params: &DenoiseParams, guides: &[DenoiseGuide], level_in: &[[f32;
                         + (l - luminance(rgb(other))).abs() / luminance_scale;
                     let w = b3_spline(dx)
                         * b3_spline(dy)
+                        * object_weight(params, g, &guides[q])
                         * normal_weight(params, g.normal, guides[q].normal)
                         * (-exponent).exp();
                     weight_sum += w;
@@ -318,6 +325,10 @@ mod tests {
             max_history: 32.0,
             depth_tolerance: 0.1,
             normal_tolerance: 0.906,
+            object_edges: 0,
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
         }
     }
 
@@ -398,6 +409,16 @@ mod tests {
         let (guides, levels) = split(near, near, 0.0, 4.0);
         let out = atrous(&params(16, 8, 1, false), &guides, &levels);
         assert!(out[3 * 16 + 7][0] > 1.2, "{}", out[3 * 16 + 7][0]);
+        // Two objects in one plane mix too, unless object edges stop the filter.
+        let (guides, levels) = split(near, plane(2.0, [0.0, 0.0, 1.0], 1), 0.0, 4.0);
+        let out = atrous(&params(16, 8, 1, false), &guides, &levels);
+        assert!(out[3 * 16 + 7][0] > 1.2, "{}", out[3 * 16 + 7][0]);
+        let objects = DenoiseParams { object_edges: 1, ..params(16, 8, 1, false) };
+        let out = atrous(&objects, &guides, &levels);
+        let (left, right) = (mean_of_side(&out, false).0, mean_of_side(&out, true).0);
+        assert!(left == 1.0 && right == 3.0, "object edge: {left} {right}");
+        let out = variance(&objects, &guides, &levels, &vec![[1.0, 1.0]; 128]);
+        assert_eq!(out[3 * 16 + 7][..3], [1.0; 3], "the spatial variance estimate stops there too");
     }
 
     #[test]

@@ -4,6 +4,8 @@
 //   w_z = exp(-|z - z'| / (σ_z |slope · offset| + ε)),
 //   w_n = max(0, n · n')^(2^normal_power_log2),
 //   w_l = exp(-|l - l'| / (σ_l sqrt(g(var)) + ε)),
+// and, with params.object_edges, 0 between different objects (not in SVGF: measured in
+// BENCHMARKS.md),
 // where g(var) is the pixel's variance blurred by a 3 x 3 Gaussian (1/4, 1/2, 1/4 per
 // axis). The illumination is the weighted mean; the variance is filtered with the
 // squared weights (Σ w² var / (Σ w)²), so that the next level, with taps twice as far
@@ -76,7 +78,8 @@ fn svgf_atrous(@builtin(global_invocation_id) id: vec3<u32>) {
             let offset = vec2<f32>(f32(dx * step), f32(dy * step));
             let exponent = depth_distance(g.depth, guides[q].depth, slope, offset)
                 + abs(l - luminance(other.xyz)) / luminance_scale;
-            let w = b3_spline(dx) * b3_spline(dy) * normal_weight(g.normal, guides[q].normal) * exp(-exponent);
+            let w = b3_spline(dx) * b3_spline(dy) * object_weight(g, guides[q]) * normal_weight(g.normal, guides[q].normal)
+                * exp(-exponent);
             weight_sum += w;
             illumination += w * other.xyz;
             variance += w * w * other.w;

@@ -40,6 +40,12 @@ struct DenoiseParams {
     depth_tolerance: f32,
     // ...with normals whose cosine is at least this.
     normal_tolerance: f32,
+    // 1: the spatial filters (variance estimate and à-trous) also stop at object
+    // boundaries (DenoiseGuide.mesh), as the temporal pass does; 0: SVGF's own weights.
+    object_edges: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: DenoiseParams;
@@ -107,6 +113,13 @@ fn depth_slope(x: i32, y: i32, depth: f32) -> vec2<f32> {
         slope[axis] = max(smallest, 0.0);
     }
     return slope;
+}
+
+// 0 between pixels of different objects when object_edges is on, 1 otherwise. A pixel at
+// the rim of a light sees it in some frames and the ceiling in others: its luminance
+// variance is then so large that w_l lets the light's radiance bleed into the ceiling.
+fn object_weight(a: DenoiseGuide, b: DenoiseGuide) -> f32 {
+    return select(1.0, 0.0, params.object_edges != 0u && a.mesh != b.mesh);
 }
 
 // The exponent of w_z (§4.3): |z - z'| over σ_z times the depth's change along the offset

@@ -14,6 +14,10 @@ pub enum Denoiser {
     /// [`SvgfSettings::default`]: temporal accumulation through the motion vectors, a
     /// variance estimate, five levels of an edge-avoiding à-trous wavelet filter.
     Svgf,
+    /// SVGF whose spatial filters also stop at object boundaries (the guide's object id),
+    /// as its temporal pass does: not in the paper; around lights it removes most of the
+    /// paper's filter's error (BENCHMARKS.md).
+    SvgfObjects,
 }
 
 impl Denoiser {
@@ -21,6 +25,15 @@ impl Denoiser {
     pub fn name(self) -> &'static str {
         match self {
             Denoiser::Svgf => "svgf",
+            Denoiser::SvgfObjects => "svgf-objects",
+        }
+    }
+
+    /// Its settings.
+    pub fn settings(self) -> SvgfSettings {
+        match self {
+            Denoiser::Svgf => SvgfSettings::default(),
+            Denoiser::SvgfObjects => SvgfSettings { object_edges: true, ..SvgfSettings::default() },
         }
     }
 }
@@ -54,6 +67,10 @@ pub struct SvgfSettings {
     pub depth_tolerance: f32,
     /// ...and its normal is within this cosine (0.906: 25 degrees), in [-1, 1].
     pub normal_tolerance: f32,
+    /// The spatial filters (variance estimate, à-trous) also give weight 0 between
+    /// pixels of different objects (not in SVGF, which stops at depth, normal and
+    /// luminance edges only; default off, as in the paper).
+    pub object_edges: bool,
 }
 
 impl Default for SvgfSettings {
@@ -68,6 +85,7 @@ impl Default for SvgfSettings {
             max_history: 32.0,
             depth_tolerance: 0.1,
             normal_tolerance: 0.906,
+            object_edges: false,
         }
     }
 }
@@ -122,6 +140,10 @@ impl SvgfSettings {
             max_history: self.max_history,
             depth_tolerance: self.depth_tolerance,
             normal_tolerance: self.normal_tolerance,
+            object_edges: u32::from(self.object_edges),
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
         }
     }
 }

@@ -93,7 +93,8 @@ pub(crate) struct CompareArgs {
     #[arg(long, default_value_t = 1.0, value_parser = super::finite_positive)]
     exposure: f32,
     /// Also measure every frame after a denoiser: `svgf` (Schied et al. 2017, with the
-    /// paper's settings), applied alike to every method's frames as rendered, its history
+    /// paper's settings) or `svgf-objects` (its spatial filters also stop at object
+    /// boundaries), applied alike to every method's frames as rendered, its history
     /// reprojected from frame to frame. Writes `errors_denoised.csv`, the denoised
     /// previews and the same tables for them.
     #[arg(long, value_enum)]

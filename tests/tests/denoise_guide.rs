@@ -84,3 +84,25 @@ fn motion_vectors_lead_to_where_the_surface_was() {
         "same surface {forwards} along the motion, {backwards} against it"
     );
 }
+
+#[test]
+fn guides_enabled_late_are_offered_only_after_a_frame_that_wrote_them() {
+    let mut backend = CpuBackend::new(CpuOptions::default()).unwrap();
+    let backend: &mut dyn Backend = &mut backend;
+    let scene = default_scene();
+    let gpu_scene = GpuScene::build(&scene).unwrap();
+    let render = RenderSettings::for_scene(&scene, 8, 8, 1);
+    let mut renderer =
+        RestirRenderer::new(backend, &gpu_scene, &render, RestirSettings::default(), scene.extent()).unwrap();
+    renderer.render_frame(backend, None).unwrap();
+    renderer.enable_guides(backend).unwrap();
+    assert!(renderer.denoiser_inputs().is_none(), "no frame has written a guide yet");
+    renderer.render_frame(backend, None).unwrap();
+    let first = renderer.denoiser_inputs().unwrap();
+    assert_eq!(first.guides, first.previous_guides, "the first guided frame has no earlier guide");
+    renderer.render_frame(backend, None).unwrap();
+    let second = renderer.denoiser_inputs().unwrap();
+    assert_eq!(second.previous_guides, first.guides);
+    assert_ne!(second.guides, second.previous_guides);
+    renderer.destroy(backend).unwrap();
+}

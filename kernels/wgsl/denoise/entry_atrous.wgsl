@@ -1,7 +1,9 @@
 // SVGF pass 3, one level of the edge-avoiding à-trous wavelet filter (Schied et al.
 // 2017, §4.3; Dammertz et al. 2010): a 5 x 5 B3-spline kernel (1/16, 1/4, 3/8, 1/4,
 // 1/16 per axis) whose taps are params.step pixels apart, each weighted by
-//   w_z = exp(-|z - z'| / (σ_z |slope · offset| + ε)),
+//   w_z = exp(-|z - z'| / (σ_z (|slope_x offset_x| + |slope_y offset_y|) + 1e-3 z)),
+// (the paper: σ_z |∇z · offset| + ε with clip-space depth; here the slope is the smaller
+// one-sided difference per axis of the guide's depth, and ε is relative to the depth),
 //   w_n = max(0, n · n')^(2^normal_power_log2),
 //   w_l = exp(-|l - l'| / (σ_l sqrt(g(var)) + ε)),
 // and, with params.object_edges, 0 between different objects (not in SVGF: measured in

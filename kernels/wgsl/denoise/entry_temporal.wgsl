@@ -58,8 +58,9 @@ fn svgf_temporal(@builtin(global_invocation_id) id: vec3<u32>) {
     var previous_moment = vec2<f32>(0.0);
     var previous_length = 0.0;
     if params.history != 0u {
-        // Pixel centres sit at integer + 0.5: the four pixels around the previous position
-        // start at floor(position - 0.5).
+        // Pixel centres sit at integer + 0.5, so the previous image position is
+        // id + 0.5 + motion and the four pixels around it start at
+        // floor(id + 0.5 + motion - 0.5) = floor(id + motion).
         let position = vec2<f32>(id.xy) + g.motion;
         let corner = floor(position);
         let f = position - corner;

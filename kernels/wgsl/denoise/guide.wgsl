@@ -7,8 +7,10 @@ struct DenoiseGuide {
     // by after (SVGF §4: filtering untextured illumination keeps texture detail sharp).
     // Components at or below MIN_ALBEDO are not divided.
     albedo: vec3<f32>,
-    // Linear depth of the surface the pixel sees (distance along its ray); 0: no surface
-    // (the sky): the pixel is passed through unfiltered and never used as a neighbour.
+    // Linear depth of the surface the pixel sees (distance along its ray; the renderer
+    // gives the path length through a mirror chain, where SVGF uses clip-space depth);
+    // 0: no surface (the sky): the pixel is passed through unfiltered and never used as a
+    // neighbour.
     depth: f32,
     // Unit world-space normal of that surface.
     normal: vec3<f32>,

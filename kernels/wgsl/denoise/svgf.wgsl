@@ -11,6 +11,9 @@
 //                                   output is the next frame's history
 //   modulate (entry_modulate.wgsl)  times the albedo again
 //
+// Left out: the paper's final temporal anti-aliasing pass (the frames are scored as
+// modulated), and its 3 x 3 search for a history when no bilinear tap matches.
+//
 // Every pass: 8 x 8 pixels per workgroup, one invocation per pixel, binding 0 the
 // DenoiseParams below, buffers indexed y * width + x.
 

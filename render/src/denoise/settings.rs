@@ -62,7 +62,8 @@ pub struct SvgfSettings {
     /// averages weigh the new frame `alpha_*`.
     pub max_history: f32,
     /// Reprojection: a previous pixel continues this one's history if it saw the same
-    /// object at a depth within this fraction (SVGF compares depths too: 0.1), in
+    /// object at a depth within this fraction (0.1, the renderer's own temporal test;
+    /// SVGF's implementation scales its depth test by screen-space derivatives), in
     /// (0, 1]...
     pub depth_tolerance: f32,
     /// ...and its normal is within this cosine (0.906: 25 degrees), in [-1, 1].

@@ -92,7 +92,9 @@ impl SvgfDenoiser {
 
     /// Denoises one frame: `colour` holds its noisy rgb per pixel (`vec4<f32>`, w
     /// unused), `guides` its [`DenoiseGuide`](strata_kernels::denoise_types::DenoiseGuide)s
-    /// and `previous_guides` the previous frame's (unread on the first frame). Returns
+    /// and `previous_guides` the previous frame's (unread on the first frame). Call it for
+    /// every frame the guides' motion vectors step through (or [`SvgfDenoiser::reset`]
+    /// after a skipped one): the history is the last frame this pass denoised. Returns
     /// the buffer of the denoised colour (`vec4<f32>`, w 0), valid until the next call.
     pub fn denoise(
         &mut self,

@@ -82,9 +82,10 @@ pub struct RestirRenderer {
     previous_camera: Option<CameraFrame>,
     min_distance: f32,
     timed: bool,
-    /// With a denoiser ([`RestirRenderer::enable_guides`]): `restir_guide` and this
-    /// frame's and the previous frame's guides, alternating like the G-buffers.
-    guides: Option<(&'static Kernel, [BufferId; 2])>,
+    /// With a denoiser ([`RestirRenderer::enable_guides`]): `restir_guide`, this
+    /// frame's and the previous frame's guides (alternating like the G-buffers), and the
+    /// first frame that wrote one.
+    guides: Option<(&'static Kernel, [BufferId; 2], u32)>,
 }
 
 /// What a denoiser reads of the last frame ([`RestirRenderer::denoiser_inputs`]).
@@ -195,19 +196,21 @@ impl RestirRenderer {
         let (width, height) = (self.render.camera.width, self.render.camera.height);
         let bytes = u64::from(width) * u64::from(height) * size_of::<DenoiseGuide>() as u64;
         let buffers = [backend.create_buffer("guides A", bytes)?, backend.create_buffer("guides B", bytes)?];
-        self.guides = Some((kernel, buffers));
+        self.guides = Some((kernel, buffers, self.frame));
         Ok(())
     }
 
     /// The last frame's colour and guides, for a denoiser; `None` before
     /// [`RestirRenderer::enable_guides`] or before a frame with guides.
     pub fn denoiser_inputs(&self) -> Option<DenoiserInputs> {
-        let (_, guides) = self.guides?;
-        if self.frame == 0 {
+        let (_, guides, first) = self.guides?;
+        if self.frame <= first {
             return None;
         }
         let last = ((self.frame + 1) % 2) as usize;
-        Some(DenoiserInputs { colour: self.frame_out, guides: guides[last], previous_guides: guides[1 - last] })
+        // On the first frame with a guide there is no earlier one: its own stands in.
+        let previous = if self.frame == first + 1 { last } else { 1 - last };
+        Some(DenoiserInputs { colour: self.frame_out, guides: guides[last], previous_guides: guides[previous] })
     }
 
     /// Frames rendered so far.
@@ -382,7 +385,7 @@ impl RestirRenderer {
                 ],
             )?,
         )?;
-        if let Some((guide_kernel, guides)) = self.guides {
+        if let Some((guide_kernel, guides, _)) = self.guides {
             run(
                 backend,
                 guide_kernel,
@@ -453,7 +456,7 @@ impl RestirRenderer {
             self.blue_noise,
             self.frame_out,
         ];
-        let guides = self.guides.map(|(_, guides)| guides).into_iter().flatten();
+        let guides = self.guides.map(|(_, guides, _)| guides).into_iter().flatten();
         buffers
             .into_iter()
             .chain(guides)

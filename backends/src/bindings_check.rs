@@ -55,6 +55,19 @@ pub fn check_binds(
             return Err(error(bind.binding, "the kernel has no such binding".into()));
         }
     }
+    // One buffer at several bindings: WebGPU allows it only when none of them writes
+    // (a writable storage binding is an exclusive usage within a dispatch).
+    for (index, bind) in binds.iter().enumerate() {
+        for other in binds[..index].iter().filter(|b| b.buffer == bind.buffer) {
+            let writes = |binding: u32| kernel.binding(0, binding).is_some_and(|info| info.is_writable());
+            if writes(bind.binding) || writes(other.binding) {
+                return Err(error(
+                    bind.binding,
+                    format!("its buffer is also bound at binding {}, and one of them is writable", other.binding),
+                ));
+            }
+        }
+    }
     for info in &kernel.bindings {
         let bind = binds
             .iter()

@@ -46,6 +46,12 @@ fn bindings_that_do_not_fit_the_kernel_are_named() {
     let error = backend.dispatch(kernel, &twice, [1, 1, 1]).unwrap_err();
     assert!(error.to_string().contains("bound twice"), "{error}");
 
+    // One buffer at a read-only and a writable binding: WebGPU forbids it.
+    let mut aliased = binds.clone();
+    aliased[2] = Bind::new(2, buffers[1]);
+    let error = backend.dispatch(kernel, &aliased, [1, 1, 1]).unwrap_err();
+    assert!(error.to_string().contains("also bound at binding 1, and one of them is writable"), "{error}");
+
     let mut extra = binds.clone();
     extra.push(Bind::new(9, buffers[0]));
     let error = backend.dispatch(kernel, &extra, [1, 1, 1]).unwrap_err();

@@ -1344,3 +1344,38 @@ fn f16_matrices_are_refused_with_their_line() {
     assert!(message.contains("unsupported: f16 matrices"), "{message}");
     assert!(message.contains("(WGSL line 3)"), "{message}");
 }
+
+/// One buffer bound at two read-only bindings (WebGPU allows it): the interpreter reads
+/// it through both and keeps its contents (it once moved the buffer out for the first
+/// binding, gave the second an empty one, and put that back last: zeros, then an empty
+/// buffer for every later dispatch).
+#[test]
+fn a_buffer_bound_at_two_read_only_bindings_is_read_through_both_and_kept() {
+    use strata_kernels::denoise_types::DenoiseGuide;
+    let mut backend = CpuBackend::new(CpuOptions::default()).unwrap();
+    let kernel = strata_kernels::Registry::shared().unwrap().get(strata_kernels::KernelId::SvgfModulate);
+    let params = strata::denoise::SvgfSettings::default().params(4, 1, 0, false);
+    let colour: Vec<[f32; 4]> = (0..4).map(|i| [i as f32 + 1.0; 4]).collect();
+    let guide = DenoiseGuide { albedo: [1.0; 3], depth: 1.0, normal: [0.0, 0.0, 1.0], ..Default::default() };
+    let buffers = [
+        upload(&mut backend, "params", &[params]).unwrap(),
+        upload(&mut backend, "colour and filtered", &colour).unwrap(),
+        upload(&mut backend, "guides", &[guide; 4]).unwrap(),
+        backend.create_buffer("denoised", 64).unwrap(),
+    ];
+    let bind = |name: &str, buffer| Bind::new(kernel.binding_named(name).unwrap().binding, buffer);
+    let binds = [
+        bind("params", buffers[0]),
+        bind("colour", buffers[1]),
+        bind("guides", buffers[2]),
+        bind("filtered", buffers[1]),
+        bind("denoised", buffers[3]),
+    ];
+    for _ in 0..2 {
+        backend.dispatch(kernel, &binds, [1, 1, 1]).unwrap();
+        let denoised: Vec<[f32; 4]> = download(&mut backend, buffers[3]).unwrap();
+        let expected: Vec<[f32; 4]> = colour.iter().map(|c| [c[0], c[1], c[2], 0.0]).collect();
+        assert_eq!(denoised, expected, "the filtered colour, read through the second binding");
+        assert_eq!(download::<[f32; 4]>(&mut backend, buffers[1]).unwrap(), colour, "the shared buffer is kept");
+    }
+}

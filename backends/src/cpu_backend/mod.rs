@@ -210,16 +210,27 @@ impl Backend for CpuBackend {
         let subgroup_size = self.options.subgroup_size.unwrap_or(1);
         self.program(kernel)?;
         // Move the bound buffers out (in the kernel's binding order), run, put them back.
+        // A buffer bound at several (read-only: checked) bindings is moved out once and
+        // copied for the others, and only its first binding's words go back.
         let ids: Vec<u64> = kernel
             .bindings
             .iter()
             .map(|b| binds.iter().find(|bind| bind.binding == b.binding).expect("checked").buffer.0)
             .collect();
-        let mut bound: Vec<Vec<u32>> =
-            ids.iter().map(|id| std::mem::take(&mut self.buffers.get_mut(id).expect("checked").words)).collect();
+        let first_of = |index: usize| ids[..index].iter().position(|id| *id == ids[index]);
+        let mut bound: Vec<Vec<u32>> = Vec::with_capacity(ids.len());
+        for (index, id) in ids.iter().enumerate() {
+            let words = match first_of(index) {
+                Some(first) => bound[first].clone(),
+                None => std::mem::take(&mut self.buffers.get_mut(id).expect("checked").words),
+            };
+            bound.push(words);
+        }
         let result = exec::run(&self.programs[&kernel.id], &mut bound, workgroups, subgroup_size);
-        for (id, words) in ids.iter().zip(bound) {
-            self.buffers.get_mut(id).expect("checked").words = words;
+        for (index, (id, words)) in ids.iter().zip(bound).enumerate() {
+            if first_of(index).is_none() {
+                self.buffers.get_mut(id).expect("checked").words = words;
+            }
         }
         self.last_counts = result?;
         *self.counts_by_kernel.entry(kernel.id).or_default() += self.last_counts;

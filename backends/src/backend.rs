@@ -23,6 +23,22 @@ impl Bind {
     pub fn new(binding: u32, buffer: BufferId) -> Self {
         Self { binding, buffer }
     }
+
+    /// `buffers`, each under its WGSL variable's name, bound at the binding number
+    /// `kernel` declares for it (the registry's reflection; never a number written by
+    /// hand). A name the kernel's source declares but its entry point never reaches is
+    /// left out (naga drops such bindings); a name it does not declare is an error.
+    pub fn named(kernel: &Kernel, buffers: &[(&str, BufferId)]) -> Result<Vec<Bind>, BackendError> {
+        let mut binds = Vec::with_capacity(buffers.len());
+        for &(name, buffer) in buffers {
+            if let Some(info) = kernel.binding_named(name) {
+                binds.push(Bind::new(info.binding, buffer));
+            } else if !kernel.declares(name) {
+                return Err(BackendError::UnknownBinding { kernel: kernel.name().to_string(), name: name.to_string() });
+            }
+        }
+        Ok(binds)
+    }
 }
 
 /// Something that runs registry kernels.

@@ -53,6 +53,14 @@ pub enum BackendError {
         /// What is wrong.
         reason: String,
     },
+    /// A binding named by a WGSL variable the kernel does not declare.
+    #[error("kernel `{kernel}` declares no binding named `{name}`")]
+    UnknownBinding {
+        /// Kernel name.
+        kernel: String,
+        /// The name asked for.
+        name: String,
+    },
     /// A buffer id this backend does not own (destroyed or from another backend).
     #[error("unknown buffer {0}")]
     UnknownBuffer(u64),

@@ -1,20 +1,19 @@
 //! The Vulkan objects of [`crate::AshSelection`] and how they are made: its pipelines
-//! (naga's SPIR-V of the registry's kernels, a descriptor set layout from each kernel's
-//! bindings) and its own buffers, created through [`Created`], which destroys whatever
-//! was made if creation fails half-way.
+//! (naga's SPIR-V of the registry's kernels, made by the backends' plumbing,
+//! `strata_backends::ash_backend::create_compute_pipeline`) and its own buffers, created
+//! through [`Created`], which destroys whatever was made if creation fails half-way.
 
 use crate::error::EmbedError;
 use crate::wgsl::WgslModule;
 use ash::vk;
-use strata_kernels::Registry;
+use strata_backends::ash_backend::{PipelineObjects, create_compute_pipeline, destroy_compute_pipeline};
 use strata_kernels::translate::{TranslateOptions, spirv};
+use strata_kernels::{Kernel, Registry};
 
-/// A compute pipeline of one kernel, with its layouts and the module it runs.
+/// A compute pipeline of one kernel, with its layouts and the kernel it runs.
 pub(crate) struct Pipeline {
-    pub(crate) pipeline: vk::Pipeline,
-    pub(crate) layout: vk::PipelineLayout,
-    pub(crate) set_layout: vk::DescriptorSetLayout,
-    pub(crate) module: WgslModule,
+    pub(crate) objects: PipelineObjects,
+    pub(crate) kernel: &'static Kernel,
 }
 
 /// A buffer the pass owns, with its memory.
@@ -29,23 +28,18 @@ pub(crate) fn vk_error(operation: &str, result: vk::Result) -> EmbedError {
     EmbedError::Api { api: "Vulkan", operation: operation.into(), message: format!("{result:?}") }
 }
 
-/// The descriptor type of binding `binding` of `module`.
-pub(crate) fn descriptor_type(module: &WgslModule, binding: u32) -> vk::DescriptorType {
-    match module.bindings.iter().find(|b| b.binding == binding) {
-        Some(b) if b.uniform => vk::DescriptorType::UNIFORM_BUFFER,
-        _ => vk::DescriptorType::STORAGE_BUFFER,
-    }
+/// The descriptor type of binding `binding` of `kernel`.
+pub(crate) fn descriptor_type(kernel: &Kernel, binding: u32) -> vk::DescriptorType {
+    kernel
+        .binding(0, binding)
+        .map_or(vk::DescriptorType::STORAGE_BUFFER, |b| strata_backends::ash_backend::descriptor_type(b.kind))
 }
 
 /// # Safety
 /// The pipeline must be unused.
 pub(crate) unsafe fn destroy_pipeline(device: &ash::Device, pipeline: &Pipeline) {
     // SAFETY: per the function's contract.
-    unsafe {
-        device.destroy_pipeline(pipeline.pipeline, None);
-        device.destroy_pipeline_layout(pipeline.layout, None);
-        device.destroy_descriptor_set_layout(pipeline.set_layout, None);
-    }
+    unsafe { destroy_compute_pipeline(device, &pipeline.objects) }
 }
 
 /// Objects made so far by [`AshSelection::new`], destroyed if it fails half-way.
@@ -53,7 +47,7 @@ pub(crate) struct Created<'a> {
     pub(crate) device: &'a ash::Device,
     /// How the pipelines' SPIR-V zeroes workgroup memory.
     pub(crate) translate: TranslateOptions,
-    pub(crate) pipelines: Vec<(vk::Pipeline, vk::PipelineLayout, vk::DescriptorSetLayout)>,
+    pub(crate) pipelines: Vec<PipelineObjects>,
     pub(crate) buffers: Vec<(vk::Buffer, vk::DeviceMemory)>,
 }
 
@@ -61,54 +55,13 @@ impl Created<'_> {
     pub(crate) fn pipeline(&mut self, module: &WgslModule) -> Result<Pipeline, EmbedError> {
         let kernel = Registry::shared()?.get(module.id.kernel());
         let code = spirv(kernel, self.translate)?;
-        let layout_bindings: Vec<_> = module
-            .bindings
-            .iter()
-            .map(|b| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(b.binding)
-                    .descriptor_type(descriptor_type(module, b.binding))
-                    .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::COMPUTE)
-            })
-            .collect();
-        let device = self.device;
-        let operation = format!("creating the `{}` pipeline", module.entry_point);
-        // SAFETY: valid device; every object is destroyed by `Drop` on failure or by
-        // AshSelection::destroy.
-        unsafe {
-            let set_layout = device
-                .create_descriptor_set_layout(
-                    &vk::DescriptorSetLayoutCreateInfo::default().bindings(&layout_bindings),
-                    None,
-                )
-                .map_err(|e| vk_error(&operation, e))?;
-            let layouts = [set_layout];
-            let layout = match device
-                .create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts), None)
-            {
-                Ok(layout) => layout,
-                Err(e) => {
-                    device.destroy_descriptor_set_layout(set_layout, None);
-                    return Err(vk_error(&operation, e));
-                }
-            };
-            self.pipelines.push((vk::Pipeline::null(), layout, set_layout));
-            let shader = device
-                .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&code.words), None)
-                .map_err(|e| vk_error(&operation, e))?;
-            let entry = std::ffi::CString::new(code.entry_point).expect("entry points have no NUL");
-            let stage = vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::COMPUTE)
-                .module(shader)
-                .name(&entry);
-            let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout);
-            let result = device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None);
-            device.destroy_shader_module(shader, None);
-            let pipeline = result.map_err(|(_, e)| vk_error(&operation, e))?[0];
-            self.pipelines.last_mut().expect("pushed above").0 = pipeline;
-            Ok(Pipeline { pipeline, layout, set_layout, module: module.clone() })
-        }
+        let entry = std::ffi::CString::new(code.entry_point).expect("entry points have no NUL");
+        // SAFETY: valid device; the objects are destroyed by `Drop` if a later creation
+        // fails, else by AshSelection::destroy.
+        let objects = unsafe { create_compute_pipeline(self.device, &code.words, &entry, &kernel.bindings) }
+            .map_err(|e| vk_error(&format!("creating the `{}` pipeline", module.entry_point), e))?;
+        self.pipelines.push(objects);
+        Ok(Pipeline { objects, kernel })
     }
 
     pub(crate) fn buffer(
@@ -177,10 +130,8 @@ impl Drop for Created<'_> {
     fn drop(&mut self) {
         // SAFETY: these objects were never used by a command buffer.
         unsafe {
-            for &(pipeline, layout, set_layout) in &self.pipelines {
-                self.device.destroy_pipeline(pipeline, None);
-                self.device.destroy_pipeline_layout(layout, None);
-                self.device.destroy_descriptor_set_layout(set_layout, None);
+            for objects in &self.pipelines {
+                destroy_compute_pipeline(self.device, objects);
             }
             for &(buffer, memory) in &self.buffers {
                 self.device.destroy_buffer(buffer, None);

@@ -3,7 +3,7 @@
 //! engine's buffers.
 
 use crate::ash_objects::{Created, OwnBuffer, Pipeline, descriptor_type, destroy_pipeline, vk_error};
-use crate::binding_plan::{BindingPlan, EngineBuffers, OwnBuffers, PassBuffer, ResampleBuffers, Resource};
+use crate::binding_plan::{BindingPlan, EngineBuffers, OwnBuffers, ResampleBuffers, Resource};
 use crate::contract::check_size;
 use crate::error::EmbedError;
 use crate::frame::{FrameId, FrameParams, frame_params, max_blocks};
@@ -12,6 +12,7 @@ use crate::wgsl::{ModuleId, module};
 use ash::vk;
 use strata_kernels::Executor;
 use strata_kernels::blue_noise::BlueNoiseTables;
+use strata_kernels::pass_plan::PassBuffer;
 use strata_kernels::selection::SelectionSettings;
 use strata_kernels::translate::{TranslateOptions, WorkgroupZeroInit};
 
@@ -228,7 +229,7 @@ impl AshSelection {
     /// The parameters frame `frame` runs with.
     pub fn frame_params(&self, frame: u32, identity_payload: bool) -> Result<FrameParams, EmbedError> {
         let id = FrameId { frame, seed: self.seed, identity_payload };
-        frame_params(&self.settings, self.width, self.height, id, self.max_workgroups)
+        Ok(frame_params(&self.settings, self.width, self.height, id, self.max_workgroups)?)
     }
 
     /// Checks the engine's buffers against the contract and writes their descriptor sets.
@@ -252,7 +253,8 @@ impl AshSelection {
         // SAFETY: valid device; the pool is destroyed by destroy_bindings.
         let pool = unsafe { self.device.create_descriptor_pool(&info, None) }
             .map_err(|e| vk_error("creating the descriptor pool", e))?;
-        let layouts = [self.histogram.set_layout, self.select.set_layout, self.resample.set_layout];
+        let layouts =
+            [self.histogram.objects.set_layout, self.select.objects.set_layout, self.resample.objects.set_layout];
         let count = if buffers.resample.is_some() { 3 } else { 2 };
         let allocate = vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts[..count]);
         // SAFETY: the pool has room for these sets.
@@ -271,7 +273,7 @@ impl AshSelection {
             writes.push((allocated[2], &self.resample, resources));
         }
         for (set, pipeline, resources) in &writes {
-            let numbered = BindingPlan::numbered(&pipeline.module, resources);
+            let numbered = BindingPlan::numbered(pipeline.kernel, resources);
             let infos: Vec<[vk::DescriptorBufferInfo; 1]> = numbered
                 .iter()
                 .map(|(_, resource)| {
@@ -292,7 +294,7 @@ impl AshSelection {
                     vk::WriteDescriptorSet::default()
                         .dst_set(*set)
                         .dst_binding(*binding)
-                        .descriptor_type(descriptor_type(&pipeline.module, *binding))
+                        .descriptor_type(descriptor_type(pipeline.kernel, *binding))
                         .buffer_info(info)
                 })
                 .collect();
@@ -349,11 +351,11 @@ impl AshSelection {
     ) {
         // SAFETY: as for `barrier`; the set matches the pipeline's layout.
         unsafe {
-            self.device.cmd_bind_pipeline(command_buffer, vk::PipelineBindPoint::COMPUTE, pipeline.pipeline);
+            self.device.cmd_bind_pipeline(command_buffer, vk::PipelineBindPoint::COMPUTE, pipeline.objects.pipeline);
             self.device.cmd_bind_descriptor_sets(
                 command_buffer,
                 vk::PipelineBindPoint::COMPUTE,
-                pipeline.layout,
+                pipeline.objects.layout,
                 0,
                 &[set],
                 &[],

@@ -35,6 +35,7 @@ pub use strata_kernels::embed_types::{
     CANONICAL_SLOT, INVALID_SLOT, MAX_SELECTED, NO_PAYLOAD, NO_SLOT, ResampleInput, ResampleOutput, SelectedCandidates,
     SelectionParams,
 };
+use strata_kernels::pass_plan::PassBuffer;
 pub use strata_kernels::types::{Candidate, ClusterSpan, OBJECT_ID_ENVIRONMENT, OBJECT_ID_NONE};
 
 /// The engine-visible buffers of the contract.
@@ -62,42 +63,30 @@ impl BufferRole {
         BufferRole::Resampled,
     ];
 
+    /// The pass's buffer this role is (`strata_kernels::pass_plan`).
+    pub fn buffer(self) -> PassBuffer {
+        match self {
+            BufferRole::Candidates => PassBuffer::Candidates,
+            BufferRole::Payloads => PassBuffer::Payloads,
+            BufferRole::Selections => PassBuffer::Selections,
+            BufferRole::ResampleInputs => PassBuffer::ResampleInputs,
+            BufferRole::Resampled => PassBuffer::Resampled,
+        }
+    }
+
     /// The name used in errors and docs.
     pub fn name(self) -> &'static str {
-        match self {
-            BufferRole::Candidates => "candidates",
-            BufferRole::Payloads => "payloads",
-            BufferRole::Selections => "selections",
-            BufferRole::ResampleInputs => "resample_inputs",
-            BufferRole::Resampled => "resampled",
-        }
+        self.buffer().name()
     }
 
     /// Bytes per pixel.
     pub fn bytes_per_pixel(self) -> u64 {
-        (match self {
-            BufferRole::Candidates => size_of::<Candidate>(),
-            BufferRole::Payloads => size_of::<u32>(),
-            BufferRole::Selections => size_of::<SelectedCandidates>(),
-            BufferRole::ResampleInputs => size_of::<ResampleInput>(),
-            BufferRole::Resampled => size_of::<ResampleOutput>(),
-        }) as u64
+        self.buffer().size_rule().bytes(1, 0)
     }
 
     /// Bytes for a `width` × `height` image.
     pub fn size(self, width: u32, height: u32) -> u64 {
-        self.bytes_per_pixel() * u64::from(width) * u64::from(height)
-    }
-
-    /// The WGSL element type and (kernel, binding) pairs this buffer is bound to.
-    pub fn wgsl_bindings(self) -> (&'static str, &'static [(&'static str, u32)]) {
-        match self {
-            BufferRole::Candidates => ("Candidate", &[("block_histogram", 1), ("strata_select", 1)]),
-            BufferRole::Payloads => ("u32", &[("strata_select", 2)]),
-            BufferRole::Selections => ("SelectedCandidates", &[("strata_select", 6), ("strata_resample", 1)]),
-            BufferRole::ResampleInputs => ("ResampleInput", &[("strata_resample", 2)]),
-            BufferRole::Resampled => ("ResampleOutput", &[("strata_resample", 3)]),
-        }
+        self.buffer().bytes(width, height, 0)
     }
 }
 
@@ -121,30 +110,38 @@ pub(crate) fn check_size(role: BufferRole, size: u64, width: u32, height: u32) -
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::wgsl::{ModuleId, module};
+    use crate::wgsl::ModuleId;
+    use strata_kernels::pass_plan::Stage;
 
-    /// Every engine buffer of the contract is bound where the docs say, with the WGSL
-    /// element type and stride of its host record (layouts: strata_kernels' layout test).
+    /// Every engine buffer of the contract is bound with the WGSL element type of the
+    /// table above and the stride of its host record (layouts: strata_kernels' layout
+    /// test), and written by exactly the kernels the table names.
     #[test]
     fn contract_matches_the_kernels_bindings() {
-        for role in BufferRole::ALL {
-            let (element, places) = role.wgsl_bindings();
-            for &(entry, binding) in places {
-                let id = match entry {
-                    "block_histogram" => ModuleId::Histogram,
-                    "strata_select" => ModuleId::Select,
-                    _ => ModuleId::Resample,
-                };
-                let module = module(id).unwrap();
-                assert_eq!(module.entry_point, entry);
-                let bound = module.bindings.iter().find(|b| b.binding == binding).unwrap();
-                assert_eq!(bound.element, element, "{role:?} in {entry}");
-                assert_eq!(u64::from(bound.stride), role.bytes_per_pixel(), "{role:?} in {entry}");
-                let writes =
-                    matches!(role, BufferRole::Selections | BufferRole::Resampled) && entry != "strata_resample";
-                let writes = writes || (role == BufferRole::Resampled);
-                assert_eq!(bound.writable, writes, "{role:?} in {entry}: written by the pass?");
+        let registry = strata_kernels::Registry::shared().unwrap();
+        let elements = [
+            (BufferRole::Candidates, "Candidate"),
+            (BufferRole::Payloads, "u32"),
+            (BufferRole::Selections, "SelectedCandidates"),
+            (BufferRole::ResampleInputs, "ResampleInput"),
+            (BufferRole::Resampled, "ResampleOutput"),
+        ];
+        for (role, element) in elements {
+            let mut places = 0;
+            for id in ModuleId::ALL {
+                let kernel = registry.get(id.kernel());
+                let stage = Stage::of(id.kernel()).unwrap();
+                for (name, _) in stage.bindings().iter().filter(|(_, buffer)| *buffer == role.buffer()) {
+                    let bound = kernel.bindings.iter().find(|b| b.name == *name).unwrap();
+                    assert_eq!(bound.element.type_name, element, "{role:?} in {id:?}");
+                    assert_eq!(u64::from(bound.element.stride), role.bytes_per_pixel(), "{role:?} in {id:?}");
+                    let writes = matches!((role, stage), (BufferRole::Selections, Stage::Select))
+                        || matches!((role, stage), (BufferRole::Resampled, Stage::Resample));
+                    assert_eq!(bound.is_writable(), writes, "{role:?} in {id:?}: written by the pass?");
+                    places += 1;
+                }
             }
+            assert!(places > 0, "{role:?} is bound somewhere");
         }
     }
 

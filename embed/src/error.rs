@@ -92,3 +92,14 @@ pub enum EmbedError {
         message: String,
     },
 }
+
+impl From<strata_kernels::pass_plan::PlanError> for EmbedError {
+    fn from(error: strata_kernels::pass_plan::PlanError) -> Self {
+        use strata_kernels::pass_plan::PlanError;
+        match error {
+            PlanError::Setting(error) => EmbedError::Setting(error),
+            PlanError::ImageSize { width, height, why } => EmbedError::ImageSize { width, height, why },
+            PlanError::Kernel(error) => EmbedError::Kernel(error),
+        }
+    }
+}

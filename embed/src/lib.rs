@@ -55,11 +55,14 @@ mod wgpu_selection;
 
 #[cfg(feature = "ash")]
 pub use ash_selection::{AshBindings, AshBufferSlice, AshBuffers, AshDevice, AshResampleBuffers, AshSelection};
-pub use binding_plan::{EngineBuffers, PassBuffer, ResampleBuffers, SizeRule, Stage, Writer};
+pub use binding_plan::{EngineBuffers, ResampleBuffers};
 pub use error::EmbedError;
 /// What runs the kernels (a GPU, a CPU driver such as lavapipe), for
 /// [`wgsl::histogram_module`]'s choice.
 pub use strata_kernels::Executor;
+/// The pass as data (its buffers, their bindings by name, who writes them and how large
+/// they are): the one plan strata's renderer and the export package follow too.
+pub use strata_kernels::pass_plan::{PassBuffer, SizeRule, Stage, Writer};
 /// The selection's settings and sampler variants: the paper's one settings struct, shared
 /// with strata's renderer and command line.
 pub use strata_kernels::selection::{SamplerVariant, SelectionSettings};

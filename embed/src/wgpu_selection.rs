@@ -1,15 +1,16 @@
 //! [`WgpuSelection`]: the pass on an engine's own `wgpu::Device`, recording into the
 //! engine's command encoder with the engine's buffers.
 
-use crate::binding_plan::{BindingPlan, EngineBuffers, OwnBuffers, PassBuffer, ResampleBuffers, Resource};
+use crate::binding_plan::{BindingPlan, EngineBuffers, OwnBuffers, ResampleBuffers, Resource};
 use crate::contract::{BufferRole, check_size};
 use crate::error::EmbedError;
 use crate::frame::{FrameId, FrameParams, frame_params, max_blocks};
 use crate::limits::{DeviceLimits, WGPU_NAMES, check_limits};
 use crate::wgsl::{ModuleId, WgslModule, module};
-use strata_kernels::Executor;
 use strata_kernels::blue_noise::BlueNoiseTables;
+use strata_kernels::pass_plan::PassBuffer;
 use strata_kernels::selection::SelectionSettings;
+use strata_kernels::{Executor, Kernel, Registry};
 use wgpu::util::DeviceExt;
 
 /// An engine buffer bound to the pass: the buffer and the byte offset where its records
@@ -46,7 +47,7 @@ pub struct WgpuBindings {
 struct Pipeline {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
-    module: WgslModule,
+    kernel: &'static Kernel,
 }
 
 /// The stratified selection on an engine's wgpu device: the histogram pass, the
@@ -86,29 +87,18 @@ fn scoped<T>(device: &wgpu::Device, operation: &str, f: impl FnOnce() -> T) -> R
     }
 }
 
-/// A pipeline with an explicit bind-group layout from the module's bindings.
-fn pipeline(device: &wgpu::Device, module: &WgslModule) -> Pipeline {
-    let entries = module.wgpu_layout_entries();
-    let label = Some(module.entry_point.as_str());
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label, entries: &entries });
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label,
-        bind_group_layouts: &[Some(&layout)],
-        immediate_size: 0,
-    });
-    let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label,
-        source: wgpu::ShaderSource::Wgsl(module.source.as_str().into()),
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label,
-        layout: Some(&pipeline_layout),
-        module: &shader,
-        entry_point: Some(&module.entry_point),
-        compilation_options: wgpu::PipelineCompilationOptions::default(),
-        cache: None,
-    });
-    Pipeline { pipeline, layout, module: module.clone() }
+/// The module's pipeline, made by the backends' plumbing (an explicit bind-group layout
+/// from the registry's bindings; on GL, integer division with WGSL's meaning).
+fn pipeline(device: &wgpu::Device, module: &WgslModule) -> Result<Pipeline, EmbedError> {
+    let kernel = Registry::shared()?.get(module.id.kernel());
+    let define_integer_division = device.adapter_info().backend == wgpu::Backend::Gl;
+    let (pipeline, layout) = strata_backends::wgpu_backend::kernel_pipeline(device, kernel, define_integer_division)
+        .map_err(|error| EmbedError::Api {
+            api: "wgpu",
+            operation: format!("creating the `{}` pipeline", module.entry_point),
+            message: error.to_string(),
+        })?;
+    Ok(Pipeline { pipeline, layout, kernel })
 }
 
 fn check_usage(role: BufferRole, slice: WgpuBufferSlice, alignment: u64) -> Result<(), EmbedError> {
@@ -172,19 +162,19 @@ impl WgpuSelection {
                 })
             })
             .expect("wgpu reports buffer errors through the error scope");
-            Self {
+            Ok(Self {
                 settings,
                 seed: 0,
                 width,
                 height,
                 max_workgroups: limits.max_compute_workgroups_per_dimension,
                 offset_alignment: limits.min_storage_buffer_offset_alignment.into(),
-                histogram: pipeline(device, &histogram_module),
-                select: pipeline(device, &select_module),
-                resample: pipeline(device, &resample_module),
+                histogram: pipeline(device, &histogram_module)?,
+                select: pipeline(device, &select_module)?,
+                resample: pipeline(device, &resample_module)?,
                 own,
-            }
-        })
+            })
+        })?
     }
 
     /// The settings.
@@ -218,7 +208,7 @@ impl WgpuSelection {
     /// The parameters frame `frame` runs with.
     pub fn frame_params(&self, frame: u32, identity_payload: bool) -> Result<FrameParams, EmbedError> {
         let id = FrameId { frame, seed: self.seed, identity_payload };
-        frame_params(&self.settings, self.width, self.height, id, self.max_workgroups)
+        Ok(frame_params(&self.settings, self.width, self.height, id, self.max_workgroups)?)
     }
 
     /// Checks the engine's buffers against the contract and makes their bind groups.
@@ -238,7 +228,7 @@ impl WgpuSelection {
             }
         }
         let group = |pipeline: &Pipeline, resources: &[(&'static str, Resource<'_, wgpu::Buffer, WgpuBufferSlice>)]| {
-            let entries: Vec<_> = BindingPlan::numbered(&pipeline.module, resources)
+            let entries: Vec<_> = BindingPlan::numbered(pipeline.kernel, resources)
                 .iter()
                 .map(|(binding, r)| wgpu::BindGroupEntry { binding: *binding, resource: resource(r) })
                 .collect();

@@ -107,23 +107,8 @@ impl WgslModule {
     /// The module's bind-group layout as wgpu entries (compute stage, no dynamic offsets,
     /// minimum binding sizes from the WGSL types).
     pub fn wgpu_layout_entries(&self) -> Vec<wgpu::BindGroupLayoutEntry> {
-        self.bindings
-            .iter()
-            .map(|binding| wgpu::BindGroupLayoutEntry {
-                binding: binding.binding,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty: if binding.uniform {
-                        wgpu::BufferBindingType::Uniform
-                    } else {
-                        wgpu::BufferBindingType::Storage { read_only: !binding.writable }
-                    },
-                    has_dynamic_offset: false,
-                    min_binding_size: std::num::NonZeroU64::new(binding.min_size),
-                },
-                count: None,
-            })
-            .collect()
+        let kernel = Registry::shared().expect("a module exists only for a loaded registry").get(self.id.kernel());
+        strata_backends::wgpu_backend::layout_entries(&kernel.bindings)
     }
 }
 

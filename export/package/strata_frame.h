@@ -5,9 +5,10 @@
  * What a frame needs before its dispatches: the two uniforms (StrataHistogramParams for
  * the histogram kernel, StrataSelectionParams for strata_select and strata_resample), the
  * workgroup counts of the three dispatches, and the sizes of the pass's buffers. Each
- * function here computes exactly what strata-embed's `frame.rs` and `binding_plan.rs`
- * compute (a test of the strata repository runs both on the same inputs and compares the
- * bytes); manifest.json says the same as formulas.
+ * function here computes exactly what the pass plan of strata's kernels crate
+ * (`pass_plan/frame.rs`, `pass_plan/buffers.rs`) computes, which strata's renderer and
+ * strata-embed run (a test of the strata repository runs both on the same inputs and
+ * compares the bytes); manifest.json says the same as formulas.
  *
  * Written by hand for the strata project (MIT OR Apache-2.0); strata.h, which it
  * includes, is generated from the Rust twins of the kernels' structs.

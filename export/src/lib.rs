@@ -34,9 +34,9 @@ pub mod translations;
 
 use std::path::{Path, PathBuf};
 use strata_embed::wgsl::ModuleId;
-use strata_embed::{PassBuffer, Stage};
 use strata_kernels::constants::{ConstantValue, SHARED, module_constants};
 use strata_kernels::embed_types::{ResampleInput, ResampleOutput, SelectedCandidates, SelectionParams};
+use strata_kernels::pass_plan::PassBuffer;
 use strata_kernels::selection::SamplerVariant;
 use strata_kernels::types::{BlockStats, Candidate, ClusterSpan, HistogramParams};
 use strata_kernels::{KernelId, Registry};
@@ -209,7 +209,6 @@ pub fn export(out: &Path) -> Result<Exported, ExportError> {
     files.push(("include/strata_frame.h".into(), include_bytes!("../package/strata_frame.h").to_vec()));
     files.push(("include/strata_vk.h".into(), abi_header::header(version)?.into_bytes()));
     files.push(("README.md".into(), include_bytes!("../package/README.md").to_vec()));
-    let _ = Stage::ALL;
     write_package(out, &files)?;
     Ok(Exported { folder: out.to_path_buf(), files: files.into_iter().map(|(name, _)| name).collect() })
 }
@@ -227,7 +226,7 @@ fn device_requirements(registry: &Registry) -> Vec<(&'static str, String)> {
     let size_y = kernels.iter().map(|k| k.workgroup_size[1]).max();
     let largest: Vec<String> = PassBuffer::ALL
         .iter()
-        .filter(|b| !matches!(b.size_rule(), strata_embed::SizeRule::Fixed(_)))
+        .filter(|b| !matches!(b.size_rule(), strata_kernels::pass_plan::SizeRule::Fixed(_)))
         .map(|&b| manifest::buffer_entry(b).size.formula)
         .collect();
     vec![

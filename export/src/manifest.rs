@@ -1,14 +1,14 @@
 //! `manifest.json`: everything an engine needs to create the pass's pipelines and bind
 //! its buffers without reading Rust, derived from naga's reflection of the kernels (the
-//! registry), the pass's buffer plan (`strata_embed::Stage::bindings`,
+//! registry), the pass's buffer plan (`strata_kernels::pass_plan::Stage::bindings`,
 //! `PassBuffer::size_rule`) and the Rust twins of the structs: never written by hand.
 //! Every field is documented here and, for readers of the package, in its README.
 
 use crate::translations::{MSL_SIZES_BUFFER, Translated};
 use serde::Serialize;
 use strata_embed::wgsl::ModuleId;
-use strata_embed::{PassBuffer, SizeRule, Stage, Writer};
 use strata_kernels::layout::ShaderStruct;
+use strata_kernels::pass_plan::{PassBuffer, SizeRule, Stage, Writer};
 use strata_kernels::{BindingKind, Kernel};
 
 /// The version of this manifest's layout: raised when a field changes meaning or goes
@@ -283,7 +283,7 @@ pub fn buffer_entry(buffer: PassBuffer) -> BufferEntry {
     };
     BufferEntry {
         name: buffer.name(),
-        owner: if buffer.engine_role().is_some() { "engine" } else { "pass" },
+        owner: if buffer.engine_owned() { "engine" } else { "pass" },
         written_by: match buffer.writer() {
             Writer::Engine => "engine",
             Writer::HostEveryFrame => "host_every_frame",
@@ -298,7 +298,7 @@ pub fn buffer_entry(buffer: PassBuffer) -> BufferEntry {
 /// The kernel entry of `module` translated as `translated`.
 pub fn kernel_entry(module: ModuleId, kernel: &Kernel, translated: &Translated) -> KernelEntry {
     let name = kernel.name().to_string();
-    let stage = Stage::of(module);
+    let stage = Stage::of(module.kernel()).expect("every module is a stage of the pass");
     let bindings: Vec<BindingEntry> = kernel
         .bindings
         .iter()
@@ -308,7 +308,7 @@ pub fn kernel_entry(module: ModuleId, kernel: &Kernel, translated: &Translated) 
                 .iter()
                 .find(|(wgsl, _)| *wgsl == binding.name)
                 .map(|(_, buffer)| buffer.name())
-                .expect("strata_embed's plan names every binding (its test checks it)");
+                .expect("the pass plan names every binding (its test checks it)");
             let (_, register, space) = translated
                 .hlsl_registers
                 .iter()

@@ -31,6 +31,9 @@
 //!   the tests.
 //! * [`selection`]: the paper's stratified selection on the host (§4.2): the settings
 //!   struct every user shares, the sampler variants and the table of position patterns.
+//! * [`pass_plan`]: the paper's pass as data (buffers, bindings by name, per-frame
+//!   uniforms, grid shift and dispatch sizes): the one driver that strata's renderer,
+//!   strata-embed and the export package follow.
 //!
 //! Where the paper lives in WGSL (`kernels/wgsl/strata/`): §4.1 `histogram.wgsl` (with
 //! its records in `candidate.wgsl`), §4.2 `selection.wgsl` (and its last step,
@@ -48,6 +51,7 @@ pub mod glslang;
 pub mod hash;
 pub mod integer_division;
 pub mod layout;
+pub mod pass_plan;
 pub mod reference;
 pub mod registry;
 pub mod render_types;

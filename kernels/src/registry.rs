@@ -67,6 +67,12 @@ impl Kernel {
         self.bindings.iter().find(|b| b.name == name)
     }
 
+    /// Whether the kernel's source declares a global named `name` (a binding its entry
+    /// point may never reach, which naga then leaves out of [`Self::bindings`]).
+    pub fn declares(&self, name: &str) -> bool {
+        self.module.global_variables.iter().any(|(_, variable)| variable.name.as_deref() == Some(name))
+    }
+
     /// Bytes of workgroup memory the entry point declares.
     pub fn workgroup_memory_bytes(&self) -> u64 {
         let mut layouter = naga::proc::Layouter::default();

@@ -1,20 +1,19 @@
 //! The block-histogram pass on any backend: buffers, parameters, dispatch, read-back.
+//! A thin runner of the one plan of the paper's pass (`strata_kernels::pass_plan`): its
+//! buffers are sized, bound (by the WGSL variable's name) and shifted per frame as the
+//! plan says, the same plan strata-embed records into an engine's command buffers.
 
 use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, BackendError, Bind, BufferId};
+use strata_kernels::pass_plan::{PassBuffer, Stage, histogram_dispatch};
 use strata_kernels::reference::block_histogram::HistogramOutput;
+use strata_kernels::selection::SelectionSettings;
 use strata_kernels::types::{BlockStats, Candidate, ClusterSpan};
 use strata_kernels::{BlockGrid, Executor, GridError, Kernel, KernelError, KernelId, Registry};
 use thiserror::Error;
 
 /// Slots one workgroup sorts (`SLOTS` in `strata/histogram.wgsl`).
 pub const SLOTS_PER_WORKGROUP: u32 = strata_kernels::types::HISTOGRAM_SLOTS_PER_WORKGROUP;
-
-/// Workgroups of a dispatch over `grid`, in rows of at most the backend's limit
-/// ([`BlockGrid::histogram_workgroups`]).
-fn workgroups_of(backend: &dyn Backend, grid: BlockGrid) -> [u32; 3] {
-    grid.histogram_workgroups(backend.info().limits.max_workgroups_per_dimension)
-}
 
 /// Which entry point of the histogram kernel to run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -74,6 +73,8 @@ pub struct BlockHistogramPass {
     grid: BlockGrid,
     masking: bool,
     workgroups: [u32; 3],
+    /// The kernel's bindings, numbered by the registry from the plan's names.
+    binds: Vec<Bind>,
     /// Uniform `HistogramParams`.
     pub params: BufferId,
     /// Input: one `Candidate` per pixel.
@@ -110,30 +111,65 @@ impl BlockHistogramPass {
         };
         let kernel = registry.get(id);
         backend.check_kernel(kernel)?;
-        let workgroups = workgroups_of(backend, grid);
-        let x = workgroups[0];
-        let params = grid.histogram_params(x, masking);
-        let pixels = grid.pixel_count() as u64;
-        let params = upload(backend, "histogram params", &[params])?;
-        let candidates = backend.create_buffer("candidates", pixels * size_of::<Candidate>() as u64)?;
-        let sorted_pixels = backend.create_buffer("sorted pixels", pixels * 4)?;
-        let spans = backend.create_buffer("cluster spans", pixels * size_of::<ClusterSpan>() as u64)?;
+        let max_workgroups = backend.info().limits.max_workgroups_per_dimension;
+        let frame = histogram_dispatch(grid, (grid.shift_x, grid.shift_y), masking, max_workgroups)?;
         // Room for every shift of the grid (set_grid_shift).
-        let blocks = grid.max_shifted_block_count().max(grid.block_count());
-        let block_stats = backend.create_buffer("block stats", u64::from(blocks) * size_of::<BlockStats>() as u64)?;
-        Ok(Self { kernel, grid, masking, workgroups, params, candidates, sorted_pixels, spans, block_stats })
+        let blocks = u64::from(grid.max_shifted_block_count().max(grid.block_count()));
+        let bytes = |buffer: PassBuffer| buffer.bytes(grid.width, grid.height, blocks);
+        let params = upload(backend, "histogram params", &[frame.params])?;
+        let candidates = backend.create_buffer("candidates", bytes(PassBuffer::Candidates))?;
+        let sorted_pixels = backend.create_buffer("sorted pixels", bytes(PassBuffer::SortedPixels))?;
+        let spans = backend.create_buffer("cluster spans", bytes(PassBuffer::Spans))?;
+        let block_stats = backend.create_buffer("block stats", bytes(PassBuffer::BlockStats))?;
+        let binds = Stage::Histogram
+            .bind(kernel, |buffer| match buffer {
+                PassBuffer::HistogramParams => Some(params),
+                PassBuffer::Candidates => Some(candidates),
+                PassBuffer::SortedPixels => Some(sorted_pixels),
+                PassBuffer::Spans => Some(spans),
+                PassBuffer::BlockStats => Some(block_stats),
+                _ => None,
+            })
+            .expect("the histogram binds only the buffers above")
+            .into_iter()
+            .map(|(binding, buffer)| Bind::new(binding, buffer))
+            .collect();
+        Ok(Self {
+            kernel,
+            grid,
+            masking,
+            workgroups: frame.workgroups,
+            binds,
+            params,
+            candidates,
+            sorted_pixels,
+            spans,
+            block_stats,
+        })
     }
 
     /// Moves the block grid to shift (sx, sy), each in 0..B (§5.3 / limitations: a
     /// different shift every frame), for the next dispatches.
     pub fn set_grid_shift(&mut self, backend: &mut dyn Backend, shift_x: u32, shift_y: u32) -> Result<(), PassError> {
-        let grid = self.grid.with_shift(shift_x, shift_y)?;
-        let workgroups = workgroups_of(backend, grid);
-        let params = grid.histogram_params(workgroups[0], self.masking);
-        backend.write_buffer(self.params, 0, bytemuck::bytes_of(&params))?;
-        self.grid = grid;
-        self.workgroups = workgroups;
+        let max_workgroups = backend.info().limits.max_workgroups_per_dimension;
+        let frame = histogram_dispatch(self.grid, (shift_x, shift_y), self.masking, max_workgroups)?;
+        backend.write_buffer(self.params, 0, bytemuck::bytes_of(&frame.params))?;
+        self.grid = frame.grid;
+        self.workgroups = frame.workgroups;
         Ok(())
+    }
+
+    /// Shifts the grid for frame `frame` of the render `seed` as the plan says
+    /// ([`strata_kernels::pass_plan::grid_shift`]: not at all without block shifting).
+    pub fn set_frame(
+        &mut self,
+        backend: &mut dyn Backend,
+        settings: &SelectionSettings,
+        frame: u32,
+        seed: u32,
+    ) -> Result<(), PassError> {
+        let (shift_x, shift_y) = strata_kernels::pass_plan::grid_shift(settings, frame, seed);
+        self.set_grid_shift(backend, shift_x, shift_y)
     }
 
     /// The kernel this pass runs.
@@ -180,25 +216,15 @@ impl BlockHistogramPass {
         Ok(())
     }
 
-    fn binds(&self) -> [Bind; 5] {
-        [
-            Bind::new(0, self.params),
-            Bind::new(1, self.candidates),
-            Bind::new(2, self.sorted_pixels),
-            Bind::new(3, self.spans),
-            Bind::new(4, self.block_stats),
-        ]
-    }
-
     /// Runs the pass on the uploaded candidates.
     pub fn dispatch(&self, backend: &mut dyn Backend) -> Result<(), PassError> {
-        backend.dispatch(self.kernel, &self.binds(), self.workgroups)?;
+        backend.dispatch(self.kernel, &self.binds, self.workgroups)?;
         Ok(())
     }
 
     /// Runs the pass and returns its device time (timestamp queries).
     pub fn dispatch_timed(&self, backend: &mut dyn Backend) -> Result<std::time::Duration, PassError> {
-        Ok(backend.dispatch_timed(self.kernel, &self.binds(), self.workgroups)?)
+        Ok(backend.dispatch_timed(self.kernel, &self.binds, self.workgroups)?)
     }
 
     /// Reads the outputs back.

@@ -113,15 +113,16 @@ impl TracePass {
         let params_buffer = upload(backend, "trace params", &[params])?;
         let rays_buffer = upload(backend, "rays", rays)?;
         let hits_buffer = backend.create_buffer("hits", (rays.len() * size_of::<Hit>()) as u64)?;
-        let binds = [
-            Bind::new(0, params_buffer),
-            Bind::new(1, self.nodes),
-            Bind::new(2, self.primitive_indices),
-            Bind::new(3, self.triangles),
-            Bind::new(4, rays_buffer),
-            Bind::new(5, hits_buffer),
+        let buffers = [
+            ("trace_params", params_buffer),
+            ("nodes", self.nodes),
+            ("primitive_indices", self.primitive_indices),
+            ("triangles", self.triangles),
+            ("rays", rays_buffer),
+            ("hits", hits_buffer),
         ];
-        let result = backend.dispatch(self.kernel, &binds, [x, groups.div_ceil(x), 1]);
+        let result = Bind::named(self.kernel, &buffers)
+            .and_then(|binds| backend.dispatch(self.kernel, &binds, [x, groups.div_ceil(x), 1]));
         let hits = result.and_then(|()| download::<Hit>(backend, hits_buffer));
         for buffer in [params_buffer, rays_buffer, hits_buffer] {
             backend.destroy_buffer(buffer)?;
@@ -148,7 +149,8 @@ pub fn camera_rays(backend: &mut dyn Backend, params: &CameraParams) -> Result<V
     let params_buffer = upload(backend, "camera params", std::slice::from_ref(params))?;
     let rays_buffer = backend.create_buffer("camera rays", pixels * size_of::<Ray>() as u64)?;
     let workgroups = [params.width.div_ceil(8), params.height.div_ceil(8), 1];
-    let result = backend.dispatch(kernel, &[Bind::new(0, params_buffer), Bind::new(1, rays_buffer)], workgroups);
+    let result = Bind::named(kernel, &[("camera", params_buffer), ("camera_rays", rays_buffer)])
+        .and_then(|binds| backend.dispatch(kernel, &binds, workgroups));
     let rays = result.and_then(|()| download::<Ray>(backend, rays_buffer));
     backend.destroy_buffer(params_buffer)?;
     backend.destroy_buffer(rays_buffer)?;

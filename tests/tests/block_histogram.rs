@@ -149,3 +149,39 @@ fn set_grid_shift_moves_the_blocks() {
     assert!(pass.set_grid_shift(&mut backend, 16, 0).is_err());
     pass.destroy(&mut backend).unwrap();
 }
+
+/// The renderer's histogram follows the one plan of the pass frame by frame: its
+/// uniform and workgroups are the ones `pass_plan::frame_params` gives strata-embed and
+/// the export package for the same settings, frame and seed, and its output is the
+/// reference of the frame's shifted grid.
+#[test]
+fn the_renderers_histogram_runs_each_frame_as_the_plan_says() {
+    use strata_backends::backend::download;
+    use strata_kernels::pass_plan::{FrameId, frame_params};
+    use strata_kernels::selection::SelectionSettings;
+    use strata_kernels::types::HistogramParams;
+    let Some(mut backend) = vulkan_backend("block_histogram") else {
+        return;
+    };
+    let settings = SelectionSettings { block_size: 8, block_shift: true, ..SelectionSettings::default() };
+    let (width, height, seed) = (45, 38, 9);
+    let grid = BlockGrid::new(width, height, settings.block_size).unwrap();
+    let candidates = candidate_image(width, height, 78, CandidateMix::default());
+    let mut pass = BlockHistogramPass::new(&mut backend, HistogramVariant::Auto, grid).unwrap();
+    let max_workgroups = backend.info().limits.max_workgroups_per_dimension;
+    let mut shifted_frames = 0;
+    for frame in 0..6 {
+        pass.set_frame(&mut backend, &settings, frame, seed).unwrap();
+        let id = FrameId { frame, seed, identity_payload: true };
+        let plan = frame_params(&settings, width, height, id, max_workgroups).unwrap();
+        let params: Vec<HistogramParams> = download(&mut backend, pass.params).unwrap();
+        assert_eq!(params[0], plan.histogram, "frame {frame}");
+        assert_eq!(pass.workgroups(), plan.histogram_workgroups, "frame {frame}");
+        let shifted = grid.with_shift(plan.histogram.shift_x, plan.histogram.shift_y).unwrap();
+        shifted_frames += usize::from(plan.histogram.shift_x + plan.histogram.shift_y > 0);
+        let got = pass.run(&mut backend, &candidates).unwrap();
+        assert_same(shifted, HistogramVariant::Auto, &got, &block_histogram(shifted, &candidates));
+    }
+    assert!(shifted_frames >= 4, "block shifting moves the grid on most frames");
+    pass.destroy(&mut backend).unwrap();
+}

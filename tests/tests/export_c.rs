@@ -474,11 +474,11 @@ fn the_export_refuses_a_folder_that_is_not_a_package() {
     let _ = std::fs::remove_dir_all(&folder);
 }
 
-/// Frame parameters of `strata_frame.h` against `strata_embed::frame::frame_params` for
+/// Frame parameters of `strata_frame.h` against `strata_kernels::pass_plan::frame_params` for
 /// many settings, sizes, frames, seeds and workgroup limits, byte for byte.
 #[test]
 fn strata_frame_h_computes_what_frame_rs_does() {
-    use strata_embed::frame::{FrameId, frame_params};
+    use strata_kernels::pass_plan::{FrameId, frame_params};
     let folder = scratch("frame");
     let package = folder.join("package");
     strata_export::export(&package).unwrap();
@@ -573,7 +573,7 @@ int main(void) {
         bytes.extend_from_slice(bytemuck::bytes_of(&params.selection));
         bytes.extend(params.histogram_workgroups.iter().chain(&params.pixel_workgroups).flat_map(|w| w.to_le_bytes()));
         let hex: String = bytes.iter().map(|b| format!("{b:02x}")).collect();
-        let blocks = strata_embed::frame::max_blocks(settings, *width, *height);
+        let blocks = strata_kernels::pass_plan::max_blocks(settings, *width, *height);
         assert_eq!(line, &format!("{hex} {blocks}"), "{settings:?} {width}x{height} {id:?} max {max_workgroups}");
     }
     // Bad settings are refused by both, naming the field in C as in Rust.

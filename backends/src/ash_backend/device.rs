@@ -395,11 +395,9 @@ impl VulkanDevice {
                         vk::WriteDescriptorSet::default()
                             .dst_set(set)
                             .dst_binding(binding)
-                            .descriptor_type(if kind == Some(BindingKind::Uniform) {
-                                vk::DescriptorType::UNIFORM_BUFFER
-                            } else {
-                                vk::DescriptorType::STORAGE_BUFFER
-                            })
+                            .descriptor_type(
+                                kind.map_or(vk::DescriptorType::STORAGE_BUFFER, super::pipelines::descriptor_type),
+                            )
                             .buffer_info(info)
                     })
                     .collect();

@@ -10,6 +10,8 @@ mod device;
 mod device_setup;
 mod pipelines;
 
+pub use pipelines::{PipelineObjects, create_compute_pipeline, descriptor_type, destroy_compute_pipeline};
+
 use crate::backend::{Backend, Bind, BufferId};
 use crate::bindings_check::{check_binds, check_buffer_size, check_kernel_fits, check_workgroups, check_write};
 use crate::device_info::DeviceInfo;

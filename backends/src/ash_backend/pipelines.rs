@@ -1,5 +1,7 @@
 //! One compute pipeline per registry kernel for the ash backend: SPIR-V from naga (or
 //! from glslang on naga's GLSL / HLSL), descriptor set 0 laid out from the registry.
+//! [`create_compute_pipeline`] and [`destroy_compute_pipeline`] are the Vulkan plumbing
+//! strata-embed's ash flavour uses too.
 
 use super::SpirvSource;
 use super::device::{ComputePipeline, VulkanDevice};
@@ -10,19 +12,112 @@ use std::ffi::CString;
 use std::sync::Arc;
 use strata_kernels::glslang::{self, GlslangInput};
 use strata_kernels::translate::{self, TranslateOptions, WorkgroupZeroInit};
-use strata_kernels::{BindingKind, Kernel, KernelId};
+use strata_kernels::{BindingInfo, BindingKind, Kernel, KernelId};
 
-pub(super) struct AshPipeline {
-    module: vk::ShaderModule,
-    pub(super) set_layout: vk::DescriptorSetLayout,
-    pub(super) layout: vk::PipelineLayout,
-    pub(super) pipeline: vk::Pipeline,
+/// The Vulkan objects of one compute pipeline with one descriptor set (set 0).
+#[derive(Clone, Copy, Debug)]
+pub struct PipelineObjects {
+    /// Set 0's layout, from the kernel's bindings.
+    pub set_layout: vk::DescriptorSetLayout,
+    /// The pipeline layout (set 0 only).
+    pub layout: vk::PipelineLayout,
+    /// The compute pipeline.
+    pub pipeline: vk::Pipeline,
 }
+
+/// The descriptor type of a binding of `kind`.
+pub fn descriptor_type(kind: BindingKind) -> vk::DescriptorType {
+    match kind {
+        BindingKind::Uniform => vk::DescriptorType::UNIFORM_BUFFER,
+        BindingKind::Storage(_) => vk::DescriptorType::STORAGE_BUFFER,
+    }
+}
+
+/// Creates a compute pipeline of the SPIR-V `words` at `entry_point`, with descriptor set
+/// 0 laid out from `bindings` (compute stage, one descriptor each). On failure nothing
+/// is left behind; the shader module is destroyed once the pipeline exists.
+///
+/// # Safety
+/// `device` must be a valid device; the objects must be destroyed with
+/// [`destroy_compute_pipeline`] once unused.
+pub unsafe fn create_compute_pipeline(
+    device: &ash::Device,
+    words: &[u32],
+    entry_point: &std::ffi::CStr,
+    bindings: &[BindingInfo],
+) -> Result<PipelineObjects, vk::Result> {
+    let bindings: Vec<_> = bindings
+        .iter()
+        .map(|binding| {
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(binding.binding)
+                .descriptor_type(descriptor_type(binding.kind))
+                .descriptor_count(1)
+                .stage_flags(vk::ShaderStageFlags::COMPUTE)
+        })
+        .collect();
+    // SAFETY: valid device (the caller's contract) and create infos; every object made
+    // is destroyed on the error paths.
+    unsafe {
+        let module = device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(words), None)?;
+        let set_layout = match device
+            .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None)
+        {
+            Ok(layout) => layout,
+            Err(e) => {
+                device.destroy_shader_module(module, None);
+                return Err(e);
+            }
+        };
+        let set_layouts = [set_layout];
+        let layout = match device
+            .create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts), None)
+        {
+            Ok(layout) => layout,
+            Err(e) => {
+                device.destroy_descriptor_set_layout(set_layout, None);
+                device.destroy_shader_module(module, None);
+                return Err(e);
+            }
+        };
+        let stage = vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::COMPUTE)
+            .module(module)
+            .name(entry_point);
+        let create = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout)];
+        let result = device.create_compute_pipelines(vk::PipelineCache::null(), &create, None);
+        device.destroy_shader_module(module, None);
+        match result {
+            Ok(pipelines) => Ok(PipelineObjects { set_layout, layout, pipeline: pipelines[0] }),
+            Err((_, e)) => {
+                device.destroy_pipeline_layout(layout, None);
+                device.destroy_descriptor_set_layout(set_layout, None);
+                Err(e)
+            }
+        }
+    }
+}
+
+/// Destroys what [`create_compute_pipeline`] made.
+///
+/// # Safety
+/// No command buffer that uses the pipeline may be pending; each pipeline is destroyed
+/// once.
+pub unsafe fn destroy_compute_pipeline(device: &ash::Device, objects: &PipelineObjects) {
+    // SAFETY: per the function's contract.
+    unsafe {
+        device.destroy_pipeline(objects.pipeline, None);
+        device.destroy_pipeline_layout(objects.layout, None);
+        device.destroy_descriptor_set_layout(objects.set_layout, None);
+    }
+}
+
+pub(super) struct AshPipeline(PipelineObjects);
 
 impl AshPipeline {
     /// What a dispatch binds.
     pub(super) fn handles(&self) -> ComputePipeline {
-        ComputePipeline { set_layout: self.set_layout, layout: self.layout, pipeline: self.pipeline }
+        ComputePipeline { set_layout: self.0.set_layout, layout: self.0.layout, pipeline: self.0.pipeline }
     }
 }
 
@@ -109,77 +204,19 @@ impl PipelineCache {
             operation: operation.clone(),
             message: format!("{result:?}"),
         };
-        let device = &vulkan.device;
-        let bindings: Vec<_> = kernel
-            .bindings
-            .iter()
-            .map(|binding| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(binding.binding)
-                    .descriptor_type(match binding.kind {
-                        BindingKind::Uniform => vk::DescriptorType::UNIFORM_BUFFER,
-                        BindingKind::Storage(_) => vk::DescriptorType::STORAGE_BUFFER,
-                    })
-                    .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::COMPUTE)
-            })
-            .collect();
-        // SAFETY: valid device and create infos; every object is destroyed on the error
-        // paths or in `destroy`.
-        unsafe {
-            let module = device
-                .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), None)
-                .map_err(error)?;
-            let set_layout = match device
-                .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None)
-            {
-                Ok(layout) => layout,
-                Err(e) => {
-                    device.destroy_shader_module(module, None);
-                    return Err(error(e));
-                }
-            };
-            let set_layouts = [set_layout];
-            let layout = match device
-                .create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts), None)
-            {
-                Ok(layout) => layout,
-                Err(e) => {
-                    device.destroy_descriptor_set_layout(set_layout, None);
-                    device.destroy_shader_module(module, None);
-                    return Err(error(e));
-                }
-            };
-            let stage = vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::COMPUTE)
-                .module(module)
-                .name(&entry_point);
-            let create = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout)];
-            let pipeline = match device.create_compute_pipelines(vk::PipelineCache::null(), &create, None) {
-                Ok(pipelines) => pipelines[0],
-                Err((_, e)) => {
-                    device.destroy_pipeline_layout(layout, None);
-                    device.destroy_descriptor_set_layout(set_layout, None);
-                    device.destroy_shader_module(module, None);
-                    return Err(error(e));
-                }
-            };
-            let pipeline = Arc::new(AshPipeline { module, set_layout, layout, pipeline });
-            self.pipelines.insert(kernel.id, Arc::clone(&pipeline));
-            Ok(pipeline)
-        }
+        // SAFETY: a valid device; the pipeline is destroyed in `destroy`.
+        let objects = unsafe { create_compute_pipeline(&vulkan.device, &words, &entry_point, &kernel.bindings) }
+            .map_err(error)?;
+        let pipeline = Arc::new(AshPipeline(objects));
+        self.pipelines.insert(kernel.id, Arc::clone(&pipeline));
+        Ok(pipeline)
     }
 
     pub(super) fn destroy(&mut self, vulkan: &VulkanDevice) {
         let device = &vulkan.device;
         for (_, pipeline) in self.pipelines.drain() {
-            // SAFETY: the device is idle; each object is destroyed once.
-            unsafe {
-                device.destroy_pipeline(pipeline.pipeline, None);
-                device.destroy_pipeline_layout(pipeline.layout, None);
-                device.destroy_descriptor_set_layout(pipeline.set_layout, None);
-                device.destroy_shader_module(pipeline.module, None);
-            }
+            // SAFETY: the device is idle; each pipeline is destroyed once.
+            unsafe { destroy_compute_pipeline(device, &pipeline.0) };
         }
     }
 }

@@ -5,6 +5,8 @@ mod buffers;
 mod errors;
 mod pipelines;
 
+pub use pipelines::{kernel_pipeline, layout_entries};
+
 use crate::backend::{Backend, Bind, BufferId};
 use crate::bindings_check::{check_binds, check_kernel_fits, check_workgroups, check_write};
 use crate::device_info::{DeviceInfo, DeviceLimits};

@@ -1,5 +1,7 @@
 //! One compute pipeline per registry kernel, with an explicit bind group layout built
 //! from the registry's bindings (so a registry mistake fails here, not silently).
+//! [`kernel_pipeline`] and [`layout_entries`] are the wgpu plumbing strata-embed's wgpu
+//! flavour uses too.
 
 use super::errors::ErrorSink;
 use crate::error::BackendError;
@@ -7,7 +9,7 @@ use std::borrow::Cow;
 use std::collections::HashMap;
 use std::num::NonZeroU64;
 use std::sync::Arc;
-use strata_kernels::{BindingAccess, BindingKind, Kernel, KernelId};
+use strata_kernels::{BindingAccess, BindingInfo, BindingKind, Kernel, KernelId};
 
 pub(super) struct Pipeline {
     pub(super) pipeline: wgpu::ComputePipeline,
@@ -37,61 +39,78 @@ impl PipelineCache {
             return Ok(Arc::clone(pipeline));
         }
         let scope = errors.scope(device);
-        let entries: Vec<_> = kernel
-            .bindings
-            .iter()
-            .map(|binding| wgpu::BindGroupLayoutEntry {
-                binding: binding.binding,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty: match binding.kind {
-                        BindingKind::Uniform => wgpu::BufferBindingType::Uniform,
-                        BindingKind::Storage(access) => {
-                            wgpu::BufferBindingType::Storage { read_only: access == BindingAccess::ReadOnly }
-                        }
-                    },
-                    has_dynamic_offset: false,
-                    min_binding_size: NonZeroU64::new(binding.min_size()),
-                },
-                count: None,
-            })
-            .collect();
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some(kernel.name()),
-            entries: &entries,
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(kernel.name()),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let defined = if self.define_integer_division {
-            strata_kernels::integer_division::define_integer_division_validated(&kernel.module, &kernel.info).map_err(
-                |message| BackendError::Validation {
-                    backend: "wgpu-gl".into(),
-                    operation: format!("integer division helpers for `{}`", kernel.name()),
-                    message,
-                },
-            )?
-        } else {
-            None
-        };
-        let naga_module = defined.map_or_else(|| kernel.module.clone(), |(module, _)| module);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some(kernel.name()),
-            source: wgpu::ShaderSource::Naga(Cow::Owned(naga_module)),
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(kernel.name()),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some(kernel.entry_point()),
-            compilation_options: wgpu::PipelineCompilationOptions::default(),
-            cache: None,
-        });
+        let (pipeline, layout) = kernel_pipeline(device, kernel, self.define_integer_division)?;
         scope.finish(&format!("pipeline creation for `{}`", kernel.name()))?;
         let pipeline = Arc::new(Pipeline { pipeline, layout });
         self.pipelines.insert(kernel.id, Arc::clone(&pipeline));
         Ok(pipeline)
     }
+}
+
+/// The bind group layout entries of `bindings`: compute stage, no dynamic offsets,
+/// minimum binding sizes from the WGSL types.
+pub fn layout_entries(bindings: &[BindingInfo]) -> Vec<wgpu::BindGroupLayoutEntry> {
+    bindings
+        .iter()
+        .map(|binding| wgpu::BindGroupLayoutEntry {
+            binding: binding.binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: match binding.kind {
+                    BindingKind::Uniform => wgpu::BufferBindingType::Uniform,
+                    BindingKind::Storage(access) => {
+                        wgpu::BufferBindingType::Storage { read_only: access == BindingAccess::ReadOnly }
+                    }
+                },
+                has_dynamic_offset: false,
+                min_binding_size: NonZeroU64::new(binding.min_size()),
+            },
+            count: None,
+        })
+        .collect()
+}
+
+/// `kernel`'s compute pipeline from naga's IR, with an explicit bind group layout of its
+/// bindings ([`layout_entries`]). `define_integer_division`: rewrite integer `/` and `%`
+/// with WGSL's meaning first, as wgpu's GL back end needs (it writes GLSL's, undefined
+/// for negative operands and zero divisors). wgpu reports creation errors through the
+/// device's error scopes: the caller opens them.
+pub fn kernel_pipeline(
+    device: &wgpu::Device,
+    kernel: &Kernel,
+    define_integer_division: bool,
+) -> Result<(wgpu::ComputePipeline, wgpu::BindGroupLayout), BackendError> {
+    let entries = layout_entries(&kernel.bindings);
+    let layout = device
+        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(kernel.name()), entries: &entries });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(kernel.name()),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let defined = if define_integer_division {
+        strata_kernels::integer_division::define_integer_division_validated(&kernel.module, &kernel.info).map_err(
+            |message| BackendError::Validation {
+                backend: "wgpu-gl".into(),
+                operation: format!("integer division helpers for `{}`", kernel.name()),
+                message,
+            },
+        )?
+    } else {
+        None
+    };
+    let naga_module = defined.map_or_else(|| kernel.module.clone(), |(module, _)| module);
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(kernel.name()),
+        source: wgpu::ShaderSource::Naga(Cow::Owned(naga_module)),
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(kernel.name()),
+        layout: Some(&pipeline_layout),
+        module: &module,
+        entry_point: Some(kernel.entry_point()),
+        compilation_options: wgpu::PipelineCompilationOptions::default(),
+        cache: None,
+    });
+    Ok((pipeline, layout))
 }

@@ -117,13 +117,9 @@ impl SvgfDenoiser {
                             params: BufferId,
                             buffers: &[(&str, BufferId)]|
          -> Result<(), PassError> {
-            let mut binds = vec![Bind::new(0, params)];
-            for &(name, buffer) in buffers {
-                let info = kernel
-                    .binding_named(name)
-                    .ok_or_else(|| PassError::Input(format!("kernel {}: no binding named {name}", kernel.name())))?;
-                binds.push(Bind::new(info.binding, buffer));
-            }
+            let mut named = vec![("params", params)];
+            named.extend_from_slice(buffers);
+            let binds = Bind::named(kernel, &named)?;
             if timed {
                 time += backend.dispatch_timed(kernel, &binds, groups)?;
                 return Ok(());

@@ -181,11 +181,14 @@ impl SceneBuffers {
         })
     }
 
-    /// Binds 1–7, after the parameters at 0.
-    pub fn binds(&self, params: BufferId) -> Vec<Bind> {
-        let mut binds = vec![Bind::new(0, params)];
-        binds.extend(self.buffers.iter().enumerate().map(|(i, &b)| Bind::new(i as u32 + 1, b)));
-        binds
+    /// The scene's buffers and the parameters `params` under their WGSL names
+    /// (`render/scene.wgsl`), for [`Bind::named`].
+    pub fn named(&self, params: BufferId) -> Vec<(&'static str, BufferId)> {
+        const NAMES: [&str; 7] =
+            ["nodes", "triangles", "triangle_info", "materials", "lights", "texels", "environment_cdf"];
+        let mut named = vec![("params", params)];
+        named.extend(NAMES.into_iter().zip(self.buffers));
+        named
     }
 
     /// Frees the buffers.
@@ -237,8 +240,9 @@ impl PathTracer {
     fn add_sample_with(&mut self, backend: &mut dyn Backend, timed: bool) -> Result<std::time::Duration, PassError> {
         let params = RenderParams { sample_index: self.samples, ..self.params };
         backend.write_buffer(self.params_buffer, 0, bytemuck::bytes_of(&params))?;
-        let mut binds = self.scene.binds(self.params_buffer);
-        binds.push(Bind::new(8, self.accumulation));
+        let mut named = self.scene.named(self.params_buffer);
+        named.push(("accumulation", self.accumulation));
+        let binds = Bind::named(self.kernel, &named)?;
         let workgroups = [params.width.div_ceil(8), params.height.div_ceil(8), 1];
         let time = if timed && backend.info().timestamps {
             backend.dispatch_timed(self.kernel, &binds, workgroups)?

@@ -9,7 +9,6 @@ use crate::rgb_image::RgbImage;
 use crate::scene::{Camera, CameraFrame};
 use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, BackendError, Bind, BufferId};
-use strata_kernels::block_grid::frame_shift;
 use strata_kernels::blue_noise::BlueNoiseTables;
 use strata_kernels::denoise_types::DenoiseGuide;
 use strata_kernels::render_types::{FLAG_HIT_LIGHTS, FLAG_SAMPLE_LIGHTS, RenderParams};
@@ -237,10 +236,9 @@ impl RestirRenderer {
             .ok_or_else(|| PassError::Input("camera: invalid frame (fov axis or up vector)".into()))?;
         let selection = self.settings.selection;
         if selection.block_shift && self.settings.method.uses_histogram() {
-            let (sx, sy) = frame_shift(selection.block_size, self.frame, self.render.seed);
-            self.histogram.set_grid_shift(backend, sx, sy)?;
+            self.histogram.set_frame(backend, &selection, self.frame, self.render.seed)?;
             if let Some(temporal) = &mut self.temporal_histogram {
-                temporal.set_grid_shift(backend, sx, sy)?;
+                temporal.set_frame(backend, &selection, self.frame, self.render.seed)?;
             }
         }
         let params =
@@ -266,17 +264,10 @@ impl RestirRenderer {
         // The scene, the settings and the pass's own buffers by their WGSL names, restricted
         // to what `kernel` uses (naga drops bindings an entry point never reaches).
         let with = |kernel: &Kernel, extra: &[(&str, BufferId)]| -> Result<Vec<Bind>, PassError> {
-            let mut binds = self.scene.binds(self.render_params);
-            binds.push(Bind::new(8, self.restir_params));
-            binds.retain(|bind| kernel.bindings.iter().any(|b| b.binding == bind.binding));
-            for &(name, buffer) in extra {
-                if let Some(info) = kernel.binding_named(name) {
-                    binds.push(Bind::new(info.binding, buffer));
-                } else if !declares(kernel, name) {
-                    return Err(PassError::Input(format!("kernel {}: no binding named {name}", kernel.name())));
-                }
-            }
-            Ok(binds)
+            let mut named = self.scene.named(self.render_params);
+            named.push(("restir", self.restir_params));
+            named.extend_from_slice(extra);
+            Ok(Bind::named(kernel, &named)?)
         };
         let [candidates_kernel, select_kernel, keys_kernel, temporal_kernel, shade_kernel] = self.kernels;
         let timed = self.timed && backend.info().timestamps;
@@ -463,10 +454,4 @@ impl RestirRenderer {
             .try_for_each(|b| backend.destroy_buffer(b))
             .map_err(|e: BackendError| e.into())
     }
-}
-
-/// Whether `kernel`'s WGSL declares a global variable `name` (naga keeps every declared
-/// global in the module, also those its entry point never reaches).
-fn declares(kernel: &Kernel, name: &str) -> bool {
-    kernel.module.global_variables.iter().any(|(_, variable)| variable.name.as_deref() == Some(name))
 }

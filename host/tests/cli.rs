@@ -91,10 +91,12 @@ fn compare_without_a_vulkan_device_runs_on_the_interpreter_and_says_so() {
     assert!(plot.status.success(), "{}", text(&plot.stderr));
     assert!(std::fs::read_to_string(&svg).unwrap().starts_with("<svg"));
     // The whole-run ratios, each `... over frames 1-2 (...): MEAN ± HALF (N seeds)`; the
-    // plot reads them from the CSV's 7 significant digits, so they agree to rounding.
-    let ratios = |stdout: &str| -> Vec<(String, f64)> {
+    // plot reads them from the CSV's 7 significant digits, so they agree to rounding. With
+    // both regimes (the default) compare says which each line is.
+    let ratios = |stdout: &str, regime: &str| -> Vec<(String, f64)> {
         stdout
             .lines()
+            .filter_map(|l| l.strip_prefix(regime))
             .filter(|l| l.contains(" over frames 1-2 "))
             .map(|l| {
                 let mean = l.split("): ").nth(1).and_then(|r| r.split(' ').next()).unwrap();
@@ -102,10 +104,23 @@ fn compare_without_a_vulkan_device_runs_on_the_interpreter_and_says_so() {
             })
             .collect()
     };
-    let (from_compare, from_plot) = (ratios(&stdout), ratios(&text(&plot.stdout)));
+    let (from_compare, from_plot) = (ratios(&stdout, "temporal reuse: "), ratios(&text(&plot.stdout), ""));
     assert_eq!(from_compare.len(), 2, "a whole-run ratio per baseline:\n{stdout}");
+    // The accumulated regime's, from its own CSV.
+    let accumulated = strata_without_vulkan(&[
+        "plot",
+        out.join("errors_accumulated.csv").to_str().unwrap(),
+        "--out",
+        out_str(&out.join("accumulated.svg")),
+    ]);
+    assert!(accumulated.status.success(), "{}", text(&accumulated.stderr));
+    let (accumulated_compare, accumulated_plot) =
+        (ratios(&stdout, "accumulated frames: "), ratios(&text(&accumulated.stdout), ""));
+    assert_eq!(accumulated_compare.len(), 2, "a whole-run ratio per baseline, accumulated:\n{stdout}");
+    let pairs = from_compare.iter().zip(&from_plot).chain(accumulated_compare.iter().zip(&accumulated_plot));
     assert_eq!(from_compare.len(), from_plot.len());
-    for ((label, a), (plot_label, b)) in from_compare.iter().zip(&from_plot) {
+    assert_eq!(accumulated_compare.len(), accumulated_plot.len());
+    for ((label, a), (plot_label, b)) in pairs {
         assert!(label == plot_label && (a - b).abs() <= 2e-4 && *a > 0.0, "{label} {a} against {plot_label} {b}");
     }
     let _ = std::fs::remove_dir_all(&out);

@@ -84,6 +84,8 @@ fn compare_with_default_settings_reproduces_its_committed_numbers() {
     let out = compare("default", &[]);
     assert_same_as_committed(&out.join("errors.csv"), "compare_default_errors.csv");
     assert_same_as_committed(&out.join("strata_frame003.exr"), "compare_default_strata_frame003.exr");
+    // The other regime (`--both-regimes`, on by default) is exactly `--accumulate`'s run.
+    assert_same_as_committed(&out.join("errors_accumulated.csv"), "compare_accumulated_errors.csv");
     let _ = std::fs::remove_dir_all(out);
 }
 
@@ -125,6 +127,9 @@ fn compare_with_every_setting_moved_reproduces_its_committed_numbers() {
 fn accumulated_compare_reproduces_its_committed_numbers() {
     let out = compare("accumulated", &["--accumulate", "--film", "stratified"]);
     assert_same_as_committed(&out.join("errors.csv"), "compare_accumulated_errors.csv");
+    // And its other regime is the default run's (the film given holds for both regimes,
+    // so the default run's errors are not expected here: only that it ran).
+    assert!(out.join("errors_temporal.csv").is_file());
     let _ = std::fs::remove_dir_all(out);
 }
 

@@ -51,6 +51,10 @@ frame.addEventListener('load', () => {
       const filled = cells.filter(c => c.textContent.trim() !== '' || c.querySelector('img'));
       if (filled.length === 0) found.push('empty table ' + (table.caption ? table.caption.textContent : ''));
     }
+    const regimes = [...doc.querySelectorAll('#headline .ratio')].map(r =>
+      r.textContent.includes('accumulated frames') ? 'accumulated' :
+      r.textContent.includes('temporal reuse') ? 'temporal' : 'unlabelled');
+    found.push('headline ' + regimes.join(','));
     for (const id of ['headline', 'plots', 'images', 'closeups', 'tables', 'record']) {
       if (!doc.getElementById(id)) found.push('missing section ' + id);
     }
@@ -126,8 +130,13 @@ fn the_report_page_shows_every_image_and_table_in_chromium() {
     assert!(images >= 3 * 7 + 3, "too few images ({images}): {found:?}");
     let tables: usize = found.iter().find_map(|l| l.strip_prefix("tables ")?.parse().ok()).expect("a table count");
     assert!(tables >= 3, "too few tables ({tables}): {found:?}");
-    let problems: Vec<&String> =
-        found.iter().filter(|l| !l.starts_with("images ") && !l.starts_with("tables ")).collect();
+    // The headline gives strata ÷ each baseline in both regimes, side by side.
+    let headline = found.iter().find_map(|l| l.strip_prefix("headline ")).expect("a headline");
+    assert_eq!(headline, "temporal,temporal,accumulated,accumulated", "{found:?}");
+    let problems: Vec<&String> = found
+        .iter()
+        .filter(|l| !l.starts_with("images ") && !l.starts_with("tables ") && !l.starts_with("headline "))
+        .collect();
     assert!(problems.is_empty(), "the page has problems: {problems:?}");
     assert!(console.is_empty(), "Chromium's console has errors: {console:?}");
 

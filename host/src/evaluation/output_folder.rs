@@ -68,9 +68,11 @@ pub fn lock(folder: &Path) -> Result<FolderLock> {
 /// the report page and its plots and colour bar, the reference and every method's frame
 /// images and error maps.
 pub fn is_run_output(name: &str) -> bool {
-    const FIXED: [&str; 7] = [
+    const FIXED: [&str; 9] = [
         "errors.csv",
         "errors_denoised.csv",
+        "errors_accumulated.csv",
+        "errors_temporal.csv",
         "variance.csv",
         "summary.txt",
         "run.json",

@@ -30,14 +30,23 @@ pub struct Page<'a> {
     pub crops: Vec<CropShown>,
     /// The frames (0-based) whose close-ups are shown.
     pub crop_frames: Vec<u32>,
-    /// strata ÷ each baseline over the whole run.
-    pub whole_run: Vec<WholeRunRatio>,
+    /// strata ÷ each baseline over the whole run, per regime measured (the run's own
+    /// first, then the other one with `--both-regimes`).
+    pub whole_run: Vec<RegimeRatios>,
     /// Plots: (file, caption).
     pub plots: Vec<(String, String)>,
     /// The summary tables.
     pub tables: Vec<Table>,
     /// The error maps' colour bar (a PNG of [`COLOUR_BAR_DECADES`] decades).
     pub colour_bar: String,
+}
+
+/// strata ÷ each baseline over the whole run in one regime.
+pub struct RegimeRatios {
+    /// The regime, as the page names it (`temporal reuse`, `accumulated frames`).
+    pub regime: String,
+    /// Its ratios.
+    pub ratios: Vec<WholeRunRatio>,
 }
 
 /// The decades of RelMSE the error maps' colours span, from 1e-4 (black) to 1 (white).
@@ -141,21 +150,24 @@ impl Page<'_> {
     }
 
     fn headline(&self) -> String {
-        if self.whole_run.is_empty() {
+        if self.whole_run.iter().all(|regime| regime.ratios.is_empty()) {
             return String::new();
         }
         let mut html = String::from("<section id=\"headline\">\n<h2>Over the whole run</h2>\n<div class=\"ratios\">\n");
-        for w in &self.whole_run {
-            html += &format!(
-                "<div class=\"ratio\"><div class=\"big\">{}</div>\
-                 <div>{} ÷ {} RelMSE, frames 1–{}</div><div class=\"note\">per seed, summed over frames; mean and \
-                 95 % interval over {} seeds (below 1: strata better)</div></div>\n",
-                headline_ratio(&w.ratio),
-                method_label(Method::Strata),
-                method_label(w.baseline),
-                self.record.frames,
-                w.ratio.count
-            );
+        for regime in &self.whole_run {
+            for w in &regime.ratios {
+                html += &format!(
+                    "<div class=\"ratio\"><div class=\"big\">{}</div>\
+                     <div>{} ÷ {} RelMSE, {}, frames 1–{}</div><div class=\"note\">per seed, summed over frames; mean \
+                     and 95 % interval over {} seeds (below 1: strata better)</div></div>\n",
+                    headline_ratio(&w.ratio),
+                    method_label(Method::Strata),
+                    method_label(w.baseline),
+                    escape(&regime.regime),
+                    self.record.frames,
+                    w.ratio.count
+                );
+            }
         }
         html + "</div>\n</section>\n"
     }

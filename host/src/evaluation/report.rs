@@ -9,7 +9,7 @@
 use super::compare::{Comparison, errors_csv, run_comparison};
 use super::crops::{self, Crop};
 use super::metrics::{self, Metric};
-use super::page::{CropShown, FrameImages, MethodImage, Page};
+use super::page::{CropShown, FrameImages, MethodImage, Page, RegimeRatios};
 use super::record::{MethodTime, RunRecord};
 use super::summary::{self, SeedImages, Table};
 use crate::progress::Progress;
@@ -21,9 +21,33 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+/// The other regime of `strata compare --both-regimes`: every method and seed again with
+/// temporal reuse switched (accumulated frames for a temporal run, and the other way),
+/// against the same references; its errors go to their own CSV
+/// ([`OtherRegime::csv_name`]), the summary and the page's headline.
+#[derive(Clone, Debug)]
+pub struct OtherRegime {
+    /// What to run: the run's comparison with `restir.temporal` switched (and no denoiser).
+    pub comparison: Comparison,
+    /// The render settings (the other regime's film).
+    pub render: RenderSettings,
+}
+
+impl OtherRegime {
+    /// The CSV its errors are written to.
+    pub fn csv_name(&self) -> &'static str {
+        if self.comparison.restir.temporal { "errors_temporal.csv" } else { "errors_accumulated.csv" }
+    }
+}
+
+/// A regime as the summary and the page name it.
+pub fn regime_name(temporal: bool) -> &'static str {
+    if temporal { "temporal reuse" } else { "accumulated frames" }
+}
+
 /// What to run and where to write it. The scene, size, frames, seeds and mode are the
 /// record's ([`RunRecord`]), stated once.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct ReportOptions {
     /// The methods, in the order their rows are printed.
     pub methods: Vec<Method>,
@@ -41,6 +65,8 @@ pub struct ReportOptions {
     pub record: RunRecord,
     /// When the run began (the reference included), for the record's duration.
     pub started: Instant,
+    /// The other regime, measured too (`--both-regimes`); `None`: the run's own only.
+    pub other_regime: Option<OtherRegime>,
 }
 
 /// The frames whose images are written and shown: 1, 2, 4, … and the last (0-based).
@@ -69,7 +95,8 @@ pub fn run_and_report(
 ) -> Result<()> {
     let out = &options.out;
     let (frames, seeds) = (options.record.frames, options.record.seeds);
-    let total = u64::from(frames) * u64::from(seeds) * options.methods.len() as u64;
+    let regimes = 1 + u64::from(options.other_regime.is_some());
+    let total = regimes * u64::from(frames) * u64::from(seeds) * options.methods.len() as u64;
     let mut progress = Progress::new("methods", total, "frames");
     let compared = Instant::now();
     let mut write_error: Option<anyhow::Error> = None;
@@ -120,7 +147,6 @@ pub fn run_and_report(
         },
     )?;
     let errors = measured.raw;
-    progress.finish();
     if let Some(error) = write_error {
         return Err(error);
     }
@@ -129,9 +155,20 @@ pub fn run_and_report(
     if !measured.denoised.is_empty() {
         write(&out.join("errors_denoised.csv"), errors_csv(&measured.denoised))?;
     }
+    let other_errors = match &options.other_regime {
+        Some(other) => {
+            let run = |_: Method, _: u32, _: u32, _: &RgbImage, _: Option<&RgbImage>, _: Duration| progress.inc(1);
+            let measured =
+                run_comparison(backend, gpu_scene, &other.render, extent, &other.comparison, references, run)?;
+            write(&out.join(other.csv_name()), errors_csv(&measured.raw))?;
+            Some((regime_name(other.comparison.restir.temporal), measured.raw))
+        }
+        None => None,
+    };
+    progress.finish();
 
     // Plots.
-    let mode = if options.record.temporal { "temporal reuse" } else { "accumulated frames" };
+    let mode = regime_name(options.record.temporal);
     let title =
         format!("{} {}x{}, {} seeds, {mode}", options.record.scene, render.camera.width, render.camera.height, seeds);
     let plotted = super::plot::write_relmse_and_ratio_plots(
@@ -160,8 +197,22 @@ pub fn run_and_report(
     );
     let mut tables: Vec<Table> = vec![summary::relmse_table(&errors, &options.methods, &shown, &heading)];
     let mut text = tables[0].to_text();
+    // With both regimes each whole-run line says which it is, side by side.
+    let label = if other_errors.is_some() { format!("{mode}: ") } else { String::new() };
     for line in summary::whole_run_lines(&errors, frames) {
-        text += &format!("{line}\n");
+        text += &format!("{label}{line}\n");
+    }
+    if let Some((regime, other)) = &other_errors {
+        let heading = format!(
+            "The same methods and seeds with {regime} ({}): RelMSE, mean ± 95% CI over seeds:",
+            options.other_regime.as_ref().map_or("", |o| o.csv_name())
+        );
+        let table = summary::relmse_table(other, &options.methods, &shown, &heading);
+        text += &table.to_text();
+        tables.push(table);
+        for line in summary::whole_run_lines(other, frames) {
+            text += &format!("{regime}: {line}\n");
+        }
     }
     if let Some(flip) = summary::flip_table(&errors, &options.methods, &shown) {
         text += &flip.to_text();
@@ -267,7 +318,15 @@ pub fn run_and_report(
         frames,
         crops: page_crops,
         crop_frames: if last == 0 { vec![0] } else { vec![0, last] },
-        whole_run: summary::whole_run_ratios(&errors),
+        whole_run: std::iter::once(RegimeRatios {
+            regime: mode.to_string(),
+            ratios: summary::whole_run_ratios(&errors),
+        })
+        .chain(other_errors.iter().map(|(regime, other)| RegimeRatios {
+            regime: regime.to_string(),
+            ratios: summary::whole_run_ratios(other),
+        }))
+        .collect(),
         plots,
         tables,
         colour_bar: "relmse_colourbar.png".to_string(),

@@ -12,7 +12,7 @@ use strata::evaluation::crops::{self, Crop};
 use strata::evaluation::image_checks::check_reference;
 use strata::evaluation::output_folder;
 use strata::evaluation::record::{self, RunRecord};
-use strata::evaluation::report::{ReportOptions, run_and_report};
+use strata::evaluation::report::{OtherRegime, ReportOptions, run_and_report};
 use strata::progress::Progress;
 use strata::render::{Film, GpuScene, RenderSettings};
 use strata::restir::{Method, RestirSettings};
@@ -99,6 +99,15 @@ pub(crate) struct CompareArgs {
     /// previews and the same tables for them.
     #[arg(long, value_enum)]
     denoise: Option<Denoiser>,
+    /// Also run every method and seed in the other regime, against the same reference:
+    /// accumulated frames when the run reuses temporally, temporal reuse with
+    /// `--accumulate` (each with its default film unless `--film` or `--pixel-centres`
+    /// says otherwise; no denoiser). The summary and the report's headline then give
+    /// strata's gain in both side by side (the paper's shows most in accumulated
+    /// frames); its errors go to `errors_accumulated.csv` (or `errors_temporal.csv`).
+    /// Skipped, and said, with a moving camera, whose frames cannot be accumulated.
+    #[arg(long, default_value_t = true, action = clap::ArgAction::Set, value_name = "BOOL")]
+    both_regimes: bool,
     /// Backend to run on.
     #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
     backend: BackendChoice,
@@ -157,12 +166,7 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
     if let (Some(image), Some(path)) = (&given_reference, &args.reference) {
         check_reference(image, &path.display().to_string())?;
     }
-    let film = match (args.pixel_centres, args.film) {
-        (true, _) => Film::Centres,
-        (false, Some(film)) => film,
-        (false, None) if !args.restir.temporal => Film::Stratified,
-        (false, None) => Film::White,
-    };
+    let film = film_of(args, args.restir.temporal);
     let render = RenderSettings { film, ..render };
     if args.frames == 0 || args.seeds == 0 {
         bail!("--frames and --seeds must be at least 1");
@@ -307,7 +311,23 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
         frame_ms: Vec::new(),
         seconds: 0.0,
     };
+    let other_regime = match (args.both_regimes, comparison.cameras.is_empty()) {
+        (true, true) => Some(OtherRegime {
+            comparison: Comparison {
+                restir: RestirSettings { temporal: !restir.temporal, ..restir },
+                denoise: None,
+                ..comparison.clone()
+            },
+            render: RenderSettings { film: film_of(args, !restir.temporal), ..render.clone() },
+        }),
+        (true, false) => {
+            println!("the accumulated regime is left out: a moving camera's frames cannot be accumulated");
+            None
+        }
+        (false, _) => None,
+    };
     let options = ReportOptions {
+        other_regime,
         methods: args.methods.clone(),
         out: args.out.clone(),
         exposure: args.exposure,
@@ -317,6 +337,17 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
         started,
     };
     run_and_report(&options, backend.as_mut(), &gpu_scene, &render, scene.extent(), &comparison, &references)
+}
+
+/// The film of a regime: pixel centres or the user's film when given, else the regime's
+/// default (stratified for accumulated frames, white with temporal reuse).
+fn film_of(args: &CompareArgs, temporal: bool) -> Film {
+    match (args.pixel_centres, args.film) {
+        (true, _) => Film::Centres,
+        (false, Some(film)) => film,
+        (false, None) if !temporal => Film::Stratified,
+        (false, None) => Film::White,
+    }
 }
 
 /// The settings every method shared, by name, for the run's record.
@@ -340,6 +371,7 @@ fn settings_record(
     put("film", clap::ValueEnum::to_possible_value(&film).map(|p| p.get_name().to_string()).into());
     put("camera_path", args.camera_path.to_string_lossy().into_owned().into());
     put("denoise", args.denoise.map(|d| d.name()).into());
+    put("both_regimes", args.both_regimes.into());
     map
 }
 

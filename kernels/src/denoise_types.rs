@@ -63,6 +63,37 @@ pub struct DenoiseParams {
     pub _pad2: u32,
 }
 
+/// Levels of SVGF's à-trous filter in the paper (Schied et al. 2017): taps 1, 2, 4, 8
+/// and 16 pixels apart.
+pub const PAPER_LEVELS: u32 = 5;
+
+impl DenoiseParams {
+    /// The paper's settings (Schied et al. 2017: α = 0.2 for colour and moments, σ_l = 4,
+    /// σ_z = 1, σ_n = 128, a history of at most 32 frames) with the renderer's
+    /// reprojection tolerances (depth within 10 %, normals within 25°), no object edges,
+    /// for the first level (step 1) of a frame without history.
+    pub fn paper(width: u32, height: u32) -> DenoiseParams {
+        DenoiseParams {
+            width,
+            height,
+            history: 0,
+            step: 1,
+            alpha_colour: 0.2,
+            alpha_moments: 0.2,
+            sigma_luminance: 4.0,
+            sigma_depth: 1.0,
+            normal_power_log2: 7,
+            max_history: 32.0,
+            depth_tolerance: 0.1,
+            normal_tolerance: 0.906,
+            object_edges: 0,
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
+        }
+    }
+}
+
 /// Albedo components at or below this are not divided out (WGSL `MIN_ALBEDO`).
 pub const MIN_ALBEDO: f32 = 1e-3;
 /// Histories shorter than this many frames take their variance from their neighbours

@@ -26,6 +26,12 @@ pub struct RgbImage {
 }
 
 impl RgbImage {
+    /// The image of a kernel's `vec4<f32>` per pixel (rgb, and a fourth word the image
+    /// leaves out: the frame's invalid flag, the denoiser's variance), row-major.
+    pub fn from_rgba(width: u32, height: u32, pixels: &[[f32; 4]]) -> RgbImage {
+        RgbImage { width, height, pixels: pixels.iter().map(|p| [p[0], p[1], p[2]]).collect() }
+    }
+
     /// A black image.
     pub fn new(width: u32, height: u32) -> RgbImage {
         RgbImage { width, height, pixels: vec![[0.0; 3]; width as usize * height as usize] }

@@ -154,11 +154,7 @@ pub fn run_comparison(
                             let output =
                                 denoiser.denoise(backend, inputs.colour, inputs.guides, inputs.previous_guides)?;
                             let pixels: Vec<[f32; 4]> = download(backend, output)?;
-                            let denoised = RgbImage {
-                                width: image.width,
-                                height: image.height,
-                                pixels: pixels.iter().map(|p| [p[0], p[1], p[2]]).collect(),
-                            };
+                            let denoised = RgbImage::from_rgba(image.width, image.height, &pixels);
                             super::image_checks::check_frame(&denoised, &format!("{name}, denoised"))
                                 .map_err(|e| PassError::Input(e.to_string()))?;
                             errors.denoised.push(measure(method, frame, seed, &denoised, reference, comparison)?);

@@ -312,24 +312,7 @@ mod tests {
 
     /// SVGF's settings (the renderer's defaults) at `width` x `height`.
     fn params(width: u32, height: u32, step: u32, history: bool) -> DenoiseParams {
-        DenoiseParams {
-            width,
-            height,
-            history: u32::from(history),
-            step,
-            alpha_colour: 0.2,
-            alpha_moments: 0.2,
-            sigma_luminance: 4.0,
-            sigma_depth: 1.0,
-            normal_power_log2: 7,
-            max_history: 32.0,
-            depth_tolerance: 0.1,
-            normal_tolerance: 0.906,
-            object_edges: 0,
-            _pad0: 0,
-            _pad1: 0,
-            _pad2: 0,
-        }
+        DenoiseParams { history: u32::from(history), step, ..DenoiseParams::paper(width, height) }
     }
 
     fn plane(depth: f32, normal: [f32; 3], mesh: u32) -> DenoiseGuide {

@@ -15,24 +15,6 @@
 @group(0) @binding(9) var<storage, read> primaries: array<Primary>;
 @group(0) @binding(10) var<storage, read_write> guides_out: array<DenoiseGuide>;
 
-// Where `point` lands on a camera's film in pixels (x right, y down; pixel centres at
-// integer + 0.5), and its depth along the camera's axis in z.
-fn image_position(
-    point: vec3<f32>,
-    origin: vec3<f32>,
-    forward: vec3<f32>,
-    right: vec3<f32>,
-    up: vec3<f32>,
-    tan_half_x: f32,
-    tan_half_y: f32,
-) -> vec3<f32> {
-    let d = point - origin;
-    let z = dot(d, forward);
-    let sx = dot(d, right) / (z * tan_half_x);
-    let sy = dot(d, up) / (z * tan_half_y);
-    return vec3<f32>((sx + 1.0) * 0.5 * f32(params.width), (1.0 - sy) * 0.5 * f32(params.height), z);
-}
-
 @compute @workgroup_size(8, 8)
 fn restir_guide(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= params.width || id.y >= params.height {

@@ -29,15 +29,15 @@ const NO_SOURCE: u32 = 0xffffffffu;
 
 // The previous frame's pixel that saw `position`, or NO_SOURCE outside its image.
 fn reproject(position: vec3<f32>) -> u32 {
-    let d = position - restir.previous_origin;
-    let z = dot(d, restir.previous_forward);
-    if z <= 0.0 {
+    let q = image_position(
+        position, restir.previous_origin, restir.previous_forward, restir.previous_right, restir.previous_up,
+        restir.previous_tan_half_x, restir.previous_tan_half_y,
+    );
+    if q.z <= 0.0 {
         return NO_SOURCE;
     }
-    let sx = dot(d, restir.previous_right) / (z * restir.previous_tan_half_x);
-    let sy = dot(d, restir.previous_up) / (z * restir.previous_tan_half_y);
-    let px = (sx + 1.0) * 0.5 * f32(params.width);
-    let py = (1.0 - sy) * 0.5 * f32(params.height);
+    let px = q.x;
+    let py = q.y;
     if !(px >= 0.0 && py >= 0.0 && px < f32(params.width) && py < f32(params.height)) {
         return NO_SOURCE;
     }

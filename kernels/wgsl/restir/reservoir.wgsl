@@ -168,6 +168,26 @@ struct Reservoir {
 
 @group(0) @binding(8) var<uniform> restir: RestirParams;
 
+// Where `point` lands on a camera's film in pixels (x right, y down; pixel centres at
+// integer + 0.5), and its depth along the camera's axis in z (divided by when not
+// positive: callers test z first). The temporal reprojection (entry_temporal_keys.wgsl)
+// and the denoiser's motion vectors (entry_guide.wgsl) both project with it.
+fn image_position(
+    point: vec3<f32>,
+    origin: vec3<f32>,
+    forward: vec3<f32>,
+    right: vec3<f32>,
+    up: vec3<f32>,
+    tan_half_x: f32,
+    tan_half_y: f32,
+) -> vec3<f32> {
+    let d = point - origin;
+    let z = dot(d, forward);
+    let sx = dot(d, right) / (z * tan_half_x);
+    let sy = dot(d, up) / (z * tan_half_y);
+    return vec3<f32>((sx + 1.0) * 0.5 * f32(params.width), (1.0 - sy) * 0.5 * f32(params.height), z);
+}
+
 fn luminance(c: vec3<f32>) -> f32 {
     return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
 }

@@ -2,7 +2,7 @@
 //! (Schied et al. 2017, §4 and §5).
 
 use crate::histogram_pass::PassError;
-use strata_kernels::denoise_types::DenoiseParams;
+use strata_kernels::denoise_types::{DenoiseParams, PAPER_LEVELS};
 
 /// Which denoiser filters the frames (`strata compare --denoise`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -75,18 +75,20 @@ pub struct SvgfSettings {
 }
 
 impl Default for SvgfSettings {
+    /// The paper's settings ([`DenoiseParams::paper`]).
     fn default() -> Self {
+        let paper = DenoiseParams::paper(0, 0);
         SvgfSettings {
-            levels: 5,
-            alpha_colour: 0.2,
-            alpha_moments: 0.2,
-            sigma_luminance: 4.0,
-            sigma_depth: 1.0,
-            normal_power_log2: 7,
-            max_history: 32.0,
-            depth_tolerance: 0.1,
-            normal_tolerance: 0.906,
-            object_edges: false,
+            levels: PAPER_LEVELS,
+            alpha_colour: paper.alpha_colour,
+            alpha_moments: paper.alpha_moments,
+            sigma_luminance: paper.sigma_luminance,
+            sigma_depth: paper.sigma_depth,
+            normal_power_log2: paper.normal_power_log2,
+            max_history: paper.max_history,
+            depth_tolerance: paper.depth_tolerance,
+            normal_tolerance: paper.normal_tolerance,
+            object_edges: paper.object_edges != 0,
         }
     }
 }

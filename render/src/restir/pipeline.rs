@@ -387,7 +387,7 @@ impl RestirRenderer {
         self.frame += 1;
         self.previous_camera = Some(frame_camera);
         let invalid_pixels = pixels.iter().filter(|p| p[3] != 0.0).count() as u32;
-        let image = RgbImage { width, height, pixels: pixels.iter().map(|p| [p[0], p[1], p[2]]).collect() };
+        let image = RgbImage::from_rgba(width, height, &pixels);
         Ok((image, FrameStats { invalid_pixels, pass_times }))
     }
 

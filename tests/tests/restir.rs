@@ -381,6 +381,47 @@ fn shaded_parts_add_up_to_the_image() {
     }
 }
 
+/// `dispatch_only` (the warm-up of `strata compare`) dispatches just the kernels named:
+/// with none, a frame leaves every buffer as it was; with the candidates' kernel alone,
+/// only the G-buffer and candidates are written; with `None` again the frame is the
+/// image an untouched renderer renders.
+#[test]
+fn dispatch_only_runs_just_the_kernels_named() {
+    use strata_kernels::KernelId;
+    let Some(mut backend) = strata_tests::vulkan_backend("dispatch_only_runs_just_the_kernels_named") else {
+        assert!(!gpu_required());
+        return;
+    };
+    let scene = default_scene();
+    let gpu_scene = GpuScene::build(&scene).unwrap();
+    let render = RenderSettings {
+        camera: Camera { width: 16, height: 16, ..settings(&scene, 3).camera },
+        ..settings(&scene, 3)
+    };
+    let restir = RestirSettings { selection: blocks_of_8(), ..RestirSettings::default() };
+    let new =
+        |backend: &mut dyn Backend| RestirRenderer::new(backend, &gpu_scene, &render, restir, scene.extent()).unwrap();
+    let mut warm_up = new(&mut backend);
+    warm_up.dispatch_only(Some(Vec::new()));
+    let (nothing, _) = warm_up.render_frame(&mut backend, None).unwrap();
+    assert!(nothing.pixels.iter().all(|p| *p == [0.0; 3]), "no kernel ran, yet the frame was written");
+    warm_up.dispatch_only(Some(vec![KernelId::RestirCandidates]));
+    warm_up.render_frame(&mut backend, None).unwrap();
+    let buffers = warm_up.frame_buffers(&mut backend).unwrap();
+    assert!(buffers.base_radiance.iter().any(|p| p[..3].iter().any(|&c| c > 0.0)), "the candidates pass ran");
+    assert!(buffers.image.iter().all(|p| *p == [0.0; 4]), "only the candidates pass should have run");
+    warm_up.destroy(&mut backend).unwrap();
+    let mut again = new(&mut backend);
+    again.dispatch_only(Some(vec![KernelId::RestirShade]));
+    again.dispatch_only(None);
+    let (image, _) = again.render_frame(&mut backend, None).unwrap();
+    again.destroy(&mut backend).unwrap();
+    let mut plain = new(&mut backend);
+    let (want, _) = plain.render_frame(&mut backend, None).unwrap();
+    plain.destroy(&mut backend).unwrap();
+    assert_eq!(image.pixels, want.pixels);
+}
+
 /// `min_roughness` decides which conductors resample at the primary hit: with the default
 /// scene's white surfaces (floor, ceiling, back wall, boxes) made a GGX conductor of alpha
 /// 0.1, they have no resampled part at a threshold of 0.2 (the default until 2026-11-25)

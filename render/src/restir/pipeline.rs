@@ -85,6 +85,8 @@ pub struct RestirRenderer {
     /// frame's and the previous frame's guides (alternating like the G-buffers), and the
     /// first frame that wrote one.
     guides: Option<(&'static Kernel, [BufferId; 2], u32)>,
+    /// Warm-up only ([`RestirRenderer::dispatch_only`]): the kernels frames dispatch.
+    dispatch_only: Option<Vec<KernelId>>,
 }
 
 /// What a denoiser reads of the last frame ([`RestirRenderer::denoiser_inputs`]).
@@ -175,8 +177,19 @@ impl RestirRenderer {
             min_distance: if settings.min_distance > 0.0 { settings.min_distance } else { 1e-3 * scene_extent },
             timed: false,
             guides: None,
+            dispatch_only: None,
         };
         Ok(renderer)
+    }
+
+    /// For warming up a CPU driver that compiles each kernel at its first dispatch (and
+    /// lavapipe compiles it for the uniform values it then sees, inlining some): from
+    /// now on frames dispatch only `kernels` (every pass again with `None`), so that
+    /// threads with a device each can compile the kernels side by side on small
+    /// renderers with the run's own settings. Frames rendered so are not images: drop
+    /// the renderer after.
+    pub fn dispatch_only(&mut self, kernels: Option<Vec<KernelId>>) {
+        self.dispatch_only = kernels;
     }
 
     /// Time every pass with timestamp queries (each dispatch then waits for the device).
@@ -272,8 +285,13 @@ impl RestirRenderer {
         let [candidates_kernel, select_kernel, keys_kernel, temporal_kernel, shade_kernel] = self.kernels;
         let timed = self.timed && backend.info().timestamps;
         let mut pass_times = [std::time::Duration::ZERO; 5];
+        let only = self.dispatch_only.clone();
+        let wanted = |kernel: &Kernel| only.as_ref().is_none_or(|ids| ids.contains(&kernel.id));
         let run =
             |backend: &mut dyn Backend, kernel: &Kernel, binds: &[Bind]| -> Result<std::time::Duration, PassError> {
+                if !wanted(kernel) {
+                    return Ok(std::time::Duration::ZERO);
+                }
                 let [group_x, group_y, _] = kernel.workgroup_size;
                 let groups = [width.div_ceil(group_x), height.div_ceil(group_y), 1];
                 if timed {
@@ -295,7 +313,7 @@ impl RestirRenderer {
                 ],
             )?,
         )?;
-        if self.settings.method.uses_histogram() {
+        if self.settings.method.uses_histogram() && wanted(self.histogram.kernel()) {
             if timed {
                 pass_times[1] = self.histogram.dispatch_timed(backend)?;
             } else {
@@ -335,7 +353,7 @@ impl RestirRenderer {
                     ],
                 )?,
             )?;
-            if let Some(temporal) = &self.temporal_histogram {
+            if let Some(temporal) = self.temporal_histogram.as_ref().filter(|t| wanted(t.kernel())) {
                 pass_times[3] += if timed {
                     temporal.dispatch_timed(backend)?
                 } else {

@@ -375,36 +375,58 @@ fn settings_record(
     map
 }
 
-/// Builds and runs every kernel the methods use, once each at 8x8 on a device of its own,
-/// on another thread; anything failing there is left for the real run to report.
+/// Builds and runs every kernel the methods use at 8x8, with the run's settings, on
+/// another thread; anything failing there is left for the real run to report. The
+/// kernels are split between two threads with a device each, which compile side by side
+/// (the path tracer's candidates with the small passes; the selection and the temporal
+/// merge, each as large), and each renders two frames per method (the first without
+/// temporal reuse, the second with it: lavapipe evidently compiles a kernel for the
+/// uniform values it sees, as a dispatch on zeroed uniforms built nothing the run could
+/// reuse; BENCHMARKS "First run on a fresh machine").
 fn warm_up_kernels(
     choice: strata::backend_choice::BackendChoice,
     scene: strata::scene::Scene,
     methods: Vec<Method>,
     restir: RestirSettings,
 ) -> std::thread::JoinHandle<()> {
+    use strata_kernels::KernelId;
     std::thread::spawn(move || {
-        let run = || -> Result<()> {
-            let mut backend = strata::backend_choice::open_backend_quietly(choice)?;
-            let gpu_scene = GpuScene::build(&scene)?;
-            let mut render = RenderSettings::for_scene(&scene, 8, 8, 1);
-            render.seed = 1;
-            for method in methods {
-                let settings = RestirSettings { method, ..restir };
-                let mut renderer = strata::restir::RestirRenderer::new(
-                    backend.as_mut(),
-                    &gpu_scene,
-                    &render,
-                    settings,
-                    scene.extent(),
-                )?;
-                let frame = renderer.render_frame(backend.as_mut(), None);
-                renderer.destroy(backend.as_mut())?;
-                frame?;
+        let histograms = [KernelId::BlockHistogram, KernelId::BlockHistogramSubgroup, KernelId::BlockHistogramRank];
+        let shares = [
+            [&[KernelId::RestirCandidates, KernelId::RestirTemporalKeys, KernelId::RestirShade][..], &histograms]
+                .concat(),
+            vec![KernelId::RestirSelect, KernelId::RestirTemporal],
+        ];
+        std::thread::scope(|threads| {
+            for share in shares {
+                let (scene, methods) = (&scene, &methods);
+                threads.spawn(move || {
+                    let run = || -> Result<()> {
+                        let mut backend = strata::backend_choice::open_backend_quietly(choice)?;
+                        let gpu_scene = GpuScene::build(scene)?;
+                        let mut render = RenderSettings::for_scene(scene, 8, 8, 1);
+                        render.seed = 1;
+                        for &method in methods {
+                            let settings = RestirSettings { method, ..restir };
+                            let mut renderer = strata::restir::RestirRenderer::new(
+                                backend.as_mut(),
+                                &gpu_scene,
+                                &render,
+                                settings,
+                                scene.extent(),
+                            )?;
+                            renderer.dispatch_only(Some(share.clone()));
+                            let frames =
+                                (0..2).try_for_each(|_| renderer.render_frame(backend.as_mut(), None).map(drop));
+                            renderer.destroy(backend.as_mut())?;
+                            frames?;
+                        }
+                        Ok(())
+                    };
+                    let _ = run();
+                });
             }
-            Ok(())
-        };
-        let _ = run();
+        });
     })
 }
 

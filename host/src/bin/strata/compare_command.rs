@@ -279,7 +279,9 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
     if let Some(warm_up) = warm_up {
         // Joined before the methods run, so that no kernel is compiled twice at once.
         if !warm_up.is_finished() {
-            println!("waiting for the methods' kernels to finish compiling (once per machine: Mesa's cache keeps them)");
+            println!(
+                "waiting for the methods' kernels to finish compiling (once per machine: Mesa's cache keeps them)"
+            );
         }
         let _ = warm_up.join();
     }

@@ -3,7 +3,7 @@
 //! engine's buffers.
 
 use crate::ash_objects::{Created, OwnBuffer, Pipeline, descriptor_type, destroy_pipeline, vk_error};
-use crate::binding_plan::{BindingPlan, EngineBuffers, OwnBuffers, ResampleBuffers, Resource};
+use crate::binding_plan::{EngineBuffers, OwnBuffers, ResampleBuffers, Resource};
 use crate::contract::check_size;
 use crate::error::EmbedError;
 use crate::frame::{FrameId, FrameParams, frame_params, max_blocks};
@@ -273,7 +273,7 @@ impl AshSelection {
             writes.push((allocated[2], &self.resample, resources));
         }
         for (set, pipeline, resources) in &writes {
-            let numbered = BindingPlan::numbered(pipeline.kernel, resources);
+            let numbered = strata_kernels::pass_plan::numbered(pipeline.kernel, resources);
             let infos: Vec<[vk::DescriptorBufferInfo; 1]> = numbered
                 .iter()
                 .map(|(_, resource)| {

@@ -4,7 +4,6 @@
 //! package for engines outside Rust serialises too.
 
 use crate::contract::BufferRole;
-use strata_kernels::Kernel;
 use strata_kernels::pass_plan::{PassBuffer, Stage};
 
 /// The engine's buffers of the contract ([`crate::contract`]); `S` is the API's buffer
@@ -91,22 +90,11 @@ impl<B, S: Copy> Clone for Resource<'_, B, S> {
 impl<B, S: Copy> Copy for Resource<'_, B, S> {}
 
 /// Resources of the three kernels' bindings, each under its WGSL variable's name (the
-/// binding numbers come from the registry, [`BindingPlan::numbered`]).
+/// binding numbers come from the registry, `strata_kernels::pass_plan::numbered`).
 pub(crate) struct BindingPlan<'a, B, S> {
     pub histogram: Vec<(&'static str, Resource<'a, B, S>)>,
     pub select: Vec<(&'static str, Resource<'a, B, S>)>,
     pub resample: Option<Vec<(&'static str, Resource<'a, B, S>)>>,
-}
-
-impl<'a, B, S: Copy> BindingPlan<'a, B, S> {
-    /// `resources` with the binding number `kernel` declares for each name, in binding
-    /// order ([`strata_kernels::pass_plan::numbered`]).
-    pub fn numbered(
-        kernel: &Kernel,
-        resources: &[(&'static str, Resource<'a, B, S>)],
-    ) -> Vec<(u32, Resource<'a, B, S>)> {
-        strata_kernels::pass_plan::numbered(kernel, resources)
-    }
 }
 
 impl<S: Copy> EngineBuffers<S> {

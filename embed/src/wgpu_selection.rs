@@ -1,7 +1,7 @@
 //! [`WgpuSelection`]: the pass on an engine's own `wgpu::Device`, recording into the
 //! engine's command encoder with the engine's buffers.
 
-use crate::binding_plan::{BindingPlan, EngineBuffers, OwnBuffers, ResampleBuffers, Resource};
+use crate::binding_plan::{EngineBuffers, OwnBuffers, ResampleBuffers, Resource};
 use crate::contract::{BufferRole, check_size};
 use crate::error::EmbedError;
 use crate::frame::{FrameId, FrameParams, frame_params, max_blocks};
@@ -228,7 +228,7 @@ impl WgpuSelection {
             }
         }
         let group = |pipeline: &Pipeline, resources: &[(&'static str, Resource<'_, wgpu::Buffer, WgpuBufferSlice>)]| {
-            let entries: Vec<_> = BindingPlan::numbered(pipeline.kernel, resources)
+            let entries: Vec<_> = strata_kernels::pass_plan::numbered(pipeline.kernel, resources)
                 .iter()
                 .map(|(binding, r)| wgpu::BindGroupEntry { binding: *binding, resource: resource(r) })
                 .collect();

@@ -285,8 +285,8 @@ impl RestirRenderer {
         let [candidates_kernel, select_kernel, keys_kernel, temporal_kernel, shade_kernel] = self.kernels;
         let timed = self.timed && backend.info().timestamps;
         let mut pass_times = [std::time::Duration::ZERO; 5];
-        let only = self.dispatch_only.clone();
-        let wanted = |kernel: &Kernel| only.as_ref().is_none_or(|ids| ids.contains(&kernel.id));
+        let only = self.dispatch_only.as_deref();
+        let wanted = |kernel: &Kernel| only.is_none_or(|ids| ids.contains(&kernel.id));
         let run =
             |backend: &mut dyn Backend, kernel: &Kernel, binds: &[Bind]| -> Result<std::time::Duration, PassError> {
                 if !wanted(kernel) {

@@ -1,7 +1,9 @@
-//! The [`Backend`] trait: buffers in, registry kernel dispatched, buffers out.
+//! The [`Backend`] trait: buffers and textures in, kernel dispatched, buffers and
+//! textures out.
 
 use crate::device_info::DeviceInfo;
 use crate::error::BackendError;
+use crate::texture::{SamplerDesc, SamplerId, TextureDesc, TextureId};
 use std::time::Duration;
 use strata_kernels::Kernel;
 
@@ -9,19 +11,60 @@ use strata_kernels::Kernel;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct BufferId(pub u64);
 
-/// Buffer bound at `@group(0) @binding(binding)` of a dispatch.
+/// What a binding receives: a buffer (bound whole), a texture (all its mip levels) or a
+/// sampler.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Resource {
+    /// A uniform or storage buffer.
+    Buffer(BufferId),
+    /// A sampled or storage texture.
+    Texture(TextureId),
+    /// A sampler.
+    Sampler(SamplerId),
+}
+
+impl Resource {
+    /// What it is, for messages ("buffer 3", "texture 1", "sampler 2").
+    pub fn describe(self) -> String {
+        match self {
+            Self::Buffer(id) => format!("buffer {}", id.0),
+            Self::Texture(id) => format!("texture {}", id.0),
+            Self::Sampler(id) => format!("sampler {}", id.0),
+        }
+    }
+}
+
+/// A resource bound at `@group(0) @binding(binding)` of a dispatch.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Bind {
     /// WGSL binding number.
     pub binding: u32,
-    /// The buffer, bound whole.
-    pub buffer: BufferId,
+    /// What is bound.
+    pub resource: Resource,
 }
 
 impl Bind {
     /// Binds `buffer` at `binding`.
     pub fn new(binding: u32, buffer: BufferId) -> Self {
-        Self { binding, buffer }
+        Self { binding, resource: Resource::Buffer(buffer) }
+    }
+
+    /// Binds `texture` at `binding`.
+    pub fn texture(binding: u32, texture: TextureId) -> Self {
+        Self { binding, resource: Resource::Texture(texture) }
+    }
+
+    /// Binds `sampler` at `binding`.
+    pub fn sampler(binding: u32, sampler: SamplerId) -> Self {
+        Self { binding, resource: Resource::Sampler(sampler) }
+    }
+
+    /// The buffer bound, if a buffer is.
+    pub fn buffer(&self) -> Option<BufferId> {
+        match self.resource {
+            Resource::Buffer(id) => Some(id),
+            _ => None,
+        }
     }
 
     /// `buffers`, each under its WGSL variable's name, bound at the binding number
@@ -61,12 +104,32 @@ pub trait Backend {
     /// Frees the buffer.
     fn destroy_buffer(&mut self, buffer: BufferId) -> Result<(), BackendError>;
 
+    /// A zero-filled texture (every mip level), usable as sampled and as storage texture
+    /// of its format.
+    fn create_texture(&mut self, desc: &TextureDesc) -> Result<TextureId, BackendError>;
+
+    /// Replaces mip `level` of `texture` with `data` (the whole level, see
+    /// [`crate::texture`] for the byte order).
+    fn write_texture(&mut self, texture: TextureId, level: u32, data: &[u8]) -> Result<(), BackendError>;
+
+    /// Mip `level` of `texture`, after every submitted dispatch has finished.
+    fn read_texture(&mut self, texture: TextureId, level: u32) -> Result<Vec<u8>, BackendError>;
+
+    /// Frees the texture.
+    fn destroy_texture(&mut self, texture: TextureId) -> Result<(), BackendError>;
+
+    /// A sampler.
+    fn create_sampler(&mut self, desc: &SamplerDesc) -> Result<SamplerId, BackendError>;
+
+    /// Frees the sampler.
+    fn destroy_sampler(&mut self, sampler: SamplerId) -> Result<(), BackendError>;
+
     /// Whether the device can run `kernel` at all (features, workgroup size and memory);
     /// the error says what is missing.
     fn check_kernel(&self, kernel: &Kernel) -> Result<(), BackendError>;
 
     /// Runs `kernel` on `workgroups` workgroups with `binds` (every binding the kernel
-    /// uses, each exactly once).
+    /// uses, each exactly once, with a resource of the binding's kind).
     fn dispatch(&mut self, kernel: &Kernel, binds: &[Bind], workgroups: [u32; 3]) -> Result<(), BackendError>;
 
     /// Like [`Backend::dispatch`], waits for it, and returns the device time of the pass

@@ -1,10 +1,11 @@
 //! Checks every backend makes before a dispatch, so that a mistake becomes a clear
 //! [`BackendError`] instead of a validation panic or a silent wrong result.
 
-use crate::backend::{Bind, BufferId};
+use crate::backend::{Bind, BufferId, Resource};
 use crate::device_info::DeviceInfo;
 use crate::error::BackendError;
-use strata_kernels::{BindingKind, Kernel};
+use crate::texture::{SamplerId, TextureDesc, TextureId};
+use strata_kernels::{BindingInfo, BindingKind, Kernel};
 
 /// Whether `device` can run `kernel`: features, workgroup size, workgroup memory and
 /// storage buffer count.
@@ -38,13 +39,26 @@ pub fn check_kernel_fits(kernel: &Kernel, device: &DeviceInfo) -> Result<(), Bac
     exceeded("storage buffers per stage", storage as u64, u64::from(limits.max_storage_buffers_per_stage))
 }
 
-/// Whether `binds` bind every binding of `kernel` once, with buffers large enough and
-/// within the device's binding limits. `size_of` gives a buffer's size in bytes.
+/// How the checks look up a backend's resources: a buffer's size, a texture's
+/// description, whether a sampler exists (each an error for an id the backend does not
+/// own).
+pub struct ResourceLookup<'a> {
+    /// Size in bytes of a buffer.
+    pub buffer_size: &'a dyn Fn(BufferId) -> Result<u64, BackendError>,
+    /// What a texture was created as.
+    pub texture: &'a dyn Fn(TextureId) -> Result<TextureDesc, BackendError>,
+    /// Whether a sampler exists.
+    pub sampler: &'a dyn Fn(SamplerId) -> Result<(), BackendError>,
+}
+
+/// Whether `binds` bind every binding of `kernel` once, each with a resource of its kind:
+/// buffers large enough and within the device's binding limits, textures of the shape,
+/// texel kind and format the kernel declares, samplers where it samples.
 pub fn check_binds(
     kernel: &Kernel,
     binds: &[Bind],
     device: &DeviceInfo,
-    size_of: impl Fn(BufferId) -> Result<u64, BackendError>,
+    lookup: &ResourceLookup,
 ) -> Result<(), BackendError> {
     let error = |binding: u32, reason: String| BackendError::Binding { kernel: kernel.name().into(), binding, reason };
     for (index, bind) in binds.iter().enumerate() {
@@ -55,15 +69,19 @@ pub fn check_binds(
             return Err(error(bind.binding, "the kernel has no such binding".into()));
         }
     }
-    // One buffer at several bindings: WebGPU allows it only when none of them writes
+    // One resource at several bindings: WebGPU allows it only when none of them writes
     // (a writable storage binding is an exclusive usage within a dispatch).
     for (index, bind) in binds.iter().enumerate() {
-        for other in binds[..index].iter().filter(|b| b.buffer == bind.buffer) {
+        for other in binds[..index].iter().filter(|b| b.resource == bind.resource) {
             let writes = |binding: u32| kernel.binding(0, binding).is_some_and(|info| info.is_writable());
             if writes(bind.binding) || writes(other.binding) {
                 return Err(error(
                     bind.binding,
-                    format!("its buffer is also bound at binding {}, and one of them is writable", other.binding),
+                    format!(
+                        "its {} is also bound at binding {}, and one of them is writable",
+                        bind.resource.describe(),
+                        other.binding
+                    ),
                 ));
             }
         }
@@ -73,31 +91,86 @@ pub fn check_binds(
             .iter()
             .find(|b| b.binding == info.binding)
             .ok_or_else(|| error(info.binding, format!("`{}` is not bound", info.name)))?;
-        let size = size_of(bind.buffer)?;
-        if size < info.min_size() {
-            return Err(error(
+        let wrong_kind = || {
+            error(
                 info.binding,
-                format!(
-                    "`{}` needs at least {} bytes ({} of {}), the buffer has {size}",
-                    info.name,
-                    info.min_size(),
-                    info.element.count.unwrap_or(1),
-                    info.element.type_name
-                ),
-            ));
-        }
-        let (limit, available) = match info.kind {
-            BindingKind::Uniform => ("uniform binding bytes", device.limits.max_uniform_binding),
-            BindingKind::Storage(_) => ("storage binding bytes", device.limits.max_storage_binding),
+                format!("`{}` is a {}, but {} is bound", info.name, info.element.type_name, bind.resource.describe()),
+            )
         };
-        if size > available {
-            return Err(BackendError::LimitExceeded {
-                what: format!("kernel `{}` binding `{}`", kernel.name(), info.name),
-                limit,
-                requested: size,
-                available,
-            });
+        match (info.kind, bind.resource) {
+            (BindingKind::Uniform | BindingKind::Storage(_), Resource::Buffer(buffer)) => {
+                check_buffer_binding(kernel, info, (lookup.buffer_size)(buffer)?, device)?;
+            }
+            (BindingKind::SampledTexture { dimension, kind }, Resource::Texture(texture)) => {
+                let desc = (lookup.texture)(texture)?;
+                if desc.dimension != dimension || desc.format.kind() != kind {
+                    return Err(error(
+                        info.binding,
+                        format!(
+                            "`{}` is a {}, but texture `{}` is a {} texture of {}",
+                            info.name,
+                            info.element.type_name,
+                            desc.label,
+                            desc.dimension.wgsl(),
+                            desc.format.wgsl()
+                        ),
+                    ));
+                }
+            }
+            (BindingKind::StorageTexture { dimension, format, .. }, Resource::Texture(texture)) => {
+                let desc = (lookup.texture)(texture)?;
+                if desc.dimension != dimension || desc.format != format {
+                    return Err(error(
+                        info.binding,
+                        format!(
+                            "`{}` is a {}, but texture `{}` is a {} texture of {}",
+                            info.name,
+                            info.element.type_name,
+                            desc.label,
+                            desc.dimension.wgsl(),
+                            desc.format.wgsl()
+                        ),
+                    ));
+                }
+            }
+            (BindingKind::Sampler, Resource::Sampler(sampler)) => (lookup.sampler)(sampler)?,
+            _ => return Err(wrong_kind()),
         }
+    }
+    Ok(())
+}
+
+/// Whether a buffer of `size` bytes fits buffer binding `info`.
+fn check_buffer_binding(
+    kernel: &Kernel,
+    info: &BindingInfo,
+    size: u64,
+    device: &DeviceInfo,
+) -> Result<(), BackendError> {
+    if size < info.min_size() {
+        return Err(BackendError::Binding {
+            kernel: kernel.name().into(),
+            binding: info.binding,
+            reason: format!(
+                "`{}` needs at least {} bytes ({} of {}), the buffer has {size}",
+                info.name,
+                info.min_size(),
+                info.element.count.unwrap_or(1),
+                info.element.type_name
+            ),
+        });
+    }
+    let (limit, available) = match info.kind {
+        BindingKind::Uniform => ("uniform binding bytes", device.limits.max_uniform_binding),
+        _ => ("storage binding bytes", device.limits.max_storage_binding),
+    };
+    if size > available {
+        return Err(BackendError::LimitExceeded {
+            what: format!("kernel `{}` binding `{}`", kernel.name(), info.name),
+            limit,
+            requested: size,
+            available,
+        });
     }
     Ok(())
 }

@@ -50,4 +50,10 @@ pub struct DeviceLimits {
     pub max_buffer_size: u64,
     /// Storage buffers per shader stage.
     pub max_storage_buffers_per_stage: u32,
+    /// Width and height of a 1-D or 2-D texture.
+    pub max_texture_2d: u32,
+    /// Each axis of a 3-D texture.
+    pub max_texture_3d: u32,
+    /// Layers of a 2-D array texture.
+    pub max_texture_layers: u32,
 }

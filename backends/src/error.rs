@@ -72,6 +72,30 @@ pub enum BackendError {
         /// What is wrong.
         reason: String,
     },
+    /// A texture id this backend does not own.
+    #[error("unknown texture {0}")]
+    UnknownTexture(u64),
+    /// A sampler id this backend does not own.
+    #[error("unknown sampler {0}")]
+    UnknownSampler(u64),
+    /// A texture size, mip level or write that cannot be done.
+    #[error("texture `{label}`: {reason}")]
+    Texture {
+        /// Texture label.
+        label: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// Something this backend cannot do at all (a format, a binding kind), named.
+    #[error("{backend}: {what} is unavailable: {why}")]
+    Unavailable {
+        /// Backend.
+        backend: String,
+        /// What was asked.
+        what: String,
+        /// Why not.
+        why: String,
+    },
     /// The API's validation rejected an operation.
     #[error("{backend}: validation error in {operation}: {message}")]
     Validation {

@@ -36,11 +36,13 @@ pub mod cpu_backend;
 pub mod device_info;
 pub mod error;
 pub mod require_gpu;
+pub mod texture;
 pub mod wgpu_backend;
 
 pub use ash_backend::{AshBackend, AshOptions, SpirvSource};
-pub use backend::{Backend, Bind, BufferId};
+pub use backend::{Backend, Bind, BufferId, Resource};
 pub use device_info::{DeviceInfo, DeviceLimits};
 pub use error::BackendError;
 pub use require_gpu::{GPU_REQUIRED_VARIABLE, gpu_required};
+pub use texture::{AddressMode, FilterMode, SamplerDesc, SamplerId, TextureDesc, TextureId};
 pub use wgpu_backend::{WgpuBackend, WgpuOptions};

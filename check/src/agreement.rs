@@ -183,6 +183,11 @@ pub fn judge(runs: &[BackendRun], reference: Option<&str>, tolerance: &Tolerance
                         agreement.floats_beyond += usize::from(beyond);
                         beyond
                     }
+                    WordKind::HalfPair => {
+                        let beyond = !halves_within_one_ulp(g, w);
+                        agreement.floats_beyond += usize::from(beyond);
+                        beyond
+                    }
                     _ => {
                         agreement.integers_differing += 1;
                         true
@@ -196,6 +201,22 @@ pub fn judge(runs: &[BackendRun], reference: Option<&str>, tolerance: &Tolerance
         }
     }
     Ok(Judgement { reference: reference_run.backend.clone(), buffers, failed })
+}
+
+/// Whether each f16 of `got` is `want`'s or one of its representable neighbours (the
+/// other rounding a device may choose); NaN only against NaN.
+fn halves_within_one_ulp(got: u32, want: u32) -> bool {
+    let ordered = |h: u32| -> Option<i32> {
+        let h = h & 0xffff;
+        let nan = h & 0x7c00 == 0x7c00 && h & 0x03ff != 0;
+        // Sign-magnitude to a monotonic integer line (-0 and +0 both 0).
+        (!nan).then(|| if h & 0x8000 != 0 { -((h & 0x7fff) as i32) } else { h as i32 })
+    };
+    [0, 16].iter().all(|&shift| match (ordered(got >> shift), ordered(want >> shift)) {
+        (Some(g), Some(w)) => (g - w).abs() <= 1,
+        (None, None) => true,
+        _ => false,
+    })
 }
 
 #[cfg(test)]
@@ -247,6 +268,16 @@ mod tests {
         let judgement = judge(&[reference, wrong_id], None, &ulps(1000)).unwrap();
         assert_eq!(judgement.buffers[0].integers_differing, 1);
         assert!(judgement.buffers[0].describe().ends_with("FAILS"), "{}", judgement.buffers[0].describe());
+    }
+
+    #[test]
+    fn half_pairs_admit_either_rounding_and_nothing_further() {
+        let one = 0x3c00u32;
+        let pair = |low: u32, high: u32| low | high << 16;
+        assert!(halves_within_one_ulp(pair(one, one + 1), pair(one, one)));
+        assert!(halves_within_one_ulp(pair(one - 1, 0x8001), pair(one, 0x0000)));
+        assert!(!halves_within_one_ulp(pair(one + 2, one), pair(one, one)));
+        assert!(!halves_within_one_ulp(pair(one, 0x7e00), pair(one, 0x7c00)), "NaN is not next to infinity");
     }
 
     #[test]

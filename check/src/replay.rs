@@ -15,7 +15,9 @@ use crate::compare::{Compare, Output};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
-use strata_backends::{Backend, BackendError, Bind, BufferId, DeviceInfo};
+use strata_backends::{
+    Backend, BackendError, Bind, BufferId, DeviceInfo, SamplerDesc, SamplerId, TextureDesc, TextureId,
+};
 use strata_kernels::{Kernel, KernelId, Registry, WordKind};
 
 /// One dispatch as the interpreter ran it.
@@ -67,6 +69,30 @@ impl Backend for RecordingBackend<'_> {
         self.inner.destroy_buffer(buffer)
     }
 
+    fn create_texture(&mut self, desc: &TextureDesc) -> Result<TextureId, BackendError> {
+        self.inner.create_texture(desc)
+    }
+
+    fn write_texture(&mut self, texture: TextureId, level: u32, data: &[u8]) -> Result<(), BackendError> {
+        self.inner.write_texture(texture, level, data)
+    }
+
+    fn read_texture(&mut self, texture: TextureId, level: u32) -> Result<Vec<u8>, BackendError> {
+        self.inner.read_texture(texture, level)
+    }
+
+    fn destroy_texture(&mut self, texture: TextureId) -> Result<(), BackendError> {
+        self.inner.destroy_texture(texture)
+    }
+
+    fn create_sampler(&mut self, desc: &SamplerDesc) -> Result<SamplerId, BackendError> {
+        self.inner.create_sampler(desc)
+    }
+
+    fn destroy_sampler(&mut self, sampler: SamplerId) -> Result<(), BackendError> {
+        self.inner.destroy_sampler(sampler)
+    }
+
     fn check_kernel(&self, kernel: &Kernel) -> Result<(), BackendError> {
         self.inner.check_kernel(kernel)
     }
@@ -75,11 +101,22 @@ impl Backend for RecordingBackend<'_> {
         if !self.kernels.contains(&kernel.id) {
             return self.inner.dispatch(kernel, binds, workgroups);
         }
-        let before: Vec<Vec<u8>> = binds.iter().map(|b| self.inner.read_buffer(b.buffer)).collect::<Result<_, _>>()?;
+        // The recorded kernels (the renderers' passes) bind buffers only.
+        let buffers = binds
+            .iter()
+            .map(|b| {
+                b.buffer().ok_or_else(|| BackendError::Binding {
+                    kernel: kernel.name().into(),
+                    binding: b.binding,
+                    reason: "a pass replay records buffers only".into(),
+                })
+            })
+            .collect::<Result<Vec<BufferId>, _>>()?;
+        let before: Vec<Vec<u8>> = buffers.iter().map(|&b| self.inner.read_buffer(b)).collect::<Result<_, _>>()?;
         self.inner.dispatch(kernel, binds, workgroups)?;
         let mut recorded = Vec::new();
-        for (bind, before) in binds.iter().zip(before) {
-            recorded.push((bind.binding, before, self.inner.read_buffer(bind.buffer)?));
+        for ((bind, &buffer), before) in binds.iter().zip(&buffers).zip(before) {
+            recorded.push((bind.binding, before, self.inner.read_buffer(buffer)?));
         }
         self.recording.insert(kernel.id, RecordedDispatch { workgroups, binds: recorded });
         Ok(())

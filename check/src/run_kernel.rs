@@ -7,8 +7,8 @@
 use crate::{BackendSlot, backend_slots};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
-use strata_backends::{Backend, Bind};
-use strata_kernels::{Kernel, WordKinds};
+use strata_backends::{Backend, Bind, BufferId, SamplerDesc, SamplerId, TextureDesc, TextureId};
+use strata_kernels::{BindingKind, Kernel, WordKinds};
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -31,7 +31,7 @@ pub struct RunRequest {
     pub out: PathBuf,
 }
 
-/// One writable buffer after a run.
+/// One writable buffer (or storage texture, its level 0) after a run.
 #[derive(Clone, Debug)]
 pub struct OutputBuffer {
     /// `@binding` number (group 0).
@@ -65,46 +65,121 @@ pub fn load_shader(path: &Path, entry: &str, overrides: &[(String, f64)]) -> Res
     }
 }
 
-/// Initial contents of every binding of `kernel`: given bytes (rounded up to whole
-/// words), or zeros of the binding's minimum size.
+/// Initial contents of every buffer binding of `kernel`: given bytes (rounded up to
+/// whole words), or zeros of the binding's minimum size.
 pub type Inputs = Vec<(u32, Vec<u8>)>;
+
+/// What a texture or sampler binding receives.
+#[derive(Clone, Debug)]
+pub enum ImageInput {
+    /// A texture: what it is and each mip level's bytes, in order (levels not given are
+    /// zero-filled; a storage texture the kernel only writes needs none).
+    Texture {
+        /// Its shape, size, levels and format.
+        desc: TextureDesc,
+        /// Bytes of levels 0, 1, ... (see `strata_backends::texture` for their order).
+        levels: Vec<Vec<u8>>,
+    },
+    /// A sampler.
+    Sampler(SamplerDesc),
+}
+
+/// The textures and samplers of a run, by binding (group 0).
+pub type ImageInputs = Vec<(u32, ImageInput)>;
+
+/// A resource created for one binding of a run.
+enum Created {
+    Buffer(BufferId),
+    Texture(TextureId),
+    Sampler(SamplerId),
+}
 
 fn run_on(
     backend: &mut dyn Backend,
     kernel: &Kernel,
     inputs: &Inputs,
+    images: &ImageInputs,
     workgroups: [u32; 3],
 ) -> Result<Vec<OutputBuffer>> {
     backend.check_kernel(kernel)?;
-    let mut binds = Vec::new();
-    for binding in &kernel.bindings {
-        let bytes = match inputs.iter().find(|(b, _)| *b == binding.binding) {
-            Some((_, bytes)) => {
-                let mut bytes = bytes.clone();
-                bytes.resize(bytes.len().div_ceil(4) * 4, 0);
-                bytes
-            }
-            None => vec![0; binding.min_size().div_ceil(4) as usize * 4],
-        };
-        let buffer = backend.create_buffer(&binding.name, bytes.len() as u64)?;
-        backend.write_buffer(buffer, 0, &bytes)?;
-        binds.push((binding, buffer));
-    }
-    let plain: Vec<Bind> = binds.iter().map(|(b, id)| Bind::new(b.binding, *id)).collect();
-    backend.dispatch(kernel, &plain, workgroups)?;
-    let mut outputs = Vec::new();
-    for (binding, buffer) in &binds {
-        if binding.is_writable() {
+    let mut created = Vec::new();
+    let result = (|| {
+        for binding in &kernel.bindings {
+            let image = images.iter().find(|(b, _)| *b == binding.binding).map(|(_, input)| input);
+            let resource = match (binding.kind, image) {
+                (BindingKind::Sampler, Some(ImageInput::Sampler(desc))) => {
+                    Created::Sampler(backend.create_sampler(desc)?)
+                }
+                (BindingKind::Sampler, _) => {
+                    bail!("binding {} (`{}`) is a sampler: give it one", binding.binding, binding.name)
+                }
+                (kind, Some(ImageInput::Texture { desc, levels })) if kind.is_texture() => {
+                    let texture = backend.create_texture(desc)?;
+                    created.push((binding, Created::Texture(texture)));
+                    for (level, bytes) in levels.iter().enumerate() {
+                        backend.write_texture(texture, level as u32, bytes)?;
+                    }
+                    continue;
+                }
+                (kind, _) if kind.is_texture() => {
+                    bail!(
+                        "binding {} (`{}`) is a {}: give it a texture",
+                        binding.binding,
+                        binding.name,
+                        binding.element.type_name
+                    )
+                }
+                _ => {
+                    let bytes = match inputs.iter().find(|(b, _)| *b == binding.binding) {
+                        Some((_, bytes)) => {
+                            let mut bytes = bytes.clone();
+                            bytes.resize(bytes.len().div_ceil(4) * 4, 0);
+                            bytes
+                        }
+                        None => vec![0; binding.min_size().div_ceil(4) as usize * 4],
+                    };
+                    let buffer = backend.create_buffer(&binding.name, bytes.len() as u64)?;
+                    created.push((binding, Created::Buffer(buffer)));
+                    backend.write_buffer(buffer, 0, &bytes)?;
+                    continue;
+                }
+            };
+            created.push((binding, resource));
+        }
+        let binds: Vec<Bind> = created
+            .iter()
+            .map(|(b, resource)| match resource {
+                Created::Buffer(id) => Bind::new(b.binding, *id),
+                Created::Texture(id) => Bind::texture(b.binding, *id),
+                Created::Sampler(id) => Bind::sampler(b.binding, *id),
+            })
+            .collect();
+        backend.dispatch(kernel, &binds, workgroups)?;
+        let mut outputs = Vec::new();
+        for (binding, resource) in &created {
+            let bytes = match resource {
+                Created::Buffer(id) if binding.is_writable() => backend.read_buffer(*id)?,
+                Created::Texture(id) if binding.is_writable() => backend.read_texture(*id, 0)?,
+                _ => continue,
+            };
             outputs.push(OutputBuffer {
                 binding: binding.binding,
                 name: binding.name.clone(),
-                bytes: backend.read_buffer(*buffer)?,
+                bytes,
                 kinds: binding.words.clone(),
             });
         }
-        backend.destroy_buffer(*buffer)?;
+        Ok(outputs)
+    })();
+    for (_, resource) in created {
+        // A failed run's error is the one to report, not a clean-up's.
+        let _ = match resource {
+            Created::Buffer(id) => backend.destroy_buffer(id),
+            Created::Texture(id) => backend.destroy_texture(id),
+            Created::Sampler(id) => backend.destroy_sampler(id),
+        };
     }
-    Ok(outputs)
+    result
 }
 
 /// The backend slots named by `names` (`all` for every one; `wgpu` is `wgpu-vulkan`).
@@ -125,16 +200,28 @@ pub fn named_slots(names: &[String]) -> Result<Vec<BackendSlot>> {
     Ok(chosen)
 }
 
-/// Runs a loaded kernel with `inputs` on every slot; a backend that cannot open or
-/// fails records its error instead of outputs.
+/// Runs a loaded kernel with buffer `inputs` on every slot; a backend that cannot open
+/// or fails records its error instead of outputs.
 pub fn run_loaded(kernel: &Kernel, inputs: &Inputs, workgroups: [u32; 3], slots: &[BackendSlot]) -> Vec<BackendRun> {
+    run_loaded_with_images(kernel, inputs, &ImageInputs::new(), workgroups, slots)
+}
+
+/// [`run_loaded`] with textures and samplers too; writable storage textures come back
+/// (mip level 0) among the outputs, their words' kinds from their format.
+pub fn run_loaded_with_images(
+    kernel: &Kernel,
+    inputs: &Inputs,
+    images: &ImageInputs,
+    workgroups: [u32; 3],
+    slots: &[BackendSlot],
+) -> Vec<BackendRun> {
     slots
         .iter()
         .map(|slot| BackendRun {
             backend: slot.name.to_string(),
             outputs: (slot.open)()
                 .map_err(anyhow::Error::from)
-                .and_then(|mut backend| run_on(backend.as_mut(), kernel, inputs, workgroups))
+                .and_then(|mut backend| run_on(backend.as_mut(), kernel, inputs, images, workgroups))
                 .map_err(|e| format!("{e:#}")),
         })
         .collect()

@@ -1,15 +1,47 @@
 //! A kernel's resource bindings, read from naga's IR (never maintained by hand).
 
+use crate::texture::{StorageTextureAccess, TexelFormat, TexelKind, TextureDimension};
 use crate::word_kinds::WordKinds;
 use naga::proc::Layouter;
 
-/// Whether a binding is a uniform or a storage buffer.
+/// What is bound: a uniform or storage buffer, a texture or a sampler.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BindingKind {
     /// `var<uniform>`.
     Uniform,
     /// `var<storage, ...>`.
     Storage(BindingAccess),
+    /// `var t: texture_1d<T>` ... `texture_3d<T>`: a sampled texture, read with
+    /// `textureLoad` and the `textureSample*` built-ins.
+    SampledTexture {
+        /// Its shape.
+        dimension: TextureDimension,
+        /// What its components read as (`T`).
+        kind: TexelKind,
+    },
+    /// `var t: texture_storage_*<format, access>`.
+    StorageTexture {
+        /// Its shape.
+        dimension: TextureDimension,
+        /// Its texel format.
+        format: TexelFormat,
+        /// `read`, `write` or `read_write`.
+        access: StorageTextureAccess,
+    },
+    /// `var s: sampler` (filtering and addressing of `textureSample*`).
+    Sampler,
+}
+
+impl BindingKind {
+    /// Whether a buffer (uniform or storage) is bound here.
+    pub fn is_buffer(self) -> bool {
+        matches!(self, Self::Uniform | Self::Storage(_))
+    }
+
+    /// Whether a texture (sampled or storage) is bound here.
+    pub fn is_texture(self) -> bool {
+        matches!(self, Self::SampledTexture { .. } | Self::StorageTexture { .. })
+    }
 }
 
 /// Access mode of a storage buffer.
@@ -60,7 +92,11 @@ impl BindingInfo {
 
     /// Whether the kernel may write the buffer.
     pub fn is_writable(&self) -> bool {
-        self.kind == BindingKind::Storage(BindingAccess::ReadWrite)
+        match self.kind {
+            BindingKind::Storage(access) => access == BindingAccess::ReadWrite,
+            BindingKind::StorageTexture { access, .. } => access.writes(),
+            _ => false,
+        }
     }
 }
 

@@ -94,10 +94,19 @@ const GET_DIMENSIONS: &str = "    buffer.GetDimensions(ret);\n";
 ///
 /// `tests/tests/glslang_hlsl_buffer_length.rs` holds a six-line HLSL reproducer: it
 /// fails when a glslang that returns bytes is installed, and then this function must
-/// go. Refuses (rather than compile something wrong) HLSL whose `GetDimensions` calls
-/// are not all in naga's helpers as this function knows them.
+/// go. Refuses (rather than compile something wrong) HLSL whose buffer `GetDimensions`
+/// calls are not all in naga's helpers as this function knows them.
 pub fn byte_address_lengths_in_bytes(hlsl: &str) -> Result<String, ToolError> {
-    let calls = hlsl.matches(".GetDimensions(").count();
+    // A buffer's call passes one plain `uint` variable; a texture's passes components
+    // (`ret.x`) or several values, and is not affected.
+    let calls = hlsl
+        .match_indices(".GetDimensions(")
+        .filter(|(at, call)| {
+            let arguments = &hlsl[at + call.len()..];
+            let arguments = &arguments[..arguments.find(')').unwrap_or(arguments.len())];
+            !arguments.contains(',') && !arguments.contains('.')
+        })
+        .count();
     let helpers = hlsl.matches(GET_DIMENSIONS).count();
     if calls != helpers {
         return Err(ToolError::Failed(format!(

@@ -23,8 +23,8 @@
 
 use naga::valid::ModuleInfo;
 use naga::{
-    BinaryOperator, Block, Expression, Function, FunctionArgument, FunctionResult, Handle, Literal, Scalar, ScalarKind,
-    Span, Statement, Type, TypeInner, VectorSize,
+    BinaryOperator, Expression, Function, FunctionArgument, FunctionResult, Handle, Literal, Scalar, ScalarKind, Span,
+    Statement, Type, TypeInner, VectorSize,
 };
 
 /// One operator on one integer type.
@@ -84,24 +84,9 @@ pub fn define_integer_division(module: &naga::Module, info: &ModuleInfo) -> Opti
             helpers.push(*helper);
         }
     }
-    // Helpers first, then the module's functions in their order.
-    let old = std::mem::take(&mut module.functions);
-    let mut helper_handles = Vec::new();
-    for helper in &helpers {
-        let function = helper_function(&mut module.types, *helper);
-        helper_handles.push(module.functions.append(function, Span::UNDEFINED));
-    }
-    let mut moved = Vec::new();
-    for (handle, function) in old.iter() {
-        moved.push(module.functions.append(function.clone(), old.get_span(handle)));
-    }
-    let remap = |handle: Handle<Function>| moved[handle.index()];
-    for (_, function) in module.functions.iter_mut().skip(helpers.len()) {
-        remap_calls(function, &remap);
-    }
-    for entry in &mut module.entry_points {
-        remap_calls(&mut entry.function, &remap);
-    }
+    let functions = helpers.iter().map(|helper| helper_function(&mut module.types, *helper)).collect();
+    let (helper_handles, remap) = crate::ir_edit::prepend_functions(&mut module, functions);
+    let remap = |handle: Handle<Function>| remap[handle.index()];
 
     for (owner, entry, handle, helper, left, right) in sites {
         let function = match owner {
@@ -111,7 +96,7 @@ pub fn define_integer_division(module: &naga::Module, info: &ModuleInfo) -> Opti
         let callee = helper_handles[helpers.iter().position(|h| *h == helper).expect("collected above")];
         function.expressions[handle] = Expression::CallResult(callee);
         let call = Statement::Call { function: callee, arguments: vec![left, right], result: Some(handle) };
-        replace_emit(&mut function.body, handle, &call);
+        crate::ir_edit::replace_emit(&mut function.body, handle, &[call], false);
     }
     Some(module)
 }
@@ -131,77 +116,6 @@ pub fn define_integer_division_validated(
         .validate(&rewritten)
         .map_err(|e| format!("WGSL integer division helpers made an invalid module: {e:?}"))?;
     Ok(Some((rewritten, info)))
-}
-
-/// Points every call at the moved callee.
-fn remap_calls(function: &mut Function, remap: &impl Fn(Handle<Function>) -> Handle<Function>) {
-    for (_, expression) in function.expressions.iter_mut() {
-        if let Expression::CallResult(callee) = expression {
-            *callee = remap(*callee);
-        }
-    }
-    visit_blocks(&mut function.body, &mut |block| {
-        for statement in block.iter_mut() {
-            if let Statement::Call { function, .. } = statement {
-                *function = remap(*function);
-            }
-        }
-    });
-}
-
-/// Calls `f` on `block` and every block nested in it.
-fn visit_blocks(block: &mut Block, f: &mut impl FnMut(&mut Block)) {
-    f(block);
-    for statement in block.iter_mut() {
-        match statement {
-            Statement::Block(inner) => visit_blocks(inner, f),
-            Statement::If { accept, reject, .. } => {
-                visit_blocks(accept, f);
-                visit_blocks(reject, f);
-            }
-            Statement::Switch { cases, .. } => cases.iter_mut().for_each(|case| visit_blocks(&mut case.body, f)),
-            Statement::Loop { body, continuing, .. } => {
-                visit_blocks(body, f);
-                visit_blocks(continuing, f);
-            }
-            _ => {}
-        }
-    }
-}
-
-/// Splits the `Emit` that covers `handle` around it and puts `call` (which now produces
-/// it) in its place.
-fn replace_emit(body: &mut Block, handle: Handle<Expression>, call: &Statement) {
-    visit_blocks(body, &mut |block| {
-        let Some(position) = block.iter().position(|s| match s {
-            Statement::Emit(range) => range.index_range().contains(&(handle.index() as u32)),
-            _ => false,
-        }) else {
-            return;
-        };
-        let range = match &block[position] {
-            Statement::Emit(range) => range.clone(),
-            _ => unreachable!("found as an Emit"),
-        };
-        let indices = range.index_range();
-        let at = handle.index() as u32;
-        let mut replacement = Block::new();
-        let emit = |from: u32, to: u32| {
-            // Rebuild a range over [from, to) from the original one's handles.
-            let all: Vec<Handle<Expression>> = range.clone().collect();
-            let pick: Vec<Handle<Expression>> =
-                all.into_iter().filter(|h| (from..to).contains(&(h.index() as u32))).collect();
-            pick.first().map(|first| Statement::Emit(naga::Range::new_from_bounds(*first, *pick.last().unwrap())))
-        };
-        if let Some(before) = emit(indices.start, at) {
-            replacement.push(before, Span::UNDEFINED);
-        }
-        replacement.push(call.clone(), Span::UNDEFINED);
-        if let Some(after) = emit(at + 1, indices.end) {
-            replacement.push(after, Span::UNDEFINED);
-        }
-        block.splice(position..position + 1, replacement);
-    });
 }
 
 /// `fn(a: T, b: T) -> T` computing `a / b` or `a % b` as WGSL defines them.

@@ -1,10 +1,11 @@
 //! The kernel registry: every kernel strata ships, with what the backends need to run
 //! it, derived from naga's IR of the WGSL source.
 
-use crate::binding::{BindingAccess, BindingInfo, BindingKind, element_layout};
+use crate::binding::{BindingAccess, BindingInfo, BindingKind, ElementLayout, element_layout, type_name};
 pub use crate::catalogue::{KernelFeatures, KernelId, KernelSpec};
 use crate::error::KernelError;
 use crate::source::{ComposedSource, Fragment};
+use crate::texture::{StorageTextureAccess, TexelFormat, TexelKind, TextureDimension};
 use crate::word_kinds::WordKinds;
 use naga::valid::{Capabilities, ModuleInfo, ShaderStages, SubgroupOperationSet, ValidationFlags};
 
@@ -254,24 +255,71 @@ fn describe_bindings(
                     BindingKind::Storage(BindingAccess::ReadOnly)
                 }
             }
+            naga::AddressSpace::Handle => handle_kind(module, var.ty).map_err(|reason| unsupported(&reason))?,
             _ => {
-                return Err(unsupported("only uniform and storage buffers are supported"));
+                return Err(unsupported("only buffers, textures and samplers can be bound"));
             }
         };
         if resource.group != 0 {
             return Err(unsupported("registry kernels use @group(0) only (GLSL has no descriptor sets)"));
         }
-        bindings.push(BindingInfo {
-            group: resource.group,
-            binding: resource.binding,
-            name,
-            kind,
-            element: element_layout(module, &layouter, var.ty),
-            words: WordKinds::of_type(module, &layouter, var.ty),
-        });
+        let (element, words) = match kind {
+            BindingKind::Uniform | BindingKind::Storage(_) => {
+                (element_layout(module, &layouter, var.ty), WordKinds::of_type(module, &layouter, var.ty))
+            }
+            // A texture or sampler has no bytes of its own a buffer would need; a storage
+            // texture's words are its texels.
+            _ => (
+                ElementLayout { type_name: type_name(module, var.ty), stride: 0, align: 1, count: Some(1) },
+                match kind {
+                    BindingKind::StorageTexture { format, .. } => WordKinds::of_texels(format),
+                    _ => WordKinds::default(),
+                },
+            ),
+        };
+        bindings.push(BindingInfo { group: resource.group, binding: resource.binding, name, kind, element, words });
     }
     bindings.sort_by_key(|b| (b.group, b.binding));
     Ok(bindings)
+}
+
+/// The kind of a texture or sampler variable of type `ty`, or why the project cannot bind
+/// it.
+fn handle_kind(module: &naga::Module, ty: naga::Handle<naga::Type>) -> Result<BindingKind, String> {
+    match module.types[ty].inner {
+        naga::TypeInner::Image { dim, arrayed, class } => {
+            let dimension = TextureDimension::of(dim, arrayed).ok_or_else(|| {
+                format!("{} textures are not supported (1d, 2d, 2d_array and 3d are)", type_name(module, ty))
+            })?;
+            match class {
+                naga::ImageClass::Sampled { kind, multi: false } => {
+                    let kind = match kind {
+                        naga::ScalarKind::Float => TexelKind::Float,
+                        naga::ScalarKind::Sint => TexelKind::Sint,
+                        naga::ScalarKind::Uint => TexelKind::Uint,
+                        _ => return Err(format!("{} has no texel kind", type_name(module, ty))),
+                    };
+                    Ok(BindingKind::SampledTexture { dimension, kind })
+                }
+                naga::ImageClass::Storage { format, access } => {
+                    let format = TexelFormat::of(format).ok_or_else(|| {
+                        let supported: Vec<&str> = TexelFormat::ALL.iter().map(|f| f.wgsl()).collect();
+                        format!("storage format {format:?} is not supported (supported: {})", supported.join(", "))
+                    })?;
+                    Ok(BindingKind::StorageTexture { dimension, format, access: StorageTextureAccess::of(access) })
+                }
+                _ => Err(format!(
+                    "{} is not supported (multisampled, depth and external textures)",
+                    type_name(module, ty)
+                )),
+            }
+        }
+        naga::TypeInner::Sampler { comparison: false } => Ok(BindingKind::Sampler),
+        _ => Err(format!(
+            "{} cannot be bound (comparison samplers and binding arrays are not supported)",
+            type_name(module, ty)
+        )),
+    }
 }
 
 /// Every registry kernel, loaded.

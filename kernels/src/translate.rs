@@ -70,6 +70,7 @@ pub fn spirv(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, 
     let spv_options = spv::Options {
         lang_version: (1, 3),
         flags,
+        bounds_check_policies: image_bounds_checks(),
         zero_initialize_workgroup_memory: match options.workgroup_zero_init {
             WorkgroupZeroInit::Polyfill => spv::ZeroInitializeWorkgroupMemoryMode::Polyfill,
             WorkgroupZeroInit::Native => spv::ZeroInitializeWorkgroupMemoryMode::Native,
@@ -164,18 +165,31 @@ pub fn glsl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, K
         multiview: None,
     };
     // GLSL leaves integer `%` of negative numbers and division by zero undefined; WGSL
-    // does not (see `integer_division`).
-    let defined = crate::integer_division::define_integer_division_validated(&kernel.module, &kernel.info)
+    // does not (see `integer_division`). And naga's writer passes unsigned texture
+    // levels where GLSL takes `int` (see `signed_image_levels`).
+    let defined = crate::signed_image_levels::defined_for_glsl(&kernel.module, &kernel.info)
         .map_err(|e| error(kernel, "GLSL", e))?;
     let (module, info) = match &defined {
         Some((module, info)) => (module, info),
         None => (&kernel.module, &kernel.info),
     };
     let mut text = String::new();
-    glsl::Writer::new(&mut text, module, info, &glsl_options, &pipeline, naga::proc::BoundsCheckPolicies::default())
+    glsl::Writer::new(&mut text, module, info, &glsl_options, &pipeline, image_bounds_checks())
         .and_then(|mut writer| writer.write())
         .map_err(|e| error(kernel, "GLSL", e))?;
     Ok(Translation { text, words: Vec::new(), entry_point: "main".into() })
+}
+
+/// The bounds checks every translation gets: none on buffers and arrays (as before:
+/// Vulkan's robust buffer access and the kernels' own bounds serve), and out-of-range
+/// texture loads defined to read zero, as the interpreter's do (naga's
+/// `ReadZeroSkipWrite`; a device without robust image access would otherwise read
+/// anything).
+fn image_bounds_checks() -> naga::proc::BoundsCheckPolicies {
+    naga::proc::BoundsCheckPolicies {
+        image_load: naga::proc::BoundsCheckPolicy::ReadZeroSkipWrite,
+        ..naga::proc::BoundsCheckPolicies::default()
+    }
 }
 
 fn translated_name<E: std::fmt::Display>(

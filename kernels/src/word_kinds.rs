@@ -14,6 +14,11 @@ pub enum WordKind {
     /// 64-bit and 16-bit scalars (two `f16` share a word, so neither can be bounded in
     /// f32 ULPs).
     Integer,
+    /// Two IEEE binary16 values a device rounded from f32 (an `rgba16float` texel's
+    /// components as a store writes them): Vulkan leaves the rounding of a float
+    /// conversion to the implementation, so each half may be either representable
+    /// neighbour of the exact value; compared within one f16 ULP each.
+    HalfPair,
     /// Bytes no member covers (struct and array padding): backends may leave anything.
     Padding,
 }
@@ -43,6 +48,19 @@ impl WordKinds {
     /// Whether any word is an f32.
     pub fn has_floats(&self) -> bool {
         self.head.iter().chain(&self.tail).any(|&kind| kind == WordKind::Float)
+    }
+
+    /// The kinds of the words of a texture of `format`, texel after texel: f32 words
+    /// for the 32-bit float formats, f16 pairs for `rgba16float`, bit-exact integers for
+    /// the others (8-bit components share words).
+    pub fn of_texels(format: crate::texture::TexelFormat) -> WordKinds {
+        use crate::texture::TexelFormat as F;
+        let kind = match format {
+            F::Rgba32Float | F::R32Float => WordKind::Float,
+            F::Rgba16Float => WordKind::HalfPair,
+            _ => WordKind::Integer,
+        };
+        WordKinds { head: Vec::new(), tail: vec![kind; format.bytes_per_texel() as usize / 4] }
     }
 
     /// The kinds of a buffer of type `ty`.

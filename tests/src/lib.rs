@@ -1,5 +1,6 @@
 //! Shared helpers of strata's integration tests.
 
+pub mod corpus_support;
 pub mod wgsl_fuzz;
 
 use strata_backends::wgpu_backend::{WgpuApi, WgpuBackend, WgpuOptions};

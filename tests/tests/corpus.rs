@@ -12,28 +12,11 @@
 //! once one backend's output is corrupted (an integer word and, where there are floats,
 //! a float word moved past its bound).
 
-use strata_backends::{BackendError, GPU_REQUIRED_VARIABLE, gpu_required};
 use strata_check::BackendSlot;
 use strata_check::agreement::{FloatBound, Judgement, Tolerance, judge};
 use strata_check::run_kernel::{BackendRun, Inputs, named_slots, run_loaded};
-use strata_kernels::{Kernel, WordKind};
-
-/// The slots that can open here; a slot without a device is skipped, or fails the test
-/// under `STRATA_REQUIRE_GPU=1` when it needs Vulkan.
-fn available_slots() -> Vec<BackendSlot> {
-    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-    let mut slots = Vec::new();
-    for slot in named_slots(&["all".to_string()]).unwrap() {
-        match (slot.open)() {
-            Ok(_) => slots.push(slot),
-            Err(error @ BackendError::NoAdapter { .. }) if !(gpu_required() && slot.needs_vulkan) => {
-                eprintln!("SKIPPED {} in the corpus: {error} (see {GPU_REQUIRED_VARIABLE})", slot.name);
-            }
-            Err(error) => panic!("{}: {error}", slot.name),
-        }
-    }
-    slots
-}
+use strata_kernels::Kernel;
+use strata_tests::corpus_support::{ONE_CASE_AT_A_TIME, assert_corruption_caught, available_slots, failures};
 
 /// One corpus shader run.
 struct Case {
@@ -71,13 +54,8 @@ impl Rng {
     }
 }
 
-/// One case at a time: six backends' devices at once per test thread crashed the
-/// process (SIGSEGV inside the drivers with eight threads), and each case already keeps
-/// both cores busy.
-static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
-
 fn run_case(case: &Case, slots: &[BackendSlot]) -> (Kernel, Vec<BackendRun>, Judgement) {
-    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let _turn = ONE_CASE_AT_A_TIME.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     let kernel = Kernel::from_wgsl_with_overrides(case.file, source(case.file), case.entry, false, &case.overrides)
         .unwrap_or_else(|e| panic!("{}: {e}", case.file));
     let mut runs = run_loaded(&kernel, &case.inputs, case.workgroups, slots);
@@ -98,51 +76,15 @@ fn run_case(case: &Case, slots: &[BackendSlot]) -> (Kernel, Vec<BackendRun>, Jud
 /// Runs the case, asserts every backend within tolerance, then corrupts the last
 /// backend's output and asserts that the judgement catches it.
 fn check(case: Case) {
-    let slots = available_slots();
+    let slots = available_slots("the corpus");
     let (_, runs, judgement) = run_case(&case, &slots);
-    let failures: Vec<String> = judgement
-        .failed
-        .iter()
-        .map(|(backend, why)| format!("{backend} failed: {why}"))
-        .chain(
-            judgement
-                .buffers
-                .iter()
-                .filter(|b| !b.passes())
-                .map(|b| format!("{} `{}`: {}", b.backend, b.name, b.describe())),
-        )
-        .collect();
+    let failures = failures(&judgement);
     assert!(failures.is_empty(), "{}:\n{}", case.file, failures.join("\n"));
-
-    // Negative control: the same judgement must fail on a corrupted output.
     let tolerance = Tolerance {
         float: FloatBound::default(),
         per_buffer: case.bounds.iter().map(|(name, bound, _)| (name.to_string(), *bound)).collect(),
     };
-    let last = runs.last().expect("at least the interpreter ran");
-    if last.backend == "cpu" {
-        return;
-    }
-    let outputs = last.outputs.as_ref().expect("checked above");
-    for kind in [WordKind::Integer, WordKind::Float] {
-        let Some((buffer, index)) = outputs
-            .iter()
-            .enumerate()
-            .find_map(|(b, o)| (0..o.bytes.len() / 4).find(|&i| o.kinds.of(i) == kind).map(|i| (b, i)))
-        else {
-            continue;
-        };
-        let mut corrupted = runs.clone();
-        let output = &mut corrupted.last_mut().unwrap().outputs.as_mut().unwrap()[buffer];
-        let name = output.name.clone();
-        let word = &mut output.bytes[4 * index..4 * index + 4];
-        let value = u32::from_le_bytes(word.try_into().unwrap());
-        // Integers: one bit; floats: far past any bound (flip the sign and exponent's top).
-        let bad = if kind == WordKind::Integer { value ^ 1 } else { value ^ 0xc000_0000 };
-        word.copy_from_slice(&bad.to_le_bytes());
-        let verdict = judge(&corrupted, Some("cpu"), &tolerance).unwrap();
-        assert!(!verdict.passes(), "{}: a corrupted {kind:?} word of `{name}` was not caught", case.file);
-    }
+    assert_corruption_caught(&runs, &tolerance, case.file);
 }
 
 #[test]
@@ -197,7 +139,7 @@ fn overrides_in_workgroup_size_and_expressions_agree_everywhere() {
 
 #[test]
 fn overriding_a_constant_changes_the_result_identically() {
-    let slots = available_slots();
+    let slots = available_slots("the corpus");
     let (_, default_runs, _) = run_case(&life_case(Vec::new(), 8), &slots);
     let (_, overridden, _) = run_case(&life_case(vec![("birth".into(), 2.0)], 8), &slots);
     let cells = |runs: &[BackendRun]| runs[0].outputs.as_ref().unwrap()[0].bytes.clone();

@@ -105,6 +105,11 @@ fn the_workaround_refuses_hlsl_it_does_not_know() {
     let known = "uint NagaBufferLength(ByteAddressBuffer buffer)\n{\n    uint ret;\n    buffer.GetDimensions(ret);\n    return ret;\n}\n";
     let patched = byte_address_lengths_in_bytes(known).unwrap();
     assert!(patched.contains("ret = ret * 4u;"), "{patched}");
+    // A texture's size query is not a buffer length: left alone.
+    let texture = format!(
+        "{known}uint2 d(Texture2D<float4> t) {{ uint4 ret; t.GetDimensions(0, ret.x, ret.y, ret.z); return ret.xy; }}\n"
+    );
+    assert_eq!(byte_address_lengths_in_bytes(&texture).unwrap().matches("ret * 4u").count(), 1);
     let unknown = format!("{known}void f() {{ uint n; other.GetDimensions(n); }}\n");
     let error = byte_address_lengths_in_bytes(&unknown).unwrap_err().to_string();
     assert!(error.contains("update the workaround"), "{error}");

@@ -8,7 +8,7 @@ use ash::vk;
 use std::ffi::{CStr, c_void};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
-use strata_kernels::{BindingKind, Kernel};
+use strata_kernels::Kernel;
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
@@ -36,7 +36,17 @@ unsafe extern "system" fn on_validation_message(
     vk::FALSE
 }
 
-/// Everything Vulkan that outlives a dispatch.
+/// What one binding of a dispatch receives.
+#[derive(Clone, Copy)]
+pub(super) enum Descriptor {
+    /// A uniform or storage buffer, whole.
+    Buffer(vk::Buffer),
+    /// A sampled or storage image view (in `GENERAL` layout).
+    Image(vk::ImageView),
+    /// A sampler.
+    Sampler(vk::Sampler),
+}
+
 /// The Vulkan objects a dispatch binds, as [`super::pipelines`] creates them per kernel.
 #[derive(Clone, Copy)]
 pub(super) struct ComputePipeline {
@@ -270,6 +280,9 @@ impl VulkanDevice {
                 max_uniform_binding: u64::from(limits.max_uniform_buffer_range),
                 max_buffer_size: maintenance3.max_memory_allocation_size,
                 max_storage_buffers_per_stage: limits.max_per_stage_descriptor_storage_buffers,
+                max_texture_2d: limits.max_image_dimension2_d.min(limits.max_image_dimension1_d),
+                max_texture_3d: limits.max_image_dimension3_d,
+                max_texture_layers: limits.max_image_array_layers,
             },
         }
     }
@@ -349,25 +362,62 @@ impl VulkanDevice {
         }
     }
 
+    /// Memory for an image of `requirements`: the host-visible type buffers use where the
+    /// image allows it, else the first type it allows.
+    pub(super) fn allocate(&self, requirements: vk::MemoryRequirements) -> Result<vk::DeviceMemory, vk::Result> {
+        let bits = requirements.memory_type_bits;
+        let index = if bits & (1 << self.memory_type) != 0 { self.memory_type } else { bits.trailing_zeros().min(31) };
+        let info = vk::MemoryAllocateInfo::default().allocation_size(requirements.size).memory_type_index(index);
+        // SAFETY: valid device and allocate info.
+        unsafe { self.device.allocate_memory(&info, None) }
+    }
+
+    /// Records commands with `record` into the command buffer, submits them and waits.
+    pub(super) fn submit_once(
+        &self,
+        operation: &str,
+        record: impl FnOnce(vk::CommandBuffer),
+    ) -> Result<(), BackendError> {
+        let error = |e| vk_error(operation, e);
+        let cb = self.command_buffer;
+        // SAFETY: the command buffer is idle between calls (every submission is waited
+        // for); the fence is reset after the wait.
+        unsafe {
+            self.device.reset_command_buffer(cb, vk::CommandBufferResetFlags::empty()).map_err(error)?;
+            self.device
+                .begin_command_buffer(
+                    cb,
+                    &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+                )
+                .map_err(error)?;
+            record(cb);
+            self.device.end_command_buffer(cb).map_err(error)?;
+            let command_buffers = [cb];
+            let submit = [vk::SubmitInfo::default().command_buffers(&command_buffers)];
+            self.device.queue_submit(self.queue, &submit, self.fence).map_err(error)?;
+            self.device.wait_for_fences(&[self.fence], true, u64::MAX).map_err(error)?;
+            self.device.reset_fences(&[self.fence]).map_err(error)
+        }
+    }
+
     /// Records, submits and waits for one dispatch; returns its device time if `timed`.
     pub(super) fn dispatch(
         &self,
         pipeline: ComputePipeline,
         kernel: &Kernel,
-        buffers: &[(u32, vk::Buffer)],
+        descriptors: &[(u32, Descriptor)],
         workgroups: [u32; 3],
         timed: bool,
     ) -> Result<Option<Duration>, BackendError> {
         let operation = format!("dispatch of `{}`", kernel.name());
         let error = |e| vk_error(&operation, e);
-        let uniform = kernel.bindings.iter().filter(|b| b.kind == BindingKind::Uniform).count() as u32;
-        let storage = kernel.bindings.len() as u32 - uniform;
-        let mut sizes = Vec::new();
-        if uniform > 0 {
-            sizes.push(vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: uniform });
-        }
-        if storage > 0 {
-            sizes.push(vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: storage });
+        let mut sizes: Vec<vk::DescriptorPoolSize> = Vec::new();
+        for binding in &kernel.bindings {
+            let ty = super::pipelines::descriptor_type(binding.kind);
+            match sizes.iter_mut().find(|size| size.ty == ty) {
+                Some(size) => size.descriptor_count += 1,
+                None => sizes.push(vk::DescriptorPoolSize { ty, descriptor_count: 1 }),
+            }
         }
         // SAFETY: all handles are valid; the pool is destroyed after the fence wait.
         unsafe {
@@ -383,22 +433,39 @@ impl VulkanDevice {
                         &vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts),
                     )
                     .map_err(error)?[0];
-                let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
+                let buffer_infos: Vec<[vk::DescriptorBufferInfo; 1]> = descriptors
                     .iter()
-                    .map(|&(_, buffer)| [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }])
+                    .map(|&(_, descriptor)| match descriptor {
+                        Descriptor::Buffer(buffer) => {
+                            [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }]
+                        }
+                        _ => [vk::DescriptorBufferInfo::default()],
+                    })
                     .collect();
-                let writes: Vec<_> = buffers
+                let image_infos: Vec<[vk::DescriptorImageInfo; 1]> = descriptors
                     .iter()
-                    .zip(&infos)
-                    .map(|(&(binding, _), info)| {
+                    .map(|&(_, descriptor)| {
+                        let info = vk::DescriptorImageInfo::default().image_layout(vk::ImageLayout::GENERAL);
+                        [match descriptor {
+                            Descriptor::Image(view) => info.image_view(view),
+                            Descriptor::Sampler(sampler) => info.sampler(sampler),
+                            Descriptor::Buffer(_) => info,
+                        }]
+                    })
+                    .collect();
+                let writes: Vec<_> = descriptors
+                    .iter()
+                    .zip(buffer_infos.iter().zip(&image_infos))
+                    .map(|(&(binding, descriptor), (buffer_info, image_info))| {
                         let kind = kernel.binding(0, binding).map(|b| b.kind);
-                        vk::WriteDescriptorSet::default()
-                            .dst_set(set)
-                            .dst_binding(binding)
-                            .descriptor_type(
+                        let write =
+                            vk::WriteDescriptorSet::default().dst_set(set).dst_binding(binding).descriptor_type(
                                 kind.map_or(vk::DescriptorType::STORAGE_BUFFER, super::pipelines::descriptor_type),
-                            )
-                            .buffer_info(info)
+                            );
+                        match descriptor {
+                            Descriptor::Buffer(_) => write.buffer_info(buffer_info),
+                            _ => write.image_info(image_info),
+                        }
                     })
                     .collect();
                 self.device.update_descriptor_sets(&writes, &[]);
@@ -428,13 +495,21 @@ impl VulkanDevice {
                 if let Some(queries) = queries {
                     self.device.cmd_write_timestamp(cb, vk::PipelineStageFlags::BOTTOM_OF_PIPE, queries, 1);
                 }
-                let barrier = vk::MemoryBarrier::default()
-                    .src_access_mask(vk::AccessFlags::SHADER_WRITE)
-                    .dst_access_mask(vk::AccessFlags::HOST_READ);
+                // The dispatch's writes, visible to the host, to later dispatches and to
+                // the copies that read textures back.
+                let barrier =
+                    vk::MemoryBarrier::default().src_access_mask(vk::AccessFlags::SHADER_WRITE).dst_access_mask(
+                        vk::AccessFlags::HOST_READ
+                            | vk::AccessFlags::SHADER_READ
+                            | vk::AccessFlags::SHADER_WRITE
+                            | vk::AccessFlags::TRANSFER_READ,
+                    );
                 self.device.cmd_pipeline_barrier(
                     cb,
                     vk::PipelineStageFlags::COMPUTE_SHADER,
-                    vk::PipelineStageFlags::HOST,
+                    vk::PipelineStageFlags::HOST
+                        | vk::PipelineStageFlags::COMPUTE_SHADER
+                        | vk::PipelineStageFlags::TRANSFER,
                     vk::DependencyFlags::empty(),
                     &[barrier],
                     &[],

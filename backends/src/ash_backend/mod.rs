@@ -8,20 +8,26 @@
 
 mod device;
 mod device_setup;
+mod images;
 mod pipelines;
+mod texture_paths;
 
 pub use pipelines::{PipelineObjects, create_compute_pipeline, descriptor_type, destroy_compute_pipeline};
 
-use crate::backend::{Backend, Bind, BufferId};
-use crate::bindings_check::{check_binds, check_buffer_size, check_kernel_fits, check_workgroups, check_write};
+use crate::backend::{Backend, Bind, BufferId, Resource};
+use crate::bindings_check::{
+    ResourceLookup, check_binds, check_buffer_size, check_kernel_fits, check_workgroups, check_write,
+};
 use crate::device_info::DeviceInfo;
 use crate::error::BackendError;
+use crate::texture::{SamplerDesc, SamplerId, TextureDesc, TextureId};
 use ash::vk;
-use device::VulkanDevice;
+use device::{Descriptor, VulkanDevice};
+use images::AshImage;
 use pipelines::PipelineCache;
 use std::collections::HashMap;
 use std::time::Duration;
-use strata_kernels::Kernel;
+use strata_kernels::{BindingKind, Kernel};
 
 /// Where the SPIR-V the ash backend runs comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -79,6 +85,8 @@ struct AshBuffer {
 pub struct AshBackend {
     // Field order is drop order: buffers and pipelines go before the device.
     buffers: HashMap<u64, AshBuffer>,
+    images: HashMap<u64, AshImage>,
+    samplers: HashMap<u64, vk::Sampler>,
     next_buffer: u64,
     pipelines: PipelineCache,
     vulkan: VulkanDevice,
@@ -107,7 +115,15 @@ impl AshBackend {
         let vulkan = VulkanDevice::open(options)?;
         let info = vulkan.device_info(options);
         let pipelines = PipelineCache::new(options.source);
-        Ok(Self { buffers: HashMap::new(), next_buffer: 0, pipelines, vulkan, info })
+        Ok(Self {
+            buffers: HashMap::new(),
+            images: HashMap::new(),
+            samplers: HashMap::new(),
+            next_buffer: 0,
+            pipelines,
+            vulkan,
+            info,
+        })
     }
 
     /// Warnings and errors the validation layer reported so far (empty without validation).
@@ -119,6 +135,14 @@ impl AshBackend {
         self.buffers.get(&id.0).ok_or(BackendError::UnknownBuffer(id.0))
     }
 
+    fn image(&self, id: TextureId) -> Result<&AshImage, BackendError> {
+        self.images.get(&id.0).ok_or(BackendError::UnknownTexture(id.0))
+    }
+
+    fn sampler(&self, id: SamplerId) -> Result<vk::Sampler, BackendError> {
+        self.samplers.get(&id.0).copied().ok_or(BackendError::UnknownSampler(id.0))
+    }
+
     fn run(
         &mut self,
         kernel: &Kernel,
@@ -128,13 +152,31 @@ impl AshBackend {
     ) -> Result<Option<Duration>, BackendError> {
         self.check_kernel(kernel)?;
         check_workgroups(kernel, workgroups, &self.info)?;
-        check_binds(kernel, binds, &self.info, |id| self.buffer(id).map(|b| b.size))?;
+        let lookup = ResourceLookup {
+            buffer_size: &|id| self.buffer(id).map(|b| b.size),
+            texture: &|id| self.image(id).map(|image| image.desc.clone()),
+            sampler: &|id| self.sampler(id).map(|_| ()),
+        };
+        check_binds(kernel, binds, &self.info, &lookup)?;
         let pipeline = self.pipelines.get_or_create(&self.vulkan, kernel)?;
-        let buffers = binds
+        let descriptors = binds
             .iter()
-            .map(|bind| Ok((bind.binding, self.buffer(bind.buffer)?.buffer)))
+            .map(|bind| {
+                let descriptor = match bind.resource {
+                    Resource::Buffer(id) => Descriptor::Buffer(self.buffer(id)?.buffer),
+                    Resource::Texture(id) => {
+                        let image = self.image(id)?;
+                        let storage = kernel
+                            .binding(0, bind.binding)
+                            .is_some_and(|info| matches!(info.kind, BindingKind::StorageTexture { .. }));
+                        Descriptor::Image(if storage { image.storage_view } else { image.sampled_view })
+                    }
+                    Resource::Sampler(id) => Descriptor::Sampler(self.sampler(id)?),
+                };
+                Ok((bind.binding, descriptor))
+            })
             .collect::<Result<Vec<_>, BackendError>>()?;
-        self.vulkan.dispatch(pipeline.handles(), kernel, &buffers, workgroups, timed)
+        self.vulkan.dispatch(pipeline.handles(), kernel, &descriptors, workgroups, timed)
     }
 }
 
@@ -178,6 +220,45 @@ impl Backend for AshBackend {
         Ok(())
     }
 
+    fn create_texture(&mut self, desc: &TextureDesc) -> Result<TextureId, BackendError> {
+        desc.check(&self.info)?;
+        let image = self.vulkan.create_image(desc)?;
+        self.next_buffer += 1;
+        self.images.insert(self.next_buffer, image);
+        Ok(TextureId(self.next_buffer))
+    }
+
+    fn write_texture(&mut self, texture: TextureId, level: u32, data: &[u8]) -> Result<(), BackendError> {
+        let image = self.image(texture)?;
+        image.desc.check_level(level, data.len())?;
+        self.vulkan.write_image(image, level, data)
+    }
+
+    fn read_texture(&mut self, texture: TextureId, level: u32) -> Result<Vec<u8>, BackendError> {
+        let image = self.image(texture)?;
+        image.desc.check_level(level, image.desc.level_bytes(level) as usize)?;
+        self.vulkan.read_image(image, level)
+    }
+
+    fn destroy_texture(&mut self, texture: TextureId) -> Result<(), BackendError> {
+        let image = self.images.remove(&texture.0).ok_or(BackendError::UnknownTexture(texture.0))?;
+        self.vulkan.destroy_image(&image);
+        Ok(())
+    }
+
+    fn create_sampler(&mut self, desc: &SamplerDesc) -> Result<SamplerId, BackendError> {
+        let sampler = self.vulkan.create_sampler(desc)?;
+        self.next_buffer += 1;
+        self.samplers.insert(self.next_buffer, sampler);
+        Ok(SamplerId(self.next_buffer))
+    }
+
+    fn destroy_sampler(&mut self, sampler: SamplerId) -> Result<(), BackendError> {
+        let sampler = self.samplers.remove(&sampler.0).ok_or(BackendError::UnknownSampler(sampler.0))?;
+        self.vulkan.destroy_sampler(sampler);
+        Ok(())
+    }
+
     fn check_kernel(&self, kernel: &Kernel) -> Result<(), BackendError> {
         check_kernel_fits(kernel, &self.info)
     }
@@ -204,6 +285,12 @@ impl Drop for AshBackend {
         self.vulkan.wait_idle();
         for (_, entry) in self.buffers.drain() {
             self.vulkan.destroy_buffer(entry.buffer, entry.memory);
+        }
+        for (_, image) in self.images.drain() {
+            self.vulkan.destroy_image(&image);
+        }
+        for (_, sampler) in self.samplers.drain() {
+            self.vulkan.destroy_sampler(sampler);
         }
         self.pipelines.destroy(&self.vulkan);
     }

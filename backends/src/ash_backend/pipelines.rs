@@ -30,6 +30,9 @@ pub fn descriptor_type(kind: BindingKind) -> vk::DescriptorType {
     match kind {
         BindingKind::Uniform => vk::DescriptorType::UNIFORM_BUFFER,
         BindingKind::Storage(_) => vk::DescriptorType::STORAGE_BUFFER,
+        BindingKind::SampledTexture { .. } => vk::DescriptorType::SAMPLED_IMAGE,
+        BindingKind::StorageTexture { .. } => vk::DescriptorType::STORAGE_IMAGE,
+        BindingKind::Sampler => vk::DescriptorType::SAMPLER,
     }
 }
 
@@ -192,6 +195,7 @@ impl PipelineCache {
         if let Some(pipeline) = self.pipelines.get(&kernel.id) {
             return Ok(Arc::clone(pipeline));
         }
+        super::texture_paths::check_texture_bindings(self.source, kernel)?;
         let (words, entry_point) = self.spirv(kernel, vulkan.native_zero_init)?;
         let entry_point = CString::new(entry_point).map_err(|e| BackendError::Validation {
             backend: self.source.name().into(),

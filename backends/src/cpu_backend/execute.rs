@@ -50,6 +50,7 @@ pub(super) fn execute(insn: &Insn, lane: &mut Lane, buffers: &[Vec<AtomicU32>], 
                     super::arith::convert(regs[*src as usize + i], *from, *to).expect("checked when compiled");
             }
         }
+        Insn::Image(image) => super::image::execute(image, regs, buffers),
         Insn::PtrAdd { dst, base, add } => {
             let (dst, base) = (*dst as usize, *base as usize);
             regs[dst] = regs[base];

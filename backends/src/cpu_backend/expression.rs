@@ -450,6 +450,9 @@ impl Compiler<'_> {
             | Expression::SubgroupBallotResult => {
                 self.reg(scope, handle);
             }
+            Expression::ImageLoad { .. } | Expression::ImageSample { .. } | Expression::ImageQuery { .. } => {
+                self.image_expression(scope, handle)?;
+            }
             // Pre-emitted when the scope opens.
             Expression::FunctionArgument(_) | Expression::GlobalVariable(_) | Expression::LocalVariable(_) => {
                 self.reg(scope, handle);

@@ -320,6 +320,8 @@ pub(super) enum Insn {
     Gather(Box<GatherInsn>),
     /// Subgroup ballot, reduction or scan.
     Collective(Box<CollectiveInsn>),
+    /// A texture built-in (load, store, query, sample, gather).
+    Image(Box<super::image::ImageInsn>),
     /// An unsupported construct reached at run time: (what, WGSL line).
     Fail(Box<(String, u32)>),
 }

@@ -46,7 +46,11 @@ pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String
         TypeInner::Vector { size, scalar } => {
             size as u32 * scalar_words(scalar).ok_or_else(|| format!("{}-bit vectors", scalar.width * 8))?
         }
-        TypeInner::Pointer { .. } | TypeInner::ValuePointer { .. } => 2,
+        // Textures and samplers are held like pointers: their binding slot and 0.
+        TypeInner::Pointer { .. }
+        | TypeInner::ValuePointer { .. }
+        | TypeInner::Image { .. }
+        | TypeInner::Sampler { .. } => 2,
         TypeInner::Matrix { scalar, .. } if scalar.width == 2 => return Err("f16 matrices".into()),
         TypeInner::Matrix { columns, rows, .. } => {
             // Columns are padded like vec3 → 4 words in memory.

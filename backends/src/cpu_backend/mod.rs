@@ -48,6 +48,8 @@ mod error;
 mod exec;
 mod execute;
 mod expression;
+mod image;
+mod image_lower;
 mod insn;
 mod interp;
 mod layout;
@@ -57,10 +59,13 @@ mod memory;
 mod statement;
 mod wide;
 
-use crate::backend::{Backend, Bind, BufferId};
-use crate::bindings_check::{check_binds, check_buffer_size, check_kernel_fits, check_workgroups, check_write};
+use crate::backend::{Backend, Bind, BufferId, Resource};
+use crate::bindings_check::{
+    ResourceLookup, check_binds, check_buffer_size, check_kernel_fits, check_workgroups, check_write,
+};
 use crate::device_info::{DeviceInfo, DeviceLimits};
 use crate::error::BackendError;
+use crate::texture::{SamplerDesc, SamplerId, TextureDesc, TextureId};
 pub use counts::{DispatchCounts, WARP_WIDTH};
 use decode::Program;
 use std::collections::HashMap;
@@ -86,11 +91,27 @@ struct CpuBuffer {
     label: String,
 }
 
+struct CpuTexture {
+    desc: TextureDesc,
+    /// Every mip level's texels, in order, as little-endian words.
+    words: Vec<u32>,
+}
+
+impl CpuTexture {
+    /// Word range of mip `level`.
+    fn level_words(&self, level: u32) -> std::ops::Range<usize> {
+        let start: u64 = (0..level).map(|l| self.desc.level_bytes(l)).sum::<u64>() / 4;
+        start as usize..(start + self.desc.level_bytes(level) / 4) as usize
+    }
+}
+
 /// The naga-IR interpreter as a backend.
 pub struct CpuBackend {
     info: DeviceInfo,
     options: CpuOptions,
     buffers: HashMap<u64, CpuBuffer>,
+    textures: HashMap<u64, CpuTexture>,
+    samplers: HashMap<u64, SamplerDesc>,
     next_buffer: u64,
     programs: HashMap<KernelId, Program>,
     last_counts: DispatchCounts,
@@ -124,12 +145,17 @@ impl CpuBackend {
                 max_uniform_binding: 64 * 1024,
                 max_buffer_size: 1 << 30,
                 max_storage_buffers_per_stage: 64,
+                max_texture_2d: 16384,
+                max_texture_3d: 2048,
+                max_texture_layers: 2048,
             },
         };
         Ok(Self {
             info,
             options,
             buffers: HashMap::new(),
+            textures: HashMap::new(),
+            samplers: HashMap::new(),
             next_buffer: 0,
             programs: HashMap::new(),
             last_counts: DispatchCounts::default(),
@@ -160,6 +186,35 @@ impl CpuBackend {
 
     fn buffer(&self, id: BufferId) -> Result<&CpuBuffer, BackendError> {
         self.buffers.get(&id.0).ok_or(BackendError::UnknownBuffer(id.0))
+    }
+
+    fn texture(&self, id: TextureId) -> Result<&CpuTexture, BackendError> {
+        self.textures.get(&id.0).ok_or(BackendError::UnknownTexture(id.0))
+    }
+
+    /// The words a binding's slot holds during a dispatch (moved out of a buffer or
+    /// texture, so that it is not copied; put back by [`CpuBackend::put_back`]).
+    fn take_bound(&mut self, resource: Resource) -> Vec<u32> {
+        match resource {
+            Resource::Buffer(id) => std::mem::take(&mut self.buffers.get_mut(&id.0).expect("checked").words),
+            Resource::Texture(id) => {
+                let texture = self.textures.get_mut(&id.0).expect("checked");
+                image::bind_texture(&texture.desc, &std::mem::take(&mut texture.words))
+            }
+            Resource::Sampler(id) => image::bind_sampler(&self.samplers[&id.0]),
+        }
+    }
+
+    /// Returns a slot's words to the buffer or texture they were taken from.
+    fn put_back(&mut self, resource: Resource, mut words: Vec<u32>) {
+        match resource {
+            Resource::Buffer(id) => self.buffers.get_mut(&id.0).expect("checked").words = words,
+            Resource::Texture(id) => {
+                words.drain(..image::HEADER_WORDS);
+                self.textures.get_mut(&id.0).expect("checked").words = words;
+            }
+            Resource::Sampler(_) => {}
+        }
     }
 }
 
@@ -199,6 +254,44 @@ impl Backend for CpuBackend {
         self.buffers.remove(&buffer.0).map(|_| ()).ok_or(BackendError::UnknownBuffer(buffer.0))
     }
 
+    fn create_texture(&mut self, desc: &TextureDesc) -> Result<TextureId, BackendError> {
+        desc.check(&self.info)?;
+        let bytes: u64 = (0..desc.mip_levels).map(|l| desc.level_bytes(l)).sum();
+        self.next_buffer += 1;
+        self.textures.insert(self.next_buffer, CpuTexture { desc: desc.clone(), words: vec![0; bytes as usize / 4] });
+        Ok(TextureId(self.next_buffer))
+    }
+
+    fn write_texture(&mut self, texture: TextureId, level: u32, data: &[u8]) -> Result<(), BackendError> {
+        let entry = self.textures.get_mut(&texture.0).ok_or(BackendError::UnknownTexture(texture.0))?;
+        entry.desc.check_level(level, data.len())?;
+        let range = entry.level_words(level);
+        for (word, chunk) in entry.words[range].iter_mut().zip(data.chunks_exact(4)) {
+            *word = u32::from_le_bytes([chunk[0], chunk[1], chunk[2], chunk[3]]);
+        }
+        Ok(())
+    }
+
+    fn read_texture(&mut self, texture: TextureId, level: u32) -> Result<Vec<u8>, BackendError> {
+        let entry = self.texture(texture)?;
+        entry.desc.check_level(level, entry.desc.level_bytes(level) as usize)?;
+        Ok(entry.words[entry.level_words(level)].iter().flat_map(|w| w.to_le_bytes()).collect())
+    }
+
+    fn destroy_texture(&mut self, texture: TextureId) -> Result<(), BackendError> {
+        self.textures.remove(&texture.0).map(|_| ()).ok_or(BackendError::UnknownTexture(texture.0))
+    }
+
+    fn create_sampler(&mut self, desc: &SamplerDesc) -> Result<SamplerId, BackendError> {
+        self.next_buffer += 1;
+        self.samplers.insert(self.next_buffer, *desc);
+        Ok(SamplerId(self.next_buffer))
+    }
+
+    fn destroy_sampler(&mut self, sampler: SamplerId) -> Result<(), BackendError> {
+        self.samplers.remove(&sampler.0).map(|_| ()).ok_or(BackendError::UnknownSampler(sampler.0))
+    }
+
     fn check_kernel(&self, kernel: &Kernel) -> Result<(), BackendError> {
         check_kernel_fits(kernel, &self.info)
     }
@@ -206,30 +299,35 @@ impl Backend for CpuBackend {
     fn dispatch(&mut self, kernel: &Kernel, binds: &[Bind], workgroups: [u32; 3]) -> Result<(), BackendError> {
         self.check_kernel(kernel)?;
         check_workgroups(kernel, workgroups, &self.info)?;
-        check_binds(kernel, binds, &self.info, |id| self.buffer(id).map(|b| b.size))?;
+        let lookup = ResourceLookup {
+            buffer_size: &|id| self.buffer(id).map(|b| b.size),
+            texture: &|id| self.texture(id).map(|t| t.desc.clone()),
+            sampler: &|id| self.samplers.get(&id.0).map(|_| ()).ok_or(BackendError::UnknownSampler(id.0)),
+        };
+        check_binds(kernel, binds, &self.info, &lookup)?;
         let subgroup_size = self.options.subgroup_size.unwrap_or(1);
         self.program(kernel)?;
-        // Move the bound buffers out (in the kernel's binding order), run, put them back.
-        // A buffer bound at several (read-only: checked) bindings is moved out once and
+        // Move the bound resources out (in the kernel's binding order), run, put them
+        // back. One bound at several (read-only: checked) bindings is moved out once and
         // copied for the others, and only its first binding's words go back.
-        let ids: Vec<u64> = kernel
+        let resources: Vec<Resource> = kernel
             .bindings
             .iter()
-            .map(|b| binds.iter().find(|bind| bind.binding == b.binding).expect("checked").buffer.0)
+            .map(|b| binds.iter().find(|bind| bind.binding == b.binding).expect("checked").resource)
             .collect();
-        let first_of = |index: usize| ids[..index].iter().position(|id| *id == ids[index]);
-        let mut bound: Vec<Vec<u32>> = Vec::with_capacity(ids.len());
-        for (index, id) in ids.iter().enumerate() {
+        let first_of = |index: usize| resources[..index].iter().position(|r| *r == resources[index]);
+        let mut bound: Vec<Vec<u32>> = Vec::with_capacity(resources.len());
+        for (index, resource) in resources.iter().enumerate() {
             let words = match first_of(index) {
                 Some(first) => bound[first].clone(),
-                None => std::mem::take(&mut self.buffers.get_mut(id).expect("checked").words),
+                None => self.take_bound(*resource),
             };
             bound.push(words);
         }
         let result = exec::run(&self.programs[&kernel.id], &mut bound, workgroups, subgroup_size);
-        for (index, (id, words)) in ids.iter().zip(bound).enumerate() {
+        for (index, (resource, words)) in resources.iter().zip(bound).enumerate() {
             if first_of(index).is_none() {
-                self.buffers.get_mut(id).expect("checked").words = words;
+                self.put_back(*resource, words);
             }
         }
         self.last_counts = result?;

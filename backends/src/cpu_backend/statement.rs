@@ -236,6 +236,9 @@ impl Compiler<'_> {
                 self.line = line;
                 self.push(Insn::Collective(Box::new(collective)));
             }
+            Statement::ImageStore { image, coordinate, array_index, value } => {
+                self.image_store(scope, *image, *coordinate, *array_index, *value)?;
+            }
             other => {
                 let name = format!("{other:?}");
                 let name = name.split([' ', '(', '{']).next().unwrap_or("statement").to_string();

@@ -3,19 +3,23 @@
 
 mod buffers;
 mod errors;
+mod gl_textures;
 mod pipelines;
+mod textures;
 
 pub use pipelines::{kernel_pipeline, layout_entries};
 
-use crate::backend::{Backend, Bind, BufferId};
-use crate::bindings_check::{check_binds, check_kernel_fits, check_workgroups, check_write};
+use crate::backend::{Backend, Bind, BufferId, Resource};
+use crate::bindings_check::{ResourceLookup, check_binds, check_kernel_fits, check_workgroups, check_write};
 use crate::device_info::{DeviceInfo, DeviceLimits};
 use crate::error::BackendError;
+use crate::texture::{SamplerDesc, SamplerId, TextureDesc, TextureId};
 use buffers::BufferTable;
 use errors::ErrorSink;
 use pipelines::PipelineCache;
 use std::time::Duration;
-use strata_kernels::Kernel;
+use strata_kernels::{BindingKind, Kernel};
+use textures::TextureTable;
 
 /// Which wgpu backend to open.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -52,6 +56,7 @@ pub struct WgpuBackend {
     queue: wgpu::Queue,
     info: DeviceInfo,
     buffers: BufferTable,
+    textures: TextureTable,
     pipelines: PipelineCache,
     errors: ErrorSink,
     timestamps: Option<(wgpu::QuerySet, wgpu::Buffer, wgpu::Buffer)>,
@@ -93,6 +98,10 @@ impl WgpuBackend {
         // 64-bit integers and f16 in shaders where the adapter has them (lavapipe
         // does), so that external kernels using `i64`/`u64`/`f16` run.
         features |= adapter_features & (wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_F16);
+        // Filtering of 32-bit float textures and read-write storage textures of every
+        // format the adapter allows, where it has them (lavapipe does).
+        features |= adapter_features
+            & (wgpu::Features::FLOAT32_FILTERABLE | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES);
         let timestamps = adapter_features.contains(wgpu::Features::TIMESTAMP_QUERY);
         if timestamps {
             features |= wgpu::Features::TIMESTAMP_QUERY;
@@ -137,6 +146,9 @@ impl WgpuBackend {
                 max_uniform_binding: limits.max_uniform_buffer_binding_size,
                 max_buffer_size: limits.max_buffer_size,
                 max_storage_buffers_per_stage: limits.max_storage_buffers_per_shader_stage,
+                max_texture_2d: limits.max_texture_dimension_2d.min(limits.max_texture_dimension_1d),
+                max_texture_3d: limits.max_texture_dimension_3d,
+                max_texture_layers: limits.max_texture_array_layers,
             },
         };
         let timestamps = timestamps.then(|| {
@@ -164,6 +176,7 @@ impl WgpuBackend {
             queue,
             info,
             buffers: BufferTable::default(),
+            textures: TextureTable::default(),
             pipelines: PipelineCache::new(options.api == WgpuApi::Gl),
             errors,
             timestamps,
@@ -189,16 +202,43 @@ impl WgpuBackend {
     ) -> Result<(), BackendError> {
         self.check_kernel(kernel)?;
         check_workgroups(kernel, workgroups, &self.info)?;
-        check_binds(kernel, binds, &self.info, |id| self.buffers.get(id).map(|b| b.size))?;
+        let lookup = ResourceLookup {
+            buffer_size: &|id| self.buffers.get(id).map(|b| b.size),
+            texture: &|id| self.textures.get(id).map(|t| t.desc.clone()),
+            sampler: &|id| self.textures.sampler(id).map(|_| ()),
+        };
+        check_binds(kernel, binds, &self.info, &lookup)?;
         let pipeline = self.pipelines.get_or_create(&self.device, &self.errors, kernel)?;
         let scope = self.errors.scope(&self.device);
+        // A storage texture binding sees one mip level (level 0); a sampled one all.
+        let views = binds
+            .iter()
+            .map(|bind| match bind.resource {
+                Resource::Texture(id) => {
+                    let storage = kernel
+                        .binding(0, bind.binding)
+                        .is_some_and(|info| matches!(info.kind, BindingKind::StorageTexture { .. }));
+                    let entry = self.textures.get(id)?;
+                    Ok(Some(entry.texture.create_view(&wgpu::TextureViewDescriptor {
+                        dimension: Some(textures::view_dimension(entry.desc.dimension)),
+                        mip_level_count: storage.then_some(1),
+                        ..Default::default()
+                    })))
+                }
+                _ => Ok(None),
+            })
+            .collect::<Result<Vec<_>, BackendError>>()?;
         let entries = binds
             .iter()
-            .map(|bind| {
-                Ok(wgpu::BindGroupEntry {
-                    binding: bind.binding,
-                    resource: self.buffers.get(bind.buffer)?.buffer.as_entire_binding(),
-                })
+            .zip(&views)
+            .map(|(bind, view)| {
+                let resource = match (bind.resource, view) {
+                    (Resource::Buffer(id), _) => self.buffers.get(id)?.buffer.as_entire_binding(),
+                    (Resource::Sampler(id), _) => wgpu::BindingResource::Sampler(self.textures.sampler(id)?),
+                    (Resource::Texture(_), Some(view)) => wgpu::BindingResource::TextureView(view),
+                    (Resource::Texture(id), None) => return Err(BackendError::UnknownTexture(id.0)),
+                };
+                Ok(wgpu::BindGroupEntry { binding: bind.binding, resource })
             })
             .collect::<Result<Vec<_>, BackendError>>()?;
         let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -262,7 +302,34 @@ impl Backend for WgpuBackend {
         self.buffers.destroy(buffer)
     }
 
+    fn create_texture(&mut self, desc: &TextureDesc) -> Result<TextureId, BackendError> {
+        self.textures.create(&self.device, &self.errors, &self.info, desc)
+    }
+
+    fn write_texture(&mut self, texture: TextureId, level: u32, data: &[u8]) -> Result<(), BackendError> {
+        self.textures.write(&self.queue, texture, level, data)
+    }
+
+    fn read_texture(&mut self, texture: TextureId, level: u32) -> Result<Vec<u8>, BackendError> {
+        self.textures.read(&self.device, &self.queue, &self.errors, texture, level)
+    }
+
+    fn destroy_texture(&mut self, texture: TextureId) -> Result<(), BackendError> {
+        self.textures.destroy(texture)
+    }
+
+    fn create_sampler(&mut self, desc: &SamplerDesc) -> Result<SamplerId, BackendError> {
+        Ok(self.textures.create_sampler(&self.device, desc))
+    }
+
+    fn destroy_sampler(&mut self, sampler: SamplerId) -> Result<(), BackendError> {
+        self.textures.destroy_sampler(sampler)
+    }
+
     fn check_kernel(&self, kernel: &Kernel) -> Result<(), BackendError> {
+        if self.info.backend == "wgpu-gl" {
+            gl_textures::check_gl_textures(kernel)?;
+        }
         check_kernel_fits(kernel, &self.info)
     }
 

@@ -4,6 +4,7 @@
 //! flavour uses too.
 
 use super::errors::ErrorSink;
+use super::textures;
 use crate::error::BackendError;
 use std::borrow::Cow;
 use std::collections::HashMap;
@@ -48,22 +49,39 @@ impl PipelineCache {
 }
 
 /// The bind group layout entries of `bindings`: compute stage, no dynamic offsets,
-/// minimum binding sizes from the WGSL types.
+/// minimum binding sizes from the WGSL types; samplers filtering, and float textures
+/// filterable where the kernel has a sampler (else unfilterable, so that `r32float` and
+/// `rgba32float` textures read with `textureLoad` bind on devices that cannot filter
+/// them).
 pub fn layout_entries(bindings: &[BindingInfo]) -> Vec<wgpu::BindGroupLayoutEntry> {
+    let samples = bindings.iter().any(|b| b.kind == BindingKind::Sampler);
     bindings
         .iter()
         .map(|binding| wgpu::BindGroupLayoutEntry {
             binding: binding.binding,
             visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: match binding.kind {
-                    BindingKind::Uniform => wgpu::BufferBindingType::Uniform,
-                    BindingKind::Storage(access) => {
-                        wgpu::BufferBindingType::Storage { read_only: access == BindingAccess::ReadOnly }
-                    }
+            ty: match binding.kind {
+                BindingKind::Uniform | BindingKind::Storage(_) => wgpu::BindingType::Buffer {
+                    ty: match binding.kind {
+                        BindingKind::Storage(access) => {
+                            wgpu::BufferBindingType::Storage { read_only: access == BindingAccess::ReadOnly }
+                        }
+                        _ => wgpu::BufferBindingType::Uniform,
+                    },
+                    has_dynamic_offset: false,
+                    min_binding_size: NonZeroU64::new(binding.min_size()),
                 },
-                has_dynamic_offset: false,
-                min_binding_size: NonZeroU64::new(binding.min_size()),
+                BindingKind::SampledTexture { dimension, kind } => wgpu::BindingType::Texture {
+                    sample_type: textures::sample_type(kind, samples),
+                    view_dimension: textures::view_dimension(dimension),
+                    multisampled: false,
+                },
+                BindingKind::StorageTexture { dimension, format, access } => wgpu::BindingType::StorageTexture {
+                    access: textures::storage_access(access),
+                    format: textures::wgpu_format(format),
+                    view_dimension: textures::view_dimension(dimension),
+                },
+                BindingKind::Sampler => wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
             },
             count: None,
         })
@@ -89,13 +107,13 @@ pub fn kernel_pipeline(
         immediate_size: 0,
     });
     let defined = if define_integer_division {
-        strata_kernels::integer_division::define_integer_division_validated(&kernel.module, &kernel.info).map_err(
-            |message| BackendError::Validation {
+        strata_kernels::signed_image_levels::defined_for_glsl(&kernel.module, &kernel.info).map_err(|message| {
+            BackendError::Validation {
                 backend: "wgpu-gl".into(),
-                operation: format!("integer division helpers for `{}`", kernel.name()),
+                operation: format!("GLSL rewrites (integer division, texture levels) of `{}`", kernel.name()),
                 message,
-            },
-        )?
+            }
+        })?
     } else {
         None
     };

@@ -1,0 +1,81 @@
+//! What the shader-corpus tests share (`corpus.rs` for buffers, `textures.rs` for
+//! textures): the backends that can open here, one case at a time, the judgement's
+//! failures as lines, and the negative control that a corrupted output is caught.
+
+use strata_backends::{BackendError, GPU_REQUIRED_VARIABLE, gpu_required};
+use strata_check::BackendSlot;
+use strata_check::agreement::{Judgement, Tolerance, judge};
+use strata_check::run_kernel::{BackendRun, named_slots};
+use strata_kernels::WordKind;
+
+/// One case at a time: six backends' devices at once per test thread crashed the
+/// process (SIGSEGV inside the drivers with eight threads), and each case already keeps
+/// both cores busy.
+pub static ONE_CASE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// The slots that can open here; a slot without a device is skipped (with a note naming
+/// `what`), or fails the test under `STRATA_REQUIRE_GPU=1` when it needs Vulkan.
+pub fn available_slots(what: &str) -> Vec<BackendSlot> {
+    let _turn = ONE_CASE_AT_A_TIME.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let mut slots = Vec::new();
+    for slot in named_slots(&["all".to_string()]).unwrap() {
+        match (slot.open)() {
+            Ok(_) => slots.push(slot),
+            Err(error @ BackendError::NoAdapter { .. }) if !(gpu_required() && slot.needs_vulkan) => {
+                eprintln!("SKIPPED {} in {what}: {error} (see {GPU_REQUIRED_VARIABLE})", slot.name);
+            }
+            Err(error) => panic!("{}: {error}", slot.name),
+        }
+    }
+    slots
+}
+
+/// Every backend that failed and every output beyond its bound, one line each.
+pub fn failures(judgement: &Judgement) -> Vec<String> {
+    judgement
+        .failed
+        .iter()
+        .map(|(backend, why)| format!("{backend} failed: {why}"))
+        .chain(
+            judgement
+                .buffers
+                .iter()
+                .filter(|b| !b.passes())
+                .map(|b| format!("{} `{}`: {}", b.backend, b.name, b.describe())),
+        )
+        .collect()
+}
+
+/// Negative control: corrupts the output of the last backend that ran (an integer word by one bit, an
+/// f16 pair by two steps, a float word far past any bound) and asserts that the same
+/// judgement fails.
+pub fn assert_corruption_caught(runs: &[BackendRun], tolerance: &Tolerance, case: &str) {
+    // The last backend that ran (one may have refused the kernel).
+    let Some(last) = runs.iter().rposition(|r| r.backend != "cpu" && r.outputs.is_ok()) else {
+        return;
+    };
+    let outputs = runs[last].outputs.as_ref().expect("found as Ok");
+    for kind in [WordKind::Integer, WordKind::Float, WordKind::HalfPair] {
+        let Some((buffer, index)) = outputs
+            .iter()
+            .enumerate()
+            .find_map(|(b, o)| (0..o.bytes.len() / 4).find(|&i| o.kinds.of(i) == kind).map(|i| (b, i)))
+        else {
+            continue;
+        };
+        let mut corrupted = runs.to_vec();
+        let output = &mut corrupted[last].outputs.as_mut().unwrap()[buffer];
+        let name = output.name.clone();
+        let word = &mut output.bytes[4 * index..4 * index + 4];
+        let value = u32::from_le_bytes(word.try_into().unwrap());
+        let bad = match kind {
+            WordKind::Integer => value ^ 1,
+            // Two f16 steps: beyond the one a device's rounding may take.
+            WordKind::HalfPair => value ^ 2,
+            _ => value ^ 0xc000_0000,
+        };
+        word.copy_from_slice(&bad.to_le_bytes());
+        let verdict = judge(&corrupted, Some("cpu"), tolerance).unwrap();
+        assert!(!verdict.passes(), "{case}: a corrupted {kind:?} word of `{name}` was not caught");
+    }
+}

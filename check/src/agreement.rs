@@ -64,7 +64,9 @@ pub struct BufferAgreement {
     /// Largest ULP distance among float words (NaN against a number counts as
     /// `u32::MAX`).
     pub max_ulp: u32,
-    /// The bound applied to float words.
+    /// Largest distance in 1/255 steps among `rgba8unorm` texel bytes.
+    pub max_steps: u32,
+    /// The bound applied to float words (and, its ULP count, to unorm steps).
     pub bound: FloatBound,
     /// The first word beyond the tolerance: (index, this backend's bits, reference bits).
     pub first_beyond: Option<(usize, u32, u32)>,
@@ -88,6 +90,9 @@ impl BufferAgreement {
                 text += &format!(" or {:e} absolute", self.bound.abs);
             }
             text += ")";
+        }
+        if self.max_steps > 0 {
+            text += &format!(", max {} unorm steps (bound {})", self.max_steps, self.bound.ulp);
         }
         if self.integers_differing > 0 {
             text += &format!(", {} integer words differ", self.integers_differing);
@@ -152,6 +157,7 @@ pub fn judge(runs: &[BackendRun], reference: Option<&str>, tolerance: &Tolerance
                 integers_differing: 0,
                 floats_beyond: 0,
                 max_ulp: 0,
+                max_steps: 0,
                 bound,
                 first_beyond: None,
             };
@@ -180,6 +186,14 @@ pub fn judge(runs: &[BackendRun], reference: Option<&str>, tolerance: &Tolerance
                         let distance = ulp_distance(g, w);
                         agreement.max_ulp = agreement.max_ulp.max(distance);
                         let beyond = !bound.admits(g, w);
+                        agreement.floats_beyond += usize::from(beyond);
+                        beyond
+                    }
+                    WordKind::Unorm8x4 => {
+                        let steps = (0..4).map(|i| ((g >> (8 * i)) & 0xff).abs_diff((w >> (8 * i)) & 0xff)).max();
+                        let steps = steps.unwrap_or(0);
+                        agreement.max_steps = agreement.max_steps.max(steps);
+                        let beyond = steps > bound.ulp;
                         agreement.floats_beyond += usize::from(beyond);
                         beyond
                     }
@@ -278,6 +292,26 @@ mod tests {
         assert!(halves_within_one_ulp(pair(one - 1, 0x8001), pair(one, 0x0000)));
         assert!(!halves_within_one_ulp(pair(one + 2, one), pair(one, one)));
         assert!(!halves_within_one_ulp(pair(one, 0x7e00), pair(one, 0x7c00)), "NaN is not next to infinity");
+    }
+
+    #[test]
+    fn unorm_texels_are_judged_in_steps_against_the_ulp_bound() {
+        let run = |backend: &str, word: u32| BackendRun {
+            backend: backend.into(),
+            outputs: Ok(vec![OutputBuffer {
+                binding: 0,
+                name: "texels".into(),
+                bytes: word.to_le_bytes().to_vec(),
+                kinds: WordKinds { head: vec![WordKind::Unorm8x4], tail: Vec::new() },
+            }]),
+        };
+        let one_step = [run("cpu", 0x10_20_30_40), run("gpu", 0x10_21_30_40)];
+        let exact = judge(&one_step, None, &ulps(0)).unwrap();
+        assert!(!exact.passes());
+        assert!(exact.buffers[0].describe().contains("max 1 unorm steps (bound 0)"), "{}", exact.buffers[0].describe());
+        assert!(judge(&one_step, None, &ulps(1)).unwrap().passes());
+        let two_steps = [run("cpu", 0x10_20_30_40), run("gpu", 0x10_20_30_42)];
+        assert!(!judge(&two_steps, None, &ulps(1)).unwrap().passes());
     }
 
     #[test]

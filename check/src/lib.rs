@@ -22,6 +22,7 @@ mod path;
 pub mod replay;
 mod report;
 mod restir;
+pub mod run_images;
 pub mod run_kernel;
 mod selection;
 mod svgf;

@@ -4,6 +4,7 @@
 //! declared tolerance (see [`crate::agreement`]). For engine developers checking their
 //! own kernels.
 
+use crate::run_images::ImageSpec;
 use crate::{BackendSlot, backend_slots};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
@@ -25,6 +26,8 @@ pub struct RunRequest {
     pub sizes: Vec<(u32, u32, u64)>,
     /// Values of `override` constants, by name; the rest keep their WGSL defaults.
     pub overrides: Vec<(String, f64)>,
+    /// Textures and samplers (see [`crate::run_images`]).
+    pub images: Vec<ImageSpec>,
     /// Backend names (`cpu`, `wgpu-vulkan`, `wgpu-gl`, `ash`, `ash-glsl`, `ash-hlsl`; `all`).
     pub backends: Vec<String>,
     /// Where output buffers are written (one folder per backend).
@@ -266,7 +269,7 @@ pub fn inexact_functions(kernel: &Kernel) -> Vec<&'static str> {
 }
 
 /// Runs the request on every named backend and writes the outputs under `request.out`
-/// (`BACKEND/0_BINDING_NAME.bin`).
+/// (`BACKEND/0_BINDING_NAME.bin`; a storage texture also as `.png` or `.exr`).
 pub fn run_kernel(request: &RunRequest) -> Result<RunOutcome> {
     let groups = request.buffers.iter().map(|(g, b, _)| (g, b)).chain(request.sizes.iter().map(|(g, b, _)| (g, b)));
     for (group, binding) in groups {
@@ -296,14 +299,23 @@ pub fn run_kernel(request: &RunRequest) -> Result<RunOutcome> {
         }
         inputs.push((*binding, vec![0; *size as usize]));
     }
-    let runs = run_loaded(&kernel, &inputs, request.workgroups, &slots);
+    let images = crate::run_images::image_inputs(&kernel, &request.images)?;
+    let runs = run_loaded_with_images(&kernel, &inputs, &images, request.workgroups, &slots);
     for run in &runs {
         if let Ok(outputs) = &run.outputs {
             let dir = request.out.join(&run.backend);
             std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
             for output in outputs {
-                let file = dir.join(format!("0_{}_{}.bin", output.binding, output.name));
+                let stem = dir.join(format!("0_{}_{}", output.binding, output.name));
+                let file = stem.with_extension("bin");
                 std::fs::write(&file, &output.bytes).with_context(|| format!("cannot write {}", file.display()))?;
+                let texture = images.iter().find_map(|(binding, input)| match input {
+                    ImageInput::Texture { desc, .. } if *binding == output.binding => Some(desc),
+                    _ => None,
+                });
+                if let Some(desc) = texture {
+                    crate::run_images::write_picture(&stem, output, desc)?;
+                }
             }
         }
     }

@@ -19,6 +19,10 @@ pub enum WordKind {
     /// conversion to the implementation, so each half may be either representable
     /// neighbour of the exact value; compared within one f16 ULP each.
     HalfPair,
+    /// Four 8-bit unsigned normalised values (an `rgba8unorm` texel): compared as steps
+    /// of 1/255, each byte within the float bound's ULP count (a filtered or blended
+    /// value a device rounds one step the other way is a step, not a wrong bit).
+    Unorm8x4,
     /// Bytes no member covers (struct and array padding): backends may leave anything.
     Padding,
 }
@@ -51,13 +55,14 @@ impl WordKinds {
     }
 
     /// The kinds of the words of a texture of `format`, texel after texel: f32 words
-    /// for the 32-bit float formats, f16 pairs for `rgba16float`, bit-exact integers for
-    /// the others (8-bit components share words).
+    /// for the 32-bit float formats, f16 pairs for `rgba16float`, unorm steps for
+    /// `rgba8unorm`, bit-exact integers for the others.
     pub fn of_texels(format: crate::texture::TexelFormat) -> WordKinds {
         use crate::texture::TexelFormat as F;
         let kind = match format {
             F::Rgba32Float | F::R32Float => WordKind::Float,
             F::Rgba16Float => WordKind::HalfPair,
+            F::Rgba8Unorm => WordKind::Unorm8x4,
             _ => WordKind::Integer,
         };
         WordKinds { head: Vec::new(), tail: vec![kind; format.bytes_per_texel() as usize / 4] }

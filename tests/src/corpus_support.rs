@@ -55,7 +55,7 @@ pub fn assert_corruption_caught(runs: &[BackendRun], tolerance: &Tolerance, case
         return;
     };
     let outputs = runs[last].outputs.as_ref().expect("found as Ok");
-    for kind in [WordKind::Integer, WordKind::Float, WordKind::HalfPair] {
+    for kind in [WordKind::Integer, WordKind::Float, WordKind::HalfPair, WordKind::Unorm8x4] {
         let Some((buffer, index)) = outputs
             .iter()
             .enumerate()
@@ -72,6 +72,8 @@ pub fn assert_corruption_caught(runs: &[BackendRun], tolerance: &Tolerance, case
             WordKind::Integer => value ^ 1,
             // Two f16 steps: beyond the one a device's rounding may take.
             WordKind::HalfPair => value ^ 2,
+            // 128 steps of 1/255: past any bound a case declares.
+            WordKind::Unorm8x4 => value ^ 0x80,
             _ => value ^ 0xc000_0000,
         };
         word.copy_from_slice(&bad.to_le_bytes());

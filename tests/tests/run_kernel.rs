@@ -2,7 +2,7 @@
 //! written to files, agreement reported, bad input named.
 
 use std::path::PathBuf;
-use strata_check::agreement::{Tolerance, judge};
+use strata_check::agreement::{FloatBound, Tolerance, judge};
 use strata_check::run_kernel::{RunRequest, run_kernel};
 
 const SQUARE: &str = r#"
@@ -27,6 +27,7 @@ fn setup(name: &str) -> (PathBuf, RunRequest) {
         buffers: vec![(0, 0, dir.join("in.bin"))],
         sizes: vec![(0, 1, 512)],
         overrides: Vec::new(),
+        images: Vec::new(),
         backends: vec!["cpu".into()],
         out: dir.join("out"),
     };
@@ -117,6 +118,7 @@ fn a_shader_with_overrides_runs_everywhere_with_and_without_override() {
             buffers: vec![(0, 0, dir.join("size.bin")), (0, 1, dir.join("cells.bin"))],
             sizes: vec![(0, 2, u64::from(width * height * 4))],
             overrides,
+            images: Vec::new(),
             backends: vec!["all".into()],
             out: dir.join(format!("out{tile}")),
         };
@@ -129,4 +131,56 @@ fn a_shader_with_overrides_runs_everywhere_with_and_without_override() {
     assert_eq!(live[0], 5);
     assert_ne!(live[1], 5);
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn a_png_texture_and_a_sampler_run_everywhere_and_the_output_comes_back_as_png() {
+    use strata_check::run_images::{ImageSpec, SamplerDesc, TextureFile};
+    let dir = std::env::temp_dir().join(format!("strata-run-png-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (width, height) = (37u32, 22u32);
+    let picture = image::RgbaImage::from_fn(width, height, |x, y| {
+        image::Rgba([(x * 7) as u8, (y * 11) as u8, ((x * y) % 251) as u8, 255 - x as u8])
+    });
+    picture.save(dir.join("in.png")).unwrap();
+    let linear = SamplerDesc::uniform(strata_backends::FilterMode::Linear, strata_backends::AddressMode::ClampToEdge);
+    let request = RunRequest {
+        shader: PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data/textures/downsample.wgsl"),
+        entry: "main".into(),
+        workgroups: [3, 2, 1],
+        buffers: Vec::new(),
+        sizes: Vec::new(),
+        overrides: Vec::new(),
+        images: vec![
+            ImageSpec::Texture(0, TextureFile::Picture(dir.join("in.png"))),
+            ImageSpec::Sampler(1, linear),
+            ImageSpec::StorageTexture(2, [width / 2, height / 2, 1], None),
+        ],
+        backends: vec!["cpu".into(), "wgpu-vulkan".into(), "wgpu-gl".into(), "ash".into()],
+        out: dir.join("out"),
+    };
+    let runs = run_kernel(&request).unwrap().runs;
+    // A filtered value a device rounds with 8-bit weights may land one 1/255 step away.
+    let tolerance = Tolerance { float: FloatBound { ulp: 1, abs: 0.0 }, per_buffer: Vec::new() };
+    let judgement = judge(&runs, Some("cpu"), &tolerance).unwrap();
+    for buffer in &judgement.buffers {
+        assert!(buffer.passes(), "{} {}", buffer.backend, buffer.describe());
+    }
+    for run in runs.iter().filter(|r| r.outputs.is_ok()) {
+        let folder = dir.join("out").join(&run.backend);
+        let written = image::open(folder.join("0_2_half_size.png")).unwrap().to_rgba8();
+        assert_eq!(written.dimensions(), (width / 2, height / 2));
+        assert_eq!(written.into_raw(), std::fs::read(folder.join("0_2_half_size.bin")).unwrap(), "{}", run.backend);
+    }
+    // The centre of each 2 x 2 footprint is the four texels' mean, to a step.
+    let out = std::fs::read(dir.join("out/cpu/0_2_half_size.bin")).unwrap();
+    let at = |x: u32, y: u32, c: usize| f64::from(picture.get_pixel(x, y)[c]);
+    let mean = (at(4, 6, 1) + at(5, 6, 1) + at(4, 7, 1) + at(5, 7, 1)) / 4.0;
+    let texel = ((3 * (width / 2) + 2) * 4 + 1) as usize;
+    assert!((f64::from(out[texel]) - mean).abs() <= 1.0, "{} against {mean}", out[texel]);
+    // A texture whose shape the kernel does not take is refused by name.
+    let mut wrong = request.clone();
+    wrong.images[2] = ImageSpec::StorageTexture(2, [4, 4, 1], Some(strata_kernels::TexelFormat::R32Float));
+    let error = run_kernel(&wrong).unwrap_err().to_string();
+    assert!(error.contains("half_size") && error.contains("r32float") && error.contains("rgba8unorm"), "{error}");
 }

@@ -10,10 +10,11 @@
 //!   GLSL and HLSL) with generated inputs and compares the outputs with the kernels'
 //!   references; prints a kernels × backends table and exits non-zero on any mismatch.
 //! * `cargo xtask run FILE.wgsl --entry NAME --workgroups X,Y,Z --buffer 0:B=FILE ...
-//!   [--size 0:B=BYTES] [--override NAME=VALUE ...] [--ulp N | --ulp BUFFER=N ...] [--abs E | --abs BUFFER=E ...]
+//!   [--size 0:B=BYTES] [--texture 0:B=FILE] [--storage-texture 0:B=WxH[:FORMAT]]
+//!   [--sampler 0:B=FILTER,ADDRESS] [--override NAME=VALUE ...] [--ulp N | --ulp BUFFER=N ...] [--abs E | --abs BUFFER=E ...]
 //!   [--reference BACKEND] --backend cpu|wgpu|wgpu-gl|ash|ash-glsl|ash-hlsl|all [--out DIR]`:
-//!   runs any WGSL compute shader, writes every writable buffer to
-//!   `DIR/BACKEND/0_B_NAME.bin`, and with several backends reports per backend and
+//!   runs any WGSL compute shader, writes every writable buffer and storage texture to
+//!   `DIR/BACKEND/0_B_NAME.bin` (a storage texture also as `.png` or `.exr`), and with several backends reports per backend and
 //!   buffer whether it is identical to the reference backend's, or how many words
 //!   differ and by how many ULP; exits non-zero only when a backend fails or a buffer
 //!   exceeds the tolerance (integers: exact; f32 words: `--ulp`, default 0).
@@ -47,6 +48,7 @@ use anyhow::{Result, bail};
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use strata_check::agreement::{Tolerance, judge};
+use strata_check::run_images::{self, ImageSpec, SamplerDesc, StorageTextureSize, TextureFile};
 use strata_check::run_kernel::RunRequest;
 use strata_kernels::Registry;
 use strata_kernels::validate::{Target, Verdict, translate_and_validate};
@@ -116,6 +118,19 @@ struct RunArgs {
     /// GROUP:BINDING=BYTES: a zero-filled buffer of that size (default: the binding's minimum).
     #[arg(long = "size", value_parser = parse_size)]
     sizes: Vec<(u32, u32, u64)>,
+    /// GROUP:BINDING=FILE: a texture from a PNG (rgba8unorm, the 8-bit codes), an EXR
+    /// (rgba32float) or raw texels (FILE@WxHxD:FORMAT); its shape is the kernel's
+    /// (repeatable).
+    #[arg(long = "texture", value_parser = parse_texture)]
+    textures: Vec<(u32, u32, TextureFile)>,
+    /// GROUP:BINDING=WxH[xD][:FORMAT]: a zero-filled storage texture, written back as
+    /// raw texels and a PNG (rgba8unorm) or EXR (float formats) (repeatable).
+    #[arg(long = "storage-texture", value_parser = parse_storage)]
+    storage_textures: Vec<(u32, u32, StorageTextureSize)>,
+    /// GROUP:BINDING=FILTER,ADDRESS: a sampler, `nearest` or `linear`, `clamp`, `repeat`
+    /// or `mirror` (repeatable).
+    #[arg(long = "sampler", value_parser = parse_sampler_flag)]
+    samplers: Vec<(u32, u32, SamplerDesc)>,
     /// NAME=VALUE: the value of an `override` constant (repeatable; by name, or by
     /// `@id` number). Others keep their WGSL defaults. Applied once, by naga, before
     /// any backend sees the shader, so every backend runs the same specialisation.
@@ -155,11 +170,28 @@ fn main() {
             })
             .map_err(Into::into),
         Command::Run(args) => {
-            let RunArgs { shader, entry, workgroups, buffers, sizes, overrides, backend, ulp, abs, reference, out } =
-                *args;
+            let RunArgs {
+                shader,
+                entry,
+                workgroups,
+                buffers,
+                sizes,
+                textures,
+                storage_textures,
+                samplers,
+                overrides,
+                backend,
+                ulp,
+                abs,
+                reference,
+                out,
+            } = *args;
             let tolerance = tolerance(&ulp, &abs);
-            let request = RunRequest { shader, entry, workgroups, buffers, sizes, overrides, backends: backend, out };
-            run(request, &tolerance, reference.as_deref())
+            images(&textures, &storage_textures, &samplers).and_then(|images| {
+                let request =
+                    RunRequest { shader, entry, workgroups, buffers, sizes, overrides, images, backends: backend, out };
+                run(request, &tolerance, reference.as_deref())
+            })
         }
     };
     if let Err(error) = result {
@@ -250,6 +282,41 @@ fn parse_buffer(text: &str) -> Result<(u32, u32, PathBuf), String> {
 fn parse_size(text: &str) -> Result<(u32, u32, u64), String> {
     let (g, b, v) = parse_binding(text)?;
     Ok((g, b, v.parse().map_err(|e| format!("size `{v}`: {e}"))?))
+}
+
+fn parse_texture(text: &str) -> Result<(u32, u32, TextureFile), String> {
+    let (g, b, v) = parse_binding(text)?;
+    Ok((g, b, run_images::parse_texture_file(v)?))
+}
+
+fn parse_storage(text: &str) -> Result<(u32, u32, StorageTextureSize), String> {
+    let (g, b, v) = parse_binding(text)?;
+    Ok((g, b, run_images::parse_storage_texture(v)?))
+}
+
+fn parse_sampler_flag(text: &str) -> Result<(u32, u32, SamplerDesc), String> {
+    let (g, b, v) = parse_binding(text)?;
+    Ok((g, b, run_images::parse_sampler(v)?))
+}
+
+/// The image flags as one list, group 0 only (as buffers).
+fn images(
+    textures: &[(u32, u32, TextureFile)],
+    storage: &[(u32, u32, StorageTextureSize)],
+    samplers: &[(u32, u32, SamplerDesc)],
+) -> Result<Vec<ImageSpec>> {
+    let groups = textures.iter().map(|t| (t.0, t.1)).chain(storage.iter().map(|t| (t.0, t.1)));
+    for (group, binding) in groups.chain(samplers.iter().map(|s| (s.0, s.1))) {
+        if group != 0 {
+            bail!("--texture/--storage-texture/--sampler {group}:{binding}: only @group(0) is supported");
+        }
+    }
+    Ok(textures
+        .iter()
+        .map(|(_, b, file)| ImageSpec::Texture(*b, file.clone()))
+        .chain(storage.iter().map(|(_, b, (size, format))| ImageSpec::StorageTexture(*b, *size, *format)))
+        .chain(samplers.iter().map(|(_, b, desc)| ImageSpec::Sampler(*b, *desc)))
+        .collect())
 }
 
 fn parse_override(text: &str) -> Result<(String, f64), String> {

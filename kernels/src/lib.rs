@@ -43,6 +43,7 @@ pub mod binding;
 pub mod block_grid;
 pub mod blue_noise;
 pub mod catalogue;
+pub mod combined_samplers;
 pub mod constants;
 pub mod denoise_types;
 pub mod embed_types;

@@ -47,7 +47,7 @@ pub fn failures(judgement: &Judgement) -> Vec<String> {
 }
 
 /// Negative control: corrupts the output of the last backend that ran (an integer word by one bit, an
-/// f16 pair by two steps, a float word far past any bound) and asserts that the same
+/// f16 pair by four steps, a float word far past any bound) and asserts that the same
 /// judgement fails.
 pub fn assert_corruption_caught(runs: &[BackendRun], tolerance: &Tolerance, case: &str) {
     // The last backend that ran (one may have refused the kernel).
@@ -70,8 +70,9 @@ pub fn assert_corruption_caught(runs: &[BackendRun], tolerance: &Tolerance, case
         let value = u32::from_le_bytes(word.try_into().unwrap());
         let bad = match kind {
             WordKind::Integer => value ^ 1,
-            // Two f16 steps: beyond the one a device's rounding may take.
-            WordKind::HalfPair => value ^ 2,
+            // Four f16 steps: beyond the one a device's rounding may take, even from a
+            // word that already differs by one.
+            WordKind::HalfPair => value ^ 4,
             // 128 steps of 1/255: past any bound a case declares.
             WordKind::Unorm8x4 => value ^ 0x80,
             _ => value ^ 0xc000_0000,

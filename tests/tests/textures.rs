@@ -202,7 +202,7 @@ fn loads_sizes_and_levels_of_every_float_format_agree_in_and_out_of_range() {
             } else {
                 vec![("outside", ANY_ULP, OUTSIDE)]
             },
-            refused_by: &["ash-glsl"],
+            refused_by: &[],
         });
         let allowed = texel_values(&texture(
             TextureDimension::D2,
@@ -253,7 +253,7 @@ fn integer_texels_load_bit_for_bit() {
                 ),
             ],
             bounds: Vec::new(),
-            refused_by: &["ash-glsl"],
+            refused_by: &[],
         });
     }
 }
@@ -330,7 +330,7 @@ fn one_d_array_and_three_d_textures_load_store_and_count_alike() {
             (5, blank(TextureDimension::D3, [8, 8, 4], TexelFormat::Rgba32Float)),
         ],
         bounds: Vec::new(),
-        refused_by: &["wgpu-gl", "ash-glsl", "ash-slang"],
+        refused_by: &["wgpu-gl", "ash-slang"],
     });
 }
 
@@ -351,7 +351,7 @@ fn a_separable_blur_through_workgroup_memory_agrees_bit_for_bit() {
                 (1, blank(TextureDimension::D2, [width, height, 1], TexelFormat::Rgba16Float)),
             ],
             bounds: Vec::new(),
-            refused_by: &["ash-glsl"],
+            refused_by: &[],
         });
     }
 }
@@ -404,7 +404,7 @@ fn sampling_and_gathering_agree_within_the_filtering_precision_for_every_sampler
                     "weights quantised to 8 bits of sub-texel and mipmap precision by the device, exact in the \
                      interpreter",
                 )],
-                refused_by: &["ash-glsl", "ash-hlsl", "ash-slang"],
+                refused_by: &["ash-hlsl", "ash-slang"],
             });
         }
     }

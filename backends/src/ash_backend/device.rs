@@ -43,6 +43,8 @@ pub(super) enum Descriptor {
     Buffer(vk::Buffer),
     /// A sampled or storage image view (in `GENERAL` layout).
     Image(vk::ImageView),
+    /// A combined image sampler: a view and the sampler state it is read with.
+    Combined(vk::ImageView, vk::Sampler),
     /// A sampler.
     Sampler(vk::Sampler),
 }
@@ -405,15 +407,14 @@ impl VulkanDevice {
         &self,
         pipeline: ComputePipeline,
         kernel: &Kernel,
-        descriptors: &[(u32, Descriptor)],
+        descriptors: &[(u32, vk::DescriptorType, Descriptor)],
         workgroups: [u32; 3],
         timed: bool,
     ) -> Result<Option<Duration>, BackendError> {
         let operation = format!("dispatch of `{}`", kernel.name());
         let error = |e| vk_error(&operation, e);
         let mut sizes: Vec<vk::DescriptorPoolSize> = Vec::new();
-        for binding in &kernel.bindings {
-            let ty = super::pipelines::descriptor_type(binding.kind);
+        for &(_, ty, _) in descriptors {
             match sizes.iter_mut().find(|size| size.ty == ty) {
                 Some(size) => size.descriptor_count += 1,
                 None => sizes.push(vk::DescriptorPoolSize { ty, descriptor_count: 1 }),
@@ -435,7 +436,7 @@ impl VulkanDevice {
                     .map_err(error)?[0];
                 let buffer_infos: Vec<[vk::DescriptorBufferInfo; 1]> = descriptors
                     .iter()
-                    .map(|&(_, descriptor)| match descriptor {
+                    .map(|&(_, _, descriptor)| match descriptor {
                         Descriptor::Buffer(buffer) => {
                             [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }]
                         }
@@ -444,10 +445,11 @@ impl VulkanDevice {
                     .collect();
                 let image_infos: Vec<[vk::DescriptorImageInfo; 1]> = descriptors
                     .iter()
-                    .map(|&(_, descriptor)| {
+                    .map(|&(_, _, descriptor)| {
                         let info = vk::DescriptorImageInfo::default().image_layout(vk::ImageLayout::GENERAL);
                         [match descriptor {
                             Descriptor::Image(view) => info.image_view(view),
+                            Descriptor::Combined(view, sampler) => info.image_view(view).sampler(sampler),
                             Descriptor::Sampler(sampler) => info.sampler(sampler),
                             Descriptor::Buffer(_) => info,
                         }]
@@ -456,12 +458,9 @@ impl VulkanDevice {
                 let writes: Vec<_> = descriptors
                     .iter()
                     .zip(buffer_infos.iter().zip(&image_infos))
-                    .map(|(&(binding, descriptor), (buffer_info, image_info))| {
-                        let kind = kernel.binding(0, binding).map(|b| b.kind);
+                    .map(|(&(binding, ty, descriptor), (buffer_info, image_info))| {
                         let write =
-                            vk::WriteDescriptorSet::default().dst_set(set).dst_binding(binding).descriptor_type(
-                                kind.map_or(vk::DescriptorType::STORAGE_BUFFER, super::pipelines::descriptor_type),
-                            );
+                            vk::WriteDescriptorSet::default().dst_set(set).dst_binding(binding).descriptor_type(ty);
                         match descriptor {
                             Descriptor::Buffer(_) => write.buffer_info(buffer_info),
                             _ => write.image_info(image_info),

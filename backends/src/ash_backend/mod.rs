@@ -87,6 +87,9 @@ pub struct AshBackend {
     buffers: HashMap<u64, AshBuffer>,
     images: HashMap<u64, AshImage>,
     samplers: HashMap<u64, vk::Sampler>,
+    /// The sampler state of a combined image sampler whose texture is only loaded
+    /// (naga's GLSL combines every sampled texture with one), made when first needed.
+    any_sampler: Option<vk::Sampler>,
     next_buffer: u64,
     pipelines: PipelineCache,
     vulkan: VulkanDevice,
@@ -119,6 +122,7 @@ impl AshBackend {
             buffers: HashMap::new(),
             images: HashMap::new(),
             samplers: HashMap::new(),
+            any_sampler: None,
             next_buffer: 0,
             pipelines,
             vulkan,
@@ -159,21 +163,36 @@ impl AshBackend {
         };
         check_binds(kernel, binds, &self.info, &lookup)?;
         let pipeline = self.pipelines.get_or_create(&self.vulkan, kernel)?;
-        let descriptors = binds
+        let combined = pipeline.plan.slots.iter().any(|s| s.1 == vk::DescriptorType::COMBINED_IMAGE_SAMPLER);
+        if combined && self.any_sampler.is_none() {
+            self.any_sampler = Some(self.vulkan.create_sampler(&crate::texture::SamplerDesc::default())?);
+        }
+        let resource_at =
+            |binding: u32| binds.iter().find(|b| b.binding == binding).map(|b| b.resource).expect("checked binds");
+        let descriptors = pipeline
+            .plan
+            .slots
             .iter()
-            .map(|bind| {
-                let descriptor = match bind.resource {
+            .map(|&(binding, ty, paired)| {
+                let descriptor = match resource_at(binding) {
                     Resource::Buffer(id) => Descriptor::Buffer(self.buffer(id)?.buffer),
+                    Resource::Texture(id) if ty == vk::DescriptorType::COMBINED_IMAGE_SAMPLER => {
+                        let sampler = match paired.map(resource_at) {
+                            Some(Resource::Sampler(sampler)) => self.sampler(sampler)?,
+                            _ => self.any_sampler.expect("created above"),
+                        };
+                        Descriptor::Combined(self.image(id)?.sampled_view, sampler)
+                    }
                     Resource::Texture(id) => {
                         let image = self.image(id)?;
                         let storage = kernel
-                            .binding(0, bind.binding)
+                            .binding(0, binding)
                             .is_some_and(|info| matches!(info.kind, BindingKind::StorageTexture { .. }));
                         Descriptor::Image(if storage { image.storage_view } else { image.sampled_view })
                     }
                     Resource::Sampler(id) => Descriptor::Sampler(self.sampler(id)?),
                 };
-                Ok((bind.binding, descriptor))
+                Ok((binding, ty, descriptor))
             })
             .collect::<Result<Vec<_>, BackendError>>()?;
         self.vulkan.dispatch(pipeline.handles(), kernel, &descriptors, workgroups, timed)
@@ -290,6 +309,9 @@ impl Drop for AshBackend {
             self.vulkan.destroy_image(&image);
         }
         for (_, sampler) in self.samplers.drain() {
+            self.vulkan.destroy_sampler(sampler);
+        }
+        if let Some(sampler) = self.any_sampler.take() {
             self.vulkan.destroy_sampler(sampler);
         }
         self.pipelines.destroy(&self.vulkan);

@@ -10,6 +10,7 @@ use ash::vk;
 use std::collections::HashMap;
 use std::ffi::CString;
 use std::sync::Arc;
+use strata_kernels::combined_samplers::combined_samplers;
 use strata_kernels::glslang::{self, GlslangInput};
 use strata_kernels::translate::{self, TranslateOptions, WorkgroupZeroInit};
 use strata_kernels::{BindingInfo, BindingKind, Kernel, KernelId};
@@ -49,12 +50,27 @@ pub unsafe fn create_compute_pipeline(
     entry_point: &std::ffi::CStr,
     bindings: &[BindingInfo],
 ) -> Result<PipelineObjects, vk::Result> {
-    let bindings: Vec<_> = bindings
+    let slots: Vec<(u32, vk::DescriptorType)> = bindings.iter().map(|b| (b.binding, descriptor_type(b.kind))).collect();
+    // SAFETY: the caller's contract.
+    unsafe { create_pipeline_with_slots(device, words, entry_point, &slots) }
+}
+
+/// [`create_compute_pipeline`] with set 0 given as (binding, descriptor type) slots.
+///
+/// # Safety
+/// As [`create_compute_pipeline`].
+unsafe fn create_pipeline_with_slots(
+    device: &ash::Device,
+    words: &[u32],
+    entry_point: &std::ffi::CStr,
+    slots: &[(u32, vk::DescriptorType)],
+) -> Result<PipelineObjects, vk::Result> {
+    let bindings: Vec<_> = slots
         .iter()
-        .map(|binding| {
+        .map(|&(binding, ty)| {
             vk::DescriptorSetLayoutBinding::default()
-                .binding(binding.binding)
-                .descriptor_type(descriptor_type(binding.kind))
+                .binding(binding)
+                .descriptor_type(ty)
                 .descriptor_count(1)
                 .stage_flags(vk::ShaderStageFlags::COMPUTE)
         })
@@ -115,12 +131,52 @@ pub unsafe fn destroy_compute_pipeline(device: &ash::Device, objects: &PipelineO
     }
 }
 
-pub(super) struct AshPipeline(PipelineObjects);
+/// Descriptor set 0 as a pipeline's SPIR-V expects it: per slot the WGSL binding, the
+/// descriptor type, and for a combined image sampler (naga's GLSL) the binding of the
+/// sampler whose state it carries (`None`: any sampler, the texture is only loaded).
+#[derive(Clone, Debug)]
+pub(super) struct DescriptorPlan {
+    pub(super) slots: Vec<(u32, vk::DescriptorType, Option<u32>)>,
+}
+
+impl DescriptorPlan {
+    /// The plan of `kernel` compiled from `source`: one descriptor per binding, except on
+    /// the GLSL path, where each sampled texture is a combined image sampler and samplers
+    /// have no descriptor of their own (`strata_kernels::combined_samplers`).
+    fn of(kernel: &Kernel, source: SpirvSource) -> Result<Self, BackendError> {
+        if source != SpirvSource::GlslangFromGlsl {
+            let slots = kernel.bindings.iter().map(|b| (b.binding, descriptor_type(b.kind), None)).collect();
+            return Ok(Self { slots });
+        }
+        let pairs = combined_samplers(kernel).map_err(|why| BackendError::Unavailable {
+            backend: source.name().into(),
+            what: format!("kernel `{}`", kernel.name()),
+            why: format!("{why}: naga's GLSL combines each texture with one sampler"),
+        })?;
+        let slots = kernel
+            .bindings
+            .iter()
+            .filter(|b| b.kind != BindingKind::Sampler)
+            .map(|b| match pairs.iter().find(|(texture, _)| *texture == b.binding) {
+                Some(&(_, sampler)) => (b.binding, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, sampler),
+                None => (b.binding, descriptor_type(b.kind), None),
+            })
+            .collect();
+        Ok(Self { slots })
+    }
+}
+
+pub(super) struct AshPipeline {
+    objects: PipelineObjects,
+    /// What each descriptor of set 0 is.
+    pub(super) plan: DescriptorPlan,
+}
 
 impl AshPipeline {
     /// What a dispatch binds.
     pub(super) fn handles(&self) -> ComputePipeline {
-        ComputePipeline { set_layout: self.0.set_layout, layout: self.0.layout, pipeline: self.0.pipeline }
+        let o = &self.objects;
+        ComputePipeline { set_layout: o.set_layout, layout: o.layout, pipeline: o.pipeline }
     }
 }
 
@@ -196,6 +252,7 @@ impl PipelineCache {
             return Ok(Arc::clone(pipeline));
         }
         super::texture_paths::check_texture_bindings(self.source, kernel)?;
+        let plan = DescriptorPlan::of(kernel, self.source)?;
         let (words, entry_point) = self.spirv(kernel, vulkan.native_zero_init)?;
         let entry_point = CString::new(entry_point).map_err(|e| BackendError::Validation {
             backend: self.source.name().into(),
@@ -209,9 +266,10 @@ impl PipelineCache {
             message: format!("{result:?}"),
         };
         // SAFETY: a valid device; the pipeline is destroyed in `destroy`.
-        let objects = unsafe { create_compute_pipeline(&vulkan.device, &words, &entry_point, &kernel.bindings) }
-            .map_err(error)?;
-        let pipeline = Arc::new(AshPipeline(objects));
+        let slots: Vec<(u32, vk::DescriptorType)> = plan.slots.iter().map(|&(b, ty, _)| (b, ty)).collect();
+        let objects =
+            unsafe { create_pipeline_with_slots(&vulkan.device, &words, &entry_point, &slots) }.map_err(error)?;
+        let pipeline = Arc::new(AshPipeline { objects, plan });
         self.pipelines.insert(kernel.id, Arc::clone(&pipeline));
         Ok(pipeline)
     }
@@ -220,7 +278,7 @@ impl PipelineCache {
         let device = &vulkan.device;
         for (_, pipeline) in self.pipelines.drain() {
             // SAFETY: the device is idle; each pipeline is destroyed once.
-            unsafe { destroy_compute_pipeline(device, &pipeline.0) };
+            unsafe { destroy_compute_pipeline(device, &pipeline.objects) };
         }
     }
 }

@@ -11,10 +11,6 @@ use strata_kernels::{BindingInfo, BindingKind, Kernel};
 fn refusal(source: SpirvSource, binding: &BindingInfo) -> Option<&'static str> {
     match (source, binding.kind) {
         (SpirvSource::Naga, _) => None,
-        (SpirvSource::GlslangFromGlsl, BindingKind::SampledTexture { .. } | BindingKind::Sampler) => Some(
-            "naga's GLSL declares every sampled texture as a combined image sampler (`sampler2D`, one descriptor \
-             with its sampler), which this path does not bind; storage textures work",
-        ),
         (SpirvSource::GlslangFromHlsl | SpirvSource::SlangFromHlsl, BindingKind::Sampler) => Some(
             "naga's HLSL reads samplers from a sampler heap indexed through a buffer, which this path does not \
              bind; textures read with textureLoad work",

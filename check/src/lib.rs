@@ -26,6 +26,7 @@ pub mod run_images;
 pub mod run_kernel;
 mod selection;
 mod svgf;
+pub mod texture_corpus;
 mod trace;
 
 pub use backends::{BackendSlot, backend_slots};

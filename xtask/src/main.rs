@@ -8,7 +8,9 @@
 //! * `cargo xtask check [--full] [--kernel NAME,...]`: runs every registry kernel on every available backend
 //!   (wgpu Vulkan and GL, ash on naga's SPIR-V and on glslang's compilation of naga's
 //!   GLSL and HLSL) with generated inputs and compares the outputs with the kernels'
-//!   references; prints a kernels × backends table and exits non-zero on any mismatch.
+//!   references; prints a kernels × backends table, then the texture corpus's table
+//!   (`strata_check::texture_corpus`, against the interpreter; not with `--kernel`), and
+//!   exits non-zero on any mismatch.
 //! * `cargo xtask run FILE.wgsl --entry NAME --workgroups X,Y,Z --buffer 0:B=FILE ...
 //!   [--size 0:B=BYTES] [--texture 0:B=FILE] [--storage-texture 0:B=WxH[:FORMAT]]
 //!   [--sampler 0:B=FILTER,ADDRESS] [--override NAME=VALUE ...] [--ulp N | --ulp BUFFER=N ...] [--abs E | --abs BUFFER=E ...]
@@ -213,9 +215,16 @@ fn check(full: bool, only: &[String]) -> Result<()> {
     }
     let report = strata_check::run_checks(strata_check::CheckConfig { full }, checks);
     print!("{}", report.render());
+    // The texture corpus (kernels outside the registry) unless only some kernels were asked for.
+    let textures = if only.is_empty() { strata_check::texture_corpus::run_texture_corpus() } else { Vec::new() };
+    if !textures.is_empty() {
+        print!("\n{}", strata_check::texture_corpus::render_table(&textures));
+    }
+    let texture_failures =
+        textures.iter().flat_map(|(_, verdicts)| verdicts).filter(|(_, verdict)| !verdict.passes()).count();
     let failures = report.failures();
-    if !failures.is_empty() {
-        bail!("{} kernel/backend pair(s) failed", failures.len());
+    if !failures.is_empty() || texture_failures > 0 {
+        bail!("{} kernel/backend pair(s) and {texture_failures} texture case/backend pair(s) failed", failures.len());
     }
     Ok(())
 }

@@ -15,6 +15,9 @@ use crate::run_kernel::{BackendRun, ImageInput, ImageInputs, Inputs, run_loaded_
 use strata_backends::{AddressMode, FilterMode, SamplerDesc, TextureDesc};
 use strata_kernels::{Kernel, TexelFormat, TextureDimension};
 
+/// A case's own rule on one backend's outputs: `Err` says what WGSL does not allow.
+pub type CaseRule = fn(&TextureCase, &BackendRun) -> Result<(), String>;
+
 /// One texture-corpus run.
 pub struct TextureCase {
     /// The corpus file.
@@ -34,7 +37,7 @@ pub struct TextureCase {
     /// Paths that must refuse the kernel (a one-line "unavailable" naming why).
     pub refused_by: &'static [&'static str],
     /// A rule of the case's own on every run's outputs (what WGSL allows), if any.
-    pub rule: Option<fn(&TextureCase, &BackendRun) -> Result<(), String>>,
+    pub rule: Option<CaseRule>,
 }
 
 /// The WGSL of a corpus file (compiled in, so the check needs no folder beside it).

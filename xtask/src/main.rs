@@ -125,7 +125,7 @@ struct RunArgs {
     /// (repeatable).
     #[arg(long = "texture", value_parser = parse_texture)]
     textures: Vec<(u32, u32, TextureFile)>,
-    /// GROUP:BINDING=WxH[xD][:FORMAT]: a zero-filled storage texture, written back as
+    /// GROUP:BINDING=WxH, WxHxD or WxH:FORMAT: a zero-filled storage texture, written back as
     /// raw texels and a PNG (rgba8unorm) or EXR (float formats) (repeatable).
     #[arg(long = "storage-texture", value_parser = parse_storage)]
     storage_textures: Vec<(u32, u32, StorageTextureSize)>,

@@ -1,6 +1,7 @@
 //! The ash backend's textures and samplers: one `VkImage` per texture (sampled, storage
-//! and transfer usage, optimal tiling), kept in `GENERAL` layout for its whole life so
-//! that a dispatch binds it as sampled or storage image without a transition; two views
+//! and transfer usage, optimal tiling), in `GENERAL` layout between operations so that a
+//! dispatch binds it as sampled or storage image without a transition (a copy moves it
+//! to the transfer layout and back); two views
 //! (every mip level for sampling, level 0 for storage); uploads and read-backs through a
 //! host-visible staging buffer, each submitted and waited for on its own.
 
@@ -179,10 +180,13 @@ impl VulkanDevice {
         unsafe { std::ptr::copy_nonoverlapping(data.as_ptr(), mapped, data.len()) };
         let region = copy_region(&image.desc, level);
         let result = self.submit_once(&operation, |cb| {
+            let copy = vk::ImageLayout::TRANSFER_DST_OPTIMAL;
+            self.relayout(cb, image, vk::ImageLayout::GENERAL, copy);
             // SAFETY: recording into the one-shot command buffer.
             unsafe {
-                self.device.cmd_copy_buffer_to_image(cb, buffer, image.image, vk::ImageLayout::GENERAL, &[region]);
+                self.device.cmd_copy_buffer_to_image(cb, buffer, image.image, copy, &[region]);
             }
+            self.relayout(cb, image, copy, vk::ImageLayout::GENERAL);
             self.transfer_done(cb);
         });
         self.destroy_buffer(buffer, memory);
@@ -196,10 +200,13 @@ impl VulkanDevice {
         let (buffer, memory, mapped) = self.create_buffer("texture read-back", size.max(4) as u64)?;
         let region = copy_region(&image.desc, level);
         let result = self.submit_once(&operation, |cb| {
+            let copy = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
+            self.relayout(cb, image, vk::ImageLayout::GENERAL, copy);
             // SAFETY: recording into the one-shot command buffer.
             unsafe {
-                self.device.cmd_copy_image_to_buffer(cb, image.image, vk::ImageLayout::GENERAL, buffer, &[region]);
+                self.device.cmd_copy_image_to_buffer(cb, image.image, copy, buffer, &[region]);
             }
+            self.relayout(cb, image, copy, vk::ImageLayout::GENERAL);
             self.transfer_done(cb);
         });
         let mut bytes = vec![0u8; size];
@@ -242,6 +249,30 @@ impl VulkanDevice {
     pub(super) fn destroy_sampler(&self, sampler: vk::Sampler) {
         // SAFETY: no dispatch is in flight between calls.
         unsafe { self.device.destroy_sampler(sampler, None) };
+    }
+
+    /// Moves every subresource of `image` from layout `from` to `to`, after every earlier
+    /// shader and transfer access and before every later one (copies use the transfer
+    /// layouts; dispatches see `GENERAL`).
+    fn relayout(&self, cb: vk::CommandBuffer, image: &AshImage, from: vk::ImageLayout, to: vk::ImageLayout) {
+        let all = vk::AccessFlags::SHADER_READ
+            | vk::AccessFlags::SHADER_WRITE
+            | vk::AccessFlags::TRANSFER_READ
+            | vk::AccessFlags::TRANSFER_WRITE;
+        let barrier = vk::ImageMemoryBarrier::default()
+            .src_access_mask(all)
+            .dst_access_mask(all)
+            .old_layout(from)
+            .new_layout(to)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .image(image.image)
+            .subresource_range(subresources(&image.desc, 0..image.desc.mip_levels));
+        let stages = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER;
+        // SAFETY: recording into a command buffer being recorded.
+        unsafe {
+            self.device.cmd_pipeline_barrier(cb, stages, stages, vk::DependencyFlags::empty(), &[], &[], &[barrier]);
+        }
     }
 
     /// Makes a transfer's writes visible to later transfers, shaders and the host.

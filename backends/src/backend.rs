@@ -34,9 +34,11 @@ impl Resource {
     }
 }
 
-/// A resource bound at `@group(0) @binding(binding)` of a dispatch.
+/// A resource bound at `@group(group) @binding(binding)` of a dispatch.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Bind {
+    /// WGSL group (registry kernels use 0 only).
+    pub group: u32,
     /// WGSL binding number.
     pub binding: u32,
     /// What is bound.
@@ -44,19 +46,29 @@ pub struct Bind {
 }
 
 impl Bind {
-    /// Binds `buffer` at `binding`.
+    /// Binds `buffer` at group 0, `binding`.
     pub fn new(binding: u32, buffer: BufferId) -> Self {
-        Self { binding, resource: Resource::Buffer(buffer) }
+        Self { group: 0, binding, resource: Resource::Buffer(buffer) }
     }
 
-    /// Binds `texture` at `binding`.
+    /// Binds `texture` at group 0, `binding`.
     pub fn texture(binding: u32, texture: TextureId) -> Self {
-        Self { binding, resource: Resource::Texture(texture) }
+        Self { group: 0, binding, resource: Resource::Texture(texture) }
     }
 
-    /// Binds `sampler` at `binding`.
+    /// Binds `sampler` at group 0, `binding`.
     pub fn sampler(binding: u32, sampler: SamplerId) -> Self {
-        Self { binding, resource: Resource::Sampler(sampler) }
+        Self { group: 0, binding, resource: Resource::Sampler(sampler) }
+    }
+
+    /// Binds `resource` at `@group(group) @binding(binding)`.
+    pub fn at(group: u32, binding: u32, resource: Resource) -> Self {
+        Self { group, binding, resource }
+    }
+
+    /// Its `(group, binding)`.
+    pub fn slot(&self) -> (u32, u32) {
+        (self.group, self.binding)
     }
 
     /// The buffer bound, if a buffer is.

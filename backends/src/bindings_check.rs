@@ -35,6 +35,7 @@ pub fn check_kernel_fits(kernel: &Kernel, device: &DeviceInfo) -> Result<(), Bac
         exceeded(["workgroup size x", "workgroup size y", "workgroup size z"][axis], u64::from(size), u64::from(max))?;
     }
     exceeded("workgroup memory bytes", kernel.workgroup_memory_bytes(), limits.max_workgroup_storage)?;
+    exceeded("bind groups", u64::from(kernel.group_count()), u64::from(limits.max_bind_groups))?;
     let storage = kernel.bindings.iter().filter(|b| matches!(b.kind, BindingKind::Storage(_))).count();
     exceeded("storage buffers per stage", storage as u64, u64::from(limits.max_storage_buffers_per_stage))
 }
@@ -60,23 +61,27 @@ pub fn check_binds(
     device: &DeviceInfo,
     lookup: &ResourceLookup,
 ) -> Result<(), BackendError> {
-    let error = |binding: u32, reason: String| BackendError::Binding { kernel: kernel.name().into(), binding, reason };
+    let error = |(group, binding): (u32, u32), reason: String| BackendError::Binding {
+        kernel: kernel.name().into(),
+        binding,
+        reason: if group == 0 { reason } else { format!("(group {group}) {reason}") },
+    };
     for (index, bind) in binds.iter().enumerate() {
-        if binds[..index].iter().any(|b| b.binding == bind.binding) {
-            return Err(error(bind.binding, "bound twice".into()));
+        if binds[..index].iter().any(|b| b.slot() == bind.slot()) {
+            return Err(error(bind.slot(), "bound twice".into()));
         }
-        if kernel.binding(0, bind.binding).is_none() {
-            return Err(error(bind.binding, "the kernel has no such binding".into()));
+        if kernel.binding(bind.group, bind.binding).is_none() {
+            return Err(error(bind.slot(), "the kernel has no such binding".into()));
         }
     }
     // One resource at several bindings: WebGPU allows it only when none of them writes
     // (a writable storage binding is an exclusive usage within a dispatch).
     for (index, bind) in binds.iter().enumerate() {
         for other in binds[..index].iter().filter(|b| b.resource == bind.resource) {
-            let writes = |binding: u32| kernel.binding(0, binding).is_some_and(|info| info.is_writable());
-            if writes(bind.binding) || writes(other.binding) {
+            let writes = |b: &Bind| kernel.binding(b.group, b.binding).is_some_and(|info| info.is_writable());
+            if writes(bind) || writes(other) {
                 return Err(error(
-                    bind.binding,
+                    bind.slot(),
                     format!(
                         "its {} is also bound at binding {}, and one of them is writable",
                         bind.resource.describe(),
@@ -87,13 +92,14 @@ pub fn check_binds(
         }
     }
     for info in &kernel.bindings {
+        let slot = (info.group, info.binding);
         let bind = binds
             .iter()
-            .find(|b| b.binding == info.binding)
-            .ok_or_else(|| error(info.binding, format!("`{}` is not bound", info.name)))?;
+            .find(|b| b.slot() == slot)
+            .ok_or_else(|| error(slot, format!("`{}` is not bound", info.name)))?;
         let wrong_kind = || {
             error(
-                info.binding,
+                slot,
                 format!("`{}` is a {}, but {} is bound", info.name, info.element.type_name, bind.resource.describe()),
             )
         };
@@ -105,7 +111,7 @@ pub fn check_binds(
                 let desc = (lookup.texture)(texture)?;
                 if desc.dimension != dimension || desc.format.kind() != kind {
                     return Err(error(
-                        info.binding,
+                        slot,
                         format!(
                             "`{}` is a {}, but texture `{}` is a {} texture of {}",
                             info.name,
@@ -121,7 +127,7 @@ pub fn check_binds(
                 let desc = (lookup.texture)(texture)?;
                 if desc.dimension != dimension || desc.format != format {
                     return Err(error(
-                        info.binding,
+                        slot,
                         format!(
                             "`{}` is a {}, but texture `{}` is a {} texture of {}",
                             info.name,

@@ -56,4 +56,6 @@ pub struct DeviceLimits {
     pub max_texture_3d: u32,
     /// Layers of a 2-D array texture.
     pub max_texture_layers: u32,
+    /// Bind groups (descriptor sets) of one pipeline.
+    pub max_bind_groups: u32,
 }

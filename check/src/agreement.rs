@@ -252,7 +252,7 @@ mod tests {
         };
         BackendRun {
             backend: backend.into(),
-            outputs: Ok(vec![OutputBuffer { binding: 1, name: "out".into(), bytes, kinds }]),
+            outputs: Ok(vec![OutputBuffer { group: 0, binding: 1, name: "out".into(), bytes, kinds }]),
         }
     }
 
@@ -299,6 +299,7 @@ mod tests {
         let run = |backend: &str, word: u32| BackendRun {
             backend: backend.into(),
             outputs: Ok(vec![OutputBuffer {
+                group: 0,
                 binding: 0,
                 name: "texels".into(),
                 bytes: word.to_le_bytes().to_vec(),

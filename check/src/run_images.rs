@@ -12,8 +12,11 @@
 //!   format defaults to the kernel's).
 //! * `--sampler G:B=FILTER,ADDRESS`: `nearest` or `linear` (magnification,
 //!   minification and mip levels alike); `clamp`, `repeat` or `mirror` (every axis).
+//!
+//! `G` is the WGSL group: a kernel may bind several (wgpu bind groups, Vulkan descriptor
+//! sets; naga's GLSL, which has no sets, gets them flattened).
 
-use crate::run_kernel::{ImageInput, ImageInputs, OutputBuffer};
+use crate::run_kernel::{GroupedImages, ImageInput, OutputBuffer, Slot};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 pub use strata_backends::SamplerDesc;
@@ -36,22 +39,22 @@ pub enum TextureFile {
     },
 }
 
-/// One texture or sampler of a run, by binding (group 0).
+/// One texture or sampler of a run, by `(group, binding)`.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ImageSpec {
     /// `--texture`.
-    Texture(u32, TextureFile),
+    Texture(Slot, TextureFile),
     /// `--storage-texture`: size, and the format if given.
-    StorageTexture(u32, [u32; 3], Option<TexelFormat>),
+    StorageTexture(Slot, [u32; 3], Option<TexelFormat>),
     /// `--sampler`.
-    Sampler(u32, SamplerDesc),
+    Sampler(Slot, SamplerDesc),
 }
 
 impl ImageSpec {
-    /// The binding it is for.
-    pub fn binding(&self) -> u32 {
+    /// The `(group, binding)` it is for.
+    pub fn slot(&self) -> Slot {
         match self {
-            Self::Texture(b, _) | Self::StorageTexture(b, ..) | Self::Sampler(b, _) => *b,
+            Self::Texture(s, _) | Self::StorageTexture(s, ..) | Self::Sampler(s, _) => *s,
         }
     }
 }
@@ -144,14 +147,14 @@ fn read_picture(path: &Path) -> Result<([u32; 3], TexelFormat, Vec<u8>)> {
 /// The textures and samplers `specs` describe, for `kernel`'s bindings: each checked
 /// against the binding's kind, shape and (for storage textures) format, with an error
 /// naming the flag, the binding and the mismatch.
-pub fn image_inputs(kernel: &Kernel, specs: &[ImageSpec]) -> Result<ImageInputs> {
-    let mut inputs = ImageInputs::new();
+pub fn image_inputs(kernel: &Kernel, specs: &[ImageSpec]) -> Result<GroupedImages> {
+    let mut inputs = GroupedImages::new();
     for spec in specs {
-        let binding = spec.binding();
-        let Some(info) = kernel.binding(0, binding) else {
-            bail!("binding 0:{binding}: entry point `{}` has no such binding", kernel.entry_point());
+        let (group, binding) = spec.slot();
+        let Some(info) = kernel.binding(group, binding) else {
+            bail!("binding {group}:{binding}: entry point `{}` has no such binding", kernel.entry_point());
         };
-        let what = format!("binding 0:{binding} (`{}`: {})", info.name, info.element.type_name);
+        let what = format!("binding {group}:{binding} (`{}`: {})", info.name, info.element.type_name);
         let (dimension, declared) = match info.kind {
             BindingKind::SampledTexture { dimension, .. } => (Some(dimension), None),
             BindingKind::StorageTexture { dimension, format, .. } => (Some(dimension), Some(format)),
@@ -197,7 +200,7 @@ pub fn image_inputs(kernel: &Kernel, specs: &[ImageSpec]) -> Result<ImageInputs>
                 ImageInput::Texture { desc, levels: Vec::new() }
             }
         };
-        inputs.push((binding, input));
+        inputs.push(((group, binding), input));
     }
     Ok(inputs)
 }

@@ -8,7 +8,7 @@ use crate::run_images::ImageSpec;
 use crate::{BackendSlot, backend_slots};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
-use strata_backends::{Backend, Bind, BufferId, SamplerDesc, SamplerId, TextureDesc, TextureId};
+use strata_backends::{Backend, Bind, BufferId, Resource, SamplerDesc, SamplerId, TextureDesc, TextureId};
 use strata_kernels::{BindingKind, Kernel, WordKinds};
 
 /// What to run.
@@ -37,7 +37,9 @@ pub struct RunRequest {
 /// One writable buffer (or storage texture, its level 0) after a run.
 #[derive(Clone, Debug)]
 pub struct OutputBuffer {
-    /// `@binding` number (group 0).
+    /// `@group` number.
+    pub group: u32,
+    /// `@binding` number.
     pub binding: u32,
     /// WGSL variable name.
     pub name: String,
@@ -97,18 +99,33 @@ enum Created {
     Sampler(SamplerId),
 }
 
+/// A binding's `(group, binding)`.
+pub type Slot = (u32, u32);
+
+/// Buffer contents by `(group, binding)`.
+pub type GroupedInputs = Vec<(Slot, Vec<u8>)>;
+
+/// Textures and samplers by `(group, binding)`.
+pub type GroupedImages = Vec<(Slot, ImageInput)>;
+
+/// Group 0's inputs as grouped ones.
+fn in_group_zero<T: Clone>(inputs: &[(u32, T)]) -> Vec<(Slot, T)> {
+    inputs.iter().map(|(binding, value)| ((0, *binding), value.clone())).collect()
+}
+
 fn run_on(
     backend: &mut dyn Backend,
     kernel: &Kernel,
-    inputs: &Inputs,
-    images: &ImageInputs,
+    inputs: &GroupedInputs,
+    images: &GroupedImages,
     workgroups: [u32; 3],
 ) -> Result<Vec<OutputBuffer>> {
     backend.check_kernel(kernel)?;
     let mut created = Vec::new();
     let result = (|| {
         for binding in &kernel.bindings {
-            let image = images.iter().find(|(b, _)| *b == binding.binding).map(|(_, input)| input);
+            let slot = (binding.group, binding.binding);
+            let image = images.iter().find(|(s, _)| *s == slot).map(|(_, input)| input);
             let resource = match (binding.kind, image) {
                 (BindingKind::Sampler, Some(ImageInput::Sampler(desc))) => {
                     Created::Sampler(backend.create_sampler(desc)?)
@@ -133,7 +150,7 @@ fn run_on(
                     )
                 }
                 _ => {
-                    let bytes = match inputs.iter().find(|(b, _)| *b == binding.binding) {
+                    let bytes = match inputs.iter().find(|(s, _)| *s == slot) {
                         Some((_, bytes)) => {
                             let mut bytes = bytes.clone();
                             bytes.resize(bytes.len().div_ceil(4) * 4, 0);
@@ -151,10 +168,13 @@ fn run_on(
         }
         let binds: Vec<Bind> = created
             .iter()
-            .map(|(b, resource)| match resource {
-                Created::Buffer(id) => Bind::new(b.binding, *id),
-                Created::Texture(id) => Bind::texture(b.binding, *id),
-                Created::Sampler(id) => Bind::sampler(b.binding, *id),
+            .map(|(b, resource)| {
+                let resource = match resource {
+                    Created::Buffer(id) => Resource::Buffer(*id),
+                    Created::Texture(id) => Resource::Texture(*id),
+                    Created::Sampler(id) => Resource::Sampler(*id),
+                };
+                Bind::at(b.group, b.binding, resource)
             })
             .collect();
         backend.dispatch(kernel, &binds, workgroups)?;
@@ -166,6 +186,7 @@ fn run_on(
                 _ => continue,
             };
             outputs.push(OutputBuffer {
+                group: binding.group,
                 binding: binding.binding,
                 name: binding.name.clone(),
                 bytes,
@@ -215,6 +236,18 @@ pub fn run_loaded_with_images(
     kernel: &Kernel,
     inputs: &Inputs,
     images: &ImageInputs,
+    workgroups: [u32; 3],
+    slots: &[BackendSlot],
+) -> Vec<BackendRun> {
+    run_loaded_in_groups(kernel, &in_group_zero(inputs), &in_group_zero(images), workgroups, slots)
+}
+
+/// [`run_loaded_with_images`] for a kernel of any bind groups: inputs by
+/// `(group, binding)`.
+pub fn run_loaded_in_groups(
+    kernel: &Kernel,
+    inputs: &GroupedInputs,
+    images: &GroupedImages,
     workgroups: [u32; 3],
     slots: &[BackendSlot],
 ) -> Vec<BackendRun> {
@@ -269,48 +302,42 @@ pub fn inexact_functions(kernel: &Kernel) -> Vec<&'static str> {
 }
 
 /// Runs the request on every named backend and writes the outputs under `request.out`
-/// (`BACKEND/0_BINDING_NAME.bin`; a storage texture also as `.png` or `.exr`).
+/// (`BACKEND/GROUP_BINDING_NAME.bin`; a storage texture also as `.png` or `.exr`).
 pub fn run_kernel(request: &RunRequest) -> Result<RunOutcome> {
-    let groups = request.buffers.iter().map(|(g, b, _)| (g, b)).chain(request.sizes.iter().map(|(g, b, _)| (g, b)));
-    for (group, binding) in groups {
-        if *group != 0 {
-            bail!("--buffer/--size {group}:{binding}: only @group(0) is supported");
-        }
-    }
     let kernel = load_shader(&request.shader, &request.entry, &request.overrides)?;
     let slots = named_slots(&request.backends)?;
-    let mut inputs = Inputs::new();
-    for (_, binding, file) in &request.buffers {
-        if kernel.binding(0, *binding).is_none() {
-            bail!("--buffer 0:{binding}={}: entry point `{}` has no such binding", file.display(), request.entry);
+    let mut inputs = GroupedInputs::new();
+    for (group, binding, file) in &request.buffers {
+        if kernel.binding(*group, *binding).is_none() {
+            bail!("--buffer {group}:{binding}={}: entry point `{}` has no such binding", file.display(), request.entry);
         }
         let bytes = std::fs::read(file).with_context(|| format!("cannot read buffer file {}", file.display()))?;
         if bytes.is_empty() {
             bail!("buffer file {} is empty", file.display());
         }
-        inputs.push((*binding, bytes));
+        inputs.push(((*group, *binding), bytes));
     }
-    for (_, binding, size) in &request.sizes {
-        if kernel.binding(0, *binding).is_none() {
-            bail!("--size 0:{binding}={size}: entry point `{}` has no such binding", request.entry);
+    for (group, binding, size) in &request.sizes {
+        if kernel.binding(*group, *binding).is_none() {
+            bail!("--size {group}:{binding}={size}: entry point `{}` has no such binding", request.entry);
         }
         if *size == 0 {
-            bail!("--size 0:{binding}=0: buffers need at least one byte");
+            bail!("--size {group}:{binding}=0: buffers need at least one byte");
         }
-        inputs.push((*binding, vec![0; *size as usize]));
+        inputs.push(((*group, *binding), vec![0; *size as usize]));
     }
     let images = crate::run_images::image_inputs(&kernel, &request.images)?;
-    let runs = run_loaded_with_images(&kernel, &inputs, &images, request.workgroups, &slots);
+    let runs = run_loaded_in_groups(&kernel, &inputs, &images, request.workgroups, &slots);
     for run in &runs {
         if let Ok(outputs) = &run.outputs {
             let dir = request.out.join(&run.backend);
             std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
             for output in outputs {
-                let stem = dir.join(format!("0_{}_{}", output.binding, output.name));
+                let stem = dir.join(format!("{}_{}_{}", output.group, output.binding, output.name));
                 let file = stem.with_extension("bin");
                 std::fs::write(&file, &output.bytes).with_context(|| format!("cannot write {}", file.display()))?;
-                let texture = images.iter().find_map(|(binding, input)| match input {
-                    ImageInput::Texture { desc, .. } if *binding == output.binding => Some(desc),
+                let texture = images.iter().find_map(|(slot, input)| match input {
+                    ImageInput::Texture { desc, .. } if *slot == (output.group, output.binding) => Some(desc),
                     _ => None,
                 });
                 if let Some(desc) = texture {

@@ -11,7 +11,7 @@
 
 use crate::BackendSlot;
 use crate::agreement::{FloatBound, Judgement, Tolerance, judge};
-use crate::run_kernel::{BackendRun, ImageInput, ImageInputs, Inputs, run_loaded_with_images};
+use crate::run_kernel::{BackendRun, GroupedImages, GroupedInputs, ImageInput, run_loaded_in_groups};
 use strata_backends::{AddressMode, FilterMode, SamplerDesc, TextureDesc};
 use strata_kernels::{Kernel, TexelFormat, TextureDimension};
 
@@ -28,10 +28,10 @@ pub struct TextureCase {
     pub name: String,
     /// Workgroups dispatched.
     pub workgroups: [u32; 3],
-    /// Buffer contents by binding.
-    pub buffers: Inputs,
-    /// Textures and samplers by binding.
-    pub images: ImageInputs,
+    /// Buffer contents by `(group, binding)`.
+    pub buffers: GroupedInputs,
+    /// Textures and samplers by `(group, binding)`.
+    pub images: GroupedImages,
     /// Bounds for f32 words (integers and texels otherwise exact), each with why.
     pub bounds: Vec<(&'static str, FloatBound, &'static str)>,
     /// Paths that must refuse the kernel (a one-line "unavailable" naming why).
@@ -51,6 +51,7 @@ pub fn source(file: &str) -> &'static str {
         "blur.wgsl" => include_str!("../../tests/data/textures/blur.wgsl"),
         "sample.wgsl" => include_str!("../../tests/data/textures/sample.wgsl"),
         "downsample.wgsl" => include_str!("../../tests/data/textures/downsample.wgsl"),
+        "two_groups.wgsl" => include_str!("../../tests/data/textures/two_groups.wgsl"),
         other => panic!("{other} is not in the texture corpus"),
     }
 }
@@ -191,12 +192,12 @@ fn load_cases() -> Vec<TextureCase> {
             name: format!("load.wgsl on {}", format.wgsl()),
             workgroups: [window.0.div_ceil(8), window.1.div_ceil(8), levels + 1],
             buffers: vec![
-                (1, vec![0; (window.0 * window.1 * (levels + 1) * 16) as usize]),
-                (2, vec![0; (4 * (1 + 2 * levels)) as usize]),
-                (3, vec![0; (window.0 * window.1 * (levels + 1) * 16) as usize]),
+                ((0, 1), vec![0; (window.0 * window.1 * (levels + 1) * 16) as usize]),
+                ((0, 2), vec![0; (4 * (1 + 2 * levels)) as usize]),
+                ((0, 3), vec![0; (window.0 * window.1 * (levels + 1) * 16) as usize]),
             ],
             images: vec![(
-                0,
+                (0, 0),
                 texture(TextureDimension::D2, [width, height, 1], levels, format, seed as u64 + 1, (-4.0, 4.0)),
             )],
             bounds: if format == TexelFormat::Rgba8Unorm {
@@ -221,10 +222,13 @@ fn integer_cases() -> Vec<TextureCase> {
             entry: "main",
             name: format!("integer.wgsl on {} and r32sint", unsigned.wgsl()),
             workgroups: [width.div_ceil(8), height.div_ceil(8), 1],
-            buffers: vec![(2, vec![0; (width * height * 16) as usize]), (3, vec![0; (width * height * 16) as usize])],
+            buffers: vec![
+                ((0, 2), vec![0; (width * height * 16) as usize]),
+                ((0, 3), vec![0; (width * height * 16) as usize]),
+            ],
             images: vec![
-                (0, texture(TextureDimension::D2, size, 1, unsigned, 10 + seed as u64, (0.0, 1.0))),
-                (1, texture(TextureDimension::D2, size, 1, TexelFormat::R32Sint, 20 + seed as u64, (0.0, 1.0))),
+                ((0, 0), texture(TextureDimension::D2, size, 1, unsigned, 10 + seed as u64, (0.0, 1.0))),
+                ((0, 1), texture(TextureDimension::D2, size, 1, TexelFormat::R32Sint, 20 + seed as u64, (0.0, 1.0))),
             ],
             bounds: Vec::new(),
             refused_by: &[],
@@ -247,11 +251,11 @@ fn store_case() -> TextureCase {
         entry: "main",
         name: "store.wgsl".into(),
         workgroups: [width.div_ceil(8), height.div_ceil(8), 1],
-        buffers: vec![(7, bytes(&values))],
+        buffers: vec![((0, 7), bytes(&values))],
         images: TexelFormat::ALL
             .iter()
             .enumerate()
-            .map(|(b, &f)| (b as u32, blank(TextureDimension::D2, [width, height, 1], f)))
+            .map(|(b, &f)| ((0, b as u32), blank(TextureDimension::D2, [width, height, 1], f)))
             .collect(),
         bounds: Vec::new(),
         refused_by: &["ash-slang"],
@@ -267,11 +271,11 @@ fn read_write_case() -> TextureCase {
         entry: "main",
         name: "read_write.wgsl".into(),
         workgroups: [width.div_ceil(8), height.div_ceil(8), 1],
-        buffers: Vec::new(),
+        buffers: GroupedInputs::new(),
         images: vec![
-            (0, texture(TextureDimension::D2, size, 1, TexelFormat::R32Uint, 4, (0.0, 1.0))),
-            (1, texture(TextureDimension::D2, size, 1, TexelFormat::R32Float, 5, (-2.0, 2.0))),
-            (2, texture(TextureDimension::D2, size, 1, TexelFormat::R32Float, 6, (-2.0, 2.0))),
+            ((0, 0), texture(TextureDimension::D2, size, 1, TexelFormat::R32Uint, 4, (0.0, 1.0))),
+            ((0, 1), texture(TextureDimension::D2, size, 1, TexelFormat::R32Float, 5, (-2.0, 2.0))),
+            ((0, 2), texture(TextureDimension::D2, size, 1, TexelFormat::R32Float, 6, (-2.0, 2.0))),
         ],
         bounds: Vec::new(),
         refused_by: &["ash-slang"],
@@ -285,14 +289,14 @@ fn shapes_case() -> TextureCase {
         entry: "main",
         name: "shapes.wgsl".into(),
         workgroups: [1, 1, 4],
-        buffers: vec![(6, vec![0; 32])],
+        buffers: vec![((0, 6), vec![0; 32])],
         images: vec![
-            (0, texture(TextureDimension::D1, [8, 1, 1], 1, TexelFormat::R32Float, 7, (0.0, 4.0))),
-            (1, texture(TextureDimension::D2Array, [8, 8, 4], 1, TexelFormat::Rgba16Float, 8, (-2.0, 2.0))),
-            (2, texture(TextureDimension::D3, [8, 8, 4], 2, TexelFormat::Rgba32Float, 9, (-2.0, 2.0))),
-            (3, blank(TextureDimension::D1, [8, 1, 1], TexelFormat::R32Uint)),
-            (4, blank(TextureDimension::D2Array, [8, 8, 4], TexelFormat::Rgba32Float)),
-            (5, blank(TextureDimension::D3, [8, 8, 4], TexelFormat::Rgba32Float)),
+            ((0, 0), texture(TextureDimension::D1, [8, 1, 1], 1, TexelFormat::R32Float, 7, (0.0, 4.0))),
+            ((0, 1), texture(TextureDimension::D2Array, [8, 8, 4], 1, TexelFormat::Rgba16Float, 8, (-2.0, 2.0))),
+            ((0, 2), texture(TextureDimension::D3, [8, 8, 4], 2, TexelFormat::Rgba32Float, 9, (-2.0, 2.0))),
+            ((0, 3), blank(TextureDimension::D1, [8, 1, 1], TexelFormat::R32Uint)),
+            ((0, 4), blank(TextureDimension::D2Array, [8, 8, 4], TexelFormat::Rgba32Float)),
+            ((0, 5), blank(TextureDimension::D3, [8, 8, 4], TexelFormat::Rgba32Float)),
         ],
         bounds: Vec::new(),
         refused_by: &["wgpu-gl", "ash-slang"],
@@ -309,10 +313,10 @@ fn blur_cases() -> Vec<TextureCase> {
             entry,
             name: format!("blur.wgsl {entry}"),
             workgroups,
-            buffers: Vec::new(),
+            buffers: GroupedInputs::new(),
             images: vec![
-                (0, texture(TextureDimension::D2, [width, height, 1], 1, TexelFormat::Rgba8Unorm, 12, (0.0, 1.0))),
-                (1, blank(TextureDimension::D2, [width, height, 1], TexelFormat::Rgba16Float)),
+                ((0, 0), texture(TextureDimension::D2, [width, height, 1], 1, TexelFormat::Rgba8Unorm, 12, (0.0, 1.0))),
+                ((0, 1), blank(TextureDimension::D2, [width, height, 1], TexelFormat::Rgba16Float)),
             ],
             bounds: Vec::new(),
             refused_by: &[],
@@ -348,13 +352,13 @@ fn sample_cases() -> Vec<TextureCase> {
                 entry: "main",
                 name: format!("sample.wgsl on {} with {what}", format.wgsl()),
                 workgroups: [4, 1, 1],
-                buffers: vec![(2, bytes(&probes)), (3, vec![0; 256 * 3 * 16])],
+                buffers: vec![((0, 2), bytes(&probes)), ((0, 3), vec![0; 256 * 3 * 16])],
                 images: vec![
                     (
-                        0,
+                        (0, 0),
                         texture(TextureDimension::D2, [width, height, 1], levels, format, 30 + seed as u64, (0.0, 1.0)),
                     ),
-                    (1, ImageInput::Sampler(*sampler)),
+                    ((0, 1), ImageInput::Sampler(*sampler)),
                 ],
                 bounds: vec![(
                     "sampled",
@@ -362,12 +366,35 @@ fn sample_cases() -> Vec<TextureCase> {
                     "weights quantised to 8 bits of sub-texel and mipmap precision by the device, exact in the \
                      interpreter",
                 )],
-                refused_by: &["ash-hlsl", "ash-slang"],
+                refused_by: &[],
                 rule: None,
             });
         }
     }
     cases
+}
+
+fn two_groups_case() -> TextureCase {
+    let (width, height) = (21u32, 13u32);
+    let params: [u32; 2] = [0.75f32.to_bits(), 16];
+    TextureCase {
+        file: "two_groups.wgsl",
+        entry: "main",
+        name: "two_groups.wgsl (groups 0 and 2)".into(),
+        workgroups: [width.div_ceil(8), height.div_ceil(8), 1],
+        buffers: vec![((0, 1), bytes(&params))],
+        images: vec![
+            ((0, 0), texture(TextureDimension::D2, [width, height, 1], 1, TexelFormat::Rgba8Unorm, 40, (0.0, 1.0))),
+            ((2, 0), blank(TextureDimension::D2, [width, height, 1], TexelFormat::Rgba8Unorm)),
+        ],
+        bounds: vec![(
+            "result",
+            FloatBound { ulp: 1, abs: 0.0 },
+            "gain × c / 255 stored as unorm: lavapipe's c × (1/255) may round it to the next step",
+        )],
+        refused_by: &[],
+        rule: None,
+    }
 }
 
 /// Every case of the corpus, in table order.
@@ -379,6 +406,7 @@ pub fn texture_cases() -> Vec<TextureCase> {
     cases.push(shapes_case());
     cases.extend(blur_cases());
     cases.extend(sample_cases());
+    cases.push(two_groups_case());
     cases
 }
 
@@ -394,7 +422,7 @@ impl TextureCase {
     /// Runs the case on `slots`.
     pub fn run(&self, slots: &[BackendSlot]) -> Vec<BackendRun> {
         match Kernel::from_wgsl(self.file, source(self.file).into(), self.entry, false) {
-            Ok(kernel) => run_loaded_with_images(&kernel, &self.buffers, &self.images, self.workgroups, slots),
+            Ok(kernel) => run_loaded_in_groups(&kernel, &self.buffers, &self.images, self.workgroups, slots),
             Err(error) => {
                 slots.iter().map(|s| BackendRun { backend: s.name.into(), outputs: Err(error.to_string()) }).collect()
             }

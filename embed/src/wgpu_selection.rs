@@ -92,13 +92,16 @@ fn scoped<T>(device: &wgpu::Device, operation: &str, f: impl FnOnce() -> T) -> R
 fn pipeline(device: &wgpu::Device, module: &WgslModule) -> Result<Pipeline, EmbedError> {
     let kernel = Registry::shared()?.get(module.id.kernel());
     let define_integer_division = device.adapter_info().backend == wgpu::Backend::Gl;
-    let (pipeline, layout) = strata_backends::wgpu_backend::kernel_pipeline(device, kernel, define_integer_division)
-        .map_err(|error| EmbedError::Api {
-            api: "wgpu",
-            operation: format!("creating the `{}` pipeline", module.entry_point),
-            message: error.to_string(),
+    let (pipeline, mut layouts) =
+        strata_backends::wgpu_backend::kernel_pipeline(device, kernel, define_integer_division).map_err(|error| {
+            EmbedError::Api {
+                api: "wgpu",
+                operation: format!("creating the `{}` pipeline", module.entry_point),
+                message: error.to_string(),
+            }
         })?;
-    Ok(Pipeline { pipeline, layout, kernel })
+    // Registry kernels use group 0 alone: one layout.
+    Ok(Pipeline { pipeline, layout: layouts.remove(0), kernel })
 }
 
 fn check_usage(role: BufferRole, slice: WgpuBufferSlice, alignment: u64) -> Result<(), EmbedError> {

@@ -12,23 +12,26 @@ use crate::binding::BindingKind;
 use crate::registry::Kernel;
 use naga::{Expression, Handle};
 
-/// Per sampled texture of `kernel` (binding), the binding of the sampler it is sampled
-/// with, `None` when it is only loaded; an error naming a texture sampled with two
+/// A sampled texture's `(group, binding)` and its sampler's, if it is sampled.
+pub type Pair = ((u32, u32), Option<(u32, u32)>);
+
+/// Per sampled texture of `kernel` (its `(group, binding)`), the `(group, binding)` of
+/// the sampler it is sampled with, `None` when it is only loaded; an error naming a texture sampled with two
 /// samplers (two combined samplers at one binding) or through a function argument
 /// (whose pairing naga resolves per call).
-pub fn combined_samplers(kernel: &Kernel) -> Result<Vec<(u32, Option<u32>)>, String> {
+pub fn combined_samplers(kernel: &Kernel) -> Result<Vec<Pair>, String> {
     let module = &kernel.module;
     let binding_of = |function: &naga::Function, h: Handle<Expression>| match function.expressions[h] {
         Expression::GlobalVariable(g) => {
-            Ok(module.global_variables[g].binding.as_ref().map_or(u32::MAX, |b| b.binding))
+            Ok(module.global_variables[g].binding.as_ref().map_or((u32::MAX, u32::MAX), |b| (b.group, b.binding)))
         }
         _ => Err("a texture sampled through a function argument".to_string()),
     };
-    let mut pairs: Vec<(u32, Option<u32>)> = kernel
+    let mut pairs: Vec<Pair> = kernel
         .bindings
         .iter()
         .filter(|b| matches!(b.kind, BindingKind::SampledTexture { .. }))
-        .map(|b| (b.binding, None))
+        .map(|b| ((b.group, b.binding), None))
         .collect();
     let functions = module.functions.iter().map(|(_, f)| f).chain(module.entry_points.iter().map(|e| &e.function));
     for function in functions {
@@ -39,7 +42,8 @@ pub fn combined_samplers(kernel: &Kernel) -> Result<Vec<(u32, Option<u32>)>, Str
             match pair.1 {
                 Some(other) if other != sampler => {
                     return Err(format!(
-                        "texture at binding {texture} sampled with the samplers at bindings {other} and {sampler}"
+                        "texture at binding {} sampled with the samplers at bindings {} and {}",
+                        texture.1, other.1, sampler.1
                     ));
                 }
                 _ => pair.1 = Some(sampler),
@@ -64,7 +68,7 @@ mod tests {
                 o[0] = textureSampleLevel(a, s, vec2(0.5), 0.0) + textureLoad(b, vec2(0), 0);
             }";
         let kernel = Kernel::from_wgsl("pairs.wgsl", source.into(), "main", false).unwrap();
-        assert_eq!(combined_samplers(&kernel), Ok(vec![(0, Some(2)), (1, None)]));
+        assert_eq!(combined_samplers(&kernel), Ok(vec![((0, 0), Some((0, 2))), ((0, 1), None)]));
         let twice = source.replace("textureLoad(b, vec2(0), 0)", "textureSampleLevel(a, t, vec2(0.5), 0.0)");
         let kernel = Kernel::from_wgsl("twice.wgsl", twice, "main", false).unwrap();
         assert!(combined_samplers(&kernel).unwrap_err().contains("bindings 2 and 3"));

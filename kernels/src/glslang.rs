@@ -60,6 +60,7 @@ pub fn compile(kernel: &Kernel, input: GlslangInput, dir: &Path) -> Result<(Vec<
     let mut translation = translation.map_err(|e| ToolError::Failed(e.to_string()))?;
     if input == GlslangInput::Hlsl {
         translation.text = byte_address_lengths_in_bytes(&translation.text)?;
+        translation.text = crate::hlsl_samplers::plain_samplers(&translation.text).map_err(ToolError::Failed)?;
     }
     let source = dir.join(format!("{}.{extension}", kernel.name()));
     let output = dir.join(format!("{}.{extension}.spv", kernel.name()));

@@ -50,6 +50,7 @@ pub mod embed_types;
 pub mod error;
 pub mod glslang;
 pub mod hash;
+pub mod hlsl_samplers;
 pub mod integer_division;
 mod ir_edit;
 pub mod layout;

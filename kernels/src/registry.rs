@@ -63,6 +63,22 @@ impl Kernel {
         self.bindings.iter().find(|b| b.group == group && b.binding == binding)
     }
 
+    /// How many bind groups (descriptor sets) its pipeline layout has: one past the
+    /// highest group it uses (groups it skips are empty), 1 without bindings.
+    pub fn group_count(&self) -> u32 {
+        self.bindings.iter().map(|b| b.group + 1).max().unwrap_or(1)
+    }
+
+    /// The binding number of `(group, binding)` in one flat set, for a translation that
+    /// has no descriptor sets (naga's GLSL): the WGSL binding itself when the kernel uses
+    /// group 0 alone, else its index in the kernel's `(group, binding)` order.
+    pub fn flat_binding(&self, group: u32, binding: u32) -> u32 {
+        if self.group_count() == 1 {
+            return binding;
+        }
+        self.bindings.iter().position(|b| b.group == group && b.binding == binding).map_or(u32::MAX, |i| i as u32)
+    }
+
     /// The binding whose WGSL variable is `name`.
     pub fn binding_named(&self, name: &str) -> Option<&BindingInfo> {
         self.bindings.iter().find(|b| b.name == name)
@@ -176,7 +192,8 @@ impl Kernel {
                 entry: spec.entry_point.to_string(),
             })?;
         let workgroup_size = module.entry_points[entry_index].workgroup_size;
-        let bindings = describe_bindings(&spec.name, &module, &info, entry_index)?;
+        let registry = !matches!(id, KernelId::External(_));
+        let bindings = describe_bindings(&spec.name, &module, &info, entry_index, registry)?;
         Ok(Kernel { id, spec, source, module, info, workgroup_size, bindings })
     }
 }
@@ -219,11 +236,15 @@ fn specialise(
     Ok((module.into_owned(), info.into_owned()))
 }
 
+/// The bindings the entry point uses. A registry kernel (`registry`) must keep to
+/// `@group(0)`: strata-embed, the export's C header and the GLSL translations of the
+/// package bind one descriptor set; an outside kernel may use any group.
 fn describe_bindings(
     kernel: &str,
     module: &naga::Module,
     info: &ModuleInfo,
     entry_index: usize,
+    registry: bool,
 ) -> Result<Vec<BindingInfo>, KernelError> {
     let mut layouter = naga::proc::Layouter::default();
     layouter
@@ -260,8 +281,8 @@ fn describe_bindings(
                 return Err(unsupported("only buffers, textures and samplers can be bound"));
             }
         };
-        if resource.group != 0 {
-            return Err(unsupported("registry kernels use @group(0) only (GLSL has no descriptor sets)"));
+        if registry && resource.group != 0 {
+            return Err(unsupported("registry kernels use @group(0) only (the package binds one descriptor set)"));
         }
         let (element, words) = match kind {
             BindingKind::Uniform | BindingKind::Storage(_) => {

@@ -6,7 +6,8 @@
 //   slang_hlsl FILE.hlsl ENTRY OUT.spv
 //
 // HLSL registers map to Vulkan bindings one to one (bN, tN, uN, sN -> binding N of set
-// `space`), as naga writes them from WGSL's @group/@binding. Part of strata (MIT OR
+// `space`, in every space: a shift given for space 0 alone left space 1's registers in
+// set 0), as naga writes them from WGSL's @group/@binding. Part of strata (MIT OR
 // Apache-2.0).
 #include <slang.h>
 
@@ -20,8 +21,8 @@ int main(int argc, char **argv) {
     SlangSession *session = spCreateSession();
     SlangCompileRequest *request = spCreateCompileRequest(session);
     const char *args[] = {"-lang", "hlsl", "-target", "spirv", "-profile", "cs_6_0", "-entry", argv[2],
-                          "-fvk-use-entrypoint-name", "-fvk-b-shift", "0", "0", "-fvk-t-shift", "0", "0",
-                          "-fvk-u-shift", "0", "0", "-fvk-s-shift", "0", "0", argv[1]};
+                          "-fvk-use-entrypoint-name", "-fvk-b-shift", "0", "all", "-fvk-t-shift", "0", "all",
+                          "-fvk-u-shift", "0", "all", "-fvk-s-shift", "0", "all", argv[1]};
     if (SLANG_FAILED(spProcessCommandLineArguments(request, args, sizeof args / sizeof args[0]))) {
         std::fprintf(stderr, "%s", spGetDiagnosticOutput(request));
         return 1;

@@ -145,13 +145,14 @@ pub fn msl_version(kernel: &Kernel, options: TranslateOptions, version: (u8, u8)
     Ok(Translation { text, words: Vec::new(), entry_point })
 }
 
-/// GLSL 4.50 core; bindings from WGSL's `@binding` (group 0 only).
+/// GLSL 4.50 core; bindings from WGSL's `@binding` (a kernel of several groups gets them
+/// flattened into one set: `Kernel::flat_binding`).
 pub fn glsl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, KernelError> {
     use naga::back::glsl;
     let mut binding_map = glsl::BindingMap::default();
     for binding in &kernel.bindings {
-        binding_map
-            .insert(naga::ResourceBinding { group: binding.group, binding: binding.binding }, binding.binding as u8);
+        let flat = kernel.flat_binding(binding.group, binding.binding) as u8;
+        binding_map.insert(naga::ResourceBinding { group: binding.group, binding: binding.binding }, flat);
     }
     let glsl_options = glsl::Options {
         version: glsl::Version::Desktop(450),

@@ -152,9 +152,9 @@ fn a_png_texture_and_a_sampler_run_everywhere_and_the_output_comes_back_as_png()
         sizes: Vec::new(),
         overrides: Vec::new(),
         images: vec![
-            ImageSpec::Texture(0, TextureFile::Picture(dir.join("in.png"))),
-            ImageSpec::Sampler(1, linear),
-            ImageSpec::StorageTexture(2, [width / 2, height / 2, 1], None),
+            ImageSpec::Texture((0, 0), TextureFile::Picture(dir.join("in.png"))),
+            ImageSpec::Sampler((0, 1), linear),
+            ImageSpec::StorageTexture((0, 2), [width / 2, height / 2, 1], None),
         ],
         backends: vec!["cpu".into(), "wgpu-vulkan".into(), "wgpu-gl".into(), "ash".into()],
         out: dir.join("out"),
@@ -180,7 +180,7 @@ fn a_png_texture_and_a_sampler_run_everywhere_and_the_output_comes_back_as_png()
     assert!((f64::from(out[texel]) - mean).abs() <= 1.0, "{} against {mean}", out[texel]);
     // A texture whose shape the kernel does not take is refused by name.
     let mut wrong = request.clone();
-    wrong.images[2] = ImageSpec::StorageTexture(2, [4, 4, 1], Some(strata_kernels::TexelFormat::R32Float));
+    wrong.images[2] = ImageSpec::StorageTexture((0, 2), [4, 4, 1], Some(strata_kernels::TexelFormat::R32Float));
     let error = run_kernel(&wrong).unwrap_err().to_string();
     assert!(error.contains("half_size") && error.contains("r32float") && error.contains("rgba8unorm"), "{error}");
 }

@@ -70,6 +70,11 @@ fn sampling_and_gathering_agree_within_the_filtering_precision_for_every_sampler
 }
 
 #[test]
+fn a_kernel_of_two_bind_groups_with_one_skipped_runs_everywhere() {
+    check_file("two_groups.wgsl");
+}
+
+#[test]
 fn the_out_of_range_rule_refuses_a_value_wgsl_does_not_allow() {
     let case = texture_cases().into_iter().find(|c| c.name == "load.wgsl on r32float").unwrap();
     let slots = strata_check::run_kernel::named_slots(&["cpu".into()]).unwrap();

@@ -11,12 +11,12 @@
 //!   references; prints a kernels × backends table, then the texture corpus's table
 //!   (`strata_check::texture_corpus`, against the interpreter; not with `--kernel`), and
 //!   exits non-zero on any mismatch.
-//! * `cargo xtask run FILE.wgsl --entry NAME --workgroups X,Y,Z --buffer 0:B=FILE ...
-//!   [--size 0:B=BYTES] [--texture 0:B=FILE] [--storage-texture 0:B=WxH[:FORMAT]]
-//!   [--sampler 0:B=FILTER,ADDRESS] [--override NAME=VALUE ...] [--ulp N | --ulp BUFFER=N ...] [--abs E | --abs BUFFER=E ...]
+//! * `cargo xtask run FILE.wgsl --entry NAME --workgroups X,Y,Z --buffer G:B=FILE ...
+//!   [--size G:B=BYTES] [--texture G:B=FILE] [--storage-texture G:B=WxH[:FORMAT]]
+//!   [--sampler G:B=FILTER,ADDRESS] [--override NAME=VALUE ...] [--ulp N | --ulp BUFFER=N ...] [--abs E | --abs BUFFER=E ...]
 //!   [--reference BACKEND] --backend cpu|wgpu|wgpu-gl|ash|ash-glsl|ash-hlsl|all [--out DIR]`:
 //!   runs any WGSL compute shader, writes every writable buffer and storage texture to
-//!   `DIR/BACKEND/0_B_NAME.bin` (a storage texture also as `.png` or `.exr`), and with several backends reports per backend and
+//!   `DIR/BACKEND/G_B_NAME.bin` (a storage texture also as `.png` or `.exr`), and with several backends reports per backend and
 //!   buffer whether it is identical to the reference backend's, or how many words
 //!   differ and by how many ULP; exits non-zero only when a backend fails or a buffer
 //!   exceeds the tolerance (integers: exact; f32 words: `--ulp`, default 0).
@@ -308,23 +308,17 @@ fn parse_sampler_flag(text: &str) -> Result<(u32, u32, SamplerDesc), String> {
     Ok((g, b, run_images::parse_sampler(v)?))
 }
 
-/// The image flags as one list, group 0 only (as buffers).
+/// The image flags as one list.
 fn images(
     textures: &[(u32, u32, TextureFile)],
     storage: &[(u32, u32, StorageTextureSize)],
     samplers: &[(u32, u32, SamplerDesc)],
 ) -> Result<Vec<ImageSpec>> {
-    let groups = textures.iter().map(|t| (t.0, t.1)).chain(storage.iter().map(|t| (t.0, t.1)));
-    for (group, binding) in groups.chain(samplers.iter().map(|s| (s.0, s.1))) {
-        if group != 0 {
-            bail!("--texture/--storage-texture/--sampler {group}:{binding}: only @group(0) is supported");
-        }
-    }
     Ok(textures
         .iter()
-        .map(|(_, b, file)| ImageSpec::Texture(*b, file.clone()))
-        .chain(storage.iter().map(|(_, b, (size, format))| ImageSpec::StorageTexture(*b, *size, *format)))
-        .chain(samplers.iter().map(|(_, b, desc)| ImageSpec::Sampler(*b, *desc)))
+        .map(|(g, b, file)| ImageSpec::Texture((*g, *b), file.clone()))
+        .chain(storage.iter().map(|(g, b, (size, format))| ImageSpec::StorageTexture((*g, *b), *size, *format)))
+        .chain(samplers.iter().map(|(g, b, desc)| ImageSpec::Sampler((*g, *b), *desc)))
         .collect())
 }
 

@@ -51,9 +51,9 @@ pub(super) enum Descriptor {
 
 /// The Vulkan objects a dispatch binds, as [`super::pipelines`] creates them per kernel.
 #[derive(Clone, Copy)]
-pub(super) struct ComputePipeline {
-    /// The descriptor-set layout of group 0.
-    pub(super) set_layout: vk::DescriptorSetLayout,
+pub(super) struct ComputePipeline<'a> {
+    /// The descriptor-set layouts, set 0 first.
+    pub(super) set_layouts: &'a [vk::DescriptorSetLayout],
     /// The pipeline layout.
     pub(super) layout: vk::PipelineLayout,
     /// The compute pipeline.
@@ -285,6 +285,7 @@ impl VulkanDevice {
                 max_texture_2d: limits.max_image_dimension2_d.min(limits.max_image_dimension1_d),
                 max_texture_3d: limits.max_image_dimension3_d,
                 max_texture_layers: limits.max_image_array_layers,
+                max_bind_groups: limits.max_bound_descriptor_sets,
             },
         }
     }
@@ -407,14 +408,14 @@ impl VulkanDevice {
         &self,
         pipeline: ComputePipeline,
         kernel: &Kernel,
-        descriptors: &[(u32, vk::DescriptorType, Descriptor)],
+        descriptors: &[(u32, u32, vk::DescriptorType, Descriptor)],
         workgroups: [u32; 3],
         timed: bool,
     ) -> Result<Option<Duration>, BackendError> {
         let operation = format!("dispatch of `{}`", kernel.name());
         let error = |e| vk_error(&operation, e);
         let mut sizes: Vec<vk::DescriptorPoolSize> = Vec::new();
-        for &(_, ty, _) in descriptors {
+        for &(_, _, ty, _) in descriptors {
             match sizes.iter_mut().find(|size| size.ty == ty) {
                 Some(size) => size.descriptor_count += 1,
                 None => sizes.push(vk::DescriptorPoolSize { ty, descriptor_count: 1 }),
@@ -424,19 +425,25 @@ impl VulkanDevice {
         unsafe {
             let pool = self
                 .device
-                .create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None)
+                .create_descriptor_pool(
+                    &vk::DescriptorPoolCreateInfo::default()
+                        .max_sets(pipeline.set_layouts.len() as u32)
+                        .pool_sizes(&sizes),
+                    None,
+                )
                 .map_err(error)?;
             let result = (|| {
-                let layouts = [pipeline.set_layout];
-                let set = self
+                let sets = self
                     .device
                     .allocate_descriptor_sets(
-                        &vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts),
+                        &vk::DescriptorSetAllocateInfo::default()
+                            .descriptor_pool(pool)
+                            .set_layouts(pipeline.set_layouts),
                     )
-                    .map_err(error)?[0];
+                    .map_err(error)?;
                 let buffer_infos: Vec<[vk::DescriptorBufferInfo; 1]> = descriptors
                     .iter()
-                    .map(|&(_, _, descriptor)| match descriptor {
+                    .map(|&(_, _, _, descriptor)| match descriptor {
                         Descriptor::Buffer(buffer) => {
                             [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }]
                         }
@@ -445,7 +452,7 @@ impl VulkanDevice {
                     .collect();
                 let image_infos: Vec<[vk::DescriptorImageInfo; 1]> = descriptors
                     .iter()
-                    .map(|&(_, _, descriptor)| {
+                    .map(|&(_, _, _, descriptor)| {
                         let info = vk::DescriptorImageInfo::default().image_layout(vk::ImageLayout::GENERAL);
                         [match descriptor {
                             Descriptor::Image(view) => info.image_view(view),
@@ -458,9 +465,11 @@ impl VulkanDevice {
                 let writes: Vec<_> = descriptors
                     .iter()
                     .zip(buffer_infos.iter().zip(&image_infos))
-                    .map(|(&(binding, ty, descriptor), (buffer_info, image_info))| {
-                        let write =
-                            vk::WriteDescriptorSet::default().dst_set(set).dst_binding(binding).descriptor_type(ty);
+                    .map(|(&(set, binding, ty, descriptor), (buffer_info, image_info))| {
+                        let write = vk::WriteDescriptorSet::default()
+                            .dst_set(sets[set as usize])
+                            .dst_binding(binding)
+                            .descriptor_type(ty);
                         match descriptor {
                             Descriptor::Buffer(_) => write.buffer_info(buffer_info),
                             _ => write.image_info(image_info),
@@ -487,7 +496,7 @@ impl VulkanDevice {
                     vk::PipelineBindPoint::COMPUTE,
                     pipeline.layout,
                     0,
-                    &[set],
+                    &sets,
                     &[],
                 );
                 self.device.cmd_dispatch(cb, workgroups[0], workgroups[1], workgroups[2]);

@@ -163,18 +163,19 @@ impl AshBackend {
         };
         check_binds(kernel, binds, &self.info, &lookup)?;
         let pipeline = self.pipelines.get_or_create(&self.vulkan, kernel)?;
-        let combined = pipeline.plan.slots.iter().any(|s| s.1 == vk::DescriptorType::COMBINED_IMAGE_SAMPLER);
+        let combined = pipeline.plan.slots.iter().any(|s| s.ty == vk::DescriptorType::COMBINED_IMAGE_SAMPLER);
         if combined && self.any_sampler.is_none() {
             self.any_sampler = Some(self.vulkan.create_sampler(&crate::texture::SamplerDesc::default())?);
         }
         let resource_at =
-            |binding: u32| binds.iter().find(|b| b.binding == binding).map(|b| b.resource).expect("checked binds");
+            |slot: (u32, u32)| binds.iter().find(|b| b.slot() == slot).map(|b| b.resource).expect("checked binds");
         let descriptors = pipeline
             .plan
             .slots
             .iter()
-            .map(|&(binding, ty, paired)| {
-                let descriptor = match resource_at(binding) {
+            .map(|slot| {
+                let (ty, paired) = (slot.ty, slot.sampler);
+                let descriptor = match resource_at(slot.wgsl) {
                     Resource::Buffer(id) => Descriptor::Buffer(self.buffer(id)?.buffer),
                     Resource::Texture(id) if ty == vk::DescriptorType::COMBINED_IMAGE_SAMPLER => {
                         let sampler = match paired.map(resource_at) {
@@ -186,13 +187,13 @@ impl AshBackend {
                     Resource::Texture(id) => {
                         let image = self.image(id)?;
                         let storage = kernel
-                            .binding(0, binding)
+                            .binding(slot.wgsl.0, slot.wgsl.1)
                             .is_some_and(|info| matches!(info.kind, BindingKind::StorageTexture { .. }));
                         Descriptor::Image(if storage { image.storage_view } else { image.sampled_view })
                     }
                     Resource::Sampler(id) => Descriptor::Sampler(self.sampler(id)?),
                 };
-                Ok((binding, ty, descriptor))
+                Ok((slot.set, slot.binding, ty, descriptor))
             })
             .collect::<Result<Vec<_>, BackendError>>()?;
         self.vulkan.dispatch(pipeline.handles(), kernel, &descriptors, workgroups, timed)

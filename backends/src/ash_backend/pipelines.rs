@@ -12,6 +12,7 @@ use std::ffi::CString;
 use std::sync::Arc;
 use strata_kernels::combined_samplers::combined_samplers;
 use strata_kernels::glslang::{self, GlslangInput};
+use strata_kernels::hlsl_samplers;
 use strata_kernels::translate::{self, TranslateOptions, WorkgroupZeroInit};
 use strata_kernels::{BindingInfo, BindingKind, Kernel, KernelId};
 
@@ -52,49 +53,65 @@ pub unsafe fn create_compute_pipeline(
 ) -> Result<PipelineObjects, vk::Result> {
     let slots: Vec<(u32, vk::DescriptorType)> = bindings.iter().map(|b| (b.binding, descriptor_type(b.kind))).collect();
     // SAFETY: the caller's contract.
-    unsafe { create_pipeline_with_slots(device, words, entry_point, &slots) }
+    let (set_layouts, layout, pipeline) = unsafe { create_with_sets(device, words, entry_point, &[slots])? };
+    Ok(PipelineObjects { set_layout: set_layouts[0], layout, pipeline })
 }
 
-/// [`create_compute_pipeline`] with set 0 given as (binding, descriptor type) slots.
+/// The set layouts, pipeline layout and pipeline of `words` with descriptor sets
+/// `sets` (per set, its (binding, descriptor type) slots; an empty set for a group the
+/// kernel skips).
 ///
 /// # Safety
-/// As [`create_compute_pipeline`].
-unsafe fn create_pipeline_with_slots(
+/// As [`create_compute_pipeline`]; the objects must be destroyed once unused.
+unsafe fn create_with_sets(
     device: &ash::Device,
     words: &[u32],
     entry_point: &std::ffi::CStr,
-    slots: &[(u32, vk::DescriptorType)],
-) -> Result<PipelineObjects, vk::Result> {
-    let bindings: Vec<_> = slots
-        .iter()
-        .map(|&(binding, ty)| {
-            vk::DescriptorSetLayoutBinding::default()
-                .binding(binding)
-                .descriptor_type(ty)
-                .descriptor_count(1)
-                .stage_flags(vk::ShaderStageFlags::COMPUTE)
-        })
-        .collect();
+    sets: &[Vec<(u32, vk::DescriptorType)>],
+) -> Result<(Vec<vk::DescriptorSetLayout>, vk::PipelineLayout, vk::Pipeline), vk::Result> {
     // SAFETY: valid device (the caller's contract) and create infos; every object made
     // is destroyed on the error paths.
     unsafe {
-        let module = device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(words), None)?;
-        let set_layout = match device
-            .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None)
-        {
-            Ok(layout) => layout,
+        let mut set_layouts = Vec::with_capacity(sets.len());
+        let destroy_sets = |layouts: &[vk::DescriptorSetLayout]| {
+            for &layout in layouts {
+                device.destroy_descriptor_set_layout(layout, None);
+            }
+        };
+        for slots in sets {
+            let bindings: Vec<_> = slots
+                .iter()
+                .map(|&(binding, ty)| {
+                    vk::DescriptorSetLayoutBinding::default()
+                        .binding(binding)
+                        .descriptor_type(ty)
+                        .descriptor_count(1)
+                        .stage_flags(vk::ShaderStageFlags::COMPUTE)
+                })
+                .collect();
+            match device
+                .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None)
+            {
+                Ok(layout) => set_layouts.push(layout),
+                Err(e) => {
+                    destroy_sets(&set_layouts);
+                    return Err(e);
+                }
+            }
+        }
+        let module = match device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(words), None) {
+            Ok(module) => module,
             Err(e) => {
-                device.destroy_shader_module(module, None);
+                destroy_sets(&set_layouts);
                 return Err(e);
             }
         };
-        let set_layouts = [set_layout];
         let layout = match device
             .create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts), None)
         {
             Ok(layout) => layout,
             Err(e) => {
-                device.destroy_descriptor_set_layout(set_layout, None);
+                destroy_sets(&set_layouts);
                 device.destroy_shader_module(module, None);
                 return Err(e);
             }
@@ -107,10 +124,10 @@ unsafe fn create_pipeline_with_slots(
         let result = device.create_compute_pipelines(vk::PipelineCache::null(), &create, None);
         device.destroy_shader_module(module, None);
         match result {
-            Ok(pipelines) => Ok(PipelineObjects { set_layout, layout, pipeline: pipelines[0] }),
+            Ok(pipelines) => Ok((set_layouts, layout, pipelines[0])),
             Err((_, e)) => {
                 device.destroy_pipeline_layout(layout, None);
-                device.destroy_descriptor_set_layout(set_layout, None);
+                destroy_sets(&set_layouts);
                 Err(e)
             }
         }
@@ -131,22 +148,44 @@ pub unsafe fn destroy_compute_pipeline(device: &ash::Device, objects: &PipelineO
     }
 }
 
-/// Descriptor set 0 as a pipeline's SPIR-V expects it: per slot the WGSL binding, the
-/// descriptor type, and for a combined image sampler (naga's GLSL) the binding of the
-/// sampler whose state it carries (`None`: any sampler, the texture is only loaded).
+/// One descriptor as a pipeline's SPIR-V expects it.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct DescriptorSlot {
+    /// Its descriptor set and binding in the SPIR-V.
+    pub(super) set: u32,
+    pub(super) binding: u32,
+    pub(super) ty: vk::DescriptorType,
+    /// The WGSL `(group, binding)` whose resource it holds.
+    pub(super) wgsl: (u32, u32),
+    /// For a combined image sampler (naga's GLSL), the WGSL sampler whose state it
+    /// carries (`None`: any sampler, the texture is only loaded).
+    pub(super) sampler: Option<(u32, u32)>,
+}
+
+/// The descriptor sets as a pipeline's SPIR-V expects them.
 #[derive(Clone, Debug)]
 pub(super) struct DescriptorPlan {
-    pub(super) slots: Vec<(u32, vk::DescriptorType, Option<u32>)>,
+    pub(super) slots: Vec<DescriptorSlot>,
+    /// Descriptor sets of the pipeline layout.
+    pub(super) sets: u32,
 }
 
 impl DescriptorPlan {
-    /// The plan of `kernel` compiled from `source`: one descriptor per binding, except on
-    /// the GLSL path, where each sampled texture is a combined image sampler and samplers
-    /// have no descriptor of their own (`strata_kernels::combined_samplers`).
+    /// The plan of `kernel` compiled from `source`: WGSL group g is set g, one descriptor
+    /// per binding, except on the GLSL path, which has no sets (every binding in set 0,
+    /// numbered by `Kernel::flat_binding`), makes each sampled texture a combined image
+    /// sampler and gives samplers no descriptor of their own
+    /// (`strata_kernels::combined_samplers`).
     fn of(kernel: &Kernel, source: SpirvSource) -> Result<Self, BackendError> {
+        let plain = |b: &BindingInfo| DescriptorSlot {
+            set: b.group,
+            binding: b.binding,
+            ty: descriptor_type(b.kind),
+            wgsl: (b.group, b.binding),
+            sampler: None,
+        };
         if source != SpirvSource::GlslangFromGlsl {
-            let slots = kernel.bindings.iter().map(|b| (b.binding, descriptor_type(b.kind), None)).collect();
-            return Ok(Self { slots });
+            return Ok(Self { slots: kernel.bindings.iter().map(plain).collect(), sets: kernel.group_count() });
         }
         let pairs = combined_samplers(kernel).map_err(|why| BackendError::Unavailable {
             backend: source.name().into(),
@@ -157,26 +196,44 @@ impl DescriptorPlan {
             .bindings
             .iter()
             .filter(|b| b.kind != BindingKind::Sampler)
-            .map(|b| match pairs.iter().find(|(texture, _)| *texture == b.binding) {
-                Some(&(_, sampler)) => (b.binding, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, sampler),
-                None => (b.binding, descriptor_type(b.kind), None),
+            .map(|b| {
+                let pair = pairs.iter().find(|(texture, _)| *texture == (b.group, b.binding));
+                DescriptorSlot {
+                    set: 0,
+                    binding: kernel.flat_binding(b.group, b.binding),
+                    ty: if pair.is_some() {
+                        vk::DescriptorType::COMBINED_IMAGE_SAMPLER
+                    } else {
+                        descriptor_type(b.kind)
+                    },
+                    wgsl: (b.group, b.binding),
+                    sampler: pair.and_then(|(_, sampler)| *sampler),
+                }
             })
             .collect();
-        Ok(Self { slots })
+        Ok(Self { slots, sets: 1 })
+    }
+
+    /// Per set, its (binding, descriptor type) slots.
+    fn sets(&self) -> Vec<Vec<(u32, vk::DescriptorType)>> {
+        (0..self.sets)
+            .map(|set| self.slots.iter().filter(|s| s.set == set).map(|s| (s.binding, s.ty)).collect())
+            .collect()
     }
 }
 
 pub(super) struct AshPipeline {
-    objects: PipelineObjects,
-    /// What each descriptor of set 0 is.
+    set_layouts: Vec<vk::DescriptorSetLayout>,
+    layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
+    /// What each descriptor is.
     pub(super) plan: DescriptorPlan,
 }
 
 impl AshPipeline {
     /// What a dispatch binds.
-    pub(super) fn handles(&self) -> ComputePipeline {
-        let o = &self.objects;
-        ComputePipeline { set_layout: o.set_layout, layout: o.layout, pipeline: o.pipeline }
+    pub(super) fn handles(&self) -> ComputePipeline<'_> {
+        ComputePipeline { set_layouts: &self.set_layouts, layout: self.layout, pipeline: self.pipeline }
     }
 }
 
@@ -233,8 +290,9 @@ impl PipelineCache {
         let n = COMPILATIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let dir = std::env::temp_dir().join(format!("strata-slang-{}-{n}", std::process::id()));
         let file = dir.join(format!("{}.hlsl", kernel.name()));
+        let text = hlsl_samplers::plain_samplers(&translation.text).map_err(failed)?;
         let result = std::fs::create_dir_all(&dir)
-            .and_then(|()| std::fs::write(&file, &translation.text))
+            .and_then(|()| std::fs::write(&file, &text))
             .map_err(|e| failed(format!("{}: {e}", file.display())))
             .and_then(|()| {
                 strata_kernels::slang::compile_hlsl(&file, &translation.entry_point).map_err(|e| failed(e.to_string()))
@@ -266,10 +324,9 @@ impl PipelineCache {
             message: format!("{result:?}"),
         };
         // SAFETY: a valid device; the pipeline is destroyed in `destroy`.
-        let slots: Vec<(u32, vk::DescriptorType)> = plan.slots.iter().map(|&(b, ty, _)| (b, ty)).collect();
-        let objects =
-            unsafe { create_pipeline_with_slots(&vulkan.device, &words, &entry_point, &slots) }.map_err(error)?;
-        let pipeline = Arc::new(AshPipeline { objects, plan });
+        let (set_layouts, layout, pipeline) =
+            unsafe { create_with_sets(&vulkan.device, &words, &entry_point, &plan.sets()) }.map_err(error)?;
+        let pipeline = Arc::new(AshPipeline { set_layouts, layout, pipeline, plan });
         self.pipelines.insert(kernel.id, Arc::clone(&pipeline));
         Ok(pipeline)
     }
@@ -278,7 +335,13 @@ impl PipelineCache {
         let device = &vulkan.device;
         for (_, pipeline) in self.pipelines.drain() {
             // SAFETY: the device is idle; each pipeline is destroyed once.
-            unsafe { destroy_compute_pipeline(device, &pipeline.objects) };
+            unsafe {
+                device.destroy_pipeline(pipeline.pipeline, None);
+                device.destroy_pipeline_layout(pipeline.layout, None);
+                for &set_layout in &pipeline.set_layouts {
+                    device.destroy_descriptor_set_layout(set_layout, None);
+                }
+            }
         }
     }
 }

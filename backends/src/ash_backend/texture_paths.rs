@@ -11,10 +11,6 @@ use strata_kernels::{BindingInfo, BindingKind, Kernel};
 fn refusal(source: SpirvSource, binding: &BindingInfo) -> Option<&'static str> {
     match (source, binding.kind) {
         (SpirvSource::Naga, _) => None,
-        (SpirvSource::GlslangFromHlsl | SpirvSource::SlangFromHlsl, BindingKind::Sampler) => Some(
-            "naga's HLSL reads samplers from a sampler heap indexed through a buffer, which this path does not \
-             bind; textures read with textureLoad work",
-        ),
         (SpirvSource::SlangFromHlsl, BindingKind::StorageTexture { format, .. }) if format.components() == 1 => Some(
             "naga's HLSL stores a 4-component value into a one-component RWTexture, which DXC truncates and \
              Slang rejects",

@@ -441,8 +441,9 @@ pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> 
         };
         let entry = match variable.space {
             naga::AddressSpace::Uniform | naga::AddressSpace::Storage { .. } | naga::AddressSpace::Handle => {
-                let binding = variable.binding.as_ref().map_or(u32::MAX, |b| b.binding);
-                let slot = kernel.bindings.iter().position(|b| b.binding == binding).unwrap_or(usize::MAX);
+                let (group, binding) = variable.binding.as_ref().map_or((u32::MAX, u32::MAX), |b| (b.group, b.binding));
+                let slot =
+                    kernel.bindings.iter().position(|b| b.group == group && b.binding == binding).unwrap_or(usize::MAX);
                 (memory::BUFFER | slot as u32 & 0xff_ffff, 0)
             }
             naga::AddressSpace::WorkGroup => {

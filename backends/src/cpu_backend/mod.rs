@@ -148,6 +148,7 @@ impl CpuBackend {
                 max_texture_2d: 16384,
                 max_texture_3d: 2048,
                 max_texture_layers: 2048,
+                max_bind_groups: 8,
             },
         };
         Ok(Self {
@@ -313,7 +314,7 @@ impl Backend for CpuBackend {
         let resources: Vec<Resource> = kernel
             .bindings
             .iter()
-            .map(|b| binds.iter().find(|bind| bind.binding == b.binding).expect("checked").resource)
+            .map(|b| binds.iter().find(|bind| bind.slot() == (b.group, b.binding)).expect("checked").resource)
             .collect();
         let first_of = |index: usize| resources[..index].iter().position(|r| *r == resources[index]);
         let mut bound: Vec<Vec<u32>> = Vec::with_capacity(resources.len());

@@ -149,6 +149,7 @@ impl WgpuBackend {
                 max_texture_2d: limits.max_texture_dimension_2d.min(limits.max_texture_dimension_1d),
                 max_texture_3d: limits.max_texture_dimension_3d,
                 max_texture_layers: limits.max_texture_array_layers,
+                max_bind_groups: limits.max_bind_groups,
             },
         };
         let timestamps = timestamps.then(|| {
@@ -216,7 +217,7 @@ impl WgpuBackend {
             .map(|bind| match bind.resource {
                 Resource::Texture(id) => {
                     let storage = kernel
-                        .binding(0, bind.binding)
+                        .binding(bind.group, bind.binding)
                         .is_some_and(|info| matches!(info.kind, BindingKind::StorageTexture { .. }));
                     let entry = self.textures.get(id)?;
                     Ok(Some(entry.texture.create_view(&wgpu::TextureViewDescriptor {
@@ -238,14 +239,24 @@ impl WgpuBackend {
                     (Resource::Texture(_), Some(view)) => wgpu::BindingResource::TextureView(view),
                     (Resource::Texture(id), None) => return Err(BackendError::UnknownTexture(id.0)),
                 };
-                Ok(wgpu::BindGroupEntry { binding: bind.binding, resource })
+                Ok((bind.group, wgpu::BindGroupEntry { binding: bind.binding, resource }))
             })
             .collect::<Result<Vec<_>, BackendError>>()?;
-        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some(kernel.name()),
-            layout: &pipeline.layout,
-            entries: &entries,
-        });
+        // One bind group per group of the pipeline's layout (empty for a skipped group).
+        let bind_groups: Vec<wgpu::BindGroup> = pipeline
+            .layouts
+            .iter()
+            .enumerate()
+            .map(|(group, layout)| {
+                let entries: Vec<wgpu::BindGroupEntry> =
+                    entries.iter().filter(|(g, _)| *g as usize == group).map(|(_, e)| e.clone()).collect();
+                self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some(kernel.name()),
+                    layout,
+                    entries: &entries,
+                })
+            })
+            .collect();
         let mut encoder =
             self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(kernel.name()) });
         {
@@ -260,7 +271,9 @@ impl WgpuBackend {
             let mut pass = encoder
                 .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(kernel.name()), timestamp_writes });
             pass.set_pipeline(&pipeline.pipeline);
-            pass.set_bind_group(0, &bind_group, &[]);
+            for (group, bind_group) in bind_groups.iter().enumerate() {
+                pass.set_bind_group(group as u32, bind_group, &[]);
+            }
             pass.dispatch_workgroups(workgroups[0], workgroups[1], workgroups[2]);
         }
         if let (Some((set, resolve, readback)), true) = (&self.timestamps, timed) {

@@ -14,7 +14,8 @@ use strata_kernels::{BindingAccess, BindingInfo, BindingKind, Kernel, KernelId};
 
 pub(super) struct Pipeline {
     pub(super) pipeline: wgpu::ComputePipeline,
-    pub(super) layout: wgpu::BindGroupLayout,
+    /// One layout per bind group, group 0 first.
+    pub(super) layouts: Vec<wgpu::BindGroupLayout>,
 }
 
 pub(super) struct PipelineCache {
@@ -40,9 +41,9 @@ impl PipelineCache {
             return Ok(Arc::clone(pipeline));
         }
         let scope = errors.scope(device);
-        let (pipeline, layout) = kernel_pipeline(device, kernel, self.define_integer_division)?;
+        let (pipeline, layouts) = kernel_pipeline(device, kernel, self.define_integer_division)?;
         scope.finish(&format!("pipeline creation for `{}`", kernel.name()))?;
-        let pipeline = Arc::new(Pipeline { pipeline, layout });
+        let pipeline = Arc::new(Pipeline { pipeline, layouts });
         self.pipelines.insert(kernel.id, Arc::clone(&pipeline));
         Ok(pipeline)
     }
@@ -88,8 +89,8 @@ pub fn layout_entries(bindings: &[BindingInfo]) -> Vec<wgpu::BindGroupLayoutEntr
         .collect()
 }
 
-/// `kernel`'s compute pipeline from naga's IR, with an explicit bind group layout of its
-/// bindings ([`layout_entries`]). `define_integer_division`: rewrite integer `/` and `%`
+/// `kernel`'s compute pipeline from naga's IR, with an explicit bind group layout per
+/// group of its bindings ([`layout_entries`]; one for a registry kernel). `define_integer_division`: rewrite integer `/` and `%`
 /// with WGSL's meaning first, as wgpu's GL back end needs (it writes GLSL's, undefined
 /// for negative operands and zero divisors). wgpu reports creation errors through the
 /// device's error scopes: the caller opens them.
@@ -97,13 +98,22 @@ pub fn kernel_pipeline(
     device: &wgpu::Device,
     kernel: &Kernel,
     define_integer_division: bool,
-) -> Result<(wgpu::ComputePipeline, wgpu::BindGroupLayout), BackendError> {
-    let entries = layout_entries(&kernel.bindings);
-    let layout = device
-        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(kernel.name()), entries: &entries });
+) -> Result<(wgpu::ComputePipeline, Vec<wgpu::BindGroupLayout>), BackendError> {
+    // One layout per group (a group the kernel skips gets an empty one).
+    let layouts: Vec<wgpu::BindGroupLayout> = (0..kernel.group_count())
+        .map(|group| {
+            let bindings: Vec<BindingInfo> = kernel.bindings.iter().filter(|b| b.group == group).cloned().collect();
+            let entries = layout_entries(&bindings);
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(kernel.name()),
+                entries: &entries,
+            })
+        })
+        .collect();
+    let layout_refs: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(Some).collect();
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(kernel.name()),
-        bind_group_layouts: &[Some(&layout)],
+        bind_group_layouts: &layout_refs,
         immediate_size: 0,
     });
     let defined = if define_integer_division {
@@ -130,5 +140,5 @@ pub fn kernel_pipeline(
         compilation_options: wgpu::PipelineCompilationOptions::default(),
         cache: None,
     });
-    Ok((pipeline, layout))
+    Ok((pipeline, layouts))
 }

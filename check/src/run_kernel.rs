@@ -263,6 +263,38 @@ pub fn run_loaded_in_groups(
         .collect()
 }
 
+/// Backends opened once for many runs: each slot's name and its backend, or why it did
+/// not open.
+pub type OpenBackends = Vec<(String, Result<Box<dyn Backend>, String>)>;
+
+/// Opens every slot once, for [`run_on_open`].
+pub fn open_backends(slots: &[BackendSlot]) -> OpenBackends {
+    slots.iter().map(|slot| (slot.name.to_string(), (slot.open)().map_err(|e| e.to_string()))).collect()
+}
+
+/// [`run_loaded_in_groups`] on backends already open (many kernels run without a device
+/// created per kernel and backend).
+pub fn run_on_open(
+    kernel: &Kernel,
+    inputs: &GroupedInputs,
+    images: &GroupedImages,
+    workgroups: [u32; 3],
+    backends: &mut OpenBackends,
+) -> Vec<BackendRun> {
+    backends
+        .iter_mut()
+        .map(|(name, backend)| BackendRun {
+            backend: name.clone(),
+            outputs: match backend {
+                Ok(backend) => {
+                    run_on(backend.as_mut(), kernel, inputs, images, workgroups).map_err(|e| format!("{e:#}"))
+                }
+                Err(why) => Err(why.clone()),
+            },
+        })
+        .collect()
+}
+
 /// What [`run_kernel`] ran and what came of it.
 #[derive(Debug)]
 pub struct RunOutcome {

@@ -11,7 +11,9 @@
 
 use crate::BackendSlot;
 use crate::agreement::{FloatBound, Judgement, Tolerance, judge};
-use crate::run_kernel::{BackendRun, GroupedImages, GroupedInputs, ImageInput, run_loaded_in_groups};
+use crate::run_kernel::{
+    BackendRun, GroupedImages, GroupedInputs, ImageInput, OpenBackends, open_backends, run_on_open,
+};
 use strata_backends::{AddressMode, FilterMode, SamplerDesc, TextureDesc};
 use strata_kernels::{Kernel, TexelFormat, TextureDimension};
 
@@ -421,11 +423,17 @@ impl TextureCase {
 
     /// Runs the case on `slots`.
     pub fn run(&self, slots: &[BackendSlot]) -> Vec<BackendRun> {
+        self.run_on(&mut open_backends(slots))
+    }
+
+    /// Runs the case on backends already open.
+    pub fn run_on(&self, backends: &mut OpenBackends) -> Vec<BackendRun> {
         match Kernel::from_wgsl(self.file, source(self.file).into(), self.entry, false) {
-            Ok(kernel) => run_loaded_in_groups(&kernel, &self.buffers, &self.images, self.workgroups, slots),
-            Err(error) => {
-                slots.iter().map(|s| BackendRun { backend: s.name.into(), outputs: Err(error.to_string()) }).collect()
-            }
+            Ok(kernel) => run_on_open(&kernel, &self.buffers, &self.images, self.workgroups, backends),
+            Err(error) => backends
+                .iter()
+                .map(|(name, _)| BackendRun { backend: name.clone(), outputs: Err(error.to_string()) })
+                .collect(),
         }
     }
 
@@ -486,19 +494,16 @@ impl Verdict {
 /// Every case's verdicts on every backend slot of the check (a slot that cannot open
 /// counts as refusing every case, with its reason).
 pub fn run_texture_corpus() -> Vec<(String, Vec<(String, Verdict)>)> {
-    let slots = crate::backend_slots();
-    let mut open = Vec::new();
-    let mut closed = Vec::new();
-    for slot in slots {
-        match (slot.open)() {
-            Ok(_) => open.push(slot),
-            Err(error) => closed.push((slot.name.to_string(), Verdict::Refused(format!("no device: {error}")))),
-        }
-    }
+    let mut backends = open_backends(&crate::backend_slots());
+    let closed: Vec<(String, Verdict)> = backends
+        .iter()
+        .filter_map(|(name, b)| b.as_ref().err().map(|e| (name.clone(), Verdict::Refused(format!("no device: {e}")))))
+        .collect();
+    backends.retain(|(_, b)| b.is_ok());
     texture_cases()
         .iter()
         .map(|case| {
-            let mut verdicts = case.verdicts(&case.run(&open));
+            let mut verdicts = case.verdicts(&case.run_on(&mut backends));
             verdicts.extend(closed.iter().cloned());
             (case.name.clone(), verdicts)
         })

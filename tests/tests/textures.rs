@@ -5,6 +5,7 @@
 //! out-of-range loads by WGSL's rule; the paths a case names must refuse it with a
 //! reason; and a corrupted output of each case must be caught.
 
+use strata_check::run_kernel::open_backends;
 use strata_check::texture_corpus::{TextureCase, Verdict, texture_cases};
 use strata_tests::corpus_support::{ONE_CASE_AT_A_TIME, assert_corruption_caught, available_slots};
 
@@ -13,11 +14,10 @@ fn check_file(file: &str) {
     let slots = available_slots("the texture corpus");
     let cases: Vec<TextureCase> = texture_cases().into_iter().filter(|c| c.file == file).collect();
     assert!(!cases.is_empty(), "no case of {file}");
+    let _turn = ONE_CASE_AT_A_TIME.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let mut backends = open_backends(&slots);
     for case in cases {
-        let runs = {
-            let _turn = ONE_CASE_AT_A_TIME.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-            case.run(&slots)
-        };
+        let runs = case.run_on(&mut backends);
         let verdicts = case.verdicts(&runs);
         for (backend, verdict) in &verdicts {
             eprintln!("{} {backend:<12} {verdict:?}", case.name);

@@ -107,25 +107,23 @@ pub fn check_binds(
             (BindingKind::Uniform | BindingKind::Storage(_), Resource::Buffer(buffer)) => {
                 check_buffer_binding(kernel, info, (lookup.buffer_size)(buffer)?, device)?;
             }
-            (BindingKind::SampledTexture { dimension, kind }, Resource::Texture(texture)) => {
+            (
+                kind @ (BindingKind::SampledTexture { .. } | BindingKind::StorageTexture { .. }),
+                Resource::Texture(texture),
+            ) => {
                 let desc = (lookup.texture)(texture)?;
-                if desc.dimension != dimension || desc.format.kind() != kind {
-                    return Err(error(
-                        slot,
-                        format!(
-                            "`{}` is a {}, but texture `{}` is a {} texture of {}",
-                            info.name,
-                            info.element.type_name,
-                            desc.label,
-                            desc.dimension.wgsl(),
-                            desc.format.wgsl()
-                        ),
-                    ));
-                }
-            }
-            (BindingKind::StorageTexture { dimension, format, .. }, Resource::Texture(texture)) => {
-                let desc = (lookup.texture)(texture)?;
-                if desc.dimension != dimension || desc.format != format {
+                // A sampled texture takes any format of its texel kind, a storage texture
+                // its own format alone.
+                let fits = match kind {
+                    BindingKind::SampledTexture { dimension, kind } => {
+                        desc.dimension == dimension && desc.format.kind() == kind
+                    }
+                    BindingKind::StorageTexture { dimension, format, .. } => {
+                        desc.dimension == dimension && desc.format == format
+                    }
+                    _ => unreachable!("matched as a texture"),
+                };
+                if !fits {
                     return Err(error(
                         slot,
                         format!(

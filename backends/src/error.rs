@@ -2,6 +2,28 @@
 
 use thiserror::Error;
 
+impl BackendError {
+    /// `backend` cannot bind `binding` of `kernel`, with why.
+    pub fn unavailable_binding(
+        backend: &str,
+        kernel: &strata_kernels::Kernel,
+        binding: &strata_kernels::BindingInfo,
+        why: &str,
+    ) -> Self {
+        BackendError::Unavailable {
+            backend: backend.into(),
+            what: format!(
+                "kernel `{}` binding {} (`{}`: {})",
+                kernel.name(),
+                binding.binding,
+                binding.name,
+                binding.element.type_name
+            ),
+            why: why.into(),
+        }
+    }
+}
+
 /// A backend failure. Messages name the kernel, binding, limit or value at fault.
 #[derive(Debug, Error)]
 pub enum BackendError {

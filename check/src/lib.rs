@@ -15,6 +15,7 @@ pub mod agreement;
 mod backends;
 mod camera;
 mod compare;
+pub mod corpus_rng;
 mod empty;
 pub mod fuzz;
 mod histogram;

@@ -11,6 +11,7 @@
 
 use crate::BackendSlot;
 use crate::agreement::{FloatBound, Judgement, Tolerance, judge};
+use crate::corpus_rng::Rng;
 use crate::run_kernel::{
     BackendRun, GroupedImages, GroupedInputs, ImageInput, OpenBackends, open_backends, run_on_open,
 };
@@ -55,20 +56,6 @@ pub fn source(file: &str) -> &'static str {
         "downsample.wgsl" => include_str!("../../tests/data/textures/downsample.wgsl"),
         "two_groups.wgsl" => include_str!("../../tests/data/textures/two_groups.wgsl"),
         other => panic!("{other} is not in the texture corpus"),
-    }
-}
-
-/// A small deterministic generator (LCG, high bits).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u32 {
-        self.0 = self.0.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-        (self.0 >> 32) as u32
-    }
-
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * ((self.next() >> 8) as f32 / (1u32 << 24) as f32)
     }
 }
 

@@ -67,12 +67,7 @@ pub fn define_integer_division(module: &naga::Module, info: &ModuleInfo) -> Opti
                 sites.push((owner, entry, handle, Helper { op, kind: scalar.kind, size }, left, right));
             }
         };
-    for (handle, function) in module.functions.iter() {
-        find(function, &info[handle], Some(handle), 0);
-    }
-    for (index, entry) in module.entry_points.iter().enumerate() {
-        find(&entry.function, info.get_entry_point(index), None, index);
-    }
+    crate::ir_edit::visit_functions(module, info, &mut find);
     if sites.is_empty() {
         return None;
     }

@@ -101,3 +101,18 @@ fn remap_calls(function: &mut Function, remap: &impl Fn(Handle<Function>) -> Han
         }
     });
 }
+
+/// Calls `f` on every function of `module` with its validation info: each of
+/// `module.functions` (with its handle), then each entry point's (`None` and its index).
+pub(crate) fn visit_functions(
+    module: &naga::Module,
+    info: &naga::valid::ModuleInfo,
+    f: &mut impl FnMut(&Function, &naga::valid::FunctionInfo, Option<Handle<Function>>, usize),
+) {
+    for (handle, function) in module.functions.iter() {
+        f(function, &info[handle], Some(handle), 0);
+    }
+    for (index, entry) in module.entry_points.iter().enumerate() {
+        f(&entry.function, info.get_entry_point(index), None, index);
+    }
+}

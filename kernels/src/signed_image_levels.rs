@@ -62,12 +62,7 @@ pub fn sign_image_levels(module: &naga::Module, info: &ModuleInfo) -> Option<nag
                 sites.push((owner, entry, handle, [Some(image), Some(coordinate), array_index, Some(level)], shape));
             }
         };
-    for (handle, function) in module.functions.iter() {
-        find(function, &info[handle], Some(handle), 0);
-    }
-    for (index, entry) in module.entry_points.iter().enumerate() {
-        find(&entry.function, info.get_entry_point(index), None, index);
-    }
+    crate::ir_edit::visit_functions(module, info, &mut find);
     if sites.is_empty() {
         return None;
     }

@@ -14,6 +14,7 @@
 
 use strata_check::BackendSlot;
 use strata_check::agreement::{FloatBound, Judgement, Tolerance, judge};
+use strata_check::corpus_rng::Rng;
 use strata_check::run_kernel::{BackendRun, Inputs, named_slots, run_loaded};
 use strata_kernels::Kernel;
 use strata_tests::corpus_support::{ONE_CASE_AT_A_TIME, assert_corruption_caught, available_slots, failures};
@@ -38,20 +39,6 @@ fn source(file: &str) -> String {
 
 fn bytes<T: bytemuck::NoUninit>(values: &[T]) -> Vec<u8> {
     bytemuck::cast_slice(values).to_vec()
-}
-
-/// A small deterministic generator (LCG, high bits).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u32 {
-        self.0 = self.0.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-        (self.0 >> 32) as u32
-    }
-
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * ((self.next() >> 8) as f32 / (1u32 << 24) as f32)
-    }
 }
 
 fn run_case(case: &Case, slots: &[BackendSlot]) -> (Kernel, Vec<BackendRun>, Judgement) {

@@ -477,58 +477,46 @@ impl VulkanDevice {
                     })
                     .collect();
                 self.device.update_descriptor_sets(&writes, &[]);
-                let cb = self.command_buffer;
-                self.device.reset_command_buffer(cb, vk::CommandBufferResetFlags::empty()).map_err(error)?;
-                self.device
-                    .begin_command_buffer(
-                        cb,
-                        &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
-                    )
-                    .map_err(error)?;
                 let queries = self.query_pool.filter(|_| timed);
-                if let Some(queries) = queries {
-                    self.device.cmd_reset_query_pool(cb, queries, 0, 2);
-                    self.device.cmd_write_timestamp(cb, vk::PipelineStageFlags::TOP_OF_PIPE, queries, 0);
-                }
-                self.device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, pipeline.pipeline);
-                self.device.cmd_bind_descriptor_sets(
-                    cb,
-                    vk::PipelineBindPoint::COMPUTE,
-                    pipeline.layout,
-                    0,
-                    &sets,
-                    &[],
-                );
-                self.device.cmd_dispatch(cb, workgroups[0], workgroups[1], workgroups[2]);
-                if let Some(queries) = queries {
-                    self.device.cmd_write_timestamp(cb, vk::PipelineStageFlags::BOTTOM_OF_PIPE, queries, 1);
-                }
-                // The dispatch's writes, visible to the host, to later dispatches and to
-                // the copies that read textures back.
-                let barrier =
-                    vk::MemoryBarrier::default().src_access_mask(vk::AccessFlags::SHADER_WRITE).dst_access_mask(
-                        vk::AccessFlags::HOST_READ
-                            | vk::AccessFlags::SHADER_READ
-                            | vk::AccessFlags::SHADER_WRITE
-                            | vk::AccessFlags::TRANSFER_READ,
+                self.submit_once(&operation, |cb| {
+                    if let Some(queries) = queries {
+                        self.device.cmd_reset_query_pool(cb, queries, 0, 2);
+                        self.device.cmd_write_timestamp(cb, vk::PipelineStageFlags::TOP_OF_PIPE, queries, 0);
+                    }
+                    self.device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, pipeline.pipeline);
+                    self.device.cmd_bind_descriptor_sets(
+                        cb,
+                        vk::PipelineBindPoint::COMPUTE,
+                        pipeline.layout,
+                        0,
+                        &sets,
+                        &[],
                     );
-                self.device.cmd_pipeline_barrier(
-                    cb,
-                    vk::PipelineStageFlags::COMPUTE_SHADER,
-                    vk::PipelineStageFlags::HOST
-                        | vk::PipelineStageFlags::COMPUTE_SHADER
-                        | vk::PipelineStageFlags::TRANSFER,
-                    vk::DependencyFlags::empty(),
-                    &[barrier],
-                    &[],
-                    &[],
-                );
-                self.device.end_command_buffer(cb).map_err(error)?;
-                let command_buffers = [cb];
-                let submit = [vk::SubmitInfo::default().command_buffers(&command_buffers)];
-                self.device.queue_submit(self.queue, &submit, self.fence).map_err(error)?;
-                self.device.wait_for_fences(&[self.fence], true, u64::MAX).map_err(error)?;
-                self.device.reset_fences(&[self.fence]).map_err(error)?;
+                    self.device.cmd_dispatch(cb, workgroups[0], workgroups[1], workgroups[2]);
+                    if let Some(queries) = queries {
+                        self.device.cmd_write_timestamp(cb, vk::PipelineStageFlags::BOTTOM_OF_PIPE, queries, 1);
+                    }
+                    // The dispatch's writes, visible to the host, to later dispatches and to
+                    // the copies that read textures back.
+                    let barrier =
+                        vk::MemoryBarrier::default().src_access_mask(vk::AccessFlags::SHADER_WRITE).dst_access_mask(
+                            vk::AccessFlags::HOST_READ
+                                | vk::AccessFlags::SHADER_READ
+                                | vk::AccessFlags::SHADER_WRITE
+                                | vk::AccessFlags::TRANSFER_READ,
+                        );
+                    self.device.cmd_pipeline_barrier(
+                        cb,
+                        vk::PipelineStageFlags::COMPUTE_SHADER,
+                        vk::PipelineStageFlags::HOST
+                            | vk::PipelineStageFlags::COMPUTE_SHADER
+                            | vk::PipelineStageFlags::TRANSFER,
+                        vk::DependencyFlags::empty(),
+                        &[barrier],
+                        &[],
+                        &[],
+                    );
+                })?;
                 match queries {
                     Some(queries) => {
                         let mut ticks = [0u64; 2];

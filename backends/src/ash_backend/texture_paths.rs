@@ -23,16 +23,6 @@ fn refusal(source: SpirvSource, binding: &BindingInfo) -> Option<&'static str> {
 pub(super) fn check_texture_bindings(source: SpirvSource, kernel: &Kernel) -> Result<(), BackendError> {
     match kernel.bindings.iter().find_map(|b| refusal(source, b).map(|why| (b, why))) {
         None => Ok(()),
-        Some((binding, why)) => Err(BackendError::Unavailable {
-            backend: source.name().into(),
-            what: format!(
-                "kernel `{}` binding {} (`{}`: {})",
-                kernel.name(),
-                binding.binding,
-                binding.name,
-                binding.element.type_name
-            ),
-            why: why.into(),
-        }),
+        Some((binding, why)) => Err(BackendError::unavailable_binding(source.name(), kernel, binding, why)),
     }
 }

@@ -19,17 +19,7 @@ pub(super) fn check_gl_textures(kernel: &Kernel) -> Result<(), BackendError> {
             }
             _ => continue,
         };
-        return Err(BackendError::Unavailable {
-            backend: "wgpu-gl".into(),
-            what: format!(
-                "kernel `{}` binding {} (`{}`: {})",
-                kernel.name(),
-                binding.binding,
-                binding.name,
-                binding.element.type_name
-            ),
-            why: why.into(),
-        });
+        return Err(BackendError::unavailable_binding("wgpu-gl", kernel, binding, why));
     }
     Ok(())
 }

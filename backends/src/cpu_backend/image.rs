@@ -120,7 +120,10 @@ struct Texture<'a> {
 
 impl<'a> Texture<'a> {
     fn of(words: &'a [AtomicU32]) -> Option<Self> {
-        let header: Vec<u32> = words.get(..HEADER_WORDS)?.iter().map(|w| w.load(Ordering::Relaxed)).collect();
+        // Read into an array: this runs for every image instruction of every invocation.
+        let header: [u32; HEADER_WORDS] =
+            std::array::from_fn(|i| words.get(i).map_or(0, |w| w.load(Ordering::Relaxed)));
+        words.get(HEADER_WORDS - 1)?;
         Some(Self {
             words,
             format: *TexelFormat::ALL.get(header[0] as usize)?,
@@ -252,14 +255,12 @@ pub(super) fn execute(insn: &ImageInsn, regs: &mut [u32], buffers: &[Vec<AtomicU
         ImageOp::NumLevels => regs[result] = texture.levels,
         ImageOp::NumLayers => regs[result] = if layered { texture.size[2] } else { 1 },
         ImageOp::SampleLevel | ImageOp::Gather(_) => {
-            let sampler: Vec<u32> = match buffers.get(slot(insn.sampler)) {
-                Some(words) => words.iter().take(SAMPLER_WORDS).map(|w| w.load(Ordering::Relaxed)).collect(),
-                None => return,
-            };
-            if sampler.len() < SAMPLER_WORDS {
+            let Some(words) = buffers.get(slot(insn.sampler)).filter(|w| w.len() >= SAMPLER_WORDS) else {
                 return;
-            }
-            let coordinate: Vec<f32> = (0..n).map(|i| f32::from_bits(regs[insn.coordinate as usize + i])).collect();
+            };
+            let sampler: [u32; SAMPLER_WORDS] = std::array::from_fn(|i| words[i].load(Ordering::Relaxed));
+            let coordinate: [f32; 3] =
+                std::array::from_fn(|i| if i < n { f32::from_bits(regs[insn.coordinate as usize + i]) } else { 0.0 });
             let layer = insn.layer.map(|l| regs[l as usize].min(texture.size[2] - 1));
             let sample =
                 Sample { texture: &texture, sampler: &sampler, coordinate: &coordinate, layer, offset: insn.offset };

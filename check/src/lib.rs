@@ -95,6 +95,8 @@ pub fn kernel_checks() -> Vec<Box<dyn KernelCheck>> {
         Box::new(restir::RestirCheck(KernelId::RestirSelect)),
         Box::new(restir::RestirCheck(KernelId::RestirTemporalKeys)),
         Box::new(restir::RestirCheck(KernelId::RestirTemporal)),
+        Box::new(restir::RestirCheck(KernelId::RestirReservoirKeys)),
+        Box::new(restir::RestirCheck(KernelId::RestirSpatial)),
         Box::new(restir::RestirCheck(KernelId::RestirShade)),
         Box::new(restir::RestirCheck(KernelId::RestirGuide)),
         Box::new(svgf::SvgfCheck(KernelId::SvgfTemporal)),

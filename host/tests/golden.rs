@@ -116,6 +116,8 @@ fn compare_with_every_setting_moved_reproduces_its_committed_numbers() {
         "true",
         "--min-distance",
         "0.01",
+        "--reuse-order",
+        "temporal-first",
     ];
     let out = compare("moved", &settings);
     assert_same_as_committed(&out.join("errors.csv"), "compare_moved_errors.csv");

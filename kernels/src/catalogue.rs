@@ -37,6 +37,13 @@ pub enum KernelId {
     RestirTemporalKeys,
     /// ReSTIR pass 4b: temporal reuse (M cap, one or several previous reservoirs).
     RestirTemporal,
+    /// ReSTIR pass 4c (temporal-first order): the block histogram's input from the
+    /// merged reservoirs (key p̂ W, object id).
+    RestirReservoirKeys,
+    /// ReSTIR pass 4d (temporal-first order): spatial reuse of the merged reservoirs,
+    /// K of them per pixel (strata, restir or restir-disc) under pairwise MIS with
+    /// confidence weights.
+    RestirSpatial,
     /// ReSTIR pass 5: shading of the reservoirs' samples with one shadow ray.
     RestirShade,
     /// ReSTIR pass 6 (with a denoiser): the denoiser's guide (albedo, depth, normal,
@@ -96,7 +103,7 @@ impl Executor {
 
 impl KernelId {
     /// Every registry kernel.
-    pub const ALL: [KernelId; 19] = [
+    pub const ALL: [KernelId; 21] = [
         KernelId::BlockHistogram,
         KernelId::BlockHistogramSubgroup,
         KernelId::BlockHistogramRank,
@@ -108,6 +115,8 @@ impl KernelId {
         KernelId::RestirSelect,
         KernelId::RestirTemporalKeys,
         KernelId::RestirTemporal,
+        KernelId::RestirReservoirKeys,
+        KernelId::RestirSpatial,
         KernelId::RestirShade,
         KernelId::RestirGuide,
         KernelId::SvgfTemporal,
@@ -287,6 +296,14 @@ impl KernelId {
             KernelId::RestirTemporal => restir(
                 "restir_temporal",
                 &[selection(), vec![fragment!("restir/reuse_slot.wgsl"), fragment!("restir/entry_temporal.wgsl")]]
+                    .concat(),
+            ),
+            KernelId::RestirReservoirKeys => {
+                restir("restir_reservoir_keys", &[fragment!("restir/entry_reservoir_keys.wgsl")])
+            }
+            KernelId::RestirSpatial => restir(
+                "restir_spatial",
+                &[selection(), vec![fragment!("restir/reuse_slot.wgsl"), fragment!("restir/entry_spatial.wgsl")]]
                     .concat(),
             ),
             KernelId::RestirShade => restir("restir_shade", &[fragment!("restir/entry_shade.wgsl")]),

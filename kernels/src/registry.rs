@@ -457,6 +457,8 @@ mod tests {
                     | KernelId::RestirSelect
                     | KernelId::RestirTemporalKeys
                     | KernelId::RestirTemporal
+                    | KernelId::RestirReservoirKeys
+                    | KernelId::RestirSpatial
                     | KernelId::RestirShade
             ) {
                 use crate::restir_types::{PathCandidate, Primary, Reservoir, RestirParams};

@@ -42,7 +42,8 @@ pub const SHADING_EXPECTATION: u32 = 1;
 pub struct RestirParams {
     /// `METHOD_*`.
     pub method: u32,
-    /// K, candidates selected per pixel.
+    /// K, candidates selected per pixel (0 in the temporal-first order's first pass:
+    /// `restir_select` then writes the canonical candidate alone).
     pub candidates: u32,
     /// strata's sampler variant (`SAMPLER_*` of [`crate::selection`], Table 2). Object
     /// masking (§4.3) is the histogram's own setting (`HistogramParams.masking`).

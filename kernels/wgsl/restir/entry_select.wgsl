@@ -2,6 +2,10 @@
 // with its own canonical candidate (paper §4.2; the canonical candidate comes on top of
 // the K, not among them).
 //
+// With RestirParams.candidates = 0 it writes the canonical candidate alone as a reservoir
+// (the temporal-first order, RestirSettings::reuse_order, reuses neighbours after the
+// temporal merge instead: restir/entry_spatial.wgsl).
+//
 // Selection, by RestirParams.method:
 //   strata      from its own cluster's run of the block's luminance-sorted list (the
 //               histogram pass), at the K positions of RestirParams.sampler for this
@@ -98,6 +102,12 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
     // `array<vec3<f32>, 4>()` into an HLSL cast `(float3[4])0` that glslang's HLSL front
     // end rejects. MAX_SELECTED is 4.
     var colours = array<vec3<f32>, MAX_SELECTED>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    if k == 0u {
+        // K = 0 (the temporal-first order's first pass, RestirSettings::reuse_order): the
+        // canonical candidate alone, a reservoir of M = 1 that restir_temporal merges and
+        // restir_spatial then reuses.
+        weight_c = target_c * c.weight;
+    }
     for (var slot = 0u; slot < k; slot++) {
         let q = selected_pixel(id.x, id.y, pixel, p, slot, positions);
         if q == NO_PIXEL {

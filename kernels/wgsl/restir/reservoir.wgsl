@@ -59,7 +59,8 @@ const SHADING_EXPECTATION: u32 = 1u;  // Reservoir.expected: the final resamplin
 
 struct RestirParams {
     method: u32,
-    // K: candidates selected per pixel (1 to 4).
+    // K: candidates selected per pixel (1 to 4; 0 in the temporal-first order's first
+    // pass: restir_select then writes each pixel's canonical candidate alone).
     candidates: u32,
     // strata's sampler variant (SAMPLER_* of strata/selection.wgsl, Table 2); object
     // masking (§4.3) is the histogram's own setting (HistogramParams.masking).

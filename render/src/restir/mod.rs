@@ -14,4 +14,4 @@ mod pipeline;
 mod settings;
 
 pub use pipeline::{DenoiserInputs, FrameBuffers, FrameStats, RestirRenderer};
-pub use settings::{MAX_SPECULAR_CHAIN, Method, RestirSettings, ShadedParts, Shading};
+pub use settings::{MAX_SPECULAR_CHAIN, Method, RestirSettings, ReuseOrder, ShadedParts, Shading};

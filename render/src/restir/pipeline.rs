@@ -1,8 +1,9 @@
 //! One ReSTIR frame after another on any backend: the scene uploaded once, per-frame
 //! buffers (two G-buffers and two reservoir buffers alternate for temporal reuse), and
-//! the five passes dispatched in order.
+//! the five passes dispatched in order (seven in the temporal-first order:
+//! [`ReuseOrder::TemporalFirst`]).
 
-use super::RestirSettings;
+use super::{RestirSettings, ReuseOrder};
 use crate::histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};
 use crate::render::{GpuScene, RenderSettings, SceneBuffers};
 use crate::rgb_image::RgbImage;
@@ -22,7 +23,8 @@ pub struct FrameStats {
     /// Pixels whose sample was dropped as invalid (non-finite, traversal overflow).
     pub invalid_pixels: u32,
     /// Device time of each pass (candidates, histogram, select, temporal (sources,
-    /// temporal histogram and merge), shade) from
+    /// temporal histogram and merge), shade; in the temporal-first order the histogram
+    /// includes its keys' pass and select the spatial reuse after the merge) from
     /// timestamp queries, when [`RestirRenderer::set_timed`] is on and the backend has
     /// them; zero otherwise (and for the histogram of restir-disc, which skips it).
     pub pass_times: [std::time::Duration; 5],
@@ -87,6 +89,21 @@ pub struct RestirRenderer {
     guides: Option<(&'static Kernel, [BufferId; 2], u32)>,
     /// Warm-up only ([`RestirRenderer::dispatch_only`]): the kernels frames dispatch.
     dispatch_only: Option<Vec<KernelId>>,
+    /// The temporal-first order's passes and buffers ([`ReuseOrder::TemporalFirst`]).
+    temporal_first: Option<TemporalFirst>,
+}
+
+/// What the temporal-first order adds: `restir_select` runs with K = 0 (each pixel's
+/// canonical candidate alone, from its own uniform), `restir_temporal` merges the history
+/// into it, `restir_reservoir_keys` gives the histogram the merged reservoirs' estimates
+/// and `restir_spatial` reuses K of them into the final reservoirs.
+struct TemporalFirst {
+    keys_kernel: &'static Kernel,
+    spatial_kernel: &'static Kernel,
+    /// `RestirParams` with K = 0, for the canonical pass.
+    canonical_params: BufferId,
+    /// The temporal merge's output, the spatial pass's input.
+    merged: BufferId,
 }
 
 /// What a denoiser reads of the last frame ([`RestirRenderer::denoiser_inputs`]).
@@ -139,6 +156,21 @@ impl RestirRenderer {
             None
         };
         let pixels = u64::from(camera.width) * u64::from(camera.height);
+        let temporal_first = match settings.reuse_order {
+            ReuseOrder::SpatialFirst => None,
+            ReuseOrder::TemporalFirst => {
+                let [keys_kernel, spatial_kernel] =
+                    [KernelId::RestirReservoirKeys, KernelId::RestirSpatial].map(|id| registry.get(id));
+                backend.check_kernel(keys_kernel)?;
+                backend.check_kernel(spatial_kernel)?;
+                Some(TemporalFirst {
+                    keys_kernel,
+                    spatial_kernel,
+                    canonical_params: upload(backend, "canonical restir params", &[RestirParams::default()])?,
+                    merged: backend.create_buffer("merged reservoirs", pixels * size_of::<Reservoir>() as u64)?,
+                })
+            }
+        };
         let scene_buffers = SceneBuffers::upload(backend, scene)?;
         let mut params = render.params(&scene.params)?;
         // ReSTIR always combines light sampling and BSDF hits (its candidates' RIS needs
@@ -178,6 +210,7 @@ impl RestirRenderer {
             timed: false,
             guides: None,
             dispatch_only: None,
+            temporal_first,
         };
         Ok(renderer)
     }
@@ -270,18 +303,28 @@ impl RestirRenderer {
             ..self.settings.uniform()
         };
         backend.write_buffer(self.restir_params, 0, bytemuck::bytes_of(&restir))?;
+        if let Some(first) = &self.temporal_first {
+            let canonical = RestirParams { candidates: 0, ..restir };
+            backend.write_buffer(first.canonical_params, 0, bytemuck::bytes_of(&canonical))?;
+        }
         let (width, height) = (camera.width, camera.height);
 
         let current = (self.frame % 2) as usize;
         let previous_index = 1 - current;
         // The scene, the settings and the pass's own buffers by their WGSL names, restricted
         // to what `kernel` uses (naga drops bindings an entry point never reaches).
-        let with = |kernel: &Kernel, extra: &[(&str, BufferId)]| -> Result<Vec<Bind>, PassError> {
+        let with_restir = |kernel: &Kernel, restir: BufferId, extra: &[(&str, BufferId)]| {
             let mut named = self.scene.named(self.render_params);
-            named.push(("restir", self.restir_params));
+            named.push(("restir", restir));
             named.extend_from_slice(extra);
-            Ok(Bind::named(kernel, &named)?)
+            Bind::named(kernel, &named).map_err(PassError::from)
         };
+        let with = |kernel: &Kernel, extra: &[(&str, BufferId)]| with_restir(kernel, self.restir_params, extra);
+        // The temporal-first order: select writes the canonical reservoirs (K = 0), the
+        // merge its own buffer, and the histogram waits for the merged reservoirs' keys.
+        let first = self.temporal_first.as_ref();
+        let select_restir = first.map_or(self.restir_params, |f| f.canonical_params);
+        let merged_out = first.map_or(self.reservoirs[current], |f| f.merged);
         let [candidates_kernel, select_kernel, keys_kernel, temporal_kernel, shade_kernel] = self.kernels;
         let timed = self.timed && backend.info().timestamps;
         let mut pass_times = [std::time::Duration::ZERO; 5];
@@ -313,18 +356,25 @@ impl RestirRenderer {
                 ],
             )?,
         )?;
-        if self.settings.method.uses_histogram() && wanted(self.histogram.kernel()) {
-            if timed {
-                pass_times[1] = self.histogram.dispatch_timed(backend)?;
-            } else {
-                self.histogram.dispatch(backend)?;
+        let histogram = |backend: &mut dyn Backend| -> Result<std::time::Duration, PassError> {
+            if !self.settings.method.uses_histogram() || !wanted(self.histogram.kernel()) {
+                return Ok(std::time::Duration::ZERO);
             }
+            if timed {
+                return self.histogram.dispatch_timed(backend);
+            }
+            self.histogram.dispatch(backend)?;
+            Ok(std::time::Duration::ZERO)
+        };
+        if first.is_none() {
+            pass_times[1] = histogram(backend)?;
         }
         pass_times[2] = run(
             backend,
             select_kernel,
-            &with(
+            &with_restir(
                 select_kernel,
+                select_restir,
                 &[
                     ("primaries", self.primaries[current]),
                     ("path_candidates", self.candidates),
@@ -373,7 +423,7 @@ impl RestirRenderer {
                     ("previous_primaries", self.primaries[previous_index]),
                     ("current_reservoirs", self.selected),
                     ("previous_reservoirs", self.reservoirs[previous_index]),
-                    ("merged_reservoirs", self.reservoirs[current]),
+                    ("merged_reservoirs", merged_out),
                     ("temporal_sorted_pixels", temporal_runs.sorted_pixels),
                     ("temporal_spans", temporal_runs.spans),
                     ("temporal_sources", self.temporal_sources),
@@ -381,6 +431,38 @@ impl RestirRenderer {
                 ],
             )?,
         )?;
+        if let Some(first) = first {
+            if self.settings.method.uses_histogram() {
+                pass_times[1] = run(
+                    backend,
+                    first.keys_kernel,
+                    &with(
+                        first.keys_kernel,
+                        &[
+                            ("primaries", self.primaries[current]),
+                            ("merged_reservoirs", first.merged),
+                            ("histogram_in", self.histogram.candidates),
+                        ],
+                    )?,
+                )?;
+                pass_times[1] += histogram(backend)?;
+            }
+            pass_times[2] += run(
+                backend,
+                first.spatial_kernel,
+                &with(
+                    first.spatial_kernel,
+                    &[
+                        ("primaries", self.primaries[current]),
+                        ("reservoirs_in", first.merged),
+                        ("sorted_pixels", self.histogram.sorted_pixels),
+                        ("spans", self.histogram.spans),
+                        ("reservoirs_out", self.reservoirs[current]),
+                        ("blue_noise", self.blue_noise),
+                    ],
+                )?,
+            )?;
+        }
         pass_times[4] = run(
             backend,
             shade_kernel,
@@ -466,9 +548,11 @@ impl RestirRenderer {
             self.frame_out,
         ];
         let guides = self.guides.map(|(_, guides, _)| guides).into_iter().flatten();
+        let temporal_first = self.temporal_first.map(|f| [f.canonical_params, f.merged]).into_iter().flatten();
         buffers
             .into_iter()
             .chain(guides)
+            .chain(temporal_first)
             .try_for_each(|b| backend.destroy_buffer(b))
             .map_err(|e: BackendError| e.into())
     }

@@ -92,6 +92,37 @@ pub enum Shading {
     Expectation,
 }
 
+/// In which order a frame reuses its neighbours' and its history's samples.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[derive(serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ReuseOrder {
+    /// The paper's (§5.1): the spatial selection on this frame's candidates, then the
+    /// temporal merge of its result with the history. The stratification acts on the
+    /// current frame's candidates only, whose share of each merge fades as the history
+    /// grows.
+    #[default]
+    SpatialFirst,
+    /// The standard ReSTIR order (Bitterli et al. 2020): each pixel's candidate merges
+    /// with its history first, then the histogram sorts the merged reservoirs by their
+    /// estimates p̂ W and the spatial selection reuses K of them (pairwise MIS with
+    /// confidence weights: `restir/entry_spatial.wgsl`); the spatial result is the
+    /// history of the next frame. Two more passes per frame (BENCHMARKS.md, "The
+    /// temporal lever").
+    TemporalFirst,
+}
+
+impl ReuseOrder {
+    /// The name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            ReuseOrder::SpatialFirst => "spatial-first",
+            ReuseOrder::TemporalFirst => "temporal-first",
+        }
+    }
+}
+
 /// Settings of a ReSTIR render; the defaults are the paper's (§5.1).
 ///
 /// The one declaration of each setting: the field docs are the command line's `--help`
@@ -189,6 +220,16 @@ pub struct RestirSettings {
     /// default before 2026-11-25).
     #[cfg_attr(feature = "clap", arg(long, value_enum, default_value_t = RestirSettings::default().shading))]
     pub shading: Shading,
+    /// The order of reuse, for every method alike: `spatial-first` (the paper's: select
+    /// among this frame's candidates, then merge the history) or `temporal-first` (the
+    /// standard ReSTIR order: merge the history into each pixel's candidate, then select
+    /// among the block's merged reservoirs, sorted by their estimates).
+    ///
+    /// Without temporal reuse (--accumulate) both orders resample this frame's samples
+    /// only; temporal-first then sorts the blocks by each candidate's own estimate as
+    /// spatial-first does.
+    #[cfg_attr(feature = "clap", arg(long, value_enum, default_value_t = RestirSettings::default().reuse_order))]
+    pub reuse_order: ReuseOrder,
 }
 
 impl Default for RestirSettings {
@@ -206,6 +247,7 @@ impl Default for RestirSettings {
             min_distance: 0.0,
             shaded_parts: ShadedParts::All,
             shading: Shading::Expectation,
+            reuse_order: ReuseOrder::SpatialFirst,
         }
     }
 }

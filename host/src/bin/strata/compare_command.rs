@@ -398,8 +398,13 @@ fn warm_up_kernels(
     std::thread::spawn(move || {
         let histograms = [KernelId::BlockHistogram, KernelId::BlockHistogramSubgroup, KernelId::BlockHistogramRank];
         let shares = [
-            [&[KernelId::RestirCandidates, KernelId::RestirTemporalKeys, KernelId::RestirShade][..], &histograms]
-                .concat(),
+            [
+                &[KernelId::RestirCandidates, KernelId::RestirTemporalKeys, KernelId::RestirShade][..],
+                &histograms,
+                // The temporal-first order's passes (dispatched only in that order).
+                &[KernelId::RestirReservoirKeys, KernelId::RestirSpatial],
+            ]
+            .concat(),
             vec![KernelId::RestirSelect, KernelId::RestirTemporal],
         ];
         std::thread::scope(|threads| {

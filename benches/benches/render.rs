@@ -20,7 +20,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::Duration;
 use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
 use strata::render::{GpuScene, PathTracer, RenderSettings};
-use strata::restir::{Method, RestirRenderer, RestirSettings, Shading};
+use strata::restir::{Method, RestirRenderer, RestirSettings, ReuseOrder, Shading};
 use strata::scene::{Scene, default_scene};
 use strata::synthetic::{CandidateMix, candidate_image};
 use strata_backends::Backend;
@@ -54,19 +54,26 @@ fn restir_frames(c: &mut Criterion, backend: &mut dyn Backend) {
     group.sample_size(10).measurement_time(Duration::from_secs(10));
     // Every method with each shading of the resampled part (`expectation`: no shadow ray
     // in the shading pass, a few more BSDF evaluations in select and temporal).
-    let runs = [Shading::Sample, Shading::Expectation]
-        .into_iter()
-        .flat_map(|shading| [Method::Strata, Method::Restir, Method::RestirDisc].map(|method| (method, shading)));
-    for (method, shading) in runs {
-        let restir = RestirSettings { method, shading, ..RestirSettings::default() };
+    // And with expectation shading in the temporal-first order (two more passes:
+    // `restir_reservoir_keys` and `restir_spatial`; select then runs with K = 0).
+    let spatial_first = [Shading::Sample, Shading::Expectation].into_iter().flat_map(|shading| {
+        [Method::Strata, Method::Restir, Method::RestirDisc].map(|method| (method, shading, ReuseOrder::SpatialFirst))
+    });
+    let temporal_first = [Method::Strata, Method::Restir, Method::RestirDisc]
+        .map(|method| (method, Shading::Expectation, ReuseOrder::TemporalFirst));
+    for (method, shading, reuse_order) in spatial_first.chain(temporal_first) {
+        let restir = RestirSettings { method, shading, reuse_order, ..RestirSettings::default() };
         let mut renderer = RestirRenderer::new(backend, &gpu_scene, &render, restir, scene.extent()).expect("renderer");
         renderer.set_timed(true);
         // The first frame builds the pipelines (seconds on a GPU driver); inside criterion's
         // warm-up it leaves the GPU idle and too few frames to bring its clocks back up.
         renderer.render_frame(backend, None).expect("first frame");
-        let name = match shading {
-            Shading::Sample => method.name().to_string(),
-            Shading::Expectation => format!("{}/expectation", method.name()),
+        let name = match (shading, reuse_order) {
+            (Shading::Sample, _) => method.name().to_string(),
+            (Shading::Expectation, ReuseOrder::SpatialFirst) => format!("{}/expectation", method.name()),
+            (Shading::Expectation, ReuseOrder::TemporalFirst) => {
+                format!("{}/expectation/temporal-first", method.name())
+            }
         };
         let mut passes = PassTimes::default();
         group.bench_function(&name, |b| {

@@ -117,7 +117,7 @@ fn compare_with_every_setting_moved_reproduces_its_committed_numbers() {
         "--min-distance",
         "0.01",
         "--reuse-order",
-        "temporal-first",
+        "spatial-first",
     ];
     let out = compare("moved", &settings);
     assert_same_as_committed(&out.join("errors.csv"), "compare_moved_errors.csv");

@@ -105,11 +105,7 @@ pub fn define_integer_division_validated(
     let Some(rewritten) = define_integer_division(module, info) else {
         return Ok(None);
     };
-    let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
-        .subgroup_stages(naga::valid::ShaderStages::COMPUTE)
-        .subgroup_operations(naga::valid::SubgroupOperationSet::all())
-        .validate(&rewritten)
-        .map_err(|e| format!("WGSL integer division helpers made an invalid module: {e:?}"))?;
+    let info = crate::ir_edit::revalidate(&rewritten, "WGSL integer division helpers")?;
     Ok(Some((rewritten, info)))
 }
 

@@ -116,3 +116,14 @@ pub(crate) fn visit_functions(
         f(&entry.function, info.get_entry_point(index), None, index);
     }
 }
+
+/// Validates a module a rewrite of this crate produced (every capability: the rewrites
+/// keep what the source used), for the writer it is handed to; an error names `what`
+/// made it invalid, a bug of that rewrite.
+pub(crate) fn revalidate(module: &naga::Module, what: &str) -> Result<naga::valid::ModuleInfo, String> {
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+        .subgroup_stages(naga::valid::ShaderStages::COMPUTE)
+        .subgroup_operations(naga::valid::SubgroupOperationSet::all())
+        .validate(module)
+        .map_err(|e| format!("{what} made an invalid module: {e:?}"))
+}

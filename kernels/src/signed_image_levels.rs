@@ -145,11 +145,7 @@ pub fn defined_for_glsl(
     let Some(signed) = sign_image_levels(module, info) else {
         return Ok(divided);
     };
-    let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
-        .subgroup_stages(naga::valid::ShaderStages::COMPUTE)
-        .subgroup_operations(naga::valid::SubgroupOperationSet::all())
-        .validate(&signed)
-        .map_err(|e| format!("signed texture levels made an invalid module: {e:?}"))?;
+    let info = crate::ir_edit::revalidate(&signed, "signed texture levels")?;
     Ok(Some((signed, info)))
 }
 

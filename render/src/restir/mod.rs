@@ -7,7 +7,11 @@
 //! One frame is five kernels (`kernels/wgsl/restir/`): candidates (G-buffer, each pixel's
 //! own estimate, one path candidate per pixel), the block histogram (strata and restir
 //! only), selection + resampling with the pixel's canonical candidate, temporal reuse
-//! and shading (and, for a denoiser, its guide). See [`RestirRenderer`] for the buffers; the selection itself (§4.1-4.3)
+//! and shading (and, for a denoiser, its guide). In the temporal-first order
+//! ([`ReuseOrder::TemporalFirst`]) the selection runs with K = 0 (the canonical candidate
+//! alone), the temporal merge follows, then the histogram of the merged reservoirs' keys
+//! and the spatial reuse of K merged reservoirs (`entry_reservoir_keys.wgsl`,
+//! `entry_spatial.wgsl`). See [`RestirRenderer`] for the buffers; the selection itself (§4.1-4.3)
 //! lives in the kernels' `strata/` folder and [`strata_kernels::selection`].
 
 mod pipeline;

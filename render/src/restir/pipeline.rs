@@ -156,9 +156,11 @@ impl RestirRenderer {
             None
         };
         let pixels = u64::from(camera.width) * u64::from(camera.height);
+        // Without temporal reuse the two orders resample the same samples with the same
+        // weights (each merged reservoir is its canonical candidate, M = 1): the
+        // paper's passes do it with two passes fewer.
         let temporal_first = match settings.reuse_order {
-            ReuseOrder::SpatialFirst => None,
-            ReuseOrder::TemporalFirst => {
+            ReuseOrder::TemporalFirst if settings.temporal => {
                 let [keys_kernel, spatial_kernel] =
                     [KernelId::RestirReservoirKeys, KernelId::RestirSpatial].map(|id| registry.get(id));
                 backend.check_kernel(keys_kernel)?;
@@ -170,6 +172,7 @@ impl RestirRenderer {
                     merged: backend.create_buffer("merged reservoirs", pixels * size_of::<Reservoir>() as u64)?,
                 })
             }
+            ReuseOrder::TemporalFirst | ReuseOrder::SpatialFirst => None,
         };
         let scene_buffers = SceneBuffers::upload(backend, scene)?;
         let mut params = render.params(&scene.params)?;

@@ -98,18 +98,19 @@ pub enum Shading {
 #[derive(serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ReuseOrder {
-    /// The paper's (§5.1): the spatial selection on this frame's candidates, then the
-    /// temporal merge of its result with the history. The stratification acts on the
-    /// current frame's candidates only, whose share of each merge fades as the history
-    /// grows.
-    #[default]
+    /// The paper's (§5.1), and the default before 2026-11-27: the spatial selection on
+    /// this frame's candidates, then the temporal merge of its result with the history.
+    /// The stratification acts on the current frame's candidates only, whose share of
+    /// each merge fades as the history grows.
     SpatialFirst,
-    /// The standard ReSTIR order (Bitterli et al. 2020): each pixel's candidate merges
-    /// with its history first, then the histogram sorts the merged reservoirs by their
-    /// estimates p̂ W and the spatial selection reuses K of them (pairwise MIS with
-    /// confidence weights: `restir/entry_spatial.wgsl`); the spatial result is the
-    /// history of the next frame. Two more passes per frame (BENCHMARKS.md, "The
+    /// The standard ReSTIR order (Bitterli et al. 2020), the default: each pixel's
+    /// candidate merges with its history first, then the histogram sorts the merged
+    /// reservoirs by their estimates p̂ W and the spatial selection reuses K of them
+    /// (pairwise MIS with confidence weights: `restir/entry_spatial.wgsl`); the spatial
+    /// result is the history of the next frame. Two more passes per frame, about 2 %
+    /// more time, and every method's error lower over frames 1-32 (BENCHMARKS.md, "The
     /// temporal lever").
+    #[default]
     TemporalFirst,
 }
 
@@ -123,7 +124,8 @@ impl ReuseOrder {
     }
 }
 
-/// Settings of a ReSTIR render; the defaults are the paper's (§5.1).
+/// Settings of a ReSTIR render; the defaults are the paper's (§5.1) but for the order of
+/// reuse ([`ReuseOrder`]) and what BENCHMARKS.md's "Levers" measured.
 ///
 /// The one declaration of each setting: the field docs are the command line's `--help`
 /// (`strata compare` flattens this struct; with the `clap` feature), the field names
@@ -220,14 +222,14 @@ pub struct RestirSettings {
     /// default before 2026-11-25).
     #[cfg_attr(feature = "clap", arg(long, value_enum, default_value_t = RestirSettings::default().shading))]
     pub shading: Shading,
-    /// The order of reuse, for every method alike: `spatial-first` (the paper's: select
-    /// among this frame's candidates, then merge the history) or `temporal-first` (the
-    /// standard ReSTIR order: merge the history into each pixel's candidate, then select
-    /// among the block's merged reservoirs, sorted by their estimates).
+    /// The order of reuse, for every method alike: `temporal-first` (the standard ReSTIR
+    /// order, the default since 2026-11-27: merge the history into each pixel's
+    /// candidate, then select among the block's merged reservoirs, sorted by their
+    /// estimates) or `spatial-first` (the paper's: select among this frame's candidates,
+    /// then merge the history).
     ///
-    /// Without temporal reuse (--accumulate) both orders resample this frame's samples
-    /// only; temporal-first then sorts the blocks by each candidate's own estimate as
-    /// spatial-first does.
+    /// Without temporal reuse (--accumulate) both orders resample this frame's candidates
+    /// with the same weights, and the renderer runs the spatial-first passes (two fewer).
     #[cfg_attr(feature = "clap", arg(long, value_enum, default_value_t = RestirSettings::default().reuse_order))]
     pub reuse_order: ReuseOrder,
 }
@@ -247,7 +249,7 @@ impl Default for RestirSettings {
             min_distance: 0.0,
             shaded_parts: ShadedParts::All,
             shading: Shading::Expectation,
-            reuse_order: ReuseOrder::SpatialFirst,
+            reuse_order: ReuseOrder::TemporalFirst,
         }
     }
 }

@@ -41,13 +41,15 @@ pub struct FrameBuffers {
     pub histogram_candidates: Vec<Candidate>,
     /// `restir_candidates`: what each pixel estimates alone (rgb, invalid flag).
     pub base_radiance: Vec<[f32; 4]>,
-    /// `restir_select`: the reservoirs after selection.
+    /// `restir_select`: the reservoirs after selection (in the temporal-first order each
+    /// pixel's canonical candidate as a reservoir).
     pub selected: Vec<Reservoir>,
     /// `restir_temporal_keys`: the temporal histogram's input.
     pub temporal_keys: Vec<Candidate>,
     /// `restir_temporal_keys`: each pixel's temporal source pixel.
     pub temporal_sources: Vec<u32>,
-    /// `restir_temporal`: the final reservoirs.
+    /// The final reservoirs: `restir_temporal`'s (`restir_spatial`'s in the temporal-first
+    /// order).
     pub reservoirs: Vec<Reservoir>,
     /// `restir_shade`: the frame (rgb, invalid flag).
     pub image: Vec<[f32; 4]>,

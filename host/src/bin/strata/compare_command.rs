@@ -383,11 +383,12 @@ fn settings_record(
 /// Builds and runs every kernel the methods use at 8x8, with the run's settings, on
 /// another thread; anything failing there is left for the real run to report. The
 /// kernels are split between two threads with a device each, which compile side by side
-/// (the path tracer's candidates with the small passes; the selection and the temporal
-/// merge, each as large), and each renders two frames per method (the first without
-/// temporal reuse, the second with it: lavapipe evidently compiles a kernel for the
-/// uniform values it sees, as a dispatch on zeroed uniforms built nothing the run could
-/// reuse; BENCHMARKS "First run on a fresh machine").
+/// (the path tracer's candidates with the small passes; the selection, the temporal
+/// merge and the temporal-first order's spatial pass, each as large), and each renders
+/// two frames per method (the first without temporal reuse, the second with it: lavapipe
+/// evidently compiles a kernel for the uniform values it sees, as a dispatch on zeroed
+/// uniforms built nothing the run could reuse; BENCHMARKS "First run on a fresh
+/// machine").
 fn warm_up_kernels(
     choice: strata::backend_choice::BackendChoice,
     scene: strata::scene::Scene,
@@ -416,8 +417,16 @@ fn warm_up_kernels(
                         let gpu_scene = GpuScene::build(scene)?;
                         let mut render = RenderSettings::for_scene(scene, 8, 8, 1);
                         render.seed = 1;
-                        for &method in methods {
-                            let settings = RestirSettings { method, ..restir };
+                        // Accumulated frames (the other regime) run the paper's passes
+                        // whatever the order, the selection with its K: built too when the
+                        // temporal regime runs the temporal-first passes.
+                        let accumulated = RestirSettings { temporal: false, ..restir };
+                        let mut variants = vec![restir];
+                        if restir.temporal && restir.reuse_order == strata::restir::ReuseOrder::TemporalFirst {
+                            variants.push(accumulated);
+                        }
+                        for (&method, variant) in methods.iter().flat_map(|m| variants.iter().map(move |v| (m, v))) {
+                            let settings = RestirSettings { method, ..*variant };
                             let mut renderer = strata::restir::RestirRenderer::new(
                                 backend.as_mut(),
                                 &gpu_scene,

@@ -199,7 +199,7 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
     // of the first run's 144 s for the ReSTIR kernels, on one core), and its shader cache
     // then serves the methods' own first frames.
     let warm_up = (!backend.info().is_interpreter())
-        .then(|| warm_up_kernels(args.backend, scene.clone(), args.methods.clone(), restir));
+        .then(|| crate::warm_up::WarmUp::start(args.backend, scene.clone(), args.methods.clone(), restir));
     let reference_spp = args.reference_spp.unwrap_or_else(|| default_reference_spp(backend.as_ref()));
     let render = sized_to_backend(args, render, backend.as_ref(), reference_spp);
     *size = Some((render.camera.width, render.camera.height));
@@ -283,7 +283,7 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
                 "waiting for the methods' kernels to finish compiling (once per machine: Mesa's cache keeps them)"
             );
         }
-        let _ = warm_up.join();
+        warm_up.join();
     }
     let comparison = Comparison {
         methods: args.methods.clone(),
@@ -378,75 +378,6 @@ fn settings_record(
     put("denoise", args.denoise.map(|d| d.name()).into());
     put("both_regimes", args.both_regimes.into());
     map
-}
-
-/// Builds and runs every kernel the methods use at 8x8, with the run's settings, on
-/// another thread; anything failing there is left for the real run to report. The
-/// kernels are split between two threads with a device each, which compile side by side
-/// (the path tracer's candidates with the small passes; the selection, the temporal
-/// merge and the temporal-first order's spatial pass, each as large), and each renders
-/// two frames per method (the first without temporal reuse, the second with it: lavapipe
-/// evidently compiles a kernel for the uniform values it sees, as a dispatch on zeroed
-/// uniforms built nothing the run could reuse; BENCHMARKS "First run on a fresh
-/// machine").
-fn warm_up_kernels(
-    choice: strata::backend_choice::BackendChoice,
-    scene: strata::scene::Scene,
-    methods: Vec<Method>,
-    restir: RestirSettings,
-) -> std::thread::JoinHandle<()> {
-    use strata_kernels::KernelId;
-    std::thread::spawn(move || {
-        let histograms = [KernelId::BlockHistogram, KernelId::BlockHistogramSubgroup, KernelId::BlockHistogramRank];
-        let shares = [
-            [
-                &[KernelId::RestirCandidates, KernelId::RestirTemporalKeys, KernelId::RestirShade][..],
-                &histograms,
-                // The temporal-first order's passes (dispatched only in that order).
-                &[KernelId::RestirReservoirKeys, KernelId::RestirSpatial],
-            ]
-            .concat(),
-            vec![KernelId::RestirSelect, KernelId::RestirTemporal],
-        ];
-        std::thread::scope(|threads| {
-            for share in shares {
-                let (scene, methods) = (&scene, &methods);
-                threads.spawn(move || {
-                    let run = || -> Result<()> {
-                        let mut backend = strata::backend_choice::open_backend_quietly(choice)?;
-                        let gpu_scene = GpuScene::build(scene)?;
-                        let mut render = RenderSettings::for_scene(scene, 8, 8, 1);
-                        render.seed = 1;
-                        // Accumulated frames (the other regime) run the paper's passes
-                        // whatever the order, the selection with its K: built too when the
-                        // temporal regime runs the temporal-first passes.
-                        let accumulated = RestirSettings { temporal: false, ..restir };
-                        let mut variants = vec![restir];
-                        if restir.temporal && restir.reuse_order == strata::restir::ReuseOrder::TemporalFirst {
-                            variants.push(accumulated);
-                        }
-                        for (&method, variant) in methods.iter().flat_map(|m| variants.iter().map(move |v| (m, v))) {
-                            let settings = RestirSettings { method, ..*variant };
-                            let mut renderer = strata::restir::RestirRenderer::new(
-                                backend.as_mut(),
-                                &gpu_scene,
-                                &render,
-                                settings,
-                                scene.extent(),
-                            )?;
-                            renderer.dispatch_only(Some(share.clone()));
-                            let frames =
-                                (0..2).try_for_each(|_| renderer.render_frame(backend.as_mut(), None).map(drop));
-                            renderer.destroy(backend.as_mut())?;
-                            frames?;
-                        }
-                        Ok(())
-                    };
-                    let _ = run();
-                });
-            }
-        });
-    })
 }
 
 /// The reference path-traced at `spp` and written to the output folder.

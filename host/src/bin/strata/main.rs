@@ -2,6 +2,7 @@
 
 mod compare_command;
 mod histogram_command;
+mod warm_up;
 
 /// `--exposure` and other scales: a finite, positive number (NaN or a negative exposure
 /// would write black pictures, an infinite one white ones).

@@ -287,8 +287,15 @@ impl KernelId {
             KernelId::RestirCandidates => restir("restir_candidates", &[fragment!("restir/entry_candidates.wgsl")]),
             KernelId::RestirSelect => restir(
                 "restir_select",
-                &[selection(), vec![fragment!("restir/reuse_slot.wgsl"), fragment!("restir/entry_select.wgsl")]]
-                    .concat(),
+                &[
+                    selection(),
+                    vec![
+                        fragment!("restir/reuse_slot.wgsl"),
+                        fragment!("restir/block_reuse.wgsl"),
+                        fragment!("restir/entry_select.wgsl"),
+                    ],
+                ]
+                .concat(),
             ),
             KernelId::RestirTemporalKeys => {
                 restir("restir_temporal_keys", &[fragment!("restir/entry_temporal_keys.wgsl")])
@@ -303,8 +310,15 @@ impl KernelId {
             }
             KernelId::RestirSpatial => restir(
                 "restir_spatial",
-                &[selection(), vec![fragment!("restir/reuse_slot.wgsl"), fragment!("restir/entry_spatial.wgsl")]]
-                    .concat(),
+                &[
+                    selection(),
+                    vec![
+                        fragment!("restir/reuse_slot.wgsl"),
+                        fragment!("restir/block_reuse.wgsl"),
+                        fragment!("restir/entry_spatial.wgsl"),
+                    ],
+                ]
+                .concat(),
             ),
             KernelId::RestirShade => restir("restir_shade", &[fragment!("restir/entry_shade.wgsl")]),
             KernelId::RestirGuide => {

@@ -6,7 +6,7 @@
 // (the temporal-first order, RestirSettings::reuse_order, reuses neighbours after the
 // temporal merge instead: restir/entry_spatial.wgsl).
 //
-// Selection, by RestirParams.method:
+// Selection, by RestirParams.method (the draw and the choice: restir/block_reuse.wgsl):
 //   strata      from its own cluster's run of the block's luminance-sorted list (the
 //               histogram pass), at the K positions of RestirParams.sampler for this
 //               pixel and frame (strata/selection.wgsl, spatial dimension pair; the
@@ -56,19 +56,6 @@ fn empty_reservoir() -> Reservoir {
     return Reservoir(PathCandidate(vec3<f32>(0.0), KIND_NONE, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), 0.0), 0.0, 0.0, 0.0, 0u, vec3<f32>(0.0), 0.0);
 }
 
-// The pixel that selection slot `slot` of pixel (x, y) takes, or NO_PIXEL for none
-// (restir/reuse_slot.wgsl).
-fn selected_pixel(x: u32, y: u32, pixel: u32, p: Primary, slot: u32, positions: vec4<f32>) -> u32 {
-    if restir.method == METHOD_RESTIR_DISC {
-        return disc_neighbour(x, y, p);
-    }
-    let index = run_index(spans[pixel], positions[slot]);
-    if index == NO_PIXEL {
-        return NO_PIXEL;
-    }
-    return sorted_pixels[index];
-}
-
 @compute @workgroup_size(8, 8)
 fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     if id.x >= params.width || id.y >= params.height {
@@ -109,7 +96,7 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
         weight_c = target_c * c.weight;
     }
     for (var slot = 0u; slot < k; slot++) {
-        let q = selected_pixel(id.x, id.y, pixel, p, slot, positions);
+        let q = block_slot_pixel(id.x, id.y, pixel, p, slot, positions);
         if q == NO_PIXEL {
             // No candidate in this slot: the canonical sample alone covers its share.
             weight_c += target_c * c.weight / f32(k);
@@ -172,28 +159,10 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
     }
     var chosen = c;
     var chosen_target = target_c;
-    if restir.method == METHOD_STRATA {
-        // Inverse CDF with the second sampler dimension; CANONICAL = MAX_SELECTED.
-        var choice = inverse_cdf_first(numbers.resample * total, weight_c, MAX_SELECTED);
-        for (var slot = 0u; slot < k; slot++) {
-            choice = inverse_cdf_next(choice, weights[slot], slot);
-        }
-        if choice.chosen < MAX_SELECTED {
-            chosen = path_candidates[sources[choice.chosen]];
-            chosen_target = targets[choice.chosen];
-        }
-    } else {
-        // Streaming weighted reservoir sampling, in slot order after the canonical.
-        var running = weight_c;
-        for (var slot = 0u; slot < k; slot++) {
-            if weights[slot] > 0.0 {
-                running += weights[slot];
-                if random() * running < weights[slot] {
-                    chosen = path_candidates[sources[slot]];
-                    chosen_target = targets[slot];
-                }
-            }
-        }
+    let kept = resampled_slot(weight_c, weights, k, total, numbers.resample);
+    if kept < MAX_SELECTED {
+        chosen = path_candidates[sources[kept]];
+        chosen_target = targets[kept];
     }
     var result = empty_reservoir();
     result.count = 1.0;

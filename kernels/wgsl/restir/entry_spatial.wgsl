@@ -7,7 +7,7 @@
 // frame's candidates alone, whose share of a merge fades as the history grows. The
 // output is the pixel's final reservoir, which the next frame's temporal merge reuses.
 //
-// Selection, by RestirParams.method, as restir_select draws its K (restir/reuse_slot.wgsl):
+// Selection, by RestirParams.method, as restir_select draws its K (restir/block_reuse.wgsl):
 //   strata      the K stratified positions of the pixel's cluster run (spatial
 //               dimension pair) and inverse-CDF resampling with the pair's second number
 //   restir      K uniformly random members of the run, streaming reservoir
@@ -48,18 +48,6 @@
 @group(0) @binding(13) var<storage, read_write> reservoirs_out: array<Reservoir>;
 @group(0) @binding(14) var<storage, read> blue_noise: array<u32>;
 
-// The pixel that reuse slot `slot` of pixel (x, y) takes, or NO_PIXEL for none.
-fn drawn_pixel(x: u32, y: u32, pixel: u32, p: Primary, slot: u32, positions: vec4<f32>) -> u32 {
-    if restir.method == METHOD_RESTIR_DISC {
-        return disc_neighbour(x, y, p);
-    }
-    let index = run_index(spans[pixel], positions[slot]);
-    if index == NO_PIXEL {
-        return NO_PIXEL;
-    }
-    return sorted_pixels[index];
-}
-
 @compute @workgroup_size(8, 8)
 fn restir_spatial(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     if id.x >= params.width || id.y >= params.height {
@@ -99,7 +87,7 @@ fn restir_spatial(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_i
     // Written out element by element (see restir_select: naga's HLSL zero constructor).
     var colours = array<vec3<f32>, MAX_SELECTED>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     for (var slot = 0u; slot < k; slot++) {
-        let q = drawn_pixel(id.x, id.y, pixel, p, slot, positions);
+        let q = block_slot_pixel(id.x, id.y, pixel, p, slot, positions);
         var neighbour_reservoir = canonical;
         var neighbour = p;
         if q != NO_PIXEL {
@@ -168,26 +156,7 @@ fn restir_spatial(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_i
         reservoirs_out[pixel] = result;
         return;
     }
-    var chosen = MAX_SELECTED;
-    if restir.method == METHOD_STRATA {
-        // Inverse CDF with the second sampler dimension; the canonical is MAX_SELECTED.
-        var choice = inverse_cdf_first(numbers.resample * total, weight_c, MAX_SELECTED);
-        for (var slot = 0u; slot < k; slot++) {
-            choice = inverse_cdf_next(choice, weights[slot], slot);
-        }
-        chosen = choice.chosen;
-    } else {
-        // Streaming weighted reservoir sampling, in slot order after the canonical.
-        var running = weight_c;
-        for (var slot = 0u; slot < k; slot++) {
-            if weights[slot] > 0.0 {
-                running += weights[slot];
-                if random() * running < weights[slot] {
-                    chosen = slot;
-                }
-            }
-        }
-    }
+    let chosen = resampled_slot(weight_c, weights, k, total, numbers.resample);
     if chosen < MAX_SELECTED {
         result.sample = reservoirs_in[sources[chosen]].sample;
         result.target_value = targets[chosen];

@@ -65,8 +65,8 @@ fn assert_complete(folder: &Path) -> usize {
 /// folder must succeed.
 fn kill_at_several_points(name: &str, args: &[&str]) {
     // A first run builds the kernels (on a machine whose shader cache lacks them, that is
-    // most of its time: on a fresh CI machine this test took 248 s when the runs below
-    // slept for fractions of it), so the second, timed run is what a killed run repeats.
+    // most of its time: in a CI run whose shader cache lacked two changed kernels this test
+    // took 248 s, the runs below sleeping for fractions of it), so the second, timed run is what a killed run repeats.
     let first = scratch(&format!("{name}-first"));
     assert!(strata(args, &first).status().unwrap().success(), "the first uninterrupted run failed");
     let timing = scratch(&format!("{name}-timing"));

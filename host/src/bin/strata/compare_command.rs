@@ -194,10 +194,8 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
     let gpu_scene = GpuScene::build(&scene)?;
     let mut backend = open_backend(args.backend)?;
     println!("backend: {}", backend.info().summary());
-    // While the reference renders, a second device builds and runs the methods' kernels
-    // once at 8x8: a CPU driver compiles each kernel at its first dispatch (lavapipe took 93
-    // of the first run's 144 s for the ReSTIR kernels, on one core), and its shader cache
-    // then serves the methods' own first frames.
+    // While the reference renders, two more devices build and run the methods' kernels
+    // (warm_up.rs: why, and why their devices come and go while this thread waits).
     let warm_up = (!backend.info().is_interpreter())
         .then(|| crate::warm_up::WarmUp::start(args.backend, scene.clone(), args.methods.clone(), restir));
     let reference_spp = args.reference_spp.unwrap_or_else(|| default_reference_spp(backend.as_ref()));

@@ -74,21 +74,19 @@ impl WarmUp {
                     let (scene, methods, lifetime) = (&scene, &methods, &lifetime);
                     let (opened, finished, done) = (opened.clone(), finished.clone(), done.clone());
                     threads.spawn(move || {
-                        let backend = {
+                        let opening = {
                             let _one_at_a_time = lifetime.lock();
                             strata::backend_choice::open_backend_quietly(choice)
                         };
                         opened.wait();
-                        if let Ok(mut backend) = backend {
+                        let mut backend = opening.ok();
+                        if let Some(backend) = backend.as_mut() {
                             let _ = render_share(backend.as_mut(), scene, methods, restir, &share);
-                            done.fetch_add(1, Ordering::Release);
-                            finished.wait();
-                            let _one_at_a_time = lifetime.lock();
-                            drop(backend);
-                        } else {
-                            done.fetch_add(1, Ordering::Release);
-                            finished.wait();
                         }
+                        done.fetch_add(1, Ordering::Release);
+                        finished.wait();
+                        let _one_at_a_time = lifetime.lock();
+                        drop(backend);
                     });
                 }
             });

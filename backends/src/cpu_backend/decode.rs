@@ -57,6 +57,13 @@ pub(super) struct Code {
     /// Registers of pointers to local variables: (register, variable's register), set
     /// to (function tag | frame depth, variable's register) when a frame starts.
     pub local_pointers: Vec<(Reg, u32)>,
+    /// The function's own local variables (register, words): set from the template
+    /// when a frame starts. Every other register is either a compile-time value (in
+    /// the template, never written) or an expression's, written where the expression
+    /// is evaluated before any use reads it (uses are dominated by the emission), so
+    /// a register file is filled from the template once and then only these are reset
+    /// (inlined callees' variables are zeroed by instructions of their own).
+    pub locals: Vec<(Reg, u32)>,
     /// Per argument read by the function: (argument index, register, words).
     pub arguments: Vec<(u32, Reg, u32)>,
 }
@@ -375,6 +382,12 @@ fn compile_code(
     };
     let mut code_arguments = Vec::new();
     let mut scope = compiler.open(function, function_info, None, None, 0, &mut code_arguments)?;
+    let locals = scope
+        .locals
+        .iter()
+        .zip(function.local_variables.iter())
+        .map(|(&reg, (_, local))| (reg, words_of(module, &module.types[local.ty].inner).unwrap_or(0)))
+        .collect();
     compiler.block(&mut scope, &function.body)?;
     compiler.line = 0;
     compiler.source = scope.source;
@@ -385,6 +398,7 @@ fn compile_code(
         sources: compiler.insn_sources,
         template: compiler.template,
         local_pointers: compiler.local_pointers,
+        locals,
         arguments: code_arguments,
     })
 }

@@ -6,7 +6,7 @@ use super::counts::DispatchCounts;
 use super::decode::Program;
 use super::error::{invalid, unsupported};
 use super::insn::Insn;
-use super::interp::{self, Invocation, Stop};
+use super::interp::{self, Invocation, Stop, Workgroup};
 use super::memory::{FUNCTION, Frame};
 use crate::error::BackendError;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
@@ -46,10 +46,12 @@ pub(super) fn run(
         let handles: Vec<_> = (0..threads)
             .map(|_| {
                 scope.spawn(|| -> Result<(), BackendError> {
-                    let mut workgroup = vec![0u32; program.workgroup_words as usize];
-                    // Kept from one workgroup to the next so that their register files
-                    // (tens of kilobytes per invocation) are reused, not allocated again:
-                    // fresh ones cost more in page faults than the kernels' work.
+                    let mut memory = Workgroup {
+                        files: vec![Vec::new(); program.codes.len()],
+                        private: Vec::new(),
+                        private_words: program.private_init.len(),
+                        shared: vec![0u32; program.workgroup_words as usize],
+                    };
                     let mut invocations = Vec::new();
                     loop {
                         let index = next.fetch_add(1, Ordering::Relaxed);
@@ -59,11 +61,11 @@ pub(super) fn run(
                         let wx = (index % u64::from(workgroups[0])) as u32;
                         let wy = (index / u64::from(workgroups[0]) % u64::from(workgroups[1])) as u32;
                         let wz = (index / (u64::from(workgroups[0]) * u64::from(workgroups[1]))) as u32;
-                        workgroup.fill(0);
+                        memory.shared.fill(0);
                         match run_workgroup(
                             program,
                             &shared,
-                            &mut workgroup,
+                            &mut memory,
                             &mut invocations,
                             [wx, wy, wz],
                             workgroups,
@@ -110,31 +112,41 @@ fn builtin_value(builtin: naga::BuiltIn, b: &Builtins) -> Result<Vec<u32>, Backe
     })
 }
 
-/// The entry point's first frame for an invocation with builtins `b`, its registers in
-/// `regs` (a register file to reuse, or an empty vector).
-fn entry_frame(program: &Program, b: &Builtins, mut regs: Vec<u32>) -> Result<Frame, BackendError> {
+/// Starts the entry point's frame in every invocation's column of the entry code's
+/// register file: the template (its variables; the rest once per file), the builtins of each (`builtins[lane]`), the pointers
+/// to its locals.
+fn enter_entry_point(program: &Program, file: &mut Vec<u32>, builtins: &[Builtins]) -> Result<(), BackendError> {
     let code = &program.codes[program.entry as usize];
-    regs.clear();
-    regs.extend_from_slice(&code.template);
+    let width = builtins.len();
+    super::interp::open_file(file, &code.template, width);
+    for &(reg, words) in &code.locals {
+        for r in reg as usize..(reg + words) as usize {
+            file[r * width..][..width].fill(code.template[r]);
+        }
+    }
     for &(argument, reg, len) in &code.arguments {
         for &(builtin, offset) in &program.entry_arguments[argument as usize] {
-            let value = builtin_value(builtin, b)?;
-            let at = (reg + offset) as usize;
-            let n = (len.saturating_sub(offset) as usize).min(value.len());
-            regs[at..at + n].copy_from_slice(&value[..n]);
+            for (lane, b) in builtins.iter().enumerate() {
+                let value = builtin_value(builtin, b)?;
+                let at = (reg + offset) as usize;
+                let n = (len.saturating_sub(offset) as usize).min(value.len());
+                for (k, &word) in value[..n].iter().enumerate() {
+                    file[(at + k) * width + lane] = word;
+                }
+            }
         }
     }
     for &(reg, offset) in &code.local_pointers {
-        regs[reg as usize] = FUNCTION;
-        regs[reg as usize + 1] = offset;
+        file[reg as usize * width..][..width].fill(FUNCTION);
+        file[(reg as usize + 1) * width..][..width].fill(offset);
     }
-    Ok(Frame { code: program.entry, pc: 0, regs, result: None })
+    Ok(())
 }
 
 fn run_workgroup(
     program: &Program,
     buffers: &[Vec<AtomicU32>],
-    workgroup: &mut [u32],
+    memory: &mut Workgroup,
     invocations: &mut Vec<Invocation>,
     [wx, wy, wz]: [u32; 3],
     workgroups: [u32; 3],
@@ -144,10 +156,11 @@ fn run_workgroup(
     let count = (sx * sy * sz) as usize;
     let subgroup_size = subgroup_size.max(1);
     let num_subgroups = (count as u32).div_ceil(subgroup_size);
-    invocations.truncate(count);
+    invocations.clear();
+    let mut builtins = Vec::with_capacity(count);
     for index in 0..count as u32 {
         let local = [index % sx, index / sx % sy, index / (sx * sy)];
-        let builtins = Builtins {
+        let b = Builtins {
             local_id: local,
             local_index: index,
             global_id: [wx * sx + local[0], wy * sy + local[1], wz * sz + local[2]],
@@ -158,33 +171,27 @@ fn run_workgroup(
             subgroup_id: index / subgroup_size,
             num_subgroups,
         };
-        if let Some(invocation) = invocations.get_mut(index as usize) {
-            // The previous workgroup's invocation: its register files become spares.
-            let Invocation { frame, callers, spare, private, .. } = invocation;
-            spare.extend(frame.take().into_iter().chain(callers.drain(..)).map(|frame| frame.regs));
-            let regs = spare.pop().unwrap_or_default();
-            *frame = Some(entry_frame(program, &builtins, regs)?);
-            private.clear();
-            private.extend_from_slice(&program.private_init);
-        } else {
-            invocations.push(Invocation {
-                frame: Some(entry_frame(program, &builtins, Vec::new())?),
-                callers: Vec::new(),
-                spare: Vec::new(),
-                private: program.private_init.clone(),
-                lane: builtins.lane,
-                subgroup_id: builtins.subgroup_id,
-                subgroup_size,
-                local_index: index,
-            });
-        }
+        invocations.push(Invocation {
+            frame: Some(Frame { code: program.entry, pc: 0, result: None }),
+            callers: Vec::new(),
+            lane: b.lane,
+            subgroup_id: b.subgroup_id,
+            subgroup_size,
+            local_index: index,
+        });
+        builtins.push(b);
+    }
+    enter_entry_point(program, &mut memory.files[program.entry as usize], &builtins)?;
+    memory.private.clear();
+    for _ in 0..count {
+        memory.private.extend_from_slice(&program.private_init);
     }
     let invocations = &mut invocations[..];
     let mut counts = DispatchCounts::default();
     let mut stops = Vec::with_capacity(count);
     let mut reached = Vec::with_capacity(count);
     loop {
-        interp::run_until_sync(program, invocations, buffers, workgroup, &mut counts, &mut reached)?;
+        interp::run_until_sync(program, invocations, memory, buffers, &mut counts, &mut reached)?;
         stops.clear();
         stops.extend(reached.iter().map(|stop| stop.expect("every invocation stopped")));
         if stops.iter().all(|s| *s == Stop::Done) {
@@ -214,9 +221,10 @@ fn run_workgroup(
         // Everyone waits at the same instruction: a barrier needs nothing more; a
         // subgroup gather is computed for all invocations now.
         let Stop::Sync(code, pc) = first else { unreachable!() };
+        let file = &mut memory.files[code as usize];
         match &program.codes[code as usize].insns[pc as usize] {
-            Insn::Gather(gather) => self::gather(invocations, gather),
-            Insn::Collective(collective) => self::collective(invocations, collective),
+            Insn::Gather(gather) => self::gather(invocations, file, gather),
+            Insn::Collective(collective) => self::collective(invocations, file, collective),
             _ => {}
         }
         for invocation in invocations.iter_mut() {
@@ -227,17 +235,15 @@ fn run_workgroup(
 }
 
 /// Computes a subgroup gather for every invocation of the workgroup.
-fn gather(invocations: &mut [Invocation], gather: &super::insn::GatherInsn) {
+fn gather(invocations: &[Invocation], file: &mut [u32], gather: &super::insn::GatherInsn) {
     use naga::GatherMode as G;
-    fn regs(inv: &Invocation) -> &[u32] {
-        &inv.frame.as_ref().expect("waiting").regs
-    }
+    let width = invocations.len();
     let (argument, len) = (gather.argument as usize, gather.len as usize);
     let values: Vec<u32> =
-        invocations.iter().flat_map(|inv| regs(inv)[argument..argument + len].iter().copied()).collect();
+        (0..width).flat_map(|l| (0..len).map(move |k| (argument + k) * width + l)).map(|at| file[at]).collect();
     let mut results = Vec::with_capacity(values.len());
     for invocation in invocations.iter() {
-        let index = gather.index.map_or(0, |reg| regs(invocation)[reg as usize]);
+        let index = gather.index.map_or(0, |reg| file[reg as usize * width + invocation.local_index as usize]);
         let base = invocation.subgroup_id * invocation.subgroup_size;
         let lane = invocation.lane;
         let source = match gather.mode {
@@ -259,23 +265,18 @@ fn gather(invocations: &mut [Invocation], gather: &super::insn::GatherInsn) {
         let from = if in_range { source_index } else { invocation.local_index as usize };
         results.extend_from_slice(&values[from * len..from * len + len]);
     }
-    let result = gather.result as usize;
-    for (i, invocation) in invocations.iter_mut().enumerate() {
-        let frame = invocation.frame.as_mut().expect("waiting");
-        frame.regs[result..result + len].copy_from_slice(&results[i * len..i * len + len]);
-    }
+    write_results(file, width, gather.result as usize, len, &results);
 }
 
 /// Computes a subgroup ballot, reduction or scan for every invocation of the workgroup:
 /// the lanes of a subgroup are the invocations `subgroup_id * size ..` in local-index
 /// order, combined lane by lane in that order (float sums and products therefore
 /// associate left to right; GPUs may use another order, a few ULPs apart).
-fn collective(invocations: &mut [Invocation], collective: &super::insn::CollectiveInsn) {
+fn collective(invocations: &[Invocation], file: &mut [u32], collective: &super::insn::CollectiveInsn) {
     use super::insn::CollectiveFun;
     use naga::CollectiveOperation as C;
-    fn regs(inv: &Invocation) -> &[u32] {
-        &inv.frame.as_ref().expect("waiting").regs
-    }
+    let width = invocations.len();
+    let reg = |member: &Invocation, r: usize| file[r * width + member.local_index as usize];
     let len = collective.len as usize;
     let mut results = vec![0u32; invocations.len() * len];
     for (i, invocation) in invocations.iter().enumerate() {
@@ -287,7 +288,7 @@ fn collective(invocations: &mut [Invocation], collective: &super::insn::Collecti
         match collective.fun {
             CollectiveFun::Ballot { predicate } => {
                 for (l, member) in members.iter().enumerate() {
-                    if predicate.is_none_or(|p| regs(member)[p as usize] != 0) {
+                    if predicate.is_none_or(|p| reg(member, p as usize) != 0) {
                         out[l / 32] |= 1 << (l % 32);
                     }
                 }
@@ -302,15 +303,21 @@ fn collective(invocations: &mut [Invocation], collective: &super::insn::Collecti
                 for (c, word) in out.iter_mut().enumerate() {
                     *word = lanes
                         .iter()
-                        .fold(identity(op, kind), |acc, member| combine(op, kind, acc, regs(member)[argument + c]));
+                        .fold(identity(op, kind), |acc, member| combine(op, kind, acc, reg(member, argument + c)));
                 }
             }
         }
     }
-    let result = collective.result as usize;
-    for (i, invocation) in invocations.iter_mut().enumerate() {
-        let frame = invocation.frame.as_mut().expect("waiting");
-        frame.regs[result..result + len].copy_from_slice(&results[i * len..i * len + len]);
+    write_results(file, width, collective.result as usize, len, &results);
+}
+
+/// Writes each invocation's `len` words of `results` (lane-major) at register `result`
+/// of its column.
+fn write_results(file: &mut [u32], width: usize, result: usize, len: usize, results: &[u32]) {
+    for (lane, words) in results.chunks_exact(len.max(1)).enumerate().take(width) {
+        for (k, &word) in words.iter().enumerate() {
+            file[(result + k) * width + lane] = word;
+        }
     }
 }
 

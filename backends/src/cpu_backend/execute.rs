@@ -3,70 +3,42 @@
 //! stores through pointers, atomics), never control flow.
 
 use super::insn::Insn;
-use super::interp::Lane;
-use super::memory::{BUFFER, Memory, TAG_MASK, copy_words, read_buffer, read_mixed, write_buffer, write_mixed};
-use std::sync::atomic::AtomicU32;
+use super::interp::GroupMemory;
+use super::lanes::LaneRegs;
+use super::memory::{BUFFER, Memory, TAG_MASK, read_mixed, write_buffer, write_mixed};
+use std::sync::atomic::Ordering;
 
-/// Executes, for one invocation, an instruction that `run_group` neither runs itself
-/// (control flow) nor loops over the group on its own (the most frequent ones).
+/// Executes, for the invocation in lane `lane` of the running file `file`, an
+/// instruction that `run_group` neither runs itself (control flow) nor runs for the
+/// whole group at once (row operations).
 #[inline(always)]
-pub(super) fn execute(insn: &Insn, lane: &mut Lane, buffers: &[Vec<AtomicU32>], workgroup: &mut [u32]) {
-    let Lane { regs, private, callers } = lane;
-    let regs = &mut **regs;
+pub(super) fn execute(insn: &Insn, file: &mut [u32], lane: usize, group: &mut GroupMemory) {
+    let width = group.width;
+    let mut lane_regs = LaneRegs::new(file, lane, width);
+    let regs = &mut lane_regs;
+    let private_words = group.private_words;
+    let GroupMemory { buffers, workgroup, private, files, callers, .. } = group;
+    let buffers: &[_] = buffers;
+    let private = &mut private[lane * private_words..(lane + 1) * private_words];
+    macro_rules! memory {
+        () => {
+            Memory {
+                buffers,
+                workgroup: &mut **workgroup,
+                private: &mut *private,
+                files: &mut **files,
+                callers,
+                lane,
+                width,
+            }
+        };
+    }
     match insn {
-        Insn::Un { op, dst, src, n } => {
-            for i in 0..*n as usize {
-                regs[*dst as usize + i] = op.apply(regs[*src as usize + i]);
-            }
-        }
-        Insn::Swizzle { dst, src, pattern, n } => {
-            let (dst, src) = (*dst as usize, *src as usize);
-            let at = |i: usize| src + pattern[i] as usize;
-            // Component by component: gathering into an array and copying it out made
-            // the CPU forward two 4-byte stores into one 8-byte load, which stalls.
-            match *n {
-                2 => {
-                    let (x, y) = (regs[at(0)], regs[at(1)]);
-                    regs[dst] = x;
-                    regs[dst + 1] = y;
-                }
-                3 => {
-                    let (x, y, z) = (regs[at(0)], regs[at(1)], regs[at(2)]);
-                    regs[dst] = x;
-                    regs[dst + 1] = y;
-                    regs[dst + 2] = z;
-                }
-                _ => {
-                    let v = [regs[at(0)], regs[at(1)], regs[at(2)], regs[at(3)]];
-                    for (i, &x) in v.iter().enumerate().take(*n as usize) {
-                        regs[dst + i] = x;
-                    }
-                }
-            }
-        }
-        Insn::Convert { from, to, dst, src, n } => {
-            for i in 0..*n as usize {
-                regs[*dst as usize + i] =
-                    super::arith::convert(regs[*src as usize + i], *from, *to).expect("checked when compiled");
-            }
-        }
         Insn::Image(image) => super::image::execute(image, regs, buffers),
-        Insn::PtrAdd { dst, base, add } => {
-            let (dst, base) = (*dst as usize, *base as usize);
-            regs[dst] = regs[base];
-            regs[dst + 1] = regs[base + 1].wrapping_add(*add);
-        }
-        Insn::PtrIndex { dst, base, index, count, stride } => {
-            let (dst, base) = (*dst as usize, *base as usize);
-            let at = (regs[*index as usize] as usize).min(count.saturating_sub(1) as usize) * *stride as usize;
-            regs[dst] = regs[base];
-            regs[dst + 1] = (regs[base + 1] as usize + at) as u32;
-        }
         Insn::PtrIndexRt { dst, base, index, stride } => {
             let (dst, base) = (*dst as usize, *base as usize);
             let (tag, offset) = (regs[base], regs[base + 1] as usize);
-            let memory =
-                Memory { buffers, workgroup: &mut *workgroup, private: &mut private[..], callers: &mut callers[..] };
+            let memory = memory!();
             let stride = *stride as usize;
             let len = (memory.words(regs, tag).saturating_sub(offset) / stride.max(1)).max(1);
             let at = (regs[*index as usize] as usize).min(len - 1) * stride;
@@ -75,14 +47,12 @@ pub(super) fn execute(insn: &Insn, lane: &mut Lane, buffers: &[Vec<AtomicU32>], 
         }
         Insn::Load { dst, pointer, len } => {
             let pointer = (regs[*pointer as usize], regs[*pointer as usize + 1]);
-            let mut memory =
-                Memory { buffers, workgroup: &mut *workgroup, private: &mut private[..], callers: &mut callers[..] };
+            let mut memory = memory!();
             memory.load(regs, pointer, *dst as usize, *len as usize);
         }
         Insn::Store { pointer, src, len } => {
             let pointer = (regs[*pointer as usize], regs[*pointer as usize + 1]);
-            let mut memory =
-                Memory { buffers, workgroup: &mut *workgroup, private: &mut private[..], callers: &mut callers[..] };
+            let mut memory = memory!();
             memory.store(regs, pointer, *src as usize, *len as usize);
         }
         Insn::LoadMixed { dst, pointer, plan } => {
@@ -102,32 +72,38 @@ pub(super) fn execute(insn: &Insn, lane: &mut Lane, buffers: &[Vec<AtomicU32>], 
         }
         Insn::LoadWorkgroup { dst, address, len } => {
             let (dst, address, len) = (*dst as usize, *address as usize, *len as usize);
-            copy_words(&mut regs[dst..dst + len], &workgroup[address..address + len]);
+            regs.write(dst, &workgroup[address..address + len]);
         }
         Insn::StoreWorkgroup { address, src, len } => {
             let (src, address, len) = (*src as usize, *address as usize, *len as usize);
-            copy_words(&mut workgroup[address..address + len], &regs[src..src + len]);
+            for i in 0..len {
+                workgroup[address + i] = regs[src + i];
+            }
         }
         Insn::LoadPrivate { dst, address, len } => {
             let (dst, address, len) = (*dst as usize, *address as usize, *len as usize);
-            copy_words(&mut regs[dst..dst + len], &private[address..address + len]);
+            regs.write(dst, &private[address..address + len]);
         }
         Insn::StorePrivate { address, src, len } => {
             let (src, address, len) = (*src as usize, *address as usize, *len as usize);
-            copy_words(&mut private[address..address + len], &regs[src..src + len]);
+            for i in 0..len {
+                private[address + i] = regs[src + i];
+            }
         }
         Insn::LoadBuffer { dst, buffer, address, len } => {
             let (dst, len) = (*dst as usize, *len as usize);
-            read_buffer(&buffers[*buffer as usize], *address as usize, &mut regs[dst..dst + len]);
+            let memory = &buffers[*buffer as usize];
+            for i in 0..len {
+                regs[dst + i] = memory.get(*address as usize + i).map_or(0, |w| w.load(Ordering::Relaxed));
+            }
         }
         Insn::StoreBuffer { buffer, address, src, len } => {
             let (src, len) = (*src as usize, *len as usize);
-            write_buffer(&buffers[*buffer as usize], *address as usize, &regs[src..src + len]);
+            write_buffer(&buffers[*buffer as usize], *address as usize, &regs.read(src, len));
         }
         Insn::ArrayLength { dst, pointer, stride } => {
             let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1]);
-            let memory =
-                Memory { buffers, workgroup: &mut *workgroup, private: &mut private[..], callers: &mut callers[..] };
+            let memory = memory!();
             let words = memory.words(regs, tag);
             regs[*dst as usize] = (words.saturating_sub(offset as usize) / (*stride).max(1) as usize) as u32;
         }
@@ -158,8 +134,7 @@ pub(super) fn execute(insn: &Insn, lane: &mut Lane, buffers: &[Vec<AtomicU32>], 
                     }
                 }
             };
-            let mut memory =
-                Memory { buffers, workgroup: &mut *workgroup, private: &mut private[..], callers: &mut callers[..] };
+            let mut memory = memory!();
             let old = memory.atomic(regs, pointer, apply);
             if let Some(result) = atomic.result {
                 regs[result as usize] = old;
@@ -179,6 +154,11 @@ pub(super) fn execute(insn: &Insn, lane: &mut Lane, buffers: &[Vec<AtomicU32>], 
         | Insn::Select { .. }
         | Insn::Splat { .. }
         | Insn::Extract { .. }
+        | Insn::Un { .. }
+        | Insn::PtrAdd { .. }
+        | Insn::PtrIndex { .. }
+        | Insn::Swizzle { .. }
+        | Insn::Convert { .. }
         | Insn::Compute(_) => unreachable!("run for the whole group by `run_group`"),
         Insn::Jump(_)
         | Insn::JumpUnless { .. }

@@ -27,6 +27,7 @@
 
 use super::arith::{f16_to_f32, f32_to_f16};
 use super::insn::Reg;
+use super::lanes::LaneRegs;
 use crate::texture::{AddressMode, FilterMode, SamplerDesc, TextureDesc};
 use std::sync::atomic::{AtomicU32, Ordering};
 use strata_kernels::{TexelFormat, TextureDimension};
@@ -210,7 +211,7 @@ fn unorm8(bits: u32) -> u8 {
 }
 
 /// Executes an image instruction for one invocation.
-pub(super) fn execute(insn: &ImageInsn, regs: &mut [u32], buffers: &[Vec<AtomicU32>]) {
+pub(super) fn execute(insn: &ImageInsn, regs: &mut LaneRegs, buffers: &[Vec<AtomicU32>]) {
     let slot = |reg: Reg| (regs[reg as usize] & 0x00ff_ffff) as usize;
     let Some(texture) = buffers.get(slot(insn.image)).and_then(|words| Texture::of(words)) else {
         return;
@@ -220,7 +221,7 @@ pub(super) fn execute(insn: &ImageInsn, regs: &mut [u32], buffers: &[Vec<AtomicU
     let layered = texture.dimension == TextureDimension::D2Array;
     // Integer coordinates `[x, y, z-or-layer]` of `level`, if the level and all of them
     // are in range (compared unsigned: a negative value is out of range).
-    let in_range = |regs: &[u32], level: u32| -> Option<[u32; 3]> {
+    let in_range = |regs: &LaneRegs, level: u32| -> Option<[u32; 3]> {
         if level >= texture.levels {
             return None;
         }
@@ -238,7 +239,7 @@ pub(super) fn execute(insn: &ImageInsn, regs: &mut [u32], buffers: &[Vec<AtomicU
         ImageOp::Load => {
             let level = insn.level.map_or(0, |l| regs[l as usize]);
             let texel = in_range(regs, level).map_or([0; 4], |at| texture.read(level, at));
-            regs[result..result + 4].copy_from_slice(&texel);
+            regs.write(result, &texel);
         }
         ImageOp::Store => {
             if let Some(at) = in_range(regs, 0) {
@@ -250,7 +251,7 @@ pub(super) fn execute(insn: &ImageInsn, regs: &mut [u32], buffers: &[Vec<AtomicU
             let level = insn.level.map_or(0, |l| regs[l as usize].min(texture.levels - 1));
             let size = texture.level_size(level);
             let axes = texture.dimension.coordinates() as usize;
-            regs[result..result + axes].copy_from_slice(&size[..axes]);
+            regs.write(result, &size[..axes]);
         }
         ImageOp::NumLevels => regs[result] = texture.levels,
         ImageOp::NumLayers => regs[result] = if layered { texture.size[2] } else { 1 },
@@ -271,7 +272,7 @@ pub(super) fn execute(insn: &ImageInsn, regs: &mut [u32], buffers: &[Vec<AtomicU
                     sample.level(level)
                 }
             };
-            regs[result..result + 4].copy_from_slice(&value.map(f32::to_bits));
+            regs.write(result, &value.map(f32::to_bits));
         }
     }
 }

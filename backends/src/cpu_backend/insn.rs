@@ -8,6 +8,7 @@
 //! (literals, constants, pointers to globals) are filled into each code's register
 //! template once and never recomputed.
 
+use super::lanes::LaneRegs;
 use super::layout::Piece;
 pub(super) use super::layout::Reg;
 use naga::ScalarKind;
@@ -177,8 +178,8 @@ impl UnOp {
 }
 
 /// A computation too rare to deserve its own instruction (matrix products, most math
-/// functions, packing): a closure over the register file, operands captured.
-pub(super) type Compute = Box<dyn Fn(&mut [u32]) + Send + Sync>;
+/// functions, packing): a closure over one invocation's registers, operands captured.
+pub(super) type Compute = Box<dyn Fn(&mut LaneRegs) + Send + Sync>;
 
 /// A call of a function that was not inlined.
 pub(super) struct CallInsn {

@@ -17,13 +17,17 @@
 //! would alone; only the interleaving between barriers changes, which a kernel free of
 //! data races cannot observe (outputs are checked byte for byte against the
 //! one-invocation-at-a-time executor this replaced: BENCHMARKS.md, "interpreter").
+//!
+//! Registers are lane-minor ([`super::lanes`]): each code has one register file for the
+//! whole workgroup, so an instruction run for a group is a loop over contiguous words.
 
 use super::counts::DispatchCounts;
 use super::decode::Program;
 use super::error::{invalid, unsupported};
 use super::execute::execute;
-use super::insn::{BinOp, CallInsn, Insn};
-use super::memory::{Frame, copy_regs, zero_words};
+use super::insn::{BinOp, CallInsn, Insn, UnOp};
+use super::lanes::{LaneRegs, Members};
+use super::memory::{FUNCTION, Frame};
 use crate::error::BackendError;
 use std::cmp::Ordering;
 use std::sync::atomic::AtomicU32;
@@ -37,17 +41,14 @@ pub(super) enum Stop {
     Sync(u32, u32),
 }
 
-/// One invocation: its running frame, its callers' frames, its private memory.
+/// One invocation: where it is (its running frame, its callers' frames) and who it is.
+/// Its registers are its column of each code's file, its private memory its slice of
+/// [`Workgroup::private`].
 pub(super) struct Invocation {
     /// The running frame (`None` once the entry point returned).
     pub frame: Option<Frame>,
     /// Callers of the running frame, outermost first.
     pub callers: Vec<Frame>,
-    /// Register files of returned frames, reused by later calls (and by the entry frame
-    /// of the next workgroup the same thread runs).
-    pub spare: Vec<Vec<u32>>,
-    /// Private memory.
-    pub private: Vec<u32>,
     /// Subgroup lane, subgroup index and size, local index (for gathers).
     pub lane: u32,
     /// Index of the invocation's subgroup.
@@ -58,29 +59,42 @@ pub(super) struct Invocation {
     pub local_index: u32,
 }
 
-/// `regs[dst + i] = f(regs[a + i * sa], regs[b + i * sb])` for `i < n`.
-#[inline(always)]
-fn component_wise(
-    regs: &mut [u32],
-    (dst, a, b, n, sa, sb): (usize, usize, usize, usize, usize, usize),
-    f: impl Fn(u32, u32) -> u32,
-) {
-    for i in 0..n {
-        regs[dst + i] = f(regs[a + i * sa], regs[b + i * sb]);
-    }
+/// The memory of a workgroup's invocations, kept by a worker thread from one workgroup to
+/// the next (register files of tens of kilobytes per invocation cost more in page faults
+/// than the kernels' work when allocated anew).
+pub(super) struct Workgroup {
+    /// Per code, its lane-minor register file (empty until the code first runs).
+    pub files: Vec<Vec<u32>>,
+    /// Every invocation's private memory, `private_words` each, in local-index order.
+    pub private: Vec<u32>,
+    /// Words of private memory per invocation.
+    pub private_words: usize,
+    /// The workgroup's shared memory.
+    pub shared: Vec<u32>,
 }
 
-/// `copy_regs` in every member's registers.
-#[inline(always)]
-fn copy_in_each(lanes: &mut [Lane], dst: u32, src: u32, len: u32) {
-    let (dst, src, len) = (dst as usize, src as usize, len as usize);
-    for lane in lanes.iter_mut() {
-        copy_regs(lane.regs, dst, src, len);
-    }
+/// What the members of a running group reach besides the running code's registers.
+pub(super) struct GroupMemory<'a> {
+    /// Bound buffers in the kernel's binding order.
+    pub buffers: &'a [Vec<AtomicU32>],
+    /// The workgroup's memory.
+    pub workgroup: &'a mut [u32],
+    /// Every invocation's private memory, `private_words` each.
+    pub private: &'a mut [u32],
+    /// Words of private memory per invocation.
+    pub private_words: usize,
+    /// Every code's register file (the running code's taken out).
+    pub files: &'a mut [Vec<u32>],
+    /// The codes of the group's callers, outermost first.
+    pub callers: &'a [u32],
+    /// Lanes per register file (the workgroup's invocations).
+    pub width: usize,
 }
 
-/// `$body` with `$operator` bound to the constant `BinOp` equal to `$op`: one copy of the
-/// loop per operator, so that the operator is decided once, outside it.
+/// `$body` with `$operator` a function computing the `BinOp` equal to `$op`: one copy of
+/// the loop per operator, so that the operator is decided once, outside it. A function
+/// item rather than a closure: closures passed to the row loops were not always
+/// inlined into them, and then each word went through the operator's jump table.
 macro_rules! per_operator {
     ($op:expr, |$operator:ident| $body:expr) => {
         per_operator!(@ $op, $operator, $body, AddF, SubF, MulF, DivF, ModF, AddI, SubI, MulI, DivU, DivS,
@@ -90,30 +104,14 @@ macro_rules! per_operator {
     (@ $op:expr, $operator:ident, $body:expr, $($variant:ident),*) => {
         match $op {
             $(BinOp::$variant => {
-                let $operator = BinOp::$variant;
+                #[inline(always)]
+                fn $operator(a: u32, c: u32) -> u32 {
+                    BinOp::$variant.apply(a, c)
+                }
                 $body
             })*
         }
     };
-}
-
-/// One member of a running group: the registers of its running frame and the memory
-/// only it sees.
-pub(super) struct Lane<'a> {
-    /// The running frame's registers.
-    pub(super) regs: &'a mut [u32],
-    /// Private memory.
-    pub(super) private: &'a mut [u32],
-    /// Callers' frames (their registers, for pointers into them).
-    pub(super) callers: &'a mut [Frame],
-}
-
-/// An empty vector with the allocation of `lanes`, to borrow the next group's lanes into
-/// (groups are formed hundreds of thousands of times per dispatch; allocating each was
-/// 5 % of the path tracer).
-fn recycle<'b>(mut lanes: Vec<Lane<'_>>) -> Vec<Lane<'b>> {
-    lanes.clear();
-    lanes.into_iter().map(|_| unreachable!("the vector is empty")).collect()
 }
 
 /// Why a group stopped running together.
@@ -172,15 +170,17 @@ fn meeting_point(leader: &Invocation, other: &Invocation) -> Option<u32> {
 pub(super) fn run_until_sync(
     program: &Program,
     invocations: &mut [Invocation],
+    memory: &mut Workgroup,
     buffers: &[Vec<AtomicU32>],
-    workgroup: &mut [u32],
     counts: &mut DispatchCounts,
     stops: &mut Vec<Option<Stop>>,
 ) -> Result<(), BackendError> {
     stops.clear();
     stops.extend(invocations.iter().map(|inv| if inv.frame.is_some() { None } else { Some(Stop::Done) }));
-    let mut members: Vec<usize> = Vec::with_capacity(invocations.len());
-    let mut targets: Vec<u32> = Vec::with_capacity(invocations.len());
+    let width = invocations.len();
+    let mut members: Vec<usize> = Vec::with_capacity(width);
+    let mut targets: Vec<u32> = Vec::with_capacity(width);
+    let mut caller_codes: Vec<u32> = Vec::new();
     // While no invocation is inside a call (the common case: small functions are
     // inlined), where an invocation is is its next instruction alone: the group to run is
     // then found from these words (`u32::MAX`: stopped) instead of by comparing stacks.
@@ -191,7 +191,6 @@ pub(super) fn run_until_sync(
         .collect();
     // Runnable invocations inside a call (stopped ones no longer count).
     let mut in_calls = invocations.iter().filter(|inv| !inv.callers.is_empty()).count();
-    let mut spare_lanes = Vec::new();
     loop {
         // The group furthest behind, and the instruction where it meets the next one.
         members.clear();
@@ -234,24 +233,27 @@ pub(super) fn run_until_sync(
         };
         let frame = invocations[leader].frame.as_ref().expect("running invocations have frames");
         let (code_index, pc) = (frame.code, frame.pc);
+        // Members at the same place have the same callers.
+        caller_codes.clear();
+        caller_codes.extend(invocations[leader].callers.iter().map(|f| f.code));
+        // An invocation's position in the workgroup is its local index and its lane in
+        // the register files (exec.rs).
+        let group = if members.len() == width { Members::All(width) } else { Members::Some(&members, width) };
         let end = {
-            let mut lanes = recycle(std::mem::take(&mut spare_lanes));
-            // The members' invocations, borrowed apart by splitting the slice at each
-            // (they are in increasing order).
-            let mut rest = &mut invocations[..];
-            let mut start = 0;
-            for &i in &members {
-                let (invocation, tail) = std::mem::take(&mut rest)[i - start..].split_first_mut().expect("a member");
-                (rest, start) = (tail, i + 1);
-                let Invocation { frame, private, callers, .. } = invocation;
-                let frame = frame.as_mut().expect("running invocations have frames");
-                lanes.push(Lane { regs: &mut frame.regs[..], private: &mut private[..], callers: &mut callers[..] });
-            }
+            let mut file = std::mem::take(&mut memory.files[code_index as usize]);
+            let mut group_memory = GroupMemory {
+                buffers,
+                workgroup: &mut memory.shared,
+                private: &mut memory.private,
+                private_words: memory.private_words,
+                files: &mut memory.files,
+                callers: &caller_codes,
+                width,
+            };
             let mut steps = 0;
             let end =
-                run_group(program, code_index, pc, meet, &mut lanes, buffers, workgroup, &mut steps, &mut targets);
-            spare_lanes = recycle(lanes);
-            // An invocation's position in the workgroup is its local index (exec.rs).
+                run_group(program, code_index, pc, meet, group, &mut file, &mut group_memory, &mut steps, &mut targets);
+            memory.files[code_index as usize] = file;
             counts.add_group(steps, members.iter().map(|&i| i as u32));
             end?
         };
@@ -277,14 +279,23 @@ pub(super) fn run_until_sync(
                 let Insn::Call(call) = &program.codes[code_index as usize].insns[return_pc as usize - 1] else {
                     unreachable!("a group ends with Call at a call instruction")
                 };
+                if caller_codes.len() >= 256 {
+                    return Err(invalid(&program.name, "call depth above 256 (recursion?)".into()));
+                }
+                let group = if members.len() == width { Members::All(width) } else { Members::Some(&members, width) };
+                enter_function(program, &mut memory.files, code_index, call, group, caller_codes.len() as u32 + 1)?;
                 for &i in &members {
                     in_calls += usize::from(invocations[i].callers.is_empty());
-                    call_function(program, &mut invocations[i], call, return_pc)?;
+                    let invocation = &mut invocations[i];
+                    let frame = invocation.frame.as_mut().expect("running");
+                    frame.pc = return_pc;
+                    let callee = Frame { code: call.code, pc: 0, result: call.result };
+                    invocation.callers.push(std::mem::replace(frame, callee));
                 }
             }
             GroupEnd::Return { src, len } => {
                 for &i in &members {
-                    if return_from_function(&mut invocations[i], src, len) {
+                    if return_from_function(&mut invocations[i], &mut memory.files, i, width, src, len) {
                         stops[i] = Some(Stop::Done);
                     }
                     in_calls -= usize::from(stops[i].is_none() && invocations[i].callers.is_empty());
@@ -300,78 +311,115 @@ pub(super) fn run_until_sync(
     }
 }
 
-/// Pushes a frame for `call` on `invocation`'s stack, its caller continuing at `return_pc`.
-fn call_function(
+/// Allocates a code's register file for `width` lanes, every register at its template
+/// value, the first time a worker thread runs the code (see [`super::decode::Code::locals`]).
+pub(super) fn open_file(file: &mut Vec<u32>, template: &[u32], width: usize) {
+    if file.is_empty() {
+        file.reserve_exact(template.len() * width);
+        for &value in template {
+            file.extend(std::iter::repeat_n(value, width));
+        }
+    }
+}
+
+/// Two distinct register files of `files`.
+fn two_files(files: &mut [Vec<u32>], a: usize, b: usize) -> (&mut Vec<u32>, &mut Vec<u32>) {
+    if a < b {
+        let (low, high) = files.split_at_mut(b);
+        (&mut low[a], &mut high[0])
+    } else {
+        let (low, high) = files.split_at_mut(a);
+        (&mut high[0], &mut low[b])
+    }
+}
+
+/// Starts the callee of `call` in the members' columns of its code's file: the
+/// template (its variables; the rest once per file), the arguments from the caller's file (code `caller`), the pointers to its
+/// locals (their frame at `depth`).
+fn enter_function(
     program: &Program,
-    invocation: &mut Invocation,
+    files: &mut [Vec<u32>],
+    caller: u32,
     call: &CallInsn,
-    return_pc: u32,
+    group: Members,
+    depth: u32,
 ) -> Result<(), BackendError> {
-    let Invocation { frame: running, callers, spare, .. } = invocation;
-    if callers.len() >= 256 {
-        return Err(invalid(&program.name, "call depth above 256 (recursion?)".into()));
+    if call.code == caller {
+        return Err(invalid(&program.name, "a function calls itself (recursion)".into()));
     }
-    let frame = running.as_mut().expect("running");
     let callee = &program.codes[call.code as usize];
-    let mut callee_regs = spare.pop().unwrap_or_default();
-    callee_regs.clear();
-    callee_regs.extend_from_slice(&callee.template);
+    let (caller_file, callee_file) = two_files(files, caller as usize, call.code as usize);
+    let width = match group {
+        Members::All(width) | Members::Some(_, width) => width,
+    };
+    open_file(callee_file, &callee.template, width);
+    for &(reg, words) in &callee.locals {
+        for r in reg as usize..(reg + words) as usize {
+            group.fill(callee_file, r, 1, callee.template[r]);
+        }
+    }
     for &(src, len, dst) in call.arguments.iter() {
-        callee_regs[dst as usize..(dst + len) as usize]
-            .copy_from_slice(&frame.regs[src as usize..(src + len) as usize]);
+        for k in 0..len as usize {
+            let (src, dst) = (src as usize + k, dst as usize + k);
+            group.for_each(|l| callee_file[dst * width + l] = caller_file[src * width + l]);
+        }
     }
-    let depth = callers.len() as u32 + 1;
     for &(reg, offset) in &callee.local_pointers {
-        callee_regs[reg as usize] = super::memory::FUNCTION | depth;
-        callee_regs[reg as usize + 1] = offset;
+        group.fill(callee_file, reg as usize, 1, FUNCTION | depth);
+        group.fill(callee_file, reg as usize + 1, 1, offset);
     }
-    frame.pc = return_pc;
-    let callee_frame = Frame { code: call.code, pc: 0, regs: callee_regs, result: call.result };
-    callers.push(std::mem::replace(frame, callee_frame));
     Ok(())
 }
 
-/// Pops `invocation`'s running frame, copying `len` words from `src` to the caller's
-/// result registers; true when it returned from the entry point.
-fn return_from_function(invocation: &mut Invocation, src: u32, len: u32) -> bool {
-    let Invocation { frame: running, callers, spare, .. } = invocation;
+/// Pops `invocation`'s running frame (its column `lane` of the files), copying `len`
+/// words from `src` to the caller's result registers; true when it returned from the
+/// entry point.
+fn return_from_function(
+    invocation: &mut Invocation,
+    files: &mut [Vec<u32>],
+    lane: usize,
+    width: usize,
+    src: u32,
+    len: u32,
+) -> bool {
+    let Invocation { frame: running, callers, .. } = invocation;
     let returned = running.take().expect("running");
     match callers.pop() {
-        None => {
-            spare.push(returned.regs);
-            true
-        }
-        Some(mut caller) => {
+        None => true,
+        Some(caller) => {
             if let Some((dst, words)) = returned.result
                 && len > 0
             {
-                let (src, words) = (src as usize, words.min(len) as usize);
-                caller.regs[dst as usize..dst as usize + words].copy_from_slice(&returned.regs[src..src + words]);
+                let (from, to) = two_files(files, returned.code as usize, caller.code as usize);
+                for k in 0..words.min(len) as usize {
+                    to[(dst as usize + k) * width + lane] = from[(src as usize + k) * width + lane];
+                }
             }
-            spare.push(returned.regs);
             *running = Some(caller);
             false
         }
     }
 }
 
-/// Runs the group `lanes` (all at instruction `pc` of code `code_index`) together until
-/// it reaches `meet`, a branch splits it (each member's next instruction into
-/// `targets`), it calls or returns, or it stops at a barrier or subgroup operation.
-/// `steps`: how many instructions the group executed (each for every member).
+/// Runs the group `group` (all at instruction `pc` of code `code_index`, whose register
+/// file is `file`) together until it reaches `meet`, a branch splits it (each member's
+/// next instruction into `targets`), it calls or returns, or it stops at a barrier or
+/// subgroup operation. `steps`: how many instructions the group executed (each for
+/// every member).
 #[allow(clippy::too_many_arguments)]
 fn run_group(
     program: &Program,
     code_index: u32,
     pc: u32,
     meet: u32,
-    lanes: &mut [Lane],
-    buffers: &[Vec<AtomicU32>],
-    workgroup: &mut [u32],
+    group: Members,
+    file: &mut [u32],
+    memory: &mut GroupMemory,
     steps: &mut u64,
     targets: &mut Vec<u32>,
 ) -> Result<GroupEnd, BackendError> {
     let insns = &program.codes[code_index as usize].insns[..];
+    let width = memory.width;
     let mut pc = pc as usize;
     let mut count = 0u64;
     let end = loop {
@@ -385,28 +433,29 @@ fn run_group(
         match insn {
             Insn::Jump(target) => pc = *target as usize,
             Insn::JumpUnless { cond, target } => {
-                let taken = lanes.iter().filter(|lane| lane.regs[*cond as usize] == 0).count();
-                if taken == lanes.len() {
+                let row = *cond as usize * width;
+                let mut taken = 0;
+                group.for_each(|l| taken += usize::from(file[row + l] == 0));
+                if taken == group.len() {
                     pc = *target as usize;
                 } else if taken > 0 {
                     targets.clear();
-                    targets.extend(
-                        lanes.iter().map(|lane| if lane.regs[*cond as usize] == 0 { *target } else { pc as u32 }),
-                    );
+                    group.for_each(|l| targets.push(if file[row + l] == 0 { *target } else { pc as u32 }));
                     break GroupEnd::Split;
                 }
             }
             Insn::Switch { selector, cases, default } => {
-                let target = |lane: &Lane| {
-                    let value = lane.regs[*selector as usize];
+                let row = *selector as usize * width;
+                let target = |l: usize| {
+                    let value = file[row + l];
                     cases.iter().find(|(v, _)| *v == value).map_or(*default, |(_, t)| *t)
                 };
-                let first = target(&lanes[0]);
-                if lanes.iter().all(|lane| target(lane) == first) {
+                targets.clear();
+                group.for_each(|l| targets.push(target(l)));
+                let first = targets[0];
+                if targets.iter().all(|&t| t == first) {
                     pc = first as usize;
                 } else {
-                    targets.clear();
-                    targets.extend(lanes.iter().map(target));
                     break GroupEnd::Split;
                 }
             }
@@ -414,68 +463,102 @@ fn run_group(
             Insn::Return { src, len } => break GroupEnd::Return { src: *src, len: *len },
             Insn::Barrier | Insn::Gather(_) | Insn::Collective(_) => break GroupEnd::Sync(pc as u32 - 1),
             Insn::Fail(failure) => return Err(unsupported(&failure.0, failure.1)),
-            // The most frequent instructions get their own loop over the members, their
-            // operands and operator decoded once for the whole group; `execute` runs the
-            // others member by member.
-            Insn::Copy1 { dst, src } => copy_in_each(lanes, *dst, *src, 1),
-            Insn::Copy2 { dst, src } => copy_in_each(lanes, *dst, *src, 2),
-            Insn::Copy3 { dst, src } => copy_in_each(lanes, *dst, *src, 3),
-            Insn::Copy4 { dst, src } => copy_in_each(lanes, *dst, *src, 4),
-            Insn::Copy { dst, src, len } => copy_in_each(lanes, *dst, *src, *len),
-            Insn::Zero { dst, len } => {
-                let (dst, len) = (*dst as usize, *len as usize);
-                for lane in lanes.iter_mut() {
-                    zero_words(&mut lane.regs[dst..dst + len]);
-                }
-            }
+            // Row operations: each register of the group's members at once (`lanes`).
+            Insn::Copy1 { dst, src } => group.copy(file, *dst as usize, *src as usize, 1),
+            Insn::Copy2 { dst, src } => group.copy(file, *dst as usize, *src as usize, 2),
+            Insn::Copy3 { dst, src } => group.copy(file, *dst as usize, *src as usize, 3),
+            Insn::Copy4 { dst, src } => group.copy(file, *dst as usize, *src as usize, 4),
+            Insn::Copy { dst, src, len } => group.copy(file, *dst as usize, *src as usize, *len as usize),
+            Insn::Zero { dst, len } => group.fill(file, *dst as usize, *len as usize, 0),
             Insn::Bin { op, dst, a, b } => {
                 let (dst, a, b) = (*dst as usize, *a as usize, *b as usize);
-                per_operator!(op, |operator| for lane in lanes.iter_mut() {
-                    let regs = &mut *lane.regs;
-                    regs[dst] = operator.apply(regs[a], regs[b]);
-                });
+                per_operator!(op, |operator| group.binary(file, dst, a, b, operator));
             }
             Insn::BinV { op, dst, a, b, n, sa, sb } => {
-                let operands = (*dst as usize, *a as usize, *b as usize, *n as usize, *sa as usize, *sb as usize);
-                per_operator!(op, |operator| for lane in lanes.iter_mut() {
-                    component_wise(lane.regs, operands, |x, y| operator.apply(x, y));
+                let (dst, a, b, n, sa, sb) =
+                    (*dst as usize, *a as usize, *b as usize, *n as usize, *sa as usize, *sb as usize);
+                per_operator!(op, |operator| for i in 0..n {
+                    group.binary(file, dst + i, a + i * sa, b + i * sb, operator);
                 });
+            }
+            Insn::Un { op, dst, src, n } => {
+                let (dst, src, n) = (*dst as usize, *src as usize, *n as usize);
+                macro_rules! each {
+                    ($op:expr) => {{
+                        #[inline(always)]
+                        fn operator(x: u32) -> u32 {
+                            $op.apply(x)
+                        }
+                        for i in 0..n {
+                            group.unary(file, dst + i, src + i, operator);
+                        }
+                    }};
+                }
+                match op {
+                    UnOp::NegF => each!(UnOp::NegF),
+                    UnOp::NegI => each!(UnOp::NegI),
+                    UnOp::Not => each!(UnOp::Not),
+                    UnOp::BitNot => each!(UnOp::BitNot),
+                }
             }
             Insn::Select { dst, cond, accept, reject, n, sc } => {
                 let (dst, cond, accept, reject) = (*dst as usize, *cond as usize, *accept as usize, *reject as usize);
-                let (n, sc) = (*n as usize, *sc as usize);
-                for lane in lanes.iter_mut() {
-                    let regs = &mut *lane.regs;
-                    for i in 0..n {
-                        regs[dst + i] = if regs[cond + i * sc] != 0 { regs[accept + i] } else { regs[reject + i] };
-                    }
+                for i in 0..*n as usize {
+                    group.select(file, dst + i, cond + i * *sc as usize, accept + i, reject + i);
                 }
             }
             Insn::Splat { dst, src, n } => {
+                for i in 0..*n as usize {
+                    group.copy(file, *dst as usize + i, *src as usize, 1);
+                }
+            }
+            Insn::Swizzle { dst, src, pattern, n } => {
                 let (dst, src, n) = (*dst as usize, *src as usize, *n as usize);
-                for lane in lanes.iter_mut() {
-                    let value = lane.regs[src];
-                    lane.regs[dst..dst + n].fill(value);
+                if dst + n <= src || src + 4 <= dst {
+                    for (i, &p) in pattern.iter().enumerate().take(n) {
+                        group.copy(file, dst + i, src + p as usize, 1);
+                    }
+                } else {
+                    // Overlapping (not compiled today): every source word read first.
+                    group.for_each(|l| {
+                        let mut regs = LaneRegs::new(file, l, width);
+                        let v = pattern.map(|p| regs[src + p as usize]);
+                        regs.write(dst, &v[..n]);
+                    });
+                }
+            }
+            Insn::Convert { from, to, dst, src, n } => {
+                let (from, to) = (*from, *to);
+                for i in 0..*n as usize {
+                    group.unary(file, *dst as usize + i, *src as usize + i, |x| {
+                        super::arith::convert(x, from, to).expect("checked when compiled")
+                    });
                 }
             }
             Insn::Extract { dst, base, index, count, stride, len } => {
                 let (dst, base, index, len) = (*dst as usize, *base as usize, *index as usize, *len as usize);
                 let (last, stride) = (count.saturating_sub(1) as usize, *stride as usize);
-                for lane in lanes.iter_mut() {
-                    let at = (lane.regs[index] as usize).min(last) * stride;
-                    copy_regs(lane.regs, dst, base + at, len);
-                }
+                group.for_each(|l| {
+                    let mut regs = LaneRegs::new(file, l, width);
+                    let at = (regs[index] as usize).min(last) * stride;
+                    regs.copy(dst, base + at, len);
+                });
             }
-            Insn::Compute(compute) => {
-                for lane in lanes.iter_mut() {
-                    compute(lane.regs);
-                }
+            Insn::PtrAdd { dst, base, add } => {
+                let (dst, base, add) = (*dst as usize, *base as usize, *add);
+                group.copy(file, dst, base, 1);
+                group.unary(file, dst + 1, base + 1, |offset| offset.wrapping_add(add));
             }
-            _ => {
-                for lane in lanes.iter_mut() {
-                    execute(insn, lane, buffers, workgroup);
-                }
+            Insn::PtrIndex { dst, base, index, count, stride } => {
+                let (dst, base, index) = (*dst as usize, *base as usize, *index as usize);
+                let (last, stride) = (count.saturating_sub(1) as usize, *stride as usize);
+                group.binary(file, dst + 1, base + 1, index, |offset, i| {
+                    (offset as usize + (i as usize).min(last) * stride) as u32
+                });
+                group.copy(file, dst, base, 1);
             }
+            Insn::Compute(compute) => group.for_each(|l| compute(&mut LaneRegs::new(file, l, width))),
+            _ => group.for_each(|l| execute(insn, file, l, memory)),
         }
     };
     *steps = count;

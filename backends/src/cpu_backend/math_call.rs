@@ -5,6 +5,7 @@
 use super::arith;
 use super::decode::{Compiler, Scope};
 use super::insn::{Insn, Reg};
+use super::lanes::{LaneRegs, Words};
 use super::layout::{is_half, is_wide, member_step, scalar_shape, shape};
 use super::wide;
 use naga::{Expression, Handle, ScalarKind, TypeInner};
@@ -181,15 +182,15 @@ fn specialised(fun: naga::MathFunction, kind: ScalarKind) -> Option<ComponentFn>
     )
 }
 
-/// Reads `len` words at `reg` of a register file.
-pub(super) fn slice(regs: &[u32], (reg, len): (Reg, u32)) -> &[u32] {
-    &regs[reg as usize..(reg + len) as usize]
+/// Reads `len` words at `reg` of an invocation's registers.
+pub(super) fn slice(regs: &LaneRegs, (reg, len): (Reg, u32)) -> Words {
+    regs.read(reg as usize, len as usize)
 }
 
 /// Writes `value` at `dst`, at most `len` words.
-pub(super) fn put(regs: &mut [u32], dst: Reg, len: u32, value: &[u32]) {
+pub(super) fn put(regs: &mut LaneRegs, dst: Reg, len: u32, value: &[u32]) {
     let n = (len as usize).min(value.len());
-    regs[dst as usize..dst as usize + n].copy_from_slice(&value[..n]);
+    regs.write(dst as usize, &value[..n]);
 }
 
 impl Compiler<'_> {
@@ -212,15 +213,15 @@ impl Compiler<'_> {
         let arg_type = self.ty(scope, arg).clone();
         let compute: Result<super::insn::Compute, String> = match fun {
             M::Transpose => match arg_type {
-                TypeInner::Matrix { columns, rows, .. } => Ok(Box::new(move |regs: &mut [u32]| {
-                    let value = super::matrix::transpose(slice(regs, a), columns, rows);
+                TypeInner::Matrix { columns, rows, .. } => Ok(Box::new(move |regs: &mut LaneRegs| {
+                    let value = super::matrix::transpose(&slice(regs, a), columns, rows);
                     put(regs, dst, len, &value);
                 })),
                 other => Err(format!("transpose of {other:?}")),
             },
             M::Determinant => match arg_type {
-                TypeInner::Matrix { columns, .. } => Ok(Box::new(move |regs: &mut [u32]| {
-                    let value = super::matrix::determinant(slice(regs, a), columns);
+                TypeInner::Matrix { columns, .. } => Ok(Box::new(move |regs: &mut LaneRegs| {
+                    let value = super::matrix::determinant(&slice(regs, a), columns);
                     put(regs, dst, len, &[value]);
                 })),
                 other => Err(format!("determinant of {other:?}")),
@@ -231,7 +232,7 @@ impl Compiler<'_> {
                     if members.len() == 2 && a.1 as usize == comps =>
                 {
                     let second = dst + member_step(self.module, self.ty(scope, handle), 1, false);
-                    Ok(Box::new(move |regs: &mut [u32]| {
+                    Ok(Box::new(move |regs: &mut LaneRegs| {
                         for i in 0..comps {
                             let x = regs[a.0 as usize + i];
                             let (first, other) = if fun == M::Modf { arith::modf(x) } else { arith::frexp(x) };
@@ -249,7 +250,7 @@ impl Compiler<'_> {
                     Err(format!("math function {fun:?} on 64-bit integers"))
                 } else {
                     let (b, c) = (operands[1], operands[2]);
-                    Ok(Box::new(move |regs: &mut [u32]| {
+                    Ok(Box::new(move |regs: &mut LaneRegs| {
                         for i in 0..comps {
                             let at = |o: Option<(Reg, u32)>| o.map_or(0, |(r, _)| wide::read(regs, r as usize + 2 * i));
                             let value = wide::math(fun, signed, wide::read(regs, a.0 as usize + 2 * i), at(b), at(c));
@@ -258,11 +259,11 @@ impl Compiler<'_> {
                     }))
                 }
             }
-            _ if arith::pack(fun, &[0; 4]).is_some() => Ok(Box::new(move |regs: &mut [u32]| {
-                let value = arith::pack(fun, slice(regs, a)).expect("a pack function");
+            _ if arith::pack(fun, &[0; 4]).is_some() => Ok(Box::new(move |regs: &mut LaneRegs| {
+                let value = arith::pack(fun, &slice(regs, a)).expect("a pack function");
                 put(regs, dst, len, &[value]);
             })),
-            _ if arith::unpack(fun, 0).is_some() => Ok(Box::new(move |regs: &mut [u32]| {
+            _ if arith::unpack(fun, 0).is_some() => Ok(Box::new(move |regs: &mut LaneRegs| {
                 let value = arith::unpack(fun, regs[a.0 as usize]).expect("an unpack function");
                 put(regs, dst, len, &value);
             })),
@@ -292,7 +293,7 @@ impl Compiler<'_> {
                             let (a, sa) = at(Some(a)).expect("a first argument");
                             let (b, c) = (at(b), at(c));
                             let (dst, n) = (dst as usize, comps.min(len as usize));
-                            Ok(Box::new(move |regs: &mut [u32]| {
+                            Ok(Box::new(move |regs: &mut LaneRegs| {
                                 for i in 0..n {
                                     let operand = |o: Option<(usize, usize)>| o.map_or(0, |(r, s)| regs[r + i * s]);
                                     let (y, z) = (operand(b), operand(c));
@@ -301,20 +302,22 @@ impl Compiler<'_> {
                             }))
                         } else if let (M::Dot, ScalarKind::Float, Some(b)) = (fun, kind, b) {
                             let (a, b, dst) = (a.0 as usize, b.0 as usize, dst as usize);
-                            Ok(Box::new(move |regs: &mut [u32]| {
-                                regs[dst] = dot(&regs[a..a + comps], &regs[b..b + comps]).to_bits();
+                            Ok(Box::new(move |regs: &mut LaneRegs| {
+                                regs[dst] = dot(&regs.read(a, comps), &regs.read(b, comps)).to_bits();
                             }))
                         } else {
-                            Ok(Box::new(move |regs: &mut [u32]| {
+                            Ok(Box::new(move |regs: &mut LaneRegs| {
                                 let mut value = [0u32; 4];
+                                let (b, c, d) =
+                                    (b.map(|b| slice(regs, b)), c.map(|c| slice(regs, c)), d.map(|d| slice(regs, d)));
                                 let words = math(
                                     fun,
                                     kind,
                                     comps,
-                                    slice(regs, a),
-                                    b.map(|b| slice(regs, b)),
-                                    c.map(|c| slice(regs, c)),
-                                    d.map(|d| slice(regs, d)),
+                                    &slice(regs, a),
+                                    b.as_deref(),
+                                    c.as_deref(),
+                                    d.as_deref(),
                                     &mut value,
                                 )
                                 .expect("probed");
@@ -340,9 +343,9 @@ impl Compiler<'_> {
     /// Rounds the `len` f16 values at `dst` (held as f32) to binary16.
     pub(super) fn round_half(&mut self, dst: Reg, len: u32) {
         let (dst, len) = (dst as usize, len as usize);
-        self.push(Insn::Compute(Box::new(move |regs: &mut [u32]| {
-            for x in &mut regs[dst..dst + len] {
-                *x = arith::round_f16(*x);
+        self.push(Insn::Compute(Box::new(move |regs: &mut LaneRegs| {
+            for r in dst..dst + len {
+                regs[r] = arith::round_f16(regs[r]);
             }
         })));
     }

@@ -52,6 +52,7 @@ mod image;
 mod image_lower;
 mod insn;
 mod interp;
+mod lanes;
 mod layout;
 mod math_call;
 mod matrix;

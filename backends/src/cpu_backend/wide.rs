@@ -5,17 +5,18 @@
 //! clamped to the largest float the type holds. These lower to closures
 //! ([`super::insn::Compute`]): rare enough that the dispatch loop need not know them.
 
+use super::lanes::LaneRegs;
 use naga::{BinaryOperator, Scalar, ScalarKind};
 
 /// Reads the 64-bit value at word `at` of `regs`.
 #[inline(always)]
-pub(super) fn read(regs: &[u32], at: usize) -> u64 {
+pub(super) fn read(regs: &LaneRegs, at: usize) -> u64 {
     u64::from(regs[at]) | u64::from(regs[at + 1]) << 32
 }
 
 /// Writes a 64-bit value at word `at` of `regs`.
 #[inline(always)]
-pub(super) fn write(regs: &mut [u32], at: usize, value: u64) {
+pub(super) fn write(regs: &mut LaneRegs, at: usize, value: u64) {
     regs[at] = value as u32;
     regs[at + 1] = (value >> 32) as u32;
 }

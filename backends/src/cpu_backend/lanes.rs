@@ -1,0 +1,256 @@
+//! The lane-minor register file: one code's registers for every invocation of a
+//! workgroup, register `r` of invocation `l` at word `r * width + l` (`width`: the
+//! workgroup's invocations). An instruction run for a whole group then reads and writes
+//! whole rows of contiguous words, a loop the compiler vectorises, where a file per
+//! invocation put the same register of two invocations tens of kilobytes apart
+//! (BENCHMARKS.md, "interpreter": that layout cost about 5 ns per invocation and
+//! instruction). [`LaneRegs`] is one invocation's view of such a file, for the
+//! instructions run member by member (memory through pointers, atomics, rare math).
+
+use smallvec::SmallVec;
+use std::ops::{Index, IndexMut};
+
+/// A few words of one invocation's registers, copied out.
+pub(super) type Words = SmallVec<[u32; 16]>;
+
+/// One invocation's registers in a lane-minor file: `regs[r]` is its register `r`.
+pub(super) struct LaneRegs<'a> {
+    words: &'a mut [u32],
+    lane: usize,
+    width: usize,
+}
+
+impl<'a> LaneRegs<'a> {
+    /// Invocation `lane`'s registers in `words`, a file of `width` lanes.
+    #[inline(always)]
+    pub(super) fn new(words: &'a mut [u32], lane: usize, width: usize) -> Self {
+        debug_assert!(lane < width && words.len().is_multiple_of(width));
+        Self { words, lane, width }
+    }
+
+    /// How many registers the file holds.
+    #[inline(always)]
+    pub(super) fn len(&self) -> usize {
+        self.words.len() / self.width
+    }
+
+    /// Registers `reg..reg + len`, copied out.
+    #[inline(always)]
+    pub(super) fn read(&self, reg: usize, len: usize) -> Words {
+        (reg..reg + len).map(|r| self[r]).collect()
+    }
+
+    /// Writes `value` into registers `reg..`.
+    #[inline(always)]
+    pub(super) fn write(&mut self, reg: usize, value: &[u32]) {
+        for (i, &word) in value.iter().enumerate() {
+            self[reg + i] = word;
+        }
+    }
+
+    /// Copies registers `src..src + len` to `dst..` (the ranges may overlap: the copy
+    /// reads each word before it is overwritten, as `copy_within` does).
+    #[inline(always)]
+    pub(super) fn copy(&mut self, dst: usize, src: usize, len: usize) {
+        if dst <= src {
+            for i in 0..len {
+                self[dst + i] = self[src + i];
+            }
+        } else {
+            for i in (0..len).rev() {
+                self[dst + i] = self[src + i];
+            }
+        }
+    }
+}
+
+impl Index<usize> for LaneRegs<'_> {
+    type Output = u32;
+
+    #[inline(always)]
+    fn index(&self, reg: usize) -> &u32 {
+        &self.words[reg * self.width + self.lane]
+    }
+}
+
+impl IndexMut<usize> for LaneRegs<'_> {
+    #[inline(always)]
+    fn index_mut(&mut self, reg: usize) -> &mut u32 {
+        &mut self.words[reg * self.width + self.lane]
+    }
+}
+
+/// Lanes a row operation handles per step: its operands are copied into arrays of this
+/// many words, so that the loop over them has no aliasing for the compiler to fear and,
+/// for a full chunk, a length it knows (the common workgroups of 64 are one chunk).
+const N: usize = 64;
+
+/// Runs `$body` for the chunks of a row of `$width` lanes, with `$start` the chunk's first
+/// lane and `$n` its length: full chunks first (`$n` is then the constant `N`, and the
+/// body is compiled for it), then the rest. A macro rather than a function taking a
+/// closure: such closures were not always inlined, and then every chunk's copy became a
+/// call of the C library's `memcpy` with a variable length.
+macro_rules! chunks {
+    ($width:expr, |$start:ident, $n:ident| $body:block) => {{
+        let width: usize = $width;
+        let mut $start = 0;
+        while $start + N <= width {
+            let $n = N;
+            $body
+            $start += N;
+        }
+        if $start < width {
+            let $n = width - $start;
+            $body
+        }
+    }};
+}
+
+/// Words `at..at + n` of `regs` (`n <= M`) copied into an array.
+#[inline(always)]
+fn row<const M: usize>(regs: &[u32], at: usize, n: usize) -> [u32; M] {
+    let mut words = [0u32; M];
+    words[..n].copy_from_slice(&regs[at..at + n]);
+    words
+}
+
+/// The invocations of a running group: every lane of the file (`All`, the common case,
+/// rows are contiguous) or some, by lane, in increasing order.
+#[derive(Clone, Copy)]
+pub(super) enum Members<'a> {
+    /// Every lane `0..width`.
+    All(usize),
+    /// These lanes of a file `width` lanes wide.
+    Some(&'a [usize], usize),
+}
+
+impl Members<'_> {
+    /// How many invocations the group has.
+    #[inline(always)]
+    pub(super) fn len(self) -> usize {
+        match self {
+            Members::All(width) => width,
+            Members::Some(lanes, _) => lanes.len(),
+        }
+    }
+
+    /// Calls `f` with each member's lane, in increasing order.
+    #[inline(always)]
+    pub(super) fn for_each(self, mut f: impl FnMut(usize)) {
+        match self {
+            Members::All(width) => (0..width).for_each(f),
+            Members::Some(lanes, _) => {
+                for &l in lanes {
+                    f(l)
+                }
+            }
+        }
+    }
+
+    /// `regs[dst row] = f(regs[a row], regs[b row])` for the members (rows are register
+    /// indices; each is `width` words).
+    #[inline(always)]
+    pub(super) fn binary(self, regs: &mut [u32], dst: usize, a: usize, b: usize, f: impl Fn(u32, u32) -> u32) {
+        match self {
+            Members::All(width) => chunks!(width, |start, n| {
+                let (x, y) = (row::<N>(regs, a * width + start, n), row::<N>(regs, b * width + start, n));
+                let out = &mut regs[dst * width + start..][..n];
+                for (i, o) in out.iter_mut().enumerate() {
+                    *o = f(x[i], y[i]);
+                }
+            }),
+            Members::Some(lanes, width) => {
+                for &l in lanes {
+                    regs[dst * width + l] = f(regs[a * width + l], regs[b * width + l]);
+                }
+            }
+        }
+    }
+
+    /// `regs[dst row] = f(regs[src row])` for the members.
+    #[inline(always)]
+    pub(super) fn unary(self, regs: &mut [u32], dst: usize, src: usize, f: impl Fn(u32) -> u32) {
+        match self {
+            Members::All(width) => chunks!(width, |start, n| {
+                let x = row::<N>(regs, src * width + start, n);
+                let out = &mut regs[dst * width + start..][..n];
+                for (i, o) in out.iter_mut().enumerate() {
+                    *o = f(x[i]);
+                }
+            }),
+            Members::Some(lanes, width) => {
+                for &l in lanes {
+                    regs[dst * width + l] = f(regs[src * width + l]);
+                }
+            }
+        }
+    }
+
+    /// `regs[dst row] = regs[cond row] != 0 ? regs[accept row] : regs[reject row]`.
+    #[inline(always)]
+    pub(super) fn select(self, regs: &mut [u32], dst: usize, cond: usize, accept: usize, reject: usize) {
+        match self {
+            Members::All(width) => chunks!(width, |start, n| {
+                let c = row::<N>(regs, cond * width + start, n);
+                let (x, y) = (row::<N>(regs, accept * width + start, n), row::<N>(regs, reject * width + start, n));
+                let out = &mut regs[dst * width + start..][..n];
+                for (i, o) in out.iter_mut().enumerate() {
+                    *o = if c[i] != 0 { x[i] } else { y[i] };
+                }
+            }),
+            Members::Some(lanes, width) => {
+                for &l in lanes {
+                    let from = if regs[cond * width + l] != 0 { accept } else { reject };
+                    regs[dst * width + l] = regs[from * width + l];
+                }
+            }
+        }
+    }
+
+    /// Copies `len` rows from `src` to `dst` (the ranges may overlap).
+    #[inline(always)]
+    pub(super) fn copy(self, regs: &mut [u32], dst: usize, src: usize, len: usize) {
+        match self {
+            Members::All(width) => {
+                // Row by row through a register-sized buffer: rows are a few hundred
+                // bytes, where calling the C library's memmove cost more than the copy.
+                for i in 0..len {
+                    let r = if dst <= src { i } else { len - 1 - i };
+                    chunks!(width, |start, n| {
+                        let x = row::<N>(regs, (src + r) * width + start, n);
+                        regs[(dst + r) * width + start..][..n].copy_from_slice(&x[..n]);
+                    });
+                }
+            }
+            Members::Some(lanes, width) => {
+                for i in 0..len {
+                    let r = if dst <= src { i } else { len - 1 - i };
+                    for &l in lanes {
+                        regs[(dst + r) * width + l] = regs[(src + r) * width + l];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Sets `len` rows from `dst` to `value`.
+    #[inline(always)]
+    pub(super) fn fill(self, regs: &mut [u32], dst: usize, len: usize, value: u32) {
+        match self {
+            Members::All(width) => {
+                for r in dst..dst + len {
+                    chunks!(width, |start, n| {
+                        regs[r * width + start..][..n].fill(value);
+                    });
+                }
+            }
+            Members::Some(lanes, width) => {
+                for r in dst..dst + len {
+                    for &l in lanes {
+                        regs[r * width + l] = value;
+                    }
+                }
+            }
+        }
+    }
+}

@@ -153,10 +153,23 @@ impl Members<'_> {
     pub(super) fn binary(self, regs: &mut [u32], dst: usize, a: usize, b: usize, f: impl Fn(u32, u32) -> u32) {
         match self {
             Members::All(width) => chunks!(width, |start, n| {
-                let (x, y) = (row::<N>(regs, a * width + start, n), row::<N>(regs, b * width + start, n));
-                let out = &mut regs[dst * width + start..][..n];
-                for (i, o) in out.iter_mut().enumerate() {
-                    *o = f(x[i], y[i]);
+                let (d, x, y) = (dst * width + start, a * width + start, b * width + start);
+                if d != x && d != y && x != y {
+                    let [out, xs, ys] = regs.get_disjoint_mut([d..d + n, x..x + n, y..y + n]).expect("distinct rows");
+                    for i in 0..n {
+                        out[i] = f(xs[i], ys[i]);
+                    }
+                } else if d != x && x == y {
+                    let [out, xs] = regs.get_disjoint_mut([d..d + n, x..x + n]).expect("distinct rows");
+                    for i in 0..n {
+                        out[i] = f(xs[i], xs[i]);
+                    }
+                } else {
+                    // The destination is an operand (not compiled today): through copies.
+                    let (xs, ys) = (row::<N>(regs, x, n), row::<N>(regs, y, n));
+                    for (i, o) in regs[d..d + n].iter_mut().enumerate() {
+                        *o = f(xs[i], ys[i]);
+                    }
                 }
             }),
             Members::Some(lanes, width) => {
@@ -172,10 +185,16 @@ impl Members<'_> {
     pub(super) fn unary(self, regs: &mut [u32], dst: usize, src: usize, f: impl Fn(u32) -> u32) {
         match self {
             Members::All(width) => chunks!(width, |start, n| {
-                let x = row::<N>(regs, src * width + start, n);
-                let out = &mut regs[dst * width + start..][..n];
-                for (i, o) in out.iter_mut().enumerate() {
-                    *o = f(x[i]);
+                let (d, x) = (dst * width + start, src * width + start);
+                if d != x {
+                    let [out, xs] = regs.get_disjoint_mut([d..d + n, x..x + n]).expect("distinct rows");
+                    for i in 0..n {
+                        out[i] = f(xs[i]);
+                    }
+                } else {
+                    for o in &mut regs[d..d + n] {
+                        *o = f(*o);
+                    }
                 }
             }),
             Members::Some(lanes, width) => {
@@ -191,11 +210,19 @@ impl Members<'_> {
     pub(super) fn select(self, regs: &mut [u32], dst: usize, cond: usize, accept: usize, reject: usize) {
         match self {
             Members::All(width) => chunks!(width, |start, n| {
-                let c = row::<N>(regs, cond * width + start, n);
-                let (x, y) = (row::<N>(regs, accept * width + start, n), row::<N>(regs, reject * width + start, n));
-                let out = &mut regs[dst * width + start..][..n];
-                for (i, o) in out.iter_mut().enumerate() {
-                    *o = if c[i] != 0 { x[i] } else { y[i] };
+                let (d, c, x, y) = (dst * width + start, cond * width + start, accept * width + start, reject * width + start);
+                if let Ok([out, cs, xs, ys]) = regs.get_disjoint_mut([d..d + n, c..c + n, x..x + n, y..y + n]) {
+                    // With masks, not a choice of address: the compiler vectorises this.
+                    for i in 0..n {
+                        let mask = 0u32.wrapping_sub(u32::from(cs[i] != 0));
+                        out[i] = (xs[i] & mask) | (ys[i] & !mask);
+                    }
+                } else {
+                    // Rows repeated (`select(x, x, c)`, ...): through copies.
+                    let (cs, xs, ys) = (row::<N>(regs, c, n), row::<N>(regs, x, n), row::<N>(regs, y, n));
+                    for (i, o) in regs[d..d + n].iter_mut().enumerate() {
+                        *o = if cs[i] != 0 { xs[i] } else { ys[i] };
+                    }
                 }
             }),
             Members::Some(lanes, width) => {
@@ -217,8 +244,10 @@ impl Members<'_> {
                 for i in 0..len {
                     let r = if dst <= src { i } else { len - 1 - i };
                     chunks!(width, |start, n| {
-                        let x = row::<N>(regs, (src + r) * width + start, n);
-                        regs[(dst + r) * width + start..][..n].copy_from_slice(&x[..n]);
+                        let (d, x) = ((dst + r) * width + start, (src + r) * width + start);
+                        if let Ok([to, from]) = regs.get_disjoint_mut([d..d + n, x..x + n]) {
+                            to.copy_from_slice(from);
+                        }
                     });
                 }
             }

@@ -1,113 +1,123 @@
-//! One instruction for one invocation: what the group loop of [`super::interp`] hands to
-//! each member in turn (arithmetic not looped over the group itself, memory loads and
-//! stores through pointers, atomics), never control flow.
+//! The instructions that the group loop of [`super::interp`] runs member by member
+//! (memory through pointers, atomics, textures): decoded once for the group, then
+//! executed for each member in turn; never control flow.
 
 use super::insn::Insn;
 use super::interp::GroupMemory;
-use super::lanes::LaneRegs;
+use super::lanes::{LaneRegs, Members};
 use super::memory::{BUFFER, Memory, TAG_MASK, read_mixed, write_buffer, write_mixed};
 use std::sync::atomic::Ordering;
 
-/// Executes, for the invocation in lane `lane` of the running file `file`, an
-/// instruction that `run_group` neither runs itself (control flow) nor runs for the
-/// whole group at once (row operations).
-#[inline(always)]
-pub(super) fn execute(insn: &Insn, file: &mut [u32], lane: usize, group: &mut GroupMemory) {
+/// Executes, for each member of `members` (lanes of the running file `file`), an
+/// instruction that `run_group` neither runs itself (control flow) nor runs as row
+/// operations.
+pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &mut GroupMemory) {
     let width = group.width;
-    let mut lane_regs = LaneRegs::new(file, lane, width);
-    let regs = &mut lane_regs;
     let private_words = group.private_words;
-    let GroupMemory { buffers, workgroup, private, files, callers, .. } = group;
+    let GroupMemory { buffers, workgroup, private: privates, files, callers, .. } = group;
     let buffers: &[_] = buffers;
-    let private = &mut private[lane * private_words..(lane + 1) * private_words];
+    // `$body` for each member, with its registers, lane and private memory.
+    macro_rules! each_lane {
+        (|$regs:ident, $lane:ident, $private:ident| $body:block) => {
+            members.for_each(|$lane| {
+                let mut lane_regs = LaneRegs::new(file, $lane, width);
+                let $regs = &mut lane_regs;
+                let $private = &mut privates[$lane * private_words..($lane + 1) * private_words];
+                let _ = (&$regs, &$private);
+                $body
+            })
+        };
+    }
     macro_rules! memory {
-        () => {
+        ($lane:ident, $private:ident) => {
             Memory {
                 buffers,
                 workgroup: &mut **workgroup,
-                private: &mut *private,
+                private: &mut *$private,
                 files: &mut **files,
                 callers,
-                lane,
+                lane: $lane,
                 width,
             }
         };
     }
     match insn {
-        Insn::Image(image) => super::image::execute(image, regs, buffers),
-        Insn::PtrIndexRt { dst, base, index, stride } => {
+        Insn::Image(image) => each_lane!(|regs, lane, private| {
+            super::image::execute(image, regs, buffers);
+        }),
+        Insn::PtrIndexRt { dst, base, index, stride } => each_lane!(|regs, lane, private| {
             let (dst, base) = (*dst as usize, *base as usize);
             let (tag, offset) = (regs[base], regs[base + 1] as usize);
-            let memory = memory!();
+            let memory = memory!(lane, private);
             let stride = *stride as usize;
             let len = (memory.words(regs, tag).saturating_sub(offset) / stride.max(1)).max(1);
             let at = (regs[*index as usize] as usize).min(len - 1) * stride;
             regs[dst] = tag;
             regs[dst + 1] = (offset + at) as u32;
-        }
-        Insn::Load { dst, pointer, len } => {
+        }),
+        Insn::Load { dst, pointer, len } => each_lane!(|regs, lane, private| {
             let pointer = (regs[*pointer as usize], regs[*pointer as usize + 1]);
-            let mut memory = memory!();
+            let mut memory = memory!(lane, private);
             memory.load(regs, pointer, *dst as usize, *len as usize);
-        }
-        Insn::Store { pointer, src, len } => {
+        }),
+        Insn::Store { pointer, src, len } => each_lane!(|regs, lane, private| {
             let pointer = (regs[*pointer as usize], regs[*pointer as usize + 1]);
-            let mut memory = memory!();
+            let mut memory = memory!(lane, private);
             memory.store(regs, pointer, *src as usize, *len as usize);
-        }
-        Insn::LoadMixed { dst, pointer, plan } => {
+        }),
+        Insn::LoadMixed { dst, pointer, plan } => each_lane!(|regs, lane, private| {
             let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1]);
             // Only pointers into buffers get a plan.
             if tag & TAG_MASK == BUFFER {
                 let buffer = &buffers[(tag & !TAG_MASK) as usize];
                 read_mixed(buffer, offset as usize, regs, *dst as usize, plan);
             }
-        }
-        Insn::StoreMixed { pointer, src, plan } => {
+        }),
+        Insn::StoreMixed { pointer, src, plan } => each_lane!(|regs, lane, private| {
             let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1]);
             if tag & TAG_MASK == BUFFER {
                 let buffer = &buffers[(tag & !TAG_MASK) as usize];
                 write_mixed(buffer, offset as usize, regs, *src as usize, plan);
             }
-        }
-        Insn::LoadWorkgroup { dst, address, len } => {
+        }),
+        Insn::LoadWorkgroup { dst, address, len } => each_lane!(|regs, lane, private| {
             let (dst, address, len) = (*dst as usize, *address as usize, *len as usize);
             regs.write(dst, &workgroup[address..address + len]);
-        }
-        Insn::StoreWorkgroup { address, src, len } => {
+        }),
+        Insn::StoreWorkgroup { address, src, len } => each_lane!(|regs, lane, private| {
             let (src, address, len) = (*src as usize, *address as usize, *len as usize);
             for i in 0..len {
                 workgroup[address + i] = regs[src + i];
             }
-        }
-        Insn::LoadPrivate { dst, address, len } => {
+        }),
+        Insn::LoadPrivate { dst, address, len } => each_lane!(|regs, lane, private| {
             let (dst, address, len) = (*dst as usize, *address as usize, *len as usize);
             regs.write(dst, &private[address..address + len]);
-        }
-        Insn::StorePrivate { address, src, len } => {
+        }),
+        Insn::StorePrivate { address, src, len } => each_lane!(|regs, lane, private| {
             let (src, address, len) = (*src as usize, *address as usize, *len as usize);
             for i in 0..len {
                 private[address + i] = regs[src + i];
             }
-        }
-        Insn::LoadBuffer { dst, buffer, address, len } => {
+        }),
+        Insn::LoadBuffer { dst, buffer, address, len } => each_lane!(|regs, lane, private| {
             let (dst, len) = (*dst as usize, *len as usize);
             let memory = &buffers[*buffer as usize];
             for i in 0..len {
                 regs[dst + i] = memory.get(*address as usize + i).map_or(0, |w| w.load(Ordering::Relaxed));
             }
-        }
-        Insn::StoreBuffer { buffer, address, src, len } => {
+        }),
+        Insn::StoreBuffer { buffer, address, src, len } => each_lane!(|regs, lane, private| {
             let (src, len) = (*src as usize, *len as usize);
             write_buffer(&buffers[*buffer as usize], *address as usize, &regs.read(src, len));
-        }
-        Insn::ArrayLength { dst, pointer, stride } => {
+        }),
+        Insn::ArrayLength { dst, pointer, stride } => each_lane!(|regs, lane, private| {
             let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1]);
-            let memory = memory!();
+            let memory = memory!(lane, private);
             let words = memory.words(regs, tag);
             regs[*dst as usize] = (words.saturating_sub(offset as usize) / (*stride).max(1) as usize) as u32;
-        }
-        Insn::Atomic(atomic) => {
+        }),
+        Insn::Atomic(atomic) => each_lane!(|regs, lane, private| {
             use naga::AtomicFunction as A;
             let pointer = (regs[atomic.pointer as usize], regs[atomic.pointer as usize + 1]);
             let operand = regs[atomic.value as usize];
@@ -134,7 +144,7 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], lane: usize, group: &mut Gr
                     }
                 }
             };
-            let mut memory = memory!();
+            let mut memory = memory!(lane, private);
             let old = memory.atomic(regs, pointer, apply);
             if let Some(result) = atomic.result {
                 regs[result as usize] = old;
@@ -142,7 +152,7 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], lane: usize, group: &mut Gr
                     regs[result as usize + 1] = u32::from(old == expected);
                 }
             }
-        }
+        }),
         Insn::Copy1 { .. }
         | Insn::Copy2 { .. }
         | Insn::Copy3 { .. }

@@ -558,7 +558,7 @@ fn run_group(
                 group.copy(file, dst, base, 1);
             }
             Insn::Compute(compute) => group.for_each(|l| compute(&mut LaneRegs::new(file, l, width))),
-            _ => group.for_each(|l| execute(insn, file, l, memory)),
+            _ => execute(insn, file, group, memory),
         }
     };
     *steps = count;

@@ -149,7 +149,7 @@ impl Members<'_> {
 
     /// `regs[dst row] = f(regs[a row], regs[b row])` for the members (rows are register
     /// indices; each is `width` words).
-    #[inline(always)]
+    #[inline(never)]
     pub(super) fn binary(self, regs: &mut [u32], dst: usize, a: usize, b: usize, f: impl Fn(u32, u32) -> u32) {
         match self {
             Members::All(width) => chunks!(width, |start, n| {
@@ -181,7 +181,7 @@ impl Members<'_> {
     }
 
     /// `regs[dst row] = f(regs[src row])` for the members.
-    #[inline(always)]
+    #[inline(never)]
     pub(super) fn unary(self, regs: &mut [u32], dst: usize, src: usize, f: impl Fn(u32) -> u32) {
         match self {
             Members::All(width) => chunks!(width, |start, n| {
@@ -206,7 +206,7 @@ impl Members<'_> {
     }
 
     /// `regs[dst row] = regs[cond row] != 0 ? regs[accept row] : regs[reject row]`.
-    #[inline(always)]
+    #[inline(never)]
     pub(super) fn select(self, regs: &mut [u32], dst: usize, cond: usize, accept: usize, reject: usize) {
         match self {
             Members::All(width) => chunks!(width, |start, n| {
@@ -235,22 +235,11 @@ impl Members<'_> {
     }
 
     /// Copies `len` rows from `src` to `dst` (the ranges may overlap).
-    #[inline(always)]
+    #[inline(never)]
     pub(super) fn copy(self, regs: &mut [u32], dst: usize, src: usize, len: usize) {
         match self {
-            Members::All(width) => {
-                // Row by row through a register-sized buffer: rows are a few hundred
-                // bytes, where calling the C library's memmove cost more than the copy.
-                for i in 0..len {
-                    let r = if dst <= src { i } else { len - 1 - i };
-                    chunks!(width, |start, n| {
-                        let (d, x) = ((dst + r) * width + start, (src + r) * width + start);
-                        if let Ok([to, from]) = regs.get_disjoint_mut([d..d + n, x..x + n]) {
-                            to.copy_from_slice(from);
-                        }
-                    });
-                }
-            }
+            // The rows of a value are contiguous: one copy of `len * width` words.
+            Members::All(width) => regs.copy_within(src * width..(src + len) * width, dst * width),
             Members::Some(lanes, width) => {
                 for i in 0..len {
                     let r = if dst <= src { i } else { len - 1 - i };
@@ -263,7 +252,7 @@ impl Members<'_> {
     }
 
     /// Sets `len` rows from `dst` to `value`.
-    #[inline(always)]
+    #[inline(never)]
     pub(super) fn fill(self, regs: &mut [u32], dst: usize, len: usize, value: u32) {
         match self {
             Members::All(width) => {

@@ -7,7 +7,7 @@
 use super::arith;
 use super::constant::{compose_offsets, literal};
 use super::decode::{Compiler, Scope};
-use super::insn::{BinOp, Insn, Reg, UnOp};
+use super::insn::{BinOp, Insn, Reg, UnOp, per_lane};
 use super::lanes::LaneRegs;
 use super::layout::{
     Place, Words, array_length, byte_addressed, component_step, component_words, element_step, is_half, is_wide,
@@ -208,7 +208,7 @@ impl Compiler<'_> {
                         return Ok(());
                     }
                 };
-                self.push(Insn::Compute(Box::new(move |regs: &mut LaneRegs| {
+                self.push(Insn::Compute(per_lane(move |regs: &mut LaneRegs| {
                     for i in (0..n as usize).step_by(2) {
                         let x = wide::read(regs, src as usize + i);
                         wide::write(regs, dst as usize + i, apply(x));
@@ -235,7 +235,7 @@ impl Compiler<'_> {
                 // Shift amounts are u32: one word per component.
                 let wb = component_words(right_scalar) as usize;
                 let (a, b, dst) = (a as usize, b as usize, dst as usize);
-                self.push(Insn::Compute(Box::new(move |regs: &mut LaneRegs| {
+                self.push(Insn::Compute(per_lane(move |regs: &mut LaneRegs| {
                     for i in 0..n {
                         let x = wide::read(regs, a + 2 * i * sa);
                         let y = if wb == 2 { wide::read(regs, b + 2 * i * sb) } else { u64::from(regs[b + i * sb]) };
@@ -274,7 +274,7 @@ impl Compiler<'_> {
                 if probe.is_none() {
                     self.fail(format!("{op:?} on matrices"), line);
                 } else {
-                    self.push(Insn::Compute(Box::new(move |regs: &mut LaneRegs| {
+                    self.push(Insn::Compute(per_lane(move |regs: &mut LaneRegs| {
                         let value =
                             super::matrix::binary(op, &ta, &slice(regs, a), &tb, &slice(regs, b)).expect("probed");
                         put(regs, dst, len, &value);
@@ -315,7 +315,7 @@ impl Compiler<'_> {
                     // Components of several words (64-bit) under a vector condition.
                     let w = (n / lc) as usize;
                     let (dst, cond, accept, reject) = (dst as usize, cond as usize, accept as usize, reject as usize);
-                    self.push(Insn::Compute(Box::new(move |regs: &mut LaneRegs| {
+                    self.push(Insn::Compute(per_lane(move |regs: &mut LaneRegs| {
                         for i in 0..lc as usize {
                             let src = if regs[cond + i] != 0 { accept } else { reject };
                             regs.copy(dst + i * w, src + i * w, w);
@@ -328,7 +328,7 @@ impl Compiler<'_> {
             Expression::Relational { fun, argument } => {
                 let v = operand!(argument);
                 let dst = self.reg(scope, handle);
-                self.push(Insn::Compute(Box::new(move |regs: &mut LaneRegs| {
+                self.push(Insn::Compute(per_lane(move |regs: &mut LaneRegs| {
                     let value: Words = {
                         let v = slice(regs, v);
                         match fun {
@@ -364,7 +364,7 @@ impl Compiler<'_> {
                 }
                 let (ws, wd) = (component_words(from) as usize, component_words(to) as usize);
                 let (src, dst) = (src as usize, dst as usize);
-                self.push(Insn::Compute(Box::new(move |regs: &mut LaneRegs| {
+                self.push(Insn::Compute(per_lane(move |regs: &mut LaneRegs| {
                     for i in 0..comps {
                         let x = if ws == 2 { wide::read(regs, src + 2 * i) } else { u64::from(regs[src + i]) };
                         let v = wide::convert(x, from, to).expect("probed");
@@ -391,7 +391,7 @@ impl Compiler<'_> {
                     return Ok(());
                 }
                 let (src, dst) = (src as usize, dst as usize);
-                self.push(Insn::Compute(Box::new(move |regs: &mut LaneRegs| {
+                self.push(Insn::Compute(per_lane(move |regs: &mut LaneRegs| {
                     for i in 0..comps {
                         regs[dst + i] = arith::convert_half(regs[src + i], from, to).expect("probed");
                     }

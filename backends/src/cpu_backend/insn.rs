@@ -8,7 +8,7 @@
 //! (literals, constants, pointers to globals) are filled into each code's register
 //! template once and never recomputed.
 
-use super::lanes::LaneRegs;
+use super::lanes::{LaneRegs, Members};
 use super::layout::Piece;
 pub(super) use super::layout::Reg;
 use naga::ScalarKind;
@@ -178,8 +178,18 @@ impl UnOp {
 }
 
 /// A computation too rare to deserve its own instruction (matrix products, most math
-/// functions, packing): a closure over one invocation's registers, operands captured.
-pub(super) type Compute = Box<dyn Fn(&mut LaneRegs) + Send + Sync>;
+/// functions, packing): a closure over a group's register file and members, operands
+/// captured.
+pub(super) type Compute = Box<dyn Fn(&mut [u32], Members) + Send + Sync>;
+
+/// The [`Compute`] that runs `f` on each member's registers in turn (`f` compiled into
+/// the loop over the members, one dynamic call per group rather than per member).
+pub(super) fn per_lane(f: impl Fn(&mut LaneRegs) + Send + Sync + 'static) -> Compute {
+    Box::new(move |file, members| {
+        let width = members.width();
+        members.for_each(|lane| f(&mut LaneRegs::new(file, lane, width)))
+    })
+}
 
 /// A call of a function that was not inlined.
 pub(super) struct CallInsn {

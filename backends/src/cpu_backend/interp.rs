@@ -349,9 +349,7 @@ fn enter_function(
     }
     let callee = &program.codes[call.code as usize];
     let (caller_file, callee_file) = two_files(files, caller as usize, call.code as usize);
-    let width = match group {
-        Members::All(width) | Members::Some(_, width) => width,
-    };
+    let width = group.width();
     open_file(callee_file, &callee.template, width);
     for &(reg, words) in &callee.locals {
         for r in reg as usize..(reg + words) as usize {
@@ -557,7 +555,7 @@ fn run_group(
                 });
                 group.copy(file, dst, base, 1);
             }
-            Insn::Compute(compute) => group.for_each(|l| compute(&mut LaneRegs::new(file, l, width))),
+            Insn::Compute(compute) => compute(file, group),
             _ => execute(insn, file, group, memory),
         }
     };

@@ -134,6 +134,14 @@ impl Members<'_> {
         }
     }
 
+    /// Lanes per row of the file the members run in.
+    #[inline(always)]
+    pub(super) fn width(self) -> usize {
+        match self {
+            Members::All(width) | Members::Some(_, width) => width,
+        }
+    }
+
     /// Calls `f` with each member's lane, in increasing order.
     #[inline(always)]
     pub(super) fn for_each(self, mut f: impl FnMut(usize)) {
@@ -232,6 +240,26 @@ impl Members<'_> {
                 }
             }
         }
+    }
+
+    /// `regs[dst row] = f(regs[a row], regs[b row], regs[c row])` for the members, an
+    /// absent operand row reading as 0.
+    #[inline(always)]
+    pub(super) fn ternary(
+        self,
+        regs: &mut [u32],
+        dst: usize,
+        a: usize,
+        b: Option<usize>,
+        c: Option<usize>,
+        f: impl Fn(u32, u32, u32) -> u32,
+    ) {
+        let width = self.width();
+        let value = |regs: &[u32], row: Option<usize>, l: usize| row.map_or(0, |r| regs[r * width + l]);
+        self.for_each(|l| {
+            let v = f(regs[a * width + l], value(regs, b, l), value(regs, c, l));
+            regs[dst * width + l] = v;
+        });
     }
 
     /// Copies `len` rows from `src` to `dst` (the ranges may overlap).

@@ -4,8 +4,8 @@
 
 use super::arith;
 use super::decode::{Compiler, Scope};
-use super::insn::{Insn, Reg};
-use super::lanes::{LaneRegs, Words};
+use super::insn::{Compute, Insn, Reg, per_lane};
+use super::lanes::{LaneRegs, Members, Words};
 use super::layout::{is_half, is_wide, member_step, scalar_shape, shape};
 use super::wide;
 use naga::{Expression, Handle, ScalarKind, TypeInner};
@@ -129,20 +129,54 @@ fn math(
     }
 }
 
-/// A component-wise function of [`arith::math`] with its function and kind fixed, so that
-/// the compiler specialises it: the path tracer spends a fifth of its interpreted time in
-/// math builtins, and matching on the function per component was most of that.
-type ComponentFn = fn(u32, u32, u32) -> u32;
+/// Operand rows of a component-wise math call: (first register, step per component: 1
+/// for a vector, 0 for a scalar broadcast over the components).
+type Operand = (usize, usize);
 
-/// The specialised form of the common component-wise functions (`None`: use the general
-/// form, which gives the same results).
-fn specialised(fun: naga::MathFunction, kind: ScalarKind) -> Option<ComponentFn> {
+/// The row form of a component-wise function: component `i` of every member at once,
+/// `f` compiled into the loop over them (absent operands are 0).
+fn component_rows(
+    f: impl Fn(u32, u32, u32) -> u32 + Copy + Send + Sync + 'static,
+    dst: usize,
+    n: usize,
+    (a, sa): Operand,
+    b: Option<Operand>,
+    c: Option<Operand>,
+) -> Compute {
+    Box::new(move |file: &mut [u32], members: Members| {
+        for i in 0..n {
+            let row = |o: Option<Operand>| o.map(|(r, s)| r + i * s);
+            members.ternary(file, dst + i, a + i * sa, row(b), row(c), f);
+        }
+    })
+}
+
+/// The common component-wise functions of [`arith::math`] with the function and kind
+/// fixed, so that the compiler specialises each (the path tracer spends a fifth of its
+/// interpreted time in math builtins, and matching on the function per component was
+/// most of that); `None`: use the general form, which gives the same results.
+fn specialised(
+    fun: naga::MathFunction,
+    kind: ScalarKind,
+    dst: usize,
+    n: usize,
+    a: Operand,
+    b: Option<Operand>,
+    c: Option<Operand>,
+) -> Option<Compute> {
     use ScalarKind as K;
     use naga::MathFunction as M;
     macro_rules! table {
         ($(($fun:ident, $kind:ident)),*) => {
             match (fun, kind) {
-                $((M::$fun, K::$kind) => Some(|x, y, z| arith::math(M::$fun, K::$kind, x, y, z).unwrap_or(0)),)*
+                $((M::$fun, K::$kind) => Some(component_rows(
+                    |x, y, z| arith::math(M::$fun, K::$kind, x, y, z).unwrap_or(0),
+                    dst,
+                    n,
+                    a,
+                    b,
+                    c,
+                )),)*
                 _ => None,
             }
         };
@@ -213,14 +247,14 @@ impl Compiler<'_> {
         let arg_type = self.ty(scope, arg).clone();
         let compute: Result<super::insn::Compute, String> = match fun {
             M::Transpose => match arg_type {
-                TypeInner::Matrix { columns, rows, .. } => Ok(Box::new(move |regs: &mut LaneRegs| {
+                TypeInner::Matrix { columns, rows, .. } => Ok(per_lane(move |regs: &mut LaneRegs| {
                     let value = super::matrix::transpose(&slice(regs, a), columns, rows);
                     put(regs, dst, len, &value);
                 })),
                 other => Err(format!("transpose of {other:?}")),
             },
             M::Determinant => match arg_type {
-                TypeInner::Matrix { columns, .. } => Ok(Box::new(move |regs: &mut LaneRegs| {
+                TypeInner::Matrix { columns, .. } => Ok(per_lane(move |regs: &mut LaneRegs| {
                     let value = super::matrix::determinant(&slice(regs, a), columns);
                     put(regs, dst, len, &[value]);
                 })),
@@ -232,7 +266,7 @@ impl Compiler<'_> {
                     if members.len() == 2 && a.1 as usize == comps =>
                 {
                     let second = dst + member_step(self.module, self.ty(scope, handle), 1, false);
-                    Ok(Box::new(move |regs: &mut LaneRegs| {
+                    Ok(per_lane(move |regs: &mut LaneRegs| {
                         for i in 0..comps {
                             let x = regs[a.0 as usize + i];
                             let (first, other) = if fun == M::Modf { arith::modf(x) } else { arith::frexp(x) };
@@ -250,7 +284,7 @@ impl Compiler<'_> {
                     Err(format!("math function {fun:?} on 64-bit integers"))
                 } else {
                     let (b, c) = (operands[1], operands[2]);
-                    Ok(Box::new(move |regs: &mut LaneRegs| {
+                    Ok(per_lane(move |regs: &mut LaneRegs| {
                         for i in 0..comps {
                             let at = |o: Option<(Reg, u32)>| o.map_or(0, |(r, _)| wide::read(regs, r as usize + 2 * i));
                             let value = wide::math(fun, signed, wide::read(regs, a.0 as usize + 2 * i), at(b), at(c));
@@ -259,11 +293,11 @@ impl Compiler<'_> {
                     }))
                 }
             }
-            _ if arith::pack(fun, &[0; 4]).is_some() => Ok(Box::new(move |regs: &mut LaneRegs| {
+            _ if arith::pack(fun, &[0; 4]).is_some() => Ok(per_lane(move |regs: &mut LaneRegs| {
                 let value = arith::pack(fun, &slice(regs, a)).expect("a pack function");
                 put(regs, dst, len, &[value]);
             })),
-            _ if arith::unpack(fun, 0).is_some() => Ok(Box::new(move |regs: &mut LaneRegs| {
+            _ if arith::unpack(fun, 0).is_some() => Ok(per_lane(move |regs: &mut LaneRegs| {
                 let value = arith::unpack(fun, regs[a.0 as usize]).expect("an unpack function");
                 put(regs, dst, len, &value);
             })),
@@ -286,27 +320,20 @@ impl Compiler<'_> {
                         Err(format!("math function {fun:?} on {kind:?}"))
                     } else {
                         let (b, c, d) = (operands[1], operands[2], operands[3]);
-                        if let Some(component) = specialised(fun, kind) {
-                            // Operands of one word are broadcast over the components; absent
-                            // ones are 0, as in the general form.
-                            let at = |o: Option<(Reg, u32)>| o.map(|(r, l)| (r as usize, usize::from(l > 1)));
-                            let (a, sa) = at(Some(a)).expect("a first argument");
-                            let (b, c) = (at(b), at(c));
-                            let (dst, n) = (dst as usize, comps.min(len as usize));
-                            Ok(Box::new(move |regs: &mut LaneRegs| {
-                                for i in 0..n {
-                                    let operand = |o: Option<(usize, usize)>| o.map_or(0, |(r, s)| regs[r + i * s]);
-                                    let (y, z) = (operand(b), operand(c));
-                                    regs[dst + i] = component(regs[a + i * sa], y, z);
-                                }
-                            }))
+                        // Operands of one word are broadcast over the components; absent
+                        // ones are 0, as in the general form.
+                        let at = |o: Option<(Reg, u32)>| o.map(|(r, l)| (r as usize, usize::from(l > 1)));
+                        let rows = (at(Some(a)).expect("a first argument"), at(b), at(c));
+                        let (rows_dst, n) = (dst as usize, comps.min(len as usize));
+                        if let Some(compute) = specialised(fun, kind, rows_dst, n, rows.0, rows.1, rows.2) {
+                            Ok(compute)
                         } else if let (M::Dot, ScalarKind::Float, Some(b)) = (fun, kind, b) {
                             let (a, b, dst) = (a.0 as usize, b.0 as usize, dst as usize);
-                            Ok(Box::new(move |regs: &mut LaneRegs| {
+                            Ok(per_lane(move |regs: &mut LaneRegs| {
                                 regs[dst] = dot(&regs.read(a, comps), &regs.read(b, comps)).to_bits();
                             }))
                         } else {
-                            Ok(Box::new(move |regs: &mut LaneRegs| {
+                            Ok(per_lane(move |regs: &mut LaneRegs| {
                                 let mut value = [0u32; 4];
                                 let (b, c, d) =
                                     (b.map(|b| slice(regs, b)), c.map(|c| slice(regs, c)), d.map(|d| slice(regs, d)));
@@ -343,7 +370,7 @@ impl Compiler<'_> {
     /// Rounds the `len` f16 values at `dst` (held as f32) to binary16.
     pub(super) fn round_half(&mut self, dst: Reg, len: u32) {
         let (dst, len) = (dst as usize, len as usize);
-        self.push(Insn::Compute(Box::new(move |regs: &mut LaneRegs| {
+        self.push(Insn::Compute(per_lane(move |regs: &mut LaneRegs| {
             for r in dst..dst + len {
                 regs[r] = arith::round_f16(regs[r]);
             }

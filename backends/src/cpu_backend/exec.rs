@@ -9,6 +9,7 @@ use super::insn::Insn;
 use super::interp::{self, Invocation, Stop, Workgroup};
 use super::memory::{FUNCTION, Frame};
 use crate::error::BackendError;
+use smallvec::SmallVec;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 
 /// Builtin values of one invocation.
@@ -96,18 +97,20 @@ pub(super) fn run(
     result.map(|_| DispatchCounts { instructions: instructions.into_inner(), warp_issues: warp_issues.into_inner() })
 }
 
-fn builtin_value(builtin: naga::BuiltIn, b: &Builtins) -> Result<Vec<u32>, BackendError> {
+/// The words of a builtin: up to three, and how many.
+fn builtin_value(builtin: naga::BuiltIn, b: &Builtins) -> Result<([u32; 3], usize), BackendError> {
     use naga::BuiltIn as B;
+    let one = |x: u32| ([x, 0, 0], 1);
     Ok(match builtin {
-        B::LocalInvocationId => b.local_id.to_vec(),
-        B::LocalInvocationIndex => vec![b.local_index],
-        B::GlobalInvocationId => b.global_id.to_vec(),
-        B::WorkGroupId => b.workgroup_id.to_vec(),
-        B::NumWorkGroups => b.num_workgroups.to_vec(),
-        B::SubgroupSize => vec![b.subgroup_size],
-        B::SubgroupInvocationId => vec![b.lane],
-        B::SubgroupId => vec![b.subgroup_id],
-        B::NumSubgroups => vec![b.num_subgroups],
+        B::LocalInvocationId => (b.local_id, 3),
+        B::LocalInvocationIndex => one(b.local_index),
+        B::GlobalInvocationId => (b.global_id, 3),
+        B::WorkGroupId => (b.workgroup_id, 3),
+        B::NumWorkGroups => (b.num_workgroups, 3),
+        B::SubgroupSize => one(b.subgroup_size),
+        B::SubgroupInvocationId => one(b.lane),
+        B::SubgroupId => one(b.subgroup_id),
+        B::NumSubgroups => one(b.num_subgroups),
         other => return Err(unsupported(&format!("entry point argument {other:?}"), 0)),
     })
 }
@@ -127,9 +130,9 @@ fn enter_entry_point(program: &Program, file: &mut Vec<u32>, builtins: &[Builtin
     for &(argument, reg, len) in &code.arguments {
         for &(builtin, offset) in &program.entry_arguments[argument as usize] {
             for (lane, b) in builtins.iter().enumerate() {
-                let value = builtin_value(builtin, b)?;
+                let (value, words) = builtin_value(builtin, b)?;
                 let at = (reg + offset) as usize;
-                let n = (len.saturating_sub(offset) as usize).min(value.len());
+                let n = (len.saturating_sub(offset) as usize).min(words);
                 for (k, &word) in value[..n].iter().enumerate() {
                     file[(at + k) * width + lane] = word;
                 }
@@ -190,8 +193,9 @@ fn run_workgroup(
     let mut counts = DispatchCounts::default();
     let mut stops = Vec::with_capacity(count);
     let mut reached = Vec::with_capacity(count);
+    let mut scratch = interp::Scratch::default();
     loop {
-        interp::run_until_sync(program, invocations, memory, buffers, &mut counts, &mut reached)?;
+        interp::run_until_sync(program, invocations, memory, &mut scratch, buffers, &mut counts, &mut reached)?;
         stops.clear();
         stops.extend(reached.iter().map(|stop| stop.expect("every invocation stopped")));
         if stops.iter().all(|s| *s == Stop::Done) {
@@ -239,33 +243,41 @@ fn gather(invocations: &[Invocation], file: &mut [u32], gather: &super::insn::Ga
     use naga::GatherMode as G;
     let width = invocations.len();
     let (argument, len) = (gather.argument as usize, gather.len as usize);
-    let values: Vec<u32> =
-        (0..width).flat_map(|l| (0..len).map(move |k| (argument + k) * width + l)).map(|at| file[at]).collect();
-    let mut results = Vec::with_capacity(values.len());
-    for invocation in invocations.iter() {
-        let index = gather.index.map_or(0, |reg| file[reg as usize * width + invocation.local_index as usize]);
-        let base = invocation.subgroup_id * invocation.subgroup_size;
-        let lane = invocation.lane;
-        let source = match gather.mode {
-            G::BroadcastFirst => 0,
-            G::Broadcast(_) | G::Shuffle(_) => index,
-            G::ShuffleDown(_) => lane.wrapping_add(index),
-            G::ShuffleUp(_) => lane.wrapping_sub(index),
-            G::ShuffleXor(_) => lane ^ index,
-            G::QuadBroadcast(_) => (lane & !3) | (index & 3),
-            G::QuadSwap(direction) => match direction {
-                naga::Direction::X => lane ^ 1,
-                naga::Direction::Y => lane ^ 2,
-                naga::Direction::Diagonal => lane ^ 3,
-            },
-        };
-        // Lanes outside the subgroup are indeterminate in WGSL: the invocation's own value.
-        let source_index = base.wrapping_add(source) as usize;
-        let in_range = source < invocation.subgroup_size && source_index < invocations.len();
-        let from = if in_range { source_index } else { invocation.local_index as usize };
-        results.extend_from_slice(&values[from * len..from * len + len]);
+    let sources: SmallVec<[usize; 64]> = invocations
+        .iter()
+        .map(|invocation| {
+            let index = gather.index.map_or(0, |reg| file[reg as usize * width + invocation.local_index as usize]);
+            let base = invocation.subgroup_id * invocation.subgroup_size;
+            let lane = invocation.lane;
+            let source = match gather.mode {
+                G::BroadcastFirst => 0,
+                G::Broadcast(_) | G::Shuffle(_) => index,
+                G::ShuffleDown(_) => lane.wrapping_add(index),
+                G::ShuffleUp(_) => lane.wrapping_sub(index),
+                G::ShuffleXor(_) => lane ^ index,
+                G::QuadBroadcast(_) => (lane & !3) | (index & 3),
+                G::QuadSwap(direction) => match direction {
+                    naga::Direction::X => lane ^ 1,
+                    naga::Direction::Y => lane ^ 2,
+                    naga::Direction::Diagonal => lane ^ 3,
+                },
+            };
+            // Lanes outside the subgroup are indeterminate in WGSL: the invocation's own value.
+            let source_index = base.wrapping_add(source) as usize;
+            let in_range = source < invocation.subgroup_size && source_index < invocations.len();
+            if in_range { source_index } else { invocation.local_index as usize }
+        })
+        .collect();
+    // Component by component: the argument's row read through the sources, then written
+    // to the result's row (every row read before any is written, as the result may be
+    // the argument's registers).
+    let mut rows: SmallVec<[u32; 256]> = SmallVec::with_capacity(width * len);
+    for k in 0..len {
+        let row = (argument + k) * width;
+        rows.extend(sources.iter().map(|&from| file[row + from]));
     }
-    write_results(file, width, gather.result as usize, len, &results);
+    let result = gather.result as usize;
+    file[result * width..(result + len) * width].copy_from_slice(&rows);
 }
 
 /// Computes a subgroup ballot, reduction or scan for every invocation of the workgroup:

@@ -73,6 +73,15 @@ pub(super) struct Workgroup {
     pub shared: Vec<u32>,
 }
 
+/// The scheduler's working lists, kept from one synchronisation point to the next.
+#[derive(Default)]
+pub(super) struct Scratch {
+    members: Vec<usize>,
+    targets: Vec<u32>,
+    caller_codes: Vec<u32>,
+    pcs: Vec<u32>,
+}
+
 /// What the members of a running group reach besides the running code's registers.
 pub(super) struct GroupMemory<'a> {
     /// Bound buffers in the kernel's binding order.
@@ -171,6 +180,7 @@ pub(super) fn run_until_sync(
     program: &Program,
     invocations: &mut [Invocation],
     memory: &mut Workgroup,
+    scratch: &mut Scratch,
     buffers: &[Vec<AtomicU32>],
     counts: &mut DispatchCounts,
     stops: &mut Vec<Option<Stop>>,
@@ -178,17 +188,17 @@ pub(super) fn run_until_sync(
     stops.clear();
     stops.extend(invocations.iter().map(|inv| if inv.frame.is_some() { None } else { Some(Stop::Done) }));
     let width = invocations.len();
-    let mut members: Vec<usize> = Vec::with_capacity(width);
-    let mut targets: Vec<u32> = Vec::with_capacity(width);
-    let mut caller_codes: Vec<u32> = Vec::new();
+    let Scratch { members, targets, caller_codes, pcs } = scratch;
     // While no invocation is inside a call (the common case: small functions are
     // inlined), where an invocation is is its next instruction alone: the group to run is
     // then found from these words (`u32::MAX`: stopped) instead of by comparing stacks.
-    let mut pcs: Vec<u32> = invocations
-        .iter()
-        .zip(stops.iter())
-        .map(|(inv, stop)| if stop.is_none() { inv.frame.as_ref().map_or(u32::MAX, |f| f.pc) } else { u32::MAX })
-        .collect();
+    pcs.clear();
+    pcs.extend(
+        invocations
+            .iter()
+            .zip(stops.iter())
+            .map(|(inv, stop)| if stop.is_none() { inv.frame.as_ref().map_or(u32::MAX, |f| f.pc) } else { u32::MAX }),
+    );
     // Runnable invocations inside a call (stopped ones no longer count).
     let mut in_calls = invocations.iter().filter(|inv| !inv.callers.is_empty()).count();
     loop {
@@ -200,16 +210,22 @@ pub(super) fn run_until_sync(
             if behind == u32::MAX {
                 return Ok(());
             }
-            // Without branches: which invocations are members is unpredictable, and a
-            // branch on it mispredicted often enough to cost a fifth of the path tracer.
-            members.resize(pcs.len(), 0);
-            let mut count = 0;
-            for (i, &pc) in pcs.iter().enumerate() {
-                members[count] = i;
-                count += usize::from(pc == behind);
+            // Without branches on membership (unpredictable: a branch on it mispredicted
+            // often enough to cost a fifth of the path tracer): loops the compiler
+            // vectorises, then the members from a bit mask per 64 invocations.
+            for &pc in pcs.iter() {
                 meet = meet.min(if pc == behind { u32::MAX } else { pc });
             }
-            members.truncate(count);
+            for (block, chunk) in pcs.chunks(64).enumerate() {
+                let mut mask = 0u64;
+                for (i, &pc) in chunk.iter().enumerate() {
+                    mask |= u64::from(pc == behind) << i;
+                }
+                while mask != 0 {
+                    members.push(block * 64 + mask.trailing_zeros() as usize);
+                    mask &= mask - 1;
+                }
+            }
             members[0]
         } else {
             let mut leader = None;
@@ -238,7 +254,7 @@ pub(super) fn run_until_sync(
         caller_codes.extend(invocations[leader].callers.iter().map(|f| f.code));
         // An invocation's position in the workgroup is its local index and its lane in
         // the register files (exec.rs).
-        let group = if members.len() == width { Members::All(width) } else { Members::Some(&members, width) };
+        let group = if members.len() == width { Members::All(width) } else { Members::Some(members, width) };
         let end = {
             let mut file = std::mem::take(&mut memory.files[code_index as usize]);
             let mut group_memory = GroupMemory {
@@ -247,29 +263,29 @@ pub(super) fn run_until_sync(
                 private: &mut memory.private,
                 private_words: memory.private_words,
                 files: &mut memory.files,
-                callers: &caller_codes,
+                callers: caller_codes,
                 width,
             };
             let mut steps = 0;
             let end =
-                run_group(program, code_index, pc, meet, group, &mut file, &mut group_memory, &mut steps, &mut targets);
+                run_group(program, code_index, pc, meet, group, &mut file, &mut group_memory, &mut steps, targets);
             memory.files[code_index as usize] = file;
             counts.add_group(steps, members.iter().map(|&i| i as u32));
             end?
         };
         match end {
             GroupEnd::Meet(pc) => {
-                for &i in &members {
+                for &i in members.iter() {
                     invocations[i].frame.as_mut().expect("running").pc = pc;
                 }
             }
             GroupEnd::Split => {
-                for (&i, &pc) in members.iter().zip(&targets) {
+                for (&i, &pc) in members.iter().zip(targets.iter()) {
                     invocations[i].frame.as_mut().expect("running").pc = pc;
                 }
             }
             GroupEnd::Sync(pc) => {
-                for &i in &members {
+                for &i in members.iter() {
                     invocations[i].frame.as_mut().expect("running").pc = pc;
                     stops[i] = Some(Stop::Sync(code_index, pc));
                     in_calls -= usize::from(!invocations[i].callers.is_empty());
@@ -282,9 +298,9 @@ pub(super) fn run_until_sync(
                 if caller_codes.len() >= 256 {
                     return Err(invalid(&program.name, "call depth above 256 (recursion?)".into()));
                 }
-                let group = if members.len() == width { Members::All(width) } else { Members::Some(&members, width) };
+                let group = if members.len() == width { Members::All(width) } else { Members::Some(members, width) };
                 enter_function(program, &mut memory.files, code_index, call, group, caller_codes.len() as u32 + 1)?;
-                for &i in &members {
+                for &i in members.iter() {
                     in_calls += usize::from(invocations[i].callers.is_empty());
                     let invocation = &mut invocations[i];
                     let frame = invocation.frame.as_mut().expect("running");
@@ -294,7 +310,7 @@ pub(super) fn run_until_sync(
                 }
             }
             GroupEnd::Return { src, len } => {
-                for &i in &members {
+                for &i in members.iter() {
                     if return_from_function(&mut invocations[i], &mut memory.files, i, width, src, len) {
                         stops[i] = Some(Stop::Done);
                     }
@@ -302,7 +318,7 @@ pub(super) fn run_until_sync(
                 }
             }
         }
-        for &i in &members {
+        for &i in members.iter() {
             pcs[i] = match (&stops[i], &invocations[i].frame) {
                 (None, Some(frame)) => frame.pc,
                 _ => u32::MAX,

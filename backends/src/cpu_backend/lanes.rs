@@ -218,7 +218,8 @@ impl Members<'_> {
     pub(super) fn select(self, regs: &mut [u32], dst: usize, cond: usize, accept: usize, reject: usize) {
         match self {
             Members::All(width) => chunks!(width, |start, n| {
-                let (d, c, x, y) = (dst * width + start, cond * width + start, accept * width + start, reject * width + start);
+                let (d, c, x, y) =
+                    (dst * width + start, cond * width + start, accept * width + start, reject * width + start);
                 if let Ok([out, cs, xs, ys]) = regs.get_disjoint_mut([d..d + n, c..c + n, x..x + n, y..y + n]) {
                     // With masks, not a choice of address: the compiler vectorises this.
                     for i in 0..n {

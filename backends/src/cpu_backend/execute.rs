@@ -5,7 +5,7 @@
 use super::insn::Insn;
 use super::interp::GroupMemory;
 use super::lanes::{LaneRegs, Members};
-use super::memory::{BUFFER, Memory, TAG_MASK, read_mixed, write_buffer, write_mixed};
+use super::memory::{BUFFER, Memory, TAG_MASK, WORKGROUP, read_mixed, write_buffer, write_mixed};
 use std::sync::atomic::Ordering;
 
 /// Executes, for each member of `members` (lanes of the running file `file`), an
@@ -55,16 +55,51 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
             regs[dst] = tag;
             regs[dst + 1] = (offset + at) as u32;
         }),
-        Insn::Load { dst, pointer, len } => each_lane!(|regs, lane, private| {
-            let pointer = (regs[*pointer as usize], regs[*pointer as usize + 1]);
-            let mut memory = memory!(lane, private);
-            memory.load(regs, pointer, *dst as usize, *len as usize);
-        }),
-        Insn::Store { pointer, src, len } => each_lane!(|regs, lane, private| {
-            let pointer = (regs[*pointer as usize], regs[*pointer as usize + 1]);
-            let mut memory = memory!(lane, private);
-            memory.store(regs, pointer, *src as usize, *len as usize);
-        }),
+        Insn::Load { dst, pointer, len } => {
+            let (dst, len) = (*dst as usize, *len as usize);
+            each_lane!(|regs, lane, private| {
+                let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1] as usize);
+                // The common regions inline; the others (and the general rules) in `Memory`.
+                match tag & TAG_MASK {
+                    BUFFER => {
+                        let memory = &buffers[(tag & !TAG_MASK) as usize];
+                        for i in 0..len {
+                            regs[dst + i] = memory.get(offset / 4 + i).map_or(0, |w| w.load(Ordering::Relaxed));
+                        }
+                    }
+                    WORKGROUP => {
+                        for i in 0..len {
+                            regs[dst + i] = workgroup.get(offset + i).copied().unwrap_or(0);
+                        }
+                    }
+                    _ => memory!(lane, private).load(regs, (tag, offset as u32), dst, len),
+                }
+            })
+        }
+        Insn::Store { pointer, src, len } => {
+            let (src, len) = (*src as usize, *len as usize);
+            each_lane!(|regs, lane, private| {
+                let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1] as usize);
+                match tag & TAG_MASK {
+                    BUFFER => {
+                        let memory = &buffers[(tag & !TAG_MASK) as usize];
+                        for i in 0..len {
+                            if let Some(word) = memory.get(offset / 4 + i) {
+                                word.store(regs[src + i], Ordering::Relaxed);
+                            }
+                        }
+                    }
+                    WORKGROUP => {
+                        for i in 0..len {
+                            if let Some(word) = workgroup.get_mut(offset + i) {
+                                *word = regs[src + i];
+                            }
+                        }
+                    }
+                    _ => memory!(lane, private).store(regs, (tag, offset as u32), src, len),
+                }
+            })
+        }
         Insn::LoadMixed { dst, pointer, plan } => each_lane!(|regs, lane, private| {
             let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1]);
             // Only pointers into buffers get a plan.

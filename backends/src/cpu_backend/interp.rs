@@ -486,13 +486,17 @@ fn run_group(
             Insn::Zero { dst, len } => group.fill(file, *dst as usize, *len as usize, 0),
             Insn::Bin { op, dst, a, b } => {
                 let (dst, a, b) = (*dst as usize, *a as usize, *b as usize);
-                per_operator!(op, |operator| group.binary(file, dst, a, b, operator));
+                per_operator!(op, |operator| group.binary(file, (dst, a, b), 1, operator));
             }
             Insn::BinV { op, dst, a, b, n, sa, sb } => {
                 let (dst, a, b, n, sa, sb) =
                     (*dst as usize, *a as usize, *b as usize, *n as usize, *sa as usize, *sb as usize);
-                per_operator!(op, |operator| for i in 0..n {
-                    group.binary(file, dst + i, a + i * sa, b + i * sb, operator);
+                per_operator!(op, |operator| if sa == 1 && sb == 1 {
+                    group.binary(file, (dst, a, b), n, operator);
+                } else {
+                    for i in 0..n {
+                        group.binary(file, (dst + i, a + i * sa, b + i * sb), 1, operator);
+                    }
                 });
             }
             Insn::Un { op, dst, src, n } => {
@@ -503,9 +507,7 @@ fn run_group(
                         fn operator(x: u32) -> u32 {
                             $op.apply(x)
                         }
-                        for i in 0..n {
-                            group.unary(file, dst + i, src + i, operator);
-                        }
+                        group.unary(file, dst, src, n, operator);
                     }};
                 }
                 match op {
@@ -517,8 +519,12 @@ fn run_group(
             }
             Insn::Select { dst, cond, accept, reject, n, sc } => {
                 let (dst, cond, accept, reject) = (*dst as usize, *cond as usize, *accept as usize, *reject as usize);
-                for i in 0..*n as usize {
-                    group.select(file, dst + i, cond + i * *sc as usize, accept + i, reject + i);
+                if *sc == 1 {
+                    group.select(file, (dst, cond, accept, reject), *n as usize);
+                } else {
+                    for i in 0..*n as usize {
+                        group.select(file, (dst + i, cond, accept + i, reject + i), 1);
+                    }
                 }
             }
             Insn::Splat { dst, src, n } => {
@@ -543,11 +549,9 @@ fn run_group(
             }
             Insn::Convert { from, to, dst, src, n } => {
                 let (from, to) = (*from, *to);
-                for i in 0..*n as usize {
-                    group.unary(file, *dst as usize + i, *src as usize + i, |x| {
-                        super::arith::convert(x, from, to).expect("checked when compiled")
-                    });
-                }
+                group.unary(file, *dst as usize, *src as usize, *n as usize, |x| {
+                    super::arith::convert(x, from, to).expect("checked when compiled")
+                });
             }
             Insn::Extract { dst, base, index, count, stride, len } => {
                 let (dst, base, index, len) = (*dst as usize, *base as usize, *index as usize, *len as usize);
@@ -561,12 +565,12 @@ fn run_group(
             Insn::PtrAdd { dst, base, add } => {
                 let (dst, base, add) = (*dst as usize, *base as usize, *add);
                 group.copy(file, dst, base, 1);
-                group.unary(file, dst + 1, base + 1, |offset| offset.wrapping_add(add));
+                group.unary(file, dst + 1, base + 1, 1, |offset| offset.wrapping_add(add));
             }
             Insn::PtrIndex { dst, base, index, count, stride } => {
                 let (dst, base, index) = (*dst as usize, *base as usize, *index as usize);
                 let (last, stride) = (count.saturating_sub(1) as usize, *stride as usize);
-                group.binary(file, dst + 1, base + 1, index, |offset, i| {
+                group.binary(file, (dst + 1, base + 1, index), 1, |offset, i| {
                     (offset as usize + (i as usize).min(last) * stride) as u32
                 });
                 group.copy(file, dst, base, 1);

@@ -155,12 +155,19 @@ impl Members<'_> {
         }
     }
 
-    /// `regs[dst row] = f(regs[a row], regs[b row])` for the members (rows are register
-    /// indices; each is `width` words).
+    /// `regs[dst + r row] = f(regs[a + r row], regs[b + r row])` for the members and
+    /// `r < rows`, in that order (rows are register indices; each is `width` words). The
+    /// rows of a vector are contiguous, so a whole group's vector operation is one loop.
     #[inline(never)]
-    pub(super) fn binary(self, regs: &mut [u32], dst: usize, a: usize, b: usize, f: impl Fn(u32, u32) -> u32) {
+    pub(super) fn binary(
+        self,
+        regs: &mut [u32],
+        (dst, a, b): (usize, usize, usize),
+        rows: usize,
+        f: impl Fn(u32, u32) -> u32,
+    ) {
         match self {
-            Members::All(width) => chunks!(width, |start, n| {
+            Members::All(width) => chunks!(rows * width, |start, n| {
                 let (d, x, y) = (dst * width + start, a * width + start, b * width + start);
                 if d != x && d != y && x != y {
                     let [out, xs, ys] = regs.get_disjoint_mut([d..d + n, x..x + n, y..y + n]).expect("distinct rows");
@@ -181,18 +188,20 @@ impl Members<'_> {
                 }
             }),
             Members::Some(lanes, width) => {
-                for &l in lanes {
-                    regs[dst * width + l] = f(regs[a * width + l], regs[b * width + l]);
+                for r in 0..rows {
+                    for &l in lanes {
+                        regs[(dst + r) * width + l] = f(regs[(a + r) * width + l], regs[(b + r) * width + l]);
+                    }
                 }
             }
         }
     }
 
-    /// `regs[dst row] = f(regs[src row])` for the members.
+    /// `regs[dst + r row] = f(regs[src + r row])` for the members and `r < rows`.
     #[inline(never)]
-    pub(super) fn unary(self, regs: &mut [u32], dst: usize, src: usize, f: impl Fn(u32) -> u32) {
+    pub(super) fn unary(self, regs: &mut [u32], dst: usize, src: usize, rows: usize, f: impl Fn(u32) -> u32) {
         match self {
-            Members::All(width) => chunks!(width, |start, n| {
+            Members::All(width) => chunks!(rows * width, |start, n| {
                 let (d, x) = (dst * width + start, src * width + start);
                 if d != x {
                     let [out, xs] = regs.get_disjoint_mut([d..d + n, x..x + n]).expect("distinct rows");
@@ -206,18 +215,26 @@ impl Members<'_> {
                 }
             }),
             Members::Some(lanes, width) => {
-                for &l in lanes {
-                    regs[dst * width + l] = f(regs[src * width + l]);
+                for r in 0..rows {
+                    for &l in lanes {
+                        regs[(dst + r) * width + l] = f(regs[(src + r) * width + l]);
+                    }
                 }
             }
         }
     }
 
-    /// `regs[dst row] = regs[cond row] != 0 ? regs[accept row] : regs[reject row]`.
+    /// `regs[dst + r row] = regs[cond + r row] != 0 ? regs[accept + r row] : regs[reject
+    /// + r row]` for the members and `r < rows`.
     #[inline(never)]
-    pub(super) fn select(self, regs: &mut [u32], dst: usize, cond: usize, accept: usize, reject: usize) {
+    pub(super) fn select(
+        self,
+        regs: &mut [u32],
+        (dst, cond, accept, reject): (usize, usize, usize, usize),
+        rows: usize,
+    ) {
         match self {
-            Members::All(width) => chunks!(width, |start, n| {
+            Members::All(width) => chunks!(rows * width, |start, n| {
                 let (d, c, x, y) =
                     (dst * width + start, cond * width + start, accept * width + start, reject * width + start);
                 if let Ok([out, cs, xs, ys]) = regs.get_disjoint_mut([d..d + n, c..c + n, x..x + n, y..y + n]) {
@@ -235,9 +252,11 @@ impl Members<'_> {
                 }
             }),
             Members::Some(lanes, width) => {
-                for &l in lanes {
-                    let from = if regs[cond * width + l] != 0 { accept } else { reject };
-                    regs[dst * width + l] = regs[from * width + l];
+                for r in 0..rows {
+                    for &l in lanes {
+                        let from = if regs[(cond + r) * width + l] != 0 { accept } else { reject };
+                        regs[(dst + r) * width + l] = regs[(from + r) * width + l];
+                    }
                 }
             }
         }

@@ -11,7 +11,9 @@
 //! the invocations of a workgroup run together from barrier to barrier (`exec`), each
 //! a resumable stack of frames, so every invocation reaches a barrier before any passes
 //! it; those at the same place run as one group, each instruction decoded once for the
-//! whole group (`interp`). Each dispatch is counted (`counts`): instructions, and
+//! whole group (`interp`), as a loop over the members' words: registers are
+//! lane-minor, one file per code for the whole workgroup with register `r` of invocation
+//! `l` at `r * width + l` (`lanes`). Each dispatch is counted (`counts`): instructions, and
 //! the issue slots a 32-wide SIMT GPU would spend on the same groups, by kernel. A
 //! barrier or subgroup operation reached in non-uniform control flow is an error
 //! naming the line and function. Subgroup operations run with a configurable subgroup

@@ -148,6 +148,20 @@ pub(super) struct Compiler<'a> {
     pub template: Vec<u32>,
     /// Local-variable pointer registers being built.
     pub local_pointers: Vec<(Reg, u32)>,
+    /// Register ranges of inlined callees whose bodies are compiled, free for later
+    /// values (see [`Compiler::release`]).
+    free: Vec<(Reg, u32)>,
+    /// Ranges allocated for values computed at run time, in allocation order.
+    runtime: Vec<(Reg, u32)>,
+    /// Ranges holding values that are not computed where they are used: compile-time
+    /// values in the template, pointers set when a frame starts. Never reused.
+    permanent: std::collections::HashSet<Reg>,
+    /// Ranges handed out again from `free`.
+    reused: std::collections::HashSet<Reg>,
+    /// The register of each compile-time value in the template, by its words: equal
+    /// values share registers (never written at run time), so that a callee inlined
+    /// many times adds its constants once.
+    constants: std::collections::HashMap<Vec<u32>, Reg>,
     /// Line of the instructions being pushed.
     pub line: u32,
     /// Source function of the instructions being pushed.
@@ -155,11 +169,91 @@ pub(super) struct Compiler<'a> {
 }
 
 impl Compiler<'_> {
-    /// Allocates `len` registers.
+    /// Allocates `len` registers for a value computed at run time: from the ranges of
+    /// inlined callees already compiled (first fit) if one is large enough, else new.
     pub(super) fn alloc(&mut self, len: u32) -> Reg {
+        let at = match self.free.iter().position(|&(_, free)| free >= len && len > 0) {
+            Some(i) => {
+                let (at, free) = self.free[i];
+                if free == len {
+                    self.free.swap_remove(i);
+                } else {
+                    self.free[i] = (at + len, free - len);
+                }
+                self.reused.insert(at);
+                at
+            }
+            None => self.alloc_new(len),
+        };
+        self.runtime.push((at, len));
+        at
+    }
+
+    /// Allocates `len` new registers (never used before, never reused).
+    fn alloc_new(&mut self, len: u32) -> Reg {
         let at = self.template.len() as Reg;
         self.template.resize(self.template.len() + len as usize, 0);
         at
+    }
+
+    /// The register of `handle`, a value that is not computed where it is used (a
+    /// compile-time value written into the template, a pointer set when the frame
+    /// starts): new registers, never reused, since the template and the frame start
+    /// write them once while the code using them may run many times.
+    pub(super) fn reg_permanent(&mut self, scope: &mut Scope, handle: Handle<Expression>) -> Reg {
+        let index = handle.index();
+        if scope.regs[index] == NONE {
+            scope.regs[index] = self.alloc_new(scope.lens[index]);
+        } else if self.reused.contains(&scope.regs[index]) {
+            // Not reached: these expressions get their register where they are compiled.
+            self.fail("internal: a compile-time value in a reused register".into(), self.line);
+        }
+        self.permanent.insert(scope.regs[index]);
+        scope.regs[index]
+    }
+
+    /// The register of `handle`, a compile-time value `value` (zero-extended to the
+    /// expression's words), written into the template: the register of an equal value
+    /// already there, or new ones.
+    pub(super) fn constant(&mut self, scope: &mut Scope, handle: Handle<Expression>, value: &[u32]) -> Reg {
+        let index = handle.index();
+        let len = scope.lens[index] as usize;
+        let mut words = value[..value.len().min(len)].to_vec();
+        words.resize(len, 0);
+        if scope.regs[index] == NONE {
+            if let Some(&reg) = self.constants.get(&words) {
+                scope.regs[index] = reg;
+                return reg;
+            }
+            let reg = self.reg_permanent(scope, handle);
+            self.template[reg as usize..reg as usize + len].copy_from_slice(&words);
+            self.constants.insert(words, reg);
+            reg
+        } else {
+            let reg = self.reg_permanent(scope, handle);
+            self.template[reg as usize..reg as usize + len].copy_from_slice(&words);
+            reg
+        }
+    }
+
+    /// The number of run-time ranges allocated so far: what [`Compiler::release`] takes.
+    pub(super) fn mark(&self) -> usize {
+        self.runtime.len()
+    }
+
+    /// Frees the run-time ranges allocated since `mark`, once an inlined callee's body is
+    /// compiled. Sound because a callee's values are dead after it returns (WGSL returns
+    /// no pointers, the caller receives the result in its own registers), every value is
+    /// written where it is evaluated before any use reads it, its variables are zeroed
+    /// when its body starts, and a register taken again afterwards belongs to an
+    /// expression whose uses end with its block, before the callee can run again (naga
+    /// scopes expressions to the block that emits them).
+    pub(super) fn release(&mut self, mark: usize) {
+        for (at, len) in self.runtime.drain(mark..) {
+            if !self.permanent.contains(&at) {
+                self.free.push((at, len));
+            }
+        }
     }
 
     /// Appends an instruction; returns its index.
@@ -302,9 +396,7 @@ impl Compiler<'_> {
                 },
                 Expression::GlobalVariable(g) => {
                     let (tag, offset) = self.globals[g.index()];
-                    let reg = self.reg(&mut scope, handle);
-                    self.template[reg as usize] = tag;
-                    self.template[reg as usize + 1] = offset;
+                    self.constant(&mut scope, handle, &[tag, offset]);
                     scope.constant[index] = true;
                     scope.places[index] = match tag & memory::TAG_MASK {
                         memory::WORKGROUP => Some(Place::Workgroup(offset)),
@@ -317,14 +409,13 @@ impl Compiler<'_> {
                 }
                 Expression::LocalVariable(l) => {
                     let variable = scope.locals[l.index()];
-                    let reg = self.reg(&mut scope, handle);
+                    let reg = self.reg_permanent(&mut scope, handle);
                     self.local_pointers.push((reg, variable));
                     scope.places[index] = Some(Place::Local(variable));
                 }
                 _ => match const_value(self, &scope, handle) {
                     Some(value) => {
-                        let reg = self.reg(&mut scope, handle);
-                        self.template[reg as usize..reg as usize + value.len()].copy_from_slice(&value);
+                        self.constant(&mut scope, handle, &value);
                         scope.constant[index] = true;
                     }
                     None => self.expression(&mut scope, handle)?,
@@ -377,6 +468,11 @@ fn compile_code(
         insn_sources: Vec::new(),
         template: Vec::new(),
         local_pointers: Vec::new(),
+        free: Vec::new(),
+        runtime: Vec::new(),
+        permanent: Default::default(),
+        reused: Default::default(),
+        constants: Default::default(),
         line: 0,
         source: 0,
     };

@@ -39,21 +39,18 @@ impl Compiler<'_> {
             }};
         }
         match *expression {
-            Expression::Literal(ref value) => {
-                let dst = self.reg(scope, handle);
-                match literal(value) {
-                    Some(v) => {
-                        let n = v.len().min(len as usize);
-                        self.template[dst as usize..dst as usize + n].copy_from_slice(&v[..n]);
-                    }
-                    None => self.fail(format!("literal {value:?}"), line),
+            Expression::Literal(ref value) => match literal(value) {
+                Some(v) => {
+                    self.constant(scope, handle, &v);
                 }
-            }
+                None => {
+                    self.reg_permanent(scope, handle);
+                    self.fail(format!("literal {value:?}"), line);
+                }
+            },
             Expression::Constant(c) => {
-                let dst = self.reg(scope, handle);
-                let value = &self.global_values[module.constants[c].init.index()];
-                let n = value.len().min(len as usize);
-                self.template[dst as usize..dst as usize + n].copy_from_slice(&value[..n]);
+                let value = self.global_values[module.constants[c].init.index()].clone();
+                self.constant(scope, handle, &value);
             }
             Expression::ZeroValue(_) => {
                 let dst = self.reg(scope, handle);
@@ -516,7 +513,7 @@ impl Compiler<'_> {
                 Some(place) => {
                     let place = place.offset(step);
                     scope.places[i] = Some(place);
-                    let dst = self.reg(scope, handle);
+                    let dst = self.reg_permanent(scope, handle);
                     match place {
                         // Pointer values known now: in the template, or set when the frame starts.
                         Place::Local(variable) => self.local_pointers.push((dst, variable)),

@@ -265,12 +265,15 @@ impl Compiler<'_> {
             let values: Vec<(Reg, Option<Place>)> =
                 arguments.iter().map(|a| (self.reg(scope, *a), scope.places[a.index()])).collect();
             let mut unused = Vec::new();
+            let mark = self.mark();
             let mut inner = self.open(callee, &info[function], Some(&values), result, scope.depth + 1, &mut unused)?;
             self.block(&mut inner, &callee.body)?;
             let end = self.here();
             for at in std::mem::take(&mut inner.returns) {
                 self.patch(at, end);
             }
+            // The callee's registers, dead from here on, serve the caller's later values.
+            self.release(mark);
         } else {
             let callee_arguments = &self.arguments[function.index()];
             let arguments = callee_arguments

@@ -193,6 +193,73 @@ fn control_flow_calls_pointers_and_atomics_follow_wgsl() {
     assert_eq!(got, control_flow_reference(&inputs));
 }
 
+/// Inlined callees in a lane-dependent loop, called again while values computed after an
+/// earlier call are still live: the interpreter's compiler gives a callee's registers to
+/// the caller's later values once the callee's body is compiled, and shares registers
+/// between equal constants. The callee's literals must keep their values (they are in the
+/// template, written once), its variable must start at zero on every call, and a value
+/// living across a later inlining of the same callee must keep its own registers.
+const REGISTER_REUSE: &str = r#"
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+
+fn mix_in(x: u32, salt: u32) -> u32 {
+    var scratch: u32;
+    scratch += x * 2654435761u;
+    scratch ^= salt + 40503u;
+    return (scratch >> 7u) + 1013904223u;
+}
+
+fn pair(x: u32) -> vec2<u32> {
+    let a = mix_in(x, 1u);
+    let b = mix_in(a, 2u);
+    return vec2<u32>(a, b);
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let x = input[id.x];
+    var acc = 0u;
+    for (var i = 0u; i < 3u + (x & 3u); i++) {
+        let before = acc + i;
+        let p = pair(before ^ x);
+        let after = p.x + p.y * 3u;
+        acc = before + after + mix_in(after, i);
+    }
+    output[id.x] = acc;
+}
+"#;
+
+/// What the register-reuse kernel must compute, stated in Rust.
+fn register_reuse_reference(inputs: &[u32]) -> Vec<u32> {
+    let mix_in = |x: u32, salt: u32| {
+        ((x.wrapping_mul(2_654_435_761) ^ salt.wrapping_add(40503)) >> 7).wrapping_add(1_013_904_223)
+    };
+    inputs
+        .iter()
+        .map(|&x| {
+            let mut acc = 0u32;
+            for i in 0..3 + (x & 3) {
+                let before = acc.wrapping_add(i);
+                let a = mix_in(before ^ x, 1);
+                let b = mix_in(a, 2);
+                let after = a.wrapping_add(b.wrapping_mul(3));
+                acc = before.wrapping_add(after).wrapping_add(mix_in(after, i));
+            }
+            acc
+        })
+        .collect()
+}
+
+#[test]
+fn inlined_callees_registers_serve_later_values_without_clobbering() {
+    let kernel = Kernel::from_wgsl("register_reuse.wgsl", REGISTER_REUSE.into(), "main", false).unwrap();
+    let inputs: Vec<u32> = (0..128u32).map(|i| i.wrapping_mul(2_246_822_519) ^ (i << 5)).collect();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &inputs, 128, 2);
+    assert_eq!(got, register_reuse_reference(&inputs));
+}
+
 /// Chains of functions deeper than the interpreter inlines (each function's code
 /// inlines 8 levels of callees, so `main` → `l8` → `l16` are real calls, and from the
 /// `l3` branch `main` → `l11` → `l19`): entered from divergent branches at two places,

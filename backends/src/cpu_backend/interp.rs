@@ -26,7 +26,7 @@ use super::decode::Program;
 use super::error::{invalid, unsupported};
 use super::execute::execute;
 use super::insn::{BinOp, CallInsn, Insn, UnOp};
-use super::lanes::{LaneRegs, Members};
+use super::lanes::{LaneRegs, Members, N as LANES};
 use super::memory::{FUNCTION, Frame};
 use crate::error::BackendError;
 use std::cmp::Ordering;
@@ -77,6 +77,8 @@ pub(super) struct Workgroup {
 #[derive(Default)]
 pub(super) struct Scratch {
     members: Vec<usize>,
+    /// Per lane, all ones for a member of the running group (see [`Members::Masked`]).
+    mask: Vec<u32>,
     targets: Vec<u32>,
     caller_codes: Vec<u32>,
     pcs: Vec<u32>,
@@ -188,7 +190,7 @@ pub(super) fn run_until_sync(
     stops.clear();
     stops.extend(invocations.iter().map(|inv| if inv.frame.is_some() { None } else { Some(Stop::Done) }));
     let width = invocations.len();
-    let Scratch { members, targets, caller_codes, pcs } = scratch;
+    let Scratch { members, mask, targets, caller_codes, pcs } = scratch;
     // While no invocation is inside a call (the common case: small functions are
     // inlined), where an invocation is is its next instruction alone: the group to run is
     // then found from these words (`u32::MAX`: stopped) instead of by comparing stacks.
@@ -254,7 +256,7 @@ pub(super) fn run_until_sync(
         caller_codes.extend(invocations[leader].callers.iter().map(|f| f.code));
         // An invocation's position in the workgroup is its local index and its lane in
         // the register files (exec.rs).
-        let group = if members.len() == width { Members::All(width) } else { Members::Some(members, width) };
+        let group = group_of(members, mask, width);
         let end = {
             let mut file = std::mem::take(&mut memory.files[code_index as usize]);
             let mut group_memory = GroupMemory {
@@ -335,6 +337,24 @@ pub(super) fn open_file(file: &mut Vec<u32>, template: &[u32], width: usize) {
         for &value in template {
             file.extend(std::iter::repeat_n(value, width));
         }
+    }
+}
+
+/// The group of invocations `members` (in increasing order) of a workgroup `width` wide:
+/// all of them, a quarter or more of a 64-wide workgroup (by mask, rows computed whole:
+/// cheaper than member by member from there on), or a few.
+fn group_of<'a>(members: &'a [usize], mask: &'a mut Vec<u32>, width: usize) -> Members<'a> {
+    if members.len() == width {
+        Members::All(width)
+    } else if width == LANES && members.len() * 4 >= width {
+        mask.clear();
+        mask.resize(width, 0);
+        for &l in members {
+            mask[l] = u32::MAX;
+        }
+        Members::Masked(members, (&mask[..]).try_into().expect("64 lanes"))
+    } else {
+        Members::Some(members, width)
     }
 }
 

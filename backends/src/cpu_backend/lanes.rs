@@ -83,7 +83,7 @@ impl IndexMut<usize> for LaneRegs<'_> {
 /// Lanes a row operation handles per step: its operands are copied into arrays of this
 /// many words, so that the loop over them has no aliasing for the compiler to fear and,
 /// for a full chunk, a length it knows (the common workgroups of 64 are one chunk).
-const N: usize = 64;
+pub(super) const N: usize = 64;
 
 /// Runs `$body` for the chunks of a row of `$width` lanes, with `$start` the chunk's first
 /// lane and `$n` its length: full chunks first (`$n` is then the constant `N`, and the
@@ -106,6 +106,14 @@ macro_rules! chunks {
     }};
 }
 
+/// `row[i] = words[i]` where `mask[i]` is all ones, unchanged where it is 0.
+#[inline(always)]
+fn keep_members(row: &mut [u32], words: &[u32; N], mask: &[u32; N]) {
+    for (i, word) in row.iter_mut().enumerate() {
+        *word = (words[i] & mask[i]) | (*word & !mask[i]);
+    }
+}
+
 /// Words `at..at + n` of `regs` (`n <= M`) copied into an array.
 #[inline(always)]
 fn row<const M: usize>(regs: &[u32], at: usize, n: usize) -> [u32; M] {
@@ -122,6 +130,11 @@ pub(super) enum Members<'a> {
     All(usize),
     /// These lanes of a file `width` lanes wide.
     Some(&'a [usize], usize),
+    /// These lanes of a file [`N`] lanes wide, many of them: the row operations compute
+    /// whole rows and keep the members' words (`mask`: all ones for a member, else 0),
+    /// loops the compiler vectorises where a member at a time could not be (a
+    /// divergent kernel's groups have tens of members).
+    Masked(&'a [usize], &'a [u32; N]),
 }
 
 impl Members<'_> {
@@ -130,7 +143,7 @@ impl Members<'_> {
     pub(super) fn len(self) -> usize {
         match self {
             Members::All(width) => width,
-            Members::Some(lanes, _) => lanes.len(),
+            Members::Some(lanes, _) | Members::Masked(lanes, _) => lanes.len(),
         }
     }
 
@@ -139,6 +152,7 @@ impl Members<'_> {
     pub(super) fn width(self) -> usize {
         match self {
             Members::All(width) | Members::Some(_, width) => width,
+            Members::Masked(..) => N,
         }
     }
 
@@ -147,7 +161,7 @@ impl Members<'_> {
     pub(super) fn for_each(self, mut f: impl FnMut(usize)) {
         match self {
             Members::All(width) => (0..width).for_each(f),
-            Members::Some(lanes, _) => {
+            Members::Some(lanes, _) | Members::Masked(lanes, _) => {
                 for &l in lanes {
                     f(l)
                 }
@@ -194,6 +208,13 @@ impl Members<'_> {
                     }
                 }
             }
+            Members::Masked(_, mask) => {
+                for r in 0..rows {
+                    let (xs, ys) = (&regs[(a + r) * N..][..N], &regs[(b + r) * N..][..N]);
+                    let words: [u32; N] = std::array::from_fn(|i| f(xs[i], ys[i]));
+                    keep_members(&mut regs[(dst + r) * N..][..N], &words, mask);
+                }
+            }
         }
     }
 
@@ -219,6 +240,13 @@ impl Members<'_> {
                     for &l in lanes {
                         regs[(dst + r) * width + l] = f(regs[(src + r) * width + l]);
                     }
+                }
+            }
+            Members::Masked(_, mask) => {
+                for r in 0..rows {
+                    let xs = &regs[(src + r) * N..][..N];
+                    let words: [u32; N] = std::array::from_fn(|i| f(xs[i]));
+                    keep_members(&mut regs[(dst + r) * N..][..N], &words, mask);
                 }
             }
         }
@@ -259,6 +287,17 @@ impl Members<'_> {
                     }
                 }
             }
+            Members::Masked(_, mask) => {
+                for r in 0..rows {
+                    let (cs, xs, ys) =
+                        (&regs[(cond + r) * N..][..N], &regs[(accept + r) * N..][..N], &regs[(reject + r) * N..][..N]);
+                    let words: [u32; N] = std::array::from_fn(|i| {
+                        let m = 0u32.wrapping_sub(u32::from(cs[i] != 0));
+                        (xs[i] & m) | (ys[i] & !m)
+                    });
+                    keep_members(&mut regs[(dst + r) * N..][..N], &words, mask);
+                }
+            }
         }
     }
 
@@ -296,6 +335,13 @@ impl Members<'_> {
                     }
                 }
             }
+            Members::Masked(_, mask) => {
+                for i in 0..len {
+                    let r = if dst <= src { i } else { len - 1 - i };
+                    let words: [u32; N] = std::array::from_fn(|k| regs[(src + r) * N + k]);
+                    keep_members(&mut regs[(dst + r) * N..][..N], &words, mask);
+                }
+            }
         }
     }
 
@@ -317,6 +363,7 @@ impl Members<'_> {
                     }
                 }
             }
+            Members::Masked(lanes, _) => Members::Some(lanes, N).fill(regs, dst, len, value),
         }
     }
 }

@@ -260,6 +260,47 @@ fn inlined_callees_registers_serve_later_values_without_clobbering() {
     assert_eq!(got, register_reuse_reference(&inputs));
 }
 
+/// A struct with padding (`n` starts at byte 16) built after an inlined callee that ran
+/// in some invocations only: its registers may be the callee's, reused, and a store
+/// writes the padding words too. They must be zeros, as GPUs leave a fresh buffer's
+/// padding, not what the registers last held.
+const PADDING: &str = r#"
+struct Hit { t: f32, n: vec3<f32> }
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<Hit>;
+
+fn scratch_sum(x: f32) -> f32 {
+    var tmp: array<f32, 16>;
+    for (var i = 0; i < 16; i++) {
+        tmp[i] = x * f32(i) + 1.0;
+    }
+    return tmp[5] + tmp[15];
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let x = input[id.x];
+    var t = 0.0;
+    if x % 3u == 0u {
+        t = scratch_sum(f32(x));
+    }
+    output[id.x] = Hit(t, vec3<f32>(f32(id.x), 2.0, 3.0));
+}
+"#;
+
+#[test]
+fn padding_of_stored_structs_is_zero() {
+    let kernel = Kernel::from_wgsl("padding.wgsl", PADDING.into(), "main", false).unwrap();
+    let inputs: Vec<u32> = (0..128u32).map(|i| i.wrapping_mul(2_654_435_761) >> 7).collect();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &inputs, 128 * 8, 2);
+    for (i, (hit, &x)) in got.chunks(8).zip(&inputs).enumerate() {
+        let t = if x % 3 == 0 { (x as f32 * 5.0 + 1.0) + (x as f32 * 15.0 + 1.0) } else { 0.0 };
+        let want = [t.to_bits(), 0, 0, 0, (i as f32).to_bits(), 2.0f32.to_bits(), 3.0f32.to_bits(), 0];
+        assert_eq!(hit, want, "invocation {i} (x = {x})");
+    }
+}
+
 /// Chains of functions deeper than the interpreter inlines (each function's code
 /// inlines 8 levels of callees, so `main` → `l8` → `l16` are real calls, and from the
 /// `l3` branch `main` → `l11` → `l19`): entered from divergent branches at two places,

@@ -62,6 +62,23 @@ impl Compiler<'_> {
                 match compose_offsets(module, self.ty(scope, handle), &lens) {
                     Ok(offsets) => {
                         let dst = self.reg(scope, handle);
+                        // Padding between members is zeroed, not left as whatever the
+                        // registers last held (they may be another value's, reused): a
+                        // store writes a value's padding words too.
+                        let mut covered = vec![false; len as usize];
+                        for (&part, &at) in lens.iter().zip(&offsets) {
+                            for word in covered.iter_mut().skip(at as usize).take(part as usize) {
+                                *word = true;
+                            }
+                        }
+                        let mut word = 0;
+                        while word < covered.len() {
+                            let gap = covered[word..].iter().take_while(|&&c| !c).count();
+                            if gap > 0 {
+                                self.push(Insn::Zero { dst: dst + word as Reg, len: gap as u32 });
+                            }
+                            word += gap + covered[word + gap..].iter().take_while(|&&c| c).count();
+                        }
                         for ((src, part), at) in parts.into_iter().zip(offsets) {
                             self.copy(dst + at, src, part.min(len.saturating_sub(at)));
                         }
@@ -407,6 +424,9 @@ impl Compiler<'_> {
                     None => {
                         let dst = self.reg(scope, handle);
                         self.copy(dst, src, n.min(len));
+                        if n < len {
+                            self.push(Insn::Zero { dst: dst + n, len: len - n });
+                        }
                     }
                     Some(4) | Some(1) => {
                         let dst = self.reg(scope, handle);

@@ -183,21 +183,30 @@ impl Members<'_> {
         match self {
             Members::All(width) => chunks!(rows * width, |start, n| {
                 let (d, x, y) = (dst * width + start, a * width + start, b * width + start);
-                if d != x && d != y && x != y {
-                    let [out, xs, ys] = regs.get_disjoint_mut([d..d + n, x..x + n, y..y + n]).expect("distinct rows");
+                // Rows of distinct registers are `n` or more words apart: chunks of them
+                // never overlap in part (checked, not assumed: see the last branch).
+                let apart = |p: usize, q: usize| p.abs_diff(q) >= n;
+                if apart(d, x) && apart(d, y) && apart(x, y) {
+                    let [out, xs, ys] = regs.get_disjoint_mut([d..d + n, x..x + n, y..y + n]).expect("rows apart");
                     for i in 0..n {
                         out[i] = f(xs[i], ys[i]);
                     }
-                } else if d != x && x == y {
-                    let [out, xs] = regs.get_disjoint_mut([d..d + n, x..x + n]).expect("distinct rows");
+                } else if apart(d, x) && x == y {
+                    let [out, xs] = regs.get_disjoint_mut([d..d + n, x..x + n]).expect("rows apart");
                     for i in 0..n {
                         out[i] = f(xs[i], xs[i]);
                     }
-                } else {
+                } else if [(d, x), (d, y), (x, y)].iter().all(|&(p, q)| p == q || apart(p, q)) {
                     // The destination is an operand (not compiled today): through copies.
                     let (xs, ys) = (row::<N>(regs, x, n), row::<N>(regs, y, n));
                     for (i, o) in regs[d..d + n].iter_mut().enumerate() {
                         *o = f(xs[i], ys[i]);
+                    }
+                } else {
+                    // Overlapping in part (never compiled): word by word in order, as one
+                    // invocation at a time would.
+                    for i in 0..n {
+                        regs[d + i] = f(regs[x + i], regs[y + i]);
                     }
                 }
             }),
@@ -224,14 +233,19 @@ impl Members<'_> {
         match self {
             Members::All(width) => chunks!(rows * width, |start, n| {
                 let (d, x) = (dst * width + start, src * width + start);
-                if d != x {
-                    let [out, xs] = regs.get_disjoint_mut([d..d + n, x..x + n]).expect("distinct rows");
+                if d.abs_diff(x) >= n {
+                    let [out, xs] = regs.get_disjoint_mut([d..d + n, x..x + n]).expect("rows apart");
                     for i in 0..n {
                         out[i] = f(xs[i]);
                     }
-                } else {
+                } else if d == x {
                     for o in &mut regs[d..d + n] {
                         *o = f(*o);
+                    }
+                } else {
+                    // Overlapping in part (never compiled): word by word in order.
+                    for i in 0..n {
+                        regs[d + i] = f(regs[x + i]);
                     }
                 }
             }),
@@ -271,11 +285,19 @@ impl Members<'_> {
                         let mask = 0u32.wrapping_sub(u32::from(cs[i] != 0));
                         out[i] = (xs[i] & mask) | (ys[i] & !mask);
                     }
-                } else {
+                } else if [(d, c), (d, x), (d, y), (c, x), (c, y), (x, y)]
+                    .iter()
+                    .all(|&(p, q)| p == q || p.abs_diff(q) >= n)
+                {
                     // Rows repeated (`select(x, x, c)`, ...): through copies.
                     let (cs, xs, ys) = (row::<N>(regs, c, n), row::<N>(regs, x, n), row::<N>(regs, y, n));
                     for (i, o) in regs[d..d + n].iter_mut().enumerate() {
                         *o = if cs[i] != 0 { xs[i] } else { ys[i] };
+                    }
+                } else {
+                    // Overlapping in part (never compiled): word by word in order.
+                    for i in 0..n {
+                        regs[d + i] = if regs[c + i] != 0 { regs[x + i] } else { regs[y + i] };
                     }
                 }
             }),

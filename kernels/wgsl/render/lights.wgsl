@@ -57,45 +57,50 @@ fn direct_light(
     let u_choice = random();
     let u = random2();
     let weigh_against_bsdf = (params.flags & FLAG_HIT_LIGHTS) != 0u;
+    // The branches only choose the light sample; the BSDF and the shadow ray are
+    // evaluated once after them, so that a kernel holds one copy of each (a driver
+    // inlines every call site).
+    var direction: vec3<f32>;
+    var pdf: f32;
+    var emitted: vec3<f32>;
+    var shadow: Ray;
     if u_choice < params.environment_probability {
-        let direction = sample_environment(u);
-        let pdf = environment_light_pdf(direction);
-        let wi = to_local(frame, direction);
-        let f = bsdf_eval(material, albedo, wo, wi);
-        if pdf <= 0.0 || all(f == vec3<f32>(0.0)) || !unoccluded(position, normal, direction, lane) {
+        direction = sample_environment(u);
+        pdf = environment_light_pdf(direction);
+        if pdf <= 0.0 {
             return vec3<f32>(0.0);
         }
-        var weight = 1.0;
-        if weigh_against_bsdf {
-            weight = mis_power(pdf, bsdf_pdf(material, wo, wi));
+        emitted = environment_radiance(direction);
+        shadow = shadow_ray_along(position, normal, direction);
+    } else {
+        if params.light_count == 0u {
+            return vec3<f32>(0.0);
         }
-        return f * environment_radiance(direction) * (weight / pdf);
-    }
-    if params.light_count == 0u {
-        return vec3<f32>(0.0);
-    }
-    let light = find_light(random());
-    let entry = lights[light];
-    let tri = triangles[entry.triangle];
-    let su = sqrt(u.x);
-    let point = (1.0 - su) * tri.v0 + (u.y * su) * tri.v1 + (su - u.y * su) * tri.v2;
-    let light_normal = normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
-    let to_light = point - position;
-    let distance = length(to_light);
-    let direction = to_light / distance;
-    let cos_light = -dot(light_normal, direction);
-    if cos_light <= 0.0 || distance <= 0.0 {
-        return vec3<f32>(0.0);
+        let light = find_light(random());
+        let entry = lights[light];
+        let tri = triangles[entry.triangle];
+        let su = sqrt(u.x);
+        let point = (1.0 - su) * tri.v0 + (u.y * su) * tri.v1 + (su - u.y * su) * tri.v2;
+        let light_normal = normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
+        let to_light = point - position;
+        let distance = length(to_light);
+        direction = to_light / distance;
+        let cos_light = -dot(light_normal, direction);
+        if cos_light <= 0.0 || distance <= 0.0 {
+            return vec3<f32>(0.0);
+        }
+        pdf = area_light_pdf(light, distance, cos_light);
+        emitted = entry.radiance;
+        shadow = shadow_ray_to(position, normal, point);
     }
     let wi = to_local(frame, direction);
     let f = bsdf_eval(material, albedo, wo, wi);
-    if all(f == vec3<f32>(0.0)) || !visible(position, normal, point, lane) {
+    if all(f == vec3<f32>(0.0)) || !ray_unblocked(shadow, lane) {
         return vec3<f32>(0.0);
     }
-    let pdf = area_light_pdf(light, distance, cos_light);
     var weight = 1.0;
     if weigh_against_bsdf {
         weight = mis_power(pdf, bsdf_pdf(material, wo, wi));
     }
-    return f * entry.radiance * (weight / pdf);
+    return f * emitted * (weight / pdf);
 }

@@ -18,76 +18,7 @@ fn trace_path(camera: Ray, lane: u32) -> PathSample {
 // a BSDF sample of density `start_pdf` (`start_specular` for a specular one), estimated
 // by continuing the path to params.max_depth segments in all.
 fn trace_path_from(start: Ray, first_depth: u32, start_pdf: f32, start_specular: bool, lane: u32) -> PathSample {
-    let sample_lights = (params.flags & FLAG_SAMPLE_LIGHTS) != 0u;
-    let hit_lights = (params.flags & FLAG_HIT_LIGHTS) != 0u;
-    var ray = start;
-    var throughput = vec3<f32>(1.0);
-    var radiance = vec3<f32>(0.0);
-    // Density of the BSDF sample that made `ray`, and whether it was specular.
-    var previous_pdf = start_pdf;
-    var previous_specular = start_specular;
-    for (var depth = first_depth; depth <= params.max_depth; depth++) {
-        let hit = traverse(ray, lane, false);
-        if hit.primitive == STACK_OVERFLOW {
-            return PathSample(vec3<f32>(0.0), true);
-        }
-        let counts_emission = hit_lights || previous_specular || !sample_lights;
-        if hit.primitive == MISS {
-            if params.env_width > 0u && counts_emission {
-                var weight = 1.0;
-                if sample_lights && !previous_specular {
-                    weight = mis_power(previous_pdf, environment_light_pdf(ray.direction));
-                }
-                radiance += throughput * environment_radiance(ray.direction) * weight;
-            }
-            break;
-        }
-        let surface = surface_at(hit);
-        let wo_world = -ray.direction;
-        let cos_out = dot(surface.normal, wo_world);
-        if surface.light != NO_LIGHT && cos_out > 0.0 && counts_emission {
-            var weight = 1.0;
-            if sample_lights && !previous_specular {
-                weight = mis_power(previous_pdf, area_light_pdf(surface.light, hit.t, cos_out));
-            }
-            radiance += throughput * lights[surface.light].radiance * weight;
-        }
-        if depth == params.max_depth {
-            break;
-        }
-        let material = materials[surface.material];
-        var shading_normal = surface.normal;
-        if material.kind != MATERIAL_DIELECTRIC && cos_out < 0.0 {
-            if material.two_sided == 0u {
-                break;
-            }
-            shading_normal = -shading_normal;
-        }
-        let frame = make_frame(shading_normal);
-        let wo = to_local(frame, wo_world);
-        let albedo = albedo_at(material, surface.uv);
-        if sample_lights && !is_specular(material) {
-            radiance += throughput * direct_light(surface.position, surface.normal, frame, material, albedo, wo, lane);
-        }
-        let u = random2();
-        let sample = bsdf_sample(material, albedo, wo, u, random());
-        if all(sample.weight == vec3<f32>(0.0)) {
-            break;
-        }
-        throughput *= sample.weight;
-        previous_pdf = sample.pdf;
-        previous_specular = sample.specular;
-        let direction = normalize(to_world(frame, sample.wi));
-        ray = spawn_ray(surface.position, surface.normal, direction, INFINITY);
-        if (params.flags & FLAG_RUSSIAN_ROULETTE) != 0u && depth >= params.rr_depth {
-            let survive = min(max(throughput.x, max(throughput.y, throughput.z)), 0.95);
-            if random() >= survive {
-                break;
-            }
-            throughput /= survive;
-        }
-    }
-    return PathSample(radiance, false);
+    return path_from(start, first_depth, start_pdf, start_specular, false, PathVertex(), lane);
 }
 
 // The radiance leaving `surface` (hit by path segment number `depth`) towards
@@ -118,22 +49,155 @@ fn scatter_at(
     depth: u32,
     lane: u32,
 ) -> PathSample {
-    if depth >= params.max_depth {
+    let vertex = PathVertex(position, normal, material, albedo, wo_world);
+    return path_from(Ray(), depth, 0.0, false, true, vertex, lane);
+}
+
+// A scattering vertex found before path_from starts (scatter_at's arguments).
+struct PathVertex {
+    position: vec3<f32>,
+    normal: vec3<f32>,
+    material: Material,
+    albedo: vec3<f32>,
+    wo_world: vec3<f32>,
+}
+
+// The one path loop behind trace_path_from and scatter_at. A driver inlines every call
+// site, and the loop (with its traversal, next-event estimation and BSDF sampling) is
+// most of every kernel that traces paths: a kernel that reaches both entry points through
+// one call holds one copy of it (BENCHMARKS "First run on a fresh machine").
+//
+// With `at_vertex` the path starts at `vertex` (segment number `depth`): its emission is
+// left out, and its own part (next-event estimation there) is kept apart from what the
+// rest of the path brings back, which is weighted by the vertex's BSDF sample at the end,
+// so that the sum is the one scatter_at always computed; no Russian roulette there.
+// Otherwise the path starts by tracing `start`, as trace_path_from describes.
+fn path_from(
+    start: Ray,
+    first_depth: u32,
+    start_pdf: f32,
+    start_specular: bool,
+    at_vertex: bool,
+    vertex: PathVertex,
+    lane: u32,
+) -> PathSample {
+    let sample_lights = (params.flags & FLAG_SAMPLE_LIGHTS) != 0u;
+    let hit_lights = (params.flags & FLAG_HIT_LIGHTS) != 0u;
+    if at_vertex && first_depth >= params.max_depth {
         return PathSample(vec3<f32>(0.0), false);
     }
-    let frame = make_frame(normal);
-    let wo = to_local(frame, wo_world);
+    var ray = start;
+    var throughput = vec3<f32>(1.0);
     var radiance = vec3<f32>(0.0);
-    if (params.flags & FLAG_SAMPLE_LIGHTS) != 0u && !is_specular(material) {
-        radiance = direct_light(position, normal, frame, material, albedo, wo, lane);
+    // Density of the BSDF sample that made `ray`, and whether it was specular.
+    var previous_pdf = start_pdf;
+    var previous_specular = start_specular;
+    // The starting vertex's own part and BSDF weight, while it is to be (or was) scattered
+    // at; the loop then estimates the rest of the path from throughput 1.
+    var at_start_vertex = at_vertex;
+    var vertex_radiance = vec3<f32>(0.0);
+    var vertex_weight = vec3<f32>(0.0);
+    for (var depth = first_depth; depth <= params.max_depth; depth++) {
+        var position: vec3<f32>;
+        // The geometric normal that ray offsets and shadow rays use, and the one the BSDF
+        // frame is built on.
+        var offset_normal: vec3<f32>;
+        var shading_normal: vec3<f32>;
+        var material: Material;
+        var albedo: vec3<f32>;
+        var wo_world: vec3<f32>;
+        if at_start_vertex {
+            position = vertex.position;
+            offset_normal = vertex.normal;
+            shading_normal = vertex.normal;
+            material = vertex.material;
+            albedo = vertex.albedo;
+            wo_world = vertex.wo_world;
+        } else {
+            let hit = traverse(ray, lane, false);
+            if hit.primitive == STACK_OVERFLOW {
+                return finish_path(at_vertex, vertex_radiance, vertex_weight, PathSample(vec3<f32>(0.0), true));
+            }
+            let counts_emission = hit_lights || previous_specular || !sample_lights;
+            if hit.primitive == MISS {
+                if params.env_width > 0u && counts_emission {
+                    var weight = 1.0;
+                    if sample_lights && !previous_specular {
+                        weight = mis_power(previous_pdf, environment_light_pdf(ray.direction));
+                    }
+                    radiance += throughput * environment_radiance(ray.direction) * weight;
+                }
+                break;
+            }
+            let surface = surface_at(hit);
+            wo_world = -ray.direction;
+            let cos_out = dot(surface.normal, wo_world);
+            if surface.light != NO_LIGHT && cos_out > 0.0 && counts_emission {
+                var weight = 1.0;
+                if sample_lights && !previous_specular {
+                    weight = mis_power(previous_pdf, area_light_pdf(surface.light, hit.t, cos_out));
+                }
+                radiance += throughput * lights[surface.light].radiance * weight;
+            }
+            if depth == params.max_depth {
+                break;
+            }
+            material = materials[surface.material];
+            shading_normal = surface.normal;
+            if material.kind != MATERIAL_DIELECTRIC && cos_out < 0.0 {
+                if material.two_sided == 0u {
+                    break;
+                }
+                shading_normal = -shading_normal;
+            }
+            position = surface.position;
+            offset_normal = surface.normal;
+            albedo = albedo_at(material, surface.uv);
+        }
+        let frame = make_frame(shading_normal);
+        let wo = to_local(frame, wo_world);
+        if sample_lights && !is_specular(material) {
+            let direct = direct_light(position, offset_normal, frame, material, albedo, wo, lane);
+            if at_start_vertex {
+                vertex_radiance = direct;
+            } else {
+                radiance += throughput * direct;
+            }
+        }
+        let u = random2();
+        let sample = bsdf_sample(material, albedo, wo, u, random());
+        if all(sample.weight == vec3<f32>(0.0)) {
+            if at_start_vertex {
+                return PathSample(vertex_radiance, false);
+            }
+            break;
+        }
+        previous_pdf = sample.pdf;
+        previous_specular = sample.specular;
+        let direction = normalize(to_world(frame, sample.wi));
+        ray = spawn_ray(position, offset_normal, direction, INFINITY);
+        if at_start_vertex {
+            vertex_weight = sample.weight;
+            at_start_vertex = false;
+            continue;
+        }
+        throughput *= sample.weight;
+        if (params.flags & FLAG_RUSSIAN_ROULETTE) != 0u && depth >= params.rr_depth {
+            let survive = min(max(throughput.x, max(throughput.y, throughput.z)), 0.95);
+            if random() >= survive {
+                break;
+            }
+            throughput /= survive;
+        }
     }
-    let u = random2();
-    let sample = bsdf_sample(material, albedo, wo, u, random());
-    if all(sample.weight == vec3<f32>(0.0)) {
-        return PathSample(radiance, false);
+    return finish_path(at_vertex, vertex_radiance, vertex_weight, PathSample(radiance, false));
+}
+
+// What path_from returns once the path ends with `rest`: that alone when it started with
+// a ray, else the starting vertex's own part plus its BSDF weight times the rest.
+fn finish_path(at_vertex: bool, vertex_radiance: vec3<f32>, vertex_weight: vec3<f32>, rest: PathSample) -> PathSample {
+    if at_vertex {
+        return PathSample(vertex_radiance + vertex_weight * rest.radiance, rest.invalid);
     }
-    let direction = normalize(to_world(frame, sample.wi));
-    let ray = spawn_ray(position, normal, direction, INFINITY);
-    let rest = trace_path_from(ray, depth + 1u, sample.pdf, sample.specular, lane);
-    return PathSample(radiance + sample.weight * rest.radiance, rest.invalid);
+    return rest;
 }

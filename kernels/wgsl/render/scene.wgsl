@@ -192,28 +192,41 @@ fn spawn_ray(position: vec3<f32>, normal: vec3<f32>, direction: vec3<f32>, tmax:
     return Ray(origin, 0.0, direction, tmax);
 }
 
-// True when nothing blocks the segment from `position` (on a surface with `normal`) to
+// The shadow ray of the segment from `position` (on a surface with `normal`) to
 // `target_point`, which lies on a light. The segment starts at the offset origin of
 // spawn_ray and stops the same scale-relative epsilon short of the target, so neither
-// the surface nor the light's own triangle can occlude it.
-fn visible(position: vec3<f32>, normal: vec3<f32>, target_point: vec3<f32>, lane: u32) -> bool {
+// the surface nor the light's own triangle can occlude it; tmax <= 0 when nothing is
+// left to test (ray_unblocked then says so without a traversal).
+fn shadow_ray_to(position: vec3<f32>, normal: vec3<f32>, target_point: vec3<f32>) -> Ray {
     let start = spawn_ray(position, normal, target_point - position, 0.0).origin;
     let to_target = target_point - start;
     let distance = length(to_target);
     let extent = max(max(abs(target_point.x), abs(target_point.y)), max(abs(target_point.z), 1.0));
     let tmax = distance - params.ray_epsilon * extent;
     if tmax <= 0.0 {
+        return Ray(start, 0.0, to_target, tmax);
+    }
+    return Ray(start, 0.0, to_target / distance, tmax);
+}
+
+// The shadow ray from `position` towards the environment along `direction`.
+fn shadow_ray_along(position: vec3<f32>, normal: vec3<f32>, direction: vec3<f32>) -> Ray {
+    return spawn_ray(position, normal, direction, INFINITY);
+}
+
+// True when nothing blocks shadow ray `ray` (shadow_ray_to, shadow_ray_along). Every
+// shadow test of a kernel goes through one call of this, its branches only choosing the
+// ray: a driver inlines each call site's BVH traversal, and the traversals were most of
+// what a CPU driver took minutes to compile (BENCHMARKS "First run on a fresh machine").
+fn ray_unblocked(ray: Ray, lane: u32) -> bool {
+    if ray.tmax <= 0.0 {
         return true;
     }
-    let ray = Ray(start, 0.0, to_target / distance, tmax);
     return traverse(ray, lane, true).primitive == MISS;
 }
 
-// True when nothing blocks the ray from `position` towards the environment.
-fn unoccluded(position: vec3<f32>, normal: vec3<f32>, direction: vec3<f32>, lane: u32) -> bool {
-    return traverse(spawn_ray(position, normal, direction, INFINITY), lane, true).primitive == MISS;
-}
-
+fn visible(position: vec3<f32>, normal: vec3<f32>, target_point: vec3<f32>, lane: u32) -> bool { return ray_unblocked(shadow_ray_to(position, normal, target_point), lane); }
+fn unoccluded(position: vec3<f32>, normal: vec3<f32>, direction: vec3<f32>, lane: u32) -> bool { return ray_unblocked(shadow_ray_along(position, normal, direction), lane); }
 // The camera ray through film position `film` (pixels, (0, 0) the top-left corner),
 // starting on the near plane (CONVENTIONS.md "Camera").
 fn camera_ray(film: vec2<f32>) -> Ray {

@@ -335,8 +335,9 @@ fn candidate_visible(p: Primary, x: PathCandidate, lane: u32) -> bool {
     if x.kind == KIND_REPLAY {
         return true;
     }
+    var ray = shadow_ray_to(p.position, p.normal, x.position);
     if x.kind == KIND_ENVIRONMENT {
-        return unoccluded(p.position, p.normal, x.position, lane);
+        ray = shadow_ray_along(p.position, p.normal, x.position);
     }
-    return visible(p.position, p.normal, x.position, lane);
+    return ray_unblocked(ray, lane);
 }

@@ -225,8 +225,6 @@ fn ray_unblocked(ray: Ray, lane: u32) -> bool {
     return traverse(ray, lane, true).primitive == MISS;
 }
 
-fn visible(position: vec3<f32>, normal: vec3<f32>, target_point: vec3<f32>, lane: u32) -> bool { return ray_unblocked(shadow_ray_to(position, normal, target_point), lane); }
-fn unoccluded(position: vec3<f32>, normal: vec3<f32>, direction: vec3<f32>, lane: u32) -> bool { return ray_unblocked(shadow_ray_along(position, normal, direction), lane); }
 // The camera ray through film position `film` (pixels, (0, 0) the top-left corner),
 // starting on the near plane (CONVENTIONS.md "Camera").
 fn camera_ray(film: vec2<f32>) -> Ray {

@@ -55,12 +55,13 @@ fn light_area_density(light: u32) -> f32 {
 }
 
 // (p̂, RIS weight p̂ / (p_bsdf + p_light)) of `candidate` at `primary`, given the
-// density with which next-event estimation draws it; zero for no candidate.
-fn ris_weight(primary: Primary, candidate: PathCandidate, light_density: f32, lane: u32) -> vec2<f32> {
+// density with which next-event estimation draws it; zero for no candidate. The
+// candidate is a reconnection (never a replay, which draw_candidate does not draw).
+fn ris_weight(primary: Primary, candidate: PathCandidate, light_density: f32) -> vec2<f32> {
     if candidate.kind == KIND_NONE {
         return vec2<f32>(0.0);
     }
-    let target_value = target_function(primary, candidate, lane);
+    let target_value = luminance(reconnection_integrand(primary, candidate));
     let density = bsdf_density(primary, candidate) + light_density;
     if !(density > 0.0) {
         return vec2<f32>(target_value, 0.0);
@@ -96,6 +97,12 @@ struct Drawn {
 // flipped), drawn by BSDF sampling and next-event estimation and chosen by RIS. The
 // vertex after it is path segment primary.segment + 1: the rest of the path there is
 // estimated with the segments the path tracer would have left.
+//
+// Both techniques run in one loop whose branches only choose rays and vertices: its
+// traversal, the path traced on from the vertex found and the RIS weight are each one
+// call, so that a driver, which inlines every call site, compiles each once (BENCHMARKS
+// "First run on a fresh machine"). The random numbers are drawn in the order of the two
+// techniques one after the other.
 fn draw_candidate(primary: Primary, surface: Surface, lane: u32) -> Drawn {
     let material = materials[primary.material];
     let albedo = primary.albedo;
@@ -104,73 +111,141 @@ fn draw_candidate(primary: Primary, surface: Surface, lane: u32) -> Drawn {
     var invalid = false;
     let frame = make_frame(normal);
     let wo = to_local(frame, primary.wo);
-    // Technique 1, BSDF sampling: the next vertex of the path.
+    // Technique 0, BSDF sampling: the next vertex of the path. Technique 1, next-event
+    // estimation: a point on a light or an environment direction, drawn as
+    // render/lights.wgsl draws them. Each gives its candidate and the density with which
+    // next-event estimation draws that candidate (for the balance heuristic).
     var bsdf_candidate = no_candidate();
     var bsdf_light_density = 0.0;
-    let sample = bsdf_sample(material, albedo, wo, random2(), random());
-    if any(sample.weight != vec3<f32>(0.0)) && sample.pdf > 0.0 {
-        let direction = normalize(to_world(frame, sample.wi));
-        let next = traverse(spawn_ray(surface.position, surface.normal, direction, INFINITY), lane, false);
-        if next.primitive == STACK_OVERFLOW {
-            invalid = true;
-        } else if next.primitive == MISS {
-            if params.env_width > 0u {
-                bsdf_candidate = PathCandidate(direction, KIND_ENVIRONMENT, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), 0.0);
-                bsdf_light_density = environment_light_pdf(direction);
-            }
-        } else {
-            let vertex = surface_at(next);
-            let rest = scatter_from(vertex, -direction, next_segment, lane);
-            invalid = invalid || rest.invalid;
-            bsdf_candidate = vertex_candidate(vertex, surface.position, rest.radiance);
-            if vertex.light != NO_LIGHT {
-                bsdf_light_density = light_area_density(vertex.light);
-            }
-        }
-    }
-    // Technique 2, next-event estimation: a point on a light or an environment
-    // direction, drawn as render/lights.wgsl draws them.
     var light_candidate = no_candidate();
     var light_density = 0.0;
-    let u_choice = random();
-    let u_light = random2();
-    if u_choice < params.environment_probability {
-        let direction = sample_environment(u_light);
-        light_density = environment_light_pdf(direction);
-        if light_density > 0.0 && unoccluded(surface.position, normal, direction, lane) {
-            light_candidate = PathCandidate(direction, KIND_ENVIRONMENT, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), 0.0);
+    for (var technique = 0u; technique < 2u; technique++) {
+        // The technique's ray (none: nothing to trace), whether only its being unblocked
+        // matters (a shadow ray), and what it found.
+        var ray = Ray();
+        var traced = false;
+        var shadow = false;
+        var direction = vec3<f32>(0.0);
+        var candidate = no_candidate();
+        var density = 0.0;
+        // The light point next-event estimation drew (unless it drew the environment).
+        var light_surface = Surface();
+        var to_environment = false;
+        if technique == 0u {
+            let sample = bsdf_sample(material, albedo, wo, random2(), random());
+            if any(sample.weight != vec3<f32>(0.0)) && sample.pdf > 0.0 {
+                direction = normalize(to_world(frame, sample.wi));
+                ray = spawn_ray(surface.position, surface.normal, direction, INFINITY);
+                traced = true;
+            }
+        } else {
+            let u_choice = random();
+            let u_light = random2();
+            if u_choice < params.environment_probability {
+                direction = sample_environment(u_light);
+                density = environment_light_pdf(direction);
+                to_environment = true;
+                if density > 0.0 {
+                    ray = shadow_ray_along(surface.position, normal, direction);
+                    traced = true;
+                    shadow = true;
+                }
+            } else if params.light_count > 0u {
+                let light = find_light(random());
+                let entry = lights[light];
+                let tri = triangles[entry.triangle];
+                let su = sqrt(u_light.x);
+                let b1 = u_light.y * su;
+                let b2 = su - u_light.y * su;
+                let point = (1.0 - su) * tri.v0 + b1 * tri.v1 + b2 * tri.v2;
+                let info = triangle_info[entry.triangle];
+                var uv = vec2<f32>(b1, b2);
+                if info.has_uv != 0u {
+                    uv = (1.0 - su) * info.uv0 + b1 * info.uv1 + b2 * info.uv2;
+                }
+                let light_normal = normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
+                light_surface = Surface(point, light_normal, uv, info.object_id, info.material, light);
+                density = light_area_density(light);
+                ray = shadow_ray_to(surface.position, normal, point);
+                traced = true;
+                shadow = true;
+            }
         }
-    } else if params.light_count > 0u {
-        let light = find_light(random());
-        let entry = lights[light];
-        let tri = triangles[entry.triangle];
-        let su = sqrt(u_light.x);
-        let b1 = u_light.y * su;
-        let b2 = su - u_light.y * su;
-        let point = (1.0 - su) * tri.v0 + b1 * tri.v1 + b2 * tri.v2;
-        let info = triangle_info[entry.triangle];
-        var uv = vec2<f32>(b1, b2);
-        if info.has_uv != 0u {
-            uv = (1.0 - su) * info.uv0 + b1 * info.uv1 + b2 * info.uv2;
+        var hit = Hit(0.0, 0.0, 0.0, MISS);
+        if traced && ray.tmax > 0.0 {
+            hit = traverse(ray, lane, shadow);
         }
-        let light_normal = normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
-        let light_surface = Surface(point, light_normal, uv, info.object_id, info.material, light);
-        light_density = light_area_density(light);
-        if visible(surface.position, normal, point, lane) {
-            // What the light reflects towards y (nothing for a black fixture).
+        // The vertex the technique found, the direction towards the primary from it, and
+        // whether the path is traced on from it (for the radiance it reflects).
+        var found = false;
+        var vertex = Surface();
+        var to_primary = vec3<f32>(0.0);
+        var scatters = false;
+        if traced && !shadow {
+            if hit.primitive == STACK_OVERFLOW {
+                invalid = true;
+            } else if hit.primitive == MISS {
+                if params.env_width > 0u {
+                    candidate = PathCandidate(direction, KIND_ENVIRONMENT, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), 0.0);
+                    density = environment_light_pdf(direction);
+                }
+            } else {
+                vertex = surface_at(hit);
+                to_primary = -direction;
+                found = true;
+                scatters = true;
+                if vertex.light != NO_LIGHT {
+                    density = light_area_density(vertex.light);
+                }
+            }
+        } else if traced && hit.primitive == MISS {
+            if to_environment {
+                candidate = PathCandidate(direction, KIND_ENVIRONMENT, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), 0.0);
+            } else {
+                vertex = light_surface;
+                to_primary = normalize(surface.position - vertex.position);
+                found = true;
+                // What the light reflects towards y (nothing for a black fixture).
+                let light_material = materials[vertex.material];
+                scatters = light_material.kind != MATERIAL_DIFFUSE
+                    || any(albedo_at(light_material, vertex.uv) != vec3<f32>(0.0));
+            }
+        }
+        if found {
             var reflected = vec3<f32>(0.0);
-            let light_material = materials[info.material];
-            if light_material.kind != MATERIAL_DIFFUSE || any(albedo_at(light_material, uv) != vec3<f32>(0.0)) {
-                let rest = scatter_from(light_surface, normalize(surface.position - point), next_segment, lane);
+            if scatters {
+                let rest = scatter_from(vertex, to_primary, next_segment, lane);
                 invalid = invalid || rest.invalid;
                 reflected = rest.radiance;
             }
-            light_candidate = vertex_candidate(light_surface, surface.position, reflected);
+            candidate = vertex_candidate(vertex, surface.position, reflected);
+        }
+        if technique == 0u {
+            bsdf_candidate = candidate;
+            bsdf_light_density = density;
+        } else {
+            light_candidate = candidate;
+            light_density = density;
         }
     }
-    // RIS over the two samples, balance heuristic: w = p̂ / (p_bsdf + p_light).
-    let bsdf_ris = ris_weight(primary, bsdf_candidate, bsdf_light_density, lane);
-    let light_ris = ris_weight(primary, light_candidate, light_density, lane);
+    // RIS over the two samples, balance heuristic: w = p̂ / (p_bsdf + p_light); neither
+    // sample is a replay, so the target is the reconnection's.
+    var bsdf_ris = vec2<f32>(0.0);
+    var light_ris = vec2<f32>(0.0);
+    for (var technique = 0u; technique < 2u; technique++) {
+        var candidate = bsdf_candidate;
+        var density = bsdf_light_density;
+        if technique == 1u {
+            candidate = light_candidate;
+            density = light_density;
+        }
+        let ris = ris_weight(primary, candidate, density);
+        if technique == 0u {
+            bsdf_ris = ris;
+        } else {
+            light_ris = ris;
+        }
+    }
     let total = bsdf_ris.y + light_ris.y;
     var candidate = no_candidate();
     if total > 0.0 && total < INFINITY {

@@ -260,6 +260,13 @@ fn integrand(p: Primary, x: PathCandidate, lane: u32) -> vec3<f32> {
     if replay_pixel {
         return replayed(p, x, lane);
     }
+    return reconnection_integrand(p, x);
+}
+
+// `integrand` for a candidate `x` that is no replay (of a pixel `p` that resamples and
+// does not replay): the reconnection's f(y1) cos (Le(x2) + Lr(x2)) |cos x2| / d², which
+// traces nothing.
+fn reconnection_integrand(p: Primary, x: PathCandidate) -> vec3<f32> {
     let t = towards(p, x);
     let direction = t.xyz;
     let material = materials[p.material];

@@ -127,20 +127,31 @@ fn pair_terms(p: Primary, current: Reservoir, s: u32, share: f32, lane: u32) -> 
         return terms;
     }
     terms.m = m_previous;
-    // The current sample's half: its target here is stored; there, evaluate it.
-    if target_current > 0.0 {
-        let there = target_at(previous_primary, current.sample, lane);
-        let m = m_current * target_current / (m_current * target_current + m_previous * there);
-        terms.current_part = share * m * target_current * current.weight;
-    }
-    // The previous sample shifted here.
-    if previous.target_value > 0.0 {
-        let colour = contribution_at(p, previous.sample, lane);
-        let here = luminance(colour);
-        if here > 0.0 {
-            let m = m_previous * previous.target_value / (m_current * here + m_previous * previous.target_value);
-            terms.weight = share * m * here * previous.weight;
-            terms.target_here = here;
+    // The two halves in one loop whose branches choose what to evaluate where, so that a
+    // driver compiles contribution_at (which may re-trace a replayed path) once: half 0
+    // the current sample there (its target here is stored), half 1 the previous sample
+    // shifted here.
+    for (var half = 0u; half < 2u; half++) {
+        var at = previous_primary;
+        var y = current.sample;
+        var wanted = target_current > 0.0;
+        if half == 1u {
+            at = p;
+            y = previous.sample;
+            wanted = previous.target_value > 0.0;
+        }
+        if !wanted {
+            continue;
+        }
+        let colour = contribution_at(at, y, lane);
+        let value = luminance(colour);
+        if half == 0u {
+            let m = m_current * target_current / (m_current * target_current + m_previous * value);
+            terms.current_part = share * m * target_current * current.weight;
+        } else if value > 0.0 {
+            let m = m_previous * previous.target_value / (m_current * value + m_previous * previous.target_value);
+            terms.weight = share * m * value * previous.weight;
+            terms.target_here = value;
             terms.colour_here = colour;
         }
     }
@@ -162,12 +173,7 @@ fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
     rng_seed(pixel, params.sample_index, params.seed ^ 0x7e3907u);
     let drawn = min(restir.temporal_candidates, MAX_SELECTED);
     let share = 1.0 / f32(1u + drawn);
-    // The pixel's own reprojected reservoir.
-    let own_source = temporal_sources[pixel];
-    let own = pair_terms(p, current, own_source, share, lane);
-    var weight_current = own.current_part;
-    var m_sum = own.m;
-    // The drawn ones: per slot resampling weight, target here, source pixel.
+    // The drawn previous reservoirs: per slot resampling weight, target here, source pixel.
     var numbers = SelectionNumbers(vec4<f32>(0.0), 0.0);
     if restir.method == METHOD_STRATA && drawn > 0u {
         numbers = selection_numbers(id.xy, params.sample_index, params.seed, restir.sampler, drawn, 1u);
@@ -181,9 +187,25 @@ fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
     // `array<vec3<f32>, 4>()` into an HLSL cast `(float3[4])0` that glslang's HLSL front
     // end rejects. MAX_SELECTED is 4.
     var colours = array<vec3<f32>, MAX_SELECTED>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
-    for (var slot = 0u; slot < drawn; slot++) {
-        let s = drawn_source(id.x, id.y, pixel, p, slot, positions);
+    // Pair 0 is the pixel's own reprojected reservoir, pairs 1 to `drawn` the drawn slots:
+    // one loop, so that pair_terms is compiled once.
+    let own_source = temporal_sources[pixel];
+    var own = PairTerms(0.0, 0.0, 0.0, 0.0, vec3<f32>(0.0));
+    var weight_current = 0.0;
+    var m_sum = 0.0;
+    for (var pair = 0u; pair <= drawn; pair++) {
+        var s = own_source;
+        if pair > 0u {
+            s = drawn_source(id.x, id.y, pixel, p, pair - 1u, positions);
+        }
         let terms = pair_terms(p, current, s, share, lane);
+        if pair == 0u {
+            own = terms;
+            weight_current = terms.current_part;
+            m_sum = terms.m;
+            continue;
+        }
+        let slot = pair - 1u;
         weight_current += terms.current_part;
         m_sum += terms.m;
         weights[slot] = terms.weight;

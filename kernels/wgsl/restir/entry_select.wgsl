@@ -122,29 +122,52 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
             }
             continue;
         }
-        // The canonical candidate's half: m_c = p̂_i / (p̂_i + p̂_j) at x_c, with p̂_j
-        // including the visibility from the neighbour's primary hit.
-        if target_c > 0.0 {
-            var target_neighbour_c = 0.0;
-            if shares && c_shareable && reconnectable(neighbour, c) {
-                target_neighbour_c = target_function(neighbour, c, lane);
-                if target_neighbour_c > 0.0 && !candidate_visible(neighbour, c, lane) {
-                    target_neighbour_c = 0.0;
-                }
+        // The pair's three evaluations in one loop whose branches choose what to evaluate
+        // where, so that a driver compiles the integrand (which may re-trace a replayed
+        // path) and the visibility test once:
+        // - step 0, the canonical candidate's half: p̂_j(x_c) at the neighbour, visibility
+        //   included, for m_c = p̂_i / (p̂_i + p̂_j) at x_c;
+        // - step 1, the neighbour's half: x_j reconnected here, f and p̂_i, visibility
+        //   included;
+        // - step 2, for its m_j = p̂_j / (p̂_i + p̂_j) at x_j: p̂_j(x_j) at the neighbour
+        //   (p̂_j(x_j) > 0 and visible wherever W_j > 0).
+        var target_neighbour_c = 0.0;
+        var colour = vec3<f32>(0.0);
+        var value = 0.0;
+        for (var step = 0u; step < 3u; step++) {
+            var at = neighbour;
+            var y = c;
+            var wanted = target_c > 0.0 && shares && c_shareable && reconnectable(neighbour, c);
+            if step == 1u {
+                at = p;
+                y = x;
+                wanted = shares && x.weight > 0.0 && reconnectable(p, x) && reconnectable(neighbour, x);
+            } else if step == 2u {
+                y = x;
+                wanted = value > 0.0;
             }
-            weight_c += target_c / (target_c + f32(k) * target_neighbour_c) * target_c * c.weight / f32(k);
-        }
-        // The neighbour's half: x_j reconnected here, m_j = p̂_j / (p̂_i + p̂_j) at x_j
-        // (p̂_j(x_j) > 0 and visible wherever W_j > 0).
-        if shares && x.weight > 0.0 && reconnectable(p, x) && reconnectable(neighbour, x) {
-            let colour = integrand(p, x, lane);
-            let value = luminance(colour);
-            if value > 0.0 && candidate_visible(p, x, lane) {
-                let there = target_function(neighbour, x, lane);
+            if !wanted {
+                continue;
+            }
+            let f = integrand(at, y, lane);
+            var target_value = luminance(f);
+            if step < 2u && target_value > 0.0 && !candidate_visible(at, y, lane) {
+                target_value = 0.0;
+            }
+            if step == 0u {
+                target_neighbour_c = target_value;
+            } else if step == 1u {
+                colour = f;
+                value = target_value;
+            } else {
+                let there = target_value;
                 weights[slot] = f32(k) * there / (value + f32(k) * there) * value * x.weight / f32(k);
                 targets[slot] = value;
                 colours[slot] = colour;
             }
+        }
+        if target_c > 0.0 {
+            weight_c += target_c / (target_c + f32(k) * target_neighbour_c) * target_c * c.weight / f32(k);
         }
     }
     // Pick one of {c, samples...} in proportion to its weight.

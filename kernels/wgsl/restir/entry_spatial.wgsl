@@ -78,6 +78,12 @@ fn restir_spatial(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_i
         target_c = canonical.target_value;
     }
     let c_shareable = target_c > 0.0 && reconnectable(p, c);
+    // f(y_c) here, for the pixel's own reservoir drawn again and for the expectation: one
+    // evaluation (a replayed candidate costs a traced path), compiled once.
+    var colour_c = vec3<f32>(0.0);
+    if target_c > 0.0 {
+        colour_c = integrand(p, c, lane);
+    }
     var weight_c = 0.0;
     var m_sum = 0.0;
     // Per slot: resampling weight, target p̂_i here, f here and the pixel it came from.
@@ -111,36 +117,50 @@ fn restir_spatial(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_i
                 weight_c += share * target_c * canonical.weight / f32(k);
                 weights[slot] = (1.0 - share) * target_c * canonical.weight / f32(k);
                 targets[slot] = target_c;
-                colours[slot] = integrand(p, c, lane);
+                colours[slot] = colour_c;
             } else {
                 weight_c += target_c * canonical.weight / f32(k);
             }
             continue;
         }
-        // The canonical half: p̂_j(y_c) at the neighbour's primary hit, visibility included.
-        if target_c > 0.0 {
-            var target_neighbour_c = 0.0;
-            if c_shareable && reconnectable(neighbour, c) {
-                target_neighbour_c = target_function(neighbour, c, lane);
-                if target_neighbour_c > 0.0 && !candidate_visible(neighbour, c, lane) {
-                    target_neighbour_c = 0.0;
-                }
-            }
-            let m = m_c * target_c / (m_c * target_c + f32(k) * m_j * target_neighbour_c);
-            weight_c += m * target_c * canonical.weight / f32(k);
-        }
-        // The neighbour's half: y_j reconnected here (p̂_j(y_j) is its stored target).
+        // The pair's two evaluations in one loop whose branches choose what to evaluate
+        // where, so that a driver compiles the integrand (which may re-trace a replayed
+        // path) and the visibility test once: step 0, the canonical half, p̂_j(y_c) at the
+        // neighbour's primary hit; step 1, the neighbour's half, y_j reconnected here
+        // (p̂_j(y_j) is its stored target); both with visibility included.
         let y = neighbour_reservoir.sample;
         let there = neighbour_reservoir.target_value;
-        if neighbour_reservoir.weight > 0.0 && there > 0.0 && reconnectable(p, y) && reconnectable(neighbour, y) {
-            let colour = integrand(p, y, lane);
-            let value = luminance(colour);
-            if value > 0.0 && candidate_visible(p, y, lane) {
+        var target_neighbour_c = 0.0;
+        for (var step = 0u; step < 2u; step++) {
+            var at = neighbour;
+            var candidate = c;
+            var wanted = c_shareable && reconnectable(neighbour, c);
+            if step == 1u {
+                at = p;
+                candidate = y;
+                wanted = neighbour_reservoir.weight > 0.0 && there > 0.0 && reconnectable(p, y)
+                    && reconnectable(neighbour, y);
+            }
+            if !wanted {
+                continue;
+            }
+            let colour = integrand(at, candidate, lane);
+            var value = luminance(colour);
+            if value > 0.0 && !candidate_visible(at, candidate, lane) {
+                value = 0.0;
+            }
+            if step == 0u {
+                target_neighbour_c = value;
+            } else if value > 0.0 {
                 let m = f32(k) * m_j * there / (m_c * value + f32(k) * m_j * there);
                 weights[slot] = m * value * neighbour_reservoir.weight / f32(k);
                 targets[slot] = value;
                 colours[slot] = colour;
             }
+        }
+        if target_c > 0.0 {
+            let m = m_c * target_c / (m_c * target_c + f32(k) * m_j * target_neighbour_c);
+            weight_c += m * target_c * canonical.weight / f32(k);
         }
     }
     var total = weight_c;
@@ -167,7 +187,7 @@ fn restir_spatial(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_i
     // The expectation over the choice: sum_i w_i f(y_i) / p̂_i(y_i), each f here.
     var expected = vec3<f32>(0.0);
     if weight_c > 0.0 && target_c > 0.0 {
-        expected += weight_c / target_c * integrand(p, c, lane);
+        expected += weight_c / target_c * colour_c;
     }
     for (var slot = 0u; slot < k; slot++) {
         if weights[slot] > 0.0 && targets[slot] > 0.0 {

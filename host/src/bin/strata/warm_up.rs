@@ -1,8 +1,10 @@
 //! `strata compare`'s warm-up: every kernel the methods use is built and run once at 8x8,
 //! with the run's settings, on two more devices while the reference renders. A CPU driver
-//! compiles each kernel at its first dispatch (lavapipe took 93 of a fresh machine's
-//! 144 s for the ReSTIR kernels, on one core), and its shader cache then serves the
-//! methods' own first frames (BENCHMARKS "First run on a fresh machine").
+//! compiles each kernel at its first dispatch (lavapipe compiles a variant for the uniform
+//! values it sees, on one core; the two threads took 16 and 20 s for the ReSTIR kernels
+//! once each heavy function had one call site per kernel, 41-45 s before), and its shader
+//! cache then serves the methods' own first frames (BENCHMARKS "First run on a fresh
+//! machine").
 //!
 //! The warm-up's devices are created and destroyed while no other thread uses Vulkan:
 //! Debian 12's validation layer (1.3.239) keeps its per-instance and per-device data in
@@ -34,21 +36,22 @@ pub struct WarmUp {
     finished: Arc<Barrier>,
 }
 
-/// The kernels of each warm-up thread: they compile side by side, the path tracer's
-/// candidates with the small passes on one device; the selection and the temporal merge,
-/// each as large, on the other. The temporal-first order's spatial pass (as large as the
-/// selection) goes with the candidates: measured faster there (BENCHMARKS).
+/// The kernels of each warm-up thread: they compile side by side, the candidates (the
+/// largest kernel, 23k inlined expressions) with the small passes on one device; the
+/// selection, the temporal merge and the spatial pass (11k each) on the other (measured:
+/// 20 s and 16 s on a fresh machine, BENCHMARKS).
 fn shares() -> [Vec<KernelId>; 2] {
     let histograms = [KernelId::BlockHistogram, KernelId::BlockHistogramSubgroup, KernelId::BlockHistogramRank];
     [
         [
             &[KernelId::RestirCandidates, KernelId::RestirTemporalKeys, KernelId::RestirShade][..],
             &histograms,
-            // The temporal-first order's passes (dispatched only in that order).
-            &[KernelId::RestirReservoirKeys, KernelId::RestirSpatial],
+            // The temporal-first order's small pass (dispatched only in that order).
+            &[KernelId::RestirReservoirKeys],
         ]
         .concat(),
-        vec![KernelId::RestirSelect, KernelId::RestirTemporal],
+        // The temporal-first order's spatial pass too.
+        vec![KernelId::RestirSelect, KernelId::RestirTemporal, KernelId::RestirSpatial],
     ]
 }
 

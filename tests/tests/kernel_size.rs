@@ -16,7 +16,7 @@ use strata_kernels::Registry;
 /// Most expressions a kernel may hold once its calls are inlined; kernels not named here
 /// get `DEFAULT_BUDGET`.
 const BUDGETS: &[(&str, usize)] = &[
-    ("restir_candidates", 24_500),
+    ("restir_candidates", 17_000),
     ("restir_select", 12_500),
     ("restir_spatial", 12_500),
     ("restir_temporal", 12_500),
@@ -80,6 +80,8 @@ fn every_kernel_inlines_within_its_budget() {
         let mut copies = HashMap::new();
         let size = inlined_size(&kernel.module, &entry.function, &mut copies);
         let budget = BUDGETS.iter().find(|(name, _)| *name == kernel.name()).map_or(DEFAULT_BUDGET, |b| b.1);
+        // Shown with --nocapture: the sizes to set a budget from.
+        println!("{:24} {size:>6} of {budget:>6} ({})", kernel.name(), heavy_copies(&copies));
         if size > budget {
             over.push(format!(
                 "{}: {size} expressions inlined, budget {budget} ({})",

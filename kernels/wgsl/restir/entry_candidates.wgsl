@@ -264,6 +264,27 @@ fn draw_candidate(primary: Primary, surface: Surface, lane: u32) -> Drawn {
     return Drawn(candidate, invalid);
 }
 
+// How the candidates pass's walk along the camera path ended (restir_candidates).
+const EXIT_OTHER: u32 = 0u;
+// At a glossy conductor that resamples by random replay.
+const EXIT_REPLAY: u32 = 1u;
+// Where no resampling happens: the rest of the path is path-traced into the base.
+const EXIT_PATH_TRACE: u32 = 2u;
+
+// p̂ of the pixel's own candidate `x` at its own resampling vertex `p`: target_function's
+// value, without the re-trace it holds for replays. A replay candidate drawn at `p`
+// carries Ĉ(y, u) itself, which `replayed` would read back (same vertex, same numbers);
+// any other candidate is a reconnection. So the kernel holds no path loop it never runs.
+fn own_target(p: Primary, x: PathCandidate) -> f32 {
+    if x.kind == KIND_NONE || (p.flags & PRIMARY_RESAMPLE) == 0u {
+        return 0.0;
+    }
+    if x.kind == KIND_REPLAY {
+        return luminance(x.reflected);
+    }
+    return luminance(reconnection_integrand(p, x));
+}
+
 @compute @workgroup_size(8, 8)
 fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     if id.x >= params.width || id.y >= params.height {
@@ -297,6 +318,9 @@ fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
         var length = hit.t;
         var throughput = vec3<f32>(1.0);
         var chain = 0u;
+        // How the loop below left the path: EXIT_REPLAY and EXIT_PATH_TRACE trace the rest
+        // of it from `surface` after the loop, in one call for both.
+        var exit = EXIT_OTHER;
         let camera_hit = surface.position;
         if surface.light != NO_LIGHT && cos_out > 0.0 {
             base = lights[surface.light].radiance;
@@ -321,10 +345,7 @@ fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
                 // the path's random numbers, u uniform (W = 1), and the estimate Ĉ(y, u)
                 // they give here (restir/reservoir.wgsl, "Random replay").
                 primary.flags |= PRIMARY_RESAMPLE | PRIMARY_REPLAY;
-                let seed = rng_state;
-                let own = replayed_sample(primary, seed, lane);
-                candidate = PathCandidate(primary.position, KIND_REPLAY, primary.wo, seed, own.radiance, 1.0);
-                invalid = invalid || own.invalid;
+                exit = EXIT_REPLAY;
                 break;
             }
             if rough && front && segment < params.max_depth {
@@ -336,9 +357,7 @@ fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
             }
             if rough || replay || !front || chain >= restir.specular_chain || segment >= params.max_depth {
                 // No resampling from here: the rest of the path, as the path tracer does it.
-                let rest = scatter_from(surface, wo_world, segment, lane);
-                base += throughput * rest.radiance;
-                invalid = invalid || rest.invalid;
+                exit = EXIT_PATH_TRACE;
                 break;
             }
             // One smooth vertex of the chain, exactly as render/path.wgsl's
@@ -393,11 +412,26 @@ fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
                 base += throughput * lights[surface.light].radiance * weight;
             }
         }
+        if exit != EXIT_OTHER {
+            // The rest of the path from the vertex the loop stopped at. For a replay it is
+            // the estimate Ĉ(y, u) of the random numbers u the pixel's stream gives from
+            // here (its state is the candidate), and the stream is left where it was, as
+            // replayed_sample leaves it (restir/reservoir.wgsl, "Random replay").
+            let seed = rng_state;
+            let rest = scatter_from(surface, wo_world, segment, lane);
+            invalid = invalid || rest.invalid;
+            if exit == EXIT_REPLAY {
+                rng_state = seed;
+                candidate = PathCandidate(primary.position, KIND_REPLAY, primary.wo, seed, rest.radiance, 1.0);
+            } else {
+                base += throughput * rest.radiance;
+            }
+        }
     }
     var key = 0.0;
     if candidate.kind != KIND_NONE && candidate.weight > 0.0 && finite3(candidate.reflected) {
         // The luminance of the pixel's own one-sample estimate f(Y) W at its vertex.
-        key = target_function(primary, candidate, lane) * candidate.weight;
+        key = own_target(primary, candidate) * candidate.weight;
     } else {
         // A drawn candidate whose radiance overflowed is an invalid sample, not an
         // absent one.

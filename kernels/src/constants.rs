@@ -92,6 +92,10 @@ pub const KERNEL_PRIVATE: &[&str] = &[
     // "No temporal source" and "no pixel" between two ReSTIR passes' locals.
     "NO_SOURCE",
     "NO_PIXEL",
+    // How restir_candidates' walk along the camera path ended (restir/entry_candidates.wgsl).
+    "EXIT_OTHER",
+    "EXIT_REPLAY",
+    "EXIT_PATH_TRACE",
     // Mathematics.
     "PI",
     "INFINITY",

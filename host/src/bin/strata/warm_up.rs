@@ -37,9 +37,9 @@ pub struct WarmUp {
 }
 
 /// The kernels of each warm-up thread: they compile side by side, the candidates (the
-/// largest kernel, 23k inlined expressions) with the small passes on one device; the
+/// largest kernel, 16k inlined expressions) with the small passes on one device; the
 /// selection, the temporal merge and the spatial pass (11k each) on the other (measured:
-/// 20 s and 16 s on a fresh machine, BENCHMARKS).
+/// 20 s and 16 s on a fresh machine with the candidates at 23k, BENCHMARKS).
 fn shares() -> [Vec<KernelId>; 2] {
     let histograms = [KernelId::BlockHistogram, KernelId::BlockHistogramSubgroup, KernelId::BlockHistogramRank];
     [

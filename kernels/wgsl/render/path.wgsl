@@ -67,10 +67,11 @@ struct PathVertex {
 // most of every kernel that traces paths: a kernel that reaches both entry points through
 // one call holds one copy of it (BENCHMARKS "First run on a fresh machine").
 //
-// With `at_vertex` the path starts at `vertex` (segment number `depth`): its emission is
-// left out, and its own part (next-event estimation there) is kept apart from what the
-// rest of the path brings back, which is weighted by the vertex's BSDF sample at the end,
-// so that the sum is the one scatter_at always computed; no Russian roulette there.
+// With `at_vertex` the path starts at `vertex` (segment number `first_depth`): its
+// emission is left out, and its own part (next-event estimation there) is kept apart
+// from what the rest of the path brings back, which is weighted by the vertex's BSDF
+// sample at the end, so that the sum is the one scatter_at always computed; no Russian
+// roulette there.
 // Otherwise the path starts by tracing `start`, as trace_path_from describes.
 fn path_from(
     start: Ray,

@@ -214,10 +214,12 @@ fn shadow_ray_along(position: vec3<f32>, normal: vec3<f32>, direction: vec3<f32>
     return spawn_ray(position, normal, direction, INFINITY);
 }
 
-// True when nothing blocks shadow ray `ray` (shadow_ray_to, shadow_ray_along). Every
-// shadow test of a kernel goes through one call of this, its branches only choosing the
-// ray: a driver inlines each call site's BVH traversal, and the traversals were most of
-// what a CPU driver took minutes to compile (BENCHMARKS "First run on a fresh machine").
+// True when nothing blocks shadow ray `ray` (shadow_ray_to, shadow_ray_along). Callers
+// choose the ray in branches and call this once (next-event estimation, a candidate's
+// visibility): a driver inlines each call site's BVH traversal, and the traversals were
+// most of what a CPU driver took minutes to compile (BENCHMARKS "First run on a fresh
+// machine"). restir_candidates' draw_candidate tests its shadow rays through its own one
+// traversal, which also finds its BSDF sample's next vertex.
 fn ray_unblocked(ray: Ray, lane: u32) -> bool {
     if ray.tmax <= 0.0 {
         return true;

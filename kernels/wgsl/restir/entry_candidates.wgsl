@@ -172,7 +172,9 @@ fn draw_candidate(primary: Primary, surface: Surface, lane: u32) -> Drawn {
             }
         }
         var hit = Hit(0.0, 0.0, 0.0, MISS);
-        if traced && ray.tmax > 0.0 {
+        // As ray_unblocked: a shadow ray with nothing left to test (tmax <= 0) is unblocked;
+        // a NaN tmax is traced, as it always was.
+        if traced && !(ray.tmax <= 0.0) {
             hit = traverse(ray, lane, shadow);
         }
         // The vertex the technique found, the direction towards the primary from it, and

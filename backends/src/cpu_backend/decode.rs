@@ -166,6 +166,9 @@ pub(super) struct Compiler<'a> {
     pub line: u32,
     /// Source function of the instructions being pushed.
     pub source: u32,
+    /// The expression compiled last, while the statement after it may store it
+    /// ([`super::retarget`]).
+    pub(super) last_value: Option<super::retarget::LastValue>,
 }
 
 impl Compiler<'_> {
@@ -262,6 +265,13 @@ impl Compiler<'_> {
         self.insn_lines.push(self.line);
         self.insn_sources.push(self.source);
         self.insns.len() - 1
+    }
+
+    /// Removes the instructions from index `len` on (an undone compilation).
+    pub(super) fn truncate(&mut self, len: usize) {
+        self.insns.truncate(len);
+        self.insn_lines.truncate(len);
+        self.insn_sources.truncate(len);
     }
 
     /// Appends a copy of `len` words (nothing when `len` is 0 or source and target agree).
@@ -475,6 +485,7 @@ fn compile_code(
         constants: Default::default(),
         line: 0,
         source: 0,
+        last_value: None,
     };
     let mut code_arguments = Vec::new();
     let mut scope = compiler.open(function, function_info, None, None, 0, &mut code_arguments)?;
@@ -488,6 +499,7 @@ fn compile_code(
     compiler.line = 0;
     compiler.source = scope.source;
     compiler.push(Insn::Return { src: 0, len: 0 });
+    super::jump_cleanup::clean_up_jumps(&mut compiler.insns, &mut compiler.insn_lines, &mut compiler.insn_sources);
     Ok(Code {
         insns: compiler.insns,
         lines: compiler.insn_lines,

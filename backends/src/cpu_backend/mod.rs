@@ -50,15 +50,18 @@ mod error;
 mod exec;
 mod execute;
 mod expression;
+mod if_conversion;
 mod image;
 mod image_lower;
 mod insn;
 mod interp;
+mod jump_cleanup;
 mod lanes;
 mod layout;
 mod math_call;
 mod matrix;
 mod memory;
+mod retarget;
 mod statement;
 mod wide;
 

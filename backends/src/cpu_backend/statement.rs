@@ -8,6 +8,7 @@ use super::decode::{Compiler, INLINE_DEPTH, INLINE_EXPRESSIONS, Scope};
 use super::error::unsupported;
 use super::insn::{CallInsn, CollectiveFun, CollectiveInsn, GatherInsn, Insn, Reg};
 use super::layout::{Place, is_half, is_wide, shape};
+use super::retarget::LastValue;
 use crate::error::BackendError;
 use naga::{Expression, Handle, Statement, TypeInner};
 
@@ -24,15 +25,23 @@ impl Compiler<'_> {
         let line = self.lines_of.line(span);
         self.line = line;
         self.source = scope.source;
+        // Only a store or return right after an expression may compute it in place
+        // (`retarget`): any other statement may place a jump target in between.
+        if !matches!(statement, Statement::Emit(_) | Statement::Store { .. } | Statement::Return { .. }) {
+            self.last_value = None;
+        }
         match statement {
             Statement::Emit(range) => {
                 for handle in range.clone() {
                     if !scope.pre_emitted[handle.index()] {
+                        let first = self.insns.len();
                         self.expression(scope, handle)?;
+                        self.last_value = Some(LastValue::new(scope, handle, first));
                     }
                 }
             }
             Statement::Block(block) => self.block(scope, block)?,
+            Statement::If { condition, accept, reject } if self.if_as_select(scope, *condition, accept, reject)? => {}
             Statement::If { condition, accept, reject } => {
                 let cond = self.reg(scope, *condition);
                 self.line = line;
@@ -140,11 +149,13 @@ impl Compiler<'_> {
                 // and moved outwards when a switch closes.
                 scope.loops.last_mut().ok_or_else(|| unsupported("`continue` outside a loop", line))?.1.push(at);
             }
-            Statement::Return { value } => {
-                let value = value.map(|v| (self.reg(scope, v), scope.lens[v.index()]));
+            Statement::Return { value: value_handle } => {
+                let value = value_handle.map(|v| (self.reg(scope, v), scope.lens[v.index()]));
                 self.line = line;
                 if scope.inlined {
-                    if let (Some((src, len)), Some((dst, words))) = (value, scope.result) {
+                    if let (Some((src, len)), Some((dst, words)), Some(handle)) = (value, scope.result, *value_handle)
+                        && !(len == words && self.retarget_last(scope, handle, dst, len))
+                    {
                         self.copy(dst, src, len.min(words));
                     }
                     let at = self.push(Insn::Jump(0));
@@ -162,7 +173,13 @@ impl Compiler<'_> {
             Statement::Store { pointer, value } => {
                 let src = self.reg(scope, *value);
                 let len = scope.lens[value.index()];
-                self.store(scope, *pointer, src, len);
+                let in_place = match scope.places[pointer.index()] {
+                    Some(Place::Local(variable)) => self.retarget_last(scope, *value, variable, len),
+                    _ => false,
+                };
+                if !in_place {
+                    self.store(scope, *pointer, src, len);
+                }
             }
             Statement::Call { function, arguments, result } => self.call(scope, *function, arguments, *result)?,
             Statement::WorkGroupUniformLoad { pointer, result } => {

@@ -1,0 +1,219 @@
+//! If-conversion: an `if` whose branches only compute values and store them into local
+//! variables is compiled without a branch. Both branches' values are computed, then each
+//! stored variable gets one `Select` between its two new values (a branch that does not
+//! store it keeps the old value).
+//!
+//! Why: a branch taken one way by some members of a group and the other way by the rest
+//! splits the group ([`super::interp`]). Each half then runs on its own with a scheduler
+//! round trip before they merge again. A `Select` is one row operation for the whole
+//! group. The common case is the short-circuit operators: naga's WGSL front end lowers
+//! `a && b` and `a || b` into an `if` that stores `b` or a constant into a local
+//! variable. In a BVH traversal these conditions differ between lanes most of the time.
+//!
+//! Sound because the expressions a branch emits have no side effects (naga expressions
+//! only read; stores, calls and atomics are statements), every operation is defined for
+//! every input in WGSL (division by zero, out-of-range indices clamped, out-of-bounds
+//! memory reads 0), and the stores are deferred to the selects after both branches'
+//! expressions, each of which was emitted before the first store of its branch or does
+//! not read memory. The compiled branches are checked instruction by instruction; if
+//! one holds anything but register and memory reads (a runtime failure for an
+//! unsupported construct, a jump), the compilation is undone and the `if` is compiled
+//! as a branch.
+
+use super::decode::{Compiler, Scope};
+use super::error::unsupported;
+use super::insn::{Insn, Reg};
+use super::layout::Place;
+use crate::error::BackendError;
+use naga::{Expression, Handle, Statement};
+
+/// At most this many IR expressions emitted by the two branches together: both branches
+/// always run once converted, so a long branch would cost more than the split it saves.
+const SPECULATED_EXPRESSIONS: usize = 12;
+
+/// At most this many stores per branch.
+const STORES_PER_BRANCH: usize = 4;
+
+/// A store of a branch: the variable's registers and words, and the new value's register.
+#[derive(Clone, Copy)]
+struct LocalStore {
+    variable: Reg,
+    len: u32,
+    value: Reg,
+}
+
+impl Compiler<'_> {
+    /// Compiles `if condition { accept } else { reject }` as selects if both branches
+    /// only emit expressions and store into local variables; false (nothing compiled)
+    /// otherwise.
+    pub(super) fn if_as_select(
+        &mut self,
+        scope: &mut Scope,
+        condition: Handle<Expression>,
+        accept: &naga::Block,
+        reject: &naga::Block,
+    ) -> Result<bool, BackendError> {
+        let (Some(accept_count), Some(reject_count)) = (branch_shape(scope, accept), branch_shape(scope, reject))
+        else {
+            return Ok(false);
+        };
+        if accept_count + reject_count > SPECULATED_EXPRESSIONS || (accept.is_empty() && reject.is_empty()) {
+            return Ok(false);
+        }
+        let line = self.line;
+        let cond = self.reg(scope, condition);
+        let start = self.here() as usize;
+        let (regs, places, constant) = (scope.regs.clone(), scope.places.clone(), scope.constant.clone());
+        let local_pointers = self.local_pointers.len();
+        let accept_stores = self.speculate(scope, accept)?;
+        let reject_stores = self.speculate(scope, reject)?;
+        let selects = match (accept_stores, reject_stores) {
+            (Some(a), Some(r)) if self.insns[start..].iter().all(speculable) => merge(&a, &r),
+            _ => None,
+        };
+        self.line = line;
+        self.source = scope.source;
+        let Some(selects) = selects else {
+            // Undo: the `if` is compiled as a branch, its expressions anew.
+            self.truncate(start);
+            (scope.regs, scope.places, scope.constant) = (regs, places, constant);
+            self.local_pointers.truncate(local_pointers);
+            return Ok(false);
+        };
+        for (variable, len, accept, reject) in selects {
+            // `n` is a byte: long values in pieces.
+            for at in (0..len).step_by(u8::MAX as usize) {
+                let n = (len - at).min(u32::from(u8::MAX));
+                self.push(Insn::Select {
+                    dst: variable + at,
+                    cond,
+                    accept: accept + at,
+                    reject: reject + at,
+                    n: n as u8,
+                    sc: 0,
+                });
+            }
+        }
+        Ok(true)
+    }
+
+    /// Compiles a branch's expressions; returns its stores (`None` if one is not into a
+    /// local variable).
+    fn speculate(&mut self, scope: &mut Scope, block: &naga::Block) -> Result<Option<Vec<LocalStore>>, BackendError> {
+        let mut stores = Vec::new();
+        for (statement, span) in block.span_iter() {
+            self.line = self.lines_of.line(*span);
+            self.source = scope.source;
+            match statement {
+                Statement::Emit(range) => {
+                    for handle in range.clone() {
+                        if !scope.pre_emitted[handle.index()] {
+                            self.expression(scope, handle)?;
+                        }
+                    }
+                }
+                Statement::Store { pointer, value } => match scope.places[pointer.index()] {
+                    Some(Place::Local(variable)) => {
+                        let value_reg = self.reg(scope, *value);
+                        stores.push(LocalStore { variable, len: scope.lens[value.index()], value: value_reg });
+                    }
+                    _ => return Ok(None),
+                },
+                _ => {
+                    return Err(unsupported("internal: if-conversion of a branch that is not straight-line", self.line));
+                }
+            }
+        }
+        Ok(Some(stores))
+    }
+}
+
+/// The number of expressions `block` emits if it is a branch if-conversion can take:
+/// only `Emit` and `Store` statements, at most [`STORES_PER_BRANCH`] stores, and no
+/// memory read emitted after its first store (deferring the stores must not change what
+/// a load sees).
+fn branch_shape(scope: &Scope, block: &naga::Block) -> Option<usize> {
+    let mut emitted = 0;
+    let mut stores = 0;
+    for statement in block.iter() {
+        match statement {
+            Statement::Emit(range) => {
+                for handle in range.clone() {
+                    if stores > 0 && matches!(scope.function.expressions[handle], Expression::Load { .. }) {
+                        return None;
+                    }
+                    emitted += 1;
+                }
+            }
+            Statement::Store { .. } if stores < STORES_PER_BRANCH => stores += 1,
+            _ => return None,
+        }
+    }
+    Some(emitted)
+}
+
+/// Whether an instruction compiled from an expression may run where its branch was not
+/// taken: it reads registers or memory and writes only its own registers.
+fn speculable(insn: &Insn) -> bool {
+    matches!(
+        insn,
+        Insn::Copy1 { .. }
+            | Insn::Copy2 { .. }
+            | Insn::Copy3 { .. }
+            | Insn::Copy4 { .. }
+            | Insn::Copy { .. }
+            | Insn::Zero { .. }
+            | Insn::Bin { .. }
+            | Insn::BinV { .. }
+            | Insn::Un { .. }
+            | Insn::Select { .. }
+            | Insn::Swizzle { .. }
+            | Insn::Splat { .. }
+            | Insn::Convert { .. }
+            | Insn::Extract { .. }
+            | Insn::PtrAdd { .. }
+            | Insn::PtrIndex { .. }
+            | Insn::PtrIndexRt { .. }
+            | Insn::Load { .. }
+            | Insn::LoadMixed { .. }
+            | Insn::LoadWorkgroup { .. }
+            | Insn::LoadPrivate { .. }
+            | Insn::LoadBuffer { .. }
+            | Insn::ArrayLength { .. }
+            | Insn::Compute(_)
+    )
+}
+
+/// The selects of the two branches' stores: per variable (register, words, value if
+/// accepted, value if rejected), the variable itself where a branch does not store it.
+/// `None` where stores overlap without covering the same registers (a field of a
+/// variable in one branch, the whole variable in the other).
+fn merge(accept: &[LocalStore], reject: &[LocalStore]) -> Option<Vec<(Reg, u32, Reg, Reg)>> {
+    let overlap = |a: &LocalStore, b: &LocalStore| a.variable < b.variable + b.len && b.variable < a.variable + a.len;
+    let same = |a: &LocalStore, b: &LocalStore| a.variable == b.variable && a.len == b.len;
+    // Within a branch the last store of a variable wins.
+    let last = |stores: &[LocalStore]| -> Option<Vec<LocalStore>> {
+        let mut kept: Vec<LocalStore> = Vec::new();
+        for store in stores {
+            match kept.iter().position(|k| overlap(k, store)) {
+                Some(i) if same(&kept[i], store) => kept[i] = *store,
+                Some(_) => return None,
+                None => kept.push(*store),
+            }
+        }
+        Some(kept)
+    };
+    let (accept, reject) = (last(accept)?, last(reject)?);
+    let mut selects = Vec::new();
+    for a in &accept {
+        match reject.iter().find(|r| overlap(a, r)) {
+            Some(r) if same(a, r) => selects.push((a.variable, a.len, a.value, r.value)),
+            Some(_) => return None,
+            None => selects.push((a.variable, a.len, a.value, a.variable)),
+        }
+    }
+    for r in reject.iter().filter(|r| !accept.iter().any(|a| overlap(a, r))) {
+        selects.push((r.variable, r.len, r.variable, r.value));
+    }
+    Some(selects)
+}

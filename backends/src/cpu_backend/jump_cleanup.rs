@@ -1,0 +1,136 @@
+//! Jump cleanup, once a code is compiled: a jump to a forward jump goes straight to the
+//! final target, instructions no path reaches are removed, and so are jumps to the next
+//! instruction; the remaining targets are renumbered.
+//!
+//! Why: structured lowering leaves many of them. An inlined callee's `return` as its
+//! last statement jumps to the instruction after it; a loop's `if i < n {} else {
+//! break; }` jumps over the `break`'s jump; a `continue` jumps to an empty continuing
+//! block that jumps back. Each costs the interpreter a dispatch per group, and the path
+//! tracer's BVH loop ran one of them per four other instructions.
+//!
+//! The order of the instructions is kept, so structured code stays laid out in order
+//! (what the scheduler's reconvergence relies on, [`super::interp`]). A call's return
+//! address is the instruction after the call, which stays after it.
+
+use super::insn::Insn;
+
+/// Jumps followed through at most this many jumps.
+const THREAD_HOPS: usize = 16;
+
+/// Cleans up the jumps of one code: `lines` and `sources` are its per-instruction
+/// tables, kept in step.
+pub(super) fn clean_up_jumps(insns: &mut Vec<Insn>, lines: &mut Vec<u32>, sources: &mut Vec<u32>) {
+    thread_jumps(insns);
+    // Removing an instruction may make a jump reach the next one: a few rounds.
+    for _ in 0..4 {
+        let keep = kept(insns);
+        if keep.iter().all(|&k| k) {
+            break;
+        }
+        remove(insns, lines, sources, &keep);
+    }
+}
+
+/// Points every jump past the forward unconditional jumps at its target.
+fn thread_jumps(insns: &mut [Insn]) {
+    let resolve = |insns: &[Insn], mut target: u32| {
+        for _ in 0..THREAD_HOPS {
+            match insns.get(target as usize) {
+                // Forward only: a jump through a loop's back edge would send the lanes
+                // that take it to the loop's start alone, ahead of the others still in
+                // the body, where they used to wait at the back edge and go round
+                // together (measured: 12 % more group steps in the path tracer).
+                Some(Insn::Jump(next)) if *next > target => target = *next,
+                _ => break,
+            }
+        }
+        target
+    };
+    for at in 0..insns.len() {
+        let threaded = match &insns[at] {
+            Insn::Jump(t) => Insn::Jump(resolve(insns, *t)),
+            Insn::JumpUnless { cond, target } => Insn::JumpUnless { cond: *cond, target: resolve(insns, *target) },
+            Insn::Switch { selector, cases, default } => Insn::Switch {
+                selector: *selector,
+                cases: cases.iter().map(|&(value, t)| (value, resolve(insns, t))).collect(),
+                default: resolve(insns, *default),
+            },
+            _ => continue,
+        };
+        insns[at] = threaded;
+    }
+}
+
+/// Per instruction, whether it stays: reached from the first instruction, and not a
+/// jump (conditional or not) to the next one.
+fn kept(insns: &[Insn]) -> Vec<bool> {
+    let mut reached = vec![false; insns.len()];
+    let mut pending = vec![0usize];
+    while let Some(at) = pending.pop() {
+        if at >= insns.len() || reached[at] {
+            continue;
+        }
+        reached[at] = true;
+        match &insns[at] {
+            Insn::Jump(t) => pending.push(*t as usize),
+            Insn::JumpUnless { target, .. } => pending.extend([*target as usize, at + 1]),
+            Insn::Switch { cases, default, .. } => {
+                pending.extend(cases.iter().map(|&(_, t)| t as usize));
+                pending.push(*default as usize);
+            }
+            Insn::Return { .. } => {}
+            _ => pending.push(at + 1),
+        }
+    }
+    insns
+        .iter()
+        .enumerate()
+        .map(|(at, insn)| {
+            let to_next = match insn {
+                Insn::Jump(t) | Insn::JumpUnless { target: t, .. } => *t as usize == at + 1,
+                _ => false,
+            };
+            reached[at] && !to_next
+        })
+        .collect()
+}
+
+/// Removes the instructions not kept and renumbers the targets: a removed instruction's
+/// index becomes that of the next kept one (where a removed jump to the next instruction
+/// would have gone; no kept jump targets an unreached instruction).
+fn remove(insns: &mut Vec<Insn>, lines: &mut Vec<u32>, sources: &mut Vec<u32>, keep: &[bool]) {
+    let mut renumbered = Vec::with_capacity(insns.len() + 1);
+    let mut next = 0u32;
+    for &k in keep {
+        renumbered.push(next);
+        next += u32::from(k);
+    }
+    renumbered.push(next);
+    let map = |t: &mut u32| *t = renumbered[*t as usize];
+    let mut at = 0;
+    insns.retain_mut(|insn| {
+        let k = keep[at];
+        at += 1;
+        if k {
+            match insn {
+                Insn::Jump(t) | Insn::JumpUnless { target: t, .. } => map(t),
+                Insn::Switch { cases, default, .. } => {
+                    cases.iter_mut().for_each(|(_, t)| map(t));
+                    map(default);
+                }
+                _ => {}
+            }
+        }
+        k
+    });
+    let mut at = 0;
+    lines.retain(|_| {
+        at += 1;
+        keep[at - 1]
+    });
+    let mut at = 0;
+    sources.retain(|_| {
+        at += 1;
+        keep[at - 1]
+    });
+}

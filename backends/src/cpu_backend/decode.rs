@@ -655,3 +655,21 @@ pub(super) fn const_value(compiler: &Compiler, scope: &Scope, handle: Handle<Exp
     };
     (value.len() == len).then_some(value)
 }
+
+#[cfg(test)]
+pub(super) mod tests {
+    use super::*;
+
+    /// The entry point's instructions of a kernel whose body is `body` after `let x =
+    /// data[id.x];` (`data`: a read-write `array<u32>`, `id`: the global invocation id).
+    pub(in super::super) fn compiled(body: &str) -> Vec<Insn> {
+        let source = format!(
+            "@group(0) @binding(0) var<storage, read_write> data: array<u32>;\n\
+             @compute @workgroup_size(8) fn main(@builtin(global_invocation_id) id: vec3<u32>) {{\n\
+             let x = data[id.x];\n{body}\n}}"
+        );
+        let kernel = Kernel::from_wgsl("compiled.wgsl", source, "main", false).expect("valid WGSL");
+        let program = compile_program(&kernel).expect("compiles");
+        program.codes.into_iter().nth(program.entry as usize).expect("entry code").insns
+    }
+}

@@ -120,7 +120,10 @@ impl Compiler<'_> {
                     _ => return Ok(None),
                 },
                 _ => {
-                    return Err(unsupported("internal: if-conversion of a branch that is not straight-line", self.line));
+                    return Err(unsupported(
+                        "internal: if-conversion of a branch that is not straight-line",
+                        self.line,
+                    ));
                 }
             }
         }
@@ -216,4 +219,31 @@ fn merge(accept: &[LocalStore], reject: &[LocalStore]) -> Option<Vec<(Reg, u32, 
         selects.push((r.variable, r.len, r.variable, r.value));
     }
     Some(selects)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::decode::tests::compiled;
+    use super::*;
+
+    fn branches(insns: &[Insn]) -> usize {
+        insns.iter().filter(|i| matches!(i, Insn::JumpUnless { .. } | Insn::Jump(_))).count()
+    }
+
+    #[test]
+    fn short_circuit_operators_compile_without_branches() {
+        let insns = compiled("data[id.x] = u32((x > 3u && x < 9u) || x == 20u);");
+        assert_eq!(branches(&insns), 0);
+        assert_eq!(insns.iter().filter(|i| matches!(i, Insn::Select { .. })).count(), 2);
+    }
+
+    #[test]
+    fn branches_with_side_effects_or_reloads_stay_branches() {
+        // A store into a buffer.
+        assert!(branches(&compiled("if x > 3u { data[0] = 1u; }")) > 0);
+        // A load of a variable after a store into it in the same branch.
+        assert!(branches(&compiled("var t = 0u; if x > 3u { t = x; t = t * 2u; } data[id.x] = t;")) > 0);
+        // The same without the reload is converted.
+        assert_eq!(branches(&compiled("var t = 0u; if x > 3u { t = x * 2u; } data[id.x] = t;")), 0);
+    }
 }

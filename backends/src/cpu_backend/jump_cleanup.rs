@@ -134,3 +134,28 @@ fn remove(insns: &mut Vec<Insn>, lines: &mut Vec<u32>, sources: &mut Vec<u32>, k
         keep[at - 1]
     });
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::decode::tests::compiled;
+    use super::*;
+
+    #[test]
+    fn no_jump_lands_on_the_next_instruction_or_a_forward_jump() {
+        let insns = compiled(
+            "var n = 0u;\n\
+             for (var j = 0u; j < x; j++) { if j == 5u { continue; } if j > 9u { break; } n += j; }\n\
+             data[id.x] = n;",
+        );
+        for (at, insn) in insns.iter().enumerate() {
+            let target = match insn {
+                Insn::Jump(t) | Insn::JumpUnless { target: t, .. } => *t as usize,
+                _ => continue,
+            };
+            assert_ne!(target, at + 1, "instruction {at} jumps to the next one");
+            if let Some(Insn::Jump(next)) = insns.get(target) {
+                assert!(*next as usize <= target, "instruction {at} jumps to a forward jump at {target}");
+            }
+        }
+    }
+}

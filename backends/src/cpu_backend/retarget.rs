@@ -103,3 +103,30 @@ fn retargetable(insn: &mut Insn, src: Reg, dst: Reg, len: u32) -> bool {
     *target = dst;
     true
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::decode::tests::compiled;
+    use super::*;
+
+    fn copies(body: &str) -> usize {
+        compiled(body).iter().filter(|i| matches!(i, Insn::Copy1 { .. })).count()
+    }
+
+    /// The copies of a kernel that declares `a` and stores it into the buffer.
+    fn baseline() -> usize {
+        copies("var a = 0u; data[id.x] = a;")
+    }
+
+    #[test]
+    fn stored_values_are_computed_in_place() {
+        // One more load of `a` (for `a * 3u`); the two stores copy nothing.
+        assert_eq!(copies("var a = 0u; a = x + 1u; a = a * 3u; data[id.x] = a;"), baseline() + 1);
+    }
+
+    #[test]
+    fn values_used_again_keep_their_registers() {
+        // `y` is read after the store: computed into its own registers, then copied.
+        assert_eq!(copies("var a = 0u; let y = x + 1u; a = y; data[id.x] = a + y;"), baseline() + 1);
+    }
+}

@@ -5,7 +5,11 @@
 //! Each kernel is compiled once into a register bytecode (`insn`, compiled by
 //! `decode` and `expression`): instructions whose operands are word offsets in the
 //! frame's register file, small callees inlined, fields and bitcasts aliasing their
-//! source's registers, compile-time values in a register template. `interp` runs it;
+//! source's registers, compile-time values in a register template. Three passes make
+//! the code shorter and less divergent: an `if` that only stores into locals becomes
+//! selects (`if_conversion`), a value stored right after it is computed goes straight
+//! into the variable (`retarget`), and jumps to jumps or to the next instruction are
+//! tidied away (`jump_cleanup`). `interp` runs it;
 //! `memory` is the pointer model (offsets in bytes into bound buffers, in register
 //! words elsewhere). Workgroups run in parallel on the machine's cores;
 //! the invocations of a workgroup run together from barrier to barrier (`exec`), each

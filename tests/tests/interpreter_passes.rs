@@ -197,3 +197,39 @@ fn optimising_passes_keep_wgsl_semantics_on_divergent_lanes() {
         }
     }
 }
+
+/// naga accepts a loop body's expression used by the continuing block even where a
+/// `continue` skipped it (WGSL forbids this; naga does not check). Store forwarding must
+/// not compute such a value into the variable at the body's end: a `continue` lands
+/// between that instruction and the store, which then copies what the expression's
+/// registers last held (here `e` = 1 at `i` = 2: v = 1 + 100), as without the pass.
+#[test]
+fn a_store_at_the_start_of_a_continuing_block_stays_a_copy() {
+    let source = r#"
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+@compute @workgroup_size(1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    var v = 0u;
+    var i = input[id.x];
+    loop {
+        if i >= 3u { break; }
+        if i == 2u { continue; }
+        let e = i;
+        continuing {
+            v = e;
+            v = v + 100u;
+            i = i + 1u;
+        }
+    }
+    output[id.x] = v;
+}
+"#;
+    let kernel = Kernel::from_wgsl("continuing.wgsl", source.into(), "main", false).unwrap();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let input = upload(&mut cpu, "input", &[0u32]).unwrap();
+    let output = cpu.create_buffer("output", 4).unwrap();
+    cpu.dispatch(&kernel, &[Bind::new(0, input), Bind::new(1, output)], [1, 1, 1]).unwrap();
+    let got: Vec<u32> = download(&mut cpu, output).unwrap();
+    assert_eq!(got, [101]);
+}

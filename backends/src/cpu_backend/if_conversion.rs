@@ -53,7 +53,8 @@ impl Compiler<'_> {
         accept: &naga::Block,
         reject: &naga::Block,
     ) -> Result<bool, BackendError> {
-        let (Some(accept_count), Some(reject_count)) = (branch_shape(scope, accept), branch_shape(scope, reject))
+        let (Some(accept_count), Some(reject_count)) =
+            (branch_shape(self.module, scope, accept), branch_shape(self.module, scope, reject))
         else {
             return Ok(false);
         };
@@ -135,7 +136,7 @@ impl Compiler<'_> {
 /// only `Emit` and `Store` statements, at most [`STORES_PER_BRANCH`] stores, and no
 /// memory read emitted after its first store (deferring the stores must not change what
 /// a load sees).
-fn branch_shape(scope: &Scope, block: &naga::Block) -> Option<usize> {
+fn branch_shape(module: &naga::Module, scope: &Scope, block: &naga::Block) -> Option<usize> {
     let mut emitted = 0;
     let mut stores = 0;
     for statement in block.iter() {
@@ -148,11 +149,27 @@ fn branch_shape(scope: &Scope, block: &naga::Block) -> Option<usize> {
                     emitted += 1;
                 }
             }
-            Statement::Store { .. } if stores < STORES_PER_BRANCH => stores += 1,
+            // Only into function-space variables: a store into memory is a side effect
+            // (refused here rather than after compiling the branch, which would be undone).
+            Statement::Store { pointer, .. }
+                if stores < STORES_PER_BRANCH && into_function_space(module, scope, *pointer) =>
+            {
+                stores += 1
+            }
             _ => return None,
         }
     }
     Some(emitted)
+}
+
+/// Whether `pointer` points into the function address space (a local variable).
+fn into_function_space(module: &naga::Module, scope: &Scope, pointer: Handle<Expression>) -> bool {
+    use naga::{AddressSpace, TypeInner};
+    matches!(
+        scope.info[pointer].ty.inner_with(&module.types),
+        TypeInner::Pointer { space: AddressSpace::Function, .. }
+            | TypeInner::ValuePointer { space: AddressSpace::Function, .. }
+    )
 }
 
 /// Whether an instruction compiled from an expression may run where its branch was not

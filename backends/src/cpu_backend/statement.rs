@@ -119,6 +119,11 @@ impl Compiler<'_> {
                 scope.loops.push((Vec::new(), Vec::new()));
                 self.block(scope, body)?;
                 let continuing_start = self.here();
+                // `continue` jumps here, between the body's last expression and the
+                // continuing block's first store, which naga lets use it (WGSL forbids a
+                // `continue` before a declaration the continuing block uses; naga does
+                // not check): that store must stay a copy (`retarget`).
+                self.last_value = None;
                 self.block(scope, continuing)?;
                 self.line = line;
                 self.source = scope.source;

@@ -6,6 +6,26 @@ pub mod wgsl_fuzz;
 use strata_backends::wgpu_backend::{WgpuApi, WgpuBackend, WgpuOptions};
 use strata_backends::{BackendError, GPU_REQUIRED_VARIABLE, gpu_required};
 
+/// Dispatches `kernel` on `workgroups` workgroups with `inputs` bound as binding 0 and an
+/// output buffer of `outputs` words as binding 1; returns the output's words.
+pub fn run_words(
+    backend: &mut dyn strata_backends::Backend,
+    kernel: &strata_kernels::Kernel,
+    inputs: &[u32],
+    outputs: usize,
+    workgroups: u32,
+) -> Vec<u32> {
+    use strata_backends::backend::{download, upload};
+    let input = upload(backend, "input", inputs).unwrap();
+    let output = backend.create_buffer("output", outputs as u64 * 4).unwrap();
+    let binds = [strata_backends::Bind::new(0, input), strata_backends::Bind::new(1, output)];
+    backend.dispatch(kernel, &binds, [workgroups, 1, 1]).unwrap();
+    let words = download(backend, output).unwrap();
+    backend.destroy_buffer(input).unwrap();
+    backend.destroy_buffer(output).unwrap();
+    words
+}
+
 /// The test scenes committed in the repository (`scenes/`: the shared JSON + PLY scenes
 /// with their licences), so that a clone alone passes its tests.
 pub fn scenes_folder() -> std::path::PathBuf {

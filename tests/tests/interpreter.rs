@@ -11,6 +11,7 @@ use strata_backends::{Backend, BackendError, Bind};
 use strata_kernels::reference::block_histogram::block_histogram;
 use strata_kernels::types::BLOCK_SIZES;
 use strata_kernels::{BlockGrid, Kernel};
+use strata_tests::run_words;
 
 #[test]
 fn histogram_kernels_match_the_reference_at_every_subgroup_size() {
@@ -37,16 +38,6 @@ fn histogram_kernels_match_the_reference_at_every_subgroup_size() {
             }
         }
     }
-}
-
-fn run_words(backend: &mut dyn Backend, kernel: &Kernel, inputs: &[u32], outputs: usize, workgroups: u32) -> Vec<u32> {
-    let input = upload(backend, "input", inputs).unwrap();
-    let output = backend.create_buffer("output", outputs as u64 * 4).unwrap();
-    backend.dispatch(kernel, &[Bind::new(0, input), Bind::new(1, output)], [workgroups, 1, 1]).unwrap();
-    let words = download(backend, output).unwrap();
-    backend.destroy_buffer(input).unwrap();
-    backend.destroy_buffer(output).unwrap();
-    words
 }
 
 /// `count` f32 bit patterns uniform in [-4, 4) from an LCG seeded with `seed`.

@@ -4,10 +4,9 @@
 //! kernel below puts each pass at its edges, per invocation on divergent inputs, and
 //! its outputs are checked word for word against the same program written in Rust.
 
-use strata_backends::backend::{download, upload};
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
-use strata_backends::{Backend, Bind};
 use strata_kernels::Kernel;
+use strata_tests::run_words;
 
 const PASSES: &str = r#"
 @group(0) @binding(0) var<storage, read> input: array<u32>;
@@ -185,10 +184,7 @@ fn optimising_passes_keep_wgsl_semantics_on_divergent_lanes() {
     let inputs: Vec<u32> =
         (0..256u32).map(|i| if i < 192 { i.wrapping_mul(37) % 97 } else { i.wrapping_mul(2_654_435_761) }).collect();
     let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
-    let input = upload(&mut cpu, "input", &inputs).unwrap();
-    let output = cpu.create_buffer("output", (inputs.len() * OUTPUTS * 4) as u64).unwrap();
-    cpu.dispatch(&kernel, &[Bind::new(0, input), Bind::new(1, output)], [inputs.len() as u32 / 64, 1, 1]).unwrap();
-    let got: Vec<u32> = download(&mut cpu, output).unwrap();
+    let got = run_words(&mut cpu, &kernel, &inputs, inputs.len() * OUTPUTS, inputs.len() as u32 / 64);
     for (i, &x) in inputs.iter().enumerate() {
         let want = reference(x);
         let have = &got[i * OUTPUTS..(i + 1) * OUTPUTS];
@@ -227,9 +223,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
 "#;
     let kernel = Kernel::from_wgsl("continuing.wgsl", source.into(), "main", false).unwrap();
     let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
-    let input = upload(&mut cpu, "input", &[0u32]).unwrap();
-    let output = cpu.create_buffer("output", 4).unwrap();
-    cpu.dispatch(&kernel, &[Bind::new(0, input), Bind::new(1, output)], [1, 1, 1]).unwrap();
-    let got: Vec<u32> = download(&mut cpu, output).unwrap();
+    let got = run_words(&mut cpu, &kernel, &[0], 1, 1);
     assert_eq!(got, [101]);
 }

@@ -74,6 +74,8 @@ impl Compiler<'_> {
         };
         self.line = line;
         self.source = scope.source;
+        // The speculated expressions are no store's to forward (`retarget`).
+        self.last_value = None;
         let Some(selects) = selects else {
             // Undo: the `if` is compiled as a branch, its expressions anew.
             self.truncate(start);
@@ -103,16 +105,8 @@ impl Compiler<'_> {
     fn speculate(&mut self, scope: &mut Scope, block: &naga::Block) -> Result<Option<Vec<LocalStore>>, BackendError> {
         let mut stores = Vec::new();
         for (statement, span) in block.span_iter() {
-            self.line = self.lines_of.line(*span);
-            self.source = scope.source;
             match statement {
-                Statement::Emit(range) => {
-                    for handle in range.clone() {
-                        if !scope.pre_emitted[handle.index()] {
-                            self.expression(scope, handle)?;
-                        }
-                    }
-                }
+                Statement::Emit(_) => self.statement(scope, statement, *span)?,
                 Statement::Store { pointer, value } => match scope.places[pointer.index()] {
                     Some(Place::Local(variable)) => {
                         let value_reg = self.reg(scope, *value);

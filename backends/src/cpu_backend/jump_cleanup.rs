@@ -33,31 +33,35 @@ pub(super) fn clean_up_jumps(insns: &mut Vec<Insn>, lines: &mut Vec<u32>, source
 
 /// Points every jump past the forward unconditional jumps at its target.
 fn thread_jumps(insns: &mut [Insn]) {
-    let resolve = |insns: &[Insn], mut target: u32| {
+    let jumps: Vec<Option<u32>> =
+        insns.iter().map(|insn| if let Insn::Jump(t) = insn { Some(*t) } else { None }).collect();
+    let resolve = |mut target: u32| {
         for _ in 0..THREAD_HOPS {
-            match insns.get(target as usize) {
+            match jumps.get(target as usize) {
                 // Forward only: a jump through a loop's back edge would send the lanes
                 // that take it to the loop's start alone, ahead of the others still in
                 // the body, where they used to wait at the back edge and go round
                 // together (measured: 12 % more group steps in the path tracer).
-                Some(Insn::Jump(next)) if *next > target => target = *next,
+                Some(Some(next)) if *next > target => target = *next,
                 _ => break,
             }
         }
         target
     };
-    for at in 0..insns.len() {
-        let threaded = match &insns[at] {
-            Insn::Jump(t) => Insn::Jump(resolve(insns, *t)),
-            Insn::JumpUnless { cond, target } => Insn::JumpUnless { cond: *cond, target: resolve(insns, *target) },
-            Insn::Switch { selector, cases, default } => Insn::Switch {
-                selector: *selector,
-                cases: cases.iter().map(|&(value, t)| (value, resolve(insns, t))).collect(),
-                default: resolve(insns, *default),
-            },
-            _ => continue,
-        };
-        insns[at] = threaded;
+    for insn in insns {
+        for_each_target(insn, |t| *t = resolve(*t));
+    }
+}
+
+/// Calls `f` on every jump target of `insn` (none for an instruction that falls through).
+fn for_each_target(insn: &mut Insn, mut f: impl FnMut(&mut u32)) {
+    match insn {
+        Insn::Jump(t) | Insn::JumpUnless { target: t, .. } => f(t),
+        Insn::Switch { cases, default, .. } => {
+            cases.iter_mut().for_each(|(_, t)| f(t));
+            f(default);
+        }
+        _ => {}
     }
 }
 
@@ -106,33 +110,18 @@ fn remove(insns: &mut Vec<Insn>, lines: &mut Vec<u32>, sources: &mut Vec<u32>, k
         next += u32::from(k);
     }
     renumbered.push(next);
-    let map = |t: &mut u32| *t = renumbered[*t as usize];
-    let mut at = 0;
-    insns.retain_mut(|insn| {
-        let k = keep[at];
-        at += 1;
-        if k {
-            match insn {
-                Insn::Jump(t) | Insn::JumpUnless { target: t, .. } => map(t),
-                Insn::Switch { cases, default, .. } => {
-                    cases.iter_mut().for_each(|(_, t)| map(t));
-                    map(default);
-                }
-                _ => {}
-            }
-        }
-        k
-    });
-    let mut at = 0;
-    lines.retain(|_| {
-        at += 1;
-        keep[at - 1]
-    });
-    let mut at = 0;
-    sources.retain(|_| {
-        at += 1;
-        keep[at - 1]
-    });
+    for insn in insns.iter_mut() {
+        for_each_target(insn, |t| *t = renumbered[*t as usize]);
+    }
+    retain_kept(insns, keep);
+    retain_kept(lines, keep);
+    retain_kept(sources, keep);
+}
+
+/// Keeps the items whose entry of `keep` is true (`retain` visits them in order).
+fn retain_kept<T>(items: &mut Vec<T>, keep: &[bool]) {
+    let mut keep = keep.iter();
+    items.retain(|_| *keep.next().expect("one flag per item"));
 }
 
 #[cfg(test)]

@@ -21,7 +21,13 @@ impl Compiler<'_> {
         Ok(())
     }
 
-    fn statement(&mut self, scope: &mut Scope, statement: &Statement, span: naga::Span) -> Result<(), BackendError> {
+    /// Lowers one statement.
+    pub(super) fn statement(
+        &mut self,
+        scope: &mut Scope,
+        statement: &Statement,
+        span: naga::Span,
+    ) -> Result<(), BackendError> {
         let line = self.lines_of.line(span);
         self.line = line;
         self.source = scope.source;

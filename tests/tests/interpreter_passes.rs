@@ -1,6 +1,7 @@
 //! The interpreter compiler's optimising passes keep WGSL's semantics: if-conversion
 //! (an `if` that only stores into local variables becomes selects), store forwarding (a
-//! value computed straight into the variable it is stored in) and jump cleanup. The
+//! value computed straight into the variable it is stored in), loads read in place (a
+//! loaded value that is the variable's own registers) and jump cleanup. The
 //! kernel below puts each pass at its edges, per invocation on divergent inputs, and
 //! its outputs are checked word for word against the same program written in Rust.
 
@@ -14,7 +15,11 @@ const PASSES: &str = r#"
 
 struct Pair { a: u32, b: u32 }
 
-const OUTPUTS: u32 = 13u;
+const OUTPUTS: u32 = 20u;
+
+fn bump(p: ptr<function, u32>) {
+    *p += 10u;
+}
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -113,10 +118,69 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let y = x * 5u + 1u;
     stored = y;
     output[o + 12u] = stored * 3u + y;
+
+    // Loads read in place only while their variable keeps the value: a value used
+    // after a store into its variable.
+    var a = x;
+    let old = a;
+    a = a + 5u;
+    output[o + 13u] = old * 7u + a;
+
+    // A value used in a loop that stores its variable; a value read at a loop's head and
+    // stored back at its end.
+    var b = x & 7u;
+    let start = b;
+    var acc = 0u;
+    for (var j = 0u; j < 3u; j++) { acc += start; b += 1u; }
+    var cnt = 0u;
+    var sum = 0u;
+    loop {
+        let cur = cnt;
+        if cur >= (x & 7u) { break; }
+        sum += cur;
+        cnt = cur + 1u;
+    }
+    output[o + 14u] = acc * 1000u + sum * 10u + b;
+
+    // A swap through a loaded value.
+    var s0 = x;
+    var s1 = x * 3u;
+    let t0 = s0;
+    s0 = s1;
+    s1 = t0;
+    output[o + 15u] = s0 * 10u + s1;
+
+    // If-conversion where one branch stores a loaded value before storing its variable,
+    // and the other branch stores that variable too (its select comes first).
+    var f2 = x;
+    var g2 = 0u;
+    if c { f2 = 9u; } else { let t = f2; g2 = t; f2 = 4u; }
+    output[o + 16u] = f2 * 1000u + g2;
+
+    // Fields: a field's value used after a store into the field; a whole struct's field
+    // used after a store into another field.
+    var pr = Pair(x, x + 1u);
+    let fa = pr.a;
+    pr.a = fa + pr.b;
+    let whole = pr;
+    pr.b = 0u;
+    output[o + 17u] = pr.a * 3u + fa + whole.b * 5u + pr.b;
+
+    // A condition read from the variable its if stores.
+    var flag = (x & 8u) != 0u;
+    var o2 = 0u;
+    if flag { flag = false; o2 = 1u; } else { flag = true; o2 = 2u; }
+    output[o + 18u] = u32(flag) * 10u + o2;
+
+    // A value used after a call that writes its variable through a pointer.
+    var bp = x;
+    let before = bp;
+    bump(&bp);
+    output[o + 19u] = before * 2u + bp;
 }
 "#;
 
-const OUTPUTS: usize = 13;
+const OUTPUTS: usize = 20;
 
 /// The kernel's program in Rust.
 fn reference(x: u32) -> [u32; OUTPUTS] {
@@ -173,6 +237,18 @@ fn reference(x: u32) -> [u32; OUTPUTS] {
     out[11] = dot.to_bits();
     let y = x.wrapping_mul(5).wrapping_add(1);
     out[12] = y.wrapping_mul(3).wrapping_add(y);
+    out[13] = x.wrapping_mul(7).wrapping_add(x.wrapping_add(5));
+    let b = x & 7;
+    out[14] = (3 * b) * 1000 + (0..b).sum::<u32>() * 10 + b + 3;
+    out[15] = x.wrapping_mul(3).wrapping_mul(10).wrapping_add(x);
+    let (f2, g2) = if c { (9u32, 0u32) } else { (4, x) };
+    out[16] = f2 * 1000 + g2;
+    let fa = x;
+    let pa = fa.wrapping_add(x.wrapping_add(1));
+    out[17] = pa.wrapping_mul(3).wrapping_add(fa).wrapping_add(x.wrapping_add(1).wrapping_mul(5));
+    let flag = x & 8 == 0;
+    out[18] = u32::from(flag) * 10 + if x & 8 != 0 { 1 } else { 2 };
+    out[19] = x.wrapping_mul(2).wrapping_add(x.wrapping_add(10));
     out
 }
 

@@ -27,7 +27,7 @@ pub(super) const INLINE_EXPRESSIONS: usize = 400;
 /// Inlining stops this many calls deep.
 pub(super) const INLINE_DEPTH: u32 = 8;
 /// Marks an expression without a register yet.
-const NONE: Reg = Reg::MAX;
+pub(super) const NONE: Reg = Reg::MAX;
 
 /// Byte offsets where source lines start, for span → line lookups.
 pub(super) struct LineIndex(Vec<usize>);
@@ -110,6 +110,9 @@ pub(super) struct Scope<'a> {
     pub constant: Vec<bool>,
     /// Per expression: evaluated when the scope starts (not again where emitted).
     pub pre_emitted: Vec<bool>,
+    /// Per expression: a load that reads its variable's registers in place
+    /// ([`super::load_alias`]).
+    pub in_place_loads: Vec<bool>,
     /// Per local variable: its register.
     pub locals: Vec<Reg>,
     /// Inlined: register and words that receive the return value.
@@ -350,6 +353,7 @@ impl Compiler<'_> {
             places: vec![None; count],
             constant: vec![false; count],
             pre_emitted: vec![false; count],
+            in_place_loads: super::load_alias::in_place_loads(function, info),
             locals: Vec::new(),
             result,
             returns: Vec::new(),
@@ -435,14 +439,15 @@ impl Compiler<'_> {
         for (index, (_, local)) in function.local_variables.iter().enumerate() {
             let variable = scope.locals[index];
             let words = words_of(self.module, &self.module.types[local.ty].inner).unwrap_or(0);
-            if scope.inlined && words > 0 {
-                // A fresh frame's variables start zeroed; an inlined call's must be too.
+            let initialised = local.init.map_or(0, |init| scope.lens[init.index()].min(words));
+            if scope.inlined && words > initialised {
+                // A fresh frame's variables start zeroed; an inlined call's must be too
+                // (where no initialiser writes every word).
                 self.push(Insn::Zero { dst: variable, len: words });
             }
             if let Some(init) = local.init {
                 let src = self.reg(&mut scope, init);
-                let len = scope.lens[init.index()].min(words);
-                self.copy(variable, src, len);
+                self.copy(variable, src, initialised);
             }
         }
         self.source = saved_source;

@@ -49,9 +49,17 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
             let (dst, base) = (*dst as usize, *base as usize);
             let (tag, offset) = (regs[base], regs[base + 1] as usize);
             let memory = memory!(lane, private);
-            let stride = *stride as usize;
-            let len = (memory.words(regs, tag).saturating_sub(offset) / stride.max(1)).max(1);
-            let at = (regs[*index as usize] as usize).min(len - 1) * stride;
+            let (stride, index) = (*stride as usize, regs[*index as usize] as usize);
+            let available = memory.words(regs, tag).saturating_sub(offset);
+            // Element `index`, clamped to the last one (WGSL), without a division per
+            // lane where it lies inside the region (the common case).
+            let at = if stride == 0 {
+                0
+            } else if (index + 1) * stride <= available {
+                index * stride
+            } else {
+                ((available / stride).max(1) - 1) * stride
+            };
             regs[dst] = tag;
             regs[dst + 1] = (offset + at) as u32;
         }),
@@ -63,8 +71,18 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
                 match tag & TAG_MASK {
                     BUFFER => {
                         let memory = &buffers[(tag & !TAG_MASK) as usize];
-                        for i in 0..len {
-                            regs[dst + i] = memory.get(offset / 4 + i).map_or(0, |w| w.load(Ordering::Relaxed));
+                        match memory.get(offset / 4..offset / 4 + len) {
+                            // Inside the buffer (the common case): one bounds check.
+                            Some(words) => {
+                                for (i, word) in words.iter().enumerate() {
+                                    regs[dst + i] = word.load(Ordering::Relaxed);
+                                }
+                            }
+                            None => {
+                                for i in 0..len {
+                                    regs[dst + i] = memory.get(offset / 4 + i).map_or(0, |w| w.load(Ordering::Relaxed));
+                                }
+                            }
                         }
                     }
                     WORKGROUP => {

@@ -6,7 +6,7 @@
 
 use super::arith;
 use super::constant::{compose_offsets, literal};
-use super::decode::{Compiler, Scope};
+use super::decode::{Compiler, NONE, Scope};
 use super::insn::{BinOp, Insn, Reg, UnOp, per_lane};
 use super::lanes::LaneRegs;
 use super::layout::{
@@ -208,8 +208,16 @@ impl Compiler<'_> {
             Expression::AccessIndex { base, index: i } => self.access_index(scope, handle, base, i),
             Expression::Load { pointer } => {
                 self.reg(scope, pointer);
-                let dst = self.reg(scope, handle);
-                self.load(scope, pointer, dst, len);
+                match scope.places[pointer.index()] {
+                    // Read in place (`load_alias`): the variable's own registers.
+                    Some(Place::Local(variable)) if scope.in_place_loads[index] && scope.regs[index] == NONE => {
+                        scope.regs[index] = variable;
+                    }
+                    _ => {
+                        let dst = self.reg(scope, handle);
+                        self.load(scope, pointer, dst, len);
+                    }
+                }
             }
             Expression::Unary { op, expr } if is_wide(self.ty(scope, expr)) => {
                 let (src, n) = operand!(expr);

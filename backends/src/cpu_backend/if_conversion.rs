@@ -69,7 +69,9 @@ impl Compiler<'_> {
         let accept_stores = self.speculate(scope, accept)?;
         let reject_stores = self.speculate(scope, reject)?;
         let selects = match (accept_stores, reject_stores) {
-            (Some(a), Some(r)) if self.insns[start..].iter().all(speculable) => merge(&a, &r),
+            (Some(a), Some(r)) if self.insns[start..].iter().all(speculable) => {
+                merge(&a, &r).filter(|selects| reads_before_writes(selects, cond))
+            }
             _ => None,
         };
         self.line = line;
@@ -230,6 +232,21 @@ fn merge(accept: &[LocalStore], reject: &[LocalStore]) -> Option<Vec<(Reg, u32, 
         selects.push((r.variable, r.len, r.variable, r.value));
     }
     Some(selects)
+}
+
+/// Whether the selects, run in order, read only values their branches computed before
+/// any store: no select reads a variable an earlier one wrote (a value may be a load
+/// read in place, [`super::load_alias`]), the condition is no variable, and a select's
+/// value is its own variable exactly or lies apart from it.
+fn reads_before_writes(selects: &[(Reg, u32, Reg, Reg)], cond: Reg) -> bool {
+    let apart = |at: Reg, len: u32, other: Reg, other_len: u32| at + len <= other || other + other_len <= at;
+    selects.iter().enumerate().all(|(i, &(variable, len, accept, reject))| {
+        apart(cond, 1, variable, len)
+            && [accept, reject].iter().all(|&value| {
+                (value == variable || apart(value, len, variable, len))
+                    && selects[..i].iter().all(|&(written, words, ..)| apart(value, len, written, words))
+            })
+    })
 }
 
 #[cfg(test)]

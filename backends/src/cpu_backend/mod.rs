@@ -62,6 +62,7 @@ mod interp;
 mod jump_cleanup;
 mod lanes;
 mod layout;
+mod load_alias;
 mod math_call;
 mod matrix;
 mod memory;

@@ -1,0 +1,269 @@
+//! Loads read in place: a load of a local variable (or of a field of one, at a place
+//! known when compiling) takes the variable's own registers instead of a copy of them,
+//! where nothing can write the variable while the loaded value is still used.
+//!
+//! Why: naga IR reads a variable through a `Load` expression, which the compiler
+//! otherwise lowers to a copy into the expression's registers. In the path tracer's
+//! BVH loop most of the copies left after store forwarding ([`super::retarget`]) were
+//! such loads, read once right after: the node index at the loop's head, the
+//! short-circuit temporaries of `&&` and `||` read by the branch after their `if`.
+//!
+//! Sound because the value and the variable hold the same words from the load until
+//! the variable is next written, and every use of the value comes before that:
+//! - the uses counted are those of the load and of the expressions that share its
+//!   registers (a field or component taken with a constant index, a bitcast); their
+//!   number must equal naga's reference counts, so a use this analysis does not see
+//!   (an expression kind it does not list, the continuing block of a loop reading a
+//!   body's value) keeps the copy;
+//! - they all lie in the rest of the block that emits the load, and no statement from
+//!   the load up to and including the one holding the last use may write the variable
+//!   (a store or call through a pointer into it, or a statement this file does not
+//!   know); a statement containing a loop counts as a whole, so a store later in a loop
+//!   body that also holds a use is seen;
+//! - instructions that write a variable from an operand are only the stores: a copy,
+//!   or the value's own instruction where store forwarding checks its operands'
+//!   overlap, or if-conversion's selects, which check that no select reads what an
+//!   earlier one wrote.
+
+use naga::valid::FunctionInfo;
+use naga::{Block, Expression, Function, Handle, LocalVariable, Statement};
+
+/// Per expression of `function` (validated: `info`): true for a load that may read its
+/// variable's registers in place.
+pub(super) fn in_place_loads(function: &Function, info: &FunctionInfo) -> Vec<bool> {
+    let expressions = &function.expressions;
+    let count = expressions.len();
+    // The load whose registers each expression shares, if any.
+    let mut shares: Vec<Option<Handle<Expression>>> = vec![None; count];
+    // Per candidate load: the uses of every expression sharing its registers.
+    let mut uses_needed = vec![0usize; count];
+    for (handle, expression) in expressions.iter() {
+        let load = match *expression {
+            Expression::Load { pointer } if local_place(function, pointer).is_some() => Some(handle),
+            Expression::AccessIndex { base, .. } => shares[base.index()],
+            Expression::As { expr, convert: None, .. } => shares[expr.index()],
+            _ => None,
+        };
+        if let Some(load) = load {
+            shares[handle.index()] = Some(load);
+            uses_needed[load.index()] += info[handle].ref_count;
+        }
+    }
+    let analysis = Analysis { function, shares, uses_needed };
+    let mut in_place = vec![false; count];
+    analysis.block(&function.body, &mut in_place);
+    in_place
+}
+
+/// The local variable `pointer` points into at an offset known when compiling (a chain
+/// of constant indices from the variable), if it does.
+fn local_place(function: &Function, mut pointer: Handle<Expression>) -> Option<Handle<LocalVariable>> {
+    loop {
+        match function.expressions[pointer] {
+            Expression::AccessIndex { base, .. } => pointer = base,
+            Expression::LocalVariable(variable) => return Some(variable),
+            _ => return None,
+        }
+    }
+}
+
+/// The local variable `pointer` points into, at any offset.
+fn local_root(function: &Function, mut pointer: Handle<Expression>) -> Option<Handle<LocalVariable>> {
+    loop {
+        match function.expressions[pointer] {
+            Expression::AccessIndex { base, .. } | Expression::Access { base, .. } => pointer = base,
+            Expression::LocalVariable(variable) => return Some(variable),
+            _ => return None,
+        }
+    }
+}
+
+struct Analysis<'a> {
+    function: &'a Function,
+    /// Per expression: the candidate load whose registers it shares.
+    shares: Vec<Option<Handle<Expression>>>,
+    /// Per candidate load: the references to it and to the expressions sharing it.
+    uses_needed: Vec<usize>,
+}
+
+impl Analysis<'_> {
+    /// Decides every candidate load emitted in `block` and in the blocks it contains.
+    fn block(&self, block: &Block, in_place: &mut [bool]) {
+        for (at, statement) in block.iter().enumerate() {
+            match statement {
+                Statement::Emit(range) => {
+                    for handle in range.clone() {
+                        if let Expression::Load { pointer } = self.function.expressions[handle]
+                            && self.shares[handle.index()] == Some(handle)
+                        {
+                            let variable = local_place(self.function, pointer).expect("a candidate");
+                            in_place[handle.index()] = self.reads_in_place(block, at, handle, variable);
+                        }
+                    }
+                }
+                _ => self.nested(statement, |inner| self.block(inner, in_place)),
+            }
+        }
+    }
+
+    /// Whether every use of `load` (emitted by statement `at` of `block`, a load of
+    /// `variable`) comes before anything may write `variable`.
+    fn reads_in_place(
+        &self,
+        block: &Block,
+        at: usize,
+        load: Handle<Expression>,
+        variable: Handle<LocalVariable>,
+    ) -> bool {
+        let needed = self.uses_needed[load.index()];
+        let Statement::Emit(range) = &block[at] else { return false };
+        // Expressions emitted after the load by the same statement.
+        let mut found: usize = range
+            .clone()
+            .filter(|h| h.index() > load.index())
+            .map(|h| self.expression_uses(&self.function.expressions[h], load))
+            .sum();
+        for statement in block.iter().skip(at + 1) {
+            if found >= needed {
+                break;
+            }
+            if self.may_write(statement, variable) {
+                return false;
+            }
+            found += self.statement_uses(statement, load);
+        }
+        found == needed
+    }
+
+    /// How many times `expression` reads `load`'s registers as an operand.
+    fn expression_uses(&self, expression: &Expression, load: Handle<Expression>) -> usize {
+        let mut uses = 0;
+        let mut operand = |h: Handle<Expression>| uses += usize::from(self.shares[h.index()] == Some(load));
+        match *expression {
+            Expression::Compose { ref components, .. } => components.iter().for_each(|&c| operand(c)),
+            Expression::Access { base, index } => {
+                operand(base);
+                operand(index);
+            }
+            Expression::AccessIndex { base, .. } => operand(base),
+            Expression::Splat { value, .. } => operand(value),
+            Expression::Swizzle { vector, .. } => operand(vector),
+            Expression::Load { pointer } => operand(pointer),
+            Expression::Unary { expr, .. }
+            | Expression::As { expr, .. }
+            | Expression::Derivative { expr, .. }
+            | Expression::Relational { argument: expr, .. }
+            | Expression::ArrayLength(expr) => operand(expr),
+            Expression::Binary { left, right, .. } => {
+                operand(left);
+                operand(right);
+            }
+            Expression::Select { condition, accept, reject } => {
+                operand(condition);
+                operand(accept);
+                operand(reject);
+            }
+            Expression::Math { arg, arg1, arg2, arg3, .. } => {
+                operand(arg);
+                [arg1, arg2, arg3].into_iter().flatten().for_each(operand);
+            }
+            // Others are not counted: a load they read keeps its copy (the counts differ).
+            _ => {}
+        }
+        uses
+    }
+
+    /// How many times `statement` (with the blocks it contains) reads `load`'s registers.
+    fn statement_uses(&self, statement: &Statement, load: Handle<Expression>) -> usize {
+        let counts = |h: Handle<Expression>| usize::from(self.shares[h.index()] == Some(load));
+        let own = match *statement {
+            Statement::Emit(ref range) => {
+                range.clone().map(|h| self.expression_uses(&self.function.expressions[h], load)).sum()
+            }
+            Statement::If { condition, .. } => counts(condition),
+            Statement::Switch { selector, .. } => counts(selector),
+            Statement::Loop { break_if, .. } => break_if.map_or(0, counts),
+            Statement::Return { value } => value.map_or(0, counts),
+            Statement::Store { pointer, value } => counts(pointer) + counts(value),
+            Statement::Call { ref arguments, .. } => arguments.iter().map(|&a| counts(a)).sum(),
+            _ => 0,
+        };
+        let mut inner = 0;
+        self.nested(statement, |block| inner += block.iter().map(|s| self.statement_uses(s, load)).sum::<usize>());
+        own + inner
+    }
+
+    /// Whether running `statement` may write `variable`'s registers: a store or an
+    /// atomic through a pointer into it, a call given such a pointer, or a statement kind
+    /// not known to write only elsewhere.
+    fn may_write(&self, statement: &Statement, variable: Handle<LocalVariable>) -> bool {
+        let into = |pointer: Handle<Expression>| local_root(self.function, pointer) == Some(variable);
+        let own = match *statement {
+            Statement::Store { pointer, .. } | Statement::Atomic { pointer, .. } => into(pointer),
+            Statement::Call { ref arguments, .. } => arguments.iter().any(|&a| into(a)),
+            Statement::Emit(_)
+            | Statement::Block(_)
+            | Statement::If { .. }
+            | Statement::Switch { .. }
+            | Statement::Loop { .. }
+            | Statement::Break
+            | Statement::Continue
+            | Statement::Return { .. }
+            | Statement::Kill
+            | Statement::ControlBarrier(_)
+            | Statement::MemoryBarrier(_)
+            | Statement::ImageStore { .. }
+            | Statement::WorkGroupUniformLoad { .. }
+            | Statement::SubgroupBallot { .. }
+            | Statement::SubgroupGather { .. }
+            | Statement::SubgroupCollectiveOperation { .. } => false,
+            _ => true,
+        };
+        let mut inner = false;
+        self.nested(statement, |block| inner |= block.iter().any(|s| self.may_write(s, variable)));
+        own || inner
+    }
+
+    /// Calls `visit` with each block `statement` contains.
+    fn nested(&self, statement: &Statement, mut visit: impl FnMut(&Block)) {
+        match statement {
+            Statement::Block(block) => visit(block),
+            Statement::If { accept, reject, .. } => {
+                visit(accept);
+                visit(reject);
+            }
+            Statement::Switch { cases, .. } => cases.iter().for_each(|case| visit(&case.body)),
+            Statement::Loop { body, continuing, .. } => {
+                visit(body);
+                visit(continuing);
+            }
+            _ => {}
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::decode::tests::compiled;
+    use super::super::insn::Insn;
+
+    fn copies(body: &str) -> usize {
+        compiled(body).iter().filter(|i| matches!(i, Insn::Copy1 { .. })).count()
+    }
+
+    #[test]
+    fn loads_read_in_place_until_their_variable_is_written() {
+        // The copies of declaring `k` and `a` (their initialisers).
+        let declared = copies("var k = 0u; var a = x; data[id.x] = k + a;");
+        // The loop's head reads `k`, its end stores `k`: no copy for the loads.
+        let loop_body = "var k = 0u; var a = x; loop { let cur = k; if cur >= a { break; } k = cur + 1u; } \
+            data[id.x] = k + a;";
+        assert_eq!(copies(loop_body), declared);
+        // The loaded value is used after the store: one copy keeps it.
+        assert_eq!(copies("var k = 0u; var a = x; let old = a; a = a + 5u; data[id.x] = old + a + k;"), declared + 1);
+        // A call given a pointer to the variable writes it: `old` keeps a copy.
+        let bump = "} fn bump(p: ptr<function, u32>) { *p += 1u;";
+        let without_old = copies(&format!("var a = x; bump(&a); data[id.x] = a; {bump}"));
+        assert_eq!(copies(&format!("var a = x; let old = a; bump(&a); data[id.x] = old + a; {bump}")), without_old + 1);
+    }
+}

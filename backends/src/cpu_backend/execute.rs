@@ -73,11 +73,7 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
                         let memory = &buffers[(tag & !TAG_MASK) as usize];
                         match memory.get(offset / 4..offset / 4 + len) {
                             // Inside the buffer (the common case): one bounds check.
-                            Some(words) => {
-                                for (i, word) in words.iter().enumerate() {
-                                    regs[dst + i] = word.load(Ordering::Relaxed);
-                                }
-                            }
+                            Some(words) => regs.write_each(dst, words.iter().map(|w| w.load(Ordering::Relaxed))),
                             None => {
                                 for i in 0..len {
                                     regs[dst + i] = memory.get(offset / 4 + i).map_or(0, |w| w.load(Ordering::Relaxed));

@@ -34,18 +34,44 @@ impl<'a> LaneRegs<'a> {
         self.words.len() / self.width
     }
 
-    /// Registers `reg..reg + len`, copied out.
+    /// Registers `reg..reg + len`, copied out (through an array: collecting into the
+    /// small vector word by word cost more than the instructions that read them).
     #[inline(always)]
     pub(super) fn read(&self, reg: usize, len: usize) -> Words {
-        (reg..reg + len).map(|r| self[r]).collect()
+        const INLINE: usize = 16;
+        if len > INLINE {
+            return (reg..reg + len).map(|r| self[r]).collect();
+        }
+        let mut words = [0u32; INLINE];
+        for (word, &value) in words.iter_mut().zip(self.column(reg, len)) {
+            *word = value;
+        }
+        Words::from_buf_and_len(words, len)
     }
 
     /// Writes `value` into registers `reg..`.
     #[inline(always)]
     pub(super) fn write(&mut self, reg: usize, value: &[u32]) {
-        for (i, &word) in value.iter().enumerate() {
-            self[reg + i] = word;
+        self.write_each(reg, value.iter().copied());
+    }
+
+    /// Writes the words `values` yields into registers `reg..` (one bounds check for the
+    /// whole column, not one per word).
+    #[inline(always)]
+    pub(super) fn write_each(&mut self, reg: usize, values: impl ExactSizeIterator<Item = u32>) {
+        let len = values.len();
+        assert!(len == 0 || (reg + len - 1) * self.width + self.lane < self.words.len(), "registers in the file");
+        let column = self.words[reg * self.width + self.lane..].iter_mut().step_by(self.width);
+        for (slot, value) in column.zip(values) {
+            *slot = value;
         }
+    }
+
+    /// Registers `reg..reg + len`, in order.
+    #[inline(always)]
+    fn column(&self, reg: usize, len: usize) -> impl Iterator<Item = &u32> {
+        assert!(len == 0 || (reg + len - 1) * self.width + self.lane < self.words.len(), "registers in the file");
+        self.words[reg * self.width + self.lane..].iter().step_by(self.width).take(len)
     }
 
     /// Copies registers `src..src + len` to `dst..` (the ranges may overlap: the copy

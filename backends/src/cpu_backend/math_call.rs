@@ -146,7 +146,13 @@ fn component_rows(
     Box::new(move |file: &mut [u32], members: Members| {
         for i in 0..n {
             let row = |o: Option<Operand>| o.map(|(r, s)| r + i * s);
-            members.ternary(file, dst + i, a + i * sa, row(b), row(c), f);
+            // One and two operands as the row operations the compiler vectorises over a
+            // whole group (`min`, `max`, `abs`, ... in a BVH loop's box tests).
+            match (row(b), row(c)) {
+                (None, None) => members.unary(file, dst + i, a + i * sa, 1, |x| f(x, 0, 0)),
+                (Some(b), None) => members.binary(file, (dst + i, a + i * sa, b), 1, |x, y| f(x, y, 0)),
+                (b, c) => members.ternary(file, dst + i, a + i * sa, b, c, f),
+            }
         }
     })
 }
@@ -330,7 +336,10 @@ impl Compiler<'_> {
                         } else if let (M::Dot, ScalarKind::Float, Some(b)) = (fun, kind, b) {
                             let (a, b, dst) = (a.0 as usize, b.0 as usize, dst as usize);
                             Ok(per_lane(move |regs: &mut LaneRegs| {
-                                regs[dst] = dot(&regs.read(a, comps), &regs.read(b, comps)).to_bits();
+                                // `dot`'s order of operations, without copying the operands out.
+                                let f = |r: usize| f32::from_bits(regs[r]);
+                                let sum = (1..comps).fold(f(a) * f(b), |sum, i| sum + f(a + i) * f(b + i));
+                                regs[dst] = sum.to_bits();
                             }))
                         } else {
                             Ok(per_lane(move |regs: &mut LaneRegs| {

@@ -5,11 +5,12 @@
 //! Each kernel is compiled once into a register bytecode (`insn`, compiled by
 //! `decode` and `expression`): instructions whose operands are word offsets in the
 //! frame's register file, small callees inlined, fields and bitcasts aliasing their
-//! source's registers, compile-time values in a register template. Three passes make
+//! source's registers, compile-time values in a register template. Four passes make
 //! the code shorter and less divergent: an `if` that only stores into locals becomes
 //! selects (`if_conversion`), a value stored right after it is computed goes straight
-//! into the variable (`retarget`), and jumps to jumps or to the next instruction are
-//! tidied away (`jump_cleanup`). `interp` runs it;
+//! into the variable (`retarget`), a local's load reads the variable's registers where
+//! nothing writes it before the value's last use (`load_alias`), and jumps to jumps or
+//! to the next instruction are tidied away (`jump_cleanup`). `interp` runs it;
 //! `memory` is the pointer model (offsets in bytes into bound buffers, in register
 //! words elsewhere). Workgroups run in parallel on the machine's cores;
 //! the invocations of a workgroup run together from barrier to barrier (`exec`), each

@@ -15,7 +15,7 @@ const PASSES: &str = r#"
 
 struct Pair { a: u32, b: u32 }
 
-const OUTPUTS: u32 = 20u;
+const OUTPUTS: u32 = 21u;
 
 fn bump(p: ptr<function, u32>) {
     *p += 10u;
@@ -177,10 +177,17 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let before = bp;
     bump(&bp);
     output[o + 19u] = before * 2u + bp;
+
+    // If-conversion where one branch stores a variable the other branch reads in place:
+    // each side's lanes see the variable as it was.
+    var a3 = 0u;
+    var b3 = x;
+    if c { b3 = 0u; } else { a3 = b3; }
+    output[o + 20u] = a3 * 1000u + b3;
 }
 "#;
 
-const OUTPUTS: usize = 20;
+const OUTPUTS: usize = 21;
 
 /// The kernel's program in Rust.
 fn reference(x: u32) -> [u32; OUTPUTS] {
@@ -249,6 +256,7 @@ fn reference(x: u32) -> [u32; OUTPUTS] {
     let flag = x & 8 == 0;
     out[18] = u32::from(flag) * 10 + if x & 8 != 0 { 1 } else { 2 };
     out[19] = x.wrapping_mul(2).wrapping_add(x.wrapping_add(10));
+    out[20] = if c { 0 } else { x.wrapping_mul(1000).wrapping_add(x) };
     out
 }
 

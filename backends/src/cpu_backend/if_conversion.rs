@@ -15,7 +15,9 @@
 //! every input in WGSL (division by zero, out-of-range indices clamped, out-of-bounds
 //! memory reads 0), and the stores are deferred to the selects after both branches'
 //! expressions, each of which was emitted before the first store of its branch or does
-//! not read memory. The compiled branches are checked instruction by instruction; if
+//! not read memory. A value may be a variable's own registers (a load read in place,
+//! [`super::load_alias`]), read when its select runs: the selects are refused if one
+//! would read a variable that an earlier select changed in the same branch's lanes. The compiled branches are checked instruction by instruction; if
 //! one holds anything but register and memory reads (a runtime failure for an
 //! unsupported construct, a jump), the compilation is undone and the `if` is compiled
 //! as a branch.
@@ -234,18 +236,23 @@ fn merge(accept: &[LocalStore], reject: &[LocalStore]) -> Option<Vec<(Reg, u32, 
     Some(selects)
 }
 
-/// Whether the selects, run in order, read only values their branches computed before
-/// any store: no select reads a variable an earlier one wrote (a value may be a load
-/// read in place, [`super::load_alias`]), the condition is no variable, and a select's
-/// value is its own variable exactly or lies apart from it.
+/// Whether the selects, run in order, read only what the branches read before any
+/// store (a value may be a variable's registers, a load read in place:
+/// [`super::load_alias`]): no select reads, on one side of the branch, a variable that an
+/// earlier select wrote on that side (a variable a branch does not store keeps its
+/// words in that branch's lanes), the condition is no variable, and a select's value is
+/// its own variable exactly or lies apart from it.
 fn reads_before_writes(selects: &[(Reg, u32, Reg, Reg)], cond: Reg) -> bool {
     let apart = |at: Reg, len: u32, other: Reg, other_len: u32| at + len <= other || other + other_len <= at;
     selects.iter().enumerate().all(|(i, &(variable, len, accept, reject))| {
-        apart(cond, 1, variable, len)
-            && [accept, reject].iter().all(|&value| {
-                (value == variable || apart(value, len, variable, len))
-                    && selects[..i].iter().all(|&(written, words, ..)| apart(value, len, written, words))
-            })
+        let side_reads_before_writes = |side: usize, value: Reg| {
+            (value == variable || apart(value, len, variable, len))
+                && selects[..i].iter().all(|&(written, words, earlier_accept, earlier_reject)| {
+                    let stored = if side == 0 { earlier_accept } else { earlier_reject };
+                    stored == written || apart(value, len, written, words)
+                })
+        };
+        apart(cond, 1, variable, len) && side_reads_before_writes(0, accept) && side_reads_before_writes(1, reject)
     })
 }
 
@@ -273,5 +280,13 @@ mod tests {
         assert!(branches(&compiled("var t = 0u; if x > 3u { t = x; t = t * 2u; } data[id.x] = t;")) > 0);
         // The same without the reload is converted.
         assert_eq!(branches(&compiled("var t = 0u; if x > 3u { t = x * 2u; } data[id.x] = t;")), 0);
+        // A branch storing a variable the other reads in place: converted (each side's
+        // lanes see the variable unchanged) ...
+        let other_side = "var a = 0u; var b = x; if x > 3u { b = 0u; } else { a = b; } data[id.x] = a + b;";
+        assert_eq!(branches(&compiled(other_side)), 0);
+        // ... but not where both branches store it and one reads it first.
+        let both_sides = "var a = 0u; var b = x; if x > 3u { b = 9u; } else { let t = b; a = t; b = 4u; } \
+            data[id.x] = a + b;";
+        assert!(branches(&compiled(both_sides)) > 0);
     }
 }

@@ -61,7 +61,8 @@ impl<'a> LaneRegs<'a> {
     pub(super) fn write_each(&mut self, reg: usize, values: impl ExactSizeIterator<Item = u32>) {
         let len = values.len();
         assert!(len == 0 || (reg + len - 1) * self.width + self.lane < self.words.len(), "registers in the file");
-        let column = self.words[reg * self.width + self.lane..].iter_mut().step_by(self.width);
+        let start = (reg * self.width + self.lane).min(self.words.len());
+        let column = self.words[start..].iter_mut().step_by(self.width);
         for (slot, value) in column.zip(values) {
             *slot = value;
         }
@@ -71,7 +72,8 @@ impl<'a> LaneRegs<'a> {
     #[inline(always)]
     fn column(&self, reg: usize, len: usize) -> impl Iterator<Item = &u32> {
         assert!(len == 0 || (reg + len - 1) * self.width + self.lane < self.words.len(), "registers in the file");
-        self.words[reg * self.width + self.lane..].iter().step_by(self.width).take(len)
+        let start = (reg * self.width + self.lane).min(self.words.len());
+        self.words[start..].iter().step_by(self.width).take(len)
     }
 
     /// Copies registers `src..src + len` to `dst..` (the ranges may overlap: the copy

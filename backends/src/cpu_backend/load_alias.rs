@@ -18,12 +18,15 @@
 //! - they all lie in the rest of the block that emits the load, and no statement from
 //!   the load up to and including the one holding the last use may write the variable
 //!   (a store or call through a pointer into it, or a statement this file does not
-//!   know); a statement containing a loop counts as a whole, so a store later in a loop
-//!   body that also holds a use is seen;
-//! - instructions that write a variable from an operand are only the stores: a copy,
-//!   or the value's own instruction where store forwarding checks its operands'
-//!   overlap, or if-conversion's selects, which check that no select reads what an
-//!   earlier one wrote.
+//!   know); a compound statement (`if`, `switch`, loop, block) counts as a whole, so a
+//!   store later in a loop body that also holds a use is seen; an expression that reads
+//!   the load and is emitted twice (naga IR allows it in two branches, WGSL does not
+//!   produce it) keeps the copy, as its uses would be counted twice;
+//! - instructions that write a variable are only those of its stores: a copy; the
+//!   value's own instruction moved by store forwarding, which is the last instruction
+//!   before the store, so nothing runs in between; or if-conversion's selects, which run
+//!   after both branches' values and check that none reads a variable an earlier select
+//!   wrote on its side of the branch.
 
 use naga::valid::FunctionInfo;
 use naga::{Block, Expression, Function, Handle, LocalVariable, Statement};
@@ -117,12 +120,13 @@ impl Analysis<'_> {
     ) -> bool {
         let needed = self.uses_needed[load.index()];
         let Statement::Emit(range) = &block[at] else { return false };
+        // The expressions reading the load, each counted where it is emitted (once).
+        let mut readers = Vec::new();
         // Expressions emitted after the load by the same statement.
-        let mut found: usize = range
-            .clone()
-            .filter(|h| h.index() > load.index())
-            .map(|h| self.expression_uses(&self.function.expressions[h], load))
-            .sum();
+        let mut found = 0;
+        for handle in range.clone().filter(|h| h.index() > load.index()) {
+            found += self.emitted_uses(handle, load, &mut readers);
+        }
         for statement in block.iter().skip(at + 1) {
             if found >= needed {
                 break;
@@ -130,9 +134,24 @@ impl Analysis<'_> {
             if self.may_write(statement, variable) {
                 return false;
             }
-            found += self.statement_uses(statement, load);
+            found += self.statement_uses(statement, load, &mut readers);
         }
-        found == needed
+        found == needed && !readers.contains(&None)
+    }
+
+    /// The uses of `load` by `handle`, emitted here; a second emission of a reader is
+    /// recorded as `None` in `readers` (refused by the caller).
+    fn emitted_uses(
+        &self,
+        handle: Handle<Expression>,
+        load: Handle<Expression>,
+        readers: &mut Vec<Option<Handle<Expression>>>,
+    ) -> usize {
+        let uses = self.expression_uses(&self.function.expressions[handle], load);
+        if uses > 0 {
+            readers.push(if readers.contains(&Some(handle)) { None } else { Some(handle) });
+        }
+        uses
     }
 
     /// How many times `expression` reads `load`'s registers as an operand.
@@ -174,12 +193,16 @@ impl Analysis<'_> {
     }
 
     /// How many times `statement` (with the blocks it contains) reads `load`'s registers.
-    fn statement_uses(&self, statement: &Statement, load: Handle<Expression>) -> usize {
+    fn statement_uses(
+        &self,
+        statement: &Statement,
+        load: Handle<Expression>,
+        readers: &mut Vec<Option<Handle<Expression>>>,
+    ) -> usize {
         let counts = |h: Handle<Expression>| usize::from(self.shares[h.index()] == Some(load));
         let own = match *statement {
-            Statement::Emit(ref range) => {
-                range.clone().map(|h| self.expression_uses(&self.function.expressions[h], load)).sum()
-            }
+            Statement::Emit(ref range) => range.clone().map(|h| self.emitted_uses(h, load, readers)).sum(),
+
             Statement::If { condition, .. } => counts(condition),
             Statement::Switch { selector, .. } => counts(selector),
             Statement::Loop { break_if, .. } => break_if.map_or(0, counts),
@@ -189,7 +212,9 @@ impl Analysis<'_> {
             _ => 0,
         };
         let mut inner = 0;
-        self.nested(statement, |block| inner += block.iter().map(|s| self.statement_uses(s, load)).sum::<usize>());
+        self.nested(statement, |block| {
+            inner += block.iter().map(|s| self.statement_uses(s, load, readers)).sum::<usize>()
+        });
         own + inner
     }
 

@@ -245,14 +245,14 @@ fn merge(accept: &[LocalStore], reject: &[LocalStore]) -> Option<Vec<(Reg, u32, 
 fn reads_before_writes(selects: &[(Reg, u32, Reg, Reg)], cond: Reg) -> bool {
     let apart = |at: Reg, len: u32, other: Reg, other_len: u32| at + len <= other || other + other_len <= at;
     selects.iter().enumerate().all(|(i, &(variable, len, accept, reject))| {
-        let side_reads_before_writes = |side: usize, value: Reg| {
+        // `value`, read on the side whose stored values `side` picks from a select.
+        let reads_before_writes = |value: Reg, side: fn(&(Reg, u32, Reg, Reg)) -> Reg| {
             (value == variable || apart(value, len, variable, len))
-                && selects[..i].iter().all(|&(written, words, earlier_accept, earlier_reject)| {
-                    let stored = if side == 0 { earlier_accept } else { earlier_reject };
-                    stored == written || apart(value, len, written, words)
-                })
+                && selects[..i]
+                    .iter()
+                    .all(|earlier| side(earlier) == earlier.0 || apart(value, len, earlier.0, earlier.1))
         };
-        apart(cond, 1, variable, len) && side_reads_before_writes(0, accept) && side_reads_before_writes(1, reject)
+        apart(cond, 1, variable, len) && reads_before_writes(accept, |s| s.2) && reads_before_writes(reject, |s| s.3)
     })
 }
 

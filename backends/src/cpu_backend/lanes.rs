@@ -59,9 +59,7 @@ impl<'a> LaneRegs<'a> {
     /// whole column, not one per word).
     #[inline(always)]
     pub(super) fn write_each(&mut self, reg: usize, values: impl ExactSizeIterator<Item = u32>) {
-        let len = values.len();
-        assert!(len == 0 || (reg + len - 1) * self.width + self.lane < self.words.len(), "registers in the file");
-        let start = (reg * self.width + self.lane).min(self.words.len());
+        let start = self.column_start(reg, values.len());
         let column = self.words[start..].iter_mut().step_by(self.width);
         for (slot, value) in column.zip(values) {
             *slot = value;
@@ -71,9 +69,14 @@ impl<'a> LaneRegs<'a> {
     /// Registers `reg..reg + len`, in order.
     #[inline(always)]
     fn column(&self, reg: usize, len: usize) -> impl Iterator<Item = &u32> {
+        self.words[self.column_start(reg, len)..].iter().step_by(self.width).take(len)
+    }
+
+    /// Where registers `reg..reg + len` start in the file, checked to lie in it.
+    #[inline(always)]
+    fn column_start(&self, reg: usize, len: usize) -> usize {
         assert!(len == 0 || (reg + len - 1) * self.width + self.lane < self.words.len(), "registers in the file");
-        let start = (reg * self.width + self.lane).min(self.words.len());
-        self.words[start..].iter().step_by(self.width).take(len)
+        (reg * self.width + self.lane).min(self.words.len())
     }
 
     /// Copies registers `src..src + len` to `dst..` (the ranges may overlap: the copy

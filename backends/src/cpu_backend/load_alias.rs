@@ -42,7 +42,7 @@ pub(super) fn in_place_loads(function: &Function, info: &FunctionInfo) -> Vec<bo
     let mut uses_needed = vec![0usize; count];
     for (handle, expression) in expressions.iter() {
         let load = match *expression {
-            Expression::Load { pointer } if local_place(function, pointer).is_some() => Some(handle),
+            Expression::Load { pointer } if variable_of(function, pointer, Indices::Constant).is_some() => Some(handle),
             Expression::AccessIndex { base, .. } => shares[base.index()],
             Expression::As { expr, convert: None, .. } => shares[expr.index()],
             _ => None,
@@ -58,27 +58,40 @@ pub(super) fn in_place_loads(function: &Function, info: &FunctionInfo) -> Vec<bo
     in_place
 }
 
-/// The local variable `pointer` points into at an offset known when compiling (a chain
-/// of constant indices from the variable), if it does.
-fn local_place(function: &Function, mut pointer: Handle<Expression>) -> Option<Handle<LocalVariable>> {
+/// How a pointer may reach its variable: through constant indices only (an offset known
+/// when compiling, what a load read in place needs) or through any index (what a store
+/// may write).
+#[derive(Clone, Copy, PartialEq)]
+enum Indices {
+    Constant,
+    Any,
+}
+
+/// The local variable `pointer` points into through `indices`, if it does.
+fn variable_of(
+    function: &Function,
+    mut pointer: Handle<Expression>,
+    indices: Indices,
+) -> Option<Handle<LocalVariable>> {
     loop {
         match function.expressions[pointer] {
             Expression::AccessIndex { base, .. } => pointer = base,
+            Expression::Access { base, .. } if indices == Indices::Any => pointer = base,
             Expression::LocalVariable(variable) => return Some(variable),
             _ => return None,
         }
     }
 }
 
-/// The local variable `pointer` points into, at any offset.
-fn local_root(function: &Function, mut pointer: Handle<Expression>) -> Option<Handle<LocalVariable>> {
-    loop {
-        match function.expressions[pointer] {
-            Expression::AccessIndex { base, .. } | Expression::Access { base, .. } => pointer = base,
-            Expression::LocalVariable(variable) => return Some(variable),
-            _ => return None,
-        }
-    }
+/// What a scan for a load's uses has found so far.
+#[derive(Default)]
+struct Uses {
+    /// Uses counted.
+    found: usize,
+    /// The expressions emitted with a use, in order.
+    readers: Vec<Handle<Expression>>,
+    /// Whether one of them was emitted twice (its uses counted twice: refused).
+    emitted_twice: bool,
 }
 
 struct Analysis<'a> {
@@ -99,7 +112,7 @@ impl Analysis<'_> {
                         if let Expression::Load { pointer } = self.function.expressions[handle]
                             && self.shares[handle.index()] == Some(handle)
                         {
-                            let variable = local_place(self.function, pointer).expect("a candidate");
+                            let variable = variable_of(self.function, pointer, Indices::Constant).expect("a candidate");
                             in_place[handle.index()] = self.reads_in_place(block, at, handle, variable);
                         }
                     }
@@ -120,38 +133,31 @@ impl Analysis<'_> {
     ) -> bool {
         let needed = self.uses_needed[load.index()];
         let Statement::Emit(range) = &block[at] else { return false };
-        // The expressions reading the load, each counted where it is emitted (once).
-        let mut readers = Vec::new();
+        let mut uses = Uses::default();
         // Expressions emitted after the load by the same statement.
-        let mut found = 0;
         for handle in range.clone().filter(|h| h.index() > load.index()) {
-            found += self.emitted_uses(handle, load, &mut readers);
+            self.emitted_uses(handle, load, &mut uses);
         }
         for statement in block.iter().skip(at + 1) {
-            if found >= needed {
+            if uses.found >= needed {
                 break;
             }
             if self.may_write(statement, variable) {
                 return false;
             }
-            found += self.statement_uses(statement, load, &mut readers);
+            self.statement_uses(statement, load, &mut uses);
         }
-        found == needed && !readers.contains(&None)
+        uses.found == needed && !uses.emitted_twice
     }
 
-    /// The uses of `load` by `handle`, emitted here; a second emission of a reader is
-    /// recorded as `None` in `readers` (refused by the caller).
-    fn emitted_uses(
-        &self,
-        handle: Handle<Expression>,
-        load: Handle<Expression>,
-        readers: &mut Vec<Option<Handle<Expression>>>,
-    ) -> usize {
-        let uses = self.expression_uses(&self.function.expressions[handle], load);
-        if uses > 0 {
-            readers.push(if readers.contains(&Some(handle)) { None } else { Some(handle) });
+    /// Counts the uses of `load` by `handle`, emitted here, into `uses`.
+    fn emitted_uses(&self, handle: Handle<Expression>, load: Handle<Expression>, uses: &mut Uses) {
+        let found = self.expression_uses(&self.function.expressions[handle], load);
+        if found > 0 {
+            uses.emitted_twice |= uses.readers.contains(&handle);
+            uses.readers.push(handle);
+            uses.found += found;
         }
-        uses
     }
 
     /// How many times `expression` reads `load`'s registers as an operand.
@@ -192,17 +198,13 @@ impl Analysis<'_> {
         uses
     }
 
-    /// How many times `statement` (with the blocks it contains) reads `load`'s registers.
-    fn statement_uses(
-        &self,
-        statement: &Statement,
-        load: Handle<Expression>,
-        readers: &mut Vec<Option<Handle<Expression>>>,
-    ) -> usize {
+    /// Counts the uses of `load` by `statement` (with the blocks it contains) into `uses`.
+    fn statement_uses(&self, statement: &Statement, load: Handle<Expression>, uses: &mut Uses) {
         let counts = |h: Handle<Expression>| usize::from(self.shares[h.index()] == Some(load));
-        let own = match *statement {
-            Statement::Emit(ref range) => range.clone().map(|h| self.emitted_uses(h, load, readers)).sum(),
-
+        if let Statement::Emit(ref range) = *statement {
+            range.clone().for_each(|h| self.emitted_uses(h, load, uses));
+        }
+        uses.found += match *statement {
             Statement::If { condition, .. } => counts(condition),
             Statement::Switch { selector, .. } => counts(selector),
             Statement::Loop { break_if, .. } => break_if.map_or(0, counts),
@@ -211,18 +213,14 @@ impl Analysis<'_> {
             Statement::Call { ref arguments, .. } => arguments.iter().map(|&a| counts(a)).sum(),
             _ => 0,
         };
-        let mut inner = 0;
-        self.nested(statement, |block| {
-            inner += block.iter().map(|s| self.statement_uses(s, load, readers)).sum::<usize>()
-        });
-        own + inner
+        self.nested(statement, |block| block.iter().for_each(|s| self.statement_uses(s, load, uses)));
     }
 
     /// Whether running `statement` may write `variable`'s registers: a store or an
     /// atomic through a pointer into it, a call given such a pointer, or a statement kind
     /// not known to write only elsewhere.
     fn may_write(&self, statement: &Statement, variable: Handle<LocalVariable>) -> bool {
-        let into = |pointer: Handle<Expression>| local_root(self.function, pointer) == Some(variable);
+        let into = |pointer: Handle<Expression>| variable_of(self.function, pointer, Indices::Any) == Some(variable);
         let own = match *statement {
             Statement::Store { pointer, .. } | Statement::Atomic { pointer, .. } => into(pointer),
             Statement::Call { ref arguments, .. } => arguments.iter().any(|&a| into(a)),

@@ -7,7 +7,8 @@
 //!
 //! The layer is switched on from outside (`VK_INSTANCE_LAYERS`, and a layer settings
 //! file through `VK_LAYER_SETTINGS_PATH`) so every program runs exactly as users run
-//! it. Each writes its own log under `target/validation/`; any error or warning that is
+//! it, one per core at a time (each with its own output folder). Each writes its own
+//! log under `target/validation/`; any error or warning that is
 //! not a best-practices note fails the run, naming the program and the message ID.
 //! Best-practices notes are counted and printed, not asserted (several are about
 //! desktop GPUs and do not apply to lavapipe).
@@ -25,7 +26,7 @@ use std::process::Command;
 struct Step {
     name: &'static str,
     program: PathBuf,
-    args: Vec<&'static str>,
+    args: Vec<String>,
 }
 
 /// The workspace root (xtask's manifest folder's parent).
@@ -79,9 +80,13 @@ pub fn validate() -> Result<()> {
     let target = root.join("target");
     let folder = target.join("validation");
     std::fs::create_dir_all(&folder).with_context(|| format!("{}: cannot create", folder.display()))?;
+    // The whole workspace's binaries and examples rather than the two packages': a build of
+    // a few packages resolves their dependencies' features for those packages alone, which
+    // differ from the workspace's (serde's `alloc`, bitflags' `std`), and rebuilt naga, wgpu
+    // and 47 other crates after `cargo test --workspace` (2 min 26 s on 2 cores).
     let status = Command::new(env!("CARGO"))
         .current_dir(&root)
-        .args(["build", "-q", "-p", "strata", "--bin", "strata", "-p", "strata-embed", "--examples"])
+        .args(["build", "-q", "--workspace", "--bins", "--examples"])
         .status()
         .context("cargo build")?;
     if !status.success() {
@@ -89,96 +94,95 @@ pub fn validate() -> Result<()> {
     }
     let debug = target.join("debug");
     let strata = debug.join("strata");
-    let out = folder.join("out");
-    let out_str = out.to_str().context("a UTF-8 target path")?.to_string();
-    let out_arg: &'static str = Box::leak(out_str.into_boxed_str());
     let small = ["--width", "24", "--height", "24"];
-    let compare = |extra: &[&'static str]| -> Vec<&'static str> {
+    // Each step writes into its own folder, so that steps can run side by side.
+    let out_of = |name: &str| -> Result<String> {
+        Ok(folder.join("out").join(name).to_str().context("a UTF-8 target path")?.to_string())
+    };
+    let compare = |name: &str, extra: &[&str]| -> Result<Vec<String>> {
         let mut args = vec!["compare"];
         args.extend(small);
-        args.extend(["--frames", "3", "--seeds", "2", "--reference-spp", "4", "--out", out_arg]);
+        args.extend(["--frames", "3", "--seeds", "2", "--reference-spp", "4"]);
         args.extend(extra);
-        args
+        Ok(args.into_iter().map(String::from).chain(["--out".to_string(), out_of(name)?]).collect())
     };
-    let render = |extra: &[&'static str]| -> Vec<&'static str> {
+    let render = |name: &str, extra: &[&str]| -> Result<Vec<String>> {
         let mut args = vec!["render"];
         args.extend(small);
-        args.extend(["--spp", "4", "--out", out_arg]);
+        args.extend(["--spp", "4"]);
         args.extend(extra);
-        args
+        Ok(args.into_iter().map(String::from).chain(["--out".to_string(), out_of(name)?]).collect())
     };
     let steps = vec![
-        Step { name: "render-wgpu", program: strata.clone(), args: render(&[]) },
-        Step { name: "render-ash", program: strata.clone(), args: render(&["--backend", "ash"]) },
-        Step { name: "compare-wgpu", program: strata.clone(), args: compare(&[]) },
-        Step { name: "compare-wgpu-accumulate", program: strata.clone(), args: compare(&["--accumulate"]) },
-        Step { name: "compare-ash", program: strata.clone(), args: compare(&["--backend", "ash"]) },
+        Step { name: "render-wgpu", program: strata.clone(), args: render("render-wgpu", &[])? },
+        Step { name: "render-ash", program: strata.clone(), args: render("render-ash", &["--backend", "ash"])? },
+        Step { name: "compare-wgpu", program: strata.clone(), args: compare("compare-wgpu", &[])? },
+        Step {
+            name: "compare-wgpu-accumulate",
+            program: strata.clone(),
+            args: compare("compare-wgpu-accumulate", &["--accumulate"])?,
+        },
+        Step { name: "compare-ash", program: strata.clone(), args: compare("compare-ash", &["--backend", "ash"])? },
         Step {
             name: "compare-ash-accumulate",
             program: strata.clone(),
-            args: compare(&["--backend", "ash", "--accumulate"]),
+            args: compare("compare-ash-accumulate", &["--backend", "ash", "--accumulate"])?,
         },
         Step { name: "wgpu_embed", program: debug.join("examples").join("wgpu_embed"), args: vec![] },
         Step { name: "ash_embed", program: debug.join("examples").join("ash_embed"), args: vec![] },
-        Step { name: "xtask-check", program: std::env::current_exe()?, args: vec!["check"] },
+        Step { name: "xtask-check", program: std::env::current_exe()?, args: vec!["check".to_string()] },
     ];
+    // The steps are independent processes, mostly on one core each (pipeline compilation
+    // and the layer's own work are single-threaded): one worker per core takes the next
+    // step, and the results are printed in the steps' order.
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(steps.len());
+    let mut outcomes: Vec<Option<Result<Outcome>>> = (0..steps.len()).map(|_| None).collect();
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..workers)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut done = Vec::new();
+                    while let Some(step) = steps.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed)) {
+                        let failed = run_step(step, &root, &folder);
+                        let stop = failed.is_err();
+                        done.push((step.name, failed));
+                        if stop {
+                            // Let the other worker finish its step, start no new one.
+                            next.store(steps.len(), std::sync::atomic::Ordering::Relaxed);
+                        }
+                    }
+                    done
+                })
+            })
+            .collect();
+        for handle in handles {
+            for (name, outcome) in handle.join().expect("a validation worker panicked") {
+                let index = steps.iter().position(|s| s.name == name).expect("a step of the list");
+                outcomes[index] = Some(outcome);
+            }
+        }
+    });
     let mut failures = Vec::new();
     let mut notes: BTreeMap<String, usize> = BTreeMap::new();
-    for step in &steps {
-        let log = folder.join(format!("{}.log", step.name));
-        let _ = std::fs::remove_file(&log);
-        let settings = folder.join(format!("{}.settings.txt", step.name));
-        std::fs::write(
-            &settings,
-            format!(
-                "khronos_validation.report_flags = error,warn,perf\n\
-                 khronos_validation.debug_action = VK_DBG_LAYER_ACTION_LOG_MSG\n\
-                 khronos_validation.log_filename = {}\n\
-                 khronos_validation.enables = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT,\
-                 VK_VALIDATION_FEATURE_ENABLE_BEST_PRACTICES_EXT\n",
-                log.display()
-            ),
-        )
-        .with_context(|| format!("{}: cannot write", settings.display()))?;
-        let output = Command::new(&step.program)
-            .args(&step.args)
-            .current_dir(&root)
-            .env("VK_INSTANCE_LAYERS", "VK_LAYER_KHRONOS_validation")
-            .env("VK_LAYER_SETTINGS_PATH", &settings)
-            .output()
-            .with_context(|| format!("{}: cannot run {}", step.name, step.program.display()))?;
-        if !output.status.success() {
-            let stderr = String::from_utf8_lossy(&output.stderr);
-            let last = stderr.lines().rev().find(|line| !line.trim().is_empty()).unwrap_or("(nothing on stderr)");
-            // The status says a signal too ("signal: 11 (SIGSEGV)"): a crash inside a layer
-            // or driver prints nothing of its own.
-            bail!("{} failed under the validation layer ({}): {last}", step.name, output.status);
-        }
-        let text = std::fs::read_to_string(&log).with_context(|| {
-            format!("{}: the validation layer wrote no log (is vulkan-validationlayers installed?)", log.display())
-        })?;
-        let mut errors: BTreeMap<String, usize> = BTreeMap::new();
-        for message in messages(&text) {
-            if is_best_practice(&message) {
-                *notes.entry(message.id).or_default() += 1;
-            } else if is_known_layer_mistake(&message) {
-                *notes.entry(format!("{} (the layer's mistake, see KNOWN_LAYER_MISTAKES)", message.id)).or_default() +=
-                    1;
-            } else {
-                *errors.entry(format!("{} ({})", message.id, message.severity)).or_default() += 1;
-            }
-        }
+    for (step, outcome) in steps.iter().zip(outcomes) {
+        let Some(outcome) = outcome else { continue };
+        let outcome = outcome?;
         println!(
-            "{:<26} {}",
+            "{:<26} {} ({:.0} s)",
             step.name,
-            if errors.is_empty() {
+            if outcome.errors.is_empty() {
                 "clean".to_string()
             } else {
-                format!("{} messages", errors.values().sum::<usize>())
-            }
+                format!("{} messages", outcome.errors.values().sum::<usize>())
+            },
+            outcome.seconds
         );
-        for (id, count) in errors {
-            failures.push(format!("{}: {id} x{count} (log: {})", step.name, log.display()));
+        for (id, count) in outcome.errors {
+            failures.push(format!("{}: {id} x{count} (log: {})", step.name, outcome.log.display()));
+        }
+        for (id, count) in outcome.notes {
+            *notes.entry(id).or_default() += count;
         }
     }
     if !notes.is_empty() {
@@ -192,6 +196,68 @@ pub fn validate() -> Result<()> {
     }
     println!("no validation error or warning, synchronization validation on, in {} programs", steps.len());
     Ok(())
+}
+
+/// What the layer said of one step: its errors and warnings, its best-practices notes
+/// and known layer mistakes (by ID, counted), where its log is and how long it ran.
+struct Outcome {
+    errors: BTreeMap<String, usize>,
+    notes: BTreeMap<String, usize>,
+    log: PathBuf,
+    seconds: f64,
+}
+
+/// Runs one step under the layer (its settings file and log in `folder`); an error if
+/// the program fails or the layer wrote no log.
+fn run_step(step: &Step, root: &Path, folder: &Path) -> Result<Outcome> {
+    let started = std::time::Instant::now();
+    let log = folder.join(format!("{}.log", step.name));
+    let _ = std::fs::remove_file(&log);
+    let settings = folder.join(format!("{}.settings.txt", step.name));
+    std::fs::write(
+        &settings,
+        format!(
+            "khronos_validation.report_flags = error,warn,perf\n\
+             khronos_validation.debug_action = VK_DBG_LAYER_ACTION_LOG_MSG\n\
+             khronos_validation.log_filename = {}\n\
+             khronos_validation.enables = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT,\
+             VK_VALIDATION_FEATURE_ENABLE_BEST_PRACTICES_EXT\n",
+            log.display()
+        ),
+    )
+    .with_context(|| format!("{}: cannot write", settings.display()))?;
+    let output = Command::new(&step.program)
+        .args(&step.args)
+        .current_dir(root)
+        .env("VK_INSTANCE_LAYERS", "VK_LAYER_KHRONOS_validation")
+        .env("VK_LAYER_SETTINGS_PATH", &settings)
+        .output()
+        .with_context(|| format!("{}: cannot run {}", step.name, step.program.display()))?;
+    if !output.status.success() {
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        let last = stderr.lines().rev().find(|line| !line.trim().is_empty()).unwrap_or("(nothing on stderr)");
+        // The status says a signal too ("signal: 11 (SIGSEGV)"): a crash inside a layer
+        // or driver prints nothing of its own.
+        bail!("{} failed under the validation layer ({}): {last}", step.name, output.status);
+    }
+    let text = std::fs::read_to_string(&log).with_context(|| {
+        format!("{}: the validation layer wrote no log (is vulkan-validationlayers installed?)", log.display())
+    })?;
+    let mut outcome =
+        Outcome { errors: BTreeMap::new(), notes: BTreeMap::new(), log, seconds: started.elapsed().as_secs_f64() };
+    for message in messages(&text) {
+        if is_best_practice(&message) {
+            *outcome.notes.entry(message.id).or_default() += 1;
+        } else if is_known_layer_mistake(&message) {
+            *outcome
+                .notes
+                .entry(format!("{} (the layer's mistake, see KNOWN_LAYER_MISTAKES)", message.id))
+                .or_default() += 1;
+        } else {
+            *outcome.errors.entry(format!("{} ({})", message.id, message.severity)).or_default() += 1;
+        }
+    }
+    Ok(outcome)
 }
 
 #[cfg(test)]

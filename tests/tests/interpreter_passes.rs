@@ -1,9 +1,10 @@
 //! The interpreter compiler's optimising passes keep WGSL's semantics: if-conversion
 //! (an `if` that only stores into local variables becomes selects), store forwarding (a
 //! value computed straight into the variable it is stored in), loads read in place (a
-//! loaded value that is the variable's own registers) and jump cleanup. The
-//! kernel below puts each pass at its edges, per invocation on divergent inputs, and
-//! its outputs are checked word for word against the same program written in Rust.
+//! loaded value that is the variable's own registers), struct loads of the fields used
+//! and jump cleanup. The kernels below put each pass at its edges, per invocation on
+//! divergent inputs, and their outputs are checked word for word against the same
+//! programs written in Rust.
 
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_kernels::Kernel;
@@ -309,4 +310,76 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
     let got = run_words(&mut cpu, &kernel, &[0], 1, 1);
     assert_eq!(got, [101]);
+}
+
+/// Structs loaded through a pointer load only the fields their uses read (the
+/// interpreter's `load_fields`): fields read directly, through a callee, in divergent
+/// branches; from a buffer (an index past the end clamps to the last element), from
+/// workgroup memory and from private memory; beside loads that must stay whole (a
+/// store of the whole value). Checked word for word against Rust.
+#[test]
+fn struct_loads_read_the_fields_their_uses_need() {
+    let source = r#"
+struct Quad { a: u32, b: u32, c: u32, d: u32 }
+@group(0) @binding(0) var<storage, read> quads: array<Quad>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+var<workgroup> shared_quads: array<Quad, 64>;
+var<private> own: array<Quad, 2>;
+
+fn cross(q: Quad) -> u32 {
+    return q.a * 7u + q.c;
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let i = id.x;
+    let o = i * 6u;
+    let q = quads[i];
+    output[o] = q.b * 3u + q.d;
+    output[o + 1u] = cross(quads[(i * 5u) % 64u]);
+    var picked = 0u;
+    if (q.a & 1u) != 0u {
+        picked = quads[i + 1000u].c;
+    } else {
+        let far = quads[63u - i];
+        picked = far.b + far.d * 2u;
+    }
+    output[o + 2u] = picked;
+    shared_quads[lane] = Quad(q.d, q.c, q.b, q.a);
+    workgroupBarrier();
+    let n = shared_quads[(lane + 9u) % 64u];
+    output[o + 3u] = n.a ^ (n.d << 4u);
+    own[q.b & 1u] = Quad(i, q.a, q.b, q.c);
+    let p = own[q.b & 1u];
+    output[o + 4u] = p.a + p.c * 5u;
+    var whole = quads[i / 2u];
+    whole.b += 1u;
+    output[o + 5u] = whole.a + whole.b + whole.c + whole.d;
+}
+"#;
+    let kernel = Kernel::from_wgsl("struct_loads.wgsl", source.into(), "main", false).unwrap();
+    let words: Vec<u32> = (0..256u32).map(|k| k.wrapping_mul(2_654_435_761) >> (k % 7)).collect();
+    let quad = |k: usize| -> [u32; 4] { words[4 * k.min(63)..][..4].try_into().unwrap() };
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &words, 64 * 6, 1);
+    for i in 0..64usize {
+        let [a, b, _, d] = quad(i);
+        let cross = {
+            let q = quad(i * 5 % 64);
+            q[0].wrapping_mul(7).wrapping_add(q[2])
+        };
+        let picked = if a & 1 != 0 {
+            quad(i + 1000)[2]
+        } else {
+            let f = quad(63 - i);
+            f[1].wrapping_add(f[3].wrapping_mul(2))
+        };
+        let n = quad((i + 9) % 64);
+        let shared = n[3] ^ (n[0] << 4);
+        let private = (i as u32).wrapping_add(b.wrapping_mul(5));
+        let w = quad(i / 2);
+        let whole = w[0].wrapping_add(w[1].wrapping_add(1)).wrapping_add(w[2]).wrapping_add(w[3]);
+        let want = [b.wrapping_mul(3).wrapping_add(d), cross, picked, shared, private, whole];
+        assert_eq!(&got[i * 6..(i + 1) * 6], &want, "invocation {i}");
+    }
 }

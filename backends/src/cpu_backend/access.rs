@@ -6,6 +6,7 @@
 use super::decode::{Compiler, Scope};
 use super::insn::{Insn, Reg};
 use super::layout::{Piece, Place, byte_addressed, contains_f16, load_plan};
+use super::load_fields::Runs;
 use naga::{Expression, Handle, TypeInner};
 
 impl Compiler<'_> {
@@ -66,8 +67,17 @@ impl Compiler<'_> {
         }
     }
 
-    /// Loads `len` words through pointer expression `pointer` into register `dst`.
-    pub(super) fn load(&mut self, scope: &mut Scope, pointer: Handle<Expression>, dst: Reg, len: u32) {
+    /// Loads `len` words through pointer expression `pointer` into register `dst`; only
+    /// the words of `runs` where given and the pointer is a register (the others are
+    /// never read: [`super::load_fields`]).
+    pub(super) fn load(
+        &mut self,
+        scope: &mut Scope,
+        pointer: Handle<Expression>,
+        dst: Reg,
+        len: u32,
+        runs: Option<Runs>,
+    ) {
         if let Some(plan) = self.mixed_plan(scope, pointer) {
             let pointer = self.reg(scope, pointer);
             self.push(Insn::LoadMixed { dst, pointer, plan });
@@ -86,7 +96,10 @@ impl Compiler<'_> {
             }
             None => {
                 let pointer = self.reg(scope, pointer);
-                self.push(Insn::Load { dst, pointer, len });
+                self.push(match runs {
+                    Some(runs) => Insn::LoadRuns { dst, pointer, len, runs },
+                    None => Insn::Load { dst, pointer, len },
+                });
             }
         }
     }

@@ -113,6 +113,9 @@ pub(super) struct Scope<'a> {
     /// Per expression: a load that reads its variable's registers in place
     /// ([`super::load_alias`]).
     pub in_place_loads: Vec<bool>,
+    /// Per expression: for a load whose uses read some of its words, those words
+    /// ([`super::load_fields`]).
+    pub partial_loads: Vec<Option<super::load_fields::Runs>>,
     /// Per local variable: its register.
     pub locals: Vec<Reg>,
     /// Inlined: register and words that receive the return value.
@@ -354,6 +357,7 @@ impl Compiler<'_> {
             constant: vec![false; count],
             pre_emitted: vec![false; count],
             in_place_loads: super::load_alias::in_place_loads(function, info),
+            partial_loads: super::load_fields::partial_loads(self.module, self.info, function, info),
             locals: Vec::new(),
             result,
             returns: Vec::new(),

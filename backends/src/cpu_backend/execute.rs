@@ -90,6 +90,42 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
                 }
             })
         }
+        Insn::LoadRuns { dst, pointer, len, runs } => {
+            let dst = *dst as usize;
+            each_lane!(|regs, lane, private| {
+                let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1] as usize);
+                // Each word as `Load` reads it: inside the buffer or region, else 0.
+                match tag & TAG_MASK {
+                    BUFFER => {
+                        let memory = &buffers[(tag & !TAG_MASK) as usize];
+                        for &(start, words) in runs.iter() {
+                            let (start, words) = (start as usize, words as usize);
+                            let first = offset / 4 + start;
+                            match memory.get(first..first + words) {
+                                Some(run) => {
+                                    regs.write_each(dst + start, run.iter().map(|w| w.load(Ordering::Relaxed)))
+                                }
+                                None => {
+                                    for i in 0..words {
+                                        regs[dst + start + i] =
+                                            memory.get(first + i).map_or(0, |w| w.load(Ordering::Relaxed));
+                                    }
+                                }
+                            }
+                        }
+                    }
+                    WORKGROUP => {
+                        for &(start, words) in runs.iter() {
+                            for i in start as usize..(start + words) as usize {
+                                regs[dst + i] = workgroup.get(offset + i).copied().unwrap_or(0);
+                            }
+                        }
+                    }
+                    // Private and function memory: the whole value (words nobody reads too).
+                    _ => memory!(lane, private).load(regs, (tag, offset as u32), dst, *len as usize),
+                }
+            })
+        }
         Insn::Store { pointer, src, len } => {
             let (src, len) = (*src as usize, *len as usize);
             each_lane!(|regs, lane, private| {

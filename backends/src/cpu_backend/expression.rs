@@ -215,7 +215,8 @@ impl Compiler<'_> {
                     }
                     _ => {
                         let dst = self.reg(scope, handle);
-                        self.load(scope, pointer, dst, len);
+                        let runs = scope.partial_loads[index].take();
+                        self.load(scope, pointer, dst, len, runs);
                     }
                 }
             }

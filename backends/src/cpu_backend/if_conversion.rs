@@ -193,6 +193,7 @@ fn speculable(insn: &Insn) -> bool {
             | Insn::PtrIndex { .. }
             | Insn::PtrIndexRt { .. }
             | Insn::Load { .. }
+            | Insn::LoadRuns { .. }
             | Insn::LoadMixed { .. }
             | Insn::LoadWorkgroup { .. }
             | Insn::LoadPrivate { .. }

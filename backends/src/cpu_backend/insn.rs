@@ -289,6 +289,10 @@ pub(super) enum Insn {
     PtrIndexRt { dst: Reg, base: Reg, index: Reg, stride: u32 },
     /// Reads `len` words through a pointer register.
     Load { dst: Reg, pointer: Reg, len: u32 },
+    /// Reads the words of `runs` (first word, words) of a `len`-word value through a
+    /// pointer register: a struct whose other words are never read
+    /// ([`super::load_fields`]).
+    LoadRuns { dst: Reg, pointer: Reg, len: u32, runs: super::load_fields::Runs },
     /// Writes `len` words through a pointer register.
     Store { pointer: Reg, src: Reg, len: u32 },
     /// Reads a value holding f16 through a pointer into a buffer: naga's layout there,

@@ -64,6 +64,7 @@ mod jump_cleanup;
 mod lanes;
 mod layout;
 mod load_alias;
+mod load_fields;
 mod math_call;
 mod matrix;
 mod memory;

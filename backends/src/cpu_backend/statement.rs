@@ -198,7 +198,7 @@ impl Compiler<'_> {
                 let dst = self.reg(scope, *result);
                 let len = scope.lens[result.index()];
                 self.line = line;
-                self.load(scope, *pointer, dst, len);
+                self.load(scope, *pointer, dst, len, None);
                 self.push(Insn::Barrier);
             }
             Statement::Atomic { pointer, fun, value, result } => {

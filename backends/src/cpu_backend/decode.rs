@@ -60,7 +60,8 @@ pub(super) struct Code {
     /// The function's own local variables (register, words): set from the template
     /// when a frame starts. Every other register is either a compile-time value (in
     /// the template, never written) or an expression's, written where the expression
-    /// is evaluated before any use reads it (uses are dominated by the emission), so
+    /// is evaluated before any use reads it (uses are dominated by the emission; a
+    /// struct load of some fields writes the words its uses read, [`super::load_fields`]), so
     /// a register file is filled from the template once and then only these are reset
     /// (inlined callees' variables are zeroed by instructions of their own).
     pub locals: Vec<(Reg, u32)>,

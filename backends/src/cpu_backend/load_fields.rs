@@ -197,7 +197,8 @@ mod tests {
     fn a_struct_loads_only_the_fields_its_uses_read() {
         // Two fields: their words alone.
         assert_eq!(loads("let n = nodes[id.x]; data[id.x] = n.count + n.first;"), vec![(12, vec![(8, 2)])]);
-        // A callee reading two fields of its argument (inlined or not).
+        // A callee reading two fields of its argument (inlined here; a called one copies
+        // every word of the argument and reads the same two).
         assert_eq!(
             loads("data[id.x] = u32(corners(nodes[id.x]));"),
             vec![(12, vec![(0, 3), (4, 3)])],

@@ -44,6 +44,7 @@
 //! `RUST_BACKTRACE` says: they are findings, not bugs of xtask) and exit with 1.
 
 mod fuzz;
+mod parallel;
 mod validate;
 
 use anyhow::{Result, bail};
@@ -238,31 +239,10 @@ fn shaders(strict: bool, out: PathBuf) -> Result<()> {
     // The validators are external processes, one at a time per kernel: kernels go to one
     // worker per core (each kernel's files are its own), the table is printed in order.
     let kernels = registry.kernels();
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(kernels.len().max(1));
-    let mut verdicts: Vec<Option<Vec<(PathBuf, Verdict)>>> = (0..kernels.len()).map(|_| None).collect();
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..workers)
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut done = Vec::new();
-                    loop {
-                        let index = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        let Some(kernel) = kernels.get(index) else { return done };
-                        let results = Target::ALL.map(|target| translate_and_validate(kernel, target, &out));
-                        done.push((index, results.to_vec()));
-                    }
-                })
-            })
-            .collect();
-        for handle in handles {
-            for (index, results) in handle.join().expect("a validation worker panicked") {
-                verdicts[index] = Some(results);
-            }
-        }
-    });
+    let verdicts =
+        parallel::map(kernels, |kernel| Target::ALL.map(|target| translate_and_validate(kernel, target, &out)));
     for (kernel, results) in kernels.iter().zip(verdicts) {
-        for (target, (path, verdict)) in Target::ALL.into_iter().zip(results.expect("every kernel validated")) {
+        for (target, (path, verdict)) in Target::ALL.into_iter().zip(results) {
             let text = match &verdict {
                 Verdict::Valid(tool) => format!("valid ({tool}) -> {}", path.display()),
                 Verdict::Invalid(why) => {

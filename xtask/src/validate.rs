@@ -95,78 +95,37 @@ pub fn validate() -> Result<()> {
     let debug = target.join("debug");
     let strata = debug.join("strata");
     let small = ["--width", "24", "--height", "24"];
-    // Each step writes into its own folder, so that steps can run side by side.
-    let out_of = |name: &str| -> Result<String> {
-        Ok(folder.join("out").join(name).to_str().context("a UTF-8 target path")?.to_string())
+    // A `strata` run writing into its own folder, so that steps can run side by side.
+    let strata_step = |name: &'static str, command: &str, settings: &[&str]| -> Result<Step> {
+        let out = folder.join("out").join(name);
+        let out = out.to_str().context("a UTF-8 target path")?;
+        let args = [&[command], &small[..], settings, &["--out", out]].concat();
+        Ok(Step { name, program: strata.clone(), args: args.into_iter().map(String::from).collect() })
     };
-    let compare = |name: &str, extra: &[&str]| -> Result<Vec<String>> {
-        let mut args = vec!["compare"];
-        args.extend(small);
-        args.extend(["--frames", "3", "--seeds", "2", "--reference-spp", "4"]);
-        args.extend(extra);
-        Ok(args.into_iter().map(String::from).chain(["--out".to_string(), out_of(name)?]).collect())
-    };
-    let render = |name: &str, extra: &[&str]| -> Result<Vec<String>> {
-        let mut args = vec!["render"];
-        args.extend(small);
-        args.extend(["--spp", "4"]);
-        args.extend(extra);
-        Ok(args.into_iter().map(String::from).chain(["--out".to_string(), out_of(name)?]).collect())
-    };
+    let compare = ["--frames", "3", "--seeds", "2", "--reference-spp", "4"];
     let steps = vec![
-        Step { name: "render-wgpu", program: strata.clone(), args: render("render-wgpu", &[])? },
-        Step { name: "render-ash", program: strata.clone(), args: render("render-ash", &["--backend", "ash"])? },
-        Step { name: "compare-wgpu", program: strata.clone(), args: compare("compare-wgpu", &[])? },
-        Step {
-            name: "compare-wgpu-accumulate",
-            program: strata.clone(),
-            args: compare("compare-wgpu-accumulate", &["--accumulate"])?,
-        },
-        Step { name: "compare-ash", program: strata.clone(), args: compare("compare-ash", &["--backend", "ash"])? },
-        Step {
-            name: "compare-ash-accumulate",
-            program: strata.clone(),
-            args: compare("compare-ash-accumulate", &["--backend", "ash", "--accumulate"])?,
-        },
+        strata_step("render-wgpu", "render", &["--spp", "4"])?,
+        strata_step("render-ash", "render", &["--spp", "4", "--backend", "ash"])?,
+        strata_step("compare-wgpu", "compare", &compare)?,
+        strata_step("compare-wgpu-accumulate", "compare", &[&compare[..], &["--accumulate"]].concat())?,
+        strata_step("compare-ash", "compare", &[&compare[..], &["--backend", "ash"]].concat())?,
+        strata_step(
+            "compare-ash-accumulate",
+            "compare",
+            &[&compare[..], &["--backend", "ash", "--accumulate"]].concat(),
+        )?,
         Step { name: "wgpu_embed", program: debug.join("examples").join("wgpu_embed"), args: vec![] },
         Step { name: "ash_embed", program: debug.join("examples").join("ash_embed"), args: vec![] },
-        Step { name: "xtask-check", program: std::env::current_exe()?, args: vec!["check".to_string()] },
+        // The xtask the build above made (it may have replaced the running one).
+        Step { name: "xtask-check", program: debug.join("xtask"), args: vec!["check".to_string()] },
     ];
     // The steps are independent processes, mostly on one core each (pipeline compilation
-    // and the layer's own work are single-threaded): one worker per core takes the next
-    // step, and the results are printed in the steps' order.
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(steps.len());
-    let mut outcomes: Vec<Option<Result<Outcome>>> = (0..steps.len()).map(|_| None).collect();
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..workers)
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut done = Vec::new();
-                    while let Some(step) = steps.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed)) {
-                        let failed = run_step(step, &root, &folder);
-                        let stop = failed.is_err();
-                        done.push((step.name, failed));
-                        if stop {
-                            // Let the other worker finish its step, start no new one.
-                            next.store(steps.len(), std::sync::atomic::Ordering::Relaxed);
-                        }
-                    }
-                    done
-                })
-            })
-            .collect();
-        for handle in handles {
-            for (name, outcome) in handle.join().expect("a validation worker panicked") {
-                let index = steps.iter().position(|s| s.name == name).expect("a step of the list");
-                outcomes[index] = Some(outcome);
-            }
-        }
-    });
+    // and the layer's own work are single-threaded): one worker per core, the results
+    // printed in the steps' order.
+    let outcomes = crate::parallel::map(&steps, |step| run_step(step, &root, &folder));
     let mut failures = Vec::new();
     let mut notes: BTreeMap<String, usize> = BTreeMap::new();
     for (step, outcome) in steps.iter().zip(outcomes) {
-        let Some(outcome) = outcome else { continue };
         let outcome = outcome?;
         println!(
             "{:<26} {} ({:.0} s)",

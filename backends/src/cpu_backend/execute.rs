@@ -63,45 +63,26 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
             regs[dst] = tag;
             regs[dst + 1] = (offset + at) as u32;
         }),
-        Insn::Load { dst, pointer, len } => {
-            let (dst, len) = (*dst as usize, *len as usize);
+        // A whole value, or the runs (first word, words) of it that its uses read
+        // (`load_fields`): each word as WGSL reads it, 0 outside its buffer or region.
+        Insn::Load { dst, pointer, len } | Insn::LoadRuns { dst, pointer, len, .. } => {
+            let whole = [(0, *len)];
+            let runs: &[(u32, u32)] = match insn {
+                Insn::LoadRuns { runs, .. } => runs,
+                _ => &whole,
+            };
+            let dst = *dst as usize;
             each_lane!(|regs, lane, private| {
                 let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1] as usize);
                 // The common regions inline; the others (and the general rules) in `Memory`.
                 match tag & TAG_MASK {
                     BUFFER => {
                         let memory = &buffers[(tag & !TAG_MASK) as usize];
-                        match memory.get(offset / 4..offset / 4 + len) {
-                            // Inside the buffer (the common case): one bounds check.
-                            Some(words) => regs.write_each(dst, words.iter().map(|w| w.load(Ordering::Relaxed))),
-                            None => {
-                                for i in 0..len {
-                                    regs[dst + i] = memory.get(offset / 4 + i).map_or(0, |w| w.load(Ordering::Relaxed));
-                                }
-                            }
-                        }
-                    }
-                    WORKGROUP => {
-                        for i in 0..len {
-                            regs[dst + i] = workgroup.get(offset + i).copied().unwrap_or(0);
-                        }
-                    }
-                    _ => memory!(lane, private).load(regs, (tag, offset as u32), dst, len),
-                }
-            })
-        }
-        Insn::LoadRuns { dst, pointer, len, runs } => {
-            let dst = *dst as usize;
-            each_lane!(|regs, lane, private| {
-                let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1] as usize);
-                // Each word as `Load` reads it: inside the buffer or region, else 0.
-                match tag & TAG_MASK {
-                    BUFFER => {
-                        let memory = &buffers[(tag & !TAG_MASK) as usize];
-                        for &(start, words) in runs.iter() {
+                        for &(start, words) in runs {
                             let (start, words) = (start as usize, words as usize);
                             let first = offset / 4 + start;
                             match memory.get(first..first + words) {
+                                // Inside the buffer (the common case): one bounds check.
                                 Some(run) => {
                                     regs.write_each(dst + start, run.iter().map(|w| w.load(Ordering::Relaxed)))
                                 }
@@ -115,7 +96,7 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
                         }
                     }
                     WORKGROUP => {
-                        for &(start, words) in runs.iter() {
+                        for &(start, words) in runs {
                             for i in start as usize..(start + words) as usize {
                                 regs[dst + i] = workgroup.get(offset + i).copied().unwrap_or(0);
                             }

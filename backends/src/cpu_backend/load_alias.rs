@@ -117,7 +117,7 @@ impl Analysis<'_> {
                         }
                     }
                 }
-                _ => self.nested(statement, |inner| self.block(inner, in_place)),
+                _ => nested(statement, |inner| self.block(inner, in_place)),
             }
         }
     }
@@ -213,7 +213,7 @@ impl Analysis<'_> {
             Statement::Call { ref arguments, .. } => arguments.iter().map(|&a| counts(a)).sum(),
             _ => 0,
         };
-        self.nested(statement, |block| block.iter().for_each(|s| self.statement_uses(s, load, uses)));
+        nested(statement, |block| block.iter().for_each(|s| self.statement_uses(s, load, uses)));
     }
 
     /// Whether running `statement` may write `variable`'s registers: a store or an
@@ -243,25 +243,25 @@ impl Analysis<'_> {
             _ => true,
         };
         let mut inner = false;
-        self.nested(statement, |block| inner |= block.iter().any(|s| self.may_write(s, variable)));
+        nested(statement, |block| inner |= block.iter().any(|s| self.may_write(s, variable)));
         own || inner
     }
+}
 
-    /// Calls `visit` with each block `statement` contains.
-    fn nested(&self, statement: &Statement, mut visit: impl FnMut(&Block)) {
-        match statement {
-            Statement::Block(block) => visit(block),
-            Statement::If { accept, reject, .. } => {
-                visit(accept);
-                visit(reject);
-            }
-            Statement::Switch { cases, .. } => cases.iter().for_each(|case| visit(&case.body)),
-            Statement::Loop { body, continuing, .. } => {
-                visit(body);
-                visit(continuing);
-            }
-            _ => {}
+/// Calls `visit` with each block `statement` contains.
+pub(super) fn nested(statement: &Statement, mut visit: impl FnMut(&Block)) {
+    match statement {
+        Statement::Block(block) => visit(block),
+        Statement::If { accept, reject, .. } => {
+            visit(accept);
+            visit(reject);
         }
+        Statement::Switch { cases, .. } => cases.iter().for_each(|case| visit(&case.body)),
+        Statement::Loop { body, continuing, .. } => {
+            visit(body);
+            visit(continuing);
+        }
+        _ => {}
     }
 }
 

@@ -21,6 +21,7 @@
 //!   buffer reads 0 either way; [`super::execute`]).
 
 use super::layout::{contains_f16, member_step, words_of};
+use super::load_alias::nested;
 use naga::valid::{FunctionInfo, ModuleInfo};
 use naga::{Block, Expression, Function, Handle, Module, Statement, TypeInner};
 
@@ -101,20 +102,10 @@ fn mark_field(module: &Module, inner: &TypeInner, index: u32, words: &mut [bool]
 /// Calls `visit` with the callee and arguments of every call statement in `block`.
 fn calls(block: &Block, visit: &mut impl FnMut(Handle<Function>, &[Handle<Expression>])) {
     for statement in block.iter() {
-        match statement {
-            Statement::Call { function, arguments, .. } => visit(*function, arguments),
-            Statement::Block(inner) => calls(inner, visit),
-            Statement::If { accept, reject, .. } => {
-                calls(accept, visit);
-                calls(reject, visit);
-            }
-            Statement::Switch { cases, .. } => cases.iter().for_each(|case| calls(&case.body, visit)),
-            Statement::Loop { body, continuing, .. } => {
-                calls(body, visit);
-                calls(continuing, visit);
-            }
-            _ => {}
+        if let Statement::Call { function, arguments, .. } = statement {
+            visit(*function, arguments);
         }
+        nested(statement, |inner| calls(inner, visit));
     }
 }
 

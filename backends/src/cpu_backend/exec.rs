@@ -1,12 +1,13 @@
 //! Running a compiled kernel: workgroups in parallel on the machine's cores, the
 //! invocations of a workgroup together from barrier to barrier, each a resumable stack
-//! of frames (see [`super::interp`]).
+//! of frames (see [`super::interp`]); several workgroups together as one batch where
+//! the kernel cannot tell ([`super::batch`]).
 
 use super::counts::DispatchCounts;
 use super::decode::Program;
 use super::error::{invalid, unsupported};
 use super::insn::Insn;
-use super::interp::{self, Invocation, Stop, Workgroup};
+use super::interp::{self, Batch, Invocation, Stop};
 use super::memory::{FUNCTION, Frame};
 use crate::error::BackendError;
 use smallvec::SmallVec;
@@ -41,34 +42,35 @@ pub(super) fn run(
     let shared: Vec<Vec<AtomicU32>> =
         buffers.iter_mut().map(|words| std::mem::take(words).into_iter().map(AtomicU32::new).collect()).collect();
     let total = u64::from(workgroups[0]) * u64::from(workgroups[1]) * u64::from(workgroups[2]);
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(total.max(1) as usize);
+    let per_batch = u64::from(super::batch::workgroups_per_batch(program));
+    let batches = total.div_ceil(per_batch);
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(batches.max(1) as usize);
     let next = AtomicU64::new(0);
     let result = std::thread::scope(|scope| {
         let handles: Vec<_> = (0..threads)
             .map(|_| {
                 scope.spawn(|| -> Result<(), BackendError> {
-                    let mut memory = Workgroup {
+                    let mut memory = Batch {
                         files: vec![Vec::new(); program.codes.len()],
                         private: Vec::new(),
                         private_words: program.private_init.len(),
-                        shared: vec![0u32; program.workgroup_words as usize],
+                        shared: Vec::new(),
+                        shared_words: program.workgroup_words as usize,
+                        per_workgroup: program.workgroup_size.iter().product::<u32>().max(1) as usize,
                     };
                     let mut invocations = Vec::new();
                     loop {
-                        let index = next.fetch_add(1, Ordering::Relaxed);
-                        if index >= total {
+                        let batch = next.fetch_add(1, Ordering::Relaxed);
+                        if batch >= batches {
                             return Ok(());
                         }
-                        let wx = (index % u64::from(workgroups[0])) as u32;
-                        let wy = (index / u64::from(workgroups[0]) % u64::from(workgroups[1])) as u32;
-                        let wz = (index / (u64::from(workgroups[0]) * u64::from(workgroups[1]))) as u32;
-                        memory.shared.fill(0);
-                        match run_workgroup(
+                        let first = batch * per_batch;
+                        match run_batch(
                             program,
                             &shared,
                             &mut memory,
                             &mut invocations,
-                            [wx, wy, wz],
+                            first..(first + per_batch).min(total),
                             workgroups,
                             subgroup_size,
                         ) {
@@ -78,7 +80,7 @@ pub(super) fn run(
                             }
                             Err(error) => {
                                 // Stop the other threads early.
-                                next.store(total, Ordering::Relaxed);
+                                next.store(batches, Ordering::Relaxed);
                                 return Err(error);
                             }
                         }
@@ -146,44 +148,59 @@ fn enter_entry_point(program: &Program, file: &mut Vec<u32>, builtins: &[Builtin
     Ok(())
 }
 
-fn run_workgroup(
+/// Runs the workgroups `batch` (flat indices, x fastest) together as one wide workgroup
+/// of their invocations, workgroup after workgroup in local-index order: one workgroup
+/// unless [`super::batch`] found that the kernel cannot tell.
+fn run_batch(
     program: &Program,
     buffers: &[Vec<AtomicU32>],
-    memory: &mut Workgroup,
+    memory: &mut Batch,
     invocations: &mut Vec<Invocation>,
-    [wx, wy, wz]: [u32; 3],
+    batch: std::ops::Range<u64>,
     workgroups: [u32; 3],
     subgroup_size: u32,
 ) -> Result<DispatchCounts, BackendError> {
     let [sx, sy, sz] = program.workgroup_size;
-    let count = (sx * sy * sz) as usize;
+    let per_workgroup = sx * sy * sz;
     let subgroup_size = subgroup_size.max(1);
-    let num_subgroups = (count as u32).div_ceil(subgroup_size);
+    let num_subgroups = per_workgroup.div_ceil(subgroup_size);
+    // Each workgroup's invocations start a new warp in the SIMT count.
+    let warp_stride = per_workgroup.next_multiple_of(super::counts::WARP_WIDTH);
     invocations.clear();
-    let mut builtins = Vec::with_capacity(count);
-    for index in 0..count as u32 {
-        let local = [index % sx, index / sx % sy, index / (sx * sy)];
-        let b = Builtins {
-            local_id: local,
-            local_index: index,
-            global_id: [wx * sx + local[0], wy * sy + local[1], wz * sz + local[2]],
-            workgroup_id: [wx, wy, wz],
-            num_workgroups: workgroups,
-            subgroup_size,
-            lane: index % subgroup_size,
-            subgroup_id: index / subgroup_size,
-            num_subgroups,
-        };
-        invocations.push(Invocation {
-            frame: Some(Frame { code: program.entry, pc: 0, result: None }),
-            callers: Vec::new(),
-            lane: b.lane,
-            subgroup_id: b.subgroup_id,
-            subgroup_size,
-            local_index: index,
-        });
-        builtins.push(b);
+    let mut builtins = Vec::with_capacity(((batch.end - batch.start) * u64::from(per_workgroup)) as usize);
+    for (k, flat) in batch.enumerate() {
+        let wx = (flat % u64::from(workgroups[0])) as u32;
+        let wy = (flat / u64::from(workgroups[0]) % u64::from(workgroups[1])) as u32;
+        let wz = (flat / (u64::from(workgroups[0]) * u64::from(workgroups[1]))) as u32;
+        for index in 0..per_workgroup {
+            let local = [index % sx, index / sx % sy, index / (sx * sy)];
+            let b = Builtins {
+                local_id: local,
+                local_index: index,
+                global_id: [wx * sx + local[0], wy * sy + local[1], wz * sz + local[2]],
+                workgroup_id: [wx, wy, wz],
+                num_workgroups: workgroups,
+                subgroup_size,
+                lane: index % subgroup_size,
+                subgroup_id: index / subgroup_size,
+                num_subgroups,
+            };
+            invocations.push(Invocation {
+                frame: Some(Frame { code: program.entry, pc: 0, result: None }),
+                callers: Vec::new(),
+                lane: b.lane,
+                subgroup_id: b.subgroup_id,
+                subgroup_size,
+                local_index: index,
+                simt_index: k as u32 * warp_stride + index,
+            });
+            builtins.push(b);
+        }
     }
+    let count = invocations.len();
+    // Zero-initialised workgroup memory, one region per workgroup of the batch.
+    memory.shared.clear();
+    memory.shared.resize(count / per_workgroup as usize * memory.shared_words, 0);
     enter_entry_point(program, &mut memory.files[program.entry as usize], &builtins)?;
     memory.private.clear();
     for _ in 0..count {

@@ -13,8 +13,9 @@ use std::sync::atomic::Ordering;
 /// operations.
 pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &mut GroupMemory) {
     let width = group.width;
-    let private_words = group.private_words;
-    let GroupMemory { buffers, workgroup, private: privates, files, callers, .. } = group;
+    let (private_words, workgroup_words, per_workgroup) =
+        (group.private_words, group.workgroup_words, group.per_workgroup);
+    let GroupMemory { buffers, workgroup: shared, private: privates, files, callers, .. } = group;
     let buffers: &[_] = buffers;
     // `$body` for each member, with its registers, lane and private memory.
     macro_rules! each_lane {
@@ -28,11 +29,19 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
             })
         };
     }
+    // The memory of lane `$lane`'s workgroup (a batch holds several: `super::batch`);
+    // computed where used, as it costs a division where the batch has several.
+    macro_rules! workgroup {
+        ($lane:ident) => {{
+            let first = if workgroup_words == 0 || per_workgroup == width { 0 } else { $lane / per_workgroup };
+            &mut shared[first * workgroup_words..][..workgroup_words]
+        }};
+    }
     macro_rules! memory {
         ($lane:ident, $private:ident) => {
             Memory {
                 buffers,
-                workgroup: &mut **workgroup,
+                workgroup: workgroup!($lane),
                 private: &mut *$private,
                 files: &mut **files,
                 callers,
@@ -48,9 +57,13 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
         Insn::PtrIndexRt { dst, base, index, stride } => each_lane!(|regs, lane, private| {
             let (dst, base) = (*dst as usize, *base as usize);
             let (tag, offset) = (regs[base], regs[base + 1] as usize);
-            let memory = memory!(lane, private);
             let (stride, index) = (*stride as usize, regs[*index as usize] as usize);
-            let available = memory.words(regs, tag).saturating_sub(offset);
+            // Buffers (the common case) inline; the other regions' sizes in `Memory`.
+            let size = match tag & TAG_MASK {
+                BUFFER => buffers[(tag & !TAG_MASK) as usize].len() * 4,
+                _ => memory!(lane, private).words(regs, tag),
+            };
+            let available = size.saturating_sub(offset);
             // Element `index`, clamped to the last one (WGSL), without a division per
             // lane where it lies inside the region (the common case).
             let at = if stride == 0 {
@@ -96,6 +109,7 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
                         }
                     }
                     WORKGROUP => {
+                        let workgroup = workgroup!(lane);
                         for &(start, words) in runs {
                             for i in start as usize..(start + words) as usize {
                                 regs[dst + i] = workgroup.get(offset + i).copied().unwrap_or(0);
@@ -121,6 +135,7 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
                         }
                     }
                     WORKGROUP => {
+                        let workgroup = workgroup!(lane);
                         for i in 0..len {
                             if let Some(word) = workgroup.get_mut(offset + i) {
                                 *word = regs[src + i];
@@ -148,10 +163,11 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
         }),
         Insn::LoadWorkgroup { dst, address, len } => each_lane!(|regs, lane, private| {
             let (dst, address, len) = (*dst as usize, *address as usize, *len as usize);
-            regs.write(dst, &workgroup[address..address + len]);
+            regs.write(dst, &workgroup!(lane)[address..address + len]);
         }),
         Insn::StoreWorkgroup { address, src, len } => each_lane!(|regs, lane, private| {
             let (src, address, len) = (*src as usize, *address as usize, *len as usize);
+            let workgroup = workgroup!(lane);
             for i in 0..len {
                 workgroup[address + i] = regs[src + i];
             }

@@ -1,5 +1,5 @@
-//! The dispatch loop, a workgroup at a time: runs the bytecode of every invocation of a
-//! workgroup until each ends or reaches a barrier or subgroup operation, where it stops
+//! The dispatch loop, a workgroup (or a batch of them, [`super::batch`]) at a time: runs
+//! the bytecode of every invocation of a workgroup until each ends or reaches a barrier or subgroup operation, where it stops
 //! (that instruction still next) so that [`super::exec`] can synchronise them.
 //!
 //! Invocations at the same place (the same instruction of the same call stack) run as
@@ -19,7 +19,8 @@
 //! one-invocation-at-a-time executor this replaced: BENCHMARKS.md, "interpreter").
 //!
 //! Registers are lane-minor ([`super::lanes`]): each code has one register file for the
-//! whole workgroup, so an instruction run for a group is a loop over contiguous words.
+//! whole workgroup (or batch), so an instruction run for a group is a loop over
+//! contiguous words.
 
 use super::counts::DispatchCounts;
 use super::decode::Program;
@@ -57,20 +58,27 @@ pub(super) struct Invocation {
     pub subgroup_size: u32,
     /// `local_invocation_index`.
     pub local_index: u32,
+    /// Its index in the SIMT count ([`DispatchCounts`]): its local index, after a warp
+    /// boundary per earlier workgroup of its batch ([`super::batch`]).
+    pub simt_index: u32,
 }
 
-/// The memory of a workgroup's invocations, kept by a worker thread from one workgroup to
-/// the next (register files of tens of kilobytes per invocation cost more in page faults
+/// The memory of a batch's invocations ([`super::batch`]), kept by a worker thread from
+/// one batch to the next (register files of tens of kilobytes per invocation cost more in page faults
 /// than the kernels' work when allocated anew).
-pub(super) struct Workgroup {
+pub(super) struct Batch {
     /// Per code, its lane-minor register file (empty until the code first runs).
     pub files: Vec<Vec<u32>>,
     /// Every invocation's private memory, `private_words` each, in local-index order.
     pub private: Vec<u32>,
     /// Words of private memory per invocation.
     pub private_words: usize,
-    /// The workgroup's shared memory.
+    /// The workgroup memory of the batch's workgroups, `shared_words` each, in order.
     pub shared: Vec<u32>,
+    /// Words of workgroup memory per workgroup.
+    pub shared_words: usize,
+    /// Invocations per workgroup.
+    pub per_workgroup: usize,
 }
 
 /// The scheduler's working lists, kept from one synchronisation point to the next.
@@ -88,8 +96,12 @@ pub(super) struct Scratch {
 pub(super) struct GroupMemory<'a> {
     /// Bound buffers in the kernel's binding order.
     pub buffers: &'a [Vec<AtomicU32>],
-    /// The workgroup's memory.
+    /// The batch's workgroup memory: `workgroup_words` per workgroup, in order.
     pub workgroup: &'a mut [u32],
+    /// Words of workgroup memory per workgroup.
+    pub workgroup_words: usize,
+    /// Invocations per workgroup (lane `l` is in the batch's workgroup `l / per_workgroup`).
+    pub per_workgroup: usize,
     /// Every invocation's private memory, `private_words` each.
     pub private: &'a mut [u32],
     /// Words of private memory per invocation.
@@ -181,7 +193,7 @@ fn meeting_point(leader: &Invocation, other: &Invocation) -> Option<u32> {
 pub(super) fn run_until_sync(
     program: &Program,
     invocations: &mut [Invocation],
-    memory: &mut Workgroup,
+    memory: &mut Batch,
     scratch: &mut Scratch,
     buffers: &[Vec<AtomicU32>],
     counts: &mut DispatchCounts,
@@ -262,6 +274,8 @@ pub(super) fn run_until_sync(
             let mut group_memory = GroupMemory {
                 buffers,
                 workgroup: &mut memory.shared,
+                workgroup_words: memory.shared_words,
+                per_workgroup: memory.per_workgroup,
                 private: &mut memory.private,
                 private_words: memory.private_words,
                 files: &mut memory.files,
@@ -272,7 +286,7 @@ pub(super) fn run_until_sync(
             let end =
                 run_group(program, code_index, pc, meet, group, &mut file, &mut group_memory, &mut steps, targets);
             memory.files[code_index as usize] = file;
-            counts.add_group(steps, members.iter().map(|&i| i as u32));
+            counts.add_group(steps, members.iter().map(|&i| invocations[i].simt_index));
             end?
         };
         match end {
@@ -332,7 +346,9 @@ pub(super) fn run_until_sync(
 /// Allocates a code's register file for `width` lanes, every register at its template
 /// value, the first time a worker thread runs the code (see [`super::decode::Code::locals`]).
 pub(super) fn open_file(file: &mut Vec<u32>, template: &[u32], width: usize) {
-    if file.is_empty() {
+    // A batch narrower than the last (the dispatch's last one) needs a file of its width.
+    if file.len() != template.len() * width {
+        file.clear();
         file.reserve_exact(template.len() * width);
         for &value in template {
             file.extend(std::iter::repeat_n(value, width));
@@ -340,22 +356,27 @@ pub(super) fn open_file(file: &mut Vec<u32>, template: &[u32], width: usize) {
     }
 }
 
-/// The group of invocations `members` (in increasing order) of a workgroup `width` wide:
-/// all of them, a quarter or more of a 64-wide workgroup (by mask, rows computed whole:
-/// cheaper than member by member from there on), or a few.
+/// The group of invocations `members` (in increasing order) of a batch `width` wide:
+/// all of them; in a batch a multiple of 64 wide, members filling a quarter or more of
+/// the chunks of 64 lanes they touch (by mask, those chunks computed whole: cheaper than
+/// member by member from there on, and a batch's divergent groups touch few chunks); or
+/// a few.
 fn group_of<'a>(members: &'a [usize], mask: &'a mut Vec<u32>, width: usize) -> Members<'a> {
     if members.len() == width {
-        Members::All(width)
-    } else if width == LANES && members.len() * 4 >= width {
-        mask.clear();
-        mask.resize(width, 0);
-        for &l in members {
-            mask[l] = u32::MAX;
-        }
-        Members::Masked(members, (&mask[..]).try_into().expect("64 lanes"))
-    } else {
-        Members::Some(members, width)
+        return Members::All(width);
     }
+    if width.is_multiple_of(LANES) && width <= 64 * LANES {
+        let chunks = members.iter().fold(0u64, |chunks, &l| chunks | 1 << (l / LANES));
+        if members.len() * 4 >= chunks.count_ones() as usize * LANES {
+            mask.clear();
+            mask.resize(width, 0);
+            for &l in members {
+                mask[l] = u32::MAX;
+            }
+            return Members::Masked(members, &mask[..], chunks);
+        }
+    }
+    Members::Some(members, width)
 }
 
 /// Two distinct register files of `files`.

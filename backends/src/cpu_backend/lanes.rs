@@ -145,6 +145,17 @@ fn keep_members(row: &mut [u32], words: &[u32; N], mask: &[u32; N]) {
     }
 }
 
+/// Calls `f(first lane, mask of the chunk)` for each chunk of [`N`] lanes of `mask` with
+/// a member (bit `c` of `chunks` set for chunk `c`).
+#[inline(always)]
+fn each_chunk(mask: &[u32], mut chunks: u64, mut f: impl FnMut(usize, &[u32; N])) {
+    while chunks != 0 {
+        let c = chunks.trailing_zeros() as usize * N;
+        chunks &= chunks - 1;
+        f(c, mask[c..c + N].try_into().expect("chunks of N lanes"));
+    }
+}
+
 /// Words `at..at + n` of `regs` (`n <= M`) copied into an array.
 #[inline(always)]
 fn row<const M: usize>(regs: &[u32], at: usize, n: usize) -> [u32; M] {
@@ -161,11 +172,12 @@ pub(super) enum Members<'a> {
     All(usize),
     /// These lanes of a file `width` lanes wide.
     Some(&'a [usize], usize),
-    /// These lanes of a file [`N`] lanes wide, many of them: the row operations compute
-    /// whole rows and keep the members' words (`mask`: all ones for a member, else 0),
-    /// loops the compiler vectorises where a member at a time could not be (a
-    /// divergent kernel's groups have tens of members).
-    Masked(&'a [usize], &'a [u32; N]),
+    /// These lanes of a file whose width is a multiple of [`N`], many of them: the row
+    /// operations compute whole chunks of [`N`] lanes and keep the members' words
+    /// (`mask`: per lane, all ones for a member, else 0), loops the compiler vectorises
+    /// where a member at a time could not be (a divergent kernel's groups have tens of
+    /// members); chunks without a member (bit `c` of the `u64` clear) are skipped.
+    Masked(&'a [usize], &'a [u32], u64),
 }
 
 impl Members<'_> {
@@ -174,7 +186,7 @@ impl Members<'_> {
     pub(super) fn len(self) -> usize {
         match self {
             Members::All(width) => width,
-            Members::Some(lanes, _) | Members::Masked(lanes, _) => lanes.len(),
+            Members::Some(lanes, _) | Members::Masked(lanes, ..) => lanes.len(),
         }
     }
 
@@ -183,7 +195,7 @@ impl Members<'_> {
     pub(super) fn width(self) -> usize {
         match self {
             Members::All(width) | Members::Some(_, width) => width,
-            Members::Masked(..) => N,
+            Members::Masked(_, mask, _) => mask.len(),
         }
     }
 
@@ -192,7 +204,7 @@ impl Members<'_> {
     pub(super) fn for_each(self, mut f: impl FnMut(usize)) {
         match self {
             Members::All(width) => (0..width).for_each(f),
-            Members::Some(lanes, _) | Members::Masked(lanes, _) => {
+            Members::Some(lanes, _) | Members::Masked(lanes, ..) => {
                 for &l in lanes {
                     f(l)
                 }
@@ -248,11 +260,14 @@ impl Members<'_> {
                     }
                 }
             }
-            Members::Masked(_, mask) => {
+            Members::Masked(_, mask, chunks) => {
+                let width = mask.len();
                 for r in 0..rows {
-                    let (xs, ys) = (&regs[(a + r) * N..][..N], &regs[(b + r) * N..][..N]);
-                    let words: [u32; N] = std::array::from_fn(|i| f(xs[i], ys[i]));
-                    keep_members(&mut regs[(dst + r) * N..][..N], &words, mask);
+                    each_chunk(mask, chunks, |c, mask| {
+                        let (xs, ys) = (&regs[(a + r) * width + c..][..N], &regs[(b + r) * width + c..][..N]);
+                        let words: [u32; N] = std::array::from_fn(|i| f(xs[i], ys[i]));
+                        keep_members(&mut regs[(dst + r) * width + c..][..N], &words, mask);
+                    });
                 }
             }
         }
@@ -287,11 +302,14 @@ impl Members<'_> {
                     }
                 }
             }
-            Members::Masked(_, mask) => {
+            Members::Masked(_, mask, chunks) => {
+                let width = mask.len();
                 for r in 0..rows {
-                    let xs = &regs[(src + r) * N..][..N];
-                    let words: [u32; N] = std::array::from_fn(|i| f(xs[i]));
-                    keep_members(&mut regs[(dst + r) * N..][..N], &words, mask);
+                    each_chunk(mask, chunks, |c, mask| {
+                        let xs = &regs[(src + r) * width + c..][..N];
+                        let words: [u32; N] = std::array::from_fn(|i| f(xs[i]));
+                        keep_members(&mut regs[(dst + r) * width + c..][..N], &words, mask);
+                    });
                 }
             }
         }
@@ -340,15 +358,21 @@ impl Members<'_> {
                     }
                 }
             }
-            Members::Masked(_, mask) => {
+            Members::Masked(_, mask, chunks) => {
+                let width = mask.len();
                 for r in 0..rows {
-                    let (cs, xs, ys) =
-                        (&regs[(cond + r) * N..][..N], &regs[(accept + r) * N..][..N], &regs[(reject + r) * N..][..N]);
-                    let words: [u32; N] = std::array::from_fn(|i| {
-                        let m = 0u32.wrapping_sub(u32::from(cs[i] != 0));
-                        (xs[i] & m) | (ys[i] & !m)
+                    each_chunk(mask, chunks, |c, mask| {
+                        let (cs, xs, ys) = (
+                            &regs[(cond + r) * width + c..][..N],
+                            &regs[(accept + r) * width + c..][..N],
+                            &regs[(reject + r) * width + c..][..N],
+                        );
+                        let words: [u32; N] = std::array::from_fn(|i| {
+                            let m = 0u32.wrapping_sub(u32::from(cs[i] != 0));
+                            (xs[i] & m) | (ys[i] & !m)
+                        });
+                        keep_members(&mut regs[(dst + r) * width + c..][..N], &words, mask);
                     });
-                    keep_members(&mut regs[(dst + r) * N..][..N], &words, mask);
                 }
             }
         }
@@ -388,11 +412,14 @@ impl Members<'_> {
                     }
                 }
             }
-            Members::Masked(_, mask) => {
+            Members::Masked(_, mask, chunks) => {
+                let width = mask.len();
                 for i in 0..len {
                     let r = if dst <= src { i } else { len - 1 - i };
-                    let words: [u32; N] = std::array::from_fn(|k| regs[(src + r) * N + k]);
-                    keep_members(&mut regs[(dst + r) * N..][..N], &words, mask);
+                    each_chunk(mask, chunks, |c, mask| {
+                        let words: [u32; N] = std::array::from_fn(|k| regs[(src + r) * width + c + k]);
+                        keep_members(&mut regs[(dst + r) * width + c..][..N], &words, mask);
+                    });
                 }
             }
         }
@@ -416,7 +443,7 @@ impl Members<'_> {
                     }
                 }
             }
-            Members::Masked(lanes, _) => Members::Some(lanes, N).fill(regs, dst, len, value),
+            Members::Masked(lanes, mask, _) => Members::Some(lanes, mask.len()).fill(regs, dst, len, value),
         }
     }
 }

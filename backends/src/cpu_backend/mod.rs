@@ -13,7 +13,9 @@
 //! to the next instruction are tidied away (`jump_cleanup`). `interp` runs it;
 //! `memory` is the pointer model (offsets in bytes into bound buffers, in register
 //! words elsewhere). Workgroups run in parallel on the machine's cores;
-//! the invocations of a workgroup run together from barrier to barrier (`exec`), each
+//! the invocations of a workgroup run together from barrier to barrier (`exec`; the
+//! workgroups of a kernel without barriers or subgroup operations several at a time as
+//! one batch, `batch`), each
 //! a resumable stack of frames, so every invocation reaches a barrier before any passes
 //! it; those at the same place run as one group, each instruction decoded once for the
 //! whole group (`interp`), as a loop over the members' words: registers are
@@ -48,6 +50,7 @@
 
 mod access;
 mod arith;
+mod batch;
 mod constant;
 mod counts;
 mod decode;

@@ -50,15 +50,18 @@ pub(super) fn run(
         let handles: Vec<_> = (0..threads)
             .map(|_| {
                 scope.spawn(|| -> Result<(), BackendError> {
-                    let mut memory = Batch {
-                        files: vec![Vec::new(); program.codes.len()],
-                        private: Vec::new(),
-                        private_words: program.private_init.len(),
-                        shared: Vec::new(),
-                        shared_words: program.workgroup_words as usize,
-                        per_workgroup: program.workgroup_size.iter().product::<u32>().max(1) as usize,
+                    let mut worker = Worker {
+                        memory: Batch {
+                            files: vec![Vec::new(); program.codes.len()],
+                            private: Vec::new(),
+                            private_words: program.private_init.len(),
+                            shared: Vec::new(),
+                            shared_words: program.workgroup_words as usize,
+                            per_workgroup: program.workgroup_size.iter().product::<u32>().max(1) as usize,
+                        },
+                        invocations: Vec::new(),
+                        scratch: interp::Scratch::default(),
                     };
-                    let mut invocations = Vec::new();
                     loop {
                         let batch = next.fetch_add(1, Ordering::Relaxed);
                         if batch >= batches {
@@ -68,8 +71,7 @@ pub(super) fn run(
                         match run_batch(
                             program,
                             &shared,
-                            &mut memory,
-                            &mut invocations,
+                            &mut worker,
                             first..(first + per_batch).min(total),
                             workgroups,
                             subgroup_size,
@@ -148,18 +150,28 @@ fn enter_entry_point(program: &Program, file: &mut Vec<u32>, builtins: &[Builtin
     Ok(())
 }
 
+/// What a worker thread keeps from one batch to the next (allocated once).
+struct Worker {
+    /// The batch's memory.
+    memory: Batch,
+    /// The batch's invocations.
+    invocations: Vec<Invocation>,
+    /// The scheduler's lists.
+    scratch: interp::Scratch,
+}
+
 /// Runs the workgroups `batch` (flat indices, x fastest) together as one wide workgroup
 /// of their invocations, workgroup after workgroup in local-index order: one workgroup
 /// unless [`super::batch`] found that the kernel cannot tell.
 fn run_batch(
     program: &Program,
     buffers: &[Vec<AtomicU32>],
-    memory: &mut Batch,
-    invocations: &mut Vec<Invocation>,
+    worker: &mut Worker,
     batch: std::ops::Range<u64>,
     workgroups: [u32; 3],
     subgroup_size: u32,
 ) -> Result<DispatchCounts, BackendError> {
+    let Worker { memory, invocations, scratch } = worker;
     let [sx, sy, sz] = program.workgroup_size;
     let per_workgroup = sx * sy * sz;
     let subgroup_size = subgroup_size.max(1);
@@ -210,9 +222,8 @@ fn run_batch(
     let mut counts = DispatchCounts::default();
     let mut stops = Vec::with_capacity(count);
     let mut reached = Vec::with_capacity(count);
-    let mut scratch = interp::Scratch::default();
     loop {
-        interp::run_until_sync(program, invocations, memory, &mut scratch, buffers, &mut counts, &mut reached)?;
+        interp::run_until_sync(program, invocations, memory, scratch, buffers, &mut counts, &mut reached)?;
         stops.clear();
         stops.extend(reached.iter().map(|stop| stop.expect("every invocation stopped")));
         if stops.iter().all(|s| *s == Stop::Done) {

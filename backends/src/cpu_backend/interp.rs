@@ -29,6 +29,7 @@ use super::execute::execute;
 use super::insn::{BinOp, CallInsn, Insn, UnOp};
 use super::lanes::{LaneRegs, Members, N as LANES};
 use super::memory::{FUNCTION, Frame};
+use super::places::Places;
 use crate::error::BackendError;
 use std::cmp::Ordering;
 use std::sync::atomic::AtomicU32;
@@ -90,6 +91,7 @@ pub(super) struct Scratch {
     targets: Vec<u32>,
     caller_codes: Vec<u32>,
     pcs: Vec<u32>,
+    places: Places,
 }
 
 /// What the members of a running group reach besides the running code's registers.
@@ -202,10 +204,11 @@ pub(super) fn run_until_sync(
     stops.clear();
     stops.extend(invocations.iter().map(|inv| if inv.frame.is_some() { None } else { Some(Stop::Done) }));
     let width = invocations.len();
-    let Scratch { members, mask, targets, caller_codes, pcs } = scratch;
+    let Scratch { members, mask, targets, caller_codes, pcs, places } = scratch;
     // While no invocation is inside a call (the common case: small functions are
     // inlined), where an invocation is is its next instruction alone: the group to run is
-    // then found from these words (`u32::MAX`: stopped) instead of by comparing stacks.
+    // then found from these words (`u32::MAX`: stopped) and from `places`, the same
+    // kept by instruction, instead of by comparing stacks.
     pcs.clear();
     pcs.extend(
         invocations
@@ -215,33 +218,23 @@ pub(super) fn run_until_sync(
     );
     // Runnable invocations inside a call (stopped ones no longer count).
     let mut in_calls = invocations.iter().filter(|inv| !inv.callers.is_empty()).count();
+    let entry_instructions = program.codes[program.entry as usize].insns.len();
+    // Whether `places` holds every runnable invocation (it is not kept during calls).
+    let mut placed = false;
     loop {
         // The group furthest behind, and the instruction where it meets the next one.
         members.clear();
         let mut meet = u32::MAX;
         let leader = if in_calls == 0 {
-            let behind = pcs.iter().copied().min().unwrap_or(u32::MAX);
-            if behind == u32::MAX {
-                return Ok(());
+            if !placed {
+                places.rebuild(entry_instructions, pcs);
+                placed = true;
             }
-            // Without branches on membership (unpredictable: a branch on it mispredicted
-            // often enough to cost a fifth of the path tracer): loops the compiler
-            // vectorises, then the members from a bit mask per 64 invocations.
-            for &pc in pcs.iter() {
-                meet = meet.min(if pc == behind { u32::MAX } else { pc });
-            }
-            for (block, chunk) in pcs.chunks(64).enumerate() {
-                let mut mask = 0u64;
-                for (i, &pc) in chunk.iter().enumerate() {
-                    mask |= u64::from(pc == behind) << i;
-                }
-                while mask != 0 {
-                    members.push(block * 64 + mask.trailing_zeros() as usize);
-                    mask &= mask - 1;
-                }
-            }
+            let Some((_, next)) = places.take_first(members) else { return Ok(()) };
+            meet = next;
             members[0]
         } else {
+            placed = false;
             let mut leader = None;
             for (i, stop) in stops.iter().enumerate() {
                 if stop.is_none() && leader.is_none_or(|l: usize| position(&invocations[i], &invocations[l]).is_lt()) {
@@ -293,11 +286,17 @@ pub(super) fn run_until_sync(
             GroupEnd::Meet(pc) => {
                 for &i in members.iter() {
                     invocations[i].frame.as_mut().expect("running").pc = pc;
+                    if placed {
+                        places.add(pc, i);
+                    }
                 }
             }
             GroupEnd::Split => {
                 for (&i, &pc) in members.iter().zip(targets.iter()) {
                     invocations[i].frame.as_mut().expect("running").pc = pc;
+                    if placed {
+                        places.add(pc, i);
+                    }
                 }
             }
             GroupEnd::Sync(pc) => {

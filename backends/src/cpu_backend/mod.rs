@@ -71,6 +71,7 @@ mod load_fields;
 mod math_call;
 mod matrix;
 mod memory;
+mod places;
 mod retarget;
 mod statement;
 mod wide;

@@ -383,3 +383,36 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_
         assert_eq!(&got[i * 6..(i + 1) * 6], &want, "invocation {i}");
     }
 }
+
+/// Element loads of a runtime-sized array that starts after a header, in a buffer that
+/// ends inside an element: the interpreter loads them in one instruction
+/// (`element_load.rs`), which must clamp an index to the last whole element and count
+/// from the array's first byte, as the pointer and the load it replaces did.
+#[test]
+fn element_loads_after_a_header_clamp_to_the_last_whole_element() {
+    let source = r#"
+struct Quad { a: u32, b: u32, c: u32, d: u32 }
+struct Table { count: u32, p0: u32, p1: u32, p2: u32, quads: array<Quad> }
+@group(0) @binding(0) var<storage, read> table: Table;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    let q = table.quads[i * 3u];
+    output[2u * i] = q.a ^ (q.d << 1u);
+    output[2u * i + 1u] = table.quads[i].c + table.count;
+}
+"#;
+    let kernel = Kernel::from_wgsl("element_loads.wgsl", source.into(), "main", false).unwrap();
+    // 30 words: a 4-word header and six whole quads (the last two words belong to none).
+    let words: Vec<u32> = (0..30u32).map(|k| k.wrapping_mul(2_654_435_761) >> (k % 5)).collect();
+    let quad = |k: usize| -> [u32; 4] { words[4 + 4 * k.min(5)..][..4].try_into().unwrap() };
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &words, 128 * 2, 2);
+    for i in 0..128usize {
+        let q = quad(i * 3);
+        let want = [q[0] ^ (q[3] << 1), quad(i)[2].wrapping_add(words[0])];
+        assert_eq!(&got[i * 2..(i + 1) * 2], &want, "invocation {i}");
+    }
+}

@@ -94,6 +94,7 @@ impl Compiler<'_> {
             Some(Place::Buffer(buffer, bytes)) => {
                 self.push(Insn::LoadBuffer { dst, buffer, address: bytes / 4, len });
             }
+            None if self.fuse_element_load(scope, pointer, dst, len, &runs) => {}
             None => {
                 let pointer = self.reg(scope, pointer);
                 self.push(match runs {

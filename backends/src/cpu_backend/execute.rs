@@ -2,11 +2,12 @@
 //! (memory through pointers, atomics, textures): decoded once for the group, then
 //! executed for each member in turn; never control flow.
 
+use super::element_load::element_offset;
 use super::insn::Insn;
 use super::interp::GroupMemory;
 use super::lanes::{LaneRegs, Members};
 use super::memory::{BUFFER, Memory, TAG_MASK, WORKGROUP, read_mixed, write_buffer, write_mixed};
-use std::sync::atomic::Ordering;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Executes, for each member of `members` (lanes of the running file `file`), an
 /// instruction that `run_group` neither runs itself (control flow) nor runs as row
@@ -63,16 +64,7 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
                 BUFFER => buffers[(tag & !TAG_MASK) as usize].len() * 4,
                 _ => memory!(lane, private).words(regs, tag),
             };
-            let available = size.saturating_sub(offset);
-            // Element `index`, clamped to the last one (WGSL), without a division per
-            // lane where it lies inside the region (the common case).
-            let at = if stride == 0 {
-                0
-            } else if (index + 1) * stride <= available {
-                index * stride
-            } else {
-                ((available / stride).max(1) - 1) * stride
-            };
+            let at = element_offset(size.saturating_sub(offset), stride, index);
             regs[dst] = tag;
             regs[dst + 1] = (offset + at) as u32;
         }),
@@ -89,25 +81,7 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
                 let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1] as usize);
                 // The common regions inline; the others (and the general rules) in `Memory`.
                 match tag & TAG_MASK {
-                    BUFFER => {
-                        let memory = &buffers[(tag & !TAG_MASK) as usize];
-                        for &(start, words) in runs {
-                            let (start, words) = (start as usize, words as usize);
-                            let first = offset / 4 + start;
-                            match memory.get(first..first + words) {
-                                // Inside the buffer (the common case): one bounds check.
-                                Some(run) => {
-                                    regs.write_each(dst + start, run.iter().map(|w| w.load(Ordering::Relaxed)))
-                                }
-                                None => {
-                                    for i in 0..words {
-                                        regs[dst + start + i] =
-                                            memory.get(first + i).map_or(0, |w| w.load(Ordering::Relaxed));
-                                    }
-                                }
-                            }
-                        }
-                    }
+                    BUFFER => load_runs(&buffers[(tag & !TAG_MASK) as usize], offset / 4, runs, regs, dst),
                     WORKGROUP => {
                         let workgroup = workgroup!(lane);
                         for &(start, words) in runs {
@@ -119,6 +93,17 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
                     // Private and function memory: the whole value (words nobody reads too).
                     _ => memory!(lane, private).load(regs, (tag, offset as u32), dst, *len as usize),
                 }
+            })
+        }
+        Insn::LoadElement(load) => {
+            let memory = &buffers[load.buffer as usize];
+            let whole = [(0, load.len)];
+            let runs: &[(u32, u32)] = load.runs.as_deref().unwrap_or(&whole);
+            let (dst, index) = (load.dst as usize, load.index as usize);
+            members.for_each(|lane| {
+                let mut regs = LaneRegs::new(file, lane, width);
+                let first = load.first_word(memory.len() * 4, regs[index]);
+                load_runs(memory, first, runs, &mut regs, dst);
             })
         }
         Insn::Store { pointer, src, len } => {
@@ -261,5 +246,24 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
         | Insn::Gather(_)
         | Insn::Collective(_)
         | Insn::Fail(_) => unreachable!("control flow is run by the group"),
+    }
+}
+
+/// Loads the `runs` (first word, words) of the value at word `first` of buffer `memory`
+/// into registers `dst + first word ..` of `regs`; words past the buffer's end read as 0.
+#[inline(always)]
+fn load_runs(memory: &[AtomicU32], first: usize, runs: &[(u32, u32)], regs: &mut LaneRegs, dst: usize) {
+    for &(start, words) in runs {
+        let (start, words) = (start as usize, words as usize);
+        let first = first + start;
+        match memory.get(first..first + words) {
+            // Inside the buffer (the common case): one bounds check.
+            Some(run) => regs.write_each(dst + start, run.iter().map(|w| w.load(Ordering::Relaxed))),
+            None => {
+                for i in 0..words {
+                    regs[dst + start + i] = memory.get(first + i).map_or(0, |w| w.load(Ordering::Relaxed));
+                }
+            }
+        }
     }
 }

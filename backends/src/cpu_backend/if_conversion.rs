@@ -194,6 +194,7 @@ fn speculable(insn: &Insn) -> bool {
             | Insn::PtrIndexRt { .. }
             | Insn::Load { .. }
             | Insn::LoadRuns { .. }
+            | Insn::LoadElement(_)
             | Insn::LoadMixed { .. }
             | Insn::LoadWorkgroup { .. }
             | Insn::LoadPrivate { .. }

@@ -293,6 +293,9 @@ pub(super) enum Insn {
     /// pointer register: a struct whose other words are never read
     /// ([`super::load_fields`]).
     LoadRuns { dst: Reg, pointer: Reg, len: u32, runs: super::load_fields::Runs },
+    /// An element of a runtime-sized array in a buffer known when compiling, loaded
+    /// (`PtrIndexRt` and a load fused: [`super::element_load`]).
+    LoadElement(Box<super::element_load::ElementLoad>),
     /// Writes `len` words through a pointer register.
     Store { pointer: Reg, src: Reg, len: u32 },
     /// Reads a value holding f16 through a pointer into a buffer: naga's layout there,

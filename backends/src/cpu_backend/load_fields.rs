@@ -179,6 +179,12 @@ mod tests {
                 // (The prelude's one-word load of `data` left out.)
                 Insn::Load { len, .. } if *len > 1 => Some((*len, vec![(0, *len)])),
                 Insn::LoadRuns { len, runs, .. } => Some((*len, runs.to_vec())),
+                // The same loads of a buffer element, fused with their pointer.
+                Insn::LoadElement(load) => match &load.runs {
+                    Some(runs) => Some((load.len, runs.to_vec())),
+                    None if load.len > 1 => Some((load.len, vec![(0, load.len)])),
+                    None => None,
+                },
                 _ => None,
             })
             .collect()

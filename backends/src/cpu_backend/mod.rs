@@ -54,6 +54,7 @@ mod batch;
 mod constant;
 mod counts;
 mod decode;
+mod element_load;
 mod error;
 mod exec;
 mod execute;

@@ -88,6 +88,10 @@ fn retargetable(insn: &mut Insn, src: Reg, dst: Reg, len: u32) -> bool {
         Insn::Splat { dst: d, src: s, n } if u32::from(*n) == len => (d, apart(*s, 1)),
         Insn::Swizzle { dst: d, src: s, n, .. } if u32::from(*n) == len => (d, apart(*s, 4)),
         Insn::Load { dst: d, pointer, len: n } if *n == len => (d, apart(*pointer, 2)),
+        Insn::LoadElement(load) if load.len == len && load.runs.is_none() => {
+            let index = load.index;
+            (&mut load.dst, apart(index, 1))
+        }
         Insn::LoadBuffer { dst: d, len: n, .. }
         | Insn::LoadPrivate { dst: d, len: n, .. }
         | Insn::LoadWorkgroup { dst: d, len: n, .. }

@@ -1,0 +1,121 @@
+//! Loads of a runtime-sized buffer array's element, `nodes[i]`, as one instruction
+//! ([`ElementLoad`]) instead of a pointer computed into registers (`PtrIndexRt`) and a
+//! load through it.
+//!
+//! Why: a BVH walk loads a node or a triangle per step, and the interpreter ran both
+//! instructions member by member; the path tracer spent about a tenth of its time on
+//! the pointer alone (reading the base pointer's tag, the buffer's size through the
+//! general memory model, writing two pointer words per invocation). Where the buffer is
+//! known when compiling, only the index varies by invocation.
+//!
+//! Sound because the pointer has no other use (naga reference count 1: this load), so
+//! its registers are never read; the pointer's instruction is the one just before the
+//! load (tracked by [`Compiler::last_value`], which every statement that may place a
+//! jump target clears), so the index register holds the same value at the load; and
+//! the fused instruction clamps the index and reads out-of-bounds words as 0 exactly as
+//! the two did ([`element_offset`], `execute.rs`).
+
+use super::decode::{Compiler, Scope};
+use super::insn::{Insn, Reg};
+use super::layout::Place;
+use super::load_fields::Runs;
+use super::retarget::LastValue;
+use naga::{Expression, Handle};
+
+/// Element `index` (clamped to the array's last, as WGSL does) of the runtime-sized array
+/// at byte `address` of bound buffer `buffer`, elements `stride` bytes apart, loaded
+/// into `dst`: `len` words, or only `runs` (first word, words) where given.
+pub(super) struct ElementLoad {
+    /// First register of the loaded value.
+    pub dst: Reg,
+    /// Index of the bound buffer.
+    pub buffer: u32,
+    /// Byte of the array's first element in the buffer.
+    pub address: u32,
+    /// Register of the element index.
+    pub index: Reg,
+    /// Bytes from one element to the next.
+    pub stride: u32,
+    /// Words of the value.
+    pub len: u32,
+    /// The runs of words its uses read ([`super::load_fields`]), or `None`: all.
+    pub runs: Option<Runs>,
+}
+
+impl ElementLoad {
+    /// The buffer word where the element of `index` starts, for a buffer of `bytes`
+    /// bytes: the element clamped as `PtrIndexRt` clamps it ([`element_offset`]).
+    #[inline(always)]
+    pub(super) fn first_word(&self, bytes: usize, index: u32) -> usize {
+        let address = self.address as usize;
+        let available = bytes.saturating_sub(address);
+        (address + element_offset(available, self.stride as usize, index as usize)) / 4
+    }
+}
+
+/// Where element `index` of an array of elements `stride` apart starts, in a region of
+/// `available` units from the array's start: the element clamped to the last one that
+/// fits (WGSL), element 0 where none fits (its words then read as 0). No division
+/// where the element lies inside (the common case).
+#[inline(always)]
+pub(super) fn element_offset(available: usize, stride: usize, index: usize) -> usize {
+    if stride == 0 {
+        0
+    } else if (index + 1) * stride <= available {
+        index * stride
+    } else {
+        ((available / stride).max(1) - 1) * stride
+    }
+}
+
+impl Compiler<'_> {
+    /// The fused load of `pointer` (`len` words into `dst`), if `pointer` is an element
+    /// of a runtime-sized array in a buffer known when compiling, computed by the last
+    /// instruction, with no other use: that instruction is then replaced by the load.
+    pub(super) fn fuse_element_load(
+        &mut self,
+        scope: &Scope,
+        pointer: Handle<Expression>,
+        dst: Reg,
+        len: u32,
+        runs: &Option<Runs>,
+    ) -> bool {
+        let last = self.insns.len().wrapping_sub(1);
+        if self.last_value != Some(LastValue::new(scope, pointer, last)) || scope.info[pointer].ref_count != 1 {
+            return false;
+        }
+        let Expression::Access { base, .. } = scope.function.expressions[pointer] else { return false };
+        let Some(Place::Buffer(buffer, address)) = scope.places[base.index()] else { return false };
+        let Some(&Insn::PtrIndexRt { dst: computed, index, stride, .. }) = self.insns.last() else { return false };
+        if computed != scope.regs[pointer.index()] {
+            return false;
+        }
+        let load = ElementLoad { dst, buffer, address, index, stride, len, runs: runs.clone() };
+        *self.insns.last_mut().expect("checked above") = Insn::LoadElement(Box::new(load));
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::decode::tests::compiled;
+    use super::super::insn::Insn;
+
+    /// The element loads and pointer computations of `body`.
+    fn kinds(body: &str) -> (usize, usize) {
+        let insns = compiled(body);
+        let count = |f: fn(&Insn) -> bool| insns.iter().filter(|i| f(i)).count();
+        (count(|i| matches!(i, Insn::LoadElement(_))), count(|i| matches!(i, Insn::PtrIndexRt { .. })))
+    }
+
+    #[test]
+    fn element_loads_fuse_where_the_pointer_has_no_other_use() {
+        // `x = data[id.x]` and `data[x % 7u]`: one instruction each (the store's pointer
+        // stays).
+        assert_eq!(kinds("data[id.x] = data[x % 7u];"), (2, 1));
+        // The pointer used twice (a load and a store): kept.
+        assert_eq!(kinds("let p = &data[x % 7u]; *p = *p + 1u;"), (1, 1));
+        // Another instruction between the pointer and the load: kept.
+        assert_eq!(kinds("let p = &data[x % 7u]; let y = x * 3u; data[id.x] = *p + y;"), (1, 2));
+    }
+}

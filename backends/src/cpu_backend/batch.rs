@@ -1,4 +1,5 @@
-//! Several workgroups run as one wide batch, where the kernel cannot tell.
+//! Several workgroups run as one wide batch, where the kernel cannot tell (one
+//! exception below).
 //!
 //! Why: a divergent kernel's workgroup ends with a few invocations still looping (the
 //! path tracer's longest BVH walks), and the group loop of [`super::interp`] then decodes
@@ -13,14 +14,19 @@
 //! Every invocation still gets its own workgroup's builtins and its own workgroup's
 //! memory: a batch holds one zeroed region per workgroup (the path tracer keeps its
 //! BVH stack there, a slice per invocation).
+//!
+//! One thing a batch does change: a kernel whose invocations spin until another
+//! workgroup has written something may now wait forever (the scheduler always runs the
+//! group furthest behind, here the spinning one, as it already did within a workgroup).
+//! WGSL promises no forward progress between workgroups, so such a kernel is not
+//! portable; before batches it finished here because workgroups ran in index order.
 
 use super::decode::Program;
 use super::insn::Insn;
 
-/// How many invocations a batch holds at most: four of the common 64-wide workgroups.
-/// Wider batches made more groups full-width but each group's row operations and the
-/// scheduler's scan of every invocation's place longer (BENCHMARKS.md, "Batches of
-/// workgroups").
+/// How many invocations a batch holds at most: eight of the common 64-wide workgroups,
+/// where the path tracer's frame was fastest (128, 256 and 1 024 were slower:
+/// BENCHMARKS.md, "Batches of workgroups").
 pub(super) const BATCH_INVOCATIONS: u32 = 512;
 
 /// How many workgroups of `program` run as one batch: 1 where the kernel could observe it

@@ -176,6 +176,9 @@ pub(super) struct Compiler<'a> {
     /// The expression compiled last, while the statement after it may store it
     /// ([`super::retarget`]).
     pub(super) last_value: Option<super::retarget::LastValue>,
+    /// The instruction that the expression being compiled took over instead of adding
+    /// its own (a fused element load, [`super::element_load`]): it computes the value.
+    pub(super) took_over: Option<usize>,
 }
 
 impl Compiler<'_> {
@@ -496,6 +499,7 @@ fn compile_code(
         line: 0,
         source: 0,
         last_value: None,
+        took_over: None,
     };
     let mut code_arguments = Vec::new();
     let mut scope = compiler.open(function, function_info, None, None, 0, &mut code_arguments)?;

@@ -92,6 +92,7 @@ impl Compiler<'_> {
         }
         let load = ElementLoad { dst, buffer, address, index, stride, len, runs: runs.clone() };
         *self.insns.last_mut().expect("checked above") = Insn::LoadElement(Box::new(load));
+        self.took_over = Some(last);
         true
     }
 }
@@ -117,5 +118,13 @@ mod tests {
         assert_eq!(kinds("let p = &data[x % 7u]; *p = *p + 1u;"), (1, 1));
         // Another instruction between the pointer and the load: kept.
         assert_eq!(kinds("let p = &data[x % 7u]; let y = x * 3u; data[id.x] = *p + y;"), (1, 2));
+    }
+
+    #[test]
+    fn a_fused_load_stored_into_a_variable_is_loaded_into_it() {
+        let copies = |body: &str| compiled(body).iter().filter(|i| matches!(i, Insn::Copy1 { .. })).count();
+        // The load computed straight into `v` (store forwarding): no more copies than
+        // without it.
+        assert_eq!(copies("var v = 0u; v = data[x % 7u]; data[id.x] = v;"), copies("var v = 0u; data[id.x] = v;"));
     }
 }

@@ -266,7 +266,9 @@ fn run_batch(
     Ok(counts)
 }
 
-/// Computes a subgroup gather for every invocation of the workgroup.
+/// Computes a subgroup gather for every invocation of the workgroup (never a batch of
+/// several: [`super::batch`] keeps kernels with subgroup operations one workgroup at a
+/// time, so a local index is a lane of the register file).
 fn gather(invocations: &[Invocation], file: &mut [u32], gather: &super::insn::GatherInsn) {
     use naga::GatherMode as G;
     let width = invocations.len();
@@ -311,7 +313,8 @@ fn gather(invocations: &[Invocation], file: &mut [u32], gather: &super::insn::Ga
 /// Computes a subgroup ballot, reduction or scan for every invocation of the workgroup:
 /// the lanes of a subgroup are the invocations `subgroup_id * size ..` in local-index
 /// order, combined lane by lane in that order (float sums and products therefore
-/// associate left to right; GPUs may use another order, a few ULPs apart).
+/// associate left to right; GPUs may use another order, a few ULPs apart). One
+/// workgroup at a time, as for [`gather`].
 fn collective(invocations: &[Invocation], file: &mut [u32], collective: &super::insn::CollectiveInsn) {
     use super::insn::CollectiveFun;
     use naga::CollectiveOperation as C;

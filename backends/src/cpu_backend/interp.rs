@@ -1,6 +1,7 @@
 //! The dispatch loop, a workgroup (or a batch of them, [`super::batch`]) at a time: runs
-//! the bytecode of every invocation of a workgroup until each ends or reaches a barrier or subgroup operation, where it stops
-//! (that instruction still next) so that [`super::exec`] can synchronise them.
+//! the bytecode of every invocation of the batch until each ends or reaches a barrier or
+//! subgroup operation, where it stops (that instruction still next) so that
+//! [`super::exec`] can synchronise them.
 //!
 //! Invocations at the same place (the same instruction of the same call stack) run as
 //! one *group*: each instruction is decoded and dispatched once and executed for every
@@ -45,7 +46,7 @@ pub(super) enum Stop {
 
 /// One invocation: where it is (its running frame, its callers' frames) and who it is.
 /// Its registers are its column of each code's file, its private memory its slice of
-/// [`Workgroup::private`].
+/// [`Batch::private`].
 pub(super) struct Invocation {
     /// The running frame (`None` once the entry point returned).
     pub frame: Option<Frame>,
@@ -70,7 +71,8 @@ pub(super) struct Invocation {
 pub(super) struct Batch {
     /// Per code, its lane-minor register file (empty until the code first runs).
     pub files: Vec<Vec<u32>>,
-    /// Every invocation's private memory, `private_words` each, in local-index order.
+    /// Every invocation's private memory, `private_words` each, in the batch's order
+    /// (workgroup after workgroup, each in local-index order).
     pub private: Vec<u32>,
     /// Words of private memory per invocation.
     pub private_words: usize,
@@ -112,7 +114,7 @@ pub(super) struct GroupMemory<'a> {
     pub files: &'a mut [Vec<u32>],
     /// The codes of the group's callers, outermost first.
     pub callers: &'a [u32],
-    /// Lanes per register file (the workgroup's invocations).
+    /// Lanes per register file (the batch's invocations).
     pub width: usize,
 }
 
@@ -189,7 +191,7 @@ fn meeting_point(leader: &Invocation, other: &Invocation) -> Option<u32> {
     }
 }
 
-/// Runs every invocation of a workgroup until it returns from the entry point or stops
+/// Runs every invocation of a batch until it returns from the entry point or stops
 /// at a barrier or subgroup operation; `stops[i]` says where invocation `i` stopped.
 /// Counts what the groups executed into `counts`.
 pub(super) fn run_until_sync(
@@ -259,8 +261,9 @@ pub(super) fn run_until_sync(
         // Members at the same place have the same callers.
         caller_codes.clear();
         caller_codes.extend(invocations[leader].callers.iter().map(|f| f.code));
-        // An invocation's position in the workgroup is its local index and its lane in
-        // the register files (exec.rs).
+        // An invocation's position in the batch is its lane in the register files:
+        // its workgroup's place in the batch times the workgroup's size, plus its local
+        // index (exec.rs).
         let group = group_of(members, mask, width);
         let end = {
             let mut file = std::mem::take(&mut memory.files[code_index as usize]);

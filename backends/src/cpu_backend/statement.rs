@@ -40,8 +40,14 @@ impl Compiler<'_> {
             Statement::Emit(range) => {
                 for handle in range.clone() {
                     if !scope.pre_emitted[handle.index()] {
+                        self.took_over = None;
                         let first = self.insns.len();
                         self.expression(scope, handle)?;
+                        // A fused load computes its value in the instruction before.
+                        let first = match self.took_over.take() {
+                            Some(index) if index + 1 == first => index,
+                            _ => first,
+                        };
                         self.last_value = Some(LastValue::new(scope, handle, first));
                     }
                 }

@@ -56,8 +56,6 @@ pub(super) fn run(
                             private: Vec::new(),
                             private_words: program.private_init.len(),
                             shared: Vec::new(),
-                            shared_words: program.workgroup_words as usize,
-                            per_workgroup: program.workgroup_size.iter().product::<u32>().max(1) as usize,
                         },
                         invocations: Vec::new(),
                         scratch: interp::Scratch::default(),
@@ -212,7 +210,7 @@ fn run_batch(
     let count = invocations.len();
     // Zero-initialised workgroup memory, one region per workgroup of the batch.
     memory.shared.clear();
-    memory.shared.resize(count / per_workgroup as usize * memory.shared_words, 0);
+    memory.shared.resize(count / per_workgroup as usize * program.workgroup_words as usize, 0);
     enter_entry_point(program, &mut memory.files[program.entry as usize], &builtins)?;
     memory.private.clear();
     for _ in 0..count {

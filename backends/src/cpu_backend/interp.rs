@@ -76,12 +76,9 @@ pub(super) struct Batch {
     pub private: Vec<u32>,
     /// Words of private memory per invocation.
     pub private_words: usize,
-    /// The workgroup memory of the batch's workgroups, `shared_words` each, in order.
+    /// The workgroup memory of the batch's workgroups, the program's `workgroup_words`
+    /// each, in order.
     pub shared: Vec<u32>,
-    /// Words of workgroup memory per workgroup.
-    pub shared_words: usize,
-    /// Invocations per workgroup.
-    pub per_workgroup: usize,
 }
 
 /// The scheduler's working lists, kept from one synchronisation point to the next.
@@ -92,7 +89,6 @@ pub(super) struct Scratch {
     mask: Vec<u32>,
     targets: Vec<u32>,
     caller_codes: Vec<u32>,
-    pcs: Vec<u32>,
     places: Places,
 }
 
@@ -206,18 +202,11 @@ pub(super) fn run_until_sync(
     stops.clear();
     stops.extend(invocations.iter().map(|inv| if inv.frame.is_some() { None } else { Some(Stop::Done) }));
     let width = invocations.len();
-    let Scratch { members, mask, targets, caller_codes, pcs, places } = scratch;
+    let Scratch { members, mask, targets, caller_codes, places } = scratch;
     // While no invocation is inside a call (the common case: small functions are
     // inlined), where an invocation is is its next instruction alone: the group to run is
-    // then found from these words (`u32::MAX`: stopped) and from `places`, the same
-    // kept by instruction, instead of by comparing stacks.
-    pcs.clear();
-    pcs.extend(
-        invocations
-            .iter()
-            .zip(stops.iter())
-            .map(|(inv, stop)| if stop.is_none() { inv.frame.as_ref().map_or(u32::MAX, |f| f.pc) } else { u32::MAX }),
-    );
+    // then found from `places`, the invocations by instruction, instead of by comparing
+    // stacks.
     // Runnable invocations inside a call (stopped ones no longer count).
     let mut in_calls = invocations.iter().filter(|inv| !inv.callers.is_empty()).count();
     let entry_instructions = program.codes[program.entry as usize].insns.len();
@@ -229,7 +218,11 @@ pub(super) fn run_until_sync(
         let mut meet = u32::MAX;
         let leader = if in_calls == 0 {
             if !placed {
-                places.rebuild(entry_instructions, pcs);
+                // Every runnable invocation is in the entry point's frame.
+                let running = invocations.iter().zip(stops.iter()).enumerate().filter_map(|(lane, (inv, stop))| {
+                    inv.frame.as_ref().filter(|_| stop.is_none()).map(|frame| (lane, frame.pc))
+                });
+                places.rebuild(entry_instructions, width, running);
                 placed = true;
             }
             let Some((_, next)) = places.take_first(members) else { return Ok(()) };
@@ -270,8 +263,8 @@ pub(super) fn run_until_sync(
             let mut group_memory = GroupMemory {
                 buffers,
                 workgroup: &mut memory.shared,
-                workgroup_words: memory.shared_words,
-                per_workgroup: memory.per_workgroup,
+                workgroup_words: program.workgroup_words as usize,
+                per_workgroup: program.workgroup_size.iter().product::<u32>() as usize,
                 private: &mut memory.private,
                 private_words: memory.private_words,
                 files: &mut memory.files,
@@ -335,12 +328,6 @@ pub(super) fn run_until_sync(
                     in_calls -= usize::from(stops[i].is_none() && invocations[i].callers.is_empty());
                 }
             }
-        }
-        for &i in members.iter() {
-            pcs[i] = match (&stops[i], &invocations[i].frame) {
-                (None, Some(frame)) => frame.pc,
-                _ => u32::MAX,
-            };
         }
     }
 }

@@ -23,10 +23,15 @@ pub(super) struct Places {
 }
 
 impl Places {
-    /// Starts over for a code of `instructions` instructions and the invocations at
-    /// `pcs` (`u32::MAX`: stopped), one per lane.
-    pub(super) fn rebuild(&mut self, instructions: usize, pcs: &[u32]) {
-        let words = pcs.len().div_ceil(BITS);
+    /// Starts over for a code of `instructions` instructions, `lanes` invocations, of
+    /// which those of `running` (lane, instruction) are at those instructions.
+    pub(super) fn rebuild(
+        &mut self,
+        instructions: usize,
+        lanes: usize,
+        running: impl IntoIterator<Item = (usize, u32)>,
+    ) {
+        let words = lanes.div_ceil(BITS);
         let slots = instructions + 1;
         if self.words != words || self.sets.len() != slots * words {
             self.words = words;
@@ -39,10 +44,8 @@ impl Places {
                 self.occupied[pc / BITS] &= !(1 << (pc % BITS));
             }
         }
-        for (lane, &pc) in pcs.iter().enumerate() {
-            if pc != u32::MAX {
-                self.add(pc, lane);
-            }
+        for (lane, pc) in running {
+            self.add(pc, lane);
         }
     }
 
@@ -94,12 +97,7 @@ mod tests {
         let mut places = Places::default();
         // 130 lanes (three words per set): lanes 1, 64 and 129 at 7, lane 3 at 2, the
         // rest stopped.
-        let mut pcs = vec![u32::MAX; 130];
-        for lane in [1, 64, 129] {
-            pcs[lane] = 7;
-        }
-        pcs[3] = 2;
-        places.rebuild(100, &pcs);
+        places.rebuild(100, 130, [(1, 7), (64, 7), (129, 7), (3, 2)]);
         let mut members = Vec::new();
         assert_eq!(places.take_first(&mut members), Some((2, 7)));
         assert_eq!(members, [3]);
@@ -120,7 +118,7 @@ mod tests {
         assert_eq!(places.take_first(&mut members), None);
         // Sets left behind are emptied by the next rebuild.
         places.add(5, 0);
-        places.rebuild(100, &[u32::MAX; 130]);
+        places.rebuild(100, 130, []);
         assert_eq!(places.take_first(&mut members), None);
     }
 }

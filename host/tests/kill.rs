@@ -74,6 +74,7 @@ fn kill_at_several_points(name: &str, args: &[&str]) {
     assert!(strata(args, &timing).status().unwrap().success(), "the uninterrupted run failed");
     let whole = started.elapsed();
     assert!(assert_complete(&timing) > 0);
+    let timing_copy = timing.clone();
     let mut last = timing;
     for (index, fraction) in [0.15, 0.35, 0.55, 0.75, 0.9, 0.97].into_iter().enumerate() {
         let out = scratch(&format!("{name}-{index}"));
@@ -84,15 +85,33 @@ fn kill_at_several_points(name: &str, args: &[&str]) {
         assert_complete(&out);
         last = out;
     }
-    // The next run takes over: a stale lock and hidden leftovers do not stop it.
+    // The next run takes over: a stale lock and hidden leftovers do not stop it. A
+    // leftover of every file the run writes is planted too (a kill between writing and
+    // renaming, which the points above hit only by chance), as a dead process left it.
+    let dead = {
+        let mut child = Command::new("true").spawn().unwrap();
+        let pid = child.id();
+        child.wait().unwrap();
+        pid
+    };
+    for entry in std::fs::read_dir(&timing_copy).unwrap() {
+        let name = entry.unwrap().file_name().to_string_lossy().into_owned();
+        if name.starts_with('.') {
+            continue;
+        }
+        let leftover = match name.rsplit_once('.') {
+            Some((stem, extension)) => format!(".{stem}.tmp-{dead}.{extension}"),
+            None => format!(".{name}.tmp-{dead}"),
+        };
+        std::fs::write(last.join(leftover), b"half").unwrap();
+    }
     assert!(strata(args, &last).status().unwrap().success(), "a run after a killed one failed");
-    assert!(
-        std::fs::read_dir(&last).unwrap().all(|e| {
-            let n = e.unwrap().file_name().to_string_lossy().into_owned();
-            !n.starts_with('.')
-        }),
-        "leftovers after a complete run"
-    );
+    let leftovers: Vec<String> = std::fs::read_dir(&last)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(leftovers.is_empty(), "leftovers after a complete run: {leftovers:?}");
     assert!(Duration::from_secs(0) < whole);
 }
 

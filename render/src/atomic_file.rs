@@ -7,8 +7,10 @@
 //! checks that the file holds every byte, and only then renames it into place, which
 //! POSIX makes atomic within one file system. So:
 //! - a run killed while writing leaves at most a hidden temporary file, never a truncated
-//!   EXR, PNG or CSV under the final name that looks valid; the next run into the folder
-//!   removes such leftovers ([`is_temporary`]);
+//!   EXR, PNG or CSV under the final name that looks valid; the next write of that name
+//!   removes the temporaries that processes no longer running left for it
+//!   ([`remove_dead_temporaries`]), and `strata compare` clears a whole folder's
+//!   ([`is_temporary`]);
 //! - a full disk is an error naming the file, never a 0-byte file reported as written;
 //! - the target must be a regular file or absent: a rename would silently replace a
 //!   device node (`/dev/full`), a folder's entry of another kind or a symbolic link with
@@ -33,6 +35,55 @@ pub fn temporary_path(path: &Path) -> PathBuf {
 /// Whether a file name is one of [`temporary_path`]'s (of any process).
 pub fn is_temporary(name: &str) -> bool {
     name.starts_with('.') && name.contains(".tmp-")
+}
+
+/// Whether process `pid` is running (Linux and other systems with `/proc`; elsewhere
+/// every process counts as running, so nothing of another process is ever removed).
+pub fn process_is_running(pid: u32) -> bool {
+    if !Path::new("/proc/self").exists() {
+        return true;
+    }
+    Path::new(&format!("/proc/{pid}")).exists()
+}
+
+/// The process that wrote temporary file `name` for the target named `target_name`, if
+/// `name` is one of that target's temporaries ([`temporary_path`] of another process).
+fn temporary_writer(target_name: &str, name: &str) -> Option<u32> {
+    let (prefix, suffix) = match target_name.rsplit_once('.') {
+        Some((stem, extension)) => (format!(".{stem}.tmp-"), format!(".{extension}")),
+        None => (format!(".{target_name}.tmp-"), String::new()),
+    };
+    let pid = name.strip_prefix(&prefix)?.strip_suffix(&suffix)?;
+    if pid.is_empty() || !pid.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    pid.parse().ok()
+}
+
+/// Removes the temporary files of `path` that processes no longer running left (a run
+/// killed between writing and renaming); those of running processes (another run writing
+/// the same name now) are kept. Returns the names removed. Best effort: a leftover that
+/// cannot be listed or removed stays, hidden, and harms nothing.
+pub fn remove_dead_temporaries(path: &Path) -> Vec<String> {
+    let (Some(folder), Some(target_name)) = (path.parent(), path.file_name()) else { return Vec::new() };
+    let folder = if folder.as_os_str().is_empty() { Path::new(".") } else { folder };
+    let target_name = target_name.to_string_lossy();
+    let Ok(entries) = std::fs::read_dir(folder) else { return Vec::new() };
+    let mut removed = Vec::new();
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let Some(pid) = temporary_writer(&target_name, &name) else { continue };
+        let regular = entry.file_type().is_ok_and(|t| t.is_file());
+        if regular
+            && pid != std::process::id()
+            && !process_is_running(pid)
+            && std::fs::remove_file(entry.path()).is_ok()
+        {
+            removed.push(name);
+        }
+    }
+    removed.sort();
+    removed
 }
 
 /// Why a file cannot be written; the message names the file.
@@ -152,6 +203,9 @@ pub fn write_set(files: &[(&Path, &[u8])]) -> Result<(), WriteError> {
     for (path, _) in files {
         check_target(path)?;
     }
+    for (path, _) in files {
+        remove_dead_temporaries(path);
+    }
     let mut staged: Vec<PathBuf> = Vec::new();
     let result = (|| -> Result<(), WriteError> {
         for (path, bytes) in files {
@@ -261,6 +315,47 @@ mod tests {
         std::fs::create_dir(temporary_path(&path)).unwrap();
         assert!(write(&path, "new").is_err());
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "old");
+        std::fs::remove_dir_all(&folder).unwrap();
+    }
+
+    /// The process id of a process that has ended.
+    fn a_dead_process() -> u32 {
+        let mut child = std::process::Command::new("true").spawn().unwrap();
+        let pid = child.id();
+        child.wait().unwrap();
+        assert!(!process_is_running(pid) || !Path::new("/proc/self").exists());
+        pid
+    }
+
+    #[test]
+    fn a_write_removes_the_temporaries_a_dead_process_left_for_its_name() {
+        let folder = scratch("leftovers");
+        let dead = a_dead_process();
+        // A process still running (another run writing the same name now): kept.
+        let mut living = std::process::Command::new("sleep").arg("60").spawn().unwrap();
+        let doomed = format!(".default.tmp-{dead}.exr");
+        let kept = [
+            format!(".default.tmp-{}.exr", living.id()),
+            format!(".default.tmp-{dead}.png"),  // another target's
+            format!(".default.tmp-{dead}x.exr"), // not a process id
+            format!(".other.tmp-{dead}.exr"),    // another target's
+            "notes.txt".to_string(),
+        ];
+        for name in kept.iter().chain([&doomed]) {
+            std::fs::write(folder.join(name), b"x").unwrap();
+        }
+        write(&folder.join("default.exr"), b"image").unwrap();
+        let _ = living.kill();
+        let _ = living.wait();
+        let left = names(&folder);
+        assert_eq!(left.contains(&doomed), !Path::new("/proc/self").exists(), "{left:?}");
+        for name in &kept {
+            assert!(left.contains(name), "{name} was removed: {left:?}");
+        }
+        assert_eq!(std::fs::read(folder.join("default.exr")).unwrap(), b"image");
+        assert_eq!(temporary_writer("default.exr", &doomed), Some(dead));
+        assert_eq!(temporary_writer("default.exr", ".default.tmp-.exr"), None);
+        assert_eq!(temporary_writer("LICENSE", &format!(".LICENSE.tmp-{dead}")), Some(dead));
         std::fs::remove_dir_all(&folder).unwrap();
     }
 

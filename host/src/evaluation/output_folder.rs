@@ -23,15 +23,6 @@ impl Drop for FolderLock {
     }
 }
 
-/// Whether process `pid` is running (Linux and other systems with `/proc`; elsewhere
-/// every lock counts as held).
-fn process_is_running(pid: u32) -> bool {
-    if !Path::new("/proc/self").exists() {
-        return true;
-    }
-    Path::new(&format!("/proc/{pid}")).exists()
-}
-
 /// Takes `folder`'s lock, or says which run holds it. A lock whose process has ended
 /// (a killed run) is taken over.
 pub fn lock(folder: &Path) -> Result<FolderLock> {
@@ -47,7 +38,7 @@ pub fn lock(folder: &Path) -> Result<FolderLock> {
             Err(error) if error.kind() == std::io::ErrorKind::AlreadyExists => {
                 let holder = std::fs::read_to_string(&path).ok().and_then(|t| t.trim().parse::<u32>().ok());
                 match holder {
-                    Some(pid) if process_is_running(pid) => bail!(
+                    Some(pid) if crate::atomic_file::process_is_running(pid) => bail!(
                         "{}: another strata compare (process {pid}) is writing into this folder; wait for it or \
                          choose another --out (if no such run is going on, remove {})",
                         folder.display(),

@@ -17,11 +17,11 @@ pub struct BackendSlot {
 
 fn wgpu(api: WgpuApi) -> Result<Box<dyn Backend>, BackendError> {
     let validation = api == WgpuApi::Vulkan;
-    Ok(Box::new(WgpuBackend::new(WgpuOptions { api, validation, subgroups: true })?))
+    Ok(Box::new(WgpuBackend::new(WgpuOptions { api, validation, subgroups: true, ..Default::default() })?))
 }
 
 fn ash(source: SpirvSource) -> Result<Box<dyn Backend>, BackendError> {
-    Ok(Box::new(AshBackend::new(AshOptions { validation: false, source, subgroups: true })?))
+    Ok(Box::new(AshBackend::new(AshOptions { validation: false, source, subgroups: true, ..Default::default() })?))
 }
 
 /// Every backend of the check, in report order.

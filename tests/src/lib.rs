@@ -36,7 +36,7 @@ pub fn scenes_folder() -> std::path::PathBuf {
 /// the machine has no Vulkan device. Under `STRATA_REQUIRE_GPU=1` a missing device
 /// fails the test instead.
 pub fn vulkan_backend(test: &str) -> Option<WgpuBackend> {
-    open_or_skip(test, WgpuOptions { api: WgpuApi::Vulkan, validation: true, subgroups: true })
+    open_or_skip(test, WgpuOptions { api: WgpuApi::Vulkan, validation: true, subgroups: true, ..Default::default() })
 }
 
 /// Like [`vulkan_backend`] with explicit options.

@@ -9,7 +9,7 @@ use strata_kernels::reference::block_histogram::block_histogram;
 use strata_kernels::{BlockGrid, KernelId, Registry};
 
 fn open(validation: bool, subgroups: bool) -> Option<AshBackend> {
-    match AshBackend::new(AshOptions { validation, source: SpirvSource::Naga, subgroups }) {
+    match AshBackend::new(AshOptions { validation, source: SpirvSource::Naga, subgroups, ..Default::default() }) {
         Ok(backend) => Some(backend),
         Err(error @ BackendError::NoAdapter { .. }) if !gpu_required() => {
             eprintln!("SKIPPED: {error} (set STRATA_REQUIRE_GPU=1 to make this a failure)");

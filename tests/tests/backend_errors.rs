@@ -85,7 +85,7 @@ fn bindings_that_do_not_fit_the_kernel_are_named() {
 
 #[test]
 fn a_device_without_subgroups_refuses_the_subgroup_kernel() {
-    let options = WgpuOptions { api: WgpuApi::Vulkan, validation: true, subgroups: false };
+    let options = WgpuOptions { api: WgpuApi::Vulkan, validation: true, subgroups: false, ..Default::default() };
     let Some(mut backend) = open_or_skip("a_device_without_subgroups_refuses_the_subgroup_kernel", options) else {
         return;
     };

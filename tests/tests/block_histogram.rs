@@ -87,7 +87,7 @@ fn every_variant_matches_reference_at_1080p() {
 #[test]
 fn portable_matches_reference_on_gl() {
     use strata_backends::wgpu_backend::{WgpuApi, WgpuOptions};
-    let options = WgpuOptions { api: WgpuApi::Gl, validation: false, subgroups: true };
+    let options = WgpuOptions { api: WgpuApi::Gl, validation: false, subgroups: true, ..Default::default() };
     let Some(mut backend) = strata_tests::open_or_skip("portable_matches_reference_on_gl", options) else {
         return;
     };

@@ -78,7 +78,8 @@ fn the_workaround_makes_array_length_right_on_the_hlsl_path() {
     use strata_backends::backend::{download, upload};
     use strata_backends::{Backend, BackendError, Bind, gpu_required};
     let kernel = Kernel::from_wgsl("array_length.wgsl", ARRAY_LENGTH.into(), "main", false).unwrap();
-    let options = AshOptions { validation: true, source: SpirvSource::GlslangFromHlsl, subgroups: false };
+    let options =
+        AshOptions { validation: true, source: SpirvSource::GlslangFromHlsl, subgroups: false, ..Default::default() };
     let mut ash = match AshBackend::new(options) {
         Ok(ash) => ash,
         Err(error @ BackendError::NoAdapter { .. }) if !gpu_required() => {

@@ -1186,7 +1186,7 @@ fn int64_semantics_agree_with_lavapipe_bit_for_bit() {
     assert!(mismatches.is_empty(), "{} mismatches:\n{}", mismatches.len(), mismatches.join("\n"));
     // The ash backend runs it too (it enables shaderInt64, which Vulkan requires for
     // naga's Int64 capability; lavapipe's validation layer did not flag its absence).
-    let options = AshOptions { validation: true, source: SpirvSource::Naga, subgroups: false };
+    let options = AshOptions { validation: true, source: SpirvSource::Naga, subgroups: false, ..Default::default() };
     let mut ash = AshBackend::new(options).expect("lavapipe through ash");
     assert_eq!(run_words(&mut ash, &kernel, &inputs, words, (pairs / 64) as u32), want, "ash and wgpu agree");
 }
@@ -1358,7 +1358,7 @@ fn f16_arithmetic_and_conversions_agree_with_lavapipe_bit_for_bit() {
         .collect();
     assert!(mismatches.is_empty(), "{} mismatches:\n{}", mismatches.len(), mismatches.join("\n"));
     // The ash backend enables shaderFloat16 for it.
-    let options = AshOptions { validation: true, source: SpirvSource::Naga, subgroups: false };
+    let options = AshOptions { validation: true, source: SpirvSource::Naga, subgroups: false, ..Default::default() };
     let mut ash = AshBackend::new(options).expect("lavapipe through ash");
     assert_eq!(run_words(&mut ash, &kernel, &inputs, pairs * 22, (pairs / 64) as u32), want, "ash and wgpu agree");
 }

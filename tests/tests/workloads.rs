@@ -25,7 +25,12 @@ fn kernel(path: &str, source: &str) -> Kernel {
 }
 
 fn open_ash(test: &str) -> Option<AshBackend> {
-    match AshBackend::new(AshOptions { validation: true, source: SpirvSource::Naga, subgroups: false }) {
+    match AshBackend::new(AshOptions {
+        validation: true,
+        source: SpirvSource::Naga,
+        subgroups: false,
+        ..Default::default()
+    }) {
         Ok(backend) => Some(backend),
         Err(error @ BackendError::NoAdapter { .. }) if !gpu_required() => {
             eprintln!("SKIPPED {test} on ash: {error} (set STRATA_REQUIRE_GPU=1 to make this a failure)");

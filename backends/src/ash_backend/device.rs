@@ -79,7 +79,7 @@ pub(super) struct VulkanDevice {
 }
 
 impl VulkanDevice {
-    pub(super) fn open(options: AshOptions) -> Result<Self, BackendError> {
+    pub(super) fn open(options: &AshOptions) -> Result<Self, BackendError> {
         // SAFETY: loading the system Vulkan loader; failure is reported, not assumed.
         let entry = unsafe { ash::Entry::load() }.map_err(|e| BackendError::NoAdapter {
             backend: options.source.name().into(),
@@ -254,7 +254,15 @@ impl VulkanDevice {
         })
     }
 
-    pub(super) fn device_info(&self, options: AshOptions) -> DeviceInfo {
+    /// The pipeline cache file's name for this device: API, vendor and device ids (the
+    /// driver's own header in the data tells driver builds apart).
+    pub(super) fn pipeline_cache_key(&self) -> String {
+        // SAFETY: Vulkan 1.0 core query on this instance's physical device.
+        let properties = unsafe { self.instance.get_physical_device_properties(self.physical) };
+        format!("ash_pipeline_cache_vulkan_{}_{}", properties.vendor_id, properties.device_id)
+    }
+
+    pub(super) fn device_info(&self, options: &AshOptions) -> DeviceInfo {
         let mut maintenance3 = vk::PhysicalDeviceMaintenance3Properties::default();
         let mut driver = vk::PhysicalDeviceDriverProperties::default();
         let mut properties2 =

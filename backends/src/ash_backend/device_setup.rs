@@ -75,7 +75,7 @@ impl DeviceObjects {
 /// The best physical device with a compute queue and Vulkan 1.1: discrete first, CPU last.
 pub(super) fn pick_device(
     instance: &ash::Instance,
-    options: AshOptions,
+    options: &AshOptions,
 ) -> Result<(vk::PhysicalDevice, u32), BackendError> {
     // SAFETY: plain enumeration.
     let devices = unsafe { instance.enumerate_physical_devices() }.map_err(|e| vk_error("enumerating devices", e))?;

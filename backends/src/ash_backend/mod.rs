@@ -56,7 +56,7 @@ impl SpirvSource {
 }
 
 /// How to open an [`AshBackend`].
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct AshOptions {
     /// Enable `VK_LAYER_KHRONOS_validation`; its warnings and errors are collected
     /// (see [`AshBackend::validation_messages`]). Fails if the layer is not installed.
@@ -65,11 +65,19 @@ pub struct AshOptions {
     pub source: SpirvSource,
     /// Let kernels use subgroup operations when the device supports them.
     pub subgroups: bool,
+    /// The folder the driver's `VkPipelineCache` is kept in between runs; `None`: no
+    /// file. Default: [`crate::pipeline_cache_file::default_folder`].
+    pub pipeline_cache: Option<std::path::PathBuf>,
 }
 
 impl Default for AshOptions {
     fn default() -> Self {
-        Self { validation: false, source: SpirvSource::Naga, subgroups: true }
+        Self {
+            validation: false,
+            source: SpirvSource::Naga,
+            subgroups: true,
+            pipeline_cache: crate::pipeline_cache_file::default_folder(),
+        }
     }
 }
 
@@ -115,9 +123,13 @@ impl AshBackend {
                 });
             }
         }
-        let vulkan = VulkanDevice::open(options)?;
-        let info = vulkan.device_info(options);
-        let pipelines = PipelineCache::new(options.source);
+        let vulkan = VulkanDevice::open(&options)?;
+        let info = vulkan.device_info(&options);
+        let driver_cache = options.pipeline_cache.as_ref().and_then(|folder| {
+            let file = crate::pipeline_cache_file::PipelineCacheFile::new(folder, &vulkan.pipeline_cache_key());
+            pipelines::DriverCache::open(&vulkan, file)
+        });
+        let pipelines = PipelineCache::new(options.source, driver_cache);
         Ok(Self {
             buffers: HashMap::new(),
             images: HashMap::new(),

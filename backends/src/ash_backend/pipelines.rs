@@ -6,6 +6,7 @@
 use super::SpirvSource;
 use super::device::{ComputePipeline, VulkanDevice};
 use crate::error::BackendError;
+use crate::pipeline_cache_file::PipelineCacheFile;
 use ash::vk;
 use std::collections::HashMap;
 use std::ffi::CString;
@@ -53,7 +54,8 @@ pub unsafe fn create_compute_pipeline(
 ) -> Result<PipelineObjects, vk::Result> {
     let slots: Vec<(u32, vk::DescriptorType)> = bindings.iter().map(|b| (b.binding, descriptor_type(b.kind))).collect();
     // SAFETY: the caller's contract.
-    let (set_layouts, layout, pipeline) = unsafe { create_with_sets(device, words, entry_point, &[slots])? };
+    let (set_layouts, layout, pipeline) =
+        unsafe { create_with_sets(device, vk::PipelineCache::null(), words, entry_point, &[slots])? };
     Ok(PipelineObjects { set_layout: set_layouts[0], layout, pipeline })
 }
 
@@ -62,9 +64,11 @@ pub unsafe fn create_compute_pipeline(
 /// kernel skips).
 ///
 /// # Safety
-/// As [`create_compute_pipeline`]; the objects must be destroyed once unused.
+/// As [`create_compute_pipeline`]; the objects must be destroyed once unused; `cache`
+/// null or a pipeline cache of `device`.
 unsafe fn create_with_sets(
     device: &ash::Device,
+    cache: vk::PipelineCache,
     words: &[u32],
     entry_point: &std::ffi::CStr,
     sets: &[Vec<(u32, vk::DescriptorType)>],
@@ -121,7 +125,7 @@ unsafe fn create_with_sets(
             .module(module)
             .name(entry_point);
         let create = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout)];
-        let result = device.create_compute_pipelines(vk::PipelineCache::null(), &create, None);
+        let result = device.create_compute_pipelines(cache, &create, None);
         device.destroy_shader_module(module, None);
         match result {
             Ok(pipelines) => Ok((set_layouts, layout, pipelines[0])),
@@ -240,11 +244,55 @@ impl AshPipeline {
 pub(super) struct PipelineCache {
     source: SpirvSource,
     pipelines: HashMap<KernelId, Arc<AshPipeline>>,
+    /// The driver's pipeline cache and the file it is kept in between runs, where a
+    /// folder was given (`AshOptions::pipeline_cache`).
+    driver_cache: Option<DriverCache>,
+}
+
+/// A `VkPipelineCache` filled from its file at the start and saved after each new
+/// pipeline ([`crate::pipeline_cache_file`]).
+pub(super) struct DriverCache {
+    cache: vk::PipelineCache,
+    file: PipelineCacheFile,
+    /// What the file holds now (saved again only when the driver's data changed).
+    saved: Option<Vec<u8>>,
+}
+
+impl DriverCache {
+    /// The cache of `vulkan`'s device from `file` (empty when the file is missing or not
+    /// whole, or when the driver refuses its data); `None` if the driver cannot make one.
+    pub(super) fn open(vulkan: &VulkanDevice, file: PipelineCacheFile) -> Option<Self> {
+        let saved = file.read();
+        let initial = saved.as_deref().unwrap_or_default();
+        let create = |data: &[u8]| {
+            // SAFETY: a valid device; the data are what vkGetPipelineCacheData gave an
+            // earlier run (the file's header and CRC make sure of it) or empty, and the
+            // driver checks its own header (vendor, device, pipelineCacheUUID) and
+            // ignores data of another driver.
+            unsafe {
+                vulkan.device.create_pipeline_cache(&vk::PipelineCacheCreateInfo::default().initial_data(data), None)
+            }
+        };
+        // Data a driver refuses outright: start empty instead.
+        let cache = create(initial).or_else(|_| create(&[])).ok()?;
+        Some(Self { cache, file, saved })
+    }
+
+    /// Saves the driver's data if it changed.
+    fn save(&mut self, vulkan: &VulkanDevice) {
+        // SAFETY: the cache belongs to this device and is not being written meanwhile
+        // (one thread owns the backend).
+        let Ok(data) = (unsafe { vulkan.device.get_pipeline_cache_data(self.cache) }) else { return };
+        if self.saved.as_ref() != Some(&data) {
+            self.file.write(&data);
+            self.saved = Some(data);
+        }
+    }
 }
 
 impl PipelineCache {
-    pub(super) fn new(source: SpirvSource) -> Self {
-        Self { source, pipelines: HashMap::new() }
+    pub(super) fn new(source: SpirvSource, driver_cache: Option<DriverCache>) -> Self {
+        Self { source, pipelines: HashMap::new(), driver_cache }
     }
 
     /// SPIR-V words and entry point name of `kernel` from this cache's source.
@@ -323,9 +371,13 @@ impl PipelineCache {
             operation: operation.clone(),
             message: format!("{result:?}"),
         };
-        // SAFETY: a valid device; the pipeline is destroyed in `destroy`.
+        let cache = self.driver_cache.as_ref().map_or(vk::PipelineCache::null(), |d| d.cache);
+        // SAFETY: a valid device and its cache; the pipeline is destroyed in `destroy`.
         let (set_layouts, layout, pipeline) =
-            unsafe { create_with_sets(&vulkan.device, &words, &entry_point, &plan.sets()) }.map_err(error)?;
+            unsafe { create_with_sets(&vulkan.device, cache, &words, &entry_point, &plan.sets()) }.map_err(error)?;
+        if let Some(driver_cache) = &mut self.driver_cache {
+            driver_cache.save(vulkan);
+        }
         let pipeline = Arc::new(AshPipeline { set_layouts, layout, pipeline, plan });
         self.pipelines.insert(kernel.id, Arc::clone(&pipeline));
         Ok(pipeline)
@@ -333,6 +385,10 @@ impl PipelineCache {
 
     pub(super) fn destroy(&mut self, vulkan: &VulkanDevice) {
         let device = &vulkan.device;
+        if let Some(driver_cache) = self.driver_cache.take() {
+            // SAFETY: the device is idle; the cache is destroyed once.
+            unsafe { device.destroy_pipeline_cache(driver_cache.cache, None) };
+        }
         for (_, pipeline) in self.pipelines.drain() {
             // SAFETY: the device is idle; each pipeline is destroyed once.
             unsafe {

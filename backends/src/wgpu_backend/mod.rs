@@ -13,6 +13,7 @@ use crate::backend::{Backend, Bind, BufferId, Resource};
 use crate::bindings_check::{ResourceLookup, check_binds, check_kernel_fits, check_workgroups, check_write};
 use crate::device_info::{DeviceInfo, DeviceLimits};
 use crate::error::BackendError;
+use crate::pipeline_cache_file::PipelineCacheFile;
 use crate::texture::{SamplerDesc, SamplerId, TextureDesc, TextureId};
 use buffers::BufferTable;
 use errors::ErrorSink;
@@ -34,7 +35,7 @@ pub enum WgpuApi {
 }
 
 /// How to open a [`WgpuBackend`].
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct WgpuOptions {
     /// The graphics API.
     pub api: WgpuApi,
@@ -42,11 +43,20 @@ pub struct WgpuOptions {
     pub validation: bool,
     /// Request subgroup operations when the adapter has them.
     pub subgroups: bool,
+    /// The folder the driver's pipeline cache is kept in between runs, where the
+    /// adapter has one (wgpu's `PIPELINE_CACHE`, Vulkan only); `None`: no file.
+    /// Default: [`crate::pipeline_cache_file::default_folder`].
+    pub pipeline_cache: Option<std::path::PathBuf>,
 }
 
 impl Default for WgpuOptions {
     fn default() -> Self {
-        Self { api: WgpuApi::Vulkan, validation: false, subgroups: true }
+        Self {
+            api: WgpuApi::Vulkan,
+            validation: false,
+            subgroups: true,
+            pipeline_cache: crate::pipeline_cache_file::default_folder(),
+        }
     }
 }
 
@@ -106,6 +116,14 @@ impl WgpuBackend {
         if timestamps {
             features |= wgpu::Features::TIMESTAMP_QUERY;
         }
+        // The driver's pipeline cache, kept in a file named after the device.
+        let cache_file = match (&options.pipeline_cache, wgpu::util::pipeline_cache_key(&adapter.get_info())) {
+            (Some(folder), Some(key)) if adapter_features.contains(wgpu::Features::PIPELINE_CACHE) => {
+                features |= wgpu::Features::PIPELINE_CACHE;
+                Some(PipelineCacheFile::new(folder, &key))
+            }
+            _ => None,
+        };
         let limits = adapter.limits();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("strata"),
@@ -172,13 +190,15 @@ impl WgpuBackend {
             });
             (set, resolve, readback)
         });
+        let driver_cache = cache_file.map(|file| pipelines::DriverCache::open(&device, file));
+        let pipelines = PipelineCache::new(options.api == WgpuApi::Gl, driver_cache);
         Ok(Self {
             device,
             queue,
             info,
             buffers: BufferTable::default(),
             textures: TextureTable::default(),
-            pipelines: PipelineCache::new(options.api == WgpuApi::Gl),
+            pipelines,
             errors,
             timestamps,
         })

@@ -6,6 +6,7 @@
 use super::errors::ErrorSink;
 use super::textures;
 use crate::error::BackendError;
+use crate::pipeline_cache_file::PipelineCacheFile;
 use std::borrow::Cow;
 use std::collections::HashMap;
 use std::num::NonZeroU64;
@@ -20,15 +21,54 @@ pub(super) struct Pipeline {
 
 pub(super) struct PipelineCache {
     pipelines: HashMap<KernelId, Arc<Pipeline>>,
+    /// The driver's pipeline cache and the file it is kept in between runs, where the
+    /// device has one (Vulkan) and a folder was given (`WgpuOptions::pipeline_cache`).
+    driver_cache: Option<DriverCache>,
     /// Whether integer `/` and `%` are rewritten with WGSL's meaning before wgpu sees the
     /// module: wgpu's GL back end writes them as GLSL's, undefined for negative operands
     /// and zero divisors (`strata_kernels::integer_division`).
     define_integer_division: bool,
 }
 
+/// wgpu's pipeline cache, filled from its file at the start and saved after each new
+/// pipeline ([`crate::pipeline_cache_file`]).
+pub(super) struct DriverCache {
+    cache: wgpu::PipelineCache,
+    file: PipelineCacheFile,
+    /// What the file holds now (saved again only when the driver's data changed).
+    saved: Option<Vec<u8>>,
+}
+
+impl DriverCache {
+    /// The cache of `device` from `file` (empty when the file is missing or not whole).
+    pub(super) fn open(device: &wgpu::Device, file: PipelineCacheFile) -> Self {
+        let saved = file.read();
+        // SAFETY: the bytes are what `get_data` gave an earlier run (the file's own
+        // header and CRC make sure of it: anything else reads as `None`); wgpu checks
+        // its header against this adapter, and the driver its own.
+        let cache = unsafe {
+            device.create_pipeline_cache(&wgpu::PipelineCacheDescriptor {
+                label: Some("strata pipeline cache"),
+                data: saved.as_deref(),
+                fallback: true,
+            })
+        };
+        Self { cache, file, saved }
+    }
+
+    /// Saves the driver's data if it changed.
+    fn save(&mut self) {
+        let data = self.cache.get_data();
+        if data.is_some() && data != self.saved {
+            self.file.write(data.as_deref().unwrap_or_default());
+            self.saved = data;
+        }
+    }
+}
+
 impl PipelineCache {
-    pub(super) fn new(define_integer_division: bool) -> Self {
-        Self { pipelines: HashMap::new(), define_integer_division }
+    pub(super) fn new(define_integer_division: bool, driver_cache: Option<DriverCache>) -> Self {
+        Self { pipelines: HashMap::new(), driver_cache, define_integer_division }
     }
 
     pub(super) fn get_or_create(
@@ -41,8 +81,12 @@ impl PipelineCache {
             return Ok(Arc::clone(pipeline));
         }
         let scope = errors.scope(device);
-        let (pipeline, layouts) = kernel_pipeline(device, kernel, self.define_integer_division)?;
+        let cache = self.driver_cache.as_ref().map(|d| &d.cache);
+        let (pipeline, layouts) = cached_kernel_pipeline(device, kernel, self.define_integer_division, cache)?;
         scope.finish(&format!("pipeline creation for `{}`", kernel.name()))?;
+        if let Some(driver_cache) = &mut self.driver_cache {
+            driver_cache.save();
+        }
         let pipeline = Arc::new(Pipeline { pipeline, layouts });
         self.pipelines.insert(kernel.id, Arc::clone(&pipeline));
         Ok(pipeline)
@@ -99,6 +143,16 @@ pub fn kernel_pipeline(
     kernel: &Kernel,
     define_integer_division: bool,
 ) -> Result<(wgpu::ComputePipeline, Vec<wgpu::BindGroupLayout>), BackendError> {
+    cached_kernel_pipeline(device, kernel, define_integer_division, None)
+}
+
+/// [`kernel_pipeline`] through the driver's pipeline `cache` where one is given.
+fn cached_kernel_pipeline(
+    device: &wgpu::Device,
+    kernel: &Kernel,
+    define_integer_division: bool,
+    cache: Option<&wgpu::PipelineCache>,
+) -> Result<(wgpu::ComputePipeline, Vec<wgpu::BindGroupLayout>), BackendError> {
     // One layout per group (a group the kernel skips gets an empty one).
     let layouts: Vec<wgpu::BindGroupLayout> = (0..kernel.group_count())
         .map(|group| {
@@ -138,7 +192,7 @@ pub fn kernel_pipeline(
         module: &module,
         entry_point: Some(kernel.entry_point()),
         compilation_options: wgpu::PipelineCompilationOptions::default(),
-        cache: None,
+        cache,
     });
     Ok((pipeline, layouts))
 }

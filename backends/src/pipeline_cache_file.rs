@@ -1,0 +1,153 @@
+//! A driver's pipeline cache kept in a file between runs (Vulkan's `VkPipelineCache`,
+//! through wgpu's `PipelineCache` or ash directly), so that a driver without a shader
+//! cache of its own does not compile every kernel again at each start.
+//!
+//! The file is the driver's bytes behind a header of ours: a magic word, a format
+//! version, the payload's length and its CRC-32. Reading checks all four and gives
+//! nothing on any mismatch (a truncated, corrupted or foreign file is ignored and
+//! replaced at the next write), because the payload goes to the driver as is: wgpu does
+//! not check its hash and Vulkan drivers check only their own header, so corrupted bytes
+//! past it could reach the driver's parser. The driver's own header (vendor, device,
+//! driver build) then decides whether the data fit this device; data of another driver
+//! build is ignored by the driver.
+//!
+//! Writes go to a hidden temporary file in the same folder (one per process and write)
+//! and are renamed into place, so a killed run or two runs or threads writing at once
+//! leave a whole file (the last one's) or the old one. The cache is an optimisation: a folder that cannot be created or a file
+//! that cannot be written is left as it is, silently, and the run goes on.
+//!
+//! Where: `$XDG_CACHE_HOME/strata`, else `$HOME/.cache/strata` ([`default_folder`]),
+//! one file per API and device (`<api>_pipeline_cache_<vendor>_<device>.bin`). On
+//! lavapipe (Mesa 22.3) the driver's data is its header only, Mesa's own shader cache
+//! (in the same cache folder) being what keeps the compiled kernels there.
+
+use std::path::{Path, PathBuf};
+
+/// The first bytes of every cache file.
+const MAGIC: [u8; 8] = *b"STRATAPC";
+/// The layout of the header below; a file of another version is ignored.
+const VERSION: u32 = 1;
+/// Magic, version, payload length (u64), payload CRC-32: 24 bytes, little-endian.
+const HEADER_LENGTH: usize = 8 + 4 + 8 + 4;
+
+/// The cache folder a run uses when nobody chose one: `$XDG_CACHE_HOME/strata`, else
+/// `$HOME/.cache/strata`; `None` where neither variable is set (no cache then).
+pub fn default_folder() -> Option<PathBuf> {
+    let from = |name: &str| std::env::var_os(name).filter(|v| !v.is_empty()).map(PathBuf::from);
+    from("XDG_CACHE_HOME").or_else(|| from("HOME").map(|home| home.join(".cache"))).map(|base| base.join("strata"))
+}
+
+/// One device's pipeline cache file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PipelineCacheFile {
+    path: PathBuf,
+}
+
+impl PipelineCacheFile {
+    /// The file in `folder` for the device `key` names (API, vendor and device ids).
+    pub fn new(folder: &Path, key: &str) -> Self {
+        let name: String =
+            key.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' || c == '-' { c } else { '_' }).collect();
+        Self { path: folder.join(format!("{name}.bin")) }
+    }
+
+    /// Where the file is.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The driver's bytes saved by an earlier run, or `None` when there is no file or it
+    /// is not whole (wrong magic or version, a length that differs, a CRC that differs).
+    pub fn read(&self) -> Option<Vec<u8>> {
+        decode(&std::fs::read(&self.path).ok()?)
+    }
+
+    /// Saves the driver's bytes, whole or not at all (module documentation); failures
+    /// are ignored.
+    pub fn write(&self, payload: &[u8]) {
+        let Some(folder) = self.path.parent() else { return };
+        if std::fs::create_dir_all(folder).is_err() {
+            return;
+        }
+        let name = self.path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        // Process and write: threads of one process (strata compare's warm-up devices)
+        // save the same device's file at once.
+        static WRITES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let write = WRITES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let temporary = folder.join(format!(".{name}.tmp-{}-{write}", std::process::id()));
+        if std::fs::write(&temporary, encode(payload)).is_err() || std::fs::rename(&temporary, &self.path).is_err() {
+            let _ = std::fs::remove_file(&temporary);
+        }
+    }
+}
+
+/// The file's bytes for `payload`.
+fn encode(payload: &[u8]) -> Vec<u8> {
+    let mut bytes = Vec::with_capacity(HEADER_LENGTH + payload.len());
+    bytes.extend_from_slice(&MAGIC);
+    bytes.extend_from_slice(&VERSION.to_le_bytes());
+    bytes.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    bytes.extend_from_slice(&crc32fast::hash(payload).to_le_bytes());
+    bytes.extend_from_slice(payload);
+    bytes
+}
+
+/// The payload of a file's bytes, if they are whole.
+fn decode(bytes: &[u8]) -> Option<Vec<u8>> {
+    if bytes.len() < HEADER_LENGTH || bytes[..8] != MAGIC {
+        return None;
+    }
+    let version = u32::from_le_bytes(bytes[8..12].try_into().ok()?);
+    let length = u64::from_le_bytes(bytes[12..20].try_into().ok()?);
+    let crc = u32::from_le_bytes(bytes[20..24].try_into().ok()?);
+    let payload = &bytes[HEADER_LENGTH..];
+    if version != VERSION || length != payload.len() as u64 || crc != crc32fast::hash(payload) {
+        return None;
+    }
+    Some(payload.to_vec())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_payload_reads_back_and_anything_damaged_reads_as_nothing() {
+        let payload: Vec<u8> = (0..200u32).map(|i| (i * 7) as u8).collect();
+        let bytes = encode(&payload);
+        assert_eq!(decode(&bytes).as_deref(), Some(&payload[..]));
+        assert_eq!(decode(&encode(&[])).as_deref(), Some(&[][..]));
+        // One bit of the payload flipped.
+        let mut flipped = bytes.clone();
+        flipped[HEADER_LENGTH + 100] ^= 4;
+        assert_eq!(decode(&flipped), None);
+        // Truncated (a file cut short), or longer than its header says.
+        assert_eq!(decode(&bytes[..bytes.len() - 1]), None);
+        assert_eq!(decode(&bytes[..10]), None);
+        assert_eq!(decode(&[bytes.clone(), vec![0]].concat()), None);
+        // Another format, or another version of ours.
+        assert_eq!(decode(&payload), None);
+        let mut later = bytes.clone();
+        later[8] = 2;
+        assert_eq!(decode(&later), None);
+    }
+
+    #[test]
+    fn the_file_is_replaced_whole_and_named_after_the_device() {
+        let folder = std::env::temp_dir().join(format!("strata-pipeline-cache-unit-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&folder);
+        let file = PipelineCacheFile::new(&folder.join("nested"), "vulkan_pipeline_cache_4318/7938");
+        assert_eq!(file.path().file_name().unwrap(), "vulkan_pipeline_cache_4318_7938.bin");
+        assert_eq!(file.read(), None);
+        file.write(b"first");
+        file.write(b"second");
+        assert_eq!(file.read().as_deref(), Some(&b"second"[..]));
+        let names: Vec<_> = std::fs::read_dir(folder.join("nested")).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(names, ["vulkan_pipeline_cache_4318_7938.bin"]);
+        // A folder that cannot be created (a file in its way): nothing happens.
+        let blocked = PipelineCacheFile::new(&file.path().join("below"), "x");
+        blocked.write(b"ignored");
+        assert_eq!(blocked.read(), None);
+        std::fs::remove_dir_all(&folder).unwrap();
+    }
+}

@@ -1,0 +1,132 @@
+//! The driver's pipeline cache kept in a file between runs (wgpu's `PipelineCache` and
+//! ash's `VkPipelineCache`, `strata_backends::pipeline_cache_file`): a backend writes
+//! the file when it builds a pipeline, a later backend starts from it and renders the
+//! same image, and a damaged file is ignored and replaced, never handed to the driver.
+//! With the validation layer on, which reports any misuse of the cache objects.
+
+use std::path::{Path, PathBuf};
+use strata::render::{GpuScene, RenderSettings};
+use strata::scene::default_scene;
+use strata_backends::ash_backend::{AshBackend, AshOptions, SpirvSource};
+use strata_backends::pipeline_cache_file::PipelineCacheFile;
+use strata_backends::wgpu_backend::{WgpuApi, WgpuOptions};
+use strata_backends::{Backend, BackendError, gpu_required};
+
+fn scratch(name: &str) -> PathBuf {
+    let folder = std::env::temp_dir().join(format!("strata-pipeline-cache-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&folder);
+    folder
+}
+
+/// An 8x8 path-traced image (2 spp) of the default scene: builds the path tracer's pipeline.
+fn render(backend: &mut dyn Backend) -> Vec<[f32; 3]> {
+    let scene = default_scene();
+    let gpu_scene = GpuScene::build(&scene).unwrap();
+    let settings = RenderSettings::for_scene(&scene, 8, 8, 1);
+    strata::render::render(backend, &gpu_scene, &settings, 2, |_| {}).unwrap().pixels
+}
+
+/// The one cache file in `folder`.
+fn cache_file(folder: &Path, prefix: &str) -> PathBuf {
+    let files: Vec<PathBuf> = std::fs::read_dir(folder)
+        .unwrap_or_else(|e| panic!("{}: no cache folder: {e}", folder.display()))
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(files.len(), 1, "{files:?}");
+    let name = files[0].file_name().unwrap().to_string_lossy().into_owned();
+    assert!(name.starts_with(prefix) && name.ends_with(".bin"), "{name}");
+    files[0].clone()
+}
+
+/// Whether `path` holds a whole cache file (ours: magic, length, CRC all right).
+fn whole(path: &Path) -> bool {
+    let folder = path.parent().unwrap();
+    let key = path.file_stem().unwrap().to_string_lossy().into_owned();
+    PipelineCacheFile::new(folder, &key).read().is_some()
+}
+
+/// Runs the same render on three backends `open` makes from `folder`: the first writes the
+/// file, the second reads it, the third finds it damaged; returns the file.
+fn three_runs(folder: &Path, prefix: &str, open: impl Fn() -> Option<Box<dyn Backend>>) -> Option<PathBuf> {
+    let first = {
+        let mut backend = open()?;
+        render(backend.as_mut())
+    };
+    let file = cache_file(folder, prefix);
+    assert!(whole(&file), "{}: not a whole cache file", file.display());
+    let written = std::fs::read(&file).unwrap();
+    let second = {
+        let mut backend = open()?;
+        render(backend.as_mut())
+    };
+    assert_eq!(first, second, "the image changed with the cache read back");
+    // A damaged file (a bit of the driver's bytes flipped): ignored, the run the same,
+    // and the file written whole again.
+    let mut damaged = written.clone();
+    let last = damaged.len() - 1;
+    damaged[last] ^= 0x10;
+    std::fs::write(&file, &damaged).unwrap();
+    assert!(!whole(&file));
+    let third = {
+        let mut backend = open()?;
+        render(backend.as_mut())
+    };
+    assert_eq!(first, third, "the image changed after a damaged cache file");
+    assert!(whole(&file), "{}: the damaged file was not replaced", file.display());
+    Some(file)
+}
+
+fn skip_or_panic(test: &str, error: BackendError) -> Option<Box<dyn Backend>> {
+    match error {
+        BackendError::NoAdapter { .. } if !gpu_required() => {
+            eprintln!("SKIPPED {test}: {error} (set STRATA_REQUIRE_GPU=1 to make this a failure)");
+            None
+        }
+        error => panic!("{test}: {error}"),
+    }
+}
+
+#[test]
+fn wgpu_keeps_its_pipeline_cache_in_a_file() {
+    let folder = scratch("wgpu");
+    let open = || {
+        let options = WgpuOptions {
+            api: WgpuApi::Vulkan,
+            validation: true,
+            pipeline_cache: Some(folder.clone()),
+            ..Default::default()
+        };
+        match strata_backends::wgpu_backend::WgpuBackend::new(options) {
+            Ok(backend) => Some(Box::new(backend) as Box<dyn Backend>),
+            Err(error) => skip_or_panic("wgpu", error),
+        }
+    };
+    if three_runs(&folder, "wgpu_pipeline_cache_vulkan_", open).is_some() {
+        std::fs::remove_dir_all(&folder).unwrap();
+    }
+}
+
+#[test]
+fn ash_keeps_its_pipeline_cache_in_a_file() {
+    let folder = scratch("ash");
+    let options = AshOptions {
+        validation: true,
+        source: SpirvSource::Naga,
+        pipeline_cache: Some(folder.clone()),
+        ..Default::default()
+    };
+    let open = || match AshBackend::new(options.clone()) {
+        Ok(backend) => Some(Box::new(backend) as Box<dyn Backend>),
+        Err(error) => skip_or_panic("ash", error),
+    };
+    if three_runs(&folder, "ash_pipeline_cache_vulkan_", open).is_none() {
+        return;
+    }
+    // The layer saw the cache made from the file, used and saved: nothing to report.
+    let mut backend = AshBackend::new(options).unwrap();
+    render(&mut backend);
+    let messages = backend.validation_messages();
+    assert!(messages.is_empty(), "{messages:?}");
+    drop(backend);
+    std::fs::remove_dir_all(&folder).unwrap();
+}

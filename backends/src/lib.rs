@@ -36,6 +36,7 @@ pub mod cpu_backend;
 pub mod device_info;
 pub mod error;
 pub mod pipeline_cache_file;
+pub mod processes;
 pub mod require_gpu;
 pub mod texture;
 pub mod wgpu_backend;

@@ -4,22 +4,27 @@
 //!
 //! The file is the driver's bytes behind a header of ours: a magic word, a format
 //! version, the payload's length and its CRC-32. Reading checks all four and gives
-//! nothing on any mismatch (a truncated, corrupted or foreign file is ignored and
-//! replaced at the next write), because the payload goes to the driver as is: wgpu does
-//! not check its hash and Vulkan drivers check only their own header, so corrupted bytes
-//! past it could reach the driver's parser. The driver's own header (vendor, device,
-//! driver build) then decides whether the data fit this device; data of another driver
-//! build is ignored by the driver.
+//! nothing on any mismatch (a truncated, damaged or foreign file is ignored and replaced
+//! at the next write), because the payload goes to the driver as is: wgpu does not check
+//! its hash and Vulkan drivers check only their own header, so damaged bytes past it
+//! could reach the driver's parser. The CRC tells damage, not origin: the folder is
+//! trusted as the user's own (whoever can write it can write the user's programs too).
+//! The driver's own header (vendor, device, driver build) then decides whether the data
+//! fit this device.
 //!
-//! Writes go to a hidden temporary file in the same folder (one per process and write)
-//! and are renamed into place, so a killed run or two runs or threads writing at once
-//! leave a whole file (the last one's) or the old one. The cache is an optimisation: a folder that cannot be created or a file
-//! that cannot be written is left as it is, silently, and the run goes on.
+//! Writes go to a hidden temporary file in the same folder (one per process and write,
+//! since the devices of `strata compare`'s warm-up save from threads of one process) and
+//! are renamed into place, so a killed run, or two runs or threads saving at once, leave
+//! a whole file (the last saver's, which then holds that device's pipelines only) or the
+//! old one; a write first removes the temporaries that ended processes left. The cache is
+//! an optimisation: a folder that cannot be created or a file that cannot be written is
+//! left as it is, silently, and the run goes on.
 //!
 //! Where: `$XDG_CACHE_HOME/strata`, else `$HOME/.cache/strata` ([`default_folder`]),
-//! one file per API and device (`<api>_pipeline_cache_<vendor>_<device>.bin`). On
-//! lavapipe (Mesa 22.3) the driver's data is its header only, Mesa's own shader cache
-//! (in the same cache folder) being what keeps the compiled kernels there.
+//! one file per API and device: `wgpu_pipeline_cache_vulkan_<vendor>_<device>.bin` and
+//! `ash_pipeline_cache_vulkan_<vendor>_<device>.bin`. On lavapipe (Mesa 22.3) the
+//! driver's data is its header only: there Mesa's own shader cache
+//! (`$XDG_CACHE_HOME/mesa_shader_cache`) is what keeps the compiled kernels.
 
 use std::path::{Path, PathBuf};
 
@@ -31,9 +36,10 @@ const VERSION: u32 = 1;
 const HEADER_LENGTH: usize = 8 + 4 + 8 + 4;
 
 /// The cache folder a run uses when nobody chose one: `$XDG_CACHE_HOME/strata`, else
-/// `$HOME/.cache/strata`; `None` where neither variable is set (no cache then).
+/// `$HOME/.cache/strata`; `None` where neither variable is set (no cache then). A
+/// relative path in either is ignored, as the XDG specification asks.
 pub fn default_folder() -> Option<PathBuf> {
-    let from = |name: &str| std::env::var_os(name).filter(|v| !v.is_empty()).map(PathBuf::from);
+    let from = |name: &str| std::env::var_os(name).map(PathBuf::from).filter(|path| path.is_absolute());
     from("XDG_CACHE_HOME").or_else(|| from("HOME").map(|home| home.join(".cache"))).map(|base| base.join("strata"))
 }
 
@@ -70,6 +76,7 @@ impl PipelineCacheFile {
             return;
         }
         let name = self.path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        remove_dead_temporaries(folder, &name);
         // Process and write: threads of one process (strata compare's warm-up devices)
         // save the same device's file at once.
         static WRITES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
@@ -77,6 +84,26 @@ impl PipelineCacheFile {
         let temporary = folder.join(format!(".{name}.tmp-{}-{write}", std::process::id()));
         if std::fs::write(&temporary, encode(payload)).is_err() || std::fs::rename(&temporary, &self.path).is_err() {
             let _ = std::fs::remove_file(&temporary);
+        }
+    }
+}
+
+/// Removes the temporaries of the file `name` in `folder` whose process has ended (a
+/// run killed while saving: driver caches can be megabytes).
+fn remove_dead_temporaries(folder: &Path, name: &str) {
+    let Ok(entries) = std::fs::read_dir(folder) else { return };
+    let prefix = format!(".{name}.tmp-");
+    for entry in entries.flatten() {
+        let entry_name = entry.file_name().to_string_lossy().into_owned();
+        // `.NAME.tmp-PID-WRITE`
+        let Some((pid, write)) = entry_name.strip_prefix(&prefix).and_then(|rest| rest.split_once('-')) else {
+            continue;
+        };
+        let Some(pid) = crate::processes::writer_between(pid, "", "") else { continue };
+        let regular = entry.file_type().is_ok_and(|t| t.is_file());
+        let numbered = !write.is_empty() && write.bytes().all(|b| b.is_ascii_digit());
+        if regular && numbered && pid != std::process::id() && !crate::processes::is_running(pid) {
+            let _ = std::fs::remove_file(entry.path());
         }
     }
 }
@@ -136,14 +163,34 @@ mod tests {
     fn the_file_is_replaced_whole_and_named_after_the_device() {
         let folder = std::env::temp_dir().join(format!("strata-pipeline-cache-unit-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&folder);
-        let file = PipelineCacheFile::new(&folder.join("nested"), "vulkan_pipeline_cache_4318/7938");
-        assert_eq!(file.path().file_name().unwrap(), "vulkan_pipeline_cache_4318_7938.bin");
+        let file = PipelineCacheFile::new(&folder.join("nested"), "wgpu_pipeline_cache_vulkan_4318/7938");
+        assert_eq!(file.path().file_name().unwrap(), "wgpu_pipeline_cache_vulkan_4318_7938.bin");
         assert_eq!(file.read(), None);
         file.write(b"first");
+        // Temporaries a killed save left (an ended process's) go at the next write; a
+        // running process's (another run saving now) stay.
+        let ended = {
+            let mut child = std::process::Command::new("true").spawn().unwrap();
+            let pid = child.id();
+            child.wait().unwrap();
+            pid
+        };
+        let mut running = std::process::Command::new("sleep").arg("60").spawn().unwrap();
+        let dead = format!(".wgpu_pipeline_cache_vulkan_4318_7938.bin.tmp-{ended}-3");
+        let alive = format!(".wgpu_pipeline_cache_vulkan_4318_7938.bin.tmp-{}-0", running.id());
+        for name in [&dead, &alive] {
+            std::fs::write(folder.join("nested").join(name), b"half").unwrap();
+        }
         file.write(b"second");
         assert_eq!(file.read().as_deref(), Some(&b"second"[..]));
-        let names: Vec<_> = std::fs::read_dir(folder.join("nested")).unwrap().map(|e| e.unwrap().file_name()).collect();
-        assert_eq!(names, ["vulkan_pipeline_cache_4318_7938.bin"]);
+        let _ = running.kill();
+        let _ = running.wait();
+        let mut names: Vec<_> = std::fs::read_dir(folder.join("nested"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        assert_eq!(names, [alive, "wgpu_pipeline_cache_vulkan_4318_7938.bin".to_string()]);
         // A folder that cannot be created (a file in its way): nothing happens.
         let blocked = PipelineCacheFile::new(&file.path().join("below"), "x");
         blocked.write(b"ignored");

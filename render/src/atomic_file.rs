@@ -25,11 +25,8 @@ use std::path::{Path, PathBuf};
 /// The hidden temporary name `path` is written under before the rename.
 pub fn temporary_path(path: &Path) -> PathBuf {
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let temporary = match name.rsplit_once('.') {
-        Some((stem, extension)) => format!(".{stem}.tmp-{}.{extension}", std::process::id()),
-        None => format!(".{name}.tmp-{}", std::process::id()),
-    };
-    path.with_file_name(temporary)
+    let (prefix, suffix) = temporary_affixes(&name);
+    path.with_file_name(format!("{prefix}{}{suffix}", std::process::id()))
 }
 
 /// Whether a file name is one of [`temporary_path`]'s (of any process).
@@ -37,42 +34,50 @@ pub fn is_temporary(name: &str) -> bool {
     name.starts_with('.') && name.contains(".tmp-")
 }
 
-/// Whether process `pid` is running (Linux and other systems with `/proc`; elsewhere
-/// every process counts as running, so nothing of another process is ever removed).
-pub fn process_is_running(pid: u32) -> bool {
-    if !Path::new("/proc/self").exists() {
-        return true;
+/// Whether temporary file `name` ([`is_temporary`]) may be removed: its writer, named
+/// after `.tmp-`, has ended (or is not named there). A running process's temporary (a
+/// render writing into the same folder now) is kept.
+pub fn is_left_over(name: &str) -> bool {
+    let Some((_, after)) = name.rsplit_once(".tmp-") else { return false };
+    let digits = after.split('.').next().unwrap_or_default();
+    match strata_backends::processes::writer_between(digits, "", "") {
+        Some(pid) => pid != std::process::id() && !process_is_running(pid),
+        None => true,
     }
-    Path::new(&format!("/proc/{pid}")).exists()
+}
+
+pub use strata_backends::processes::is_running as process_is_running;
+
+/// The name parts around the process id of `target_name`'s temporaries.
+fn temporary_affixes(target_name: &str) -> (String, String) {
+    match target_name.rsplit_once('.') {
+        Some((stem, extension)) => (format!(".{stem}.tmp-"), format!(".{extension}")),
+        None => (format!(".{target_name}.tmp-"), String::new()),
+    }
 }
 
 /// The process that wrote temporary file `name` for the target named `target_name`, if
 /// `name` is one of that target's temporaries ([`temporary_path`] of another process).
+#[cfg(test)]
 fn temporary_writer(target_name: &str, name: &str) -> Option<u32> {
-    let (prefix, suffix) = match target_name.rsplit_once('.') {
-        Some((stem, extension)) => (format!(".{stem}.tmp-"), format!(".{extension}")),
-        None => (format!(".{target_name}.tmp-"), String::new()),
-    };
-    let pid = name.strip_prefix(&prefix)?.strip_suffix(&suffix)?;
-    if pid.is_empty() || !pid.bytes().all(|b| b.is_ascii_digit()) {
-        return None;
-    }
-    pid.parse().ok()
+    let (prefix, suffix) = temporary_affixes(target_name);
+    strata_backends::processes::writer_between(name, &prefix, &suffix)
 }
 
 /// Removes the temporary files of `path` that processes no longer running left (a run
 /// killed between writing and renaming); those of running processes (another run writing
-/// the same name now) are kept. Returns the names removed. Best effort: a leftover that
-/// cannot be listed or removed stays, hidden, and harms nothing.
+/// the same name now) are kept ([`process_is_running`] says what it cannot see). Returns
+/// the names removed. Best effort: a leftover that cannot be listed or removed stays,
+/// hidden, and harms nothing.
 pub fn remove_dead_temporaries(path: &Path) -> Vec<String> {
     let (Some(folder), Some(target_name)) = (path.parent(), path.file_name()) else { return Vec::new() };
     let folder = if folder.as_os_str().is_empty() { Path::new(".") } else { folder };
-    let target_name = target_name.to_string_lossy();
+    let (prefix, suffix) = temporary_affixes(&target_name.to_string_lossy());
     let Ok(entries) = std::fs::read_dir(folder) else { return Vec::new() };
     let mut removed = Vec::new();
     for entry in entries.flatten() {
         let name = entry.file_name().to_string_lossy().into_owned();
-        let Some(pid) = temporary_writer(&target_name, &name) else { continue };
+        let Some(pid) = strata_backends::processes::writer_between(&name, &prefix, &suffix) else { continue };
         let regular = entry.file_type().is_ok_and(|t| t.is_file());
         if regular
             && pid != std::process::id()
@@ -278,6 +283,9 @@ mod tests {
         let name = temporary.file_name().unwrap().to_string_lossy().into_owned();
         assert!(name.starts_with(".strata_frame001.tmp-") && name.ends_with(".png") && is_temporary(&name));
         assert!(!is_temporary("strata_frame001.png"));
+        // This process's temporary is not a leftover; one with no process id is.
+        assert!(!is_left_over(&name));
+        assert!(is_left_over(".strata_frame001.tmp-x.png"));
         std::fs::remove_dir_all(&folder).unwrap();
     }
 

@@ -190,7 +190,7 @@ impl WgpuBackend {
             });
             (set, resolve, readback)
         });
-        let driver_cache = cache_file.map(|file| pipelines::DriverCache::open(&device, file));
+        let driver_cache = cache_file.and_then(|file| pipelines::DriverCache::open(&device, &errors, file));
         let pipelines = PipelineCache::new(options.api == WgpuApi::Gl, driver_cache);
         Ok(Self {
             device,

@@ -40,20 +40,33 @@ pub(super) struct DriverCache {
 }
 
 impl DriverCache {
-    /// The cache of `device` from `file` (empty when the file is missing or not whole).
-    pub(super) fn open(device: &wgpu::Device, file: PipelineCacheFile) -> Self {
-        let saved = file.read();
-        // SAFETY: the bytes are what `get_data` gave an earlier run (the file's own
-        // header and CRC make sure of it: anything else reads as `None`); wgpu checks
-        // its header against this adapter, and the driver its own.
-        let cache = unsafe {
-            device.create_pipeline_cache(&wgpu::PipelineCacheDescriptor {
-                label: Some("strata pipeline cache"),
-                data: saved.as_deref(),
-                fallback: true,
-            })
+    /// The cache of `device` from `file`: empty when the file is missing or not whole,
+    /// or when wgpu refuses its data (made on another adapter or wgpu version; wgpu
+    /// refuses such data even with `fallback`, and a cache it refused would fail every
+    /// pipeline made with it). `None` when even an empty cache cannot be made: then
+    /// pipelines are made without one.
+    pub(super) fn open(device: &wgpu::Device, errors: &ErrorSink, file: PipelineCacheFile) -> Option<Self> {
+        let create = |data: Option<&[u8]>| {
+            let scope = errors.scope(device);
+            // SAFETY: the bytes are what `get_data` gave an earlier run, as far as a
+            // file in the user's own cache folder can tell (its header and CRC catch a
+            // damaged or foreign file, which reads as `None`; whoever can write the
+            // folder can also write the user's programs); wgpu checks its header against
+            // this adapter, and the driver its own.
+            let cache = unsafe {
+                device.create_pipeline_cache(&wgpu::PipelineCacheDescriptor {
+                    label: Some("strata pipeline cache"),
+                    data,
+                    fallback: true,
+                })
+            };
+            scope.finish("pipeline cache creation").ok().map(|()| cache)
         };
-        Self { cache, file, saved }
+        let read = file.read();
+        match read.as_deref().and_then(|data| create(Some(data))) {
+            Some(cache) => Some(Self { cache, file, saved: read }),
+            None => create(None).map(|cache| Self { cache, file, saved: None }),
+        }
     }
 
     /// Saves the driver's data if it changed.

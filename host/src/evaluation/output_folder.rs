@@ -111,7 +111,8 @@ pub fn prepare(folder: &Path, keep: Option<&Path>) -> Result<(FolderLock, Vec<St
         let name = entry.file_name().to_string_lossy().into_owned();
         let path = entry.path();
         let output = is_run_output(&name);
-        if !(output || crate::atomic_file::is_temporary(&name)) {
+        let temporary = crate::atomic_file::is_temporary(&name);
+        if !(output || temporary) || (temporary && !crate::atomic_file::is_left_over(&name)) {
             continue;
         }
         let regular = entry.file_type().is_ok_and(|t| t.is_file());
@@ -180,12 +181,26 @@ mod tests {
         let folder = std::env::temp_dir().join(format!("strata-output-folder-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&folder);
         std::fs::create_dir_all(&folder).unwrap();
-        for name in ["errors.csv", "strata_frame001.png", "notes.txt", "reference.exr", ".relmse.tmp-77.png"] {
+        // A temporary of a process that has ended (a killed run's) goes; one of a process
+        // still running (a render writing into the folder now) stays.
+        let ended = {
+            let mut child = std::process::Command::new("true").spawn().unwrap();
+            let pid = child.id();
+            child.wait().unwrap();
+            pid
+        };
+        let mut running = std::process::Command::new("sleep").arg("60").spawn().unwrap();
+        let (dead, alive) = (format!(".relmse.tmp-{ended}.png"), format!(".default.tmp-{}.exr", running.id()));
+        for name in ["errors.csv", "strata_frame001.png", "notes.txt", "reference.exr", &dead, &alive] {
             std::fs::write(folder.join(name), b"x").unwrap();
         }
         let (lock, removed) = prepare(&folder, Some(&folder.join("reference.exr"))).unwrap();
-        assert_eq!(removed, [".relmse.tmp-77.png", "errors.csv", "strata_frame001.png"]);
+        let _ = running.kill();
+        let _ = running.wait();
+        assert_eq!(removed, [dead.as_str(), "errors.csv", "strata_frame001.png"]);
         assert!(folder.join("notes.txt").exists() && folder.join("reference.exr").exists());
+        assert!(folder.join(&alive).exists());
+        std::fs::remove_file(folder.join(&alive)).unwrap();
         // While the lock is held a second run is refused, naming this process.
         let refused = prepare(&folder, None).unwrap_err().to_string();
         assert!(refused.contains(&format!("process {}", std::process::id())), "{refused}");

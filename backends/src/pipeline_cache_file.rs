@@ -169,12 +169,7 @@ mod tests {
         file.write(b"first");
         // Temporaries a killed save left (an ended process's) go at the next write; a
         // running process's (another run saving now) stay.
-        let ended = {
-            let mut child = std::process::Command::new("true").spawn().unwrap();
-            let pid = child.id();
-            child.wait().unwrap();
-            pid
-        };
+        let ended = crate::processes::an_ended_process();
         let mut running = std::process::Command::new("sleep").arg("60").spawn().unwrap();
         let dead = format!(".wgpu_pipeline_cache_vulkan_4318_7938.bin.tmp-{ended}-3");
         let alive = format!(".wgpu_pipeline_cache_vulkan_4318_7938.bin.tmp-{}-0", running.id());

@@ -24,6 +24,16 @@ pub fn writer_between(name: &str, prefix: &str, suffix: &str) -> Option<u32> {
     (pid.to_string() == digits).then_some(pid)
 }
 
+/// The id of a process that has just ended (it runs `true` and waits for it): what tests
+/// of leftover cleanup name as a dead writer. (The id may be reused by a new process
+/// later; at once that is unlikely.)
+pub fn an_ended_process() -> u32 {
+    let mut child = std::process::Command::new("true").spawn().expect("`true` runs");
+    let pid = child.id();
+    let _ = child.wait();
+    pid
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -31,10 +41,7 @@ mod tests {
     #[test]
     fn this_process_runs_and_an_ended_one_does_not() {
         assert!(is_running(std::process::id()));
-        let mut child = std::process::Command::new("true").spawn().unwrap();
-        let pid = child.id();
-        child.wait().unwrap();
-        assert_eq!(is_running(pid), !Path::new("/proc/self").exists());
+        assert_eq!(is_running(an_ended_process()), !Path::new("/proc/self").exists());
     }
 
     #[test]

@@ -88,12 +88,7 @@ fn kill_at_several_points(name: &str, args: &[&str]) {
     // The next run takes over: a stale lock and hidden leftovers do not stop it. A
     // leftover of every file the run writes is planted too (a kill between writing and
     // renaming, which the points above hit only by chance), as a dead process left it.
-    let dead = {
-        let mut child = Command::new("true").spawn().unwrap();
-        let pid = child.id();
-        child.wait().unwrap();
-        pid
-    };
+    let dead = strata_backends::processes::an_ended_process();
     for entry in std::fs::read_dir(&timing_copy).unwrap() {
         let name = entry.unwrap().file_name().to_string_lossy().into_owned();
         if name.starts_with('.') {

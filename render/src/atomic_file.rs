@@ -326,19 +326,10 @@ mod tests {
         std::fs::remove_dir_all(&folder).unwrap();
     }
 
-    /// The process id of a process that has ended.
-    fn a_dead_process() -> u32 {
-        let mut child = std::process::Command::new("true").spawn().unwrap();
-        let pid = child.id();
-        child.wait().unwrap();
-        assert!(!process_is_running(pid) || !Path::new("/proc/self").exists());
-        pid
-    }
-
     #[test]
     fn a_write_removes_the_temporaries_a_dead_process_left_for_its_name() {
         let folder = scratch("leftovers");
-        let dead = a_dead_process();
+        let dead = strata_backends::processes::an_ended_process();
         // A process still running (another run writing the same name now): kept.
         let mut living = std::process::Command::new("sleep").arg("60").spawn().unwrap();
         let doomed = format!(".default.tmp-{dead}.exr");

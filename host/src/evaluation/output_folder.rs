@@ -183,12 +183,7 @@ mod tests {
         std::fs::create_dir_all(&folder).unwrap();
         // A temporary of a process that has ended (a killed run's) goes; one of a process
         // still running (a render writing into the folder now) stays.
-        let ended = {
-            let mut child = std::process::Command::new("true").spawn().unwrap();
-            let pid = child.id();
-            child.wait().unwrap();
-            pid
-        };
+        let ended = strata_backends::processes::an_ended_process();
         let mut running = std::process::Command::new("sleep").arg("60").spawn().unwrap();
         let (dead, alive) = (format!(".relmse.tmp-{ended}.png"), format!(".default.tmp-{}.exr", running.id()));
         for name in ["errors.csv", "strata_frame001.png", "notes.txt", "reference.exr", &dead, &alive] {

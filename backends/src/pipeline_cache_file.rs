@@ -43,10 +43,13 @@ pub fn default_folder() -> Option<PathBuf> {
     from("XDG_CACHE_HOME").or_else(|| from("HOME").map(|home| home.join(".cache"))).map(|base| base.join("strata"))
 }
 
-/// One device's pipeline cache file.
+/// One device's pipeline cache file, and what it holds as far as this process knows.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct PipelineCacheFile {
     path: PathBuf,
+    /// The driver's bytes the file holds (read or saved by this process and taken by the
+    /// driver): [`Self::save`] writes only what differs.
+    on_disk: Option<Vec<u8>>,
 }
 
 impl PipelineCacheFile {
@@ -54,7 +57,7 @@ impl PipelineCacheFile {
     pub fn new(folder: &Path, key: &str) -> Self {
         let name: String =
             key.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' || c == '-' { c } else { '_' }).collect();
-        Self { path: folder.join(format!("{name}.bin")) }
+        Self { path: folder.join(format!("{name}.bin")), on_disk: None }
     }
 
     /// Where the file is.
@@ -64,11 +67,26 @@ impl PipelineCacheFile {
 
     /// The driver's bytes saved by an earlier run, or `None` when there is no file or it
     /// is not whole (wrong magic or version, a length that differs, a CRC that differs).
-    pub fn read(&self) -> Option<Vec<u8>> {
-        decode(&std::fs::read(&self.path).ok()?)
+    pub fn read(&mut self) -> Option<Vec<u8>> {
+        self.on_disk = decode(&std::fs::read(&self.path).ok()?);
+        self.on_disk.clone()
     }
 
-    /// Saves the driver's bytes, whole or not at all (module documentation); failures
+    /// The driver refused what [`Self::read`] gave: the next [`Self::save`] writes.
+    pub fn refused(&mut self) {
+        self.on_disk = None;
+    }
+
+    /// Writes the driver's bytes if the file does not hold them already (a run whose
+    /// pipelines all came from the file leaves it untouched).
+    pub fn save(&mut self, payload: &[u8]) {
+        if self.on_disk.as_deref() != Some(payload) {
+            self.write(payload);
+            self.on_disk = Some(payload.to_vec());
+        }
+    }
+
+    /// Writes the driver's bytes, whole or not at all (module documentation); failures
     /// are ignored.
     pub fn write(&self, payload: &[u8]) {
         let Some(folder) = self.path.parent() else { return };
@@ -163,7 +181,7 @@ mod tests {
     fn the_file_is_replaced_whole_and_named_after_the_device() {
         let folder = std::env::temp_dir().join(format!("strata-pipeline-cache-unit-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&folder);
-        let file = PipelineCacheFile::new(&folder.join("nested"), "wgpu_pipeline_cache_vulkan_4318/7938");
+        let mut file = PipelineCacheFile::new(&folder.join("nested"), "wgpu_pipeline_cache_vulkan_4318/7938");
         assert_eq!(file.path().file_name().unwrap(), "wgpu_pipeline_cache_vulkan_4318_7938.bin");
         assert_eq!(file.read(), None);
         file.write(b"first");
@@ -187,7 +205,7 @@ mod tests {
         names.sort();
         assert_eq!(names, [alive, "wgpu_pipeline_cache_vulkan_4318_7938.bin".to_string()]);
         // A folder that cannot be created (a file in its way): nothing happens.
-        let blocked = PipelineCacheFile::new(&file.path().join("below"), "x");
+        let mut blocked = PipelineCacheFile::new(&file.path().join("below"), "x");
         blocked.write(b"ignored");
         assert_eq!(blocked.read(), None);
         std::fs::remove_dir_all(&folder).unwrap();

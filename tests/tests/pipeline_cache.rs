@@ -124,7 +124,7 @@ fn wgpu_keeps_its_pipeline_cache_in_a_file() {
     // key in wgpu's header changed): wgpu refuses such data even with `fallback`, and the
     // backend starts from an empty cache instead of failing every pipeline.
     let key = runs.file.file_stem().unwrap().to_string_lossy().into_owned();
-    let cache = PipelineCacheFile::new(&folder, &key);
+    let mut cache = PipelineCacheFile::new(&folder, &key);
     let mut foreign = cache.read().unwrap();
     assert_eq!(&foreign[..8], b"WGPUPLCH", "wgpu's header changed: adapt this test");
     foreign[20] ^= 0x5a;

@@ -254,38 +254,37 @@ pub(super) struct PipelineCache {
 pub(super) struct DriverCache {
     cache: vk::PipelineCache,
     file: PipelineCacheFile,
-    /// What the file holds now (saved again only when the driver's data changed).
-    saved: Option<Vec<u8>>,
 }
 
 impl DriverCache {
     /// The cache of `vulkan`'s device from `file` (empty when the file is missing or not
     /// whole, or when the driver refuses its data); `None` if the driver cannot make one.
-    pub(super) fn open(vulkan: &VulkanDevice, file: PipelineCacheFile) -> Option<Self> {
-        let saved = file.read();
-        let initial = saved.as_deref().unwrap_or_default();
+    pub(super) fn open(vulkan: &VulkanDevice, mut file: PipelineCacheFile) -> Option<Self> {
         let create = |data: &[u8]| {
-            // SAFETY: a valid device; the data are what vkGetPipelineCacheData gave an
-            // earlier run (the file's header and CRC make sure of it) or empty, and the
-            // driver checks its own header (vendor, device, pipelineCacheUUID) and
-            // ignores data of another driver.
+            // SAFETY: a valid device; the data are empty or what vkGetPipelineCacheData
+            // gave an earlier run, as far as a file in the user's own cache folder can
+            // tell (its header and CRC catch a damaged or foreign file; whoever can write
+            // the folder can also write the user's programs), and the driver checks its
+            // own header (vendor, device, pipelineCacheUUID) and ignores another
+            // driver's data.
             unsafe {
                 vulkan.device.create_pipeline_cache(&vk::PipelineCacheCreateInfo::default().initial_data(data), None)
             }
         };
-        // Data a driver refuses outright: start empty instead.
-        let cache = create(initial).or_else(|_| create(&[])).ok()?;
-        Some(Self { cache, file, saved })
+        if let Some(cache) = file.read().and_then(|data| create(&data).ok()) {
+            return Some(Self { cache, file });
+        }
+        // No file, or data the driver refuses outright: start empty.
+        file.refused();
+        create(&[]).ok().map(|cache| Self { cache, file })
     }
 
     /// Saves the driver's data if it changed.
     fn save(&mut self, vulkan: &VulkanDevice) {
         // SAFETY: the cache belongs to this device and is not being written meanwhile
         // (one thread owns the backend).
-        let Ok(data) = (unsafe { vulkan.device.get_pipeline_cache_data(self.cache) }) else { return };
-        if self.saved.as_ref() != Some(&data) {
-            self.file.write(&data);
-            self.saved = Some(data);
+        if let Ok(data) = unsafe { vulkan.device.get_pipeline_cache_data(self.cache) } {
+            self.file.save(&data);
         }
     }
 }

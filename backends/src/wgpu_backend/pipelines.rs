@@ -35,8 +35,6 @@ pub(super) struct PipelineCache {
 pub(super) struct DriverCache {
     cache: wgpu::PipelineCache,
     file: PipelineCacheFile,
-    /// What the file holds now (saved again only when the driver's data changed).
-    saved: Option<Vec<u8>>,
 }
 
 impl DriverCache {
@@ -45,7 +43,7 @@ impl DriverCache {
     /// refuses such data even with `fallback`, and a cache it refused would fail every
     /// pipeline made with it). `None` when even an empty cache cannot be made: then
     /// pipelines are made without one.
-    pub(super) fn open(device: &wgpu::Device, errors: &ErrorSink, file: PipelineCacheFile) -> Option<Self> {
+    pub(super) fn open(device: &wgpu::Device, errors: &ErrorSink, mut file: PipelineCacheFile) -> Option<Self> {
         let create = |data: Option<&[u8]>| {
             let scope = errors.scope(device);
             // SAFETY: the bytes are what `get_data` gave an earlier run, as far as a
@@ -62,19 +60,17 @@ impl DriverCache {
             };
             scope.finish("pipeline cache creation").ok().map(|()| cache)
         };
-        let read = file.read();
-        match read.as_deref().and_then(|data| create(Some(data))) {
-            Some(cache) => Some(Self { cache, file, saved: read }),
-            None => create(None).map(|cache| Self { cache, file, saved: None }),
+        if let Some(cache) = file.read().and_then(|data| create(Some(&data))) {
+            return Some(Self { cache, file });
         }
+        file.refused();
+        create(None).map(|cache| Self { cache, file })
     }
 
     /// Saves the driver's data if it changed.
     fn save(&mut self) {
-        let data = self.cache.get_data();
-        if data.is_some() && data != self.saved {
-            self.file.write(data.as_deref().unwrap_or_default());
-            self.saved = data;
+        if let Some(data) = self.cache.get_data() {
+            self.file.save(&data);
         }
     }
 }

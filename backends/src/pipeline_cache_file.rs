@@ -12,13 +12,21 @@
 //! The driver's own header (vendor, device, driver build) then decides whether the data
 //! fit this device.
 //!
-//! Writes go to a hidden temporary file in the same folder (one per process and write,
-//! since the devices of `strata compare`'s warm-up save from threads of one process) and
+//! Writes go to a hidden temporary file in the same folder, created under a random name
+//! that nothing planted can redirect ([`strata_files::TemporaryFile`]: one per write,
+//! since the devices of `strata compare`'s warm-up save from threads of one process), and
 //! are renamed into place, so a killed run, or two runs or threads saving at once, leave
 //! a whole file (the last saver's, which then holds that device's pipelines only) or the
-//! old one; a write first removes the temporaries that ended processes left. The cache is
-//! an optimisation: a folder that cannot be created or a file that cannot be written is
-//! left as it is, silently, and the run goes on.
+//! old one; a write first removes the temporaries that ended processes left.
+//!
+//! The folder must be the user's own: it is created with mode 0700, and a folder that is
+//! a link, belongs to someone else or that others may write is not used at all (nothing
+//! read from it, nothing written), since its bytes reach the driver. The file is read
+//! through [`strata_files::read_regular_capped`]: a link, a named pipe or a device at its
+//! name (a link to `/dev/zero`) is ignored at once, never followed, waited on or read, and
+//! a file over [`MAX_CACHE_FILE_BYTES`] is ignored. The cache is an optimisation: a
+//! folder that cannot be created or a file that cannot be read or written is left as it
+//! is, silently, and the run goes on.
 //!
 //! Where: `$XDG_CACHE_HOME/strata`, else `$HOME/.cache/strata` ([`default_folder`]),
 //! one file per API and device: `wgpu_pipeline_cache_vulkan_<vendor>_<device>.bin` and
@@ -35,12 +43,15 @@ const VERSION: u32 = 1;
 /// Magic, version, payload length (u64), payload CRC-32: 24 bytes, little-endian.
 const HEADER_LENGTH: usize = 8 + 4 + 8 + 4;
 
+/// The largest cache file read: drivers' caches of strata's kernels are kilobytes to a
+/// few megabytes; anything larger is not ours and is ignored.
+pub const MAX_CACHE_FILE_BYTES: u64 = 256 << 20;
+
 /// The cache folder a run uses when nobody chose one: `$XDG_CACHE_HOME/strata`, else
 /// `$HOME/.cache/strata`; `None` where neither variable is set (no cache then). A
 /// relative path in either is ignored, as the XDG specification asks.
 pub fn default_folder() -> Option<PathBuf> {
-    let from = |name: &str| std::env::var_os(name).map(PathBuf::from).filter(|path| path.is_absolute());
-    from("XDG_CACHE_HOME").or_else(|| from("HOME").map(|home| home.join(".cache"))).map(|base| base.join("strata"))
+    strata_files::private_folder::user_cache_path()
 }
 
 /// One device's pipeline cache file, and what it holds as far as this process knows.
@@ -67,8 +78,11 @@ impl PipelineCacheFile {
 
     /// The driver's bytes saved by an earlier run, or `None` when there is no file or it
     /// is not whole (wrong magic or version, a length that differs, a CRC that differs).
+    /// Nothing is read from a folder that is not private (module documentation), and only
+    /// a regular file of at most [`MAX_CACHE_FILE_BYTES`] is read.
     pub fn read(&mut self) -> Option<Vec<u8>> {
-        self.on_disk = decode(&std::fs::read(&self.path).ok()?);
+        strata_files::check_private(self.path.parent()?).ok()?;
+        self.on_disk = decode(&strata_files::read_regular_capped(&self.path, MAX_CACHE_FILE_BYTES).ok()?);
         self.on_disk.clone()
     }
 
@@ -87,41 +101,18 @@ impl PipelineCacheFile {
     }
 
     /// Writes the driver's bytes, whole or not at all (module documentation); failures
-    /// are ignored.
+    /// are ignored, and nothing is written into a folder that is not private.
     pub fn write(&self, payload: &[u8]) {
+        use std::io::Write;
         let Some(folder) = self.path.parent() else { return };
-        if std::fs::create_dir_all(folder).is_err() {
+        if strata_files::private_folder(folder).is_err() {
             return;
         }
-        let name = self.path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        remove_dead_temporaries(folder, &name);
-        // Process and write: threads of one process (strata compare's warm-up devices)
-        // save the same device's file at once.
-        static WRITES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-        let write = WRITES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let temporary = folder.join(format!(".{name}.tmp-{}-{write}", std::process::id()));
-        if std::fs::write(&temporary, encode(payload)).is_err() || std::fs::rename(&temporary, &self.path).is_err() {
-            let _ = std::fs::remove_file(&temporary);
-        }
-    }
-}
-
-/// Removes the temporaries of the file `name` in `folder` whose process has ended (a
-/// run killed while saving: driver caches can be megabytes).
-fn remove_dead_temporaries(folder: &Path, name: &str) {
-    let Ok(entries) = std::fs::read_dir(folder) else { return };
-    let prefix = format!(".{name}.tmp-");
-    for entry in entries.flatten() {
-        let entry_name = entry.file_name().to_string_lossy().into_owned();
-        // `.NAME.tmp-PID-WRITE`
-        let Some((pid, write)) = entry_name.strip_prefix(&prefix).and_then(|rest| rest.split_once('-')) else {
-            continue;
-        };
-        let Some(pid) = crate::processes::writer_between(pid, "", "") else { continue };
-        let regular = entry.file_type().is_ok_and(|t| t.is_file());
-        let numbered = !write.is_empty() && write.bytes().all(|b| b.is_ascii_digit());
-        if regular && numbered && pid != std::process::id() && !crate::processes::is_running(pid) {
-            let _ = std::fs::remove_file(entry.path());
+        strata_files::remove_dead_temporaries(&self.path);
+        let Ok(temporary) = strata_files::TemporaryFile::beside(&self.path) else { return };
+        let mut file = temporary.file();
+        if file.write_all(&encode(payload)).is_ok() && file.sync_all().is_ok() {
+            let _ = temporary.persist(&self.path);
         }
     }
 }
@@ -179,8 +170,8 @@ mod tests {
 
     #[test]
     fn the_file_is_replaced_whole_and_named_after_the_device() {
-        let folder = std::env::temp_dir().join(format!("strata-pipeline-cache-unit-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&folder);
+        let scratch = strata_files::private_scratch_folder("strata-pipeline-cache-unit-").unwrap();
+        let folder = scratch.path().to_path_buf();
         let mut file = PipelineCacheFile::new(&folder.join("nested"), "wgpu_pipeline_cache_vulkan_4318/7938");
         assert_eq!(file.path().file_name().unwrap(), "wgpu_pipeline_cache_vulkan_4318_7938.bin");
         assert_eq!(file.read(), None);
@@ -189,8 +180,8 @@ mod tests {
         // running process's (another run saving now) stay.
         let ended = crate::processes::an_ended_process();
         let mut running = std::process::Command::new("sleep").arg("60").spawn().unwrap();
-        let dead = format!(".wgpu_pipeline_cache_vulkan_4318_7938.bin.tmp-{ended}-3");
-        let alive = format!(".wgpu_pipeline_cache_vulkan_4318_7938.bin.tmp-{}-0", running.id());
+        let dead = format!(".wgpu_pipeline_cache_vulkan_4318_7938.tmp-{ended}-a3.bin");
+        let alive = format!(".wgpu_pipeline_cache_vulkan_4318_7938.tmp-{}-b0.bin", running.id());
         for name in [&dead, &alive] {
             std::fs::write(folder.join("nested").join(name), b"half").unwrap();
         }
@@ -208,6 +199,35 @@ mod tests {
         let mut blocked = PipelineCacheFile::new(&file.path().join("below"), "x");
         blocked.write(b"ignored");
         assert_eq!(blocked.read(), None);
-        std::fs::remove_dir_all(&folder).unwrap();
+    }
+
+    /// Security finding 7: a named pipe at the cache's path hung `strata render --backend
+    /// wgpu` (a plain read waits for a writer), and a link to `/dev/zero` was read until
+    /// memory ran out. Both are ignored at once now, and so is a folder others may write.
+    #[cfg(unix)]
+    #[test]
+    fn a_pipe_a_device_link_or_a_shared_folder_at_the_cache_is_ignored_at_once() {
+        use std::os::unix::fs::PermissionsExt;
+        let scratch = strata_files::private_scratch_folder("strata-pipeline-cache-hostile-").unwrap();
+        let mut fifo = PipelineCacheFile::new(scratch.path(), "fifo");
+        let name = std::ffi::CString::new(fifo.path().as_os_str().as_encoded_bytes()).unwrap();
+        // SAFETY: a valid NUL-terminated path; mkfifo only creates the entry.
+        assert_eq!(unsafe { libc::mkfifo(name.as_ptr(), 0o600) }, 0);
+        let (sender, receiver) = std::sync::mpsc::channel();
+        std::thread::spawn(move || sender.send(fifo.read()).unwrap());
+        let read = receiver.recv_timeout(std::time::Duration::from_secs(10)).expect("reading a named pipe hung");
+        assert_eq!(read, None);
+        let mut zero = PipelineCacheFile::new(scratch.path(), "zero");
+        std::os::unix::fs::symlink("/dev/zero", zero.path()).unwrap();
+        assert_eq!(zero.read(), None);
+        // A whole, valid file in a folder others may write is not read, and not replaced.
+        let shared = scratch.path().join("shared");
+        std::fs::create_dir(&shared).unwrap();
+        let mut planted = PipelineCacheFile::new(&shared, "key");
+        std::fs::write(planted.path(), encode(b"someone else's")).unwrap();
+        std::fs::set_permissions(&shared, std::fs::Permissions::from_mode(0o777)).unwrap();
+        assert_eq!(planted.read(), None);
+        planted.write(b"ours");
+        assert_eq!(std::fs::read(planted.path()).unwrap(), encode(b"someone else's"));
     }
 }

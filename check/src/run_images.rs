@@ -231,7 +231,13 @@ pub fn write_picture(stem: &Path, output: &OutputBuffer, desc: &TextureDesc) -> 
             let path = stem.with_extension("png");
             let image = image::RgbaImage::from_raw(width, height, bytes.to_vec())
                 .context("a storage texture's bytes do not fill its size")?;
-            image.save(&path).with_context(|| format!("cannot write {}", path.display()))?;
+            // Encoded in memory, then written whole or not at all, never through a link
+            // (strata's one writer: strata::atomic_file).
+            let mut png = Vec::new();
+            image
+                .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+                .with_context(|| format!("cannot encode {}", path.display()))?;
+            strata::atomic_file::write(&path, png)?;
             return Ok(Some(path));
         }
         TexelFormat::Rgba16Float => floats(4, &f16_at),

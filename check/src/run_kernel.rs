@@ -367,7 +367,8 @@ pub fn run_kernel(request: &RunRequest) -> Result<RunOutcome> {
             for output in outputs {
                 let stem = dir.join(format!("{}_{}_{}", output.group, output.binding, output.name));
                 let file = stem.with_extension("bin");
-                std::fs::write(&file, &output.bytes).with_context(|| format!("cannot write {}", file.display()))?;
+                // Whole or not at all, never through a link at its or a temporary's name.
+                strata::atomic_file::write(&file, &output.bytes)?;
                 let texture = images.iter().find_map(|(slot, input)| match input {
                     ImageInput::Texture { desc, .. } if *slot == (output.group, output.binding) => Some(desc),
                     _ => None,

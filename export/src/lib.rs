@@ -300,13 +300,20 @@ fn check_out(out: &Path) -> Result<(), String> {
 /// old, at every moment.
 fn write_package(out: &Path, files: &[(String, Vec<u8>)]) -> Result<(), ExportError> {
     let name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "package".into());
-    let temporary = out.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
-    let aside = out.with_file_name(format!(".{name}.old-{}", std::process::id()));
     let failed = |path: &Path| {
         let path = path.display().to_string();
         move |source| ExportError::Write { path, source }
     };
-    let _ = std::fs::remove_dir_all(&temporary);
+    // A new folder of a random name beside `out` (made by mkdir, mode 0700, so nothing
+    // planted at a predictable name is written through), kept from here on: it is
+    // renamed into place or removed below.
+    let parent = match out.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    };
+    let temporary =
+        strata_files::private_scratch_folder_in(parent, &format!(".{name}.tmp-")).map_err(failed(parent))?.keep();
+    let aside = out.with_file_name(format!(".{name}.old-{}", std::process::id()));
     let written = files.iter().try_for_each(|(relative, bytes)| {
         let path = temporary.join(relative);
         if let Some(parent) = path.parent() {

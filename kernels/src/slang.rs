@@ -4,6 +4,9 @@
 //! HLSL strata exports is compiled, and run, by a compiler other than the one whose bugs
 //! strata works around (`glslang.rs`).
 //!
+//! The tool is built into the per-user cache folder, never found by a fixed name in a
+//! shared one ([`tool`]).
+//!
 //! Where Slang is: `STRATA_SLANG_DIR` (a folder with `include/slang.h` and
 //! `libslang-compiler.so*`), else the installed `slangpy` package's folder (found through
 //! `python3`). `pip install slangpy` installs it; CI does.
@@ -47,18 +50,46 @@ fn library(folder: &Path) -> Result<PathBuf, ToolError> {
     found.pop().ok_or_else(missing)
 }
 
+/// A 64-bit FNV-1a hash: names the built tool after its source and Slang library, so a
+/// changed source or another Slang is built anew instead of a stale tool being run.
+fn fnv1a(parts: &[&[u8]]) -> u64 {
+    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
+    for part in parts {
+        for &byte in *part {
+            hash ^= u64::from(byte);
+            hash = hash.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        hash ^= 0xff;
+        hash = hash.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    hash
+}
+
 /// The built tool, building it (with the system's C++ compiler) if it is not there yet.
+///
+/// Where: `slang-hlsl-<hash>` in the per-user folder `$XDG_CACHE_HOME/strata/tools` (else
+/// `~/.cache/strata/tools`), created with mode 0700 and checked to be the user's own and
+/// writable by nobody else before anything in it is run ([`strata_files::user_cache_folder`]).
+/// It was once built under a fixed name in the shared temporary folder, where anyone
+/// could plant a program of that name first and have it run (SECURITY.md). Without a
+/// home folder the tool is built into a private folder of this process instead.
 pub fn tool() -> Result<PathBuf, ToolError> {
     let folder = slang_folder()?;
     let library = library(&folder)?;
-    let version = library.file_name().and_then(OsStr::to_str).unwrap_or("slang").replace('.', "_");
-    let built = std::env::temp_dir().join(format!("strata-slang-hlsl-{version}-{}", TOOL_SOURCE.len()));
-    if built.is_file() {
+    let hash = fnv1a(&[TOOL_SOURCE.as_bytes(), library.as_os_str().as_encoded_bytes()]);
+    let tools = tools_folder()?;
+    let built = tools.join(format!("slang-hlsl-{hash:016x}"));
+    if is_own_program(&built)? {
         return Ok(built);
     }
-    let source = built.with_extension("cpp");
-    std::fs::write(&source, TOOL_SOURCE).map_err(|e| ToolError::Failed(format!("{}: {e}", source.display())))?;
-    let partial = built.with_extension("partial");
+    let failed = |path: &Path, e: &dyn std::fmt::Display| ToolError::Failed(format!("{}: {e}", path.display()));
+    let scratch = strata_files::private_scratch_folder("strata-slang-build-")
+        .map_err(|e| ToolError::Failed(format!("cannot make a private work folder: {e}")))?;
+    let source = scratch.path().join("slang_hlsl.cpp");
+    std::fs::write(&source, TOOL_SOURCE).map_err(|e| failed(&source, &e))?;
+    // Built under a fresh name in the private folder, then renamed into place: two
+    // processes building at once each rename a whole program.
+    let partial = strata_files::TemporaryFile::beside(&built).map_err(|e| failed(&built, &e))?;
     run_tool(
         "c++",
         &[
@@ -70,11 +101,65 @@ pub fn tool() -> Result<PathBuf, ToolError> {
             library.as_os_str(),
             OsStr::new(&format!("-Wl,-rpath,{}", folder.display())),
             OsStr::new("-o"),
-            partial.as_os_str(),
+            partial.path().as_os_str(),
         ],
     )?;
-    std::fs::rename(&partial, &built).map_err(|e| ToolError::Failed(format!("{}: {e}", built.display())))?;
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(partial.path(), std::fs::Permissions::from_mode(0o700))
+            .map_err(|e| failed(partial.path(), &e))?;
+    }
+    partial.persist(&built).map_err(|e| failed(&built, &e))?;
     Ok(built)
+}
+
+/// The folder the tool is built in: the per-user `tools` folder, or (no home folder) a
+/// private folder of this process, kept until it ends.
+fn tools_folder() -> Result<PathBuf, ToolError> {
+    match strata_files::user_cache_folder(Some("tools")) {
+        Ok(folder) => Ok(folder),
+        Err(strata_files::FolderError::NoHome) => {
+            static SCRATCH: std::sync::OnceLock<Result<PathBuf, String>> = std::sync::OnceLock::new();
+            SCRATCH
+                .get_or_init(|| {
+                    strata_files::private_scratch_folder("strata-tools-")
+                        .map(|dir| dir.keep())
+                        .map_err(|e| format!("cannot make a private tools folder: {e}"))
+                })
+                .clone()
+                .map_err(ToolError::Failed)
+        }
+        Err(error) => Err(ToolError::Failed(error.to_string())),
+    }
+}
+
+/// Whether `path` is a program this user built: a regular file (not a link) owned by this
+/// user and writable by nobody else. Anything else at the name is an error, never run.
+fn is_own_program(path: &Path) -> Result<bool, ToolError> {
+    let metadata = match std::fs::symlink_metadata(path) {
+        Ok(metadata) => metadata,
+        Err(error) if error.kind() == std::io::ErrorKind::NotFound => return Ok(false),
+        Err(error) => return Err(ToolError::Failed(format!("{}: {error}", path.display()))),
+    };
+    let refuse = |why: &str| {
+        Err(ToolError::Failed(format!("{}: {why}; not run (remove it to have it built again)", path.display())))
+    };
+    if !metadata.file_type().is_file() {
+        return refuse("is not a regular file");
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        // SAFETY: geteuid has no preconditions and cannot fail.
+        if metadata.uid() != unsafe { libc::geteuid() } {
+            return refuse("belongs to another user");
+        }
+        if metadata.mode() & 0o022 != 0 {
+            return refuse("may be written by others");
+        }
+    }
+    Ok(true)
 }
 
 /// Compiles the HLSL file `hlsl` (compute entry point `entry`) to SPIR-V words.
@@ -149,6 +234,41 @@ mod tests {
         assert_eq!(rewritten[7], words[7], "OpSource keeps its opcode and length");
         assert_eq!(rewritten[8], SOURCE_LANGUAGE_UNKNOWN);
         assert_eq!(rewritten[9], 1, "the version operand stays");
+    }
+
+    /// Security finding 4: the tool was run from `$TMPDIR/strata-slang-hlsl-<library>-<length>`
+    /// if a file of that name existed, so anyone who could write to `/tmp` first decided
+    /// what ran. Now a program is looked for only in a private folder, and anything at its
+    /// name that is not the user's own regular file, writable by nobody else, is refused.
+    #[cfg(unix)]
+    #[test]
+    fn a_program_planted_at_the_tools_name_is_refused_not_run() {
+        use std::os::unix::fs::PermissionsExt;
+        let scratch = strata_files::private_scratch_folder("strata-slang-planted-").unwrap();
+        let own = scratch.path().join("own");
+        std::fs::write(&own, b"#!/bin/sh\n").unwrap();
+        std::fs::set_permissions(&own, std::fs::Permissions::from_mode(0o700)).unwrap();
+        assert!(is_own_program(&own).unwrap());
+        assert!(!is_own_program(&scratch.path().join("absent")).unwrap());
+        let writable = scratch.path().join("writable");
+        std::fs::write(&writable, b"#!/bin/sh\n").unwrap();
+        std::fs::set_permissions(&writable, std::fs::Permissions::from_mode(0o777)).unwrap();
+        assert!(is_own_program(&writable).unwrap_err().to_string().contains("written by others"));
+        let link = scratch.path().join("link");
+        std::os::unix::fs::symlink(&own, &link).unwrap();
+        assert!(is_own_program(&link).unwrap_err().to_string().contains("not a regular file"));
+    }
+
+    /// The name the tool is found by is never in the shared temporary folder.
+    #[test]
+    fn the_tools_folder_is_private_and_not_the_shared_temporary_folder() {
+        let folder = tools_folder().unwrap();
+        strata_files::check_private(&folder).unwrap();
+        assert_ne!(folder, std::env::temp_dir());
+        assert!(
+            !folder.starts_with(std::env::temp_dir())
+                || folder.file_name().unwrap().to_string_lossy().starts_with("strata-tools-")
+        );
     }
 
     #[test]

@@ -105,10 +105,11 @@ pub fn translate_and_validate(kernel: &Kernel, target: Target, dir: &Path) -> (P
         Ok(t) => t,
         Err(e) => return (path, Verdict::Invalid(e.to_string())),
     };
+    // Whole or not at all, never through a link (strata_files::write_whole).
     let written = if target == Target::Spirv {
-        std::fs::write(&path, bytemuck::cast_slice::<u32, u8>(&translation.words))
+        strata_files::write_whole(&path, bytemuck::cast_slice::<u32, u8>(&translation.words))
     } else {
-        std::fs::write(&path, &translation.text)
+        strata_files::write_whole(&path, translation.text.as_bytes())
     };
     if let Err(e) = written {
         return (path.clone(), Verdict::Invalid(format!("cannot write {}: {e}", path.display())));

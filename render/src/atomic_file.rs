@@ -2,7 +2,8 @@
 //!
 //! Every encoder (EXR, PNG, CSV, SVG, JSON, HTML) makes its bytes in memory; [`write()`]
 //! then puts them on the disk under a hidden temporary name in the same folder
-//! (`.NAME.tmp-PID.EXT`), forces them to the device (`fsync`, which is where a full disk
+//! (`.NAME.tmp-PID-RANDOM.EXT`, created exclusively: [`strata_files::TemporaryFile`], so
+//! a symbolic link someone planted at a temporary's name is never written through), forces them to the device (`fsync`, which is where a full disk
 //! or a failing device says so for data a write call had accepted into the page cache),
 //! checks that the file holds every byte, and only then renames it into place, which
 //! POSIX makes atomic within one file system. So:
@@ -22,47 +23,22 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-/// The hidden temporary name `path` is written under before the rename.
-pub fn temporary_path(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let (prefix, suffix) = temporary_affixes(&name);
-    path.with_file_name(format!("{prefix}{}{suffix}", std::process::id()))
-}
-
-/// Whether a file name is one of [`temporary_path`]'s (of any process).
+/// Whether a file name is a temporary of this writer's (of any process and target).
 pub fn is_temporary(name: &str) -> bool {
-    name.starts_with('.') && name.contains(".tmp-")
+    strata_files::is_temporary(name)
 }
 
 /// Whether temporary file `name` ([`is_temporary`]) may be removed: its writer, named
 /// after `.tmp-`, has ended (or is not named there). A running process's temporary (a
 /// render writing into the same folder now) is kept.
 pub fn is_left_over(name: &str) -> bool {
-    let Some((_, after)) = name.rsplit_once(".tmp-") else { return false };
-    let digits = after.split('.').next().unwrap_or_default();
-    match strata_backends::processes::writer_between(digits, "", "") {
+    match strata_files::any_temporary_writer(name) {
         Some(pid) => pid != std::process::id() && !process_is_running(pid),
         None => true,
     }
 }
 
-pub use strata_backends::processes::is_running as process_is_running;
-
-/// The name parts around the process id of `target_name`'s temporaries.
-fn temporary_affixes(target_name: &str) -> (String, String) {
-    match target_name.rsplit_once('.') {
-        Some((stem, extension)) => (format!(".{stem}.tmp-"), format!(".{extension}")),
-        None => (format!(".{target_name}.tmp-"), String::new()),
-    }
-}
-
-/// The process that wrote temporary file `name` for the target named `target_name`, if
-/// `name` is one of that target's temporaries ([`temporary_path`] of another process).
-#[cfg(test)]
-fn temporary_writer(target_name: &str, name: &str) -> Option<u32> {
-    let (prefix, suffix) = temporary_affixes(target_name);
-    strata_backends::processes::writer_between(name, &prefix, &suffix)
-}
+pub use strata_files::process_is_running;
 
 /// Removes the temporary files of `path` that processes no longer running left (a run
 /// killed between writing and renaming); those of running processes (another run writing
@@ -70,25 +46,7 @@ fn temporary_writer(target_name: &str, name: &str) -> Option<u32> {
 /// the names removed. Best effort: a leftover that cannot be listed or removed stays,
 /// hidden, and harms nothing.
 pub fn remove_dead_temporaries(path: &Path) -> Vec<String> {
-    let (Some(folder), Some(target_name)) = (path.parent(), path.file_name()) else { return Vec::new() };
-    let folder = if folder.as_os_str().is_empty() { Path::new(".") } else { folder };
-    let (prefix, suffix) = temporary_affixes(&target_name.to_string_lossy());
-    let Ok(entries) = std::fs::read_dir(folder) else { return Vec::new() };
-    let mut removed = Vec::new();
-    for entry in entries.flatten() {
-        let name = entry.file_name().to_string_lossy().into_owned();
-        let Some(pid) = strata_backends::processes::writer_between(&name, &prefix, &suffix) else { continue };
-        let regular = entry.file_type().is_ok_and(|t| t.is_file());
-        if regular
-            && pid != std::process::id()
-            && !process_is_running(pid)
-            && std::fs::remove_file(entry.path()).is_ok()
-        {
-            removed.push(name);
-        }
-    }
-    removed.sort();
-    removed
+    strata_files::remove_dead_temporaries(path)
 }
 
 /// Why a file cannot be written; the message names the file.
@@ -193,6 +151,55 @@ pub fn check_target(path: &Path) -> Result<(), WriteError> {
     }
 }
 
+/// A folder whose outputs are recorded by name ([`record_outputs`]).
+#[derive(Debug)]
+struct OutputRecord {
+    folder: PathBuf,
+    journal: PathBuf,
+}
+
+/// The folder this process records its outputs in, if any.
+static RECORD: std::sync::Mutex<Option<OutputRecord>> = std::sync::Mutex::new(None);
+
+/// From now on, the name of every file this process writes into `folder` is appended to
+/// `journal` (one name a line) before the file appears under that name, so that a later
+/// run removes exactly the files this one wrote, even if this one is killed halfway
+/// (`strata compare`'s output folder: it never removes a file of the user's that merely
+/// has a name like its outputs).
+pub fn record_outputs(folder: &Path, journal: &Path) {
+    let folder = folder.canonicalize().unwrap_or_else(|_| folder.to_path_buf());
+    *RECORD.lock().unwrap_or_else(std::sync::PoisonError::into_inner) =
+        Some(OutputRecord { folder, journal: journal.to_path_buf() });
+}
+
+/// Appends the names of `files` that lie in the recorded folder to its journal.
+fn note_outputs(files: &[(&Path, &[u8])]) -> Result<(), WriteError> {
+    let record = RECORD.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let Some(record) = record.as_ref() else { return Ok(()) };
+    let mut names = String::new();
+    for (path, _) in files {
+        let parent = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        let in_folder = parent.canonicalize().is_ok_and(|p| p == record.folder);
+        if let (true, Some(name)) = (in_folder, path.file_name()) {
+            names += &format!("{}\n", name.to_string_lossy());
+        }
+    }
+    if names.is_empty() {
+        return Ok(());
+    }
+    let io = |error: std::io::Error| WriteError::Io { path: record.journal.display().to_string(), error };
+    let mut options = std::fs::OpenOptions::new();
+    options.append(true).create(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NOFOLLOW).mode(0o600);
+    }
+    let mut journal = options.open(&record.journal).map_err(io)?;
+    journal.write_all(names.as_bytes()).map_err(io)?;
+    journal.sync_all().map_err(io)
+}
+
 /// Writes `bytes` to `path`, complete or not at all (module documentation). On any error
 /// the temporary file is removed and `path` is left as it was.
 pub fn write(path: &Path, bytes: impl AsRef<[u8]>) -> Result<(), WriteError> {
@@ -211,34 +218,28 @@ pub fn write_set(files: &[(&Path, &[u8])]) -> Result<(), WriteError> {
     for (path, _) in files {
         remove_dead_temporaries(path);
     }
-    let mut staged: Vec<PathBuf> = Vec::new();
-    let result = (|| -> Result<(), WriteError> {
-        for (path, bytes) in files {
-            staged.push(temporary_path(path));
-            stage(path, bytes)?;
-        }
-        for (path, _) in files {
-            // Checked again: something may have taken the name while the bytes were written.
-            check_target(path)?;
-        }
-        for (path, _) in files {
-            let io = |error: std::io::Error| WriteError::Io { path: path.display().to_string(), error };
-            std::fs::rename(temporary_path(path), path).map_err(io)?;
-        }
-        Ok(())
-    })();
-    if result.is_err() {
-        for temporary in staged {
-            let _ = std::fs::remove_file(temporary);
-        }
+    // Every file complete under its temporary name before any is renamed; a temporary
+    // not renamed is removed when dropped (an error anywhere leaves none).
+    let mut staged = Vec::with_capacity(files.len());
+    for (path, bytes) in files {
+        staged.push(stage(path, bytes)?);
     }
-    result
+    for (path, _) in files {
+        // Checked again: something may have taken the name while the bytes were written.
+        check_target(path)?;
+    }
+    note_outputs(files)?;
+    for ((path, _), temporary) in files.iter().zip(staged) {
+        temporary.persist(path).map_err(|error| WriteError::Io { path: path.display().to_string(), error })?;
+    }
+    Ok(())
 }
 
-/// Writes `bytes` under `path`'s temporary name, synced and checked for length.
-fn stage(path: &Path, bytes: &[u8]) -> Result<(), WriteError> {
+/// Writes `bytes` under a new temporary name beside `path`, synced and checked for length.
+fn stage(path: &Path, bytes: &[u8]) -> Result<strata_files::TemporaryFile, WriteError> {
     let io = |error: std::io::Error| WriteError::Io { path: path.display().to_string(), error };
-    let mut file = std::fs::File::create(temporary_path(path)).map_err(io)?;
+    let temporary = strata_files::TemporaryFile::beside(path).map_err(io)?;
+    let mut file = temporary.file();
     file.write_all(bytes).map_err(io)?;
     file.sync_all().map_err(io)?;
     let on_disk = file.metadata().map_err(io)?.len();
@@ -249,7 +250,7 @@ fn stage(path: &Path, bytes: &[u8]) -> Result<(), WriteError> {
             expected: bytes.len() as u64,
         });
     }
-    Ok(())
+    Ok(temporary)
 }
 
 #[cfg(test)]
@@ -279,9 +280,8 @@ mod tests {
         write(&path, "c\n").unwrap();
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "c\n");
         assert_eq!(names(&folder), ["errors.csv"]);
-        let temporary = temporary_path(&folder.join("strata_frame001.png"));
-        let name = temporary.file_name().unwrap().to_string_lossy().into_owned();
-        assert!(name.starts_with(".strata_frame001.tmp-") && name.ends_with(".png") && is_temporary(&name));
+        let name = format!(".strata_frame001.tmp-{}-a1B2c3D4.png", std::process::id());
+        assert!(is_temporary(&name));
         assert!(!is_temporary("strata_frame001.png"));
         // This process's temporary is not a leftover; one with no process id is.
         assert!(!is_left_over(&name));
@@ -315,18 +315,6 @@ mod tests {
     }
 
     #[test]
-    fn a_failed_write_leaves_the_old_file_and_no_temporary() {
-        let folder = scratch("failed");
-        let path = folder.join("run.json");
-        write(&path, "old").unwrap();
-        // A folder in the temporary's place makes creating it fail.
-        std::fs::create_dir(temporary_path(&path)).unwrap();
-        assert!(write(&path, "new").is_err());
-        assert_eq!(std::fs::read_to_string(&path).unwrap(), "old");
-        std::fs::remove_dir_all(&folder).unwrap();
-    }
-
-    #[test]
     fn a_write_removes_the_temporaries_a_dead_process_left_for_its_name() {
         let folder = scratch("leftovers");
         let dead = strata_backends::processes::an_ended_process();
@@ -352,9 +340,25 @@ mod tests {
             assert!(left.contains(name), "{name} was removed: {left:?}");
         }
         assert_eq!(std::fs::read(folder.join("default.exr")).unwrap(), b"image");
-        assert_eq!(temporary_writer("default.exr", &doomed), Some(dead));
-        assert_eq!(temporary_writer("default.exr", ".default.tmp-.exr"), None);
-        assert_eq!(temporary_writer("LICENSE", &format!(".LICENSE.tmp-{dead}")), Some(dead));
+        std::fs::remove_dir_all(&folder).unwrap();
+    }
+
+    /// Security finding 5: a symbolic link planted at the name the writer's temporary
+    /// had (`.NAME.tmp-PID.EXT`, predictable) made a render overwrite the link's target,
+    /// then rename the link into place.
+    #[cfg(unix)]
+    #[test]
+    fn a_link_planted_at_a_temporary_name_is_never_written_through() {
+        let folder = scratch("planted");
+        let victim = folder.join("victim.txt");
+        std::fs::write(&victim, b"the user's").unwrap();
+        let path = folder.join("default.exr");
+        let planted = folder.join(format!(".default.tmp-{}.exr", std::process::id()));
+        std::os::unix::fs::symlink(&victim, &planted).unwrap();
+        write(&path, b"image").unwrap();
+        assert_eq!(std::fs::read(&victim).unwrap(), b"the user's", "written through the planted link");
+        assert!(std::fs::symlink_metadata(&path).unwrap().file_type().is_file(), "the link was renamed into place");
+        assert_eq!(std::fs::read(&path).unwrap(), b"image");
         std::fs::remove_dir_all(&folder).unwrap();
     }
 
@@ -363,12 +367,12 @@ mod tests {
         let folder = scratch("set");
         let (svg, png) = (folder.join("plot.svg"), folder.join("plot.png"));
         write_set(&[(&svg, b"svg 1"), (&png, b"png 1")]).unwrap();
-        // The second file's temporary cannot be created: neither file changes.
-        std::fs::create_dir(temporary_path(&png)).unwrap();
-        assert!(write_set(&[(&svg, b"svg 2"), (&png, b"png 2")]).is_err());
+        // The second file's temporary cannot be created (its folder is missing): neither
+        // file changes, and no temporary is left.
+        let missing = folder.join("missing").join("plot.png");
+        assert!(write_set(&[(&svg, b"svg 2"), (&missing, b"png 2")]).is_err());
         assert_eq!(std::fs::read(&svg).unwrap(), b"svg 1");
         assert_eq!(std::fs::read(&png).unwrap(), b"png 1");
-        std::fs::remove_dir(temporary_path(&png)).unwrap();
         assert_eq!(names(&folder), ["plot.png", "plot.svg"]);
         // A refused target anywhere in the set: nothing is written.
         let link = folder.join("new.svg");

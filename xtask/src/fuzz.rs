@@ -3,7 +3,7 @@
 //! any crash. A hang or a huge allocation ends the process at once (status 2 or 3), after
 //! writing the input.
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use std::path::PathBuf;
 use std::time::Duration;
 use strata_check::fuzz::{self, Campaign};
@@ -81,7 +81,9 @@ pub fn fuzz(args: FuzzArgs) -> Result<()> {
         println!("{}", report.summary());
         if let Some(folder) = &args.outcomes {
             std::fs::create_dir_all(folder)?;
-            std::fs::write(folder.join(format!("{}.txt", report.target)), report.outcome_kinds.join("\n") + "\n")?;
+            let file = folder.join(format!("{}.txt", report.target));
+            strata_files::write_whole(&file, (report.outcome_kinds.join("\n") + "\n").as_bytes())
+                .with_context(|| format!("{}: cannot write", file.display()))?;
         }
         for finding in &report.contained {
             println!(

@@ -173,7 +173,7 @@ fn run_step(step: &Step, root: &Path, folder: &Path) -> Result<Outcome> {
     let log = folder.join(format!("{}.log", step.name));
     let _ = std::fs::remove_file(&log);
     let settings = folder.join(format!("{}.settings.txt", step.name));
-    std::fs::write(
+    strata_files::write_whole(
         &settings,
         format!(
             "khronos_validation.report_flags = error,warn,perf\n\
@@ -182,7 +182,8 @@ fn run_step(step: &Step, root: &Path, folder: &Path) -> Result<Outcome> {
              khronos_validation.enables = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT,\
              VK_VALIDATION_FEATURE_ENABLE_BEST_PRACTICES_EXT\n",
             log.display()
-        ),
+        )
+        .as_bytes(),
     )
     .with_context(|| format!("{}: cannot write", settings.display()))?;
     let output = Command::new(&step.program)

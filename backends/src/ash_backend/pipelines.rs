@@ -308,19 +308,19 @@ impl PipelineCache {
             SpirvSource::GlslangFromHlsl => GlslangInput::Hlsl,
             SpirvSource::SlangFromHlsl => return self.slang(kernel),
         };
-        // One folder per compilation: threads of one process compile kernels of the same
-        // name (every external kernel is named after its entry point, often `main`), and
-        // each removes its folder when done.
-        static COMPILATIONS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-        let n = COMPILATIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let dir = std::env::temp_dir().join(format!("strata-glslang-{}-{n}", std::process::id()));
-        let result = glslang::compile(kernel, glslang_input, &dir);
-        let _ = std::fs::remove_dir_all(&dir);
-        result.map_err(|error| BackendError::Validation {
+        // One new private folder per compilation (random name, mode 0700, made by mkdir,
+        // which fails rather than reuse a folder someone else created first: the files
+        // in it are compiled and read back as SPIR-V): threads of one process compile
+        // kernels of the same name (every external kernel is named after its entry point,
+        // often `main`). Removed when dropped.
+        let failed = |message: String| BackendError::Validation {
             backend: self.source.name().into(),
             operation: format!("glslang compilation of `{}`", kernel.name()),
-            message: error.to_string(),
-        })
+            message,
+        };
+        let dir = strata_files::private_scratch_folder("strata-glslang-")
+            .map_err(|e| failed(format!("cannot make a private work folder: {e}")))?;
+        glslang::compile(kernel, glslang_input, dir.path()).map_err(|error| failed(error.to_string()))
     }
 
     /// naga's HLSL of `kernel` (workgroup memory zeroed in the shader, as exported)
@@ -333,19 +333,15 @@ impl PipelineCache {
         };
         let translation =
             translate::hlsl(kernel, TranslateOptions { workgroup_zero_init: WorkgroupZeroInit::Polyfill })?;
-        static COMPILATIONS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-        let n = COMPILATIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let dir = std::env::temp_dir().join(format!("strata-slang-{}-{n}", std::process::id()));
-        let file = dir.join(format!("{}.hlsl", kernel.name()));
+        // A new private folder, as for glslang above.
+        let dir = strata_files::private_scratch_folder("strata-slang-")
+            .map_err(|e| failed(format!("cannot make a private work folder: {e}")))?;
+        let file = dir.path().join(format!("{}.hlsl", kernel.name()));
         let text = hlsl_samplers::plain_samplers(&translation.text).map_err(failed)?;
-        let result = std::fs::create_dir_all(&dir)
-            .and_then(|()| std::fs::write(&file, &text))
-            .map_err(|e| failed(format!("{}: {e}", file.display())))
-            .and_then(|()| {
-                strata_kernels::slang::compile_hlsl(&file, &translation.entry_point).map_err(|e| failed(e.to_string()))
-            });
-        let _ = std::fs::remove_dir_all(&dir);
-        Ok((result?, translation.entry_point))
+        std::fs::write(&file, &text).map_err(|e| failed(format!("{}: {e}", file.display())))?;
+        let words =
+            strata_kernels::slang::compile_hlsl(&file, &translation.entry_point).map_err(|e| failed(e.to_string()))?;
+        Ok((words, translation.entry_point))
     }
 
     pub(super) fn get_or_create(

@@ -302,7 +302,7 @@ fn clock() -> u64 {
 /// Writes `input` as `<folder>/<kind>-<hash>`; returns the path.
 fn write_finding(folder: &Path, kind: &str, input: &[u8]) -> PathBuf {
     let path = folder.join(format!("{kind}-{:016x}", fnv64(input)));
-    if let Err(error) = std::fs::create_dir_all(folder).and_then(|()| std::fs::write(&path, input)) {
+    if let Err(error) = std::fs::create_dir_all(folder).and_then(|()| strata_files::write_whole(&path, input)) {
         eprintln!("fuzz: cannot write {}: {error}", path.display());
     }
     path

@@ -1,15 +1,28 @@
 //! The folder a `strata compare` run writes into, kept to one run at a time. A run takes
 //! the folder's lock file first (a second run while it is held is refused, naming the
-//! process); then the files an earlier run wrote there (recognised by name:
-//! [`is_run_output`]) and temporary files a killed run left are removed, so an old
-//! run's images never sit beside a new run's CSV. Files with other names are left alone,
-//! and so is the reference image the new run reads, wherever it lies.
+//! process); then the files an earlier run wrote there and temporary files a killed run
+//! left are removed, so an old run's images never sit beside a new run's CSV.
+//!
+//! Which files are an earlier run's is read from the folder's record ([`RECORD_NAME`]):
+//! every run appends the name of each file to it before the file appears
+//! ([`crate::atomic_file::record_outputs`]), so a killed run's files are listed too. A
+//! name alone proves nothing: a user's own `variance.csv` or `strata_frame042.png` in the
+//! folder is never removed. Where such a file has a name this run may write, the run is
+//! refused before anything is removed (it would replace it at the end), naming the file.
+//! The reference the new run reads is kept, wherever it lies.
 
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 
 /// The lock file's name in the folder.
 pub const LOCK_NAME: &str = ".strata-compare.lock";
+
+/// The record of the files runs wrote into the folder, one name a line.
+pub const RECORD_NAME: &str = ".strata-compare.files";
+
+/// The most bytes read from the lock file (a process id) and from the record.
+const LOCK_BYTES: u64 = 64;
+const RECORD_BYTES: u64 = 16 << 20;
 
 /// The folder's lock, held while a run writes into it; dropping it removes the lock file.
 #[derive(Debug)]
@@ -36,7 +49,17 @@ pub fn lock(folder: &Path) -> Result<FolderLock> {
                 return Ok(FolderLock { path });
             }
             Err(error) if error.kind() == std::io::ErrorKind::AlreadyExists => {
-                let holder = std::fs::read_to_string(&path).ok().and_then(|t| t.trim().parse::<u32>().ok());
+                // Read as a regular file of a few bytes only: a link, a named pipe or a
+                // device at the lock's name is neither followed nor waited on.
+                let holder = match strata_files::read_regular_capped(&path, LOCK_BYTES) {
+                    Ok(bytes) => String::from_utf8(bytes).ok().and_then(|t| t.trim().parse::<u32>().ok()),
+                    Err(strata_files::ReadError::NotRegular { .. }) => bail!(
+                        "{}: is not a regular file; strata compare neither follows nor removes it: remove it \
+                         yourself, or choose another --out",
+                        path.display()
+                    ),
+                    Err(_) => None,
+                };
                 match holder {
                     Some(pid) if crate::atomic_file::process_is_running(pid) => bail!(
                         "{}: another strata compare (process {pid}) is writing into this folder; wait for it or \
@@ -90,46 +113,82 @@ pub fn is_run_output(name: &str) -> bool {
     methods.contains(&prefix) && !frame.is_empty() && frame.bytes().all(|b| b.is_ascii_digit())
 }
 
+/// The names the folder's record lists ([`RECORD_NAME`]): plain file names only (no
+/// folder part, not hidden); none if there is no record. A record that is not a regular
+/// file, or too large, is an error naming it.
+fn recorded(folder: &Path) -> Result<std::collections::BTreeSet<String>> {
+    let path = folder.join(RECORD_NAME);
+    let bytes = match strata_files::read_regular_capped(&path, RECORD_BYTES) {
+        Ok(bytes) => bytes,
+        Err(strata_files::ReadError::Missing { .. }) => return Ok(Default::default()),
+        Err(error) => bail!("{error}; remove it yourself, or choose another --out"),
+    };
+    Ok(String::from_utf8_lossy(&bytes)
+        .lines()
+        .filter(|name| !name.is_empty() && !name.starts_with('.') && !name.contains(['/', '\\']))
+        .map(str::to_string)
+        .collect())
+}
+
 /// Creates `folder` if needed, takes its [`lock`] and removes the files an earlier run
-/// wrote there and temporary files a killed run left ([`crate::atomic_file`]), except
-/// `keep` (the reference this run reads, which may be an earlier run's `reference.exr`).
-/// Returns the lock, to hold until the run has written everything, and the names removed.
+/// recorded there ([`RECORD_NAME`]) and temporary files a killed run left
+/// ([`crate::atomic_file`]), except `keep` (the reference this run reads, which may be an
+/// earlier run's `reference.exr`). Then starts this run's record
+/// ([`crate::atomic_file::record_outputs`]). Returns the lock, to hold until the run has
+/// written everything, and the names removed.
 ///
-/// Everything is checked before anything is removed: an entry under a name the run
-/// writes that is not a regular file (the writer would refuse it at the end), or that is
-/// an input of this run (a scene, mesh, texture or camera path named `run.json`,
-/// `summary.txt`, ...: removing it and writing the run's file there would destroy it), is
-/// refused while the earlier run's files are all still there.
+/// Everything is checked before anything is removed: a file under a name the run writes
+/// that no earlier run recorded (a user's own), an entry under such a name that is not a
+/// regular file (the writer would refuse it at the end), or one that is an input of this
+/// run (a scene, mesh, texture or camera path named `run.json`, `summary.txt`, ...:
+/// removing it and writing the run's file there would destroy it), is refused while the
+/// earlier run's files are all still there.
 pub fn prepare(folder: &Path, keep: Option<&Path>) -> Result<(FolderLock, Vec<String>)> {
     std::fs::create_dir_all(folder).with_context(|| format!("{}: cannot create the folder", folder.display()))?;
     let lock = lock(folder)?;
+    let recorded = recorded(folder)?;
     let keep: Option<PathBuf> = keep.and_then(|k| k.canonicalize().ok());
     let mut doomed = Vec::new();
+    let mut kept_names = Vec::new();
     let entries = std::fs::read_dir(folder).with_context(|| format!("{}: cannot list the folder", folder.display()))?;
     for entry in entries {
         let entry = entry.with_context(|| format!("{}: cannot list the folder", folder.display()))?;
         let name = entry.file_name().to_string_lossy().into_owned();
         let path = entry.path();
         let output = is_run_output(&name);
+        let earlier = recorded.contains(&name);
         let temporary = crate::atomic_file::is_temporary(&name);
-        if !(output || temporary) || (temporary && !crate::atomic_file::is_left_over(&name)) {
+        if !(output || earlier || temporary) || (temporary && !crate::atomic_file::is_left_over(&name)) {
             continue;
         }
         let regular = entry.file_type().is_ok_and(|t| t.is_file());
         let kept = regular && keep.is_some() && path.canonicalize().ok() == keep;
         if kept && name == "reference.exr" {
             // The run reads it and, given a reference, writes no file of that name.
+            if earlier {
+                kept_names.push(name);
+            }
             continue;
         }
         if kept {
             bail!(
-                "--reference {}: this run writes a file of that name into --out {}; copy the reference elsewhere                  or choose another --out",
+                "--reference {}: this run writes a file of that name into --out {}; copy the reference elsewhere \
+                 or choose another --out",
                 path.display(),
                 folder.display()
             );
         }
         if output {
             crate::atomic_file::check_target(&path)?;
+            if regular && !earlier && !temporary {
+                bail!(
+                    "{}: no earlier strata compare recorded writing this file (in {}), and this run may write a file \
+                     of that name: strata compare neither removes nor replaces a file it did not write; move it, or \
+                     choose another --out",
+                    path.display(),
+                    RECORD_NAME
+                );
+            }
         }
         if regular {
             doomed.push((name, path));
@@ -142,6 +201,11 @@ pub fn prepare(folder: &Path, keep: Option<&Path>) -> Result<(FolderLock, Vec<St
         removed.push(name);
     }
     removed.sort();
+    // The new record starts with what was kept of the earlier one.
+    let record = folder.join(RECORD_NAME);
+    let text: String = kept_names.iter().map(|name| format!("{name}\n")).collect();
+    crate::atomic_file::write(&record, text)?;
+    crate::atomic_file::record_outputs(folder, &record);
     Ok((lock, removed))
 }
 
@@ -189,6 +253,8 @@ mod tests {
         for name in ["errors.csv", "strata_frame001.png", "notes.txt", "reference.exr", &dead, &alive] {
             std::fs::write(folder.join(name), b"x").unwrap();
         }
+        std::fs::write(folder.join(RECORD_NAME), "errors.csv\nstrata_frame001.png\nreference.exr\n../escape\n")
+            .unwrap();
         let (lock, removed) = prepare(&folder, Some(&folder.join("reference.exr"))).unwrap();
         let _ = running.kill();
         let _ = running.wait();
@@ -209,6 +275,56 @@ mod tests {
         std::fs::remove_dir_all(&folder).unwrap();
     }
 
+    /// Security finding 6: `prepare` once removed every file whose name looked like a
+    /// run's output, so a user's own `variance.csv` or `strata_frame042.png` in `--out` was
+    /// deleted. Only recorded files go; an unrecorded one under an output's name refuses
+    /// the run before anything is removed; other names are never touched.
+    #[test]
+    fn a_users_files_are_never_removed() {
+        let folder = std::env::temp_dir().join(format!("strata-output-folder-user-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&folder);
+        std::fs::create_dir_all(&folder).unwrap();
+        for name in ["errors.csv", "variance.csv", "strata_frame042.png", "notes.txt"] {
+            std::fs::write(folder.join(name), b"the user's").unwrap();
+        }
+        std::fs::write(folder.join(RECORD_NAME), "errors.csv\n").unwrap();
+        let refused = prepare(&folder, None).unwrap_err().to_string();
+        assert!(refused.contains("did not write"), "{refused}");
+        for name in ["errors.csv", "variance.csv", "strata_frame042.png", "notes.txt"] {
+            assert_eq!(std::fs::read(folder.join(name)).unwrap(), b"the user's", "{name}");
+        }
+        std::fs::remove_file(folder.join("variance.csv")).unwrap();
+        std::fs::remove_file(folder.join("strata_frame042.png")).unwrap();
+        let (_lock, removed) = prepare(&folder, None).unwrap();
+        assert_eq!(removed, ["errors.csv"]);
+        assert_eq!(std::fs::read(folder.join("notes.txt")).unwrap(), b"the user's");
+        drop(_lock);
+        std::fs::remove_dir_all(&folder).unwrap();
+    }
+
+    /// Security finding 9: the lock file was read through links and named pipes (a FIFO
+    /// there hung `strata compare`).
+    #[cfg(unix)]
+    #[test]
+    fn a_pipe_or_link_at_the_locks_name_is_refused_at_once() {
+        let folder = std::env::temp_dir().join(format!("strata-output-folder-lock-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&folder);
+        std::fs::create_dir_all(&folder).unwrap();
+        let fifo = folder.join(LOCK_NAME);
+        let name = std::ffi::CString::new(fifo.as_os_str().as_encoded_bytes()).unwrap();
+        // SAFETY: a valid NUL-terminated path; mkfifo only creates the entry.
+        assert_eq!(unsafe { libc::mkfifo(name.as_ptr(), 0o600) }, 0);
+        let (sender, receiver) = std::sync::mpsc::channel();
+        let inside = folder.clone();
+        std::thread::spawn(move || sender.send(lock(&inside).map(drop).map_err(|e| e.to_string())).unwrap());
+        let refused = receiver.recv_timeout(std::time::Duration::from_secs(10)).expect("the lock's pipe hung");
+        assert!(refused.unwrap_err().contains("not a regular file"));
+        std::fs::remove_file(&fifo).unwrap();
+        std::os::unix::fs::symlink("/dev/zero", &fifo).unwrap();
+        assert!(lock(&folder).unwrap_err().to_string().contains("not a regular file"));
+        std::fs::remove_dir_all(&folder).unwrap();
+    }
+
     /// An input of the run under a name the run writes, or a link there, is refused
     /// before any earlier file is removed.
     #[test]
@@ -219,6 +335,8 @@ mod tests {
         for name in ["errors.csv", "report.html", "summary.txt", "strata_frame001.exr"] {
             std::fs::write(folder.join(name), b"x").unwrap();
         }
+        let record = "errors.csv\nreport.html\nsummary.txt\nstrata_frame001.exr\nrun.json\nvariance.csv\n";
+        std::fs::write(folder.join(RECORD_NAME), record).unwrap();
         // A scene file named like the run's record, read as an input.
         std::fs::write(folder.join("run.json"), b"{}").unwrap();
         crate::atomic_file::note_input(&folder.join("run.json"));

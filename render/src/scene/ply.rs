@@ -84,6 +84,17 @@ struct Element {
     properties: Vec<Property>,
 }
 
+/// A word of a PLY header as an error may quote it: at most 24 characters, anything but
+/// printable ASCII shown as `?` (a header is the file's first bytes, whatever the file).
+fn quoted_token(word: &str) -> String {
+    const MOST: usize = 24;
+    let mut quoted: String = word.chars().take(MOST).map(|c| if c.is_ascii_graphic() { c } else { '?' }).collect();
+    if word.chars().count() > MOST {
+        quoted.push_str("...");
+    }
+    quoted
+}
+
 fn ply_error(path: &Path, element: impl Into<String>, message: impl Into<String>) -> SceneError {
     SceneError::Ply { path: PathBuf::from(path), element: element.into(), message: message.into() }
 }
@@ -116,28 +127,46 @@ pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<PlyMesh, SceneError> {
                 return Err(ply_error(
                     path,
                     at,
-                    format!("format `{other}` is not supported (binary_little_endian only)"),
+                    format!("format `{}` is not supported (binary_little_endian only)", quoted_token(other)),
                 ));
             }
             ["comment", ..] | ["obj_info", ..] | ["end_header"] | [] => {}
             ["element", name, count] => elements.push(Element {
                 name: name.to_string(),
-                count: count.parse().map_err(|_| ply_error(path, &at, format!("bad element count `{count}`")))?,
+                count: count
+                    .parse()
+                    .map_err(|_| ply_error(path, &at, format!("bad element count `{}`", quoted_token(count))))?,
                 properties: Vec::new(),
             }),
             ["property", "list", count, item, name] => {
                 let (Some(count), Some(item)) = (Scalar::parse(count), Scalar::parse(item)) else {
-                    return Err(ply_error(path, at, format!("unknown list types `{count} {item}`")));
+                    return Err(ply_error(
+                        path,
+                        at,
+                        format!("unknown list types `{} {}`", quoted_token(count), quoted_token(item)),
+                    ));
                 };
                 let element = elements.last_mut().ok_or_else(|| ply_error(path, &at, "property before any element"))?;
                 element.properties.push(Property::List(name.to_string(), count, item));
             }
             ["property", kind, name] => {
-                let kind = Scalar::parse(kind).ok_or_else(|| ply_error(path, &at, format!("unknown type `{kind}`")))?;
+                let kind = Scalar::parse(kind)
+                    .ok_or_else(|| ply_error(path, &at, format!("unknown type `{}`", quoted_token(kind))))?;
                 let element = elements.last_mut().ok_or_else(|| ply_error(path, &at, "property before any element"))?;
                 element.properties.push(Property::Scalar(name.to_string(), kind));
             }
-            _ => return Err(ply_error(path, at, format!("cannot read `{line}`"))),
+            // The line is not quoted: a scene may name any file as its mesh, and an error
+            // must not print what that file holds (SECURITY.md); its number finds it.
+            _ => {
+                return Err(ply_error(
+                    path,
+                    at,
+                    format!(
+                        "cannot read this line of {} words (expected format, element, property, comment or end_header)",
+                        words.len()
+                    ),
+                ));
+            }
         }
     }
     let mut offset = header_end;
@@ -285,5 +314,23 @@ impl PlyMesh {
             }
         }
         (triangles, uvs, dropped)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Security finding 9: a scene may name any file as its mesh; an error about that
+    /// file's header must not print the file's text (once it printed the whole line).
+    #[test]
+    fn header_errors_do_not_quote_the_files_text() {
+        let secret = b"ply\nformat binary_little_endian 1.0\npassword=hunter2 and more\nend_header\n";
+        let message = parse_ply(Path::new("mesh.ply"), secret).unwrap_err().to_string();
+        assert!(!message.contains("hunter2"), "{message}");
+        assert!(message.contains("mesh.ply") && message.contains("header line 3"), "{message}");
+        let long = format!("ply\nformat {} 1.0\nend_header\n", "s".repeat(200));
+        let message = parse_ply(Path::new("mesh.ply"), long.as_bytes()).unwrap_err().to_string();
+        assert!(message.len() < 200 && message.contains("..."), "{message}");
     }
 }

@@ -76,11 +76,18 @@ fn edge_i32(rng: &mut FuzzRng, old: i32) -> i32 {
 /// The target, with its temporary file for `read_exr`.
 pub(super) struct Exr {
     folder: PathBuf,
+    /// The private folder (random name, mode 0700) `folder` is, removed with the target.
+    _scratch: Option<strata_files::TempDir>,
 }
 
 impl Exr {
     pub(super) fn new() -> Exr {
-        Exr { folder: std::env::temp_dir().join(format!("strata-fuzz-exr-{}", std::process::id())) }
+        // A new private folder, never one someone else made first under a fixed name.
+        match strata_files::private_scratch_folder("strata-fuzz-exr-") {
+            Ok(scratch) => Exr { folder: scratch.path().to_path_buf(), _scratch: Some(scratch) },
+            // No temporary folder: every input is then refused as unwritable, by name.
+            Err(_) => Exr { folder: PathBuf::from("/nonexistent/strata-fuzz-exr"), _scratch: None },
+        }
     }
 }
 
@@ -285,7 +292,7 @@ impl Target for Exr {
         }
         // `read_exr` reads a file: one per thread, in this process's folder.
         let file = self.folder.join(format!("{:?}.exr", std::thread::current().id()).replace(['(', ')'], ""));
-        if std::fs::create_dir_all(&self.folder).and_then(|()| std::fs::write(&file, input)).is_err() {
+        if strata_files::write_whole(&file, input).is_err() {
             return Outcome::Refused("cannot write the temporary file".into());
         }
         let reference = RgbImage::read_exr(&file);

@@ -251,6 +251,8 @@ fn a_second_run_into_the_same_folder_replaces_the_first_runs_files() {
     let out = scratch("rerun");
     std::fs::write(out.join("strata_frame999.png"), b"an older run's image").unwrap();
     std::fs::write(out.join("notes.txt"), b"the user's own file").unwrap();
+    // The older run recorded its image (output_folder::RECORD_NAME): only recorded files go.
+    std::fs::write(out.join(strata::evaluation::output_folder::RECORD_NAME), "strata_frame999.png\n").unwrap();
     let args = ["compare", "--width", "8", "--height", "8", "--frames", "1", "--seeds", "2", "--reference-spp", "2"];
     let output = strata_without_vulkan(&[&args[..], &["--out", out_str(&out)]].concat());
     assert!(output.status.success(), "{}", text(&output.stderr));
@@ -259,12 +261,16 @@ fn a_second_run_into_the_same_folder_replaces_the_first_runs_files() {
     for file in ["report.html", "summary.txt", "run.json", "errors.csv", "relmse.svg", "relmse.png", "reference.png"] {
         assert!(out.join(file).exists(), "no {file}");
     }
-    // Every file the run wrote is one a later run recognises and removes (the names in
-    // report.rs and in output_folder.rs cannot drift apart), and nothing hidden is left.
+    // Every file the run wrote is one a later run recognises and is recorded, so a later
+    // run removes it (the names in report.rs and in output_folder.rs cannot drift apart),
+    // and nothing hidden is left but the record.
+    let record_name = strata::evaluation::output_folder::RECORD_NAME;
+    let recorded = std::fs::read_to_string(out.join(record_name)).unwrap();
     for entry in std::fs::read_dir(&out).unwrap() {
         let name = entry.unwrap().file_name().to_string_lossy().into_owned();
-        if name != "notes.txt" {
+        if name != "notes.txt" && name != record_name {
             assert!(strata::evaluation::output_folder::is_run_output(&name), "`{name}` would survive a later run");
+            assert!(recorded.lines().any(|line| line == name), "`{name}` is not in the record");
         }
     }
     let record: serde_json::Value =

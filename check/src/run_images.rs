@@ -137,7 +137,7 @@ fn read_picture(path: &Path) -> Result<([u32; 3], TexelFormat, Vec<u8>)> {
         let texels = image.pixels.iter().flat_map(|p| [p[0], p[1], p[2], 1.0]).flat_map(f32::to_le_bytes).collect();
         return Ok(([image.width, image.height, 1], TexelFormat::Rgba32Float, texels));
     }
-    let bytes = std::fs::read(path).with_context(|| format!("cannot read texture {}", path.display()))?;
+    let bytes = crate::run_kernel::read_input(path, crate::run_kernel::MAX_INPUT_BYTES)?;
     let image = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
         .with_context(|| format!("texture {}: not a PNG this reader understands", path.display()))?
         .to_rgba8();
@@ -168,8 +168,7 @@ pub fn image_inputs(kernel: &Kernel, specs: &[ImageSpec]) -> Result<GroupedImage
                 let (size, format, texels) = match file {
                     TextureFile::Picture(path) => read_picture(path)?,
                     TextureFile::Raw { path, size, format } => {
-                        let bytes =
-                            std::fs::read(path).with_context(|| format!("cannot read texture {}", path.display()))?;
+                        let bytes = crate::run_kernel::read_input(path, crate::run_kernel::MAX_INPUT_BYTES)?;
                         (*size, *format, bytes)
                     }
                 };

@@ -58,10 +58,24 @@ pub struct BackendRun {
     pub outputs: Result<Vec<OutputBuffer>, String>,
 }
 
+/// The largest shader file read (WGSL text).
+pub const MAX_SHADER_BYTES: u64 = 64 << 20;
+
+/// The largest buffer or texture file read; a device's own limits are checked after.
+pub const MAX_INPUT_BYTES: u64 = 4 << 30;
+
+/// The whole regular file `path` (a link to one is followed), at most `cap` bytes: a named
+/// pipe, a device (`/dev/zero`) or a link to one is refused at once by name, never waited on or read until memory runs
+/// out, and the size is checked before anything is allocated.
+pub fn read_input(path: &Path, cap: u64) -> Result<Vec<u8>> {
+    Ok(strata_files::read_named_regular_capped(path, cap)?)
+}
+
 /// Loads the shader with `overrides`; subgroup operations are allowed if the module
 /// needs them.
 pub fn load_shader(path: &Path, entry: &str, overrides: &[(String, f64)]) -> Result<Kernel> {
-    let source = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let bytes = read_input(path, MAX_SHADER_BYTES)?;
+    let source = String::from_utf8(bytes).map_err(|_| anyhow::anyhow!("{}: is not UTF-8 text", path.display()))?;
     let name = path.display().to_string();
     match Kernel::from_wgsl_with_overrides(&name, source.clone(), entry, false, overrides) {
         Ok(kernel) => Ok(kernel),
@@ -343,7 +357,7 @@ pub fn run_kernel(request: &RunRequest) -> Result<RunOutcome> {
         if kernel.binding(*group, *binding).is_none() {
             bail!("--buffer {group}:{binding}={}: entry point `{}` has no such binding", file.display(), request.entry);
         }
-        let bytes = std::fs::read(file).with_context(|| format!("cannot read buffer file {}", file.display()))?;
+        let bytes = read_input(file, MAX_INPUT_BYTES)?;
         if bytes.is_empty() {
             bail!("buffer file {} is empty", file.display());
         }

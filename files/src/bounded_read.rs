@@ -24,7 +24,9 @@ pub enum ReadError {
     },
     /// Something other than a regular file has the name: a symbolic link, a named pipe,
     /// a device, a folder or a socket.
-    #[error("{path}: is not a regular file (a link, pipe, device or folder is never read here)")]
+    #[error(
+        "{path}: is not a regular file (pipes, devices and folders are never read, nor links found rather than named)"
+    )]
     NotRegular {
         /// The file.
         path: PathBuf,
@@ -53,8 +55,19 @@ pub enum ReadError {
 /// a named pipe, a device or a folder at `path` is refused without being followed,
 /// opened for long or read (module documentation).
 pub fn read_regular_capped(path: &Path, cap: u64) -> Result<Vec<u8>, ReadError> {
+    read_capped(path, cap, false)
+}
+
+/// As [`read_regular_capped`], but a symbolic link is followed: for a file the user named
+/// (`xtask run --buffer`), where a link to the user's own file is ordinary. What it leads
+/// to must still be a regular file within the cap (a link to `/dev/zero` is refused).
+pub fn read_named_regular_capped(path: &Path, cap: u64) -> Result<Vec<u8>, ReadError> {
+    read_capped(path, cap, true)
+}
+
+fn read_capped(path: &Path, cap: u64, follow_links: bool) -> Result<Vec<u8>, ReadError> {
     let io = |error: std::io::Error| ReadError::Io { path: path.to_path_buf(), error };
-    let file = match open_no_follow(path) {
+    let file = match open_without_waiting(path, follow_links) {
         Ok(file) => file,
         Err(error) if error.kind() == std::io::ErrorKind::NotFound => {
             return Err(ReadError::Missing { path: path.to_path_buf() });
@@ -88,20 +101,21 @@ pub fn read_regular_capped(path: &Path, cap: u64) -> Result<Vec<u8>, ReadError> 
     Ok(bytes)
 }
 
-/// Opens `path` for reading without following a final symbolic link and without
-/// waiting for a named pipe's writer.
-fn open_no_follow(path: &Path) -> std::io::Result<std::fs::File> {
+/// Opens `path` for reading without waiting for a named pipe's writer, and unless
+/// `follow_links`, without following a final symbolic link.
+fn open_without_waiting(path: &Path, follow_links: bool) -> std::io::Result<std::fs::File> {
     let mut options = std::fs::OpenOptions::new();
     options.read(true);
     #[cfg(unix)]
     {
         use std::os::unix::fs::OpenOptionsExt;
-        options.custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK);
+        let no_follow = if follow_links { 0 } else { libc::O_NOFOLLOW };
+        options.custom_flags(no_follow | libc::O_NONBLOCK);
     }
     #[cfg(not(unix))]
     {
         // No O_NOFOLLOW: refuse a link seen before opening (a window remains there).
-        if std::fs::symlink_metadata(path)?.file_type().is_symlink() {
+        if !follow_links && std::fs::symlink_metadata(path)?.file_type().is_symlink() {
             return Err(std::io::Error::new(std::io::ErrorKind::InvalidInput, "a symbolic link"));
         }
     }
@@ -155,6 +169,12 @@ mod tests {
         assert_eq!(unsafe { libc::mkfifo(name.as_ptr(), 0o600) }, 0);
         for path in [&link, &zero, &fifo, &folder.path().to_path_buf(), &std::path::PathBuf::from("/dev/zero")] {
             let error = read_regular_capped(path, 1 << 20).unwrap_err();
+            assert!(matches!(error, ReadError::NotRegular { .. }), "{}: {error}", path.display());
+        }
+        // A file the user named may be a link to a regular file, never to a device or pipe.
+        assert_eq!(read_named_regular_capped(&link, 1 << 20).unwrap(), b"not ours");
+        for path in [&zero, &fifo] {
+            let error = read_named_regular_capped(path, 1 << 20).unwrap_err();
             assert!(matches!(error, ReadError::NotRegular { .. }), "{}: {error}", path.display());
         }
     }

@@ -20,7 +20,7 @@ pub mod temporary;
 
 pub use tempfile::TempDir;
 
-pub use bounded_read::{ReadError, read_regular_capped};
+pub use bounded_read::{ReadError, read_named_regular_capped, read_regular_capped};
 pub use private_folder::{
     FolderError, check_private, private_folder, private_scratch_folder, private_scratch_folder_in, user_cache_folder,
     user_cache_path,

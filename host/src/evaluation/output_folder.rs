@@ -213,6 +213,14 @@ pub fn prepare(folder: &Path, keep: Option<&Path>) -> Result<(FolderLock, Vec<St
 mod tests {
     use super::*;
 
+    /// An empty scratch folder of this test process.
+    fn scratch(name: &str) -> PathBuf {
+        let folder = std::env::temp_dir().join(format!("strata-output-folder-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&folder);
+        std::fs::create_dir_all(&folder).unwrap();
+        folder
+    }
+
     #[test]
     fn run_outputs_are_recognised_by_name() {
         for name in [
@@ -242,9 +250,7 @@ mod tests {
 
     #[test]
     fn an_earlier_runs_files_go_and_the_rest_stays() {
-        let folder = std::env::temp_dir().join(format!("strata-output-folder-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&folder);
-        std::fs::create_dir_all(&folder).unwrap();
+        let folder = scratch("earlier");
         // A temporary of a process that has ended (a killed run's) goes; one of a process
         // still running (a render writing into the folder now) stays.
         let ended = strata_backends::processes::an_ended_process();
@@ -281,9 +287,7 @@ mod tests {
     /// the run before anything is removed; other names are never touched.
     #[test]
     fn a_users_files_are_never_removed() {
-        let folder = std::env::temp_dir().join(format!("strata-output-folder-user-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&folder);
-        std::fs::create_dir_all(&folder).unwrap();
+        let folder = scratch("user");
         for name in ["errors.csv", "variance.csv", "strata_frame042.png", "notes.txt"] {
             std::fs::write(folder.join(name), b"the user's").unwrap();
         }
@@ -307,9 +311,7 @@ mod tests {
     #[cfg(unix)]
     #[test]
     fn a_pipe_or_link_at_the_locks_name_is_refused_at_once() {
-        let folder = std::env::temp_dir().join(format!("strata-output-folder-lock-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&folder);
-        std::fs::create_dir_all(&folder).unwrap();
+        let folder = scratch("lock");
         let fifo = folder.join(LOCK_NAME);
         let name = std::ffi::CString::new(fifo.as_os_str().as_encoded_bytes()).unwrap();
         // SAFETY: a valid NUL-terminated path; mkfifo only creates the entry.
@@ -329,9 +331,7 @@ mod tests {
     /// before any earlier file is removed.
     #[test]
     fn nothing_is_removed_when_an_entry_would_be_refused() {
-        let folder = std::env::temp_dir().join(format!("strata-output-folder-refused-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&folder);
-        std::fs::create_dir_all(&folder).unwrap();
+        let folder = scratch("refused");
         for name in ["errors.csv", "report.html", "summary.txt", "strata_frame001.exr"] {
             std::fs::write(folder.join(name), b"x").unwrap();
         }

@@ -1,5 +1,11 @@
 //! Checks every backend makes before a dispatch, so that a mistake becomes a clear
 //! [`BackendError`] instead of a validation panic or a silent wrong result.
+//!
+//! Sizes and offsets here come from the caller: no arithmetic may wrap or panic (the
+//! lint below refuses a plain `+`; sums are `checked_add`, and a sum that does not fit
+//! is refused, naming its values).
+
+#![deny(clippy::arithmetic_side_effects)]
 
 use crate::backend::{Bind, BufferId, Resource};
 use crate::device_info::DeviceInfo;
@@ -203,6 +209,12 @@ pub fn check_buffer_size(label: &str, size: u64, device: &DeviceInfo) -> Result<
             reason: "size 0: buffers must hold at least one byte".into(),
         });
     }
+    if size.checked_next_multiple_of(4).is_none() {
+        return Err(BackendError::Buffer {
+            label: label.into(),
+            reason: format!("size {size}: rounded up to whole 4-byte words it passes u64::MAX"),
+        });
+    }
     if size > device.limits.max_buffer_size {
         return Err(BackendError::LimitExceeded {
             what: format!("buffer `{label}`"),
@@ -214,15 +226,72 @@ pub fn check_buffer_size(label: &str, size: u64, device: &DeviceInfo) -> Result<
     Ok(())
 }
 
-/// Whether `len` bytes can be written at `offset` into a buffer of `size` bytes.
+/// Whether `len` bytes can be written at `offset` into a buffer of `size` bytes: both
+/// multiples of 4, and `offset + len` at most `size` without wrapping (an end past
+/// `u64::MAX` is refused, naming the values, never wrapped around into the buffer).
+/// What a backend's write may rely on: on `Ok`, `offset..offset + len` lies in `0..size`.
 pub fn check_write(label: &str, size: u64, offset: u64, len: usize) -> Result<(), BackendError> {
-    if !offset.is_multiple_of(4) || !len.is_multiple_of(4) || offset + len as u64 > size {
-        return Err(BackendError::Buffer {
-            label: label.into(),
-            reason: format!(
-                "write of {len} bytes at offset {offset} into {size} bytes (offset and length must be multiples of 4)"
-            ),
-        });
+    let refuse = |reason: String| Err(BackendError::Buffer { label: label.into(), reason });
+    if !offset.is_multiple_of(4) || !len.is_multiple_of(4) {
+        return refuse(format!(
+            "write of {len} bytes at offset {offset} into {size} bytes (offset and length must be multiples of 4)"
+        ));
+    }
+    let Some(end) = u64::try_from(len).ok().and_then(|len| offset.checked_add(len)) else {
+        return refuse(format!(
+            "write of {len} bytes at offset {offset}: its end lies past the end of u64 ({}), \
+             so it cannot lie inside the buffer's {size} bytes",
+            u64::MAX
+        ));
+    };
+    if end > size {
+        return refuse(format!("write of {len} bytes at offset {offset} into {size} bytes: it ends at byte {end}"));
     }
     Ok(())
+}
+
+/// The byte range `offset..offset + len` of a write into a buffer of `size` bytes, as
+/// [`check_write`] accepts it, in `usize` for indexing the buffer's memory: an error
+/// where `check_write` refuses the write or the range does not fit in `usize`. On `Ok`
+/// the range lies inside `0..size`.
+pub fn write_range(label: &str, size: u64, offset: u64, len: usize) -> Result<std::ops::Range<usize>, BackendError> {
+    check_write(label, size, offset, len)?;
+    let start = usize::try_from(offset).ok();
+    match start.and_then(|start| start.checked_add(len).map(|end| start..end)) {
+        Some(range) => Ok(range),
+        None => Err(BackendError::Buffer {
+            label: label.into(),
+            reason: format!("write of {len} bytes at offset {offset}: the offset does not fit in this machine's usize"),
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{check_write, write_range};
+
+    #[test]
+    fn a_write_whose_end_wraps_past_u64_max_is_refused() {
+        // offset + len wraps to 0 (u64::MAX - 3 + 4): an unchecked sum passed it, and the
+        // ash backend then copied to `mapped + offset`, 4 bytes before the mapping.
+        let error = check_write("target", 16, u64::MAX - 3, 4).expect_err("a wrapped range is refused");
+        let message = error.to_string();
+        assert!(message.contains("18446744073709551612"), "{message}");
+        assert!(message.contains("past the end of u64"), "{message}");
+        // Every other wrapped end too (the sum lands inside the buffer).
+        assert!(check_write("target", 16, u64::MAX - 7, 16).is_err());
+        assert!(check_write("target", 64, 1 << 63, 0).is_err());
+    }
+
+    #[test]
+    fn writes_inside_the_buffer_and_up_to_its_end_pass() {
+        assert!(check_write("target", 16, 0, 16).is_ok());
+        assert!(check_write("target", 16, 12, 4).is_ok());
+        assert!(check_write("target", 16, 16, 0).is_ok());
+        assert!(check_write("target", 16, 16, 4).is_err());
+        assert!(check_write("target", 16, 2, 4).is_err());
+        assert!(check_write("target", 16, 0, 6).is_err());
+        assert_eq!(write_range("target", 16, 8, 8).unwrap(), 8..16);
+        assert!(write_range("target", 16, u64::MAX - 3, 4).is_err());
+    }
 }

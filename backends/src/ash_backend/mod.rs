@@ -16,7 +16,7 @@ pub use pipelines::{PipelineObjects, create_compute_pipeline, descriptor_type, d
 
 use crate::backend::{Backend, Bind, BufferId, Resource};
 use crate::bindings_check::{
-    ResourceLookup, check_binds, check_buffer_size, check_kernel_fits, check_workgroups, check_write,
+    ResourceLookup, check_binds, check_buffer_size, check_kernel_fits, check_workgroups, write_range,
 };
 use crate::device_info::DeviceInfo;
 use crate::error::BackendError;
@@ -81,6 +81,12 @@ impl Default for AshOptions {
     }
 }
 
+/// A buffer and its persistent mapping.
+///
+/// Invariant (relied on by the copies of `write_buffer` and `read_buffer`): `mapped`
+/// points at the start of a host-coherent mapping of at least `size` bytes (the buffer's
+/// memory, `size` rounded up to whole words, mapped whole), alive until the buffer is
+/// destroyed, and `usize::try_from(size)` succeeded when the buffer was created.
 struct AshBuffer {
     buffer: vk::Buffer,
     memory: vk::DeviceMemory,
@@ -219,7 +225,15 @@ impl Backend for AshBackend {
 
     fn create_buffer(&mut self, label: &str, size: u64) -> Result<BufferId, BackendError> {
         check_buffer_size(label, size, &self.info)?;
-        let (buffer, memory, mapped) = self.vulkan.create_buffer(label, size.div_ceil(4) * 4)?;
+        // The copies index the mapping in usize; whole words (checked not to wrap).
+        let padded = size.checked_next_multiple_of(4).filter(|&padded| usize::try_from(padded).is_ok());
+        let Some(padded) = padded else {
+            return Err(BackendError::Buffer {
+                label: label.into(),
+                reason: format!("size {size}: more bytes than this machine can address"),
+            });
+        };
+        let (buffer, memory, mapped) = self.vulkan.create_buffer(label, padded)?;
         self.next_buffer += 1;
         self.buffers.insert(self.next_buffer, AshBuffer { buffer, memory, mapped, size, label: label.into() });
         Ok(BufferId(self.next_buffer))
@@ -227,19 +241,41 @@ impl Backend for AshBackend {
 
     fn write_buffer(&mut self, buffer: BufferId, offset: u64, data: &[u8]) -> Result<(), BackendError> {
         let entry = self.buffer(buffer)?;
-        check_write(&entry.label, entry.size, offset, data.len())?;
-        // SAFETY: the mapping covers the whole buffer, the range was checked above, and
-        // no dispatch is in flight (dispatches complete before `dispatch` returns).
+        // Checked without wrapping: on Ok the range lies inside `0..entry.size`.
+        let range = write_range(&entry.label, entry.size, offset, data.len())?;
+        if range.len() != data.len() || u64::try_from(range.end).map_or(true, |end| end > entry.size) {
+            return Err(BackendError::Buffer {
+                label: entry.label.clone(),
+                reason: format!("internal: write range {range:?} outside the buffer's {} bytes", entry.size),
+            });
+        }
+        // SAFETY: `range` lies inside the buffer's `size` bytes (checked by `write_range`
+        // without wrapping, and again above), which the mapping covers from `mapped`
+        // (`AshBuffer`'s invariant), so `mapped + range.start` and the `data.len()` bytes
+        // after it are inside the mapping; `data` is host memory of ours, not the
+        // mapping, so the two do not overlap; and no dispatch is in flight (dispatches
+        // complete before `dispatch` returns), so the device does not touch the memory.
         unsafe {
-            std::ptr::copy_nonoverlapping(data.as_ptr(), entry.mapped.add(offset as usize), data.len());
+            std::ptr::copy_nonoverlapping(data.as_ptr(), entry.mapped.add(range.start), data.len());
         }
         Ok(())
     }
 
     fn read_buffer(&mut self, buffer: BufferId) -> Result<Vec<u8>, BackendError> {
         let entry = self.buffer(buffer)?;
-        let mut bytes = vec![0u8; entry.size as usize];
-        // SAFETY: as in write_buffer.
+        let size = usize::try_from(entry.size).map_err(|_| BackendError::Buffer {
+            label: entry.label.clone(),
+            reason: format!("size {}: more bytes than this machine can address", entry.size),
+        })?;
+        let mut bytes = Vec::new();
+        bytes.try_reserve_exact(size).map_err(|_| BackendError::OutOfMemory {
+            backend: "ash".into(),
+            operation: format!("read-back of buffer `{}` ({size} bytes)", entry.label),
+        })?;
+        bytes.resize(size, 0);
+        // SAFETY: `bytes` holds `size` bytes, the buffer's size, which the mapping covers
+        // from `mapped` (`AshBuffer`'s invariant); the two do not overlap, and no
+        // dispatch is in flight (as in `write_buffer`).
         unsafe {
             std::ptr::copy_nonoverlapping(entry.mapped, bytes.as_mut_ptr(), bytes.len());
         }

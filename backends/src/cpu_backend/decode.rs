@@ -13,6 +13,7 @@
 //! Expressions lower in [`super::expression`] (math builtins in [`super::math_call`]),
 //! statements in [`super::statement`], loads and stores in [`super::access`].
 
+use super::budget::{Space, add_words, check_space};
 use super::constant::{compose, global_value, literal};
 use super::error::unsupported;
 use super::insn::{Insn, Reg};
@@ -73,6 +74,8 @@ pub(super) struct Code {
 pub(super) struct Program {
     /// The entry point's name.
     pub name: String,
+    /// The kernel's name, for messages about its memory ([`super::budget`]).
+    pub kernel: String,
     /// Per module function (by handle index), then the entry point.
     pub codes: Vec<Code>,
     /// Index of the entry point's code.
@@ -144,6 +147,12 @@ pub(super) struct Compiler<'a> {
     pub global_values: &'a [Vec<u32>],
     /// Bound buffers (for checking static buffer slots).
     pub buffer_count: usize,
+    /// The kernel's name, for messages.
+    kernel: &'a str,
+    /// Register words the scopes opened so far may take (their expressions' and
+    /// variables' words): an upper bound of the template's length, held under
+    /// [`super::budget::SPACE_CAP`] before any of it is allocated.
+    committed: u64,
     names: &'a mut Vec<String>,
     /// Per module function already compiled: its arguments' registers.
     pub(super) arguments: &'a [Vec<(u32, Reg, u32)>],
@@ -342,6 +351,29 @@ impl Compiler<'_> {
         code_arguments: &mut Vec<(u32, Reg, u32)>,
     ) -> Result<Scope<'f>, BackendError> {
         let count = function.expressions.len();
+        // What the scope may take, checked against the cap before anything of that size
+        // is allocated: every expression and variable gets at most one register range.
+        let mut lens = Vec::with_capacity(count);
+        let mut lines = Vec::with_capacity(count);
+        let mut words = 0u64;
+        for (handle, _) in function.expressions.iter() {
+            let line = self.lines_of.line(function.expressions.get_span(handle));
+            let inner = info[handle].ty.inner_with(&self.module.types);
+            let len = words_of(self.module, inner).map_err(|what| unsupported(&what, line))?;
+            words = add_words(self.kernel, Space::Function, words, u64::from(len))?;
+            lines.push(line);
+            lens.push(len);
+        }
+        let mut local_words = Vec::with_capacity(function.local_variables.len());
+        for (handle, local) in function.local_variables.iter() {
+            let line = self.lines_of.line(function.local_variables.get_span(handle));
+            let len =
+                words_of(self.module, &self.module.types[local.ty].inner).map_err(|what| unsupported(&what, line))?;
+            words = add_words(self.kernel, Space::Function, words, u64::from(len))?;
+            local_words.push(len);
+        }
+        self.committed = add_words(self.kernel, Space::Function, self.committed, words)?;
+        check_space(self.kernel, Space::Function, self.committed)?;
         let name = function.name.clone().unwrap_or_default();
         let source = match self.names.iter().position(|n| *n == name) {
             Some(at) => at as u32,
@@ -355,8 +387,8 @@ impl Compiler<'_> {
             info,
             source,
             regs: vec![NONE; count],
-            lens: Vec::with_capacity(count),
-            lines: Vec::with_capacity(count),
+            lens,
+            lines,
             places: vec![None; count],
             constant: vec![false; count],
             pre_emitted: vec![false; count],
@@ -369,16 +401,7 @@ impl Compiler<'_> {
             depth,
             loops: Vec::new(),
         };
-        for (handle, _) in function.expressions.iter() {
-            let line = self.lines_of.line(function.expressions.get_span(handle));
-            let inner = info[handle].ty.inner_with(&self.module.types);
-            scope.lines.push(line);
-            scope.lens.push(words_of(self.module, inner).map_err(|what| unsupported(&what, line))?);
-        }
-        for (handle, local) in function.local_variables.iter() {
-            let line = self.lines_of.line(function.local_variables.get_span(handle));
-            let words =
-                words_of(self.module, &self.module.types[local.ty].inner).map_err(|what| unsupported(&what, line))?;
+        for words in local_words {
             let reg = self.alloc(words);
             scope.locals.push(reg);
         }
@@ -474,6 +497,7 @@ fn compile_code(
     globals: &[(u32, u32)],
     global_values: &[Vec<u32>],
     buffer_count: usize,
+    kernel: &str,
     names: &mut Vec<String>,
     arguments: &[Vec<(u32, Reg, u32)>],
 ) -> Result<Code, BackendError> {
@@ -484,6 +508,8 @@ fn compile_code(
         globals,
         global_values,
         buffer_count,
+        kernel,
+        committed: 0,
         names,
         arguments,
         insns: Vec::new(),
@@ -529,8 +555,16 @@ fn compile_code(
 pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> {
     let module = &kernel.module;
     let lines_of = &LineIndex::new(&kernel.source.text);
+    let name = kernel.name();
+    // The constants' words, held under the cap before each is computed (its words from
+    // its type; a type the interpreter cannot size is global_value's error).
     let mut global_values = Vec::with_capacity(module.global_expressions.len());
+    let mut constant_words = 0u64;
     for (handle, _) in module.global_expressions.iter() {
+        if let Ok(words) = words_of(module, kernel.info[handle].inner_with(&module.types)) {
+            constant_words = add_words(name, Space::Constants, constant_words, u64::from(words))?;
+            check_space(name, Space::Constants, constant_words)?;
+        }
         let value = global_value(module, &global_values, handle).map_err(|what| unsupported(&what, 0))?;
         global_values.push(value);
     }
@@ -555,7 +589,10 @@ pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> 
         })
         .collect::<Result<_, _>>()?;
     let mut globals = Vec::new();
-    let (mut workgroup_words, mut private_words) = (0u32, 0u32);
+    // Every workgroup and private variable takes room, used or not, held under the caps
+    // before it is allocated (the device's workgroup limit, checked before a dispatch,
+    // counts only what the entry point uses).
+    let (mut workgroup_words, mut private_words) = (0u64, 0u64);
     let mut private_init = Vec::new();
     for (handle, variable) in module.global_variables.iter() {
         let inner = &module.types[variable.ty].inner;
@@ -582,16 +619,22 @@ pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> 
                     kernel.bindings.iter().position(|b| b.group == group && b.binding == binding).unwrap_or(usize::MAX);
                 (memory::BUFFER | slot as u32 & 0xff_ffff, 0)
             }
+            // Offsets below the cap (64 MiB, in words) fit in u32.
             naga::AddressSpace::WorkGroup => {
-                workgroup_words += words;
-                (memory::WORKGROUP, workgroup_words - words)
+                let offset = workgroup_words as u32;
+                workgroup_words = add_words(name, Space::Workgroup, workgroup_words, u64::from(words))?;
+                check_space(name, Space::Workgroup, workgroup_words)?;
+                (memory::WORKGROUP, offset)
             }
             naga::AddressSpace::Private => {
-                private_words += words;
-                let value =
-                    variable.init.map(|i| global_values[i.index()].clone()).unwrap_or_else(|| vec![0; words as usize]);
-                private_init.extend_from_slice(&value);
-                (memory::PRIVATE, private_words - words)
+                let offset = private_words as u32;
+                private_words = add_words(name, Space::Private, private_words, u64::from(words))?;
+                check_space(name, Space::Private, private_words)?;
+                match variable.init {
+                    Some(init) => private_init.extend_from_slice(&global_values[init.index()]),
+                    None => private_init.resize(private_init.len() + words as usize, 0),
+                }
+                (memory::PRIVATE, offset)
             }
             _ => (0, 0),
         };
@@ -612,6 +655,7 @@ pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> 
             &globals,
             &global_values,
             buffer_count,
+            kernel.name(),
             &mut names,
             &arguments,
         )?;
@@ -627,18 +671,21 @@ pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> 
         &globals,
         &global_values,
         buffer_count,
+        kernel.name(),
         &mut names,
         &arguments,
     )?;
     codes.push(entry);
     Ok(Program {
         name: kernel.entry_point().to_string(),
+        kernel: name.to_string(),
         entry: codes.len() as u32 - 1,
         codes,
         names,
         entry_arguments,
         workgroup_size: kernel.workgroup_size,
-        workgroup_words,
+        // At most the cap (64 MiB, in words): fits in u32.
+        workgroup_words: workgroup_words as u32,
         private_init,
     })
 }

@@ -59,9 +59,11 @@ impl ElementLoad {
 /// where the element lies inside (the common case).
 #[inline(always)]
 pub(super) fn element_offset(available: usize, stride: usize, index: usize) -> usize {
+    // `index` and `stride` come from the kernel and its data: the end is computed
+    // without wrapping (an end past usize::MAX is outside every region).
     if stride == 0 {
         0
-    } else if (index + 1) * stride <= available {
+    } else if index.checked_add(1).and_then(|n| n.checked_mul(stride)).is_some_and(|end| end <= available) {
         index * stride
     } else {
         ((available / stride).max(1) - 1) * stride

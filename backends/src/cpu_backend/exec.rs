@@ -3,6 +3,7 @@
 //! of frames (see [`super::interp`]); several workgroups together as one batch where
 //! the kernel cannot tell ([`super::batch`]).
 
+use super::budget::try_reserve;
 use super::counts::DispatchCounts;
 use super::decode::Program;
 use super::error::{invalid, unsupported};
@@ -39,12 +40,24 @@ pub(super) fn run(
 ) -> Result<DispatchCounts, BackendError> {
     let instructions = AtomicU64::new(0);
     let warp_issues = AtomicU64::new(0);
+    let total = u64::from(workgroups[0]) * u64::from(workgroups[1]) * u64::from(workgroups[2]);
+    // Batches and threads as the interpreter's memory caps allow (`budget`): each
+    // invocation holds its private memory and a column of every code's registers.
+    // Planned before the buffers are taken, so that a refusal leaves them as they were.
+    let registers: u64 = program.codes.iter().map(|code| code.template.len() as u64).sum();
+    let plan = super::budget::plan_batches(
+        &program.kernel,
+        super::budget::bytes_of(program.private_init.len() as u64 + registers),
+        u64::from(program.workgroup_size.iter().product::<u32>()),
+        super::budget::bytes_of(u64::from(program.workgroup_words)),
+        u64::from(super::batch::workgroups_per_batch(program)),
+        std::thread::available_parallelism().map_or(1, |n| n.get()),
+    )?;
+    let per_batch = plan.workgroups;
+    let batches = total.div_ceil(per_batch);
+    let threads = plan.threads.min(batches.max(1) as usize);
     let shared: Vec<Vec<AtomicU32>> =
         buffers.iter_mut().map(|words| std::mem::take(words).into_iter().map(AtomicU32::new).collect()).collect();
-    let total = u64::from(workgroups[0]) * u64::from(workgroups[1]) * u64::from(workgroups[2]);
-    let per_batch = u64::from(super::batch::workgroups_per_batch(program));
-    let batches = total.div_ceil(per_batch);
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(batches.max(1) as usize);
     let next = AtomicU64::new(0);
     let result = std::thread::scope(|scope| {
         let handles: Vec<_> = (0..threads)
@@ -123,7 +136,7 @@ fn builtin_value(builtin: naga::BuiltIn, b: &Builtins) -> Result<([u32; 3], usiz
 fn enter_entry_point(program: &Program, file: &mut Vec<u32>, builtins: &[Builtins]) -> Result<(), BackendError> {
     let code = &program.codes[program.entry as usize];
     let width = builtins.len();
-    super::interp::open_file(file, &code.template, width);
+    super::interp::open_file(file, &code.template, width, &program.kernel)?;
     for &(reg, words) in &code.locals {
         for r in reg as usize..(reg + words) as usize {
             file[r * width..][..width].fill(code.template[r]);
@@ -208,11 +221,16 @@ fn run_batch(
         }
     }
     let count = invocations.len();
-    // Zero-initialised workgroup memory, one region per workgroup of the batch.
+    // Zero-initialised workgroup memory, one region per workgroup of the batch (sizes
+    // within the caps, `run`; allocated without aborting where the machine cannot).
+    let what = |space: &'static str| move || format!("the {space} memory of a batch of `{}`", program.kernel);
+    let shared_words = count / per_workgroup as usize * program.workgroup_words as usize;
     memory.shared.clear();
-    memory.shared.resize(count / per_workgroup as usize * program.workgroup_words as usize, 0);
+    try_reserve(&mut memory.shared, shared_words, what("workgroup"))?;
+    memory.shared.resize(shared_words, 0);
     enter_entry_point(program, &mut memory.files[program.entry as usize], &builtins)?;
     memory.private.clear();
+    try_reserve(&mut memory.private, count * program.private_init.len(), what("private"))?;
     for _ in 0..count {
         memory.private.extend_from_slice(&program.private_init);
     }

@@ -37,14 +37,16 @@ pub(super) const HEADER_WORDS: usize = 6;
 /// Words of a bound sampler.
 pub(super) const SAMPLER_WORDS: usize = 6;
 
-/// A bound texture's header followed by `texels` (every level, in order).
-pub(super) fn bind_texture(desc: &TextureDesc, texels: &[u32]) -> Vec<u32> {
+/// A bound texture's header followed by `texels` (every level, in order); an error
+/// where the machine cannot give the memory (a texture's size comes from the caller).
+pub(super) fn bind_texture(desc: &TextureDesc, texels: &[u32]) -> Result<Vec<u32>, std::collections::TryReserveError> {
     let format = TexelFormat::ALL.iter().position(|f| *f == desc.format).expect("a format of ALL") as u32;
     let dimension = DIMENSIONS.iter().position(|d| *d == desc.dimension).expect("a dimension") as u32;
-    let mut words = Vec::with_capacity(HEADER_WORDS + texels.len());
+    let mut words = Vec::new();
+    words.try_reserve_exact(HEADER_WORDS.saturating_add(texels.len()))?;
     words.extend_from_slice(&[format, dimension, desc.mip_levels, desc.size[0], desc.size[1], desc.size[2]]);
     words.extend_from_slice(texels);
-    words
+    Ok(words)
 }
 
 /// A bound sampler's words.

@@ -333,16 +333,21 @@ pub(super) fn run_until_sync(
 }
 
 /// Allocates a code's register file for `width` lanes, every register at its template
-/// value, the first time a worker thread runs the code (see [`super::decode::Code::locals`]).
-pub(super) fn open_file(file: &mut Vec<u32>, template: &[u32], width: usize) {
+/// value, the first time a worker thread runs the code (see [`super::decode::Code::locals`]);
+/// an error naming kernel `kernel` where the machine cannot give the memory (its size
+/// is within the caps of [`super::budget`]).
+pub(super) fn open_file(file: &mut Vec<u32>, template: &[u32], width: usize, kernel: &str) -> Result<(), BackendError> {
     // A batch narrower than the last (the dispatch's last one) needs a file of its width.
     if file.len() != template.len() * width {
         file.clear();
-        file.reserve_exact(template.len() * width);
+        super::budget::try_reserve(file, template.len() * width, || {
+            format!("the registers of a batch of `{kernel}` ({} words for {width} invocations)", template.len())
+        })?;
         for &value in template {
             file.extend(std::iter::repeat_n(value, width));
         }
     }
+    Ok(())
 }
 
 /// The group of invocations `members` (in increasing order) of a batch `width` wide:
@@ -396,7 +401,7 @@ fn enter_function(
     let callee = &program.codes[call.code as usize];
     let (caller_file, callee_file) = two_files(files, caller as usize, call.code as usize);
     let width = group.width();
-    open_file(callee_file, &callee.template, width);
+    open_file(callee_file, &callee.template, width, &program.kernel)?;
     for &(reg, words) in &callee.locals {
         for r in reg as usize..(reg + words) as usize {
             group.fill(callee_file, r, 1, callee.template[r]);

@@ -4,6 +4,13 @@
 //! compile time. Shared by the compiler ([`super::decode`], [`super::expression`]), the
 //! instructions ([`super::insn`]) and memory access ([`super::memory`]), and dependent on
 //! none of them.
+//!
+//! Sizes and offsets here come from the kernel's types: no arithmetic may wrap or panic
+//! (the lint below). A size that does not fit in `u32` words is an error; offsets inside
+//! a value naga validated (whose bytes fit in `u32`) saturate, which never happens for
+//! such a value and would read as out of bounds if it did.
+
+#![deny(clippy::arithmetic_side_effects)]
 
 use super::wide;
 use naga::{Handle, Module, ScalarKind, TypeInner};
@@ -35,16 +42,27 @@ pub(super) fn array_length(module: &Module, size: naga::ArraySize) -> Result<Opt
     }
 }
 
+/// Bits of a scalar of `scalar`, for messages.
+fn bits(scalar: naga::Scalar) -> u32 {
+    u32::from(scalar.width).saturating_mul(8)
+}
+
+/// `a * b` words, or the error of a type of more than `u32::MAX` words.
+fn product(a: u32, b: u32) -> Result<u32, String> {
+    a.checked_mul(b).ok_or_else(|| format!("a type of more than {} words ({a} × {b})", u32::MAX))
+}
+
 /// Words of a value of type `inner` (bool and every 32-bit scalar: one word; 64-bit
-/// integers: two, the low word first).
+/// integers: two, the low word first); an error for a type of more than `u32::MAX`
+/// words.
 pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String> {
     Ok(match *inner {
-        TypeInner::Atomic(s) if s.width != 4 => return Err(format!("{}-bit atomics", s.width * 8)),
+        TypeInner::Atomic(s) if s.width != 4 => return Err(format!("{}-bit atomics", bits(s))),
         TypeInner::Scalar(s) | TypeInner::Atomic(s) => {
-            scalar_words(s).ok_or_else(|| format!("{}-bit scalars", s.width * 8))?
+            scalar_words(s).ok_or_else(|| format!("{}-bit scalars", bits(s)))?
         }
         TypeInner::Vector { size, scalar } => {
-            size as u32 * scalar_words(scalar).ok_or_else(|| format!("{}-bit vectors", scalar.width * 8))?
+            product(size as u32, scalar_words(scalar).ok_or_else(|| format!("{}-bit vectors", bits(scalar)))?)?
         }
         // Textures and samplers are held like pointers: their binding slot and 0.
         TypeInner::Pointer { .. }
@@ -55,20 +73,21 @@ pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String
         TypeInner::Matrix { columns, rows, .. } => {
             // Columns are padded like vec3 → 4 words in memory.
             let row_words = if rows == naga::VectorSize::Tri { 4 } else { rows as u32 };
-            columns as u32 * row_words
+            product(columns as u32, row_words)?
         }
         // Register layout of composites holding f16: a word per f16, members and
         // elements one after the other (naga's 2-byte layout is used in buffers only).
         TypeInner::Array { base, size, .. } if contains_f16(module, &module.types[base].inner) => {
             match array_length(module, size)? {
-                Some(n) => n * words_of(module, &module.types[base].inner)?,
+                Some(n) => product(n, words_of(module, &module.types[base].inner)?)?,
                 None => return Err("runtime-sized arrays as values".into()),
             }
         }
         TypeInner::Struct { ref members, .. } if contains_f16(module, inner) => {
-            let mut words = 0;
+            let mut words = 0u32;
             for member in members {
-                words += words_of(module, &module.types[member.ty].inner)?;
+                let member = words_of(module, &module.types[member.ty].inner)?;
+                words = words.checked_add(member).ok_or_else(|| format!("a struct of more than {} words", u32::MAX))?;
             }
             words
         }
@@ -76,7 +95,9 @@ pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String
             // The element type must be supported too.
             words_of(module, &module.types[base].inner)?;
             match array_length(module, size)? {
-                Some(n) => n * stride / 4,
+                // In u64: n * stride may pass u32::MAX bytes while its words fit.
+                Some(n) => u32::try_from(u64::from(n).saturating_mul(u64::from(stride)) / 4)
+                    .map_err(|_| format!("an array of more than {} words ({n} × {stride} bytes)", u32::MAX))?,
                 None => return Err("runtime-sized arrays as values".into()),
             }
         }
@@ -158,7 +179,11 @@ pub(super) fn load_plan(module: &Module, inner: &TypeInner, memory: u32, reg: u3
     if !contains_f16(module, inner) {
         let len = words_of(module, inner).unwrap_or(0);
         match out.last_mut() {
-            Some(Piece::Words { memory: m, reg: r, len: l }) if *m + 4 * *l == memory && *r + *l == reg => *l += len,
+            Some(Piece::Words { memory: m, reg: r, len: l })
+                if m.saturating_add(l.saturating_mul(4)) == memory && r.saturating_add(*l) == reg =>
+            {
+                *l = l.saturating_add(len)
+            }
             _ => out.push(Piece::Words { memory, reg, len }),
         }
         return;
@@ -166,20 +191,26 @@ pub(super) fn load_plan(module: &Module, inner: &TypeInner, memory: u32, reg: u3
     match *inner {
         TypeInner::Scalar(_) => out.push(Piece::Half { memory, reg }),
         TypeInner::Vector { size, .. } => {
-            out.extend((0..size as u32).map(|i| Piece::Half { memory: memory + 2 * i, reg: reg + i }))
+            out.extend((0..size as u32).map(|i| Piece::Half {
+                memory: memory.saturating_add(i.saturating_mul(2)),
+                reg: reg.saturating_add(i),
+            }))
         }
         TypeInner::Array { base, size, stride } => {
             // Only values of known size are loaded (words_of refuses the others first).
             let n = array_length(module, size).ok().flatten().unwrap_or(0);
             let words = words_of(module, &module.types[base].inner).unwrap_or(0);
             for i in 0..n {
-                load_plan(module, &module.types[base].inner, memory + i * stride, reg + i * words, out);
+                let (memory, reg) =
+                    (memory.saturating_add(i.saturating_mul(stride)), reg.saturating_add(i.saturating_mul(words)));
+                load_plan(module, &module.types[base].inner, memory, reg, out);
             }
         }
         TypeInner::Struct { ref members, .. } => {
             for (i, member) in members.iter().enumerate() {
                 let step = member_step(module, inner, i as u32, false);
-                load_plan(module, &module.types[member.ty].inner, memory + member.offset, reg + step, out);
+                let (memory, reg) = (memory.saturating_add(member.offset), reg.saturating_add(step));
+                load_plan(module, &module.types[member.ty].inner, memory, reg, out);
             }
         }
         _ => {}
@@ -216,13 +247,13 @@ pub(super) enum Place {
 }
 
 impl Place {
-    /// The place `step` words or bytes further.
+    /// The place `step` words or bytes further (saturating: see the module's note).
     pub(super) fn offset(self, step: u32) -> Self {
         match self {
-            Place::Local(r) => Place::Local(r + step),
-            Place::Workgroup(a) => Place::Workgroup(a + step),
-            Place::Private(a) => Place::Private(a + step),
-            Place::Buffer(b, a) => Place::Buffer(b, a + step),
+            Place::Local(r) => Place::Local(r.saturating_add(step)),
+            Place::Workgroup(a) => Place::Workgroup(a.saturating_add(step)),
+            Place::Private(a) => Place::Private(a.saturating_add(step)),
+            Place::Buffer(b, a) => Place::Buffer(b, a.saturating_add(step)),
         }
     }
 }

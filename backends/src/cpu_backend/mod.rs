@@ -31,6 +31,13 @@
 //! f32 without contraction. Out-of-bounds indices are clamped (naga's `Restrict` policy);
 //! out-of-bounds memory words read as 0 and are not written.
 //!
+//! The interpreter's own memory is capped (`budget`): 64 MiB of private, function
+//! (registers) or workgroup memory per invocation or workgroup and of constants,
+//! checked from the types when a kernel is compiled; 1 GiB per batch (batches shrink to
+//! fit) and 4 GiB for a dispatch's threads together. A kernel over a cap, or memory the
+//! machine cannot give, is a [`BackendError::OutOfMemory`] naming the kernel, the
+//! memory, the size and the cap, never an abort.
+//!
 //! Supported today: 32-bit scalars, bool, 64-bit integers (`wide`: two words, low
 //! first, as the storage layout has them; arithmetic, comparisons, bit operations,
 //! shifts, conversions, `abs`/`min`/`max`/`clamp`/`sign`), f16 (held in a register
@@ -51,6 +58,7 @@
 mod access;
 mod arith;
 mod batch;
+mod budget;
 mod constant;
 mod counts;
 mod decode;
@@ -79,7 +87,7 @@ mod wide;
 
 use crate::backend::{Backend, Bind, BufferId, Resource};
 use crate::bindings_check::{
-    ResourceLookup, check_binds, check_buffer_size, check_kernel_fits, check_workgroups, check_write,
+    ResourceLookup, check_binds, check_buffer_size, check_kernel_fits, check_workgroups, write_range,
 };
 use crate::device_info::{DeviceInfo, DeviceLimits};
 use crate::error::BackendError;
@@ -116,11 +124,32 @@ struct CpuTexture {
 }
 
 impl CpuTexture {
-    /// Word range of mip `level`.
+    /// Word range of mip `level` (a level of the texture: `TextureDesc::check_level`
+    /// first), clamped to the texture's words.
     fn level_words(&self, level: u32) -> std::ops::Range<usize> {
-        let start: u64 = (0..level).map(|l| self.desc.level_bytes(l)).sum::<u64>() / 4;
-        start as usize..(start + self.desc.level_bytes(level) / 4) as usize
+        let words = |bytes: u64| usize::try_from(bytes / 4).unwrap_or(usize::MAX).min(self.words.len());
+        let before = (0..level).fold(0u64, |sum, l| sum.saturating_add(self.desc.level_bytes(l)));
+        let start = words(before);
+        start..words(before.saturating_add(self.desc.level_bytes(level))).max(start)
     }
+}
+
+/// The words of `bytes` bytes (whole words), zeroed, or an error naming `what` where the
+/// machine cannot give them (instead of aborting the process).
+fn zeroed_words(bytes: u64, what: impl FnOnce() -> String) -> Result<Vec<u32>, BackendError> {
+    match usize::try_from(bytes.div_ceil(4)) {
+        Ok(words) => budget::try_zeroed(words, what),
+        Err(_) => Err(BackendError::OutOfMemory { backend: "cpu".into(), operation: what() }),
+    }
+}
+
+/// `words` as little-endian bytes, the first `len` of them, or an error naming `what`
+/// where the machine cannot give the memory.
+fn to_bytes(words: &[u32], len: usize, what: impl FnOnce() -> String) -> Result<Vec<u8>, BackendError> {
+    let mut bytes = Vec::new();
+    budget::try_reserve(&mut bytes, len, what)?;
+    bytes.extend(words.iter().flat_map(|w| w.to_le_bytes()).take(len));
+    Ok(bytes)
 }
 
 /// The naga-IR interpreter as a backend.
@@ -211,17 +240,25 @@ impl CpuBackend {
         self.textures.get(&id.0).ok_or(BackendError::UnknownTexture(id.0))
     }
 
-    /// The words a binding's slot holds during a dispatch (moved out of a buffer or
-    /// texture, so that it is not copied; put back by [`CpuBackend::put_back`]).
-    fn take_bound(&mut self, resource: Resource) -> Vec<u32> {
-        match resource {
+    /// The words a binding's slot holds during a dispatch (moved out of a buffer, so
+    /// that it is not copied; a texture's with a header before them; put back by
+    /// [`CpuBackend::put_back`]). An error, with the resource left as it was, where the
+    /// machine cannot give a texture's copy.
+    fn take_bound(&mut self, resource: Resource) -> Result<Vec<u32>, BackendError> {
+        Ok(match resource {
             Resource::Buffer(id) => std::mem::take(&mut self.buffers.get_mut(&id.0).expect("checked").words),
             Resource::Texture(id) => {
                 let texture = self.textures.get_mut(&id.0).expect("checked");
-                image::bind_texture(&texture.desc, &std::mem::take(&mut texture.words))
+                let words =
+                    image::bind_texture(&texture.desc, &texture.words).map_err(|_| BackendError::OutOfMemory {
+                        backend: "cpu".into(),
+                        operation: format!("binding texture `{}` ({} words)", texture.desc.label, texture.words.len()),
+                    })?;
+                texture.words = Vec::new();
+                words
             }
             Resource::Sampler(id) => image::bind_sampler(&self.samplers[&id.0]),
-        }
+        })
     }
 
     /// Returns a slot's words to the buffer or texture they were taken from.
@@ -244,29 +281,34 @@ impl Backend for CpuBackend {
 
     fn create_buffer(&mut self, label: &str, size: u64) -> Result<BufferId, BackendError> {
         check_buffer_size(label, size, &self.info)?;
+        let words = zeroed_words(size, || format!("creation of buffer `{label}` ({size} bytes)"))?;
         self.next_buffer += 1;
-        self.buffers.insert(
-            self.next_buffer,
-            CpuBuffer { words: vec![0; size.div_ceil(4) as usize], size, label: label.into() },
-        );
+        self.buffers.insert(self.next_buffer, CpuBuffer { words, size, label: label.into() });
         Ok(BufferId(self.next_buffer))
     }
 
     fn write_buffer(&mut self, buffer: BufferId, offset: u64, data: &[u8]) -> Result<(), BackendError> {
         let entry = self.buffers.get_mut(&buffer.0).ok_or(BackendError::UnknownBuffer(buffer.0))?;
-        check_write(&entry.label, entry.size, offset, data.len())?;
-        let start = offset as usize / 4;
-        for (i, chunk) in data.chunks_exact(4).enumerate() {
-            entry.words[start + i] = u32::from_le_bytes([chunk[0], chunk[1], chunk[2], chunk[3]]);
+        // Checked without wrapping: the range lies inside the buffer's bytes, so its
+        // words inside `words` (the buffer's size rounded up to whole words).
+        let range = write_range(&entry.label, entry.size, offset, data.len())?;
+        let words = range.start / 4..range.end / 4;
+        let Some(target) = entry.words.get_mut(words) else {
+            return Err(BackendError::Buffer {
+                label: entry.label.clone(),
+                reason: format!("internal: write range {range:?} outside the buffer's {} bytes", entry.size),
+            });
+        };
+        for (word, chunk) in target.iter_mut().zip(data.chunks_exact(4)) {
+            *word = u32::from_le_bytes([chunk[0], chunk[1], chunk[2], chunk[3]]);
         }
         Ok(())
     }
 
     fn read_buffer(&mut self, buffer: BufferId) -> Result<Vec<u8>, BackendError> {
         let entry = self.buffer(buffer)?;
-        let mut bytes: Vec<u8> = entry.words.iter().flat_map(|w| w.to_le_bytes()).collect();
-        bytes.truncate(entry.size as usize);
-        Ok(bytes)
+        let len = usize::try_from(entry.size).unwrap_or(usize::MAX).min(entry.words.len() * 4);
+        to_bytes(&entry.words, len, || format!("read-back of buffer `{}` ({len} bytes)", entry.label))
     }
 
     fn destroy_buffer(&mut self, buffer: BufferId) -> Result<(), BackendError> {
@@ -275,9 +317,10 @@ impl Backend for CpuBackend {
 
     fn create_texture(&mut self, desc: &TextureDesc) -> Result<TextureId, BackendError> {
         desc.check(&self.info)?;
-        let bytes: u64 = (0..desc.mip_levels).map(|l| desc.level_bytes(l)).sum();
+        let bytes = (0..desc.mip_levels).fold(0u64, |sum, l| sum.saturating_add(desc.level_bytes(l)));
+        let words = zeroed_words(bytes, || format!("creation of texture `{}` ({bytes} bytes)", desc.label))?;
         self.next_buffer += 1;
-        self.textures.insert(self.next_buffer, CpuTexture { desc: desc.clone(), words: vec![0; bytes as usize / 4] });
+        self.textures.insert(self.next_buffer, CpuTexture { desc: desc.clone(), words });
         Ok(TextureId(self.next_buffer))
     }
 
@@ -293,8 +336,10 @@ impl Backend for CpuBackend {
 
     fn read_texture(&mut self, texture: TextureId, level: u32) -> Result<Vec<u8>, BackendError> {
         let entry = self.texture(texture)?;
-        entry.desc.check_level(level, entry.desc.level_bytes(level) as usize)?;
-        Ok(entry.words[entry.level_words(level)].iter().flat_map(|w| w.to_le_bytes()).collect())
+        let bytes = usize::try_from(entry.desc.level_bytes(level)).unwrap_or(usize::MAX);
+        entry.desc.check_level(level, bytes)?;
+        let words = &entry.words[entry.level_words(level)];
+        to_bytes(words, words.len() * 4, || format!("read-back of texture `{}` ({bytes} bytes)", entry.desc.label))
     }
 
     fn destroy_texture(&mut self, texture: TextureId) -> Result<(), BackendError> {
@@ -336,14 +381,38 @@ impl Backend for CpuBackend {
             .collect();
         let first_of = |index: usize| resources[..index].iter().position(|r| *r == resources[index]);
         let mut bound: Vec<Vec<u32>> = Vec::with_capacity(resources.len());
+        let mut taken = Ok(());
         for (index, resource) in resources.iter().enumerate() {
             let words = match first_of(index) {
-                Some(first) => bound[first].clone(),
+                Some(first) => {
+                    let mut copy = Vec::new();
+                    budget::try_reserve(&mut copy, bound[first].len(), || {
+                        format!(
+                            "binding {} of `{}` again ({} words)",
+                            resource.describe(),
+                            kernel.name(),
+                            bound[first].len()
+                        )
+                    })
+                    .map(|()| {
+                        copy.extend_from_slice(&bound[first]);
+                        copy
+                    })
+                }
                 None => self.take_bound(*resource),
             };
-            bound.push(words);
+            match words {
+                Ok(words) => bound.push(words),
+                Err(error) => {
+                    taken = Err(error);
+                    break;
+                }
+            }
         }
-        let result = exec::run(&self.programs[&kernel.id], &mut bound, workgroups, subgroup_size);
+        let result = match taken {
+            Ok(()) => exec::run(&self.programs[&kernel.id], &mut bound, workgroups, subgroup_size),
+            Err(error) => Err(error),
+        };
         for (index, (resource, words)) in resources.iter().zip(bound).enumerate() {
             if first_of(index).is_none() {
                 self.put_back(*resource, words);
@@ -363,5 +432,46 @@ impl Backend for CpuBackend {
         let started = Instant::now();
         self.dispatch(kernel, binds, workgroups)?;
         Ok(started.elapsed())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{CpuBackend, CpuOptions};
+    use crate::backend::{Backend, Bind, download, upload};
+    use strata_kernels::Kernel;
+
+    /// A small kernel through the public API (private, function and workgroup memory,
+    /// a barrier, atomics, worker threads), and writes checked at the buffer's edges:
+    /// what Miri runs of the interpreter (SECURITY.md, "Miri").
+    #[test]
+    fn a_kernel_runs_end_to_end_and_writes_stay_inside_the_buffer() {
+        let source = "@group(0) @binding(0) var<storage, read_write> data: array<u32>;
+            @group(0) @binding(1) var<storage, read_write> total: atomic<u32>;
+            var<private> seen: array<u32, 4>;
+            var<workgroup> row: array<u32, 4>;
+            @compute @workgroup_size(4) fn main(@builtin(local_invocation_index) i: u32,
+                                                @builtin(global_invocation_id) id: vec3<u32>) {
+                var sum = 0u;
+                seen[i] = data[id.x];
+                row[i] = seen[i] * 2u;
+                workgroupBarrier();
+                for (var k = 0u; k < 4u; k++) { sum += row[k]; }
+                data[id.x] = sum + i;
+                atomicAdd(&total, 1u);
+            }";
+        let kernel = Kernel::from_wgsl("end_to_end.wgsl", source.into(), "main", false).expect("valid WGSL");
+        let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+        let data = upload(&mut cpu, "data", &[1u32, 2, 3, 4, 10, 20, 30, 40]).unwrap();
+        let total = cpu.create_buffer("total", 4).unwrap();
+        cpu.dispatch(&kernel, &[Bind::new(0, data), Bind::new(1, total)], [2, 1, 1]).unwrap();
+        assert_eq!(download::<u32>(&mut cpu, data).unwrap(), [20, 21, 22, 23, 200, 201, 202, 203]);
+        assert_eq!(download::<u32>(&mut cpu, total).unwrap(), [8]);
+        // The last word, then ranges past the end, wrapped or not: refused, unwritten.
+        cpu.write_buffer(data, 28, &7u32.to_le_bytes()).unwrap();
+        for offset in [32, u64::MAX - 3, u64::MAX - 31] {
+            assert!(cpu.write_buffer(data, offset, &[9; 4]).is_err(), "offset {offset}");
+        }
+        assert_eq!(download::<u32>(&mut cpu, data).unwrap(), [20, 21, 22, 23, 200, 201, 202, 7]);
     }
 }

@@ -11,7 +11,8 @@ use std::process::Command;
 pub enum GlslangInput {
     /// naga's GLSL 4.50 (`glslangValidator -V`).
     Glsl,
-    /// naga's HLSL SM 6.0 with workgroup zero-initialisation off (`glslangValidator -D -V`).
+    /// naga's HLSL SM 6.0 (`glslangValidator -D -V`), its workgroup zero-initialisation
+    /// rewritten as loops glslang accepts ([`crate::hlsl_zero_init`]).
     Hlsl,
 }
 
@@ -54,13 +55,15 @@ pub fn compile(kernel: &Kernel, input: GlslangInput, dir: &Path) -> Result<(Vec<
     let (translation, extension) = match input {
         GlslangInput::Glsl => (translate::glsl(kernel, TranslateOptions::default()), "comp"),
         GlslangInput::Hlsl => {
-            (translate::hlsl(kernel, TranslateOptions { workgroup_zero_init: WorkgroupZeroInit::Off }), "hlsl")
+            // Zeroed as WGSL promises: outside kernels count into workgroup variables.
+            (translate::hlsl(kernel, TranslateOptions { workgroup_zero_init: WorkgroupZeroInit::Polyfill }), "hlsl")
         }
     };
     let mut translation = translation.map_err(|e| ToolError::Failed(e.to_string()))?;
     if input == GlslangInput::Hlsl {
         translation.text = byte_address_lengths_in_bytes(&translation.text)?;
         translation.text = crate::hlsl_samplers::plain_samplers(&translation.text).map_err(ToolError::Failed)?;
+        translation.text = crate::hlsl_zero_init::zero_init_as_loops(&translation.text);
     }
     let source = dir.join(format!("{}.{extension}", kernel.name()));
     let output = dir.join(format!("{}.{extension}.spv", kernel.name()));

@@ -51,6 +51,7 @@ pub mod error;
 pub mod glslang;
 pub mod hash;
 pub mod hlsl_samplers;
+pub mod hlsl_zero_init;
 pub mod integer_division;
 mod ir_edit;
 pub mod layout;

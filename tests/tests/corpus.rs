@@ -362,3 +362,31 @@ fn workgroup_arrays_sized_by_overrides_scan_exactly_everywhere() {
         check(scan_case(wg, items, groups).0);
     }
 }
+
+/// Workgroup memory read before any write must be zero on every path (WGSL's promise):
+/// a counter nobody initialises, the unwritten rows of a 2-D array of vectors, a struct
+/// with an array member. The glslang HLSL path once skipped the zeroing (a count of
+/// 1690510940 instead of 64) and Slang refused naga's zeroing of the 2-D array; both now
+/// get loops (`strata_kernels::hlsl_zero_init`).
+#[test]
+fn workgroup_memory_starts_zeroed_everywhere() {
+    let groups = 4u32;
+    let case = Case {
+        file: "workgroup_zeroing.wgsl",
+        entry: "main",
+        overrides: Vec::new(),
+        workgroups: [groups, 1, 1],
+        inputs: vec![(0, vec![0xAB; (groups * 3 * 4) as usize]), (1, vec![0xAB; (groups * 4) as usize])],
+        bounds: Vec::new(),
+        normalise: None,
+    };
+    let slots = available_slots("the corpus");
+    let (_, runs, judgement) = run_case(&case, &slots);
+    let failures = failures(&judgement);
+    assert!(failures.is_empty(), "{}:\n{}", case.file, failures.join("\n"));
+    let counts: &[u32] = bytemuck::cast_slice(&runs[0].outputs.as_ref().unwrap()[0].bytes);
+    assert_eq!(counts, [64, 0, 16].repeat(groups as usize), "the interpreter itself");
+    let untouched: &[f32] = bytemuck::cast_slice(&runs[0].outputs.as_ref().unwrap()[1].bytes);
+    assert_eq!(untouched, vec![0.0; groups as usize]);
+    assert_corruption_caught(&runs, &Tolerance::default(), case.file);
+}

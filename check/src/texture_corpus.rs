@@ -55,6 +55,7 @@ pub fn source(file: &str) -> &'static str {
         "sample.wgsl" => include_str!("../../tests/data/textures/sample.wgsl"),
         "downsample.wgsl" => include_str!("../../tests/data/textures/downsample.wgsl"),
         "two_groups.wgsl" => include_str!("../../tests/data/textures/two_groups.wgsl"),
+        "cross_group_sampler.wgsl" => include_str!("../../tests/data/textures/cross_group_sampler.wgsl"),
         other => panic!("{other} is not in the texture corpus"),
     }
 }
@@ -386,11 +387,37 @@ fn two_groups_case() -> TextureCase {
     }
 }
 
+fn cross_group_sampler_case() -> TextureCase {
+    let (width, height) = (19u32, 11u32);
+    TextureCase {
+        file: "cross_group_sampler.wgsl",
+        entry: "main",
+        name: "cross_group_sampler.wgsl (sampler in group 0, image in group 1, r32float in group 2)".into(),
+        workgroups: [width.div_ceil(8), height.div_ceil(8), 1],
+        buffers: Vec::new(),
+        images: vec![
+            ((0, 0), ImageInput::Sampler(SamplerDesc::uniform(FilterMode::Linear, AddressMode::ClampToEdge))),
+            ((1, 0), texture(TextureDimension::D2, [width, height, 1], 1, TexelFormat::Rgba8Unorm, 50, (0.0, 1.0))),
+            ((1, 1), blank(TextureDimension::D2, [width, height, 1], TexelFormat::Rgba8Unorm)),
+            ((2, 0), texture(TextureDimension::D2, [width, height, 1], 1, TexelFormat::R32Float, 51, (0.0, 1.0))),
+        ],
+        bounds: vec![(
+            "result",
+            FloatBound { ulp: 3, abs: 0.0 },
+            "five linearly filtered taps (8-bit sub-texel weights on the device, exact in the interpreter) \
+             averaged and stored as unorm: up to a few steps apart",
+        )],
+        refused_by: &[],
+        rule: None,
+    }
+}
+
 /// Every case of the corpus, in table order.
 pub fn texture_cases() -> Vec<TextureCase> {
     let mut cases = load_cases();
     cases.extend(integer_cases());
     cases.push(store_case());
+    cases.push(cross_group_sampler_case());
     cases.push(read_write_case());
     cases.push(shapes_case());
     cases.extend(blur_cases());

@@ -108,7 +108,7 @@ impl WgslModule {
     /// minimum binding sizes from the WGSL types).
     pub fn wgpu_layout_entries(&self) -> Vec<wgpu::BindGroupLayoutEntry> {
         let kernel = Registry::shared().expect("a module exists only for a loaded registry").get(self.id.kernel());
-        strata_backends::wgpu_backend::layout_entries(&kernel.bindings)
+        strata_backends::wgpu_backend::layout_entries(kernel, 0)
     }
 }
 

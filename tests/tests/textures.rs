@@ -75,6 +75,11 @@ fn a_kernel_of_two_bind_groups_with_one_skipped_runs_everywhere() {
 }
 
 #[test]
+fn a_sampler_in_one_group_filters_a_texture_in_another() {
+    check_file("cross_group_sampler.wgsl");
+}
+
+#[test]
 fn the_out_of_range_rule_refuses_a_value_wgsl_does_not_allow() {
     let case = texture_cases().into_iter().find(|c| c.name == "load.wgsl on r32float").unwrap();
     let slots = strata_check::run_kernel::named_slots(&["cpu".into()]).unwrap();

@@ -11,7 +11,7 @@ use std::borrow::Cow;
 use std::collections::HashMap;
 use std::num::NonZeroU64;
 use std::sync::Arc;
-use strata_kernels::{BindingAccess, BindingInfo, BindingKind, Kernel, KernelId};
+use strata_kernels::{BindingAccess, BindingKind, Kernel, KernelId};
 
 pub(super) struct Pipeline {
     pub(super) pipeline: wgpu::ComputePipeline,
@@ -102,15 +102,20 @@ impl PipelineCache {
     }
 }
 
-/// The bind group layout entries of `bindings`: compute stage, no dynamic offsets,
-/// minimum binding sizes from the WGSL types; samplers filtering, and float textures
-/// filterable where the kernel has a sampler (else unfilterable, so that `r32float` and
+/// The bind group layout entries of `kernel`'s bindings in `group`: compute stage, no
+/// dynamic offsets, minimum binding sizes from the WGSL types; samplers filtering, and a
+/// float texture filterable exactly where the kernel samples it with a sampler, in
+/// whatever group that sampler is (else unfilterable, so that `r32float` and
 /// `rgba32float` textures read with `textureLoad` bind on devices that cannot filter
-/// them).
-pub fn layout_entries(bindings: &[BindingInfo]) -> Vec<wgpu::BindGroupLayoutEntry> {
-    let samples = bindings.iter().any(|b| b.kind == BindingKind::Sampler);
-    bindings
+/// them). Why per texture across groups: a blur whose sampler sits in one group and
+/// whose texture in another was refused by wgpu ("Non-filterable float textures can't
+/// be sampled with a filtering sampler") when filterability was decided per group.
+pub fn layout_entries(kernel: &Kernel, group: u32) -> Vec<wgpu::BindGroupLayoutEntry> {
+    let sampled = sampled_textures(kernel);
+    kernel
+        .bindings
         .iter()
+        .filter(|binding| binding.group == group)
         .map(|binding| wgpu::BindGroupLayoutEntry {
             binding: binding.binding,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -126,7 +131,7 @@ pub fn layout_entries(bindings: &[BindingInfo]) -> Vec<wgpu::BindGroupLayoutEntr
                     min_binding_size: NonZeroU64::new(binding.min_size()),
                 },
                 BindingKind::SampledTexture { dimension, kind } => wgpu::BindingType::Texture {
-                    sample_type: textures::sample_type(kind, samples),
+                    sample_type: textures::sample_type(kind, sampled(binding.group, binding.binding)),
                     view_dimension: textures::view_dimension(dimension),
                     multisampled: false,
                 },
@@ -140,6 +145,18 @@ pub fn layout_entries(bindings: &[BindingInfo]) -> Vec<wgpu::BindGroupLayoutEntr
             count: None,
         })
         .collect()
+}
+
+/// Whether the texture at `(group, binding)` is sampled with a sampler somewhere in
+/// `kernel`. Where the pairing cannot be read from the IR (a texture sampled through a
+/// function argument), every texture of a kernel with a sampler counts as sampled.
+fn sampled_textures(kernel: &Kernel) -> impl Fn(u32, u32) -> bool {
+    let any_sampler = kernel.bindings.iter().any(|b| b.kind == BindingKind::Sampler);
+    let pairs = strata_kernels::combined_samplers::combined_samplers(kernel).ok();
+    move |group, binding| match &pairs {
+        Some(pairs) => pairs.iter().any(|&(texture, sampler)| texture == (group, binding) && sampler.is_some()),
+        None => any_sampler,
+    }
 }
 
 /// `kernel`'s compute pipeline from naga's IR, with an explicit bind group layout per
@@ -165,8 +182,7 @@ fn cached_kernel_pipeline(
     // One layout per group (a group the kernel skips gets an empty one).
     let layouts: Vec<wgpu::BindGroupLayout> = (0..kernel.group_count())
         .map(|group| {
-            let bindings: Vec<BindingInfo> = kernel.bindings.iter().filter(|b| b.group == group).cloned().collect();
-            let entries = layout_entries(&bindings);
+            let entries = layout_entries(kernel, group);
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some(kernel.name()),
                 entries: &entries,

@@ -208,13 +208,20 @@ fn run() -> Result<(), Error> {
         // leave zeroing workgroup memory to the driver (faster to build on some drivers).
         shader_zero_initialize_workgroup_memory: false,
     };
-    let pass = AshSelection::new(vulkan, settings, WIDTH, HEIGHT)?;
-    let bindings = pass.bind(&AshBuffers {
-        candidates: candidate_buffer.slice(),
-        payloads: None,
-        selections: selections.slice(),
-        resample: Some(AshResampleBuffers { inputs: inputs.slice(), outputs: outputs.slice() }),
-    })?;
+    // SAFETY: the engine's live instance (API 1.2), its physical device and a device made
+    // from it, with core features only (so no zero-initialisation claimed); the engine
+    // outlives the pass, destroyed below.
+    let pass = unsafe { AshSelection::new(vulkan, settings, WIDTH, HEIGHT) }?;
+    // SAFETY: four live storage buffers of the pass's device, each slice its whole
+    // buffer, destroyed only after the pass and its bindings.
+    let bindings = unsafe {
+        pass.bind(&AshBuffers {
+            candidates: candidate_buffer.slice(),
+            payloads: None,
+            selections: selections.slice(),
+            resample: Some(AshResampleBuffers { inputs: inputs.slice(), outputs: outputs.slice() }),
+        })
+    }?;
 
     let tables = BlueNoiseTables::new();
     let result = (|| -> Result<(), Error> {

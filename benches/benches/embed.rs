@@ -132,8 +132,12 @@ fn embed_build(c: &mut Criterion) {
             strata_embed::AshDevice { shader_zero_initialize_workgroup_memory: native, ..engine.embed_device() };
         group.bench_function(name, |b| {
             b.iter(|| {
+                // SAFETY: the engine's live handles, with shaderZeroInitializeWorkgroupMemory
+                // enabled where `native` claims it (checked above); the engine outlives
+                // the pass.
                 let pass =
-                    strata_embed::AshSelection::new(vulkan, SelectionSettings::default(), WIDTH, HEIGHT).expect("pass");
+                    unsafe { strata_embed::AshSelection::new(vulkan, SelectionSettings::default(), WIDTH, HEIGHT) }
+                        .expect("pass");
                 // SAFETY: nothing was recorded with the pass.
                 unsafe { pass.destroy() };
                 engine.submit(|_| {});

@@ -12,13 +12,28 @@
 //! [`StrataError`], fills it with the status and a one-line message naming the argument,
 //! field, buffer or device limit at fault. Nothing unwinds across the boundary: a panic
 //! inside the pass (a bug) is caught and reported as [`StrataStatus::Internal`]. A null
-//! pointer, a handle that is not a live one of this library's (every handle is looked up
-//! in a table of live handles before it is touched, so a destroyed or foreign pointer is
-//! never read), bindings of another pass, or a pass destroyed while its bindings live are
-//! refused with [`StrataStatus::InvalidArgument`].
+//! pointer, a handle that is not a live one of this library's, bindings of another pass,
+//! or a pass destroyed while its bindings live are refused with
+//! [`StrataStatus::InvalidArgument`].
 //!
-//! Threads: calls on different passes may run concurrently; calls on one pass (and its
-//! bindings) must not (the engine synchronises them, as it does its command buffers).
+//! Handles: a `StrataVkPass *` or `StrataVkBindings *` is an opaque value, not an
+//! address: each is a number handed out once and never again (a counter), looked up in a
+//! table of live handles; nothing is ever read through it. So a destroyed handle stays
+//! refused even when later passes or bindings are made, and can never name one of them.
+//!
+//! Threads: any call may be made from any thread, and calls on different passes run
+//! concurrently. On one pass, [`strata_vk_set_seed`], [`strata_vk_bind`],
+//! [`strata_vk_record_selection`] and [`strata_vk_record_resampling`] may also run from
+//! several threads at once: each takes shared access only. Each thread records into its
+//! own command buffer (Vulkan wants a command buffer and its pool synchronised by the
+//! engine), and as the command buffers of one pass share its own buffers (uniforms,
+//! histogram), their executions must not overlap on the device: submit them to one queue
+//! (the pass's barriers follow its submission order) or order them with semaphores. A
+//! frame recorded while another thread sets the seed gets the old or the new one.
+//! [`strata_vk_destroy_bindings`] and [`strata_vk_destroy`] refuse, with
+//! [`StrataStatus::InvalidArgument`], a handle that a call on another thread is using at
+//! that moment: nothing is freed under a running call (and the engine should not destroy
+//! what another of its threads is recording with).
 //!
 //! From Rust, as C calls it (a pass needs a live Vulkan device: see `examples/c/` and
 //! `tests/tests/c_abi.rs`):
@@ -42,7 +57,7 @@ use strata_embed::{AshBindings, AshBufferSlice, AshBuffers, AshDevice, AshResamp
 use strata_embed::{SamplerVariant, SelectionSettings};
 
 mod guard;
-use guard::{Failure, Live, bindings_of, guarded, invalid, live, pass_of};
+use guard::{Failure, NewHandle, bindings_of, guarded, invalid, pass_of, remove_bindings, remove_pass};
 
 /// `VkInstance` (from `vulkan.h`).
 pub type VkInstance = vk::Instance;
@@ -165,17 +180,43 @@ pub struct StrataVkBuffers {
     pub resampled: StrataVkBufferSlice,
 }
 
-/// A pass made by [`strata_vk_create`] (opaque to C).
+/// A pass made by [`strata_vk_create`]. Opaque: a `StrataVkPass *` is a handle value
+/// (handed out once, never reused, never dereferenced), not an address.
+///
+/// Threads: any call may be made from any thread. On one pass, [`strata_vk_set_seed`],
+/// [`strata_vk_bind`], [`strata_vk_record_selection`] and
+/// [`strata_vk_record_resampling`] may run from several threads at once (shared access).
+/// Each thread records into its own command buffer, from a pool no other thread uses
+/// meanwhile. The command buffers of one pass share its own buffers (uniforms,
+/// histogram): their executions must not overlap on the device, so submit them to one
+/// queue (the pass's barriers follow its submission order) or order them with
+/// semaphores. [`strata_vk_destroy`] and [`strata_vk_destroy_bindings`] refuse a handle
+/// that a call on another thread is using at that moment (nothing is freed under it).
 pub struct StrataVkPass {
-    // Kept for the pass's lifetime: the device's functions were loaded through it.
+    _handle_only: (),
+}
+
+/// Descriptor sets of one set of engine buffers, made by [`strata_vk_bind`]. Opaque: a
+/// `StrataVkBindings *` is a handle value (never reused, never dereferenced), not an
+/// address. Several threads may record with them at once; destroying them is refused
+/// while one of them does.
+pub struct StrataVkBindings {
+    _handle_only: (),
+}
+
+/// What a pass handle stands for.
+pub(crate) struct Pass {
+    /// Kept for the pass's lifetime: the device's functions were loaded through it.
     _instance: ash::Instance,
     selection: AshSelection,
 }
 
-/// Descriptor sets of one set of engine buffers, made by [`strata_vk_bind`] (opaque).
-pub struct StrataVkBindings {
-    bindings: AshBindings,
-}
+/// What the table shares between threads must be shareable.
+const _: () = {
+    const fn shared<T: Send + Sync>() {}
+    shared::<Pass>();
+    shared::<AshBindings>();
+};
 
 fn settings_of(settings: &StrataSelectionSettings) -> Result<SelectionSettings, Failure> {
     let flag = |name: &str, value: u32| match value {
@@ -204,8 +245,12 @@ fn settings_of(settings: &StrataSelectionSettings) -> Result<SelectionSettings, 
 /// with [`strata_vk_destroy`].
 ///
 /// # Safety
-/// `device`, `settings` and `pass` are null (refused) or valid; `device` holds valid
-/// handles of a live instance and device; `error` is null or writable.
+/// `device`, `settings` and `pass` are null (refused) or valid; `device` holds handles
+/// of a live instance (`apiVersion` 1.1 or newer), one of its physical devices and a live
+/// device made from it, with `get_instance_proc_addr` the loader's or the instance's;
+/// the instance and the device stay alive until the pass is destroyed; if
+/// `device->shader_zero_initialize_workgroup_memory` is 1, the feature is enabled on the
+/// device; `error` is null or writable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn strata_vk_create(
     device: *const StrataVkDevice,
@@ -251,20 +296,23 @@ pub unsafe extern "C" fn strata_vk_create(
                 device: &logical,
                 shader_zero_initialize_workgroup_memory: zero_init,
             };
+            let handle = NewHandle::reserve()?;
+            // SAFETY: the instance and device functions were loaded for the caller's live
+            // instance and device, which outlive the pass, and the feature flag is true
+            // only where enabled (this function's contract).
             let selection = AshSelection::new(vulkan, settings, width, height)?;
-            let made = Box::into_raw(Box::new(StrataVkPass { _instance: instance, selection }));
-            live().push((made as usize, Live::Pass { bindings: 0 }));
-            *out = made;
+            *out = handle.insert_pass(Pass { _instance: instance, selection });
             Ok(())
         })
     }
 }
 
 /// Starts an independent render: the frames recorded from now on belong to `seed`
-/// (0 until the first call).
+/// (0 until the first call). May run while other threads record with the pass: a frame
+/// recorded at the same moment gets the old or the new seed.
 ///
 /// # Safety
-/// `pass` is null (refused) or a pass of this library; `error` is null or writable.
+/// `error` is null or writable (`pass` may be any value: it is looked up, never read).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn strata_vk_set_seed(
     pass: *mut StrataVkPass,
@@ -289,12 +337,18 @@ fn slice(slice: &StrataVkBufferSlice, name: &str, required: bool) -> Result<Opti
 }
 
 /// Checks the engine's buffers against the contract (sizes for the pass's image, offset
-/// alignment) and writes their descriptor sets; on success `*bindings` holds them, to be
-/// freed by [`strata_vk_destroy_bindings`].
+/// alignment, `offset + size` within 2^64 - 1 and `size` within the device's
+/// `maxStorageBufferRange`, no two ranges of one buffer overlapping: each refused with
+/// `STRATA_STATUS_BUFFER` and a message naming the buffer and the values) and writes
+/// their descriptor sets; on success `*bindings` holds them, to be freed by
+/// [`strata_vk_destroy_bindings`]. May run while other threads use the pass.
 ///
 /// # Safety
-/// `pass` is a pass of this library; `buffers` and `bindings` are null (refused) or
-/// valid; the buffers stay alive while the bindings are used; `error` is null or writable.
+/// `buffers` and `bindings` are null (refused) or valid; each buffer given is a live
+/// `VkBuffer` of the pass's device, created with `VK_BUFFER_USAGE_STORAGE_BUFFER_BIT`,
+/// with memory bound, at least `offset + size` bytes large; the buffers and their memory
+/// stay alive while a command buffer recorded with the bindings is recording or pending;
+/// `error` is null or writable (`pass` may be any value: it is looked up, never read).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn strata_vk_bind(
     pass: *mut StrataVkPass,
@@ -327,14 +381,12 @@ pub unsafe extern "C" fn strata_vk_bind(
                 selections: slice(&buffers.selections, "selections", true)?.expect("required"),
                 resample,
             };
-            let made = Box::into_raw(Box::new(StrataVkBindings { bindings: owner.selection.bind(&ash_buffers)? }));
-            let mut table = live();
-            table.push((made as usize, Live::Bindings { owner: pass as usize }));
-            if let Some((_, Live::Pass { bindings })) = table.iter_mut().find(|(address, _)| *address == pass as usize)
-            {
-                *bindings += 1;
-            }
-            *out = made;
+            let handle = NewHandle::reserve()?;
+            // SAFETY: the engine's buffers are live storage buffers of the pass's device
+            // holding their ranges, alive while the bindings are used (this function's
+            // contract).
+            let made = owner.selection.bind(&ash_buffers)?;
+            *out = handle.insert_bindings(made, pass);
             Ok(())
         })
     }
@@ -359,18 +411,22 @@ unsafe fn recording(
             if command_buffer.is_null() {
                 return Err(invalid("command_buffer is NULL"));
             }
-            Ok(record(&owner.selection, &bindings.bindings)?)
+            Ok(record(&owner.selection, &bindings)?)
         })
     }
 }
 
 /// Records frame `frame`'s uniform updates, histogram and selection into the engine's
 /// command buffer, with the barriers the pass needs (from the engine's earlier shader and
-/// transfer writes, between its dispatches, and to the engine's later reads).
+/// transfer writes, between its dispatches, and to the engine's later reads). Several
+/// threads may record with one pass (and one set of bindings) at once, each into its own
+/// command buffer (see [`StrataVkPass`] for how to submit them).
 ///
 /// # Safety
 /// `command_buffer` is recording, outside a render pass, on a queue with compute, of the
-/// pass's device; `bindings` come from this pass; `error` is null or writable.
+/// pass's device, and no other thread records into it or its pool meanwhile; the
+/// bindings' buffers stay alive until it has executed; `error` is null or writable
+/// (`pass` and `bindings` may be any values: they are looked up, never read).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn strata_vk_record_selection(
     pass: *mut StrataVkPass,
@@ -408,11 +464,12 @@ pub unsafe extern "C" fn strata_vk_record_resampling(
 }
 
 /// Frees the descriptor sets of `bindings` (null: nothing); a second call with the same
-/// pointer is refused (it is no longer live).
+/// handle is refused (it is no longer live, and its value is never handed out again).
+/// Refused while a call on another thread records with them.
 ///
 /// # Safety
-/// No pending command buffer uses them; `bindings` come from `pass`; `error` is null or
-/// writable.
+/// No pending command buffer uses them; `error` is null or writable (`pass` and
+/// `bindings` may be any values: they are looked up, never read).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn strata_vk_destroy_bindings(
     pass: *mut StrataVkPass,
@@ -425,27 +482,22 @@ pub unsafe extern "C" fn strata_vk_destroy_bindings(
             if bindings.is_null() {
                 return Ok(());
             }
-            let owner = pass_of(pass, "pass")?;
-            bindings_of(bindings, pass)?;
-            let mut table = live();
-            table.retain(|&(address, _)| address != bindings as usize);
-            if let Some((_, Live::Pass { bindings })) = table.iter_mut().find(|(address, _)| *address == pass as usize)
-            {
-                *bindings -= 1;
-            }
-            drop(table);
-            let boxed = Box::from_raw(bindings);
-            owner.selection.destroy_bindings(boxed.bindings);
+            let (owner, bindings) = remove_bindings(bindings, pass)?;
+            // SAFETY: out of the table and used by no call; no pending command buffer
+            // uses them (this function's contract).
+            owner.selection.destroy_bindings(bindings);
             Ok(())
         })
     }
 }
 
 /// Destroys the pass's pipelines and buffers (null: nothing). Refused while bindings of
-/// the pass live (destroy them first: they hold the pass's descriptor sets).
+/// the pass live (destroy them first: they hold the pass's descriptor sets) and while a
+/// call on another thread uses the pass; a second call with the same handle is refused.
 ///
 /// # Safety
-/// No pending command buffer uses the pass; `error` is null or writable.
+/// No pending command buffer uses the pass; `error` is null or writable (`pass` may be
+/// any value: it is looked up, never read).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn strata_vk_destroy(pass: *mut StrataVkPass, error: *mut StrataError) -> StrataStatus {
     // SAFETY: per this function's contract.
@@ -454,19 +506,9 @@ pub unsafe extern "C" fn strata_vk_destroy(pass: *mut StrataVkPass, error: *mut 
             if pass.is_null() {
                 return Ok(());
             }
-            pass_of(pass, "pass")?;
-            let mut table = live();
-            if let Some((_, Live::Pass { bindings })) = table.iter().find(|(address, _)| *address == pass as usize)
-                && *bindings > 0
-            {
-                return Err(invalid(format!(
-                    "{bindings} bindings of this pass are still live: destroy them first (strata_vk_destroy_bindings)"
-                )));
-            }
-            table.retain(|&(address, _)| address != pass as usize);
-            drop(table);
-            let boxed = Box::from_raw(pass);
-            boxed.selection.destroy();
+            // SAFETY: out of the table, without bindings and used by no call; no pending
+            // command buffer uses it (this function's contract).
+            remove_pass(pass)?.selection.destroy();
             Ok(())
         })
     }

@@ -42,7 +42,7 @@ pub(crate) unsafe fn destroy_pipeline(device: &ash::Device, pipeline: &Pipeline)
     unsafe { destroy_compute_pipeline(device, &pipeline.objects) }
 }
 
-/// Objects made so far by [`AshSelection::new`], destroyed if it fails half-way.
+/// Objects made so far by [`crate::AshSelection::new`], destroyed if it fails half-way.
 pub(crate) struct Created<'a> {
     pub(crate) device: &'a ash::Device,
     /// How the pipelines' SPIR-V zeroes workgroup memory.
@@ -72,6 +72,20 @@ impl Created<'_> {
         preferred: vk::MemoryPropertyFlags,
         contents: Option<&[u8]>,
     ) -> Result<OwnBuffer, EmbedError> {
+        // The contents are copied into the mapping of `size` bytes: refused, before anything
+        // is made, unless they fit.
+        if let Some(bytes) = contents
+            && !u64::try_from(bytes.len()).is_ok_and(|len| len <= size)
+        {
+            return Err(EmbedError::Api {
+                api: "Vulkan",
+                operation: "filling a buffer".into(),
+                message: format!(
+                    "{} bytes of contents for a buffer of {size} bytes (a bug of strata-embed)",
+                    bytes.len()
+                ),
+            });
+        }
         let device = self.device;
         let info = vk::BufferCreateInfo::default().size(size).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
         // SAFETY: valid device; objects are recorded for cleanup right after creation.
@@ -112,6 +126,7 @@ impl Created<'_> {
                 let mapped = device
                     .map_memory(memory, 0, size, vk::MemoryMapFlags::empty())
                     .map_err(|e| vk_error("mapping buffer memory", e))?;
+                // `bytes.len() <= size`, checked above: the copy stays inside the mapping.
                 std::ptr::copy_nonoverlapping(bytes.as_ptr(), mapped.cast::<u8>(), bytes.len());
                 device.unmap_memory(memory);
             }
@@ -138,5 +153,90 @@ impl Drop for Created<'_> {
                 self.device.free_memory(memory, None);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A Vulkan device of the first physical device, destroyed on drop.
+    struct TestDevice {
+        _entry: ash::Entry,
+        instance: ash::Instance,
+        physical_device: vk::PhysicalDevice,
+        device: ash::Device,
+    }
+
+    impl TestDevice {
+        /// The device, or `None` (with a note) where there is no Vulkan device and
+        /// `STRATA_REQUIRE_GPU` is not set.
+        fn open(test: &str) -> Option<Self> {
+            let skip = |why: String| {
+                assert!(!strata_backends::gpu_required(), "{test}: {why}");
+                eprintln!("SKIPPED {test}: {why}");
+                None
+            };
+            // SAFETY: loads the system's Vulkan loader; plain object creation with valid
+            // create infos; every object is destroyed in Drop.
+            unsafe {
+                let entry = match ash::Entry::load() {
+                    Ok(entry) => entry,
+                    Err(error) => return skip(format!("no Vulkan loader: {error}")),
+                };
+                let app = vk::ApplicationInfo::default().api_version(vk::API_VERSION_1_1);
+                let info = vk::InstanceCreateInfo::default().application_info(&app);
+                let instance = match entry.create_instance(&info, None) {
+                    Ok(instance) => instance,
+                    Err(error) => return skip(format!("vkCreateInstance: {error:?}")),
+                };
+                let Some(&physical_device) = instance.enumerate_physical_devices().unwrap_or_default().first() else {
+                    instance.destroy_instance(None);
+                    return skip("no Vulkan device".into());
+                };
+                let priorities = [1.0];
+                let queues = [vk::DeviceQueueCreateInfo::default().queue_family_index(0).queue_priorities(&priorities)];
+                let create = vk::DeviceCreateInfo::default().queue_create_infos(&queues);
+                let device = instance.create_device(physical_device, &create, None).expect("vkCreateDevice");
+                Some(Self { _entry: entry, instance, physical_device, device })
+            }
+        }
+    }
+
+    impl Drop for TestDevice {
+        fn drop(&mut self) {
+            // SAFETY: every child object was destroyed (Created's Drop).
+            unsafe {
+                self.device.destroy_device(None);
+                self.instance.destroy_instance(None);
+            }
+        }
+    }
+
+    #[test]
+    fn contents_longer_than_the_buffer_are_refused_before_anything_is_made() {
+        let Some(vulkan) = TestDevice::open("contents_longer_than_the_buffer_are_refused_before_anything_is_made")
+        else {
+            return;
+        };
+        // SAFETY: valid handles.
+        let memory = unsafe { vulkan.instance.get_physical_device_memory_properties(vulkan.physical_device) };
+        let mut created = Created {
+            device: &vulkan.device,
+            translate: TranslateOptions::default(),
+            pipelines: Vec::new(),
+            buffers: Vec::new(),
+        };
+        let (usage, host) = (vk::BufferUsageFlags::STORAGE_BUFFER, vk::MemoryPropertyFlags::HOST_VISIBLE);
+        let error = created
+            .buffer(&memory, 60, usage, host, Some(&[7; 61]))
+            .err()
+            .expect("61 bytes of contents for a 60-byte buffer are refused");
+        let message = error.to_string();
+        assert!(message.contains("61") && message.contains("60") && !message.contains('\n'), "{message}");
+        assert!(created.buffers.is_empty(), "a buffer was made for contents that do not fit");
+        // Contents of exactly the buffer's size fit (the buffer is destroyed with `created`).
+        let fits = created.buffer(&memory, 60, usage, host, Some(&[7; 60])).expect("60 bytes fit");
+        assert_eq!((fits.size, created.buffers.len()), (60, 1));
     }
 }

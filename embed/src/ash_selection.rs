@@ -10,6 +10,7 @@ use crate::frame::{FrameId, FrameParams, frame_params, max_blocks};
 use crate::limits::{DeviceLimits, VULKAN_NAMES, check_limits};
 use crate::wgsl::{ModuleId, module};
 use ash::vk;
+use std::sync::atomic::{AtomicU32, Ordering};
 use strata_kernels::Executor;
 use strata_kernels::blue_noise::BlueNoiseTables;
 use strata_kernels::pass_plan::PassBuffer;
@@ -18,7 +19,8 @@ use strata_kernels::translate::{TranslateOptions, WorkgroupZeroInit};
 
 /// The engine's Vulkan objects the pass is created on (the instance created with
 /// `apiVersion` 1.1 or newer and a Vulkan 1.1 device; nothing has to be enabled beyond
-/// core features).
+/// core features). Holding one promises nothing about the handles' lifetimes: that is
+/// [`AshSelection::new`]'s contract.
 #[derive(Clone, Copy)]
 pub struct AshDevice<'a> {
     /// The instance.
@@ -102,14 +104,23 @@ pub struct AshBindings {
 /// from the engine's shader and transfer writes; between its dispatches; and after the
 /// last, one making its outputs visible to the engine's later shader and transfer reads.
 /// Destroy it with [`Self::destroy`] once the device no longer uses it.
+///
+/// Threads: every method but [`Self::destroy`] takes `&self`, so one pass may bind and
+/// record from several threads at once (each into its own command buffer, whose pool the
+/// engine synchronises as Vulkan requires). The command buffers share the pass's own
+/// buffers (uniforms, histogram), so their executions on the device must not overlap:
+/// submit them to one queue, whose submission order the pass's barriers follow, or order
+/// them with semaphores.
 pub struct AshSelection {
     device: ash::Device,
     settings: SelectionSettings,
-    seed: u32,
+    seed: AtomicU32,
     width: u32,
     height: u32,
     max_workgroups: u32,
     offset_alignment: u64,
+    /// The device's `maxStorageBufferRange`: the most bytes an engine slice may span.
+    max_storage_buffer_range: u64,
     histogram: Pipeline,
     select: Pipeline,
     resample: Pipeline,
@@ -134,9 +145,27 @@ impl AshSelection {
     /// module [`crate::wgsl::histogram_module`] picks for the device's type (the subgroup
     /// network on a GPU whose compute shaders have subgroup shuffles). Frames belong to
     /// the render of seed 0 until [`Self::set_seed`].
-    pub fn new(vulkan: AshDevice, settings: SelectionSettings, width: u32, height: u32) -> Result<Self, EmbedError> {
+    ///
+    /// # Safety
+    /// The caller guarantees that
+    /// * `vulkan.instance` was loaded for a live `VkInstance` created with `apiVersion`
+    ///   1.1 or newer, and `vulkan.physical_device` is one of its physical devices;
+    /// * `vulkan.device` was loaded for a live `VkDevice` created from that physical
+    ///   device;
+    /// * if `vulkan.shader_zero_initialize_workgroup_memory` is true, the engine enabled
+    ///   `shaderZeroInitializeWorkgroupMemory` on that device (a device that lacks the
+    ///   feature is refused; one that has it but where it is not enabled cannot be
+    ///   detected);
+    /// * the device and the instance stay alive until [`Self::destroy`] has returned (a
+    ///   pass dropped without it leaks its Vulkan objects).
+    pub unsafe fn new(
+        vulkan: AshDevice,
+        settings: SelectionSettings,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, EmbedError> {
         crate::frame::grid(&settings, width, height)?;
-        // SAFETY: valid handles from the engine.
+        // SAFETY: live handles (this function's contract).
         let properties = unsafe { vulkan.instance.get_physical_device_properties(vulkan.physical_device) };
         if properties.api_version < vk::API_VERSION_1_1 {
             return Err(EmbedError::DeviceLimit {
@@ -198,11 +227,12 @@ impl AshSelection {
         Ok(Self {
             device,
             settings,
-            seed: 0,
+            seed: AtomicU32::new(0),
             width,
             height,
             max_workgroups: limits.max_compute_work_group_count.iter().copied().min().unwrap_or(1),
             offset_alignment: limits.min_storage_buffer_offset_alignment.max(1),
+            max_storage_buffer_range: u64::from(limits.max_storage_buffer_range),
             histogram,
             select,
             resample,
@@ -216,34 +246,83 @@ impl AshSelection {
     }
 
     /// Starts an independent render: a new seed for the frames recorded from now on
-    /// (for example per run of an unbiasedness test); costs nothing.
-    pub fn set_seed(&mut self, seed: u32) {
-        self.seed = seed;
+    /// (for example per run of an unbiasedness test); costs nothing. Shared access: a
+    /// frame recorded on another thread at the same moment gets the old or the new seed.
+    pub fn set_seed(&self, seed: u32) {
+        self.seed.store(seed, Ordering::Relaxed);
     }
 
     /// The seed of the frames recorded from now on.
     pub fn seed(&self) -> u32 {
-        self.seed
+        self.seed.load(Ordering::Relaxed)
     }
 
     /// The parameters frame `frame` runs with.
     pub fn frame_params(&self, frame: u32, identity_payload: bool) -> Result<FrameParams, EmbedError> {
-        let id = FrameId { frame, seed: self.seed, identity_payload };
+        let id = FrameId { frame, seed: self.seed(), identity_payload };
         Ok(frame_params(&self.settings, self.width, self.height, id, self.max_workgroups)?)
     }
 
-    /// Checks the engine's buffers against the contract and writes their descriptor sets.
-    pub fn bind(&self, buffers: &AshBuffers) -> Result<AshBindings, EmbedError> {
+    /// The checks of [`Self::bind`]'s errors, in that order, before any Vulkan call.
+    fn check_slices(&self, buffers: &AshBuffers) -> Result<(), EmbedError> {
+        let mut ranges = Vec::new();
         for (role, slice) in buffers.roles() {
-            if !slice.offset.is_multiple_of(self.offset_alignment) {
-                return Err(EmbedError::BufferOffset {
-                    buffer: role.name(),
-                    offset: slice.offset,
-                    alignment: self.offset_alignment,
+            let (buffer, offset, size) = (role.name(), slice.offset, slice.size);
+            if !offset.is_multiple_of(self.offset_alignment) {
+                return Err(EmbedError::BufferOffset { buffer, offset, alignment: self.offset_alignment });
+            }
+            let end = offset.checked_add(size).ok_or(EmbedError::BufferEnd { buffer, offset, size })?;
+            if size > self.max_storage_buffer_range {
+                return Err(EmbedError::BufferRange {
+                    buffer,
+                    size,
+                    limit: "maxStorageBufferRange",
+                    max: self.max_storage_buffer_range,
                 });
             }
-            check_size(role, slice.size, self.width, self.height)?;
+            check_size(role, size, self.width, self.height)?;
+            ranges.push((buffer, slice.buffer, offset, end));
         }
+        for (i, &(first, buffer, first_start, first_end)) in ranges.iter().enumerate() {
+            for &(second, other, second_start, second_end) in &ranges[i + 1..] {
+                if buffer == other && first_start < second_end && second_start < first_end {
+                    return Err(EmbedError::BufferOverlap {
+                        first,
+                        first_start,
+                        first_end,
+                        second,
+                        second_start,
+                        second_end,
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks the engine's buffers against the contract and writes their descriptor sets.
+    ///
+    /// # Errors
+    /// Each refusal names the buffer's role and the values, and is made before any Vulkan
+    /// call: a slice's offset not a multiple of `minStorageBufferOffsetAlignment`
+    /// ([`EmbedError::BufferOffset`]); `offset + size` past byte 2^64 - 1
+    /// ([`EmbedError::BufferEnd`]); a size over `maxStorageBufferRange`
+    /// ([`EmbedError::BufferRange`]; `VK_WHOLE_SIZE` included) or under what the contract
+    /// needs for the image ([`EmbedError::BufferTooSmall`]); two slices of one `VkBuffer`
+    /// in overlapping bytes ([`EmbedError::BufferOverlap`]: every role needs bytes of its
+    /// own; the pass writes `selections` and `resampled` while it reads the others, and no
+    /// engine needs two roles read from the same bytes). A failed Vulkan call is
+    /// [`EmbedError::Api`].
+    ///
+    /// # Safety
+    /// The caller guarantees that every slice's `buffer` is a live `VkBuffer` of the
+    /// pass's device, created with `STORAGE_BUFFER` usage, with memory bound; that every
+    /// slice the checks let through lies inside its buffer (`offset + size` at most the
+    /// buffer's size: Vulkan cannot be asked a buffer's size; a slice the checks refuse
+    /// never reaches the driver); and that the buffers and their memory stay alive while
+    /// a command buffer recorded with the returned bindings is recording or pending.
+    pub unsafe fn bind(&self, buffers: &AshBuffers) -> Result<AshBindings, EmbedError> {
+        self.check_slices(buffers)?;
         let sets = 3u32;
         let pool_sizes = [
             vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: sets },
@@ -298,7 +377,9 @@ impl AshSelection {
                         .buffer_info(info)
                 })
                 .collect();
-            // SAFETY: the sets and buffers are valid; sizes were checked above.
+            // SAFETY: the sets are this pool's; the engine's buffers are live buffers of the
+            // device holding their ranges (this function's contract), whose offsets,
+            // sizes and overlaps were checked above.
             unsafe { self.device.update_descriptor_sets(&descriptor_writes, &[]) };
         }
         Ok(AshBindings {

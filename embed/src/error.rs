@@ -75,6 +75,47 @@ pub enum EmbedError {
         /// The device's storage-buffer offset alignment.
         alignment: u64,
     },
+    /// An engine buffer's range is larger than one storage-buffer descriptor of the device
+    /// may see.
+    #[error("buffer `{buffer}` is bound with {size} bytes, more than the device limit {limit} ({max} bytes)")]
+    BufferRange {
+        /// The buffer's role.
+        buffer: &'static str,
+        /// The size given.
+        size: u64,
+        /// The limit's name as the API spells it.
+        limit: &'static str,
+        /// The device's value.
+        max: u64,
+    },
+    /// An engine buffer's offset plus size is past the last byte address (2^64 - 1).
+    #[error("buffer `{buffer}` is bound at offset {offset} with {size} bytes, which ends past byte 2^64 - 1")]
+    BufferEnd {
+        /// The buffer's role.
+        buffer: &'static str,
+        /// Its offset.
+        offset: u64,
+        /// Its size.
+        size: u64,
+    },
+    /// Two engine buffers are overlapping ranges of one API buffer.
+    #[error(
+        "buffers `{first}` (bytes {first_start}..{first_end}) and `{second}` (bytes {second_start}..{second_end}) overlap in one buffer: each needs bytes of its own"
+    )]
+    BufferOverlap {
+        /// The first buffer's role.
+        first: &'static str,
+        /// Where its range starts.
+        first_start: u64,
+        /// Where its range ends (exclusive).
+        first_end: u64,
+        /// The second buffer's role.
+        second: &'static str,
+        /// Where its range starts.
+        second_start: u64,
+        /// Where its range ends (exclusive).
+        second_end: u64,
+    },
     /// Resampling was recorded with bindings that have no resampling buffers.
     #[error("the bindings were made without resampling buffers (ResampleBuffers), so resampling cannot be recorded")]
     NoResampleBuffers,

@@ -81,7 +81,8 @@ fn matches_on(engine: &AshEngine, want: &Frames) {
     ];
     let slice = |i: usize| AshBufferSlice { buffer: buffers[i].0, offset: 0, size: sizes[i] };
     let vulkan = engine.embed_device();
-    let mut pass = AshSelection::new(vulkan, settings(), WIDTH, HEIGHT).unwrap();
+    // SAFETY: live handles of the engine, which outlives the pass (destroyed below).
+    let pass = unsafe { AshSelection::new(vulkan, settings(), WIDTH, HEIGHT) }.unwrap();
     pass.set_seed(9);
     let good = AshBuffers {
         candidates: slice(0),
@@ -92,19 +93,24 @@ fn matches_on(engine: &AshEngine, want: &Frames) {
     // Bind-time errors name the buffer.
     let mut bad = good;
     bad.selections.size -= 1;
-    let error = pass.bind(&bad).unwrap_err().to_string();
+    // SAFETY: live storage buffers of the device holding the ranges given, alive until
+    // after the last submission; the refused slices never reach the driver.
+    let error = unsafe { pass.bind(&bad) }.unwrap_err().to_string();
     assert!(error.contains("`selections`") && error.contains("50x27"), "{error}");
     let mut bad = good;
     bad.candidates.offset = 3;
-    let error = pass.bind(&bad).unwrap_err().to_string();
+    // SAFETY: as above.
+    let error = unsafe { pass.bind(&bad) }.unwrap_err().to_string();
     assert!(error.contains("`candidates`") && error.contains("offset 3"), "{error}");
-    let error = AshSelection::new(vulkan, SelectionSettings { block_size: 3, ..settings() }, WIDTH, HEIGHT)
+    // SAFETY: as for the pass above.
+    let error = unsafe { AshSelection::new(vulkan, SelectionSettings { block_size: 3, ..settings() }, WIDTH, HEIGHT) }
         .err()
         .expect("block size 3 refused")
         .to_string();
     assert!(error.contains("block_size = 3"), "{error}");
 
-    let bindings = pass.bind(&good).unwrap();
+    // SAFETY: as above.
+    let bindings = unsafe { pass.bind(&good) }.unwrap();
     for (frame, (want_selections, want_outputs)) in want.iter().enumerate() {
         // SAFETY: the command buffer is recording; buffers outlive the wait in submit.
         engine.submit(|cb| unsafe {
@@ -128,4 +134,138 @@ fn matches_on(engine: &AshEngine, want: &Frames) {
     for buffer in buffers {
         engine.free(buffer);
     }
+}
+
+/// The five roles as ranges of one engine buffer, back to back at aligned offsets, with
+/// the pass on `engine`: what the bind-time range checks start from.
+struct OneBuffer<'a> {
+    engine: &'a AshEngine,
+    buffer: (ash::vk::Buffer, ash::vk::DeviceMemory),
+    /// Each role's range: candidates, payloads, selections, resample inputs, resampled.
+    ranges: [(u64, u64); 5],
+    pass: Option<AshSelection>,
+    /// The device's minStorageBufferOffsetAlignment and maxStorageBufferRange.
+    alignment: u64,
+    max_range: u64,
+}
+
+impl<'a> OneBuffer<'a> {
+    fn new(engine: &'a AshEngine) -> Self {
+        // SAFETY: valid handles of the engine.
+        let limits = unsafe { engine.instance.get_physical_device_properties(engine.physical_device) }.limits;
+        let alignment = limits.min_storage_buffer_offset_alignment.max(1);
+        let pixels = u64::from(WIDTH * HEIGHT);
+        let mut ranges = [(0, 8 * pixels), (0, 4 * pixels), (0, 32 * pixels), (0, 48 * pixels), (0, 16 * pixels)];
+        for i in 1..ranges.len() {
+            ranges[i].0 = (ranges[i - 1].0 + ranges[i - 1].1).next_multiple_of(alignment);
+        }
+        let (last_offset, last_size) = ranges[4];
+        let buffer = engine.buffer(last_offset + last_size, &[]);
+        // SAFETY: live handles of the engine, which outlives the pass (destroyed on drop).
+        let pass = unsafe { AshSelection::new(engine.embed_device(), settings(), WIDTH, HEIGHT) }.unwrap();
+        let max_range = u64::from(limits.max_storage_buffer_range);
+        Self { engine, buffer, ranges, pass: Some(pass), alignment, max_range }
+    }
+
+    /// The five ranges as the pass binds them.
+    fn buffers(&self) -> AshBuffers {
+        let at = |i: usize| AshBufferSlice { buffer: self.buffer.0, offset: self.ranges[i].0, size: self.ranges[i].1 };
+        AshBuffers {
+            candidates: at(0),
+            payloads: Some(at(1)),
+            selections: at(2),
+            resample: Some(AshResampleBuffers { inputs: at(3), outputs: at(4) }),
+        }
+    }
+
+    /// Binds `buffers`: the bindings are destroyed again; the outcome is kept.
+    fn bind(&self, buffers: &AshBuffers) -> Result<(), String> {
+        let pass = self.pass.as_ref().unwrap();
+        // SAFETY: every slice that the checks under test let through lies inside
+        // `self.buffer`, a live storage buffer of the pass's device (bind's contract; a
+        // slice the checks refuse never reaches the driver). Nothing is recorded.
+        let bindings = unsafe { pass.bind(buffers) }.map_err(|error| error.to_string())?;
+        // SAFETY: never used.
+        unsafe { pass.destroy_bindings(bindings) };
+        Ok(())
+    }
+
+    /// The message of `buffers`' refusal; fails the test if they were bound.
+    fn refusal(&self, buffers: &AshBuffers, case: &str) -> String {
+        let message = self.bind(buffers).err().unwrap_or_else(|| panic!("{case}: bound, not refused"));
+        assert!(!message.contains('\n'), "{case}: one line: {message}");
+        message
+    }
+}
+
+impl Drop for OneBuffer<'_> {
+    fn drop(&mut self) {
+        // SAFETY: nothing was recorded with the pass.
+        unsafe { self.pass.take().unwrap().destroy() };
+        self.engine.free(self.buffer);
+    }
+}
+
+#[test]
+fn bind_refuses_a_range_larger_than_max_storage_buffer_range() {
+    let Some(engine) = AshEngine::open("bind_refuses_a_range_larger_than_max_storage_buffer_range") else { return };
+    let one = OneBuffer::new(&engine);
+    one.bind(&one.buffers()).expect("disjoint ranges of one buffer are bound");
+    let max = one.max_range;
+    let mut large = one.buffers();
+    large.selections.size = max + 1;
+    let message = one.refusal(&large, "maxStorageBufferRange + 1 bytes");
+    for part in ["`selections`", "maxStorageBufferRange", &(max + 1).to_string(), &max.to_string()] {
+        assert!(message.contains(part), "{part}: {message}");
+    }
+    // VK_WHOLE_SIZE as a size is not "the rest of the buffer" here: refused too.
+    let mut whole = one.buffers();
+    whole.candidates.size = ash::vk::WHOLE_SIZE;
+    let message = one.refusal(&whole, "VK_WHOLE_SIZE");
+    assert!(message.contains("`candidates`") && message.contains(&u64::MAX.to_string()), "{message}");
+}
+
+#[test]
+fn bind_refuses_a_range_that_ends_past_the_last_byte_address() {
+    let Some(engine) = AshEngine::open("bind_refuses_a_range_that_ends_past_the_last_byte_address") else { return };
+    let one = OneBuffer::new(&engine);
+    let mut wrapping = one.buffers();
+    let resampled = wrapping.resample.as_mut().unwrap();
+    // The last aligned offset: offset + size wraps around 2^64.
+    resampled.outputs.offset = u64::MAX / one.alignment * one.alignment;
+    let (offset, size) = (resampled.outputs.offset, resampled.outputs.size);
+    let message = one.refusal(&wrapping, "offset + size past 2^64 - 1");
+    for part in ["`resampled`", &offset.to_string(), &size.to_string()] {
+        assert!(message.contains(part), "{part}: {message}");
+    }
+}
+
+#[test]
+fn bind_refuses_overlapping_ranges_of_one_buffer() {
+    let Some(engine) = AshEngine::open("bind_refuses_overlapping_ranges_of_one_buffer") else { return };
+    let one = OneBuffer::new(&engine);
+    let [_, payloads, selections, inputs, _] = one.ranges;
+    // The selections (written by the pass) one byte into the resampling inputs.
+    let mut by_one = one.buffers();
+    by_one.selections.size = inputs.0 - selections.0 + 1;
+    let message = one.refusal(&by_one, "one byte of overlap");
+    let (end, inputs_start) = (inputs.0 + 1, inputs.0);
+    for part in ["`selections`", "`resample_inputs`", &end.to_string(), &inputs_start.to_string()] {
+        assert!(message.contains(part), "{part}: {message}");
+    }
+    // Ranges that touch without overlapping are bound.
+    let mut touching = one.buffers();
+    touching.selections.size = inputs.0 - selections.0;
+    one.bind(&touching).expect("ranges that touch are bound");
+    // The selections over the payloads (the pass would write what it reads).
+    let mut over = one.buffers();
+    over.selections.offset = payloads.0;
+    let message = one.refusal(&over, "selections over payloads");
+    assert!(message.contains("`selections`") && message.contains("`payloads`"), "{message}");
+    // Two roles the pass only reads, in the same bytes: refused as well (no engine
+    // aliases them: a record of one type read as another is a mistake).
+    let mut shared = one.buffers();
+    shared.payloads.as_mut().unwrap().offset = 0;
+    let message = one.refusal(&shared, "payloads over candidates");
+    assert!(message.contains("`candidates`") && message.contains("`payloads`"), "{message}");
 }

@@ -193,8 +193,11 @@ fn creating_and_destroying_the_ash_embed_pass_hundreds_of_times_keeps_host_memor
         resample: None,
     };
     let cycle = || {
-        let pass = AshSelection::new(vulkan, SelectionSettings::default(), width, height).unwrap();
-        let bindings = pass.bind(&buffers).unwrap();
+        // SAFETY: live handles of the engine, which outlives the pass (destroyed below).
+        let pass = unsafe { AshSelection::new(vulkan, SelectionSettings::default(), width, height) }.unwrap();
+        // SAFETY: live storage buffers of the device holding the ranges given, freed only
+        // after the last cycle.
+        let bindings = unsafe { pass.bind(&buffers) }.unwrap();
         // SAFETY: the command buffer is recording; submit waits before returning.
         engine.submit(|cb| unsafe { pass.record_selection(cb, &bindings, 0).unwrap() });
         // SAFETY: the submission was waited for.

@@ -983,3 +983,301 @@ fn an_output_never_replaces_an_input_of_the_run() {
     assert_eq!(std::fs::read(&path_file).unwrap(), path_text);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+// Round three (RELIABILITY.md, "Round three: loaders and camera paths").
+
+/// Writes `keyframes` (frame, origin, target) as a camera path file `dir/name`.
+fn camera_path_file(dir: &Path, name: &str, keyframes: &[(f32, [f32; 3], [f32; 3])]) -> PathBuf {
+    let keys: Vec<serde_json::Value> = keyframes
+        .iter()
+        .map(|(frame, origin, target)| serde_json::json!({"frame": frame, "origin": origin, "target": target}))
+        .collect();
+    let file = dir.join(name);
+    std::fs::write(&file, serde_json::json!({ "keyframes": keys }).to_string()).unwrap();
+    file
+}
+
+/// Every file under `folder` with its contents.
+fn contents(folder: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut found: Vec<_> =
+        files(folder).into_iter().map(|(path, _)| (path.clone(), std::fs::read(&path).unwrap())).collect();
+    found.sort();
+    found
+}
+
+// Round three, 1. A camera path of one keyframe holds that key on every frame (the
+// documentation of `CameraPath::Keyframes`): it rendered the scene's own camera while the
+// run's record named the file.
+#[test]
+fn a_one_keyframe_camera_path_renders_from_its_key() {
+    let dir = scratch("one-key");
+    let (origin, target) = ([400.0f32, 300.0, -800.0], [278.0f32, 273.0, 0.0]);
+    let scene = cornell_box(&dir, "box", |_| {});
+    let moved = cornell_box(&dir, "moved", |scene| {
+        scene["camera"]["origin"] = serde_json::json!(origin);
+        scene["camera"]["target"] = serde_json::json!(target);
+    });
+    let key = camera_path_file(&dir, "key.json", &[(5.0, origin, target)]);
+    let (with_key, moved_out) = (dir.join("with-key"), dir.join("moved-out"));
+    let output = strata(&with(
+        os(compare_args(8, 2, 2)),
+        &[scene.as_os_str(), "--camera-path".as_ref(), key.as_os_str(), "--out".as_ref(), with_key.as_os_str()],
+    ));
+    assert_succeeded(&output);
+    assert_succeeded(&strata(&with(
+        os(compare_args(8, 2, 2)),
+        &[moved.as_os_str(), "--out".as_ref(), moved_out.as_os_str()],
+    )));
+    // The key's camera is the camera: the same reference and the same errors as a scene
+    // whose own camera is the key's.
+    for name in ["reference.exr", "errors.csv"] {
+        let (a, b) = (std::fs::read(with_key.join(name)).unwrap(), std::fs::read(moved_out.join(name)).unwrap());
+        assert!(a == b, "{name} differs from the run whose scene camera is the key's");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// Round three, 2. A camera path is checked whole, every keyframe and every frame's camera,
+// before an earlier run's files are removed or a reference renders; the error names the
+// flag, the keyframe (or frame) and the field.
+#[test]
+fn camera_paths_are_checked_whole_before_the_folder_is_touched() {
+    let dir = scratch("path-whole");
+    let scene = cornell_box(&dir, "box", |_| {});
+    let out = dir.join("out");
+    assert_succeeded(&strata(&with(
+        os(compare_args(4, 1, 2)),
+        &[scene.as_os_str(), "--out".as_ref(), out.as_os_str()],
+    )));
+    let earlier = contents(&out);
+    // Key 1 looks straight up, along the scene camera's up vector.
+    let along_up = camera_path_file(
+        &dir,
+        "along-up.json",
+        &[(0.0, [278.0, 273.0, -800.0], [278.0, 273.0, 0.0]), (1.0, [278.0, 273.0, -800.0], [278.0, 274.0, -800.0])],
+    );
+    let output = strata(&with(
+        os(compare_args(4, 3, 2)),
+        &[scene.as_os_str(), "--camera-path".as_ref(), along_up.as_os_str(), "--out".as_ref(), out.as_os_str()],
+    ));
+    assert_refused(&output, &["--camera-path", "along-up.json", "keyframes[1].target", "parallel to `up`"]);
+    assert!(!text(&output.stderr).contains("fov_axis"), "{}", text(&output.stderr));
+    assert_eq!(contents(&out), earlier, "the earlier run's files were touched");
+    // Keys that can each make rays, whose spline brings origin onto target at frame 1.
+    let crossing = camera_path_file(
+        &dir,
+        "crossing.json",
+        &[(0.0, [278.0, 273.0, -900.0], [278.0, 273.0, -700.0]), (2.0, [278.0, 273.0, -700.0], [278.0, 273.0, -900.0])],
+    );
+    let output = strata(&with(
+        os(compare_args(4, 3, 2)),
+        &[scene.as_os_str(), "--camera-path".as_ref(), crossing.as_os_str(), "--out".as_ref(), out.as_os_str()],
+    ));
+    assert_refused(&output, &["--camera-path", "crossing.json", "frame 1 ", "target equals origin"]);
+    assert_eq!(contents(&out), earlier, "the earlier run's files were touched");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// Round three, 3. A GGX alpha below the smallest the renderer samples (10⁻³): every loader
+// renders it at 10⁻³ (OBJ and glTF did; JSON loaded 1e-30 and the render failed with
+// "326 samples were invalid", naming no field); JSON, which promises alpha as written,
+// says so in a warning naming the field.
+#[test]
+fn a_conductor_smoother_than_the_renderer_samples_renders_as_in_every_loader() {
+    let dir = scratch("alpha");
+    let conductor = |alpha: f64| {
+        move |scene: &mut serde_json::Value| {
+            let first = scene["materials"].as_object().unwrap().keys().next().unwrap().clone();
+            scene["materials"][&first] = serde_json::json!({"type": "roughconductor", "distribution": "ggx",
+                "alpha": alpha, "eta": [0.2, 0.9, 1.1], "k": [3.9, 2.4, 2.2], "two_sided": true});
+        }
+    };
+    let tiny = cornell_box(&dir, "tiny", conductor(1e-30));
+    let floor = cornell_box(&dir, "floor", conductor(1e-3));
+    let (tiny_out, floor_out) = (dir.join("tiny-out"), dir.join("floor-out"));
+    let output = strata(&with(os(render_args(8)), &[tiny.as_os_str(), "--out".as_ref(), tiny_out.as_os_str()]));
+    assert_succeeded(&output);
+    let stderr = text(&output.stderr);
+    let warnings: Vec<&str> = stderr.lines().filter(|l| l.starts_with("warning:")).collect();
+    assert_eq!(warnings.len(), 1, "{stderr}");
+    assert!(warnings[0].contains("scene.json") && warnings[0].contains(".alpha`") && warnings[0].contains("0.001"));
+    assert_succeeded(&strata(&with(os(render_args(8)), &[floor.as_os_str(), "--out".as_ref(), floor_out.as_os_str()])));
+    let (a, b) =
+        (std::fs::read(tiny_out.join("tiny.exr")).unwrap(), std::fs::read(floor_out.join("floor.exr")).unwrap());
+    assert!(a == b, "alpha 1e-30 must render exactly as alpha 1e-3");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// Round three, 4. A glTF camera's aspectRatio has an upper bound as it had a lower one
+// (600 gave a 512 × 1 black image and a warning about a camera seeing no light).
+#[test]
+fn gltf_aspect_ratios_beyond_the_limit_are_refused() {
+    let dir = scratch("aspect");
+    let out = dir.join("out");
+    let render =
+        |scene: &Path| strata(&with(os(render_args(4)), &[scene.as_os_str(), "--out".as_ref(), out.as_os_str()]));
+    for (name, aspect) in [("wide", 600.0), ("wider", 16.5), ("tall", 0.05)] {
+        let scene = gltf_scene(&dir, name, |d| d["cameras"][0]["perspective"]["aspectRatio"] = aspect.into());
+        assert_refused(&render(&scene), &["scene.gltf", "nodes[1].camera", "aspectRatio", "[1/16, 16]"]);
+    }
+    for (name, aspect) in [("widest", 16.0), ("tallest", 0.0625)] {
+        let scene = gltf_scene(&dir, name, |d| d["cameras"][0]["perspective"]["aspectRatio"] = aspect.into());
+        assert_succeeded(&render(&scene));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// Round three, 5. `render` into a folder it cannot write is refused before rendering (it
+// rendered for 37 s, then failed). A read-only tmpfs in a user namespace: a folder's
+// permissions do not stop root.
+#[test]
+fn render_refuses_a_folder_it_cannot_write_before_rendering() {
+    let dir = scratch("read-only");
+    let mount = dir.join("read-only");
+    std::fs::create_dir_all(&mount).unwrap();
+    // Far more samples than the deadline allows: only a refusal before rendering ends in time.
+    let script = format!(
+        "mount -t tmpfs -o size=64k,ro tmpfs '{mount}' || exit 97\ntimeout 60 '{bin}' render --backend cpu --width 64 \
+         --height 64 --spp 100000 --out '{mount}'; echo \"exit $?\"",
+        mount = mount.display(),
+        bin = binary().display()
+    );
+    let output = Command::new("unshare")
+        .args(["-rm", "sh", "-c", &script])
+        .env("RUST_BACKTRACE", "1")
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output();
+    let output = match output {
+        Ok(output) if output.status.code() != Some(97) => output,
+        other => {
+            eprintln!("SKIPPED: no read-only tmpfs could be mounted in a user namespace: {other:?}");
+            return;
+        }
+    };
+    let (stdout, stderr) = (text(&output.stdout), text(&output.stderr));
+    assert!(stdout.contains("exit 1"), "the render must be refused at once (124: it rendered):\n{stdout}\n{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error: ")).collect();
+    assert_eq!(errors.len(), 1, "{stderr}");
+    assert!(
+        errors[0].contains("--out") && errors[0].contains("read-only") && errors[0].contains("Read-only file system")
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// Round three, 6. Text files saved with a UTF-8 byte order mark or CRLF line ends read as
+// the same text: JSON scenes, camera paths, glTF, OBJ and MTL, PLY headers, errors.csv.
+#[test]
+fn text_files_with_a_byte_order_mark_or_crlf_read_the_same() {
+    let dir = scratch("bom");
+    let out = dir.join("out");
+    let bom = |path: &Path| {
+        let mut bytes = b"\xEF\xBB\xBF".to_vec();
+        bytes.extend(std::fs::read(path).unwrap());
+        std::fs::write(path, bytes).unwrap();
+    };
+    let render = |scene: &Path, name: &str| {
+        let output =
+            strata(&with(os(render_args(8)), &[scene.as_os_str(), "--out".as_ref(), out.join(name).as_os_str()]));
+        assert_succeeded(&output);
+        assert!(!text(&output.stderr).contains("warning:"), "{}", text(&output.stderr));
+        let exr = files(&out.join(name)).into_iter().find(|(p, _)| p.extension().is_some_and(|e| e == "exr"));
+        std::fs::read(exr.expect("an EXR was written").0).unwrap()
+    };
+    // JSON scene with a BOM, its PLY meshes' headers with CRLF line ends.
+    let plain = cornell_box(&dir, "plain", |_| {});
+    let marked = cornell_box(&dir, "marked", |_| {});
+    bom(&marked);
+    for entry in std::fs::read_dir(marked.parent().unwrap().join("meshes")).unwrap().map(Result::unwrap) {
+        let bytes = std::fs::read(entry.path()).unwrap();
+        let end = bytes.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+        let header = String::from_utf8(bytes[..end].to_vec()).unwrap().replace('\n', "\r\n");
+        std::fs::write(entry.path(), [header.as_bytes(), &bytes[end..]].concat()).unwrap();
+    }
+    assert!(render(&plain, "plain") == render(&marked, "marked"), "the JSON + PLY scene renders otherwise");
+    // OBJ and MTL with a BOM (in the MTL it hid the first `newmtl`), CRLF line ends.
+    let obj = obj_scene(&dir, "obj-plain", "", Some(ROOM_MTL));
+    let marked_obj = obj_scene(&dir, "obj-marked", "", Some(&ROOM_MTL.replace('\n', "\r\n")));
+    let crlf = std::fs::read_to_string(&marked_obj).unwrap().replace('\n', "\r\n");
+    std::fs::write(&marked_obj, crlf).unwrap();
+    bom(&marked_obj);
+    bom(&marked_obj.with_file_name("room.mtl"));
+    assert!(render(&obj, "obj-plain") == render(&marked_obj, "obj-marked"), "the OBJ scene renders otherwise");
+    // glTF JSON with a BOM.
+    let gltf = gltf_scene(&dir, "gltf-plain", |_| {});
+    let marked_gltf = gltf_scene(&dir, "gltf-marked", |_| {});
+    bom(&marked_gltf);
+    assert!(render(&gltf, "gltf-plain") == render(&marked_gltf, "gltf-marked"), "the glTF scene renders otherwise");
+    // A camera path with a BOM.
+    let path = camera_path_file(
+        &dir,
+        "path.json",
+        &[(0.0, [278.0, 273.0, -800.0], [278.0, 273.0, 0.0]), (1.0, [290.0, 273.0, -800.0], [278.0, 273.0, 0.0])],
+    );
+    bom(&path);
+    let output = strata(&with(
+        os(compare_args(4, 2, 2)),
+        &[
+            plain.as_os_str(),
+            "--camera-path".as_ref(),
+            path.as_os_str(),
+            "--out".as_ref(),
+            out.join("path").as_os_str(),
+        ],
+    ));
+    assert_succeeded(&output);
+    // errors.csv with a BOM and CRLF line ends.
+    let rows = [("strata", 1, 1, 0.5), ("restir", 1, 1, 1.0), ("strata", 1, 2, 0.4), ("restir", 1, 2, 0.9)];
+    let file = dir.join("errors.csv");
+    std::fs::write(&file, format!("\u{feff}{}", csv(&rows).replace('\n', "\r\n"))).unwrap();
+    assert_succeeded(&strata(&["plot".as_ref(), file.as_os_str(), "--out".as_ref(), dir.join("plot").as_os_str()]));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// Round three, 7. A control character in `plot --title` or `--label` wrote an SVG that is
+// not XML, with exit status 0.
+#[test]
+fn plot_titles_and_labels_with_control_characters_are_refused() {
+    let dir = scratch("plot-title");
+    let rows = [("strata", 1, 1, 0.5), ("restir", 1, 1, 1.0), ("strata", 1, 2, 0.4), ("restir", 1, 2, 0.9)];
+    let file = dir.join("errors.csv");
+    std::fs::write(&file, csv(&rows)).unwrap();
+    let stem = dir.join("plot");
+    for (flag, value) in [("--title", "bell\u{7}"), ("--title", "two\nlines"), ("--label", "esc\u{1b}[31m")] {
+        let output = strata(&[
+            "plot".as_ref(),
+            file.as_os_str(),
+            "--out".as_ref(),
+            stem.as_os_str(),
+            flag.as_ref(),
+            value.as_ref(),
+        ]);
+        assert_refused(&output, &[flag, "control character"]);
+        assert!(files(&dir).iter().all(|(p, _)| p == &file), "a file was written: {:?}", files(&dir));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// Round three, 8. Messages quote what the user typed, on one line.
+#[test]
+fn messages_quote_the_text_given_on_one_line() {
+    let dir = scratch("quoted");
+    // A float prints 4294967295 as 4294967300.
+    let output = strata(&["compare", "--backend", "cpu", "--disc-radius", "4294967295"]);
+    assert_refused_with(&output, 2, &["--disc-radius", "'4294967295'", "16384"]);
+    assert!(!text(&output.stderr).contains("4294967300"), "{}", text(&output.stderr));
+    let output = strata(&["compare", "--backend", "cpu", "--temporal-cap", "1e40"]);
+    assert_refused_with(&output, 2, &["--temporal-cap", "'1e40'", "at least 1"]);
+    // A broken JPEG texture: the decoder's message ended in a blank line.
+    let scene = cornell_box(&dir, "jpeg", |scene| {
+        let first = scene["materials"].as_object().unwrap().keys().next().unwrap().clone();
+        scene["materials"][&first]["reflectance"] = serde_json::json!({"texture": "broken.jpg"});
+    });
+    let jpeg = std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/report-screenshot.jpg")).unwrap();
+    std::fs::write(scene.with_file_name("broken.jpg"), &jpeg[..700]).unwrap();
+    let output = strata(&with(os(render_args(4)), &[scene.as_os_str(), "--out".as_ref(), dir.join("out").as_os_str()]));
+    assert_refused(&output, &["broken.jpg"]);
+    let stderr = text(&output.stderr);
+    assert_eq!(stderr.lines().count(), 1, "not one line: {stderr:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

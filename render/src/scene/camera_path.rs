@@ -15,7 +15,7 @@
 //! give a straight line at constant speed, and frames before the first key or after the
 //! last one hold that key (clamping).
 
-use super::{Camera, SceneError};
+use super::{Camera, CameraFrame, SceneError};
 use glam::DVec3;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -144,10 +144,17 @@ impl CameraPath {
         Camera { origin: origin.as_vec3().to_array(), target: target.as_vec3().to_array(), ..base.clone() }
     }
 
-    /// Whether every frame gets the same camera: [`CameraPath::Static`], at most one
-    /// keyframe, an orbit by 0° (or about no axis), a dolly by 0 (or along no direction).
-    pub fn is_static(&self) -> bool {
-        match self {
+    /// The one camera of every frame, when every frame gets the same: the base camera for
+    /// [`CameraPath::Static`] (and no keys), **that key's camera** for a single keyframe,
+    /// the start for an orbit by a whole number of turns (or about no axis) and a dolly by
+    /// 0 (or along no direction). `None` when the camera moves.
+    ///
+    /// This is the camera a still run renders from (one reference, frames that may be
+    /// accumulated): a caller never takes "still" to mean "the base camera", which
+    /// rendered a one-keyframe path from the scene's camera while the run's record named
+    /// the path's file.
+    pub fn still_camera(&self, base: &Camera) -> Option<Camera> {
+        let still = match self {
             CameraPath::Static => true,
             CameraPath::Keyframes(keys) => keys.len() <= 1,
             CameraPath::Orbit { axis, degrees_per_frame, .. } => {
@@ -156,7 +163,27 @@ impl CameraPath {
             CameraPath::Dolly { direction, distance_per_frame, .. } => {
                 *distance_per_frame == 0.0 || *direction == [0.0; 3]
             }
-        }
+        };
+        still.then(|| self.camera_at(base, 0))
+    }
+
+    /// The camera of each of frames `0..frames`, every one checked
+    /// ([`CameraFrame::checked`]): the first that cannot make rays (between keys that
+    /// can, a spline may pass through a view along `up`, or bring origin and target
+    /// together) is an error naming its frame, before anything is rendered.
+    pub fn frame_cameras(&self, base: &Camera, frames: u32) -> Result<Vec<Camera>, String> {
+        (0..frames)
+            .map(|frame| {
+                let camera = self.camera_at(base, frame);
+                match CameraFrame::checked(&camera) {
+                    Ok(_) => Ok(camera),
+                    Err(why) => Err(format!(
+                        "frame {frame} (counted from 0, as keyframes count): origin {:?}, target {:?}: {why}",
+                        camera.origin, camera.target
+                    )),
+                }
+            })
+            .collect()
     }
 }
 
@@ -169,11 +196,15 @@ impl CameraPath {
 ///   file named `static`).
 ///
 /// A number that is not finite, an orbit about a zero `base.up` or a dolly of a base
-/// whose origin equals its target is an error naming `spec` and the field.
+/// whose origin equals its target is an error naming `spec` and the field. A keyframe
+/// file is checked whole before anything renders: besides [`CameraPath::load`]'s rules,
+/// each key's camera (`base` with the key's origin and target) must be able to make rays
+/// ([`CameraFrame::checked`]: a key looking along `base.up` is an error naming
+/// `keyframes[i].target`).
 pub fn parse_camera_path(spec: impl AsRef<std::ffi::OsStr>, base: &Camera) -> Result<CameraPath, SceneError> {
     let spec = spec.as_ref();
     // A path that is not UTF-8 names a keyframe file; the keywords are ASCII.
-    let Some(spec) = spec.to_str() else { return CameraPath::load(Path::new(spec)) };
+    let Some(spec) = spec.to_str() else { return keyframe_file(Path::new(spec), base) };
     let error =
         |field: &str, message: String| SceneError::Json { path: PathBuf::from(spec), field: field.into(), message };
     let number = |field: &str, text: &str, unit: &str| -> Result<f32, SceneError> {
@@ -201,8 +232,30 @@ pub fn parse_camera_path(spec: impl AsRef<std::ffi::OsStr>, base: &Camera) -> Re
         }
         Ok(CameraPath::dolly(base, distance))
     } else {
-        CameraPath::load(Path::new(spec))
+        keyframe_file(Path::new(spec), base)
     }
+}
+
+/// [`CameraPath::load`], then every key's camera checked against `base` (what
+/// [`parse_camera_path`] adds to the load).
+fn keyframe_file(path: &Path, base: &Camera) -> Result<CameraPath, SceneError> {
+    let loaded = CameraPath::load(path)?;
+    if let CameraPath::Keyframes(keys) = &loaded {
+        for (index, key) in keys.iter().enumerate() {
+            let camera = Camera { origin: key.origin, target: key.target, ..base.clone() };
+            if let Err(why) = CameraFrame::checked(&camera) {
+                return Err(SceneError::Json {
+                    path: path.into(),
+                    field: format!("keyframes[{index}].target"),
+                    message: format!(
+                        "{:?} seen from origin {:?} with the scene camera's up {:?}: {why}",
+                        key.target, key.origin, base.up
+                    ),
+                });
+            }
+        }
+    }
+    Ok(loaded)
 }
 
 /// Checks the rules of [`CameraPath::load`] on the keys read from `path`.
@@ -429,12 +482,17 @@ mod tests {
     }
 
     #[test]
-    fn a_single_keyframe_and_static_are_static() {
+    fn a_single_keyframe_and_static_are_still_each_with_its_own_camera() {
         let base = base();
         let single = CameraPath::Keyframes(vec![key(3.0, [1.0, 2.0, 3.0], [0.0, 0.0, 0.0])]);
-        assert!(single.is_static());
-        assert!(CameraPath::Static.is_static());
-        assert!(!CameraPath::Keyframes(keys()).is_static());
+        // A single key is still, from the key's camera, not the base's.
+        let still = single.still_camera(&base).expect("one key does not move");
+        assert_eq!((still.origin, still.target), ([1.0, 2.0, 3.0], [0.0, 0.0, 0.0]));
+        assert_eq!((still.up, still.fov_deg, still.width), (base.up, base.fov_deg, base.width));
+        assert_eq!(CameraPath::Static.still_camera(&base), Some(base.clone()));
+        assert_eq!(CameraPath::Keyframes(Vec::new()).still_camera(&base), Some(base.clone()));
+        assert_eq!(CameraPath::orbit(&base, 720.0).still_camera(&base), Some(base.clone()));
+        assert_eq!(CameraPath::Keyframes(keys()).still_camera(&base), None);
         for frame in [0, 3, 7, 100] {
             let camera = single.camera_at(&base, frame);
             assert_eq!((camera.origin, camera.target), ([1.0, 2.0, 3.0], [0.0, 0.0, 0.0]));
@@ -453,7 +511,7 @@ mod tests {
         };
         let radius = distance(base.origin, base.target);
         let path = CameraPath::orbit(&base, 7.5);
-        assert!(!path.is_static());
+        assert_eq!(path.still_camera(&base), None);
         let start = flat(&base);
         for frame in [0u32, 1, 4, 12, 30, 47] {
             let camera = path.camera_at(&base, frame);
@@ -490,7 +548,7 @@ mod tests {
                 assert_eq!(camera.fov_deg, base.fov_deg);
             }
         }
-        assert!(CameraPath::dolly(&base, 0.0).is_static());
+        assert_eq!(CameraPath::dolly(&base, 0.0).still_camera(&base), Some(base.clone()));
     }
 
     #[test]
@@ -588,5 +646,43 @@ mod tests {
             assert_eq!(field, expected, "{name}: {message}");
             assert!(message.contains(expected), "{name}: {message}");
         }
+    }
+
+    #[test]
+    fn every_key_is_checked_against_the_base_camera_when_parsed() {
+        let base = Camera { up: [0.0, 1.0, 0.0], ..base() };
+        // Key 2 looks straight down the up axis: no right vector, so no rays.
+        let text = r#"{"keyframes": [{"frame": 0, "origin": [0, 1, -5], "target": [0, 1, 0]},
+                                     {"frame": 1, "origin": [1, 1, -5], "target": [0, 1, 0]},
+                                     {"frame": 2, "origin": [0, 5, 0], "target": [0, 1, 0]}]}"#;
+        let path = temp_file("along-up", text);
+        let parsed = parse_camera_path(&path, &base);
+        std::fs::remove_file(&path).unwrap();
+        match parsed {
+            Err(error @ SceneError::Json { .. }) => {
+                let message = error.to_string();
+                assert!(message.contains("keyframes[2].target"), "{message}");
+                assert!(message.contains("parallel to `up`"), "{message}");
+                assert!(!message.contains("fov_axis"), "{message}");
+            }
+            other => panic!("expected an error naming keyframes[2].target, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn frame_cameras_name_the_first_frame_that_cannot_make_rays() {
+        let base = Camera { up: [0.0, 1.0, 0.0], ..base() };
+        // Valid keys whose spline brings origin onto target at frame 1.
+        let path = CameraPath::Keyframes(vec![
+            key(0.0, [0.0, 0.0, -1.0], [0.0, 0.0, 1.0]),
+            key(2.0, [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]),
+        ]);
+        assert_eq!(path.frame_cameras(&base, 1).map(|c| c.len()), Ok(1));
+        let error = path.frame_cameras(&base, 3).unwrap_err();
+        assert!(error.starts_with("frame 1 "), "{error}");
+        assert!(error.contains("target equals origin"), "{error}");
+        let moving = CameraPath::orbit(&base, 10.0).frame_cameras(&base, 5).unwrap();
+        assert_eq!(moving.len(), 5);
+        assert_eq!(moving[3], CameraPath::orbit(&base, 10.0).camera_at(&base, 3));
     }
 }

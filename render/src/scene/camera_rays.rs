@@ -8,6 +8,9 @@ use super::Camera;
 use glam::Vec3;
 use strata_kernels::trace_types::CameraParams;
 
+/// Why a camera whose numbers overflow has no frame.
+const BEYOND_PRECISION: &str = "the camera's vectors or opening angle are beyond single precision";
+
 /// The camera's frame and field of view, ready to make rays.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraFrame {
@@ -29,21 +32,49 @@ pub struct CameraFrame {
 
 impl CameraFrame {
     /// The frame of `camera`; `None` if `fov_axis` is neither `x` nor `smaller`, or the
-    /// camera looks along its up vector.
+    /// camera looks along its up vector ([`CameraFrame::checked`] says which).
     pub fn new(camera: &Camera) -> Option<CameraFrame> {
+        CameraFrame::unchecked(camera).ok()
+    }
+
+    /// The frame of `camera`, or why it has none, in words that name the camera's fields:
+    /// `fov_axis` other than `x` or `smaller`, `target` equal to `origin`, a view
+    /// direction parallel to `up` (or `up` zero), or vectors or an opening angle beyond
+    /// single precision.
+    pub fn checked(camera: &Camera) -> Result<CameraFrame, &'static str> {
+        let frame = CameraFrame::unchecked(camera)?;
+        let directions = [frame.forward, frame.right, frame.up].iter().all(|v| v.is_finite());
+        if !(directions && frame.origin.is_finite() && frame.tan_half_x.is_finite() && frame.tan_half_y.is_finite()) {
+            return Err(BEYOND_PRECISION);
+        }
+        Ok(frame)
+    }
+
+    /// [`CameraFrame::checked`] without the finiteness check.
+    fn unchecked(camera: &Camera) -> Result<CameraFrame, &'static str> {
         let origin = Vec3::from(camera.origin);
-        let forward = (Vec3::from(camera.target) - origin).try_normalize()?;
-        let right = forward.cross(Vec3::from(camera.up)).try_normalize()?;
-        let up = right.cross(forward);
         let (w, h) = (camera.width as f32, camera.height as f32);
         let tan_half = (camera.fov_deg.to_radians() * 0.5).tan();
         let (tan_half_x, tan_half_y) = match camera.fov_axis.as_str() {
             "x" => (tan_half, tan_half * h / w),
             "smaller" if w <= h => (tan_half, tan_half * h / w),
             "smaller" => (tan_half * w / h, tan_half),
-            _ => return None,
+            _ => return Err("fov_axis must be `x` or `smaller`"),
         };
-        Some(CameraFrame { origin, forward, right, up, tan_half_x, tan_half_y, near_clip: camera.near_clip })
+        let view = Vec3::from(camera.target) - origin;
+        if view == Vec3::ZERO {
+            return Err("target equals origin: the camera has no view direction");
+        }
+        let forward = view.try_normalize().ok_or(BEYOND_PRECISION)?;
+        let side = forward.cross(Vec3::from(camera.up));
+        let right = side.try_normalize().ok_or(if side.is_finite() {
+            "the view direction (target - origin) is parallel to `up` (or `up` is zero): the image would have no \
+             horizontal direction"
+        } else {
+            BEYOND_PRECISION
+        })?;
+        let up = right.cross(forward);
+        Ok(CameraFrame { origin, forward, right, up, tan_half_x, tan_half_y, near_clip: camera.near_clip })
     }
 
     /// The `camera_rays` kernel's parameters for a `width × height` image; `jitter_seed`

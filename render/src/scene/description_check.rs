@@ -105,14 +105,8 @@ pub(super) fn check(path: &Path, description: &SceneDescription) -> Result<(), S
             format!("{}×{} pixels: each side must lie in 1..={MAX_IMAGE_SIDE}", camera.width, camera.height),
         ));
     }
-    let frame = super::CameraFrame::new(camera).filter(|f| {
-        [f.forward, f.right, f.up].iter().all(|v| v.is_finite()) && f.tan_half_x.is_finite() && f.tan_half_y.is_finite()
-    });
-    if frame.is_none() {
-        return Err(error(
-            "camera.target".into(),
-            "the camera has no view direction, or looks along `up` (or the vectors overflow)".into(),
-        ));
+    if let Err(why) = super::CameraFrame::checked(camera) {
+        return Err(error("camera.target".into(), why.into()));
     }
     numbers("camera.near_clip".into(), &[camera.near_clip], Rule::NonNegative)?;
     if !(camera.far_clip.is_finite() && camera.far_clip > camera.near_clip) {

@@ -98,9 +98,25 @@ fn read_waiting_for_writers(file: std::fs::File, bytes: &mut Vec<u8>) -> std::io
     }
 }
 
-/// [`read_capped`] as UTF-8 text.
+/// [`read_capped`] as UTF-8 text, without a leading byte order mark ([`without_bom`]).
 pub fn read_text_capped(path: &Path) -> std::io::Result<String> {
-    String::from_utf8(read_capped(path)?).map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
+    let mut bytes = read_capped(path)?;
+    let mark = bytes.len() - without_bom(&bytes).len();
+    bytes.drain(..mark);
+    String::from_utf8(bytes).map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
+}
+
+/// The UTF-8 byte order mark (U+FEFF) that some editors (Windows Notepad among them) put
+/// at the start of a text file.
+pub const UTF8_BOM: &[u8] = b"\xEF\xBB\xBF";
+
+/// `bytes` without a leading UTF-8 byte order mark: the one place every text reader
+/// (JSON scenes and camera paths, glTF JSON, OBJ and MTL, PLY headers, `errors.csv`)
+/// drops it, so that a file saved "as UTF-8 with BOM" reads as the same text (a JSON
+/// parser refused it at line 1 column 1; in an MTL file it hid the first `newmtl`).
+/// Binary formats never start with these bytes (a GLB starts with `glTF`).
+pub fn without_bom(bytes: &[u8]) -> &[u8] {
+    bytes.strip_prefix(UTF8_BOM).unwrap_or(bytes)
 }
 
 /// Files held in memory, by path; a path not in the map is "not found", unless a
@@ -137,4 +153,32 @@ impl FileSource for MemoryFiles {
 /// Reads `path` through `files`, as a [`super::SceneError::Io`] naming it on failure.
 pub(super) fn read(files: &dyn FileSource, path: &Path) -> Result<Vec<u8>, super::SceneError> {
     files.read(path).map_err(|source| super::SceneError::Io { path: path.into(), source })
+}
+
+/// Reads the text file `path` through `files` as UTF-8, without a leading byte order
+/// mark; bytes that are not UTF-8 are a [`super::SceneError::Io`] naming the file.
+pub(super) fn read_text(files: &dyn FileSource, path: &Path) -> Result<String, super::SceneError> {
+    let bytes = read(files, path)?;
+    String::from_utf8(without_bom(&bytes).to_vec()).map_err(|source| super::SceneError::Io {
+        path: path.into(),
+        source: std::io::Error::new(std::io::ErrorKind::InvalidData, source),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_byte_order_mark_is_dropped_once_and_only_at_the_start() {
+        assert_eq!(without_bom(b"\xEF\xBB\xBF{}"), b"{}");
+        assert_eq!(without_bom(b"\xEF\xBB\xBF\xEF\xBB\xBF{}"), b"\xEF\xBB\xBF{}");
+        assert_eq!(without_bom(b"{\xEF\xBB\xBF}"), b"{\xEF\xBB\xBF}");
+        assert_eq!(without_bom(b"\xEF\xBB"), b"\xEF\xBB");
+        let mut files = MemoryFiles::default();
+        files.insert("a.json", b"\xEF\xBB\xBF{\"a\": 1}\r\n".to_vec()).insert("b.json", vec![0xEF, 0xBB, 0xBF, 0xFF]);
+        assert_eq!(read_text(&files, Path::new("a.json")).unwrap(), "{\"a\": 1}\r\n");
+        let error = read_text(&files, Path::new("b.json")).unwrap_err().to_string();
+        assert!(error.contains("b.json"), "{error}");
+    }
 }

@@ -10,7 +10,8 @@
 //!   counted as in PLY meshes; NaN or infinite vertices are errors. Skins and morph targets
 //!   are ignored (the bind pose is used).
 //! * Camera: the first perspective camera met in the node hierarchy (depth first). Its
-//!   image is 512 pixels wide, and 512 / `aspectRatio` high (512 × 512 without one); `yfov`
+//!   image is 512 pixels wide, and 512 / `aspectRatio` high (512 × 512 without one;
+//!   `aspectRatio` must lie in [1/16, 16], [`MAX_GLTF_ASPECT_RATIO`]); `yfov`
 //!   becomes the horizontal opening angle 2·atan(tan(yfov/2)·width/height) with `fov_axis`
 //!   `x`, so the vertical field of view is exactly `yfov`. Without `zfar`, the far clip lies
 //!   beyond the whole scene. Without a perspective camera: a camera framing the scene,
@@ -42,8 +43,8 @@ use super::gltf_check::{
     check_accessor_sizes, check_glb_header, check_position_accessors, document_error, json_error, raw_json,
 };
 use super::mesh_util::{
-    DEFAULT_IMAGE_SIDE, MIN_ALPHA, assemble_scene, bounds, checked_triangles, default_material, emission,
-    far_clip_beyond, metal, tinted, without_panic,
+    DEFAULT_IMAGE_SIDE, assemble_scene, bounds, checked_triangles, default_material, emission, far_clip_beyond, metal,
+    tinted, without_panic,
 };
 use super::texture::{decode_image, rgba8};
 use super::uri::{self, Resolved};
@@ -100,6 +101,11 @@ fn check_version(path: &Path, raw: &serde_json::Value) -> Result<(), SceneError>
     }
 }
 
+/// The widest and (as its reciprocal) the tallest camera `aspectRatio` a glTF camera may
+/// have: 16, a 512 × 32 image (and 1/16, 512 × 8192). Beyond it the image is a few rows
+/// or columns whose other side spans nearly 180° (600 gave 512 × 1 pixels, black).
+pub const MAX_GLTF_ASPECT_RATIO: f32 = 16.0;
+
 /// How far from 1 the length of a node's rotation quaternion may be (exporters write
 /// unit quaternions rounded to a few decimals); beyond it the rotation is an error,
 /// since glam would turn a zero quaternion into no rotation at all.
@@ -107,6 +113,8 @@ const QUATERNION_LENGTH_TOLERANCE: f32 = 1e-2;
 
 /// Loads the document in `bytes`, read from `path`.
 fn load_bytes(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene, SceneError> {
+    // A `.gltf` is JSON text: saved with a byte order mark, it is the same document.
+    let bytes = files::without_bom(bytes);
     check_glb_header(path, bytes)?;
     let raw = raw_json(bytes).map_err(|message| json_error(path, "(document)", message))?;
     check_version(path, &raw)?;
@@ -263,7 +271,7 @@ impl Loader<'_> {
         let two_sided = material.double_sided();
         let mut tex_coord = None;
         let bsdf = if metallic >= 0.5 {
-            metal([r, g, b], (roughness * roughness).max(MIN_ALPHA), two_sided)
+            metal([r, g, b], roughness * roughness, two_sided)
         } else if let Some(info) = pbr.base_color_texture() {
             tex_coord = Some(info.tex_coord());
             let texture = self.texture(info.texture().source(), [r, g, b])?;
@@ -534,13 +542,18 @@ impl Loader<'_> {
             return Err(self.error(field, format!("yfov {yfov} must lie in (0, π)")));
         }
         let (width, height) = match perspective.aspect_ratio() {
-            Some(aspect) if aspect.is_finite() && aspect > 0.0 && DEFAULT_IMAGE_SIDE as f32 / aspect <= 8192.0 => {
-                (DEFAULT_IMAGE_SIDE, ((DEFAULT_IMAGE_SIDE as f32 / aspect).round() as u32).max(1))
+            Some(aspect) if (1.0 / MAX_GLTF_ASPECT_RATIO..=MAX_GLTF_ASPECT_RATIO).contains(&aspect) => {
+                (DEFAULT_IMAGE_SIDE, (DEFAULT_IMAGE_SIDE as f32 / aspect).round() as u32)
             }
             Some(aspect) => {
                 return Err(self.error(
                     field,
-                    format!("aspectRatio {aspect} must be ≥ 1/16 (the image is {DEFAULT_IMAGE_SIDE} pixels wide)"),
+                    format!(
+                        "aspectRatio {aspect} must lie in [1/{MAX_GLTF_ASPECT_RATIO}, {MAX_GLTF_ASPECT_RATIO}] (the image is \
+                         {DEFAULT_IMAGE_SIDE} pixels wide, so {} to {} pixels high)",
+                        (DEFAULT_IMAGE_SIDE as f32 / MAX_GLTF_ASPECT_RATIO) as u32,
+                        (DEFAULT_IMAGE_SIDE as f32 * MAX_GLTF_ASPECT_RATIO) as u32
+                    ),
                 ));
             }
             None => (DEFAULT_IMAGE_SIDE, DEFAULT_IMAGE_SIDE),

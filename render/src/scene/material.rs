@@ -25,6 +25,20 @@ pub enum Albedo {
     },
 }
 
+/// The smallest GGX alpha the renderer samples: 10⁻³. Below it the kernels' GGX
+/// terms leave single precision (alpha 10⁻³⁰ made every sample of such a surface NaN, and
+/// the render failed naming no field), and the lobe, 0.06° wide, is already narrower than
+/// a pixel at the usual fields of view: a smoother conductor is a mirror to the eye.
+pub const MIN_ALPHA: f32 = 1e-3;
+
+/// The one rule every loader (JSON `roughconductor` `alpha`, OBJ `Pr`/`Ns`, glTF
+/// `roughnessFactor`) applies to a GGX alpha: one below [`MIN_ALPHA`] (a mirror, or a
+/// near one) is rendered at [`MIN_ALPHA`]; the caller has refused one that is not finite
+/// and positive.
+pub fn ggx_alpha(alpha: f32) -> f32 {
+    alpha.max(MIN_ALPHA)
+}
+
 /// A BSDF with its parameters.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Material {
@@ -37,7 +51,8 @@ pub enum Material {
     },
     /// GGX microfacet conductor with exact complex-IOR Fresnel.
     RoughConductor {
-        /// GGX alpha (no remapping).
+        /// GGX alpha (no remapping), at least [`MIN_ALPHA`] as every loader makes it
+        /// ([`ggx_alpha`]).
         alpha: f32,
         /// Real part of the IOR per channel.
         eta: [f32; 3],

@@ -14,8 +14,7 @@ pub(super) const DEFAULT_MAX_DEPTH: u32 = 8;
 pub(super) const DEFAULT_RR_DEPTH: u32 = 5;
 /// Reflectance of the grey diffuse material given to a mesh without a material.
 pub(super) const DEFAULT_GREY: f32 = 0.8;
-/// Smallest GGX alpha a roughness is mapped to (a perfect mirror is not sampled).
-pub(super) const MIN_ALPHA: f32 = 1e-3;
+pub(super) use super::material::MIN_ALPHA;
 
 /// The grey diffuse material of a mesh without one.
 pub(super) fn default_material() -> Material {
@@ -181,7 +180,8 @@ pub(super) fn assemble_scene(
 
 /// A GGX conductor whose normal-incidence reflectance is `colour`, with the same colour as
 /// edge tint: the complex IOR of Gulbrandsen, "Artist Friendly Metallic Fresnel" (JCGT
-/// 2014), per channel.
+/// 2014), per channel; `alpha` goes through the loaders' one rule,
+/// [`super::material::ggx_alpha`].
 pub(super) fn metal(colour: [f32; 3], alpha: f32, two_sided: bool) -> Material {
     let mut eta = [0.0; 3];
     let mut k = [0.0; 3];
@@ -195,7 +195,7 @@ pub(super) fn metal(colour: [f32; 3], alpha: f32, two_sided: bool) -> Material {
         eta[channel] = n;
         k[channel] = k2.max(0.0).sqrt();
     }
-    Material::RoughConductor { alpha: alpha.max(MIN_ALPHA), eta, k, two_sided }
+    Material::RoughConductor { alpha: super::material::ggx_alpha(alpha), eta, k, two_sided }
 }
 
 /// `texture` with every texel multiplied by `factor` (a material's constant colour times

@@ -15,9 +15,12 @@
 //! Numbers are checked where they are read: a NaN, infinite or (where it means nothing)
 //! negative camera field, reflectance, emitted radiance, material parameter, texture or
 //! environment texel, or a transform that is singular or not finite, is an error naming
-//! the field; nothing is clamped. Sizes are checked before allocating: a count declared in
-//! a file (PLY elements, glTF accessors, EXR data windows) must fit in the bytes that
-//! follow. Every loader reads through a [`FileSource`], so a scene can be loaded from
+//! the field; nothing is clamped but a GGX alpha below [`MIN_ALPHA`], which every loader
+//! renders at [`MIN_ALPHA`] ([`ggx_alpha`]; a JSON scene, whose format promises alpha as
+//! written, says so in a warning). Text files may start with a UTF-8 byte order mark
+//! ([`without_bom`]) and end lines in CRLF. Sizes are checked before allocating: a count
+//! declared in a file (PLY elements, glTF accessors, EXR data windows) must fit in the
+//! bytes that follow. Every loader reads through a [`FileSource`], so a scene can be loaded from
 //! memory ([`load_scene_from`], [`MemoryFiles`]) as well as from disk.
 
 mod camera_path;
@@ -47,9 +50,11 @@ pub use environment::Environment;
 pub use exr_decode::{
     MAX_BLOCK_BYTES, MAX_BLOCK_BYTES_PER_FILE_BYTE, MAX_EXR_TEXELS, MAX_TEXELS_PER_FILE_BYTE, RgbExr, decode_rgb_exr,
 };
-pub use files::{DiskFiles, FileSource, MAX_INPUT_FILE_BYTES, MemoryFiles, read_capped, read_text_capped};
-pub use gltf_scene::{load_gltf, load_gltf_from};
-pub use material::{Albedo, Material};
+pub use files::{
+    DiskFiles, FileSource, MAX_INPUT_FILE_BYTES, MemoryFiles, UTF8_BOM, read_capped, read_text_capped, without_bom,
+};
+pub use gltf_scene::{MAX_GLTF_ASPECT_RATIO, load_gltf, load_gltf_from};
+pub use material::{Albedo, MIN_ALPHA, Material, ggx_alpha};
 pub use obj_scene::{load_obj, load_obj_from};
 pub use ply::{PlyMesh, parse_ply, read_ply};
 pub use texture::{MAX_TEXTURE_BYTES, Texture, srgb_to_linear};
@@ -79,7 +84,7 @@ pub enum SceneError {
         source: std::io::Error,
     },
     /// The JSON does not describe a scene; `field` is the JSON path of the problem.
-    #[error("{path}: field `{field}`: {message}")]
+    #[error("{}: field `{field}`: {}", .path.display(), one_line(.message))]
     Json {
         /// The file.
         path: PathBuf,
@@ -89,7 +94,7 @@ pub enum SceneError {
         message: String,
     },
     /// An image (texture or environment map) that cannot be used.
-    #[error("{path}: {message}")]
+    #[error("{}: {}", .path.display(), one_line(.message))]
     Image {
         /// The file.
         path: PathBuf,
@@ -97,7 +102,7 @@ pub enum SceneError {
         message: String,
     },
     /// A PLY file that cannot be read; `element` says where.
-    #[error("{path}: {element}: {message}")]
+    #[error("{}: {element}: {}", .path.display(), one_line(.message))]
     Ply {
         /// The file.
         path: PathBuf,
@@ -106,6 +111,23 @@ pub enum SceneError {
         /// What is wrong.
         message: String,
     },
+}
+
+/// `message` as one line: every run of whitespace that holds a line break becomes one
+/// space, and trailing whitespace goes. A decoder's own text (the `image` crate's JPEG
+/// errors end in a blank line) then never splits the one `error:` line a refusal is.
+fn one_line(message: &str) -> String {
+    let mut line = String::with_capacity(message.len());
+    for (index, piece) in message.trim_end().split(['\n', '\r']).enumerate() {
+        if index == 0 {
+            line.push_str(piece);
+        } else if !piece.trim().is_empty() {
+            line.truncate(line.trim_end().len());
+            line.push(' ');
+            line.push_str(piece.trim_start());
+        }
+    }
+    line
 }
 
 /// One shape of the scene: a mesh with its object id, material and emission.
@@ -149,8 +171,8 @@ pub struct Scene {
     /// The environment map.
     pub environment: Option<Environment>,
     /// What the loader left out or replaced and said so (an OBJ face of two vertices, a
-    /// material name no library defines, a missing material library): each names the
-    /// file and line; the command line prints them once and the run record keeps them.
+    /// material name no library defines, a missing material library, a JSON alpha below
+    /// [`MIN_ALPHA`]): each names the file and line or field; the command line prints them once and the run record keeps them.
     pub warnings: Vec<String>,
 }
 
@@ -162,20 +184,20 @@ impl Scene {
 
     /// Loads the scene description `path` and the files it names through `files`.
     pub fn load_from(path: &Path, files: &dyn FileSource) -> Result<Scene, SceneError> {
-        let bytes = files::read(files, path)?;
-        let text = String::from_utf8(bytes).map_err(|source| SceneError::Io {
-            path: path.into(),
-            source: std::io::Error::new(std::io::ErrorKind::InvalidData, source),
-        })?;
+        let text = files::read_text(files, path)?;
         let description = description::parse(path, &text)?;
         description_check::check(path, &description)?;
         let folder = path.parent().unwrap_or(Path::new("."));
         let mut material_names: Vec<String> = description.materials.keys().cloned().collect();
         material_names.sort();
         let mut textures = Vec::new();
+        let mut warnings = Vec::new();
         let materials = material_names
             .iter()
-            .map(|name| resolve_material(path, folder, name, &description.materials[name], files, &mut textures))
+            .map(|name| {
+                let description = &description.materials[name];
+                resolve_material(path, folder, name, description, files, &mut textures, &mut warnings)
+            })
             .collect::<Result<Vec<_>, _>>()?;
         let mut shapes = Vec::with_capacity(description.shapes.len());
         for (index, shape) in description.shapes.iter().enumerate() {
@@ -226,7 +248,7 @@ impl Scene {
             shapes,
             textures,
             environment,
-            warnings: Vec::new(),
+            warnings,
         })
     }
 
@@ -281,7 +303,8 @@ pub fn load_scene_from(path: &Path, files: &dyn FileSource) -> Result<Scene, Sce
 }
 
 /// The renderer's material for the description `name` of scene file `path`, loading its
-/// texture (relative to `folder`) into `textures`.
+/// texture (relative to `folder`) into `textures`; what it renders otherwise than the
+/// file says (an alpha below [`MIN_ALPHA`]) goes to `warnings`, naming the field.
 fn resolve_material(
     path: &Path,
     folder: &Path,
@@ -289,6 +312,7 @@ fn resolve_material(
     description: &MaterialDescription,
     files: &dyn FileSource,
     textures: &mut Vec<Texture>,
+    warnings: &mut Vec<String>,
 ) -> Result<Material, SceneError> {
     let field = |field: &str, message: String| SceneError::Json {
         path: path.into(),
@@ -326,10 +350,80 @@ fn resolve_material(
             if distribution != "ggx" {
                 return Err(field("distribution", format!("`{distribution}`: only `ggx` is supported")));
             }
-            Material::RoughConductor { alpha: positive(*alpha, "alpha")?, eta: *eta, k: *k, two_sided: *two_sided }
+            let alpha = positive(*alpha, "alpha")?;
+            // The loaders' one rule (OBJ and glTF apply it too); the format promises
+            // alpha as written, so the change is said.
+            let rendered = ggx_alpha(alpha);
+            if rendered != alpha {
+                warnings.push(format!(
+                    "{}: field `materials.{name}.alpha`: {alpha:e} is below {MIN_ALPHA}, the smoothest GGX the \
+                     renderer samples; rendered at {MIN_ALPHA}",
+                    path.display()
+                ));
+            }
+            Material::RoughConductor { alpha: rendered, eta: *eta, k: *k, two_sided: *two_sided }
         }
         MaterialDescription::Dielectric { int_ior, ext_ior, .. } => {
             Material::Dielectric { int_ior: positive(*int_ior, "int_ior")?, ext_ior: positive(*ext_ior, "ext_ior")? }
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn errors_print_on_one_line_whatever_a_decoder_says() {
+        let error = SceneError::Image {
+            path: "broken.jpg".into(),
+            message: "Format error decoding Jpeg: I/O errors Not enough bytes\n\n".into(),
+        };
+        assert_eq!(error.to_string(), "broken.jpg: Format error decoding Jpeg: I/O errors Not enough bytes");
+        assert_eq!(one_line("first line  \r\n   second\n\nthird "), "first line second third");
+        assert_eq!(one_line("two  spaces kept"), "two  spaces kept");
+    }
+
+    /// A JSON scene of one conductor quad (alpha `alpha`) under an emitting quad.
+    fn conductor_scene(alpha: &str) -> MemoryFiles {
+        let mut ply = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+            property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+            .to_vec();
+        for value in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+            ply.extend(value.to_le_bytes());
+        }
+        ply.push(3);
+        for index in [0i32, 1, 2] {
+            ply.extend(index.to_le_bytes());
+        }
+        let scene = format!(
+            r#"{{"name": "t", "camera": {{"origin": [0, 0, 3], "target": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 40,
+            "fov_axis": "x", "width": 8, "height": 8, "near_clip": 0.1, "far_clip": 100}},
+            "integrator": {{"type": "path", "max_depth": 8, "rr_depth": 5, "hide_emitters": false}},
+            "materials": {{"metal": {{"type": "roughconductor", "distribution": "ggx", "alpha": {alpha},
+            "eta": [0.2, 0.9, 1.1], "k": [3.9, 2.4, 2.2], "two_sided": true}}}},
+            "shapes": [{{"id": "a", "mesh": "a.ply", "material": "metal", "emitter": {{"radiance": [1, 1, 1]}}}}]}}"#
+        );
+        let mut files = MemoryFiles::default();
+        files.insert("scene.json", scene).insert("a.ply", ply);
+        files
+    }
+
+    #[test]
+    fn a_json_alpha_below_the_floor_renders_at_the_floor_with_a_warning() {
+        let load = |alpha: &str| Scene::load_from(Path::new("scene.json"), &conductor_scene(alpha)).unwrap();
+        let tiny = load("1e-30");
+        let Material::RoughConductor { alpha, .. } = tiny.materials[0] else { panic!("{:?}", tiny.materials) };
+        assert_eq!(alpha, MIN_ALPHA);
+        assert_eq!(tiny.warnings.len(), 1, "{:?}", tiny.warnings);
+        assert!(tiny.warnings[0].contains("materials.metal.alpha") && tiny.warnings[0].contains("1e-30"));
+        let floor = load("0.001");
+        assert!(floor.warnings.is_empty(), "{:?}", floor.warnings);
+        assert_eq!(floor.materials, tiny.materials);
+        let rough = load("0.3");
+        assert!(matches!(rough.materials[0], Material::RoughConductor { alpha: 0.3, .. }));
+        // Not finite and positive: refused by name, as before.
+        let error = Scene::load_from(Path::new("scene.json"), &conductor_scene("0")).unwrap_err().to_string();
+        assert!(error.contains("materials.metal.alpha"), "{error}");
+    }
 }

@@ -63,6 +63,9 @@ fn obj_error(path: &Path, element: impl Into<String>, message: impl Into<String>
 
 /// Loads the OBJ in `bytes`, read from `path`.
 fn load_bytes(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene, SceneError> {
+    // Text saved with a byte order mark is the same text (tobj read `\u{feff}v` as an
+    // unknown statement and dropped the first vertex, or hid the first `newmtl`).
+    let bytes = files::without_bom(bytes);
     let folder = path.parent().unwrap_or(Path::new("."));
     let warnings = RefCell::new(Vec::new());
     let library_missing = std::cell::Cell::new(false);
@@ -73,7 +76,7 @@ fn load_bytes(path: &Path, bytes: &[u8], files: &dyn FileSource) -> Result<Scene
     let load_library = |relative: &Path| {
         let library = folder.join(relative);
         let text = match files.read(&library) {
-            Ok(text) => text,
+            Ok(text) => files::without_bom(&text).to_vec(),
             Err(error) => {
                 if error.kind() == std::io::ErrorKind::NotFound {
                     library_missing.set(true);
@@ -300,7 +303,7 @@ impl MaterialConverter<'_> {
         let illum = material.illumination_model;
         let bsdf = if metallic.is_some_and(|m| m >= 0.5) {
             let roughness = roughness.unwrap_or(1.0);
-            metal(kd.unwrap_or([DEFAULT_GREY; 3]), (roughness * roughness).max(MIN_ALPHA), true)
+            metal(kd.unwrap_or([DEFAULT_GREY; 3]), roughness * roughness, true)
         } else if transparent || matches!(illum, Some(4 | 6 | 7 | 9)) {
             let int_ior = optical_density.unwrap_or(1.5);
             Material::Dielectric { int_ior, ext_ior: 1.0 }

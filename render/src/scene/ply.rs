@@ -99,6 +99,22 @@ fn ply_error(path: &Path, element: impl Into<String>, message: impl Into<String>
     SceneError::Ply { path: PathBuf::from(path), element: element.into(), message: message.into() }
 }
 
+/// Where the body of a PLY file starts: just after the first `end_header` line's line
+/// break (`\n` or `\r\n`).
+fn header_end(bytes: &[u8]) -> Option<usize> {
+    const KEYWORD: &[u8] = b"end_header";
+    let mut from = 0;
+    while let Some(found) = bytes[from..].windows(KEYWORD.len()).position(|w| w == KEYWORD) {
+        let after = from + found + KEYWORD.len();
+        match &bytes[after..] {
+            [b'\n', ..] => return Some(after + 1),
+            [b'\r', b'\n', ..] => return Some(after + 2),
+            _ => from = after,
+        }
+    }
+    None
+}
+
 /// Reads a binary little-endian PLY triangle mesh from the file `path`.
 pub fn read_ply(path: &Path) -> Result<PlyMesh, SceneError> {
     let bytes = crate::scene::read_capped(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
@@ -106,12 +122,15 @@ pub fn read_ply(path: &Path) -> Result<PlyMesh, SceneError> {
 }
 
 /// Reads the binary little-endian PLY triangle mesh in `bytes` (`path` names it in errors).
+///
+/// The header is text: a leading byte order mark is dropped
+/// ([`super::without_bom`]) and its lines may end in `\n` or `\r\n` (the body starts
+/// after the line break that ends `end_header`).
 pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<PlyMesh, SceneError> {
-    let header_end = bytes
-        .windows(11)
-        .position(|w| w == b"end_header\n")
-        .ok_or_else(|| ply_error(path, "header", "no `end_header` line"))?
-        + 11;
+    let bytes = super::without_bom(bytes);
+    let header_end = header_end(bytes).ok_or_else(|| {
+        ply_error(path, "header", "no `end_header` line (ending in a line feed, or a carriage return and line feed)")
+    })?;
     let header = std::str::from_utf8(&bytes[..header_end]).map_err(|_| ply_error(path, "header", "not text"))?;
     let mut lines = header.lines();
     if lines.next() != Some("ply") {
@@ -332,5 +351,46 @@ mod tests {
         let long = format!("ply\nformat {} 1.0\nend_header\n", "s".repeat(200));
         let message = parse_ply(Path::new("mesh.ply"), long.as_bytes()).unwrap_err().to_string();
         assert!(message.len() < 200 && message.contains("..."), "{message}");
+    }
+
+    /// One triangle, its header lines ended by `newline`, after `prefix`.
+    fn triangle(prefix: &[u8], newline: &str) -> Vec<u8> {
+        let header = [
+            "ply",
+            "format binary_little_endian 1.0",
+            "element vertex 3",
+            "property float x",
+            "property float y",
+            "property float z",
+            "element face 1",
+            "property list uchar int vertex_indices",
+            "end_header",
+            "",
+        ]
+        .join(newline);
+        let mut bytes = [prefix, header.as_bytes()].concat();
+        for value in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+            bytes.extend(value.to_le_bytes());
+        }
+        bytes.push(3);
+        for index in [0i32, 1, 2] {
+            bytes.extend(index.to_le_bytes());
+        }
+        bytes
+    }
+
+    #[test]
+    fn crlf_headers_and_a_byte_order_mark_read_the_same() {
+        let path = Path::new("mesh.ply");
+        let plain = parse_ply(path, &triangle(b"", "\n")).unwrap();
+        assert_eq!(plain.faces, [[0, 1, 2]]);
+        // The body starts after `end_header\r\n`: a byte off and every number would shift.
+        assert_eq!(parse_ply(path, &triangle(b"", "\r\n")).unwrap(), plain);
+        assert_eq!(parse_ply(path, &triangle(super::super::UTF8_BOM, "\r\n")).unwrap(), plain);
+        // `end_header` without a line break after it is no header's end.
+        let cut = triangle(b"", "\n");
+        let end = cut.windows(10).position(|w| w == b"end_header").unwrap() + 10;
+        let message = parse_ply(path, &cut[..end]).unwrap_err().to_string();
+        assert!(message.contains("no `end_header` line"), "{message}");
     }
 }

@@ -204,24 +204,30 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
     for crop in &args.crop {
         crops::check_inside(crop, render.camera.width, render.camera.height)?;
     }
-    let camera_path = parse_camera_path(&args.camera_path, &render.camera)?;
-    let cameras: Vec<_> = if camera_path.is_static() {
-        Vec::new()
-    } else {
-        (0..args.frames).map(|f| camera_path.camera_at(&render.camera, f)).collect()
+    // The whole path is read and every frame's camera checked here, before the output
+    // folder is touched or a reference renders.
+    let flag = || format!("--camera-path {}", args.camera_path.to_string_lossy());
+    let camera_path = parse_camera_path(&args.camera_path, &render.camera)
+        .map_err(|error| anyhow::anyhow!("--camera-path {:#}", anyhow::Error::from(error)))?;
+    let (render, cameras) = match camera_path.still_camera(&render.camera) {
+        // A still path renders from its own camera (one keyframe: that key's).
+        Some(camera) => (RenderSettings { camera, ..render }, Vec::new()),
+        None => {
+            let cameras = camera_path
+                .frame_cameras(&render.camera, args.frames)
+                .map_err(|why| anyhow::anyhow!("{}: {why}", flag()))?;
+            (render, cameras)
+        }
     };
-    if !camera_path.is_static() && !args.restir.temporal {
+    if !cameras.is_empty() && !args.restir.temporal {
         bail!(
-            "--accumulate with --camera-path {}: accumulated frames would average different viewpoints and be \
-             measured against one frame's reference; accumulate with a static camera, or use temporal reuse",
-            args.camera_path.to_string_lossy()
+            "--accumulate with {}: accumulated frames would average different viewpoints and be measured against \
+             one frame's reference; accumulate with a static camera, or use temporal reuse",
+            flag()
         );
     }
     if !cameras.is_empty() && args.reference.is_some() {
-        bail!(
-            "--reference: a moving camera (--camera-path {}) needs a reference per frame",
-            args.camera_path.to_string_lossy()
-        );
+        bail!("--reference: a moving camera ({}) needs a reference per frame", flag());
     }
     // Held until the report is written: a second run into the folder is refused meanwhile.
     let (_lock, removed) = output_folder::prepare(&args.out, args.reference.as_deref())?;

@@ -21,7 +21,7 @@ use std::time::Instant;
 use strata::backend_choice::{BackendChoice, open_backend};
 use strata::evaluation::metrics::{self, Metric};
 use strata::render::{GpuScene, LightSampling, RenderSettings};
-use strata::restir::Method;
+use strata::restir::{Method, RestirSettings};
 use strata::rgb_image::RgbImage;
 use strata::scene::{Scene, default_scene, load_scene_file};
 
@@ -135,7 +135,7 @@ struct RenderArgs {
 fn main() -> std::process::ExitCode {
     quiet_output_failures();
     write_limits_are_errors();
-    let result = match Cli::parse().command {
+    let result = match parse_command_line().command {
         Command::Histogram(args) => histogram_command::histogram(args),
         Command::Render(args) => render(args),
         Command::Metrics(args) => metrics(args),
@@ -147,6 +147,49 @@ fn main() -> std::process::ExitCode {
         Err(error) => {
             eprintln!("error: {error:#}");
             std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+/// Sets one number field of the ReSTIR settings.
+type SetNumber = fn(&mut RestirSettings, f32);
+
+/// The ReSTIR settings' number flags of `compare`, each with the setter of its field.
+const RESTIR_NUMBER_FLAGS: [(&str, SetNumber); 4] = [
+    ("disc_radius", |s, v| s.disc_radius = v),
+    ("temporal_cap", |s, v| s.temporal_cap = v),
+    ("min_roughness", |s, v| s.min_roughness = v),
+    ("min_distance", |s, v| s.min_distance = v),
+];
+
+/// The command line as parsed, the ReSTIR settings' number flags checked as they are
+/// read: a refused value is quoted as the user typed it (`--disc-radius 4294967295`,
+/// which a float prints as 4294967300), with the flag's name. The rule stays
+/// [`RestirSettings::check`]'s, run on the default settings with that one field set.
+fn parse_command_line() -> Cli {
+    use clap::{CommandFactory, FromArgMatches};
+    let command = Cli::command().mut_subcommand("compare", |compare| {
+        RESTIR_NUMBER_FLAGS
+            .iter()
+            .fold(compare, |compare, &(id, set)| compare.mut_arg(id, |arg| arg.value_parser(restir_number(set))))
+    });
+    Cli::from_arg_matches(&command.get_matches()).unwrap_or_else(|error| error.exit())
+}
+
+/// A parser of one ReSTIR number flag: the number, and [`RestirSettings::check`] on the
+/// default settings with it set by `set`; its refusal is the rule, without the number as
+/// the check formats it (clap quotes the text and the flag).
+fn restir_number(set: SetNumber) -> impl Fn(&str) -> Result<f32, String> + Clone + Send + Sync + 'static {
+    move |text: &str| {
+        let value = text.trim().parse::<f32>().map_err(|error| error.to_string())?;
+        let mut settings = RestirSettings::default();
+        set(&mut settings, value);
+        match settings.check() {
+            Ok(()) => Ok(value),
+            Err(error) => {
+                let message = error.to_string();
+                Err(message.split_once(": ").map_or(message.clone(), |(_, rule)| rule.to_string()))
+            }
         }
     }
 }
@@ -247,6 +290,18 @@ fn plot(args: PlotArgs) -> Result<()> {
             args.labels.len(),
             args.csv.len()
         );
+    }
+    // What the user typed is drawn as typed, or refused: a control character would make
+    // the SVG invalid XML (the figure replaces any that reach it from elsewhere).
+    for (flag, text) in args.title.iter().map(|t| ("--title", t)).chain(args.labels.iter().map(|l| ("--label", l))) {
+        if let Some((index, c)) = text.chars().enumerate().find(|&(_, c)| c.is_control()) {
+            bail!(
+                "{flag} {text:?}: character {} is the control character U+{:04X}; a title or label is one line of \
+                 printable text",
+                index + 1,
+                u32::from(c)
+            );
+        }
     }
     for (index, label) in args.labels.iter().enumerate() {
         if args.labels[..index].contains(label) {
@@ -386,6 +441,15 @@ fn render(args: RenderArgs) -> Result<()> {
         russian_roulette: !args.no_russian_roulette,
         ..defaults
     };
+    // The output is checked before the samples take their time: the folder made, the
+    // names free for the writer, and the folder writable (`compare` learns that from its
+    // lock file; a read-only folder failed only after the whole render).
+    std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create the folder", args.out.display()))?;
+    let stem = args.scene.as_ref().and_then(|p| scene_stem(p)).unwrap_or_else(|| "default".into());
+    let (exr, png) = (args.out.join(with_extension(&stem, "exr")), args.out.join(with_extension(&stem, "png")));
+    strata::atomic_file::check_target(&exr)?;
+    strata::atomic_file::check_target(&png)?;
+    check_writable(&args.out, &exr)?;
     let gpu_scene = GpuScene::build(&scene)?;
     let mut backend = open_backend(args.backend)?;
     println!("backend: {}", backend.info().summary());
@@ -400,12 +464,6 @@ fn render(args: RenderArgs) -> Result<()> {
         args.spp,
         settings.max_depth
     );
-    std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create the folder", args.out.display()))?;
-    let stem = args.scene.as_ref().and_then(|p| scene_stem(p)).unwrap_or_else(|| "default".into());
-    let (exr, png) = (args.out.join(with_extension(&stem, "exr")), args.out.join(with_extension(&stem, "png")));
-    // Said before the samples take their time: the writer refuses these names anyway.
-    strata::atomic_file::check_target(&exr)?;
-    strata::atomic_file::check_target(&png)?;
     let mut progress = strata::progress::Progress::new("render", u64::from(args.spp), "spp");
     let started = Instant::now();
     let image =
@@ -434,6 +492,21 @@ fn render(args: RenderArgs) -> Result<()> {
         mean[2]
     );
     println!("wrote {} and {}", exr.display(), png.display());
+    Ok(())
+}
+
+/// Whether the writer will be able to write `target` into `folder`: a temporary file of
+/// the writer's own kind is made beside `target` and removed at once. An error names the
+/// folder and the OS's reason (a read-only folder or file system, no permission).
+fn check_writable(folder: &Path, target: &Path) -> Result<()> {
+    let probe = strata_files::TemporaryFile::beside(target).map_err(|error| {
+        // tempfile appends the temporary's random name, which means nothing to the user.
+        let text = error.to_string();
+        let reason =
+            text.rsplit_once(" at path \"").filter(|(_, name)| name.contains(".tmp-")).map_or(&*text, |(r, _)| r);
+        anyhow::anyhow!("--out {}: cannot write into the folder: {reason}", folder.display())
+    })?;
+    drop(probe);
     Ok(())
 }
 

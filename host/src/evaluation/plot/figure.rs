@@ -81,6 +81,21 @@ impl Figure {
     }
 }
 
+/// `text` as a figure may draw it: every control character (C0, DEL, C1: line breaks
+/// and tabs included) and every character XML forbids (U+FFFE, U+FFFF) replaced by
+/// U+FFFD. plotters escapes `<`, `&` and quotes in an SVG, but writes control characters
+/// as they are, and most of them make the document invalid XML. The command line refuses
+/// such characters in the text it is given (`--title`, `--label`); this covers text
+/// made from other input (a label from a folder name).
+pub(super) fn drawable(text: &str) -> std::borrow::Cow<'_, str> {
+    let refused = |c: char| c.is_control() || matches!(c, '\u{FFFE}' | '\u{FFFF}');
+    if text.chars().any(refused) {
+        text.chars().map(|c| if refused(c) { char::REPLACEMENT_CHARACTER } else { c }).collect::<String>().into()
+    } else {
+        text.into()
+    }
+}
+
 /// Draws `figure` on `root` (the whole canvas), every length multiplied by `scale`.
 pub(super) fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
@@ -92,14 +107,14 @@ pub(super) fn draw<DB: DrawingBackend>(
     root.fill(&WHITE)?;
     let (width, _) = root.dim_in_pixel();
     let title = font(22.0).pos(Pos::new(HPos::Center, VPos::Top));
-    root.draw_text(&figure.title, &title, (width as i32 / 2, px(12.0)))?;
+    root.draw_text(&drawable(&figure.title), &title, (width as i32 / 2, px(12.0)))?;
 
     // The legend's column: as wide as its longest entry.
     let entry = font(15.0).pos(Pos::new(HPos::Left, VPos::Center));
     let shown: Vec<&Series> = figure.series.iter().filter(|s| !s.points.is_empty()).collect();
     let mut text_width = 0;
     for series in &shown {
-        text_width = text_width.max(root.estimate_text_size(&series.label, &entry)?.0 as i32);
+        text_width = text_width.max(root.estimate_text_size(&drawable(&series.label), &entry)?.0 as i32);
     }
     // At most 45 % of the width: a longer label runs off the canvas, the plot stays.
     let legend_width = if shown.is_empty() { px(16.0) } else { (text_width + px(72.0)).min(width as i32 * 45 / 100) };
@@ -205,7 +220,7 @@ pub(super) fn draw<DB: DrawingBackend>(
             root.draw(&Rectangle::new([corner(x0, -7.0), corner(x1, 7.0)], rgb(series.colour).mix(0.16).filled()))?;
         }
         stroke(&[(x0, y), (x1, y)], series.dash, line_style(series.colour, 2.0))?;
-        root.draw_text(&series.label, &entry, ((x1 + 8.0 * scale).round() as i32, y.round() as i32))?;
+        root.draw_text(&drawable(&series.label), &entry, ((x1 + 8.0 * scale).round() as i32, y.round() as i32))?;
     }
     Ok(())
 }

@@ -237,3 +237,24 @@ fn dashes_alternate_and_keep_corners() {
     assert_eq!(pieces, [vec![(0.0, 0.0), (4.0, 0.0), (4.0, 2.0)]]);
     assert_eq!(dash_pieces(&[(0.0, 0.0), (1.0, 1.0)], Dash::SOLID, 2.0), [vec![(0.0, 0.0), (1.0, 1.0)]]);
 }
+
+#[test]
+fn control_characters_never_reach_the_svg() {
+    // XML 1.0 allows tab, line feed and carriage return, and no other C0 character;
+    // plotters escapes `<` and `&` but writes control characters as they are.
+    let xml_forbids =
+        |c: char| (c.is_control() && !matches!(c, '\t' | '\n' | '\r')) || matches!(c, '\u{FFFE}' | '\u{FFFF}');
+    let title = "bell\u{7} <tab>\tnul\u{0}\u{FFFF}";
+    let errors = rows(&[Method::Strata, Method::Restir], 2, 2);
+    let svg = relmse_svg(&errors, &[Method::Strata, Method::Restir], 2, title);
+    assert!(!svg.chars().any(xml_forbids), "the SVG holds a character XML forbids: {svg:?}");
+    assert!(has_text(&svg, "bell\u{FFFD} &lt;tab&gt;\u{FFFD}nul\u{FFFD}\u{FFFD}"), "{:?}", texts(&svg));
+    // A legend label made from a folder name: replaced in the same way.
+    let runs = vec![("run\u{1b}[31m".to_string(), errors.clone()), ("b".to_string(), errors)];
+    let dir = folder("control");
+    let written = write_overlay_plots(&runs, "t", &dir.join("overlay")).unwrap();
+    let svg = std::fs::read_to_string(&written[0]).unwrap();
+    assert!(!svg.chars().any(xml_forbids), "{svg:?}");
+    assert!(texts(&svg).iter().any(|t| t.starts_with("run\u{FFFD}[31m")), "{:?}", texts(&svg));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -42,6 +42,55 @@ impl Tolerance {
     pub fn bound_for(&self, name: &str) -> FloatBound {
         self.per_buffer.iter().find(|(n, _)| n == name).map_or(self.float, |(_, bound)| *bound)
     }
+
+    /// The tolerance `--ulp` and `--abs` give (`cargo xtask run`): plain values for every
+    /// buffer, `BUFFER=` ones for that buffer (whose other half falls back to the plain
+    /// value). A bound given twice for the same target (two plain `--ulp`, or two
+    /// `--abs out=...`) is refused naming both flags, never one of them silently kept;
+    /// whether a named buffer exists is the run's check ([`crate::run_kernel`]).
+    pub fn from_flags(ulp: &[(Option<String>, u32)], abs: &[(Option<String>, f32)]) -> Result<Tolerance, String> {
+        fn once<T: std::fmt::Display>(flag: &str, given: &[(Option<String>, T)]) -> Result<(), String> {
+            for (index, (target, bound)) in given.iter().enumerate() {
+                if let Some((_, first)) = given[..index].iter().find(|(t, _)| t == target) {
+                    let text = |bound: &T| match target {
+                        Some(name) => format!("{flag} {name}={bound}"),
+                        None => format!("{flag} {bound}"),
+                    };
+                    let what = target.as_ref().map_or("every buffer".to_string(), |name| format!("`{name}`"));
+                    return Err(format!(
+                        "{}: the bound for {what} is given twice ({} first): give it once",
+                        text(bound),
+                        text(first)
+                    ));
+                }
+            }
+            Ok(())
+        }
+        once("--ulp", ulp)?;
+        once("--abs", abs)?;
+        let mut tolerance = Tolerance::default();
+        if let Some((_, bound)) = ulp.iter().find(|(buffer, _)| buffer.is_none()) {
+            tolerance.float.ulp = *bound;
+        }
+        if let Some((_, bound)) = abs.iter().find(|(buffer, _)| buffer.is_none()) {
+            tolerance.float.abs = *bound;
+        }
+        let named = ulp.iter().filter_map(|(b, _)| b.clone()).chain(abs.iter().filter_map(|(b, _)| b.clone()));
+        for name in named {
+            if tolerance.per_buffer.iter().any(|(n, _)| *n == name) {
+                continue;
+            }
+            let mut bound = tolerance.float;
+            if let Some((_, ulp)) = ulp.iter().find(|(b, _)| b.as_deref() == Some(&name)) {
+                bound.ulp = *ulp;
+            }
+            if let Some((_, abs)) = abs.iter().find(|(b, _)| b.as_deref() == Some(&name)) {
+                bound.abs = *abs;
+            }
+            tolerance.per_buffer.push((name, bound));
+        }
+        Ok(tolerance)
+    }
 }
 
 /// One backend's buffer against the reference's.

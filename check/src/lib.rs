@@ -19,6 +19,7 @@ pub mod corpus_rng;
 mod empty;
 pub mod fuzz;
 mod histogram;
+pub mod overrides;
 mod path;
 pub mod replay;
 mod report;

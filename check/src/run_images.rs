@@ -7,7 +7,9 @@
 //!   (no sRGB decoding: a texel reads as code / 255).
 //! * `--texture G:B=FILE.exr`: an `rgba32float` texture of the EXR's R, G, B (alpha 1).
 //! * `--texture G:B=FILE@WxHxD:FORMAT`: raw texels of one mip level (see
-//!   `strata_backends::texture` for their order).
+//!   `strata_backends::texture` for their order). The value is split at its last `@`;
+//!   a value ending in `.png` or `.exr` is always a picture, `@` in its name or not
+//!   (raw texels end in a format name), so `my@photo.png` is the picture.
 //! * `--storage-texture G:B=WxH[xD][:FORMAT]`: a zero-filled storage texture (the
 //!   format defaults to the kernel's).
 //! * `--sampler G:B=FILTER,ADDRESS`: `nearest` or `linear` (magnification,
@@ -57,6 +59,69 @@ impl ImageSpec {
             Self::Texture(s, _) | Self::StorageTexture(s, ..) | Self::Sampler(s, _) => *s,
         }
     }
+
+    /// The flag's name: `--texture`, `--storage-texture` or `--sampler`.
+    pub fn flag_name(&self) -> &'static str {
+        match self {
+            Self::Texture(..) => "--texture",
+            Self::StorageTexture(..) => "--storage-texture",
+            Self::Sampler(..) => "--sampler",
+        }
+    }
+
+    /// The flag as a user writes it (`--texture 0:0=t.bin@4x4:rgba8unorm`), for messages.
+    pub fn flag(&self) -> String {
+        let (group, binding) = self.slot();
+        let size = |[w, h, d]: [u32; 3]| if d == 1 { format!("{w}x{h}") } else { format!("{w}x{h}x{d}") };
+        let value = match self {
+            Self::Texture(_, TextureFile::Picture(path)) => path.display().to_string(),
+            Self::Texture(_, TextureFile::Raw { path, size: s, format }) => {
+                format!("{}@{}:{}", path.display(), size(*s), format.wgsl())
+            }
+            Self::StorageTexture(_, s, Some(format)) => format!("{}:{}", size(*s), format.wgsl()),
+            Self::StorageTexture(_, s, None) => size(*s),
+            Self::Sampler(_, desc) => {
+                let filter = match desc.mag_filter {
+                    FilterMode::Nearest => "nearest",
+                    FilterMode::Linear => "linear",
+                };
+                let address = match desc.address[0] {
+                    AddressMode::ClampToEdge => "clamp",
+                    AddressMode::Repeat => "repeat",
+                    AddressMode::MirrorRepeat => "mirror",
+                };
+                format!("{filter},{address}")
+            }
+        };
+        format!("{} {group}:{binding}={value}", self.flag_name())
+    }
+}
+
+/// Bytes of `size` texels of `format` (every axis counted), or `None` past `u64`.
+fn texel_bytes(size: [u32; 3], format: TexelFormat) -> Option<u64> {
+    let [w, h, d] = size.map(u64::from);
+    w.checked_mul(h)?.checked_mul(d)?.checked_mul(u64::from(format.bytes_per_texel()))
+}
+
+/// Whether a texture of `size` texels of `format` stays within what xtask run reads or
+/// makes ([`crate::run_kernel::MAX_INPUT_BYTES`]), checked before any file is read or
+/// anything allocated; the error names `flag`.
+fn check_texels(flag: &str, size: [u32; 3], format: TexelFormat) -> Result<()> {
+    let cap = crate::run_kernel::MAX_INPUT_BYTES;
+    let [w, h, d] = size;
+    match texel_bytes(size, format) {
+        Some(bytes) if bytes <= cap => Ok(()),
+        bytes => {
+            let bytes = bytes.map_or_else(
+                || (u128::from(w) * u128::from(h) * u128::from(d) * u128::from(format.bytes_per_texel())).to_string(),
+                |b| b.to_string(),
+            );
+            bail!(
+                "{flag}: {w}x{h}x{d} {} texels are {bytes} bytes, more than xtask run's cap of {cap} bytes",
+                format.wgsl()
+            )
+        }
+    }
 }
 
 fn size_of(text: &str) -> Result<[u32; 3], String> {
@@ -81,21 +146,23 @@ fn format_of(text: &str) -> Result<TexelFormat, String> {
     })
 }
 
-/// The file part of `--texture G:B=...`.
+/// The file part of `--texture G:B=...`: a name ending in `.png` or `.exr` is a picture
+/// (whatever `@` it holds: raw texels end in a format name, never in `.png`), anything
+/// else raw texels `FILE@WxH[xD]:FORMAT`, split at the last `@`.
 pub fn parse_texture_file(text: &str) -> Result<TextureFile, String> {
+    let lower = text.to_ascii_lowercase();
+    if lower.ends_with(".png") || lower.ends_with(".exr") {
+        return Ok(TextureFile::Picture(PathBuf::from(text)));
+    }
     match text.rsplit_once('@') {
         Some((path, shape)) => {
-            let (size, format) =
-                shape.split_once(':').ok_or_else(|| format!("`{text}`: raw texels need FILE@WxHxD:FORMAT"))?;
+            let (size, format) = shape.split_once(':').ok_or_else(|| {
+                format!("`{text}`: raw texels need FILE@WxH[xD]:FORMAT (e.g. t.bin@64x64:rgba8unorm)")
+            })?;
             Ok(TextureFile::Raw { path: PathBuf::from(path), size: size_of(size)?, format: format_of(format)? })
         }
         None => {
-            let lower = text.to_ascii_lowercase();
-            if lower.ends_with(".png") || lower.ends_with(".exr") {
-                Ok(TextureFile::Picture(PathBuf::from(text)))
-            } else {
-                Err(format!("`{text}`: a .png, a .exr, or raw texels as FILE@WxHxD:FORMAT"))
-            }
+            Err(format!("`{text}`: a .png, a .exr, or raw texels as FILE@WxH[xD]:FORMAT (e.g. t.bin@64x64:rgba8unorm)"))
         }
     }
 }
@@ -149,6 +216,12 @@ fn read_picture(path: &Path) -> Result<([u32; 3], TexelFormat, Vec<u8>)> {
 /// naming the flag, the binding and the mismatch.
 pub fn image_inputs(kernel: &Kernel, specs: &[ImageSpec]) -> Result<GroupedImages> {
     let mut inputs = GroupedImages::new();
+    for (index, spec) in specs.iter().enumerate() {
+        if let Some(first) = specs[..index].iter().find(|s| s.slot() == spec.slot()) {
+            let (group, binding) = spec.slot();
+            bail!("{}: binding {group}:{binding} is given twice ({} first): give it once", spec.flag(), first.flag());
+        }
+    }
     for spec in specs {
         let (group, binding) = spec.slot();
         let Some(info) = kernel.binding(group, binding) else {
@@ -160,6 +233,13 @@ pub fn image_inputs(kernel: &Kernel, specs: &[ImageSpec]) -> Result<GroupedImage
             BindingKind::StorageTexture { dimension, format, .. } => (Some(dimension), Some(format)),
             _ => (None, None),
         };
+        match spec {
+            ImageSpec::Texture(_, TextureFile::Raw { size, format, .. }) => check_texels(&spec.flag(), *size, *format)?,
+            ImageSpec::StorageTexture(_, size, format) => {
+                check_texels(&spec.flag(), *size, format.or(declared).unwrap_or(TexelFormat::Rgba32Float))?
+            }
+            _ => {}
+        }
         let input = match (spec, dimension) {
             (ImageSpec::Sampler(_, desc), _) if info.kind == BindingKind::Sampler => ImageInput::Sampler(*desc),
             (ImageSpec::Sampler(..), _) => bail!("--sampler for {what}, which is not a sampler"),
@@ -261,7 +341,10 @@ mod tests {
             parse_texture_file("t.bin@4x2:r32float"),
             Ok(TextureFile::Raw { path: "t.bin".into(), size: [4, 2, 1], format: TexelFormat::R32Float })
         );
-        assert!(parse_texture_file("t.bin").unwrap_err().contains("FILE@WxHxD:FORMAT"));
+        assert!(parse_texture_file("t.bin").unwrap_err().contains("FILE@WxH[xD]:FORMAT"));
+        // A picture's name may hold `@`: raw texels end in a format name, never `.png`.
+        assert_eq!(parse_texture_file("my@photo.png"), Ok(TextureFile::Picture("my@photo.png".into())));
+        assert_eq!(parse_texture_file("a@b@2x2.EXR"), Ok(TextureFile::Picture("a@b@2x2.EXR".into())));
         assert!(parse_texture_file("t.bin@4x2:bgra8").unwrap_err().contains("bgra8"));
         assert_eq!(parse_storage_texture("8x8x2"), Ok(([8, 8, 2], None)));
         assert_eq!(parse_storage_texture("8x8:rgba16float"), Ok(([8, 8, 1], Some(TexelFormat::Rgba16Float))));

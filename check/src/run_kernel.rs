@@ -4,11 +4,14 @@
 //! declared tolerance (see [`crate::agreement`]). For engine developers checking their
 //! own kernels.
 
+use crate::agreement::Tolerance;
 use crate::run_images::ImageSpec;
 use crate::{BackendSlot, backend_slots};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
-use strata_backends::{Backend, Bind, BufferId, Resource, SamplerDesc, SamplerId, TextureDesc, TextureId};
+use strata_backends::{
+    Backend, BackendError, Bind, BufferId, Resource, SamplerDesc, SamplerId, TextureDesc, TextureId,
+};
 use strata_kernels::{BindingKind, Kernel, WordKinds};
 
 /// What to run.
@@ -24,14 +27,21 @@ pub struct RunRequest {
     pub buffers: Vec<(u32, u32, PathBuf)>,
     /// Zero-filled buffer sizes in bytes: (group, binding, bytes).
     pub sizes: Vec<(u32, u32, u64)>,
-    /// Values of `override` constants, by name; the rest keep their WGSL defaults.
+    /// Values of `override` constants, by name or by `@id` number (`3` or `@3`); the
+    /// rest keep their WGSL defaults ([`crate::overrides`]).
     pub overrides: Vec<(String, f64)>,
     /// Textures and samplers (see [`crate::run_images`]).
     pub images: Vec<ImageSpec>,
-    /// Backend names (`cpu`, `wgpu-vulkan`, `wgpu-gl`, `ash`, `ash-glsl`, `ash-hlsl`; `all`).
+    /// Backend names (`cpu`, `wgpu-vulkan`, `wgpu-gl`, `ash`, `ash-glsl`, `ash-hlsl`,
+    /// `ash-slang`; `wgpu` for `wgpu-vulkan`; `all` for every path available here).
     pub backends: Vec<String>,
     /// Where output buffers are written (one folder per backend).
     pub out: PathBuf,
+    /// `--ulp N` (every buffer) and `--ulp BUFFER=N` flags: see
+    /// [`Tolerance::from_flags`]; each buffer named must be an output of the entry point.
+    pub ulp: Vec<(Option<String>, u32)>,
+    /// `--abs E` and `--abs BUFFER=E` flags, as `ulp`.
+    pub abs: Vec<(Option<String>, f32)>,
 }
 
 /// One writable buffer (or storage texture, its level 0) after a run.
@@ -61,7 +71,9 @@ pub struct BackendRun {
 /// The largest shader file read (WGSL text).
 pub const MAX_SHADER_BYTES: u64 = 64 << 20;
 
-/// The largest buffer or texture file read; a device's own limits are checked after.
+/// The largest buffer or texture file read, and the largest zero-filled buffer or
+/// texture made (`--size`, `--storage-texture`); a device's own limits are checked after,
+/// before anything of the size is allocated.
 pub const MAX_INPUT_BYTES: u64 = 4 << 30;
 
 /// The whole regular file `path` (a link to one is followed), at most `cap` bytes: a named
@@ -71,16 +83,39 @@ pub fn read_input(path: &Path, cap: u64) -> Result<Vec<u8>> {
     Ok(strata_files::read_named_regular_capped(path, cap)?)
 }
 
-/// Loads the shader with `overrides`; subgroup operations are allowed if the module
-/// needs them.
+/// Loads the shader with `overrides` (by name or `@id` number: [`crate::overrides`]);
+/// subgroup operations are allowed if the module needs them.
 pub fn load_shader(path: &Path, entry: &str, overrides: &[(String, f64)]) -> Result<Kernel> {
+    load_shader_resolved(path, entry, overrides).map(|(kernel, _)| kernel)
+}
+
+/// [`load_shader`], and the overrides as resolved (for errors about the workgroup size).
+fn load_shader_resolved(
+    path: &Path,
+    entry: &str,
+    overrides: &[(String, f64)],
+) -> Result<(Kernel, crate::overrides::ResolvedOverrides)> {
     let bytes = read_input(path, MAX_SHADER_BYTES)?;
     let source = String::from_utf8(bytes).map_err(|_| anyhow::anyhow!("{}: is not UTF-8 text", path.display()))?;
     let name = path.display().to_string();
-    match Kernel::from_wgsl_with_overrides(&name, source.clone(), entry, false, overrides) {
+    // A module that does not parse is left to the loader, whose error has the location.
+    let resolved = match naga::front::wgsl::parse_str(&source) {
+        Ok(module) => crate::overrides::resolve(&module, entry, overrides).map_err(anyhow::Error::msg)?,
+        Err(_) => crate::overrides::ResolvedOverrides { constants: overrides.to_vec(), ..Default::default() },
+    };
+    let constants = &resolved.constants;
+    let loaded = match Kernel::from_wgsl_with_overrides(&name, source.clone(), entry, false, constants) {
         Ok(kernel) => Ok(kernel),
-        Err(first) => Kernel::from_wgsl_with_overrides(&name, source, entry, true, overrides)
+        Err(first) => Kernel::from_wgsl_with_overrides(&name, source, entry, true, constants)
             .map_err(|_| anyhow::anyhow!("{first}")),
+    };
+    match loaded {
+        Ok(kernel) => Ok((kernel, resolved)),
+        Err(error) if !overrides.is_empty() => {
+            let flags: Vec<String> = overrides.iter().map(|(key, value)| format!("--override {key}={value}")).collect();
+            Err(error.context(flags.join(", ")))
+        }
+        Err(error) => Err(error),
     }
 }
 
@@ -127,14 +162,89 @@ fn in_group_zero<T: Clone>(inputs: &[(u32, T)]) -> Vec<(Slot, T)> {
     inputs.iter().map(|(binding, value)| ((0, *binding), value.clone())).collect()
 }
 
+/// What a buffer binding receives in [`run_on`]: bytes (rounded up to whole words) or
+/// that many zeros, and the flag that gave it (for messages).
+struct BufferInput<'a> {
+    slot: Slot,
+    flag: String,
+    contents: BufferContents<'a>,
+}
+
+enum BufferContents<'a> {
+    Bytes(&'a [u8]),
+    Zeros(u64),
+}
+
+/// Grouped inputs as [`run_on`] takes them, each named by its binding.
+fn given_bytes(inputs: &GroupedInputs) -> Vec<BufferInput<'_>> {
+    inputs
+        .iter()
+        .map(|((group, binding), bytes)| BufferInput {
+            slot: (*group, *binding),
+            flag: format!("the input of binding {group}:{binding}"),
+            contents: BufferContents::Bytes(bytes),
+        })
+        .collect()
+}
+
+/// The contents of buffer `binding` on `backend`: checked against the device's buffer
+/// limit before anything of the size is allocated, and allocated with `try_reserve` (a
+/// size from the user's input is an error naming its flag, never an abort).
+fn buffer_contents(
+    backend: &dyn Backend,
+    binding: &strata_kernels::BindingInfo,
+    input: Option<&BufferInput>,
+) -> Result<Vec<u8>> {
+    let (flag, len, bytes) = match input {
+        Some(BufferInput { flag, contents: BufferContents::Bytes(bytes), .. }) => {
+            (flag.clone(), bytes.len() as u64, *bytes)
+        }
+        Some(BufferInput { flag, contents: BufferContents::Zeros(size), .. }) => (flag.clone(), *size, &[][..]),
+        None => (
+            format!(
+                "binding {}:{} (`{}`, given no --buffer or --size: its minimum size)",
+                binding.group, binding.binding, binding.name
+            ),
+            binding.min_size(),
+            &[][..],
+        ),
+    };
+    let padded = len
+        .checked_next_multiple_of(4)
+        .ok_or_else(|| anyhow::anyhow!("{flag}: {len} bytes rounded up to whole words pass u64::MAX"))?;
+    strata_backends::bindings_check::check_buffer_size(&binding.name, padded, backend.info())
+        .with_context(|| flag.clone())?;
+    let size =
+        usize::try_from(padded).with_context(|| format!("{flag}: {padded} bytes do not fit this machine's memory"))?;
+    let mut contents = Vec::new();
+    contents.try_reserve_exact(size).map_err(|e| anyhow::anyhow!("{flag}: cannot allocate {padded} bytes: {e}"))?;
+    contents.extend_from_slice(bytes);
+    contents.resize(size, 0);
+    Ok(contents)
+}
+
+/// `error` from a backend's kernel check, with the `--override` flags that set the
+/// workgroup size named when it is a workgroup limit that failed.
+fn explain_limit(error: BackendError, kernel: &Kernel, workgroup_flags: &[String]) -> anyhow::Error {
+    let workgroup_limit = matches!(&error, BackendError::LimitExceeded { limit, .. }
+        if *limit == "invocations per workgroup" || limit.starts_with("workgroup size"));
+    if workgroup_limit && !workgroup_flags.is_empty() {
+        let [x, y, z] = kernel.workgroup_size;
+        let flags = workgroup_flags.join("; ");
+        return anyhow::Error::from(error).context(format!("{flags}: the workgroup size {x}x{y}x{z} comes from it"));
+    }
+    error.into()
+}
+
 fn run_on(
     backend: &mut dyn Backend,
     kernel: &Kernel,
-    inputs: &GroupedInputs,
+    inputs: &[BufferInput],
     images: &GroupedImages,
     workgroups: [u32; 3],
+    workgroup_flags: &[String],
 ) -> Result<Vec<OutputBuffer>> {
-    backend.check_kernel(kernel)?;
+    backend.check_kernel(kernel).map_err(|e| explain_limit(e, kernel, workgroup_flags))?;
     let mut created = Vec::new();
     let result = (|| {
         for binding in &kernel.bindings {
@@ -164,14 +274,8 @@ fn run_on(
                     )
                 }
                 _ => {
-                    let bytes = match inputs.iter().find(|(s, _)| *s == slot) {
-                        Some((_, bytes)) => {
-                            let mut bytes = bytes.clone();
-                            bytes.resize(bytes.len().div_ceil(4) * 4, 0);
-                            bytes
-                        }
-                        None => vec![0; binding.min_size().div_ceil(4) as usize * 4],
-                    };
+                    let input = inputs.iter().find(|input| input.slot == slot);
+                    let bytes = buffer_contents(&*backend, binding, input)?;
                     let buffer = backend.create_buffer(&binding.name, bytes.len() as u64)?;
                     created.push((binding, Created::Buffer(buffer)));
                     backend.write_buffer(buffer, 0, &bytes)?;
@@ -221,19 +325,35 @@ fn run_on(
 }
 
 /// The backend slots named by `names` (`all` for every one; `wgpu` is `wgpu-vulkan`).
+/// A path named twice (`cpu,cpu`, `wgpu,wgpu-vulkan`) or `all` beside other names is
+/// refused by name rather than run twice or dropped.
 pub fn named_slots(names: &[String]) -> Result<Vec<BackendSlot>> {
     let slots = backend_slots();
     if names.iter().any(|b| b == "all") {
+        if let Some(other) = names.iter().find(|b| *b != "all") {
+            bail!("--backend all,{other}: `all` already names every path: give `all` alone or name each path");
+        }
+        if names.len() > 1 {
+            bail!("--backend all,all: `all` is named twice");
+        }
         return Ok(slots);
     }
-    let mut chosen = Vec::new();
+    let mut chosen: Vec<BackendSlot> = Vec::new();
     for name in names {
         let alias = if name == "wgpu" { "wgpu-vulkan" } else { name.as_str() };
         let Some(slot) = slots.iter().find(|s| s.name == alias) else {
             let known: Vec<_> = slots.iter().map(|s| s.name).collect();
             bail!("unknown backend `{name}`: one of {}, wgpu or all", known.join(", "));
         };
-        chosen.push(BackendSlot { name: slot.name, open: slot.open, needs_vulkan: slot.needs_vulkan });
+        if chosen.iter().any(|c| c.name == slot.name) {
+            bail!("--backend {}: `{}` is named twice: name each path once", names.join(","), slot.name);
+        }
+        chosen.push(BackendSlot {
+            name: slot.name,
+            open: slot.open,
+            needs_vulkan: slot.needs_vulkan,
+            toolchain: slot.toolchain,
+        });
     }
     Ok(chosen)
 }
@@ -271,7 +391,7 @@ pub fn run_loaded_in_groups(
             backend: slot.name.to_string(),
             outputs: (slot.open)()
                 .map_err(anyhow::Error::from)
-                .and_then(|mut backend| run_on(backend.as_mut(), kernel, inputs, images, workgroups))
+                .and_then(|mut backend| run_on(backend.as_mut(), kernel, &given_bytes(inputs), images, workgroups, &[]))
                 .map_err(|e| format!("{e:#}")),
         })
         .collect()
@@ -300,9 +420,8 @@ pub fn run_on_open(
         .map(|(name, backend)| BackendRun {
             backend: name.clone(),
             outputs: match backend {
-                Ok(backend) => {
-                    run_on(backend.as_mut(), kernel, inputs, images, workgroups).map_err(|e| format!("{e:#}"))
-                }
+                Ok(backend) => run_on(backend.as_mut(), kernel, &given_bytes(inputs), images, workgroups, &[])
+                    .map_err(|e| format!("{e:#}")),
                 Err(why) => Err(why.clone()),
             },
         })
@@ -314,8 +433,14 @@ pub fn run_on_open(
 pub struct RunOutcome {
     /// The shader as loaded (overrides applied).
     pub kernel: Kernel,
-    /// One run per backend, in the order named.
+    /// One run per backend, in the order named (under `all`, those available here).
     pub runs: Vec<BackendRun>,
+    /// Under `--backend all`, the paths not available here and why: a toolchain not
+    /// installed (Slang, glslang), or no device (no Vulkan driver; with
+    /// `STRATA_REQUIRE_GPU=1` a Vulkan path without a device fails instead).
+    pub unavailable: Vec<(String, String)>,
+    /// The tolerance `--ulp` and `--abs` gave, every buffer it names an output.
+    pub tolerance: Tolerance,
 }
 
 /// The math functions of the interpreter whose results differ from GPU drivers' within
@@ -347,33 +472,115 @@ pub fn inexact_functions(kernel: &Kernel) -> Vec<&'static str> {
     used
 }
 
+/// The `--buffer` and `--size` flags checked against `kernel` before any file is read
+/// or anything allocated: each names a buffer binding of the entry point, at most once
+/// (two flags for one binding are refused by name, never one of them dropped), a size
+/// is at least one byte and at most [`MAX_INPUT_BYTES`].
+fn check_buffer_flags(kernel: &Kernel, request: &RunRequest) -> Result<Vec<(Slot, String)>> {
+    let mut given: Vec<(Slot, String)> = Vec::new();
+    let flags = request
+        .buffers
+        .iter()
+        .map(|(g, b, file)| ((*g, *b), format!("--buffer {g}:{b}={}", file.display()), None))
+        .chain(request.sizes.iter().map(|(g, b, size)| ((*g, *b), format!("--size {g}:{b}={size}"), Some(*size))));
+    for ((group, binding), flag, size) in flags {
+        let Some(info) = kernel.binding(group, binding) else {
+            bail!("{flag}: entry point `{}` has no such binding", request.entry);
+        };
+        if info.kind.is_texture() || info.kind == BindingKind::Sampler {
+            let give = if info.kind == BindingKind::Sampler { "--sampler" } else { "--texture or --storage-texture" };
+            bail!(
+                "{flag}: binding {group}:{binding} (`{}`) is a {}, not a buffer: give it {give}",
+                info.name,
+                info.element.type_name
+            );
+        }
+        if let Some((_, first)) = given.iter().find(|(slot, _)| *slot == (group, binding)) {
+            bail!("{flag}: binding {group}:{binding} (`{}`) is given twice ({first} first): give it once", info.name);
+        }
+        match size {
+            Some(0) => bail!("{flag}: buffers need at least one byte"),
+            Some(size) if size > MAX_INPUT_BYTES => {
+                bail!("{flag}: {size} bytes is more than xtask run's cap of {MAX_INPUT_BYTES} bytes (4 GiB)")
+            }
+            _ => {}
+        }
+        given.push(((group, binding), flag));
+    }
+    Ok(given)
+}
+
+/// Whether every buffer `--ulp` and `--abs` name is an output (a writable binding) of
+/// `kernel`: a bound for a buffer that is not one would silently judge nothing.
+fn check_tolerance_targets(kernel: &Kernel, request: &RunRequest) -> Result<()> {
+    let outputs: Vec<&str> = kernel.bindings.iter().filter(|b| b.is_writable()).map(|b| b.name.as_str()).collect();
+    let named =
+        request.ulp.iter().filter_map(|(name, n)| name.as_ref().map(|name| (name, format!("--ulp {name}={n}")))).chain(
+            request.abs.iter().filter_map(|(name, e)| name.as_ref().map(|name| (name, format!("--abs {name}={e}")))),
+        );
+    for (name, flag) in named {
+        if !outputs.contains(&name.as_str()) {
+            let list = if outputs.is_empty() { "none".to_string() } else { outputs.join(", ") };
+            bail!("{flag}: entry point `{}` has no output buffer `{name}` (its outputs: {list})", request.entry);
+        }
+    }
+    Ok(())
+}
+
 /// Runs the request on every named backend and writes the outputs under `request.out`
 /// (`BACKEND/GROUP_BINDING_NAME.bin`; a storage texture also as `.png` or `.exr`).
+///
+/// Every flag is checked before a file is read or a backend opened (module
+/// documentation of [`crate::overrides`], [`named_slots`], the buffer and image flags,
+/// [`Tolerance::from_flags`]). Under `all`, a path whose toolchain is not installed or
+/// that has no device here is listed in [`RunOutcome::unavailable`] instead of run.
 pub fn run_kernel(request: &RunRequest) -> Result<RunOutcome> {
-    let kernel = load_shader(&request.shader, &request.entry, &request.overrides)?;
+    let every = request.backends.iter().any(|b| b == "all");
     let slots = named_slots(&request.backends)?;
-    let mut inputs = GroupedInputs::new();
+    let tolerance = Tolerance::from_flags(&request.ulp, &request.abs).map_err(anyhow::Error::msg)?;
+    let (kernel, resolved) = load_shader_resolved(&request.shader, &request.entry, &request.overrides)?;
+    check_tolerance_targets(&kernel, request)?;
+    let flags = check_buffer_flags(&kernel, request)?;
+    let mut files = Vec::new();
     for (group, binding, file) in &request.buffers {
-        if kernel.binding(*group, *binding).is_none() {
-            bail!("--buffer {group}:{binding}={}: entry point `{}` has no such binding", file.display(), request.entry);
-        }
         let bytes = read_input(file, MAX_INPUT_BYTES)?;
         if bytes.is_empty() {
-            bail!("buffer file {} is empty", file.display());
+            bail!("--buffer {group}:{binding}={}: the file is empty", file.display());
         }
-        inputs.push(((*group, *binding), bytes));
-    }
-    for (group, binding, size) in &request.sizes {
-        if kernel.binding(*group, *binding).is_none() {
-            bail!("--size {group}:{binding}={size}: entry point `{}` has no such binding", request.entry);
-        }
-        if *size == 0 {
-            bail!("--size {group}:{binding}=0: buffers need at least one byte");
-        }
-        inputs.push(((*group, *binding), vec![0; *size as usize]));
+        files.push(bytes);
     }
     let images = crate::run_images::image_inputs(&kernel, &request.images)?;
-    let runs = run_loaded_in_groups(&kernel, &inputs, &images, request.workgroups, &slots);
+    let mut contents = files.iter().map(|bytes| BufferContents::Bytes(bytes));
+    let mut sizes = request.sizes.iter().map(|(_, _, size)| BufferContents::Zeros(*size));
+    let inputs: Vec<BufferInput> = flags
+        .into_iter()
+        .enumerate()
+        .map(|(index, (slot, flag))| {
+            let contents = if index < request.buffers.len() { contents.next() } else { sizes.next() };
+            BufferInput { slot, flag, contents: contents.expect("one per flag") }
+        })
+        .collect();
+    let mut runs = Vec::new();
+    let mut unavailable = Vec::new();
+    for slot in &slots {
+        let name = slot.name.to_string();
+        if every && let Err(why) = (slot.toolchain)() {
+            unavailable.push((name, why));
+            continue;
+        }
+        let outputs = match (slot.open)() {
+            Ok(mut backend) => {
+                run_on(backend.as_mut(), &kernel, &inputs, &images, request.workgroups, &resolved.workgroup_flags)
+                    .map_err(|e| format!("{e:#}"))
+            }
+            Err(why) if every && !(slot.needs_vulkan && strata_backends::gpu_required()) => {
+                unavailable.push((name, why.to_string()));
+                continue;
+            }
+            Err(why) => Err(why.to_string()),
+        };
+        runs.push(BackendRun { backend: name, outputs });
+    }
     for run in &runs {
         if let Ok(outputs) = &run.outputs {
             let dir = request.out.join(&run.backend);
@@ -393,5 +600,5 @@ pub fn run_kernel(request: &RunRequest) -> Result<RunOutcome> {
             }
         }
     }
-    Ok(RunOutcome { kernel, runs })
+    Ok(RunOutcome { kernel, runs, unavailable, tolerance })
 }

@@ -15,7 +15,11 @@
 //! | `data/blue_noise.bin` | the blue-noise tables, uploaded once |
 //!
 //! `cargo xtask export --out DIR` runs it. The folder is written next to `DIR` first and
-//! moved into place whole; an existing `DIR` is replaced only if it is an earlier package.
+//! moved into place whole; an existing `DIR` is replaced only if it is an earlier package
+//! holding nothing but the files its manifest lists and the files every package has: a
+//! file or folder the user added anywhere in it refuses the export by name before any
+//! work (the export never deletes a user's files). Errors are one line naming `DIR` once
+//! and the OS error once, never the temporary folder beside it.
 //!
 //! ```
 //! let out = std::env::temp_dir().join(format!("strata-doc-package-{}", std::process::id()));
@@ -52,13 +56,17 @@ pub enum ExportError {
         /// What is wrong with it.
         why: String,
     },
-    /// A file could not be written.
-    #[error("{path}: cannot write: {source}")]
+    /// The package could not be written: a file in it, the temporary folder beside the
+    /// output folder, or the swap into place.
+    #[error("--out {path}: {what}: {why}")]
     Write {
-        /// The file.
+        /// The output folder, as the user named it.
         path: String,
+        /// What failed (`cannot write kernels/spirv/strata_select.spv`), naming package
+        /// files relative to the package, never the temporary folder.
+        what: String,
         /// The OS error.
-        source: std::io::Error,
+        why: String,
     },
     /// A kernel could not be translated (a bug: the message names kernel and language).
     #[error("translation: {0}")]
@@ -257,36 +265,116 @@ fn manifest_struct(entry: &manifest::StructEntry) -> manifest::StructEntry {
     }
 }
 
-/// The entries of a package's folder: an existing folder with anything else in it is not
-/// replaced.
-const PACKAGE_ENTRIES: [&str; 5] = ["README.md", MANIFEST, "include", "kernels", "data"];
+/// The files every package has besides those its manifest names (the kernels'
+/// translations and the blue-noise tables).
+pub const FIXED_FILES: [&str; 5] =
+    ["README.md", MANIFEST, "include/strata.h", "include/strata_frame.h", "include/strata_vk.h"];
+
+/// The largest manifest read from an earlier package.
+const MAX_MANIFEST_BYTES: u64 = 16 << 20;
+
+/// The OS error of `error` alone (`Permission denied (os error 13)`), without the path
+/// some wrappers (`tempfile`) add to it: the message names the user's folder instead.
+fn os_error(error: &std::io::Error) -> String {
+    if let Some(code) = error.raw_os_error() {
+        return std::io::Error::from_raw_os_error(code).to_string();
+    }
+    // `tempfile` wraps the OS error in a private type that prints it, then ` at path "…"`.
+    match error.get_ref().map(ToString::to_string) {
+        Some(text) => text.split_once(" at path ").map_or(text.clone(), |(os, _)| os.to_string()),
+        None => error.kind().to_string(),
+    }
+}
+
+/// Whether the last part of `out` as written is `.` or `..` (`pkg/.`, `pkg/..`, `pkg/./`):
+/// [`Path::components`] drops a trailing `.`, so `pkg/.` would look like `pkg`, and the
+/// swap into place would fail (EBUSY) only after all the work.
+fn ends_in_dots(out: &Path) -> bool {
+    let bytes = out.as_os_str().as_encoded_bytes();
+    let trimmed = bytes.iter().rposition(|&b| b != b'/').map_or(&bytes[..0], |end| &bytes[..=end]);
+    let last = trimmed.rsplit(|&b| b == b'/').next().unwrap_or_default();
+    last == b"." || last == b".."
+}
+
+/// The files an earlier package's `manifest` lists (every kernel's translations, the
+/// blue-noise tables) and [`FIXED_FILES`]; `None` if it is not a strata manifest.
+fn listed_files(manifest: &[u8]) -> Option<Vec<String>> {
+    let manifest: serde_json::Value = serde_json::from_slice(manifest).ok()?;
+    manifest.get("schema_version")?;
+    manifest.get("strata_version")?;
+    let mut files: Vec<String> = FIXED_FILES.iter().map(|f| f.to_string()).collect();
+    for kernel in manifest.get("kernels")?.as_array()? {
+        if let Some(languages) = kernel.get("files").and_then(|f| f.as_object()) {
+            files.extend(languages.values().filter_map(|f| f.as_str()).map(str::to_string));
+        }
+    }
+    if let Some(file) = manifest.get("blue_noise").and_then(|b| b.get("file")).and_then(|f| f.as_str()) {
+        files.push(file.to_string());
+    }
+    Some(files)
+}
+
+/// The first entry below `out` (a package's folder) that is not one of `listed` nor a
+/// folder holding one of them: a file, link or folder of the user's, relative to `out`
+/// (`include/engine.h`, `kernels/custom/`). Folders are read in name order.
+fn first_foreign(out: &Path, listed: &[String]) -> Result<Option<String>, String> {
+    let mut folders = vec![String::new()];
+    while let Some(folder) = folders.pop() {
+        let path = if folder.is_empty() { out.to_path_buf() } else { out.join(&folder) };
+        let mut entries = Vec::new();
+        for entry in std::fs::read_dir(&path).map_err(|e| format!("cannot read {folder}: {}", os_error(&e)))? {
+            let entry = entry.map_err(|e| format!("cannot read {folder}: {}", os_error(&e)))?;
+            let file_type = entry.file_type().map_err(|e| format!("cannot read {folder}: {}", os_error(&e)))?;
+            entries.push((entry.file_name(), file_type));
+        }
+        entries.sort_by(|a, b| a.0.cmp(&b.0));
+        let mut below = Vec::new();
+        for (name, file_type) in entries {
+            let Some(name) = name.to_str() else {
+                return Ok(Some(format!("{folder}{}", name.to_string_lossy())));
+            };
+            let relative = format!("{folder}{name}");
+            // `file_type` does not follow links: a link is an entry of its own, replaced
+            // (never followed) only where the package has a file of that name.
+            if file_type.is_dir() {
+                let inside = format!("{relative}/");
+                if !listed.iter().any(|f| f.starts_with(&inside)) {
+                    return Ok(Some(inside));
+                }
+                below.push(inside);
+            } else if !listed.contains(&relative) {
+                return Ok(Some(relative));
+            }
+        }
+        folders.extend(below.into_iter().rev());
+    }
+    Ok(None)
+}
 
 /// Whether `out` may be written: a path ending in a folder's own name, absent, an empty
-/// folder, or an earlier package (a folder holding only a package's entries and a
-/// [`MANIFEST`] of this schema's kind). Anything else is refused: the export never
-/// deletes a user's files.
+/// folder, or an earlier package (a folder with a [`MANIFEST`] of this schema's kind,
+/// holding nothing but the files it lists and [`FIXED_FILES`], at any depth). Anything
+/// else is refused, naming the first entry of the user's: the export never deletes a
+/// user's files.
 fn check_out(out: &Path) -> Result<(), String> {
-    if !matches!(out.components().next_back(), Some(std::path::Component::Normal(_))) {
+    if ends_in_dots(out) || !matches!(out.components().next_back(), Some(std::path::Component::Normal(_))) {
         return Err("give the package folder's own name (not `.`, `..` or a root)".into());
     }
     let Ok(metadata) = std::fs::symlink_metadata(out) else { return Ok(()) };
     if !metadata.is_dir() {
         return Err("exists and is not a folder".into());
     }
-    let mut entries = Vec::new();
-    for entry in std::fs::read_dir(out).map_err(|e| e.to_string())? {
-        entries.push(entry.map_err(|e| e.to_string())?.file_name().to_string_lossy().into_owned());
-    }
-    if entries.is_empty() {
+    let mut entries = std::fs::read_dir(out).map_err(|e| os_error(&e))?;
+    if entries.next().is_none() {
         return Ok(());
     }
-    let manifest = std::fs::read_to_string(out.join(MANIFEST)).unwrap_or_default();
-    if !(manifest.contains("\"schema_version\"") && manifest.contains("\"strata_version\"")) {
+    let manifest = strata_files::read_named_regular_capped(&out.join(MANIFEST), MAX_MANIFEST_BYTES).ok();
+    let Some(listed) = manifest.as_deref().and_then(listed_files) else {
         return Err(
             "is a folder with other files in it (not an earlier strata package): choose an empty or new folder".into(),
         );
-    }
-    if let Some(foreign) = entries.iter().find(|e| !PACKAGE_ENTRIES.contains(&e.as_str())) {
+    };
+    if let Some(foreign) = first_foreign(out, &listed)? {
         return Err(format!(
             "is an earlier package with `{foreign}` added to it, which the export would delete: move it out, or \
              choose another folder"
@@ -300,9 +388,8 @@ fn check_out(out: &Path) -> Result<(), String> {
 /// old, at every moment.
 fn write_package(out: &Path, files: &[(String, Vec<u8>)]) -> Result<(), ExportError> {
     let name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "package".into());
-    let failed = |path: &Path| {
-        let path = path.display().to_string();
-        move |source| ExportError::Write { path, source }
+    let failed = |what: String| {
+        move |error: std::io::Error| ExportError::Write { path: out.display().to_string(), what, why: os_error(&error) }
     };
     // A new folder of a random name beside `out` (made by mkdir, mode 0700, so nothing
     // planted at a predictable name is written through), kept from here on: it is
@@ -311,15 +398,16 @@ fn write_package(out: &Path, files: &[(String, Vec<u8>)]) -> Result<(), ExportEr
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
     };
-    let temporary =
-        strata_files::private_scratch_folder_in(parent, &format!(".{name}.tmp-")).map_err(failed(parent))?.keep();
+    let temporary = strata_files::private_scratch_folder_in(parent, &format!(".{name}.tmp-"))
+        .map_err(failed("cannot make the new package's folder beside it".into()))?
+        .keep();
     let aside = out.with_file_name(format!(".{name}.old-{}", std::process::id()));
     let written = files.iter().try_for_each(|(relative, bytes)| {
         let path = temporary.join(relative);
         if let Some(parent) = path.parent() {
-            std::fs::create_dir_all(parent).map_err(failed(parent))?;
+            std::fs::create_dir_all(parent).map_err(failed(format!("cannot write {relative}")))?;
         }
-        std::fs::write(&path, bytes).map_err(failed(&path))
+        std::fs::write(&path, bytes).map_err(failed(format!("cannot write {relative}")))
     });
     if let Err(error) = written {
         let _ = std::fs::remove_dir_all(&temporary);
@@ -331,16 +419,16 @@ fn write_package(out: &Path, files: &[(String, Vec<u8>)]) -> Result<(), ExportEr
         return Err(ExportError::Out { path: out.display().to_string(), why });
     }
     let earlier = out.exists();
-    if earlier && let Err(source) = std::fs::rename(out, &aside) {
+    if earlier && let Err(error) = std::fs::rename(out, &aside) {
         let _ = std::fs::remove_dir_all(&temporary);
-        return Err(ExportError::Write { path: out.display().to_string(), source });
+        return Err(failed("cannot move the earlier package aside".into())(error));
     }
-    if let Err(source) = std::fs::rename(&temporary, out) {
+    if let Err(error) = std::fs::rename(&temporary, out) {
         if earlier {
             let _ = std::fs::rename(&aside, out);
         }
         let _ = std::fs::remove_dir_all(&temporary);
-        return Err(ExportError::Write { path: out.display().to_string(), source });
+        return Err(failed("cannot move the new package into place".into())(error));
     }
     if earlier {
         let _ = std::fs::remove_dir_all(&aside);

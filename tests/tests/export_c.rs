@@ -474,6 +474,89 @@ fn the_export_refuses_a_folder_that_is_not_a_package() {
     let _ = std::fs::remove_dir_all(&folder);
 }
 
+/// The error as `xtask` prints it: the message and each cause, `: `-separated (anyhow's
+/// `{:#}`).
+fn printed(error: &dyn std::error::Error) -> String {
+    let mut text = error.to_string();
+    let mut cause = error.source();
+    while let Some(inner) = cause {
+        text = format!("{text}: {inner}");
+        cause = inner.source();
+    }
+    text
+}
+
+/// Only the files an earlier package's manifest lists (and the files every package has)
+/// may be replaced: a file or folder the user added anywhere below is refused by name
+/// before any work, and stays.
+#[test]
+fn the_export_refuses_a_package_with_the_user_s_files_below_it() {
+    let folder = scratch("refuse-below");
+    let package = folder.join("package");
+    strata_export::export(&package).unwrap();
+    for added in ["include/engine.h", "kernels/spirv/mine.spv", "data/extra.bin", "kernels/custom/notes.txt"] {
+        let path = package.join(added);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(&path, "the user's").unwrap();
+        let message = printed(&strata_export::export(&package).unwrap_err());
+        let named = if added.starts_with("kernels/custom") { "kernels/custom" } else { added };
+        assert!(message.contains(&format!("`{named}")), "{added}: {message}");
+        assert!(path.exists(), "{added} was deleted");
+        std::fs::remove_file(&path).unwrap();
+        if added.starts_with("kernels/custom") {
+            std::fs::remove_dir(path.parent().unwrap()).unwrap();
+        }
+    }
+    // An empty folder the user made is theirs too.
+    std::fs::create_dir(package.join("include/mine")).unwrap();
+    let message = printed(&strata_export::export(&package).unwrap_err());
+    assert!(message.contains("`include/mine"), "{message}");
+    std::fs::remove_dir(package.join("include/mine")).unwrap();
+    strata_export::export(&package).unwrap();
+    let _ = std::fs::remove_dir_all(&folder);
+}
+
+/// `--out pkg/.` (and `pkg/..`) is refused before any work, not after it with EBUSY; a
+/// failed write names the user's `--out` once and the OS error once, never the
+/// temporary folder beside it.
+#[test]
+fn export_errors_name_the_out_folder_once_and_nothing_temporary() {
+    let folder = scratch("errors");
+    let package = folder.join("package");
+    strata_export::export(&package).unwrap();
+    for dotted in ["package/.", "package/./", "package/.."] {
+        let out = PathBuf::from(format!("{}/{dotted}", folder.display()));
+        let message = printed(&strata_export::export(&out).unwrap_err());
+        assert!(message.contains("own name"), "{dotted}: {message}");
+    }
+    let leftovers: Vec<String> = std::fs::read_dir(&folder)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n != "package")
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    // The temporary folder's name (`.NAME.tmp-` and 10 random characters) is past the
+    // 255 bytes a file name may have: making it fails.
+    let long = folder.join("p".repeat(245));
+    let message = printed(&strata_export::export(&long).unwrap_err());
+    assert!(!message.contains(".tmp-") && message.matches("os error 36").count() == 1, "{message}");
+    assert_eq!(message.matches(&"p".repeat(245)).count(), 1, "{message}");
+    // Deep enough that the files inside the temporary folder pass PATH_MAX (4096 bytes):
+    // writing them fails.
+    let mut deep = folder.clone();
+    while deep.as_os_str().len() < 4000 {
+        deep = deep.join("d".repeat(200));
+    }
+    let deep = deep.parent().unwrap().join("d".repeat(4040 - deep.parent().unwrap().as_os_str().len()));
+    std::fs::create_dir_all(&deep).unwrap();
+    let out = deep.join("pkg");
+    let message = printed(&strata_export::export(&out).unwrap_err());
+    assert!(!message.contains(".tmp-") && message.matches("os error 36").count() == 1, "{message}");
+    assert_eq!(message.matches(&out.display().to_string()).count(), 1, "{message}");
+    assert!(!message.contains('\n'), "{message}");
+    let _ = std::fs::remove_dir_all(&folder);
+}
+
 /// Frame parameters of `strata_frame.h` against `strata_kernels::pass_plan::frame_params` for
 /// many settings, sizes, frames, seeds and workgroup limits, byte for byte.
 #[test]

@@ -30,6 +30,8 @@ fn setup(name: &str) -> (PathBuf, RunRequest) {
         images: Vec::new(),
         backends: vec!["cpu".into()],
         out: dir.join("out"),
+        ulp: Vec::new(),
+        abs: Vec::new(),
     };
     (dir, request)
 }
@@ -121,6 +123,8 @@ fn a_shader_with_overrides_runs_everywhere_with_and_without_override() {
             images: Vec::new(),
             backends: vec!["all".into()],
             out: dir.join(format!("out{tile}")),
+            ulp: Vec::new(),
+            abs: Vec::new(),
         };
         let runs = run_kernel(&request).unwrap().runs;
         every_backend_agrees(&runs);
@@ -158,6 +162,8 @@ fn a_png_texture_and_a_sampler_run_everywhere_and_the_output_comes_back_as_png()
         ],
         backends: vec!["cpu".into(), "wgpu-vulkan".into(), "wgpu-gl".into(), "ash".into()],
         out: dir.join("out"),
+        ulp: Vec::new(),
+        abs: Vec::new(),
     };
     let runs = run_kernel(&request).unwrap().runs;
     // A filtered value a device rounds with 8-bit weights may land one 1/255 step away.

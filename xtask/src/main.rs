@@ -14,12 +14,16 @@
 //! * `cargo xtask run FILE.wgsl --entry NAME --workgroups X,Y,Z --buffer G:B=FILE ...
 //!   [--size G:B=BYTES] [--texture G:B=FILE] [--storage-texture G:B=WxH[:FORMAT]]
 //!   [--sampler G:B=FILTER,ADDRESS] [--override NAME=VALUE ...] [--ulp N | --ulp BUFFER=N ...] [--abs E | --abs BUFFER=E ...]
-//!   [--reference BACKEND] --backend cpu|wgpu|wgpu-gl|ash|ash-glsl|ash-hlsl|all [--out DIR]`:
+//!   [--reference BACKEND] --backend cpu|wgpu|wgpu-gl|ash|ash-glsl|ash-hlsl|ash-slang|all [--out DIR]`:
 //!   runs any WGSL compute shader, writes every writable buffer and storage texture to
 //!   `DIR/BACKEND/G_B_NAME.bin` (a storage texture also as `.png` or `.exr`), and with several backends reports per backend and
 //!   buffer whether it is identical to the reference backend's, or how many words
 //!   differ and by how many ULP; exits non-zero only when a backend fails or a buffer
-//!   exceeds the tolerance (integers: exact; f32 words: `--ulp`, default 0).
+//!   exceeds the tolerance (integers: exact; f32 words: `--ulp`, default 0). Every flag
+//!   is checked first: a binding given twice, a backend named twice, a bound for a
+//!   buffer that is not an output, an override value its type or naga's workgroup size
+//!   cannot take, a size past 4 GiB are one-line errors naming the flag. `all` lists a
+//!   path whose toolchain is missing (or that has no device) as unavailable.
 //!
 //! * `cargo xtask fuzz [--target T,...] [--seconds N] [--executions N] [--seed S]
 //!   [--crash-dir DIR] [--hang-ms MS] [--no-shared]`: fuzzes the loaders (scene JSON, PLY,
@@ -45,12 +49,14 @@
 
 mod fuzz;
 mod parallel;
+#[cfg(test)]
+mod tests;
 mod validate;
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
-use strata_check::agreement::{Tolerance, judge};
+use strata_check::agreement::judge;
 use strata_check::run_images::{self, ImageSpec, SamplerDesc, StorageTextureSize, TextureFile};
 use strata_check::run_kernel::RunRequest;
 use strata_kernels::Registry;
@@ -98,7 +104,9 @@ enum Command {
     /// pass in SPIR-V, HLSL, MSL, GLSL and WGSL, manifest.json, the C headers and the
     /// blue-noise tables (strata-export).
     Export {
-        /// The package's folder: new, empty, or an earlier package (replaced whole).
+        /// The package's folder: new, empty, or an earlier package holding only the files
+        /// its manifest lists (replaced whole; a file of yours anywhere in it refuses the
+        /// export by name).
         #[arg(long)]
         out: PathBuf,
     },
@@ -115,15 +123,19 @@ struct RunArgs {
     /// Workgroups X,Y,Z.
     #[arg(long, value_parser = parse_workgroups, default_value = "1,1,1")]
     workgroups: [u32; 3],
-    /// GROUP:BINDING=FILE: buffer contents (repeatable).
+    /// GROUP:BINDING=FILE: buffer contents (repeatable, once per binding).
     #[arg(long = "buffer", value_parser = parse_buffer)]
     buffers: Vec<(u32, u32, PathBuf)>,
-    /// GROUP:BINDING=BYTES: a zero-filled buffer of that size (default: the binding's minimum).
+    /// GROUP:BINDING=BYTES: a zero-filled buffer of that size, at most 4 GiB and the
+    /// device's buffer limit (default: the binding's minimum; not with --buffer for the
+    /// same binding).
     #[arg(long = "size", value_parser = parse_size)]
     sizes: Vec<(u32, u32, u64)>,
     /// GROUP:BINDING=FILE: a texture from a PNG (rgba8unorm, the 8-bit codes), an EXR
-    /// (rgba32float) or raw texels (FILE@WxHxD:FORMAT); its shape is the kernel's
-    /// (repeatable).
+    /// (rgba32float), or raw texels written FILE@WxH:FORMAT or FILE@WxHxD:FORMAT (e.g.
+    /// t.bin@64x64:rgba8unorm: the value is split at its last `@`; a value ending in .png
+    /// or .exr is always a picture, so my@photo.png is the picture); its shape is the
+    /// kernel's (repeatable, once per binding).
     #[arg(long = "texture", value_parser = parse_texture)]
     textures: Vec<(u32, u32, TextureFile)>,
     /// GROUP:BINDING=WxH, WxHxD or WxH:FORMAT: a zero-filled storage texture, written back as
@@ -134,13 +146,16 @@ struct RunArgs {
     /// or `mirror` (repeatable).
     #[arg(long = "sampler", value_parser = parse_sampler_flag)]
     samplers: Vec<(u32, u32, SamplerDesc)>,
-    /// NAME=VALUE: the value of an `override` constant (repeatable; by name, or by
-    /// `@id` number). Others keep their WGSL defaults. Applied once, by naga, before
-    /// any backend sees the shader, so every backend runs the same specialisation.
+    /// NAME=VALUE: the value of an `override` constant (repeatable; by name, or by its
+    /// `@id` number as ID=VALUE or @ID=VALUE, whether or not it has a name). Others keep
+    /// their WGSL defaults. Applied once, by naga, before any backend sees the shader, so
+    /// every backend runs the same specialisation.
     #[arg(long = "override", value_parser = parse_override)]
     overrides: Vec<(String, f64)>,
-    /// Backends, comma-separated, or `all` (cpu, wgpu-vulkan, wgpu-gl, ash, ash-glsl,
-    /// ash-hlsl; `wgpu` means wgpu-vulkan).
+    /// Backends, comma-separated, each once, or `all` (cpu, wgpu-vulkan, wgpu-gl, ash,
+    /// ash-glsl, ash-hlsl, ash-slang; `wgpu` means wgpu-vulkan). `all` runs every path
+    /// available here and lists the others as unavailable (a missing toolchain such as
+    /// Slang's, or no device) without failing; a path named on its own must run.
     #[arg(long, default_value = "cpu", value_delimiter = ',')]
     backend: Vec<String>,
     /// Tolerance for f32 words: N units in the last place for every buffer, or
@@ -162,7 +177,16 @@ struct RunArgs {
 }
 
 fn main() {
-    let result = match Cli::parse().command {
+    if let Err(error) = execute(Cli::parse()) {
+        // `{:#}` puts anyhow's causes on the line; `{:?}` would add a backtrace.
+        eprintln!("error: {error:#}");
+        std::process::exit(1);
+    }
+}
+
+/// Runs one command.
+fn execute(cli: Cli) -> Result<()> {
+    match cli.command {
         Command::Shaders { strict, out } => shaders(strict, out),
         Command::Check { full, kernel } => check(full, &kernel),
         Command::Validate => validate::validate(),
@@ -189,18 +213,22 @@ fn main() {
                 reference,
                 out,
             } = *args;
-            let tolerance = tolerance(&ulp, &abs);
-            images(&textures, &storage_textures, &samplers).and_then(|images| {
-                let request =
-                    RunRequest { shader, entry, workgroups, buffers, sizes, overrides, images, backends: backend, out };
-                run(request, &tolerance, reference.as_deref())
-            })
+            let images = images(&textures, &storage_textures, &samplers);
+            let request = RunRequest {
+                shader,
+                entry,
+                workgroups,
+                buffers,
+                sizes,
+                overrides,
+                images,
+                backends: backend,
+                out,
+                ulp,
+                abs,
+            };
+            run(request, reference.as_deref())
         }
-    };
-    if let Err(error) = result {
-        // `{:#}` puts anyhow's causes on the line; `{:?}` would add a backtrace.
-        eprintln!("error: {error:#}");
-        std::process::exit(1);
     }
 }
 
@@ -231,7 +259,7 @@ fn check(full: bool, only: &[String]) -> Result<()> {
 }
 
 fn shaders(strict: bool, out: PathBuf) -> Result<()> {
-    std::fs::create_dir_all(&out)?;
+    std::fs::create_dir_all(&out).with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
     let registry = Registry::load()?;
     let mut failures = 0;
     let mut missing = 0;
@@ -318,13 +346,13 @@ fn images(
     textures: &[(u32, u32, TextureFile)],
     storage: &[(u32, u32, StorageTextureSize)],
     samplers: &[(u32, u32, SamplerDesc)],
-) -> Result<Vec<ImageSpec>> {
-    Ok(textures
+) -> Vec<ImageSpec> {
+    textures
         .iter()
         .map(|(g, b, file)| ImageSpec::Texture((*g, *b), file.clone()))
         .chain(storage.iter().map(|(g, b, (size, format))| ImageSpec::StorageTexture((*g, *b), *size, *format)))
         .chain(samplers.iter().map(|(g, b, desc)| ImageSpec::Sampler((*g, *b), *desc)))
-        .collect())
+        .collect()
 }
 
 fn parse_override(text: &str) -> Result<(String, f64), String> {
@@ -361,39 +389,17 @@ fn parse_abs(text: &str) -> Result<(Option<String>, f32), String> {
     Ok((buffer, bound))
 }
 
-/// The tolerance of `--ulp` and `--abs`: plain values for every buffer, `BUFFER=` ones
-/// for that buffer (whose other half falls back to the plain value).
-fn tolerance(ulp: &[(Option<String>, u32)], abs: &[(Option<String>, f32)]) -> Tolerance {
-    let mut tolerance = Tolerance::default();
-    for (buffer, bound) in ulp {
-        if buffer.is_none() {
-            tolerance.float.ulp = *bound;
+fn run(request: RunRequest, reference: Option<&str>) -> Result<()> {
+    let reference = reference.map(|name| if name == "wgpu" { "wgpu-vulkan" } else { name });
+    if let Some(name) = reference {
+        let named = strata_check::run_kernel::named_slots(&request.backends)?;
+        if !named.iter().any(|slot| slot.name == name) {
+            let names: Vec<&str> = named.iter().map(|slot| slot.name).collect();
+            bail!("--reference {name}: not among the backends run ({})", names.join(", "));
         }
     }
-    for (buffer, bound) in abs {
-        if buffer.is_none() {
-            tolerance.float.abs = *bound;
-        }
-    }
-    let named = ulp.iter().filter_map(|(b, _)| b.clone()).chain(abs.iter().filter_map(|(b, _)| b.clone()));
-    for name in named {
-        if tolerance.per_buffer.iter().any(|(n, _)| *n == name) {
-            continue;
-        }
-        let mut bound = tolerance.float;
-        if let Some((_, ulp)) = ulp.iter().rev().find(|(b, _)| b.as_deref() == Some(&name)) {
-            bound.ulp = *ulp;
-        }
-        if let Some((_, abs)) = abs.iter().rev().find(|(b, _)| b.as_deref() == Some(&name)) {
-            bound.abs = *abs;
-        }
-        tolerance.per_buffer.push((name, bound));
-    }
-    tolerance
-}
-
-fn run(request: RunRequest, tolerance: &Tolerance, reference: Option<&str>) -> Result<()> {
     let outcome = strata_check::run_kernel::run_kernel(&request)?;
+    let tolerance = &outcome.tolerance;
     let runs = outcome.runs;
     for run in &runs {
         match &run.outputs {
@@ -406,9 +412,11 @@ fn run(request: RunRequest, tolerance: &Tolerance, reference: Option<&str>) -> R
             Err(error) => println!("{:<12} FAILED: {}", run.backend, error.replace('\n', " ")),
         }
     }
+    for (backend, why) in &outcome.unavailable {
+        println!("{backend:<12} unavailable: {}", why.replace('\n', " "));
+    }
     let ran = runs.iter().filter(|r| r.outputs.is_ok()).count();
     if ran > 1 || reference.is_some() {
-        let reference = reference.map(|name| if name == "wgpu" { "wgpu-vulkan" } else { name });
         let judgement = judge(&runs, reference, tolerance).map_err(anyhow::Error::msg)?;
         println!("against {}:", judgement.reference);
         for buffer in &judgement.buffers {

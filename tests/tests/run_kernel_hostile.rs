@@ -1,0 +1,159 @@
+//! `cargo xtask run`'s library given hostile or careless input: sizes past a device's
+//! limits, an override the device cannot run, a picture with `@` in its name, a path
+//! whose toolchain is missing under `--backend all`. Each is one error naming the flag
+//! or value, or (for a missing toolchain) a path listed as unavailable; never a panic,
+//! an abort or an input read as something else.
+
+use std::path::{Path, PathBuf};
+use strata_check::run_images::{ImageSpec, TextureFile, parse_texture_file};
+use strata_check::run_kernel::{RunRequest, run_kernel};
+
+const SQUARE: &str = "
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    output[id.x] = input[id.x] * input[id.x] + id.x;
+}
+";
+
+const TEXTURE: &str = "
+@group(0) @binding(0) var picture: texture_2d<f32>;
+@group(0) @binding(1) var<storage, read_write> output: array<f32>;
+@compute @workgroup_size(1)
+fn main() {
+    output[0] = textureLoad(picture, vec2<i32>(1, 0), 0).x;
+}
+";
+
+const TILE: &str = "
+@id(3) override tile: u32 = 8;
+@group(0) @binding(0) var<storage, read_write> output: array<u32>;
+@compute @workgroup_size(tile, tile)
+fn main(@builtin(local_invocation_index) i: u32) {
+    output[i] = tile;
+}
+";
+
+/// A fresh scratch folder with the shaders and an input.
+fn scratch(name: &str) -> PathBuf {
+    let folder = std::env::temp_dir().join(format!("strata-hostile-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&folder);
+    std::fs::create_dir_all(&folder).unwrap();
+    std::fs::write(folder.join("square.wgsl"), SQUARE).unwrap();
+    std::fs::write(folder.join("texture.wgsl"), TEXTURE).unwrap();
+    std::fs::write(folder.join("tile.wgsl"), TILE).unwrap();
+    std::fs::write(folder.join("in.bin"), vec![3u8; 512]).unwrap();
+    folder
+}
+
+fn request(folder: &Path, shader: &str) -> RunRequest {
+    RunRequest {
+        shader: folder.join(shader),
+        entry: "main".into(),
+        workgroups: [1, 1, 1],
+        buffers: Vec::new(),
+        sizes: Vec::new(),
+        overrides: Vec::new(),
+        images: Vec::new(),
+        backends: vec!["cpu".into()],
+        out: folder.join("out"),
+        ulp: Vec::new(),
+        abs: Vec::new(),
+    }
+}
+
+/// The one backend's error.
+fn failure(request: &RunRequest) -> String {
+    let runs = run_kernel(request).unwrap().runs;
+    runs[0].outputs.as_ref().map(|_| ()).unwrap_err().clone()
+}
+
+/// A size under xtask run's cap but past the interpreter's buffer limit (1 GiB) is that
+/// backend's failure naming the flag and the limit; nothing of that size is allocated.
+#[test]
+fn a_size_past_a_device_limit_names_the_flag_and_the_limit() {
+    let folder = scratch("limit");
+    let mut request = request(&folder, "square.wgsl");
+    request.buffers = vec![(0, 0, folder.join("in.bin"))];
+    request.sizes = vec![(0, 1, 3 << 30)];
+    let error = failure(&request);
+    assert!(error.contains("--size 0:1=3221225472") && error.contains("buffer bytes"), "{error}");
+    assert!(!error.contains('\n'), "{error}");
+    let _ = std::fs::remove_dir_all(&folder);
+}
+
+/// An override the workgroup limits refuse (64 × 64 invocations; the interpreter takes
+/// 1024) names the override, its value and the limit.
+#[test]
+fn an_override_past_a_device_limit_names_the_override() {
+    let folder = scratch("override-limit");
+    let mut request = request(&folder, "tile.wgsl");
+    request.sizes = vec![(0, 0, 4 << 14)];
+    request.overrides = vec![("3".into(), 64.0)];
+    let error = failure(&request);
+    assert!(error.contains("invocations per workgroup") && error.contains("--override 3=64"), "{error}");
+    assert!(error.contains("sets `tile` (@id(3))") && error.contains("64x64x1"), "{error}");
+    let _ = std::fs::remove_dir_all(&folder);
+}
+
+/// `my@photo.png`, a file that exists, is the picture, not raw texels `my` of size
+/// `photo.png`; raw texels are still `FILE@WxH[xD]:FORMAT`.
+#[test]
+fn a_picture_with_an_at_sign_in_its_name_is_read_as_the_picture() {
+    let folder = scratch("at-sign");
+    let picture = image::RgbaImage::from_fn(3, 2, |x, y| image::Rgba([(x * 100 + y) as u8, 0, 0, 255]));
+    picture.save(folder.join("my@photo.png")).unwrap();
+    let named = folder.join("my@photo.png").display().to_string();
+    assert_eq!(parse_texture_file(&named), Ok(TextureFile::Picture(named.clone().into())));
+    let mut request = request(&folder, "texture.wgsl");
+    request.images = vec![ImageSpec::Texture((0, 0), TextureFile::Picture(named.into()))];
+    let runs = run_kernel(&request).unwrap().runs;
+    let output = &runs[0].outputs.as_ref().unwrap()[0].bytes;
+    assert_eq!(f32::from_le_bytes(output[..4].try_into().unwrap()), 100.0 / 255.0);
+    // Raw texels whose file name has an `@` too: split at the last one.
+    let raw = format!("{}/raw@1.bin@4x2:r32float", folder.display());
+    let expected = TextureFile::Raw {
+        path: folder.join("raw@1.bin"),
+        size: [4, 2, 1],
+        format: strata_kernels::TexelFormat::R32Float,
+    };
+    assert_eq!(parse_texture_file(&raw), Ok(expected));
+    let _ = std::fs::remove_dir_all(&folder);
+}
+
+/// Runs in a child process with `STRATA_SLANG_DIR` naming an empty folder (Slang is not
+/// installed): `all` lists ash-slang as unavailable and the run passes; naming it fails.
+#[test]
+#[ignore = "run by a_missing_toolchain_is_unavailable_under_all in a child process"]
+fn child_without_slang() {
+    let folder = scratch("no-slang");
+    let mut request = request(&folder, "square.wgsl");
+    request.buffers = vec![(0, 0, folder.join("in.bin"))];
+    request.backends = vec!["all".into()];
+    let outcome = run_kernel(&request).unwrap();
+    assert!(outcome.runs.iter().all(|r| r.backend != "ash-slang"), "{:?}", outcome.runs);
+    let (_, why) = outcome.unavailable.iter().find(|(name, _)| name == "ash-slang").expect("ash-slang unavailable");
+    assert!(why.contains("slangpy"), "{why}");
+    for run in &outcome.runs {
+        let skippable = !strata_backends::gpu_required() || run.backend == "wgpu-gl";
+        assert!(run.outputs.is_ok() || skippable, "{}: {:?}", run.backend, run.outputs);
+    }
+    request.backends = vec!["ash-slang".into()];
+    let outcome = run_kernel(&request).unwrap();
+    assert!(outcome.runs[0].outputs.is_err(), "{:?}", outcome.runs);
+    let _ = std::fs::remove_dir_all(&folder);
+}
+
+#[test]
+fn a_missing_toolchain_is_unavailable_under_all() {
+    let empty = std::env::temp_dir().join(format!("strata-hostile-no-slang-dir-{}", std::process::id()));
+    std::fs::create_dir_all(&empty).unwrap();
+    let status = std::process::Command::new(std::env::current_exe().unwrap())
+        .args(["--exact", "child_without_slang", "--ignored", "--nocapture"])
+        .env("STRATA_SLANG_DIR", &empty)
+        .status()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&empty);
+    assert!(status.success(), "the child run failed: {status}");
+}

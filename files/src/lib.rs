@@ -11,7 +11,7 @@
 //!   through an existing entry, link or not), and the rename that puts them in place;
 //! - [`bounded_read`]: whole reads of regular files only, opened without following a
 //!   link and without waiting for a pipe's writer, with a size cap checked before reading;
-//! - [`private_folder`]: the per-user cache folder (created `0700`, its owner and mode
+//! - [`private_folder`](mod@private_folder): the per-user cache folder (created `0700`, its owner and mode
 //!   checked before anything in it is trusted) and private scratch folders.
 
 pub mod bounded_read;

@@ -43,23 +43,9 @@ fn text(path: &Path) -> String {
     path.to_str().unwrap().to_string()
 }
 
-const SQUARE: &str = "
-@group(0) @binding(0) var<storage, read> input: array<u32>;
-@group(0) @binding(1) var<storage, read_write> output: array<u32>;
-@compute @workgroup_size(64)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    output[id.x] = input[id.x] * input[id.x] + id.x;
-}
-";
+const SQUARE: &str = include_str!("../../tests/data/flags/square.wgsl");
 
-const TEXTURE: &str = "
-@group(0) @binding(0) var picture: texture_2d<f32>;
-@group(0) @binding(1) var<storage, read_write> output: array<f32>;
-@compute @workgroup_size(1)
-fn main() {
-    output[0] = textureLoad(picture, vec2<i32>(1, 0), 0).x;
-}
-";
+const TEXTURE: &str = include_str!("../../tests/data/flags/texture_load.wgsl");
 
 /// The override of the issue: an `@id` and a name, feeding the workgroup size.
 const TILE: &str = "

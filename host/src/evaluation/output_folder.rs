@@ -61,13 +61,14 @@ pub fn lock(folder: &Path) -> Result<FolderLock> {
                     Err(_) => None,
                 };
                 match holder {
-                    Some(pid) if crate::atomic_file::process_is_running(pid) => bail!(
+                    Some(pid) if crate::atomic_file::process_is_running(pid) && may_be_strata(pid) => bail!(
                         "{}: another strata compare (process {pid}) is writing into this folder; wait for it or \
                          choose another --out (if no such run is going on, remove {})",
                         folder.display(),
                         path.display()
                     ),
-                    // A run that was killed, or a lock half-written: take it over.
+                    // A run that was killed, a lock half-written, or a lock whose process id
+                    // now belongs to another program (ids are reused): take it over.
                     _ => std::fs::remove_file(&path)
                         .with_context(|| format!("{}: cannot remove a stale lock", path.display()))?,
                 }
@@ -76,6 +77,18 @@ pub fn lock(folder: &Path) -> Result<FolderLock> {
         }
     }
     bail!("{}: the lock keeps being taken by other runs", folder.display())
+}
+
+/// Whether the running process `pid` may be a `strata compare`: its name (Linux's
+/// `/proc/PID/comm`) starts with `strata` (the binary, or a test binary of this crate),
+/// or cannot be read (then it is taken for one, so a live run is never taken over). A
+/// lock whose process id a later, unrelated program got is stale, not "another strata
+/// compare".
+fn may_be_strata(pid: u32) -> bool {
+    match std::fs::read_to_string(format!("/proc/{pid}/comm")) {
+        Ok(name) => name.trim_end().starts_with("strata"),
+        Err(_) => true,
+    }
 }
 
 /// Whether `name` is a file a comparison run writes: the CSVs, the summary, the record,
@@ -273,10 +286,19 @@ mod tests {
         assert!(refused.contains(&format!("process {}", std::process::id())), "{refused}");
         drop(lock);
         assert!(!folder.join(LOCK_NAME).exists());
+        // A lock whose process id belongs to another program now (`sleep`) is stale.
+        let mut other = std::process::Command::new("sleep").arg("60").spawn().unwrap();
+        std::fs::write(folder.join(LOCK_NAME), other.id().to_string()).unwrap();
+        let taken = prepare(&folder, None);
+        let _ = other.kill();
+        let _ = other.wait();
+        let (lock, removed) = taken.expect("a lock held by `sleep` is not another strata compare's");
+        assert_eq!(removed, ["reference.exr"]);
+        drop(lock);
         // A lock left by a process that has ended is taken over.
         std::fs::write(folder.join(LOCK_NAME), u32::MAX.to_string()).unwrap();
         let (_lock, removed) = prepare(&folder, None).unwrap();
-        assert_eq!(removed, ["reference.exr"]);
+        assert!(removed.is_empty(), "{removed:?}");
         drop(_lock);
         std::fs::remove_dir_all(&folder).unwrap();
     }

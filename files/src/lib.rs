@@ -22,10 +22,10 @@ pub use tempfile::TempDir;
 
 pub use bounded_read::{ReadError, read_named_regular_capped, read_regular_capped};
 pub use private_folder::{
-    FolderError, check_private, private_folder, private_scratch_folder, private_scratch_folder_in, user_cache_folder,
-    user_cache_path,
+    FolderError, check_private, owned_and_unshared, private_folder, private_scratch_folder, private_scratch_folder_in,
+    user_cache_folder, user_cache_path,
 };
 pub use temporary::{
-    TemporaryFile, any_temporary_writer, is_temporary, is_temporary_of, process_is_running, remove_dead_temporaries,
-    temporary_writer, write_whole,
+    TemporaryFile, any_temporary_writer, is_temporary, process_is_running, remove_dead_temporaries, temporary_writer,
+    write_whole,
 };

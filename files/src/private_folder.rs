@@ -83,19 +83,29 @@ pub fn check_private(folder: &Path) -> Result<(), FolderError> {
     if !metadata.is_dir() {
         return Err(not_private("is not a folder".into()));
     }
+    owned_and_unshared(&metadata).map_err(not_private)
+}
+
+/// Whether the entry `metadata` describes belongs to this user and nobody else may write
+/// it (no group or other write bit): `Err` says which is not so. What a folder strata
+/// trusts ([`check_private`]) and a program it runs (the built Slang tool) must both be.
+/// On systems without Unix permissions there is nothing to check.
+pub fn owned_and_unshared(metadata: &std::fs::Metadata) -> Result<(), String> {
     #[cfg(unix)]
     {
         use std::os::unix::fs::MetadataExt;
         // SAFETY: geteuid has no preconditions and cannot fail.
         let me = unsafe { libc::geteuid() };
         if metadata.uid() != me {
-            return Err(not_private(format!("is owned by user {}, not by this user ({me})", metadata.uid())));
+            return Err(format!("is owned by user {}, not by this user ({me})", metadata.uid()));
         }
         let mode = metadata.mode() & 0o777;
         if mode & 0o022 != 0 {
-            return Err(not_private(format!("has mode {mode:o}: others may write into it")));
+            return Err(format!("has mode {mode:o}: others may write into it"));
         }
     }
+    #[cfg(not(unix))]
+    let _ = metadata;
     Ok(())
 }
 

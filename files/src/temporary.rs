@@ -11,7 +11,7 @@
 //!   write of the same target recognises as a dead process's and removes
 //!   ([`remove_dead_temporaries`]), while a running process's is left alone.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// A temporary file beside a target, removed when dropped unless [`Self::persist`]ed.
 #[derive(Debug)]
@@ -94,11 +94,6 @@ pub fn temporary_writer(target_name: &str, name: &str) -> Option<u32> {
     writer_of(name.strip_prefix(&prefix)?.strip_suffix(&suffix)?)
 }
 
-/// Whether `name` is one of `target_name`'s temporaries.
-pub fn is_temporary_of(target_name: &str, name: &str) -> bool {
-    temporary_writer(target_name, name).is_some()
-}
-
 /// The process that made `name`, if `name` is a temporary of any target.
 pub fn any_temporary_writer(name: &str) -> Option<u32> {
     let (_, after) = name.rsplit_once(".tmp-")?;
@@ -158,8 +153,9 @@ pub fn remove_dead_temporaries(target: &Path) -> Vec<String> {
 }
 
 /// The temporary name an older strata (before random suffixes) used for `target`: what
-/// tests plant as a killed run's leftover.
-pub fn legacy_temporary_path(target: &Path, pid: u32) -> PathBuf {
+/// the tests plant as a link at a predictable name.
+#[cfg(test)]
+fn legacy_temporary_path(target: &Path, pid: u32) -> std::path::PathBuf {
     let name = target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let (prefix, suffix) = affixes(&name);
     target.with_file_name(format!("{prefix}{pid}{suffix}"))

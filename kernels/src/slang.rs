@@ -148,18 +148,10 @@ fn is_own_program(path: &Path) -> Result<bool, ToolError> {
     if !metadata.file_type().is_file() {
         return refuse("is not a regular file");
     }
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        // SAFETY: geteuid has no preconditions and cannot fail.
-        if metadata.uid() != unsafe { libc::geteuid() } {
-            return refuse("belongs to another user");
-        }
-        if metadata.mode() & 0o022 != 0 {
-            return refuse("may be written by others");
-        }
+    match strata_files::owned_and_unshared(&metadata) {
+        Ok(()) => Ok(true),
+        Err(why) => refuse(&why),
     }
-    Ok(true)
 }
 
 /// Compiles the HLSL file `hlsl` (compute entry point `entry`) to SPIR-V words.
@@ -253,7 +245,7 @@ mod tests {
         let writable = scratch.path().join("writable");
         std::fs::write(&writable, b"#!/bin/sh\n").unwrap();
         std::fs::set_permissions(&writable, std::fs::Permissions::from_mode(0o777)).unwrap();
-        assert!(is_own_program(&writable).unwrap_err().to_string().contains("written by others"));
+        assert!(is_own_program(&writable).unwrap_err().to_string().contains("others may write"));
         let link = scratch.path().join("link");
         std::os::unix::fs::symlink(&own, &link).unwrap();
         assert!(is_own_program(&link).unwrap_err().to_string().contains("not a regular file"));

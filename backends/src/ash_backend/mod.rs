@@ -243,14 +243,8 @@ impl Backend for AshBackend {
         let entry = self.buffer(buffer)?;
         // Checked without wrapping: on Ok the range lies inside `0..entry.size`.
         let range = write_range(&entry.label, entry.size, offset, data.len())?;
-        if range.len() != data.len() || u64::try_from(range.end).map_or(true, |end| end > entry.size) {
-            return Err(BackendError::Buffer {
-                label: entry.label.clone(),
-                reason: format!("internal: write range {range:?} outside the buffer's {} bytes", entry.size),
-            });
-        }
-        // SAFETY: `range` lies inside the buffer's `size` bytes (checked by `write_range`
-        // without wrapping, and again above), which the mapping covers from `mapped`
+        // SAFETY: `range` lies inside the buffer's `size` bytes and is `data.len()` long
+        // (`write_range`'s contract, checked without wrapping), which the mapping covers from `mapped`
         // (`AshBuffer`'s invariant), so `mapped + range.start` and the `data.len()` bytes
         // after it are inside the mapping; `data` is host memory of ours, not the
         // mapping, so the two do not overlap; and no dispatch is in flight (dispatches

@@ -10,8 +10,8 @@
 use crate::backend::{Bind, BufferId, Resource};
 use crate::device_info::DeviceInfo;
 use crate::error::BackendError;
-use crate::texture::{SamplerId, TextureDesc, TextureId};
-use strata_kernels::{BindingInfo, BindingKind, Kernel};
+use crate::texture::{FilterMode, SamplerDesc, SamplerId, TextureDesc, TextureId};
+use strata_kernels::{BindingInfo, BindingKind, Kernel, TexelKind};
 
 /// Whether `device` can run `kernel`: features, workgroup size, workgroup memory and
 /// storage buffer count.
@@ -47,20 +47,21 @@ pub fn check_kernel_fits(kernel: &Kernel, device: &DeviceInfo) -> Result<(), Bac
 }
 
 /// How the checks look up a backend's resources: a buffer's size, a texture's
-/// description, whether a sampler exists (each an error for an id the backend does not
+/// description, a sampler's description (each an error for an id the backend does not
 /// own).
 pub struct ResourceLookup<'a> {
     /// Size in bytes of a buffer.
     pub buffer_size: &'a dyn Fn(BufferId) -> Result<u64, BackendError>,
     /// What a texture was created as.
     pub texture: &'a dyn Fn(TextureId) -> Result<TextureDesc, BackendError>,
-    /// Whether a sampler exists.
-    pub sampler: &'a dyn Fn(SamplerId) -> Result<(), BackendError>,
+    /// What a sampler was created as.
+    pub sampler: &'a dyn Fn(SamplerId) -> Result<SamplerDesc, BackendError>,
 }
 
 /// Whether `binds` bind every binding of `kernel` once, each with a resource of its kind:
 /// buffers large enough and within the device's binding limits, textures of the shape,
-/// texel kind and format the kernel declares, samplers where it samples.
+/// texel kind and format the kernel declares, samplers where it samples, and no
+/// filtering sampler sampling an integer texture (Vulkan leaves it undefined).
 pub fn check_binds(
     kernel: &Kernel,
     binds: &[Bind],
@@ -143,9 +144,61 @@ pub fn check_binds(
                     ));
                 }
             }
-            (BindingKind::Sampler, Resource::Sampler(sampler)) => (lookup.sampler)(sampler)?,
+            (BindingKind::Sampler, Resource::Sampler(sampler)) => {
+                (lookup.sampler)(sampler)?;
+            }
             _ => return Err(wrong_kind()),
         }
+    }
+    check_filtering(kernel, binds, lookup)
+}
+
+/// Whether every sampler that filters linearly (magnifying, minifying or between mip
+/// levels) samples only float textures. An integer texel cannot be filtered: Vulkan
+/// makes it undefined (VUID-vkCmdDispatch-magFilter-04553, -mipmapMode-04770) and
+/// lavapipe and the interpreter returned numbers, WebGPU refuses it; so every path
+/// refuses it here, naming the sampler binding, the texture binding and the format.
+/// `binds` are [`check_binds`]'s, already matched to the kernel's bindings.
+fn check_filtering(kernel: &Kernel, binds: &[Bind], lookup: &ResourceLookup) -> Result<(), BackendError> {
+    let info = |slot: (u32, u32)| kernel.binding(slot.0, slot.1);
+    let bound = |slot: (u32, u32)| binds.iter().find(|b| b.slot() == slot).map(|b| b.resource);
+    // The IR walk only where an integer texture and a sampler are both bound.
+    let integer =
+        |b: &BindingInfo| matches!(b.kind, BindingKind::SampledTexture { kind, .. } if kind != TexelKind::Float);
+    if !kernel.bindings.iter().any(integer) || !kernel.bindings.iter().any(|b| b.kind == BindingKind::Sampler) {
+        return Ok(());
+    }
+    for pair in strata_kernels::combined_samplers::sampled_pairs(kernel) {
+        let (Some(Resource::Texture(texture)), Some(Resource::Sampler(sampler))) =
+            (bound(pair.texture), bound(pair.sampler))
+        else {
+            continue;
+        };
+        let desc = (lookup.sampler)(sampler)?;
+        let filters = [desc.mag_filter, desc.min_filter, desc.mipmap_filter].contains(&FilterMode::Linear);
+        let texture_desc = (lookup.texture)(texture)?;
+        if !filters || texture_desc.format.kind() == TexelKind::Float {
+            continue;
+        }
+        let name = |slot: (u32, u32)| info(slot).map_or_else(String::new, |b| format!("`{}` ", b.name));
+        let at = |slot: (u32, u32)| match slot {
+            (0, binding) => format!("binding {binding}"),
+            (group, binding) => format!("group {group} binding {binding}"),
+        };
+        return Err(BackendError::Binding {
+            kernel: kernel.name().into(),
+            binding: pair.sampler.1,
+            reason: format!(
+                "sampler {}({}) filters linearly, but it samples texture {}({}) of {}, an integer format no \
+                 sampler may filter (Vulkan's VUID-vkCmdDispatch-magFilter-04553): give that sampler nearest \
+                 filtering",
+                name(pair.sampler),
+                at(pair.sampler),
+                name(pair.texture),
+                at(pair.texture),
+                texture_desc.format.wgsl()
+            ),
+        });
     }
     Ok(())
 }

@@ -1,11 +1,12 @@
 //! `cargo xtask run`'s library given hostile or careless input: sizes past a device's
 //! limits, an override the device cannot run, a picture with `@` in its name, a path
-//! whose toolchain is missing under `--backend all`. Each is one error naming the flag
-//! or value, or (for a missing toolchain) a path listed as unavailable; never a panic,
-//! an abort or an input read as something else.
+//! whose toolchain is missing under `--backend all`, a linear sampler on an integer
+//! texture. Each is one error naming the flag or value, or (for a missing toolchain) a
+//! path listed as unavailable; never a panic, an abort, an input read as something else
+//! or a number the specification leaves undefined.
 
 use std::path::{Path, PathBuf};
-use strata_check::run_images::{ImageSpec, TextureFile, parse_texture_file};
+use strata_check::run_images::{ImageSpec, TextureFile, parse_sampler, parse_texture_file};
 use strata_check::run_kernel::{RunRequest, run_kernel};
 
 const SQUARE: &str = include_str!("../data/flags/square.wgsl");
@@ -21,6 +22,29 @@ fn main(@builtin(local_invocation_index) i: u32) {
 }
 ";
 
+const GATHER: &str = "
+@group(0) @binding(0) var texels: texture_2d<u32>;
+@group(0) @binding(1) var blend: sampler;
+@group(0) @binding(2) var<storage, read_write> output: array<vec4<u32>>;
+fn gather(t: texture_2d<u32>, s: sampler) -> vec4<u32> {
+    return textureGather(0, t, s, vec2(0.5, 0.5));
+}
+@compute @workgroup_size(1)
+fn main() {
+    output[0] = gather(texels, blend);
+}
+";
+
+const GATHER_DIRECT: &str = "
+@group(0) @binding(0) var texels: texture_2d<u32>;
+@group(0) @binding(1) var blend: sampler;
+@group(0) @binding(2) var<storage, read_write> output: array<vec4<u32>>;
+@compute @workgroup_size(1)
+fn main() {
+    output[0] = textureGather(0, texels, blend, vec2(0.5, 0.5));
+}
+";
+
 /// A fresh scratch folder with the shaders and an input.
 fn scratch(name: &str) -> PathBuf {
     let folder = std::env::temp_dir().join(format!("strata-hostile-{name}-{}", std::process::id()));
@@ -29,6 +53,8 @@ fn scratch(name: &str) -> PathBuf {
     std::fs::write(folder.join("square.wgsl"), SQUARE).unwrap();
     std::fs::write(folder.join("texture.wgsl"), TEXTURE).unwrap();
     std::fs::write(folder.join("tile.wgsl"), TILE).unwrap();
+    std::fs::write(folder.join("gather.wgsl"), GATHER).unwrap();
+    std::fs::write(folder.join("gather_direct.wgsl"), GATHER_DIRECT).unwrap();
     std::fs::write(folder.join("in.bin"), vec![3u8; 512]).unwrap();
     folder
 }
@@ -80,6 +106,54 @@ fn an_override_past_a_device_limit_names_the_override() {
     let error = failure(&request);
     assert!(error.contains("invocations per workgroup") && error.contains("--override 3=64"), "{error}");
     assert!(error.contains("sets `tile` (@id(3))") && error.contains("64x64x1"), "{error}");
+    let _ = std::fs::remove_dir_all(&folder);
+}
+
+/// A linear sampler gathering an integer texture (through a helper function) is
+/// undefined in Vulkan (VUID-vkCmdDispatch-magFilter-04553): the interpreter and every
+/// ash path returned numbers, wgpu alone refused it, in its own words. Every path now
+/// refuses it before dispatch with the same line naming the sampler binding, the texture
+/// binding and the format; a nearest sampler gathers the texels alike on every path
+/// (wgpu refused that too, its layout calling every sampler filtering). Every path
+/// available here is judged (`all`; without a Vulkan device only the interpreter).
+#[test]
+fn a_linear_sampler_on_an_integer_texture_is_refused_on_every_path() {
+    let folder = scratch("integer-filter");
+    let texels: Vec<u8> = (0..64).collect();
+    std::fs::write(folder.join("texels.bin"), texels).unwrap();
+    let mut request = request(&folder, "gather.wgsl");
+    let texture = TextureFile::Raw {
+        path: folder.join("texels.bin"),
+        size: [4, 4, 1],
+        format: strata_kernels::TexelFormat::Rgba8Uint,
+    };
+    request.sizes = vec![(0, 2, 16)];
+    request.backends = vec!["all".into()];
+    let with = |filter: &str| {
+        let sampler = parse_sampler(&format!("{filter},clamp")).unwrap();
+        vec![ImageSpec::Texture((0, 0), texture.clone()), ImageSpec::Sampler((0, 1), sampler)]
+    };
+    request.images = with("linear");
+    let outcome = run_kernel(&request).unwrap();
+    let names: Vec<&str> = outcome.runs.iter().map(|r| r.backend.as_str()).collect();
+    eprintln!("paths: {names:?}; unavailable: {:?}", outcome.unavailable);
+    assert!(names.contains(&"cpu"), "{names:?}");
+    for run in &outcome.runs {
+        let error = run.outputs.as_ref().map(|_| ()).expect_err(&run.backend);
+        let expected = ["sampler `blend` (binding 1) filters linearly", "texture `texels` (binding 0) of rgba8uint"];
+        assert!(expected.iter().all(|e| error.contains(e)), "{}: {error}", run.backend);
+        assert!(!error.contains('\n'), "{}: {error}", run.backend);
+    }
+    // naga's GLSL cannot pair a texture sampled through a function argument (ash-glsl
+    // reports it unavailable): the nearest case samples in the entry point, no helper.
+    request.shader = folder.join("gather_direct.wgsl");
+    request.images = with("nearest");
+    let outcome = run_kernel(&request).unwrap();
+    let reference = outcome.runs[0].outputs.clone().unwrap();
+    for run in &outcome.runs {
+        let outputs = run.outputs.as_ref().unwrap_or_else(|e| panic!("{}: {e}", run.backend));
+        assert_eq!(outputs[0].bytes, reference[0].bytes, "{}", run.backend);
+    }
     let _ = std::fs::remove_dir_all(&folder);
 }
 

@@ -100,7 +100,8 @@ pub struct AshBackend {
     // Field order is drop order: buffers and pipelines go before the device.
     buffers: HashMap<u64, AshBuffer>,
     images: HashMap<u64, AshImage>,
-    samplers: HashMap<u64, vk::Sampler>,
+    /// Each sampler with what it was created as (the bind check reads its filters).
+    samplers: HashMap<u64, (vk::Sampler, SamplerDesc)>,
     /// The sampler state of a combined image sampler whose texture is only loaded
     /// (naga's GLSL combines every sampled texture with one), made when first needed.
     any_sampler: Option<vk::Sampler>,
@@ -162,6 +163,10 @@ impl AshBackend {
     }
 
     fn sampler(&self, id: SamplerId) -> Result<vk::Sampler, BackendError> {
+        self.sampler_desc(id).map(|(sampler, _)| sampler)
+    }
+
+    fn sampler_desc(&self, id: SamplerId) -> Result<(vk::Sampler, SamplerDesc), BackendError> {
         self.samplers.get(&id.0).copied().ok_or(BackendError::UnknownSampler(id.0))
     }
 
@@ -177,7 +182,7 @@ impl AshBackend {
         let lookup = ResourceLookup {
             buffer_size: &|id| self.buffer(id).map(|b| b.size),
             texture: &|id| self.image(id).map(|image| image.desc.clone()),
-            sampler: &|id| self.sampler(id).map(|_| ()),
+            sampler: &|id| self.sampler_desc(id).map(|(_, desc)| desc),
         };
         check_binds(kernel, binds, &self.info, &lookup)?;
         let pipeline = self.pipelines.get_or_create(&self.vulkan, kernel)?;
@@ -311,12 +316,12 @@ impl Backend for AshBackend {
     fn create_sampler(&mut self, desc: &SamplerDesc) -> Result<SamplerId, BackendError> {
         let sampler = self.vulkan.create_sampler(desc)?;
         self.next_buffer += 1;
-        self.samplers.insert(self.next_buffer, sampler);
+        self.samplers.insert(self.next_buffer, (sampler, *desc));
         Ok(SamplerId(self.next_buffer))
     }
 
     fn destroy_sampler(&mut self, sampler: SamplerId) -> Result<(), BackendError> {
-        let sampler = self.samplers.remove(&sampler.0).ok_or(BackendError::UnknownSampler(sampler.0))?;
+        let (sampler, _) = self.samplers.remove(&sampler.0).ok_or(BackendError::UnknownSampler(sampler.0))?;
         self.vulkan.destroy_sampler(sampler);
         Ok(())
     }
@@ -351,7 +356,7 @@ impl Drop for AshBackend {
         for (_, image) in self.images.drain() {
             self.vulkan.destroy_image(&image);
         }
-        for (_, sampler) in self.samplers.drain() {
+        for (_, (sampler, _)) in self.samplers.drain() {
             self.vulkan.destroy_sampler(sampler);
         }
         if let Some(sampler) = self.any_sampler.take() {

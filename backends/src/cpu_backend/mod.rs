@@ -366,7 +366,7 @@ impl Backend for CpuBackend {
         let lookup = ResourceLookup {
             buffer_size: &|id| self.buffer(id).map(|b| b.size),
             texture: &|id| self.texture(id).map(|t| t.desc.clone()),
-            sampler: &|id| self.samplers.get(&id.0).map(|_| ()).ok_or(BackendError::UnknownSampler(id.0)),
+            sampler: &|id| self.samplers.get(&id.0).copied().ok_or(BackendError::UnknownSampler(id.0)),
         };
         check_binds(kernel, binds, &self.info, &lookup)?;
         let subgroup_size = self.options.subgroup_size.unwrap_or(1);

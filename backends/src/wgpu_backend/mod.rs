@@ -226,7 +226,7 @@ impl WgpuBackend {
         let lookup = ResourceLookup {
             buffer_size: &|id| self.buffers.get(id).map(|b| b.size),
             texture: &|id| self.textures.get(id).map(|t| t.desc.clone()),
-            sampler: &|id| self.textures.sampler(id).map(|_| ()),
+            sampler: &|id| self.textures.sampler_desc(id),
         };
         check_binds(kernel, binds, &self.info, &lookup)?;
         let pipeline = self.pipelines.get_or_create(&self.device, &self.errors, kernel)?;

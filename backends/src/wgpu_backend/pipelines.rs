@@ -103,15 +103,32 @@ impl PipelineCache {
 }
 
 /// The bind group layout entries of `kernel`'s bindings in `group`: compute stage, no
-/// dynamic offsets, minimum binding sizes from the WGSL types; samplers filtering, and a
-/// float texture filterable exactly where the kernel samples it with a sampler, in
-/// whatever group that sampler is (else unfilterable, so that `r32float` and
+/// dynamic offsets, minimum binding sizes from the WGSL types; samplers filtering (but
+/// one that samples an integer texture), and a float texture filterable exactly where
+/// the kernel samples it with a sampler ([`sampled_pairs`](strata_kernels::combined_samplers::sampled_pairs), through function arguments
+/// too), in whatever group that sampler is (else unfilterable, so that `r32float` and
 /// `rgba32float` textures read with `textureLoad` bind on devices that cannot filter
 /// them). Why per texture across groups: a blur whose sampler sits in one group and
 /// whose texture in another was refused by wgpu ("Non-filterable float textures can't
 /// be sampled with a filtering sampler") when filterability was decided per group.
 pub fn layout_entries(kernel: &Kernel, group: u32) -> Vec<wgpu::BindGroupLayoutEntry> {
-    let sampled = sampled_textures(kernel);
+    let pairs = strata_kernels::combined_samplers::sampled_pairs(kernel);
+    let sampled = |group, binding| pairs.iter().any(|p| p.texture == (group, binding));
+    // A sampler that samples an integer texture cannot filter (the bind check refuses a
+    // linear one first, naming both bindings), so its layout says non-filtering and a
+    // nearest sampler gathers integer texels on wgpu as on every other path.
+    let integer = |slot: (u32, u32)| {
+        kernel.binding(slot.0, slot.1).is_some_and(
+            |b| matches!(b.kind, BindingKind::SampledTexture { kind, .. } if kind != strata_kernels::TexelKind::Float),
+        )
+    };
+    let sampler_type = |group, binding| {
+        if pairs.iter().any(|p| p.sampler == (group, binding) && integer(p.texture)) {
+            wgpu::SamplerBindingType::NonFiltering
+        } else {
+            wgpu::SamplerBindingType::Filtering
+        }
+    };
     kernel
         .bindings
         .iter()
@@ -140,23 +157,11 @@ pub fn layout_entries(kernel: &Kernel, group: u32) -> Vec<wgpu::BindGroupLayoutE
                     format: textures::wgpu_format(format),
                     view_dimension: textures::view_dimension(dimension),
                 },
-                BindingKind::Sampler => wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                BindingKind::Sampler => wgpu::BindingType::Sampler(sampler_type(binding.group, binding.binding)),
             },
             count: None,
         })
         .collect()
-}
-
-/// Whether the texture at `(group, binding)` is sampled with a sampler somewhere in
-/// `kernel`. Where the pairing cannot be read from the IR (a texture sampled through a
-/// function argument), every texture of a kernel with a sampler counts as sampled.
-fn sampled_textures(kernel: &Kernel) -> impl Fn(u32, u32) -> bool {
-    let any_sampler = kernel.bindings.iter().any(|b| b.kind == BindingKind::Sampler);
-    let pairs = strata_kernels::combined_samplers::combined_samplers(kernel).ok();
-    move |group, binding| match &pairs {
-        Some(pairs) => pairs.iter().any(|&(texture, sampler)| texture == (group, binding) && sampler.is_some()),
-        None => any_sampler,
-    }
 }
 
 /// `kernel`'s compute pipeline from naga's IR, with an explicit bind group layout per

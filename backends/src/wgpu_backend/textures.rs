@@ -19,7 +19,8 @@ pub(super) struct TextureEntry {
 pub(super) struct TextureTable {
     next: u64,
     textures: HashMap<u64, TextureEntry>,
-    samplers: HashMap<u64, wgpu::Sampler>,
+    /// Each sampler with what it was created as (the bind check reads its filters).
+    samplers: HashMap<u64, (wgpu::Sampler, SamplerDesc)>,
 }
 
 /// The wgpu format of a strata texel format.
@@ -212,12 +213,17 @@ impl TextureTable {
             ..Default::default()
         });
         self.next += 1;
-        self.samplers.insert(self.next, sampler);
+        self.samplers.insert(self.next, (sampler, *desc));
         SamplerId(self.next)
     }
 
     pub(super) fn sampler(&self, id: SamplerId) -> Result<&wgpu::Sampler, BackendError> {
-        self.samplers.get(&id.0).ok_or(BackendError::UnknownSampler(id.0))
+        self.samplers.get(&id.0).map(|(sampler, _)| sampler).ok_or(BackendError::UnknownSampler(id.0))
+    }
+
+    /// What sampler `id` was created as.
+    pub(super) fn sampler_desc(&self, id: SamplerId) -> Result<SamplerDesc, BackendError> {
+        self.samplers.get(&id.0).map(|(_, desc)| *desc).ok_or(BackendError::UnknownSampler(id.0))
     }
 
     pub(super) fn destroy_sampler(&mut self, id: SamplerId) -> Result<(), BackendError> {

@@ -826,6 +826,19 @@ fn a_histogram_of_no_objects_is_refused() {
     assert_succeeded(&output);
 }
 
+// 16b. An image too large for the device: the size flags and the limit are named, before
+// the 2 GiB of candidates are generated (it named the internal buffer `candidates`, 44 s
+// later, after generating them).
+#[test]
+fn a_histogram_too_large_for_the_device_names_the_size_flags_and_the_limit() {
+    let started = std::time::Instant::now();
+    let output = strata(&["histogram", "--backend", "cpu", "--width", "16384", "--height", "16384"]);
+    // The interpreter binds at most 1 GiB: 89478485 cluster spans of 12 bytes, the
+    // largest per-pixel buffer.
+    assert_refused(&output, &["--width 16384 --height 16384", "1073741824 bytes", "at most 89478485 pixels"]);
+    assert!(started.elapsed().as_secs() < 20, "refused only after {:?}", started.elapsed());
+}
+
 // 17. Messages that name the wrong thing; inputs that never end.
 #[test]
 fn messages_name_what_the_user_gave() {

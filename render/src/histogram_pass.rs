@@ -38,6 +38,36 @@ pub fn auto_kernel(info: &strata_backends::DeviceInfo, block_size: u32) -> Kerne
     KernelId::fastest_histogram(block_size, info.subgroup_sizes.is_some(), executor)
 }
 
+/// Whether `device` can hold the histogram pass's buffers for `grid`: each of them
+/// (candidates, sorted pixels, cluster spans, block stats) within one storage binding
+/// and one buffer. Checked before anything is allocated; the error names the image,
+/// the buffer that does not fit, its bytes, the device's limit and the most pixels it
+/// takes, so that a caller can put its own flags in front ([`PassError::ImageTooLarge`]).
+pub fn check_image_fits(device: &strata_backends::DeviceInfo, grid: BlockGrid) -> Result<(), PassError> {
+    let limit = device.limits.max_storage_binding.min(device.limits.max_buffer_size);
+    let blocks = u64::from(grid.max_shifted_block_count().max(grid.block_count()));
+    for buffer in [PassBuffer::Candidates, PassBuffer::SortedPixels, PassBuffer::Spans, PassBuffer::BlockStats] {
+        let bytes = buffer.bytes(grid.width, grid.height, blocks);
+        if bytes > limit {
+            // The per-pixel buffers are the large ones: the most pixels the largest fits.
+            let per_pixel = [PassBuffer::Candidates, PassBuffer::SortedPixels, PassBuffer::Spans]
+                .iter()
+                .map(|b| b.bytes(1, 1, 0))
+                .max()
+                .unwrap_or(1);
+            return Err(PassError::ImageTooLarge {
+                width: grid.width,
+                height: grid.height,
+                buffer: buffer.name(),
+                bytes,
+                limit,
+                max_pixels: limit / per_pixel,
+            });
+        }
+    }
+    Ok(())
+}
+
 /// A failure of a host pass.
 #[derive(Debug, Error)]
 pub enum PassError {
@@ -53,6 +83,26 @@ pub enum PassError {
     /// Input that a pass cannot take, described.
     #[error("{0}")]
     Input(String),
+    /// An image whose pass buffers do not fit the device ([`check_image_fits`]).
+    #[error(
+        "a {width}x{height} image ({pixels} pixels) needs {bytes} bytes of `{buffer}`, past this device's limit of \
+         {limit} bytes per storage buffer: at most {max_pixels} pixels (width x height)",
+        pixels = u64::from(*width) * u64::from(*height)
+    )]
+    ImageTooLarge {
+        /// Image width.
+        width: u32,
+        /// Image height.
+        height: u32,
+        /// The pass buffer that does not fit.
+        buffer: &'static str,
+        /// Its bytes.
+        bytes: u64,
+        /// The device's limit in bytes (storage binding, buffer size: the smaller).
+        limit: u64,
+        /// The most pixels the device takes.
+        max_pixels: u64,
+    },
     /// Candidate count differs from the pixel count.
     #[error("{width}x{height} image needs {expected} candidates, got {got}")]
     CandidateCount {
@@ -111,6 +161,7 @@ impl BlockHistogramPass {
         };
         let kernel = registry.get(id);
         backend.check_kernel(kernel)?;
+        check_image_fits(backend.info(), grid)?;
         let max_workgroups = backend.info().limits.max_workgroups_per_dimension;
         let frame = histogram_dispatch(grid, (grid.shift_x, grid.shift_y), masking, max_workgroups)?;
         // Room for every shift of the grid (set_grid_shift).

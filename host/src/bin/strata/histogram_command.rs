@@ -1,10 +1,10 @@
 //! `strata histogram`: the block-histogram kernel alone on a generated candidate image,
 //! checked against its Rust reference and timed.
 
-use anyhow::{Result, bail};
+use anyhow::{Result, anyhow, bail};
 use std::time::Instant;
 use strata::backend_choice::{BackendChoice, open_backend};
-use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
+use strata::histogram_pass::{BlockHistogramPass, HistogramVariant, check_image_fits};
 use strata::synthetic::{CandidateMix, candidate_image};
 use strata_kernels::BlockGrid;
 use strata_kernels::reference::block_histogram::block_histogram;
@@ -63,6 +63,10 @@ pub(crate) fn histogram(args: HistogramArgs) -> Result<()> {
         bail!("--awkward {}: must be a share between 0 and 1", args.awkward);
     }
     let mut backend = open_backend(args.backend)?;
+    // Before the candidates are generated (8 bytes a pixel on the host) or any buffer
+    // is made: the size flags, not an internal buffer, are what the user can change.
+    check_image_fits(backend.info(), grid)
+        .map_err(|e| anyhow!("--width {} --height {}: {e}", args.width, args.height))?;
     println!("backend: {}", backend.info().summary());
     let variant = match args.variant {
         VariantArg::Auto => HistogramVariant::Auto,

@@ -104,15 +104,13 @@ impl RenderSettings {
         if self.max_depth == 0 {
             return Err(PassError::Input("max_depth 0: a path needs at least its camera ray".into()));
         }
-        let frame = CameraFrame::new(camera).ok_or_else(|| {
-            PassError::Input(format!(
-                "camera: fov_axis `{}` must be `x` or `smaller`, and the view direction must not be parallel to `up`",
-                camera.fov_axis
-            ))
-        })?;
         if !(camera.fov_deg > 0.0 && camera.fov_deg < 180.0) {
             return Err(PassError::Input(format!("camera: fov_deg {} must be in (0, 180)", camera.fov_deg)));
         }
+        // The reason that holds, alone (it named fov_axis for a view along `up` too).
+        let frame = CameraFrame::checked(camera).map_err(|why| {
+            PassError::Input(format!("camera (origin {:?}, target {:?}): {why}", camera.origin, camera.target))
+        })?;
         let flags = match self.light_sampling {
             LightSampling::Mis => FLAG_SAMPLE_LIGHTS | FLAG_HIT_LIGHTS,
             LightSampling::Nee => FLAG_SAMPLE_LIGHTS,
@@ -323,4 +321,29 @@ pub fn render(
     })();
     tracer.destroy(backend)?;
     result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A camera looking along `up` is refused for that reason alone: the message named a
+    /// valid fov_axis too ("fov_axis `smaller` must be `x` or `smaller`, and ...").
+    #[test]
+    fn a_camera_that_cannot_make_rays_is_refused_for_the_reason_that_holds() {
+        let scene = crate::scene::default_scene();
+        let mut settings = RenderSettings::for_scene(&scene, 8, 8, 1);
+        settings.camera.fov_axis = "smaller".into();
+        settings.camera.origin = [0.0, 5.0, 0.0];
+        settings.camera.target = [0.0, 1.0, 0.0];
+        settings.camera.up = [0.0, 1.0, 0.0];
+        let message = settings.params(&RenderParams::default()).unwrap_err().to_string();
+        assert!(message.contains("parallel to `up`") && message.contains("[0.0, 5.0, 0.0]"), "{message}");
+        assert!(!message.contains("fov_axis"), "{message}");
+        settings.camera.target = [1.0, 1.0, 0.0];
+        settings.camera.fov_axis = "diagonal".into();
+        let message = settings.params(&RenderParams::default()).unwrap_err().to_string();
+        assert!(message.contains("fov_axis `diagonal`: expected `x` or `smaller`"), "{message}");
+        assert!(!message.contains("parallel"), "{message}");
+    }
 }

@@ -283,8 +283,12 @@ impl RestirRenderer {
             )));
         }
         let render = RenderSettings { camera: camera.clone(), ..self.render.clone() };
-        let frame_camera = CameraFrame::new(&camera)
-            .ok_or_else(|| PassError::Input("camera: invalid frame (fov axis or up vector)".into()))?;
+        let frame_camera = CameraFrame::checked(&camera).map_err(|why| {
+            PassError::Input(format!(
+                "frame {} (counted from 0): camera (origin {:?}, target {:?}): {why}",
+                self.frame, camera.origin, camera.target
+            ))
+        })?;
         let selection = self.settings.selection;
         if selection.block_shift && self.settings.method.uses_histogram() {
             self.histogram.set_frame(backend, &selection, self.frame, self.render.seed)?;

@@ -40,18 +40,20 @@ impl CameraFrame {
     /// The frame of `camera`, or why it has none, in words that name the camera's fields:
     /// `fov_axis` other than `x` or `smaller`, `target` equal to `origin`, a view
     /// direction parallel to `up` (or `up` zero), or vectors or an opening angle beyond
-    /// single precision.
-    pub fn checked(camera: &Camera) -> Result<CameraFrame, &'static str> {
+    /// single precision. Each reason is the one that holds: a valid `fov_axis` is never
+    /// blamed for a view along `up` (one message named both and so contradicted itself:
+    /// "fov_axis `smaller` must be `x` or `smaller`").
+    pub fn checked(camera: &Camera) -> Result<CameraFrame, String> {
         let frame = CameraFrame::unchecked(camera)?;
         let directions = [frame.forward, frame.right, frame.up].iter().all(|v| v.is_finite());
         if !(directions && frame.origin.is_finite() && frame.tan_half_x.is_finite() && frame.tan_half_y.is_finite()) {
-            return Err(BEYOND_PRECISION);
+            return Err(BEYOND_PRECISION.into());
         }
         Ok(frame)
     }
 
     /// [`CameraFrame::checked`] without the finiteness check.
-    fn unchecked(camera: &Camera) -> Result<CameraFrame, &'static str> {
+    fn unchecked(camera: &Camera) -> Result<CameraFrame, String> {
         let origin = Vec3::from(camera.origin);
         let (w, h) = (camera.width as f32, camera.height as f32);
         let tan_half = (camera.fov_deg.to_radians() * 0.5).tan();
@@ -59,11 +61,11 @@ impl CameraFrame {
             "x" => (tan_half, tan_half * h / w),
             "smaller" if w <= h => (tan_half, tan_half * h / w),
             "smaller" => (tan_half * w / h, tan_half),
-            _ => return Err("fov_axis must be `x` or `smaller`"),
+            other => return Err(format!("fov_axis `{other}`: expected `x` or `smaller`")),
         };
         let view = Vec3::from(camera.target) - origin;
         if view == Vec3::ZERO {
-            return Err("target equals origin: the camera has no view direction");
+            return Err("target equals origin: the camera has no view direction".into());
         }
         let forward = view.try_normalize().ok_or(BEYOND_PRECISION)?;
         let side = forward.cross(Vec3::from(camera.up));

@@ -106,7 +106,7 @@ pub(super) fn check(path: &Path, description: &SceneDescription) -> Result<(), S
         ));
     }
     if let Err(why) = super::CameraFrame::checked(camera) {
-        return Err(error("camera.target".into(), why.into()));
+        return Err(error("camera.target".into(), why));
     }
     numbers("camera.near_clip".into(), &[camera.near_clip], Rule::NonNegative)?;
     if !(camera.far_clip.is_finite() && camera.far_clip > camera.near_clip) {

@@ -20,6 +20,7 @@ mod empty;
 pub mod fuzz;
 mod histogram;
 pub mod overrides;
+pub mod parallel;
 mod path;
 pub mod replay;
 mod report;
@@ -64,8 +65,9 @@ pub struct Case {
     pub family: u32,
 }
 
-/// How one registry kernel is exercised and judged.
-pub trait KernelCheck {
+/// How one registry kernel is exercised and judged (from the worker of each backend
+/// slot: [`run_checks_reporting`]).
+pub trait KernelCheck: Sync {
     /// The kernel.
     fn kernel(&self) -> KernelId;
     /// Inputs drawn from the kernel's domain, awkward values included.
@@ -117,45 +119,122 @@ pub fn run_check(config: CheckConfig) -> CheckReport {
 /// Runs `checks` on every backend slot. Each case's reference is computed once and
 /// shared by the slots (for the path tracer it is an interpreter run).
 pub fn run_checks(config: CheckConfig, checks: Vec<Box<dyn KernelCheck>>) -> CheckReport {
-    let mut references = ReferenceCache::default();
-    let mut report = CheckReport::new(
-        checks.iter().map(|c| c.kernel()).collect(),
-        backend_slots().iter().map(|s| s.name.to_string()).collect(),
-    );
-    for slot in backend_slots() {
+    run_checks_reporting(config, checks, &|_| {})
+}
+
+/// One finished cell of a check run (a kernel on a backend slot), for a progress line.
+#[derive(Clone, Copy, Debug)]
+pub struct Progress<'a> {
+    /// The backend slot.
+    pub slot: &'a str,
+    /// The kernel's name.
+    pub kernel: &'a str,
+    /// Cells finished so far, this one included.
+    pub done: usize,
+    /// Cells in all.
+    pub total: usize,
+    /// Time since the run began.
+    pub elapsed: std::time::Duration,
+}
+
+impl Progress<'_> {
+    /// The time left if the cells still to run take as long on average as those done
+    /// (they do not: a slot's first kernels compile the longest; an estimate).
+    pub fn remaining(&self) -> std::time::Duration {
+        let left = self.total.saturating_sub(self.done) as f64;
+        self.elapsed.mul_f64(left / self.done.max(1) as f64)
+    }
+}
+
+/// [`run_checks`], the backend slots in parallel, one worker per core, each slot on its
+/// own device: most of a first run is a CPU driver (lavapipe) compiling every kernel
+/// once per slot, one pipeline per core at a time (Vulkan lets pipelines be created
+/// from several threads; each slot's device is its own anyway). `progress` is called
+/// after every cell, from the worker that ran it.
+pub fn run_checks_reporting(
+    config: CheckConfig,
+    checks: Vec<Box<dyn KernelCheck>>,
+    progress: &(dyn Fn(&Progress) + Sync),
+) -> CheckReport {
+    let slots = backend_slots();
+    let references = ReferenceCache::default();
+    let total = checks.len() * slots.len();
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let started = std::time::Instant::now();
+    let names = strata_kernels::Registry::shared().ok();
+    let report_cell = |slot: &str, kernel: KernelId| {
+        let done = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        let kernel = names.map_or("", |registry| registry.get(kernel).name());
+        progress(&Progress { slot, kernel, done, total, elapsed: started.elapsed() });
+    };
+    // The slots that compile the most first, so that no long one starts last.
+    let mut order: Vec<usize> = (0..slots.len()).collect();
+    order.sort_by_key(|&i| std::cmp::Reverse(slot_weight(slots[i].name)));
+    let results = parallel::map(&order, |&index| {
+        let slot = &slots[index];
+        let mut cells = Vec::new();
         let mut backend = match (slot.open)() {
             Ok(backend) => backend,
             Err(error) => {
                 for check in &checks {
-                    report.set(check.kernel(), slot.name, CellResult::Unavailable(error.to_string()));
+                    cells.push((check.kernel(), CellResult::Unavailable(error.to_string())));
+                    report_cell(slot.name, check.kernel());
                 }
-                continue;
+                return (None, cells);
             }
         };
-        report.set_device(slot.name, backend.info().summary());
+        let device = backend.info().summary();
         for check in &checks {
-            if let Some(slots) = check.quick_slots().filter(|_| !config.full)
+            let result = if let Some(slots) = check.quick_slots().filter(|_| !config.full)
                 && !slots.contains(&slot.name)
             {
-                let why = format!("the quick check runs it on {} only", slots.join(", "));
-                report.set(check.kernel(), slot.name, CellResult::FullRunOnly(why));
-                continue;
-            }
-            let result = run_one(check.as_ref(), backend.as_mut(), config, &mut references);
-            report.set(check.kernel(), slot.name, result);
+                CellResult::FullRunOnly(format!("the quick check runs it on {} only", slots.join(", ")))
+            } else {
+                run_one(check.as_ref(), backend.as_mut(), config, &references)
+            };
+            cells.push((check.kernel(), result));
+            report_cell(slot.name, check.kernel());
+        }
+        (Some(device), cells)
+    });
+    let mut report = CheckReport::new(
+        checks.iter().map(|c| c.kernel()).collect(),
+        slots.iter().map(|s| s.name.to_string()).collect(),
+    );
+    for (&index, (device, cells)) in order.iter().zip(results) {
+        let name = slots[index].name;
+        if let Some(device) = device {
+            report.set_device(name, device);
+        }
+        for (kernel, result) in cells {
+            report.set(kernel, name, result);
         }
     }
     report
 }
 
-/// Reference outputs by kernel and case label.
-type ReferenceCache = std::collections::HashMap<(KernelId, String), Vec<Output>>;
+/// How long a slot's first run takes, roughly (its kernels' compile time on lavapipe):
+/// the order the workers take the slots in.
+fn slot_weight(name: &str) -> u32 {
+    match name {
+        "ash-slang" => 6,
+        "wgpu-gl" => 5,
+        "ash-hlsl" | "ash-glsl" => 4,
+        "wgpu-vulkan" | "ash" => 3,
+        _ => 1,
+    }
+}
+
+/// Reference outputs by kernel and case label, shared by the workers: each computed
+/// once, by the first worker that needs it (the others wait for it).
+type ReferenceCache =
+    std::sync::Mutex<std::collections::HashMap<(KernelId, String), std::sync::Arc<std::sync::OnceLock<Vec<Output>>>>>;
 
 fn run_one(
     check: &dyn KernelCheck,
     backend: &mut dyn Backend,
     config: CheckConfig,
-    references: &mut ReferenceCache,
+    references: &ReferenceCache,
 ) -> CellResult {
     let kernel = match strata_kernels::Registry::shared() {
         Ok(registry) => registry.get(check.kernel()),
@@ -171,7 +250,13 @@ fn run_one(
             Ok(outputs) => outputs,
             Err(error) => return CellResult::Failed(format!("{}: {error}", case.label)),
         };
-        let reference = references.entry((check.kernel(), case.label.clone())).or_insert_with(|| check.reference(case));
+        let cell = references
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .entry((check.kernel(), case.label.clone()))
+            .or_default()
+            .clone();
+        let reference = cell.get_or_init(|| check.reference(case));
         match compare_outputs(&outputs, reference) {
             Ok(case_agreement) => agreement = agreement.merge(case_agreement),
             Err(mismatch) => return CellResult::Failed(format!("{}: {mismatch}", case.label)),

@@ -1,6 +1,8 @@
-//! Independent jobs on one worker per core, the results in the jobs' order: the kernels'
-//! validators (`xtask shaders`) and the programs run under the validation layer
-//! (`xtask validate`), each mostly an external process on one core.
+//! Independent jobs on one worker per core, the results in the jobs' order: the backend
+//! slots of the cross-backend check and of the texture corpus (each its own device,
+//! compiling its own pipelines: a CPU driver such as lavapipe compiles on one core per
+//! pipeline), the kernels' validators (`xtask shaders`) and the programs run under the
+//! validation layer (`xtask validate`), each mostly an external process on one core.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 

@@ -506,19 +506,30 @@ impl Verdict {
 }
 
 /// Every case's verdicts on every backend slot of the check (a slot that cannot open
-/// counts as refusing every case, with its reason).
+/// counts as refusing every case, with its reason). The slots run in parallel, one
+/// worker per core, each on its own device ([`crate::parallel`]); the verdicts come in
+/// the slots' order.
 pub fn run_texture_corpus() -> Vec<(String, Vec<(String, Verdict)>)> {
-    let mut backends = open_backends(&crate::backend_slots());
-    let closed: Vec<(String, Verdict)> = backends
+    let slots = crate::backend_slots();
+    let cases = texture_cases();
+    // Per slot: its runs of every case, or why it did not open.
+    let per_slot: Vec<Result<Vec<BackendRun>, String>> = crate::parallel::map(&slots, |slot| {
+        let mut backends = open_backends(std::slice::from_ref(slot));
+        if let Some((_, Err(why))) = backends.first() {
+            return Err(why.clone());
+        }
+        Ok(cases.iter().flat_map(|case| case.run_on(&mut backends)).collect())
+    });
+    cases
         .iter()
-        .filter_map(|(name, b)| b.as_ref().err().map(|e| (name.clone(), Verdict::Refused(format!("no device: {e}")))))
-        .collect();
-    backends.retain(|(_, b)| b.is_ok());
-    texture_cases()
-        .iter()
-        .map(|case| {
-            let mut verdicts = case.verdicts(&case.run_on(&mut backends));
-            verdicts.extend(closed.iter().cloned());
+        .enumerate()
+        .map(|(index, case)| {
+            let runs: Vec<BackendRun> =
+                per_slot.iter().filter_map(|runs| runs.as_ref().ok().map(|runs| runs[index].clone())).collect();
+            let mut verdicts = case.verdicts(&runs);
+            verdicts.extend(slots.iter().zip(&per_slot).filter_map(|(slot, runs)| {
+                runs.as_ref().err().map(|e| (slot.name.to_string(), Verdict::Refused(format!("no device: {e}"))))
+            }));
             (case.name.clone(), verdicts)
         })
         .collect()

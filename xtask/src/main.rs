@@ -10,7 +10,9 @@
 //!   GLSL and HLSL) with generated inputs and compares the outputs with the kernels'
 //!   references; prints a kernels × backends table, then the texture corpus's table
 //!   (`strata_check::texture_corpus`, against the interpreter; not with `--kernel`), and
-//!   exits non-zero on any mismatch.
+//!   exits non-zero on any mismatch. The backends run in parallel, one per core, and a
+//!   progress line per kernel and backend (with the time left, estimated) goes to
+//!   standard error.
 //! * `cargo xtask run FILE.wgsl --entry NAME --workgroups X,Y,Z --buffer G:B=FILE ...
 //!   [--size G:B=BYTES] [--texture G:B=FILE] [--storage-texture G:B=WxH[:FORMAT]]
 //!   [--sampler G:B=FILTER,ADDRESS] [--override NAME=VALUE ...] [--ulp N | --ulp BUFFER=N ...] [--abs E | --abs BUFFER=E ...]
@@ -48,7 +50,6 @@
 //! `RUST_BACKTRACE` says: they are findings, not bugs of xtask) and exit with 1.
 
 mod fuzz;
-mod parallel;
 #[cfg(test)]
 mod tests;
 mod validate;
@@ -242,9 +243,26 @@ fn check(full: bool, only: &[String]) -> Result<()> {
     if !only.is_empty() {
         checks.retain(|c| only.iter().any(|name| registry.get(c.kernel()).name() == name));
     }
-    let report = strata_check::run_checks(strata_check::CheckConfig { full }, checks);
+    // Progress on standard error (the report is standard output): a first run on a CPU
+    // driver compiles every kernel once per slot, minutes, so say where it is and about
+    // how long is left.
+    let progress = |p: &strata_check::Progress| {
+        eprintln!(
+            "check: {}/{} {} on {} ({} in, about {} left)",
+            p.done,
+            p.total,
+            p.kernel,
+            p.slot,
+            minutes(p.elapsed),
+            minutes(p.remaining())
+        );
+    };
+    let report = strata_check::run_checks_reporting(strata_check::CheckConfig { full }, checks, &progress);
     print!("{}", report.render());
     // The texture corpus (kernels outside the registry) unless only some kernels were asked for.
+    if only.is_empty() {
+        eprintln!("check: the texture corpus on every backend");
+    }
     let textures = if only.is_empty() { strata_check::texture_corpus::run_texture_corpus() } else { Vec::new() };
     if !textures.is_empty() {
         print!("\n{}", strata_check::texture_corpus::render_table(&textures));
@@ -258,6 +276,12 @@ fn check(full: bool, only: &[String]) -> Result<()> {
     Ok(())
 }
 
+/// `1 min 05 s`, `42 s`.
+fn minutes(duration: std::time::Duration) -> String {
+    let seconds = duration.as_secs();
+    if seconds < 60 { format!("{seconds} s") } else { format!("{} min {:02} s", seconds / 60, seconds % 60) }
+}
+
 fn shaders(strict: bool, out: PathBuf) -> Result<()> {
     std::fs::create_dir_all(&out).with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
     let registry = Registry::load()?;
@@ -267,8 +291,9 @@ fn shaders(strict: bool, out: PathBuf) -> Result<()> {
     // The validators are external processes, one at a time per kernel: kernels go to one
     // worker per core (each kernel's files are its own), the table is printed in order.
     let kernels = registry.kernels();
-    let verdicts =
-        parallel::map(kernels, |kernel| Target::ALL.map(|target| translate_and_validate(kernel, target, &out)));
+    let verdicts = strata_check::parallel::map(kernels, |kernel| {
+        Target::ALL.map(|target| translate_and_validate(kernel, target, &out))
+    });
     for (kernel, results) in kernels.iter().zip(verdicts) {
         for (target, (path, verdict)) in Target::ALL.into_iter().zip(results) {
             let text = match &verdict {

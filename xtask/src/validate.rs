@@ -122,7 +122,7 @@ pub fn validate() -> Result<()> {
     // The steps are independent processes, mostly on one core each (pipeline compilation
     // and the layer's own work are single-threaded): one worker per core, the results
     // printed in the steps' order.
-    let outcomes = crate::parallel::map(&steps, |step| run_step(step, &root, &folder));
+    let outcomes = strata_check::parallel::map(&steps, |step| run_step(step, &root, &folder));
     let mut failures = Vec::new();
     let mut notes: BTreeMap<String, usize> = BTreeMap::new();
     for (step, outcome) in steps.iter().zip(outcomes) {

@@ -21,7 +21,7 @@ fn interpreter(c: &mut Criterion) {
     let mut group = c.benchmark_group("interpreter");
     group.sample_size(10).measurement_time(Duration::from_secs(8));
 
-    let mut cpu = CpuBackend::new(CpuOptions { subgroup_size: Some(8) }).expect("interpreter");
+    let mut cpu = CpuBackend::new(CpuOptions { subgroup_size: Some(8), ..CpuOptions::default() }).expect("interpreter");
     let pass = BlockHistogramPass::new(&mut cpu, HistogramVariant::Subgroup, grid).expect("pass");
     pass.upload_candidates(&mut cpu, &candidates).expect("upload");
     let started = Instant::now();

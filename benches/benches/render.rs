@@ -152,7 +152,8 @@ fn histogram_share_simt(c: &mut Criterion) {
     let scene = default_scene();
     let gpu_scene = GpuScene::build(&scene).expect("default scene");
     let render = settings(&scene, 256);
-    let mut cpu = CpuBackend::new(CpuOptions { subgroup_size: Some(WARP_WIDTH) }).expect("interpreter");
+    let mut cpu =
+        CpuBackend::new(CpuOptions { subgroup_size: Some(WARP_WIDTH), ..CpuOptions::default() }).expect("interpreter");
     let is_histogram = |id: &KernelId| {
         matches!(id, KernelId::BlockHistogram | KernelId::BlockHistogramSubgroup | KernelId::BlockHistogramRank)
     };

@@ -16,7 +16,7 @@ use strata_tests::run_words;
 #[test]
 fn histogram_kernels_match_the_reference_at_every_subgroup_size() {
     for subgroup_size in [None, Some(1), Some(8), Some(32)] {
-        let mut cpu = CpuBackend::new(CpuOptions { subgroup_size }).unwrap();
+        let mut cpu = CpuBackend::new(CpuOptions { subgroup_size, ..CpuOptions::default() }).unwrap();
         let variant = if subgroup_size.is_some() { HistogramVariant::Subgroup } else { HistogramVariant::Portable };
         for (width, height) in [(17, 33), (40, 24)] {
             for block_size in BLOCK_SIZES {
@@ -423,7 +423,7 @@ fn divergent_calls_of_functions_not_inlined_reconverge() {
     let kernel = Kernel::from_wgsl("divergent_calls.wgsl", DIVERGENT_CALLS.into(), "main", false).unwrap();
     let inputs: Vec<u32> = (0..128u32).map(|i| i.wrapping_mul(2_246_822_519).rotate_left(7) ^ i).collect();
     for subgroup_size in [None, Some(8)] {
-        let mut cpu = CpuBackend::new(CpuOptions { subgroup_size }).unwrap();
+        let mut cpu = CpuBackend::new(CpuOptions { subgroup_size, ..CpuOptions::default() }).unwrap();
         let got = run_words(&mut cpu, &kernel, &inputs, 128 * 3, 2);
         assert_eq!(got, divergent_calls_reference(&inputs), "subgroup size {subgroup_size:?}");
     }
@@ -624,8 +624,8 @@ fn main(@builtin(local_invocation_index) i: u32) {
 
 #[test]
 fn bad_subgroup_sizes_are_refused() {
-    assert!(CpuBackend::new(CpuOptions { subgroup_size: Some(12) }).is_err());
-    assert!(CpuBackend::new(CpuOptions { subgroup_size: Some(0) }).is_err());
+    assert!(CpuBackend::new(CpuOptions { subgroup_size: Some(12), ..CpuOptions::default() }).is_err());
+    assert!(CpuBackend::new(CpuOptions { subgroup_size: Some(0), ..CpuOptions::default() }).is_err());
 }
 
 #[test]
@@ -835,7 +835,7 @@ fn subgroup_ballots_reductions_and_scans_agree_with_lavapipe_bit_for_bit() {
         let workgroups = inputs.len() as u32 / workgroup_size;
         let want = run_words(&mut gpu, &kernel, &inputs, inputs.len() * 24, workgroups);
         // The interpreter runs with lavapipe's subgroup size.
-        let mut cpu = CpuBackend::new(CpuOptions { subgroup_size: Some(want[0]) }).unwrap();
+        let mut cpu = CpuBackend::new(CpuOptions { subgroup_size: Some(want[0]), ..CpuOptions::default() }).unwrap();
         let got = run_words(&mut cpu, &kernel, &inputs, inputs.len() * 24, workgroups);
         if let Some(i) = (0..want.len()).find(|&i| got[i] != want[i]) {
             panic!(

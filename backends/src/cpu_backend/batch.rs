@@ -38,7 +38,7 @@ pub(super) fn workgroups_per_batch(program: &Program) -> u32 {
         .codes
         .iter()
         .flat_map(|code| &code.insns)
-        .any(|insn| matches!(insn, Insn::Barrier | Insn::Gather(_) | Insn::Collective(_)));
+        .any(|insn| matches!(insn, Insn::Barrier { .. } | Insn::Gather(_) | Insn::Collective(_)));
     if synchronises { 1 } else { (BATCH_INVOCATIONS / invocations).max(1) }
 }
 

@@ -91,6 +91,29 @@ pub(super) struct Program {
     pub workgroup_words: u32,
     /// Initial contents of private memory.
     pub private_init: Vec<u32>,
+    /// The bindings' WGSL names, in the kernel's binding order (for the sanitizer's
+    /// findings).
+    pub binding_names: Vec<String>,
+    /// Workgroup variables: (first word, words, WGSL name), for the sanitizer's findings.
+    pub workgroup_variables: Vec<(u32, u32, String)>,
+    /// The kernel's WGSL, whose lines [`Code::lines`] count (a registry kernel's is
+    /// composed of several files: [`Program::place`] names the file).
+    pub source: strata_kernels::source::ComposedSource,
+}
+
+impl Program {
+    /// Where instruction `pc` of code `code` came from: (WGSL file, line in it, function).
+    pub(super) fn place(&self, code: u32, pc: u32) -> (String, u32, String) {
+        let code = &self.codes[code as usize];
+        let line = code.lines.get(pc as usize).copied().unwrap_or(0);
+        let source = code.sources.get(pc as usize);
+        let function = source.and_then(|&s| self.names.get(s as usize)).cloned().unwrap_or_default();
+        if line == 0 {
+            return (String::new(), 0, function);
+        }
+        let (file, local) = self.source.locate(line as usize);
+        (file.to_string(), local as u32, function)
+    }
 }
 
 /// Per function being compiled into a code (the function itself or an inlined callee):
@@ -147,6 +170,9 @@ pub(super) struct Compiler<'a> {
     pub global_values: &'a [Vec<u32>],
     /// Bound buffers (for checking static buffer slots).
     pub buffer_count: usize,
+    /// Compiling a sanitizing program ([`super::sanitize`]): no if-conversion, whose
+    /// speculated loads and indices would be reported although WGSL never makes them.
+    pub sanitize: bool,
     /// The kernel's name, for messages.
     kernel: &'a str,
     /// Register words the scopes opened so far may take (their expressions' and
@@ -497,7 +523,7 @@ fn compile_code(
     globals: &[(u32, u32)],
     global_values: &[Vec<u32>],
     buffer_count: usize,
-    kernel: &str,
+    (kernel, sanitize): (&str, bool),
     names: &mut Vec<String>,
     arguments: &[Vec<(u32, Reg, u32)>],
 ) -> Result<Code, BackendError> {
@@ -508,6 +534,7 @@ fn compile_code(
         globals,
         global_values,
         buffer_count,
+        sanitize,
         kernel,
         committed: 0,
         names,
@@ -540,6 +567,15 @@ fn compile_code(
     compiler.source = scope.source;
     compiler.push(Insn::Return { src: 0, len: 0 });
     super::jump_cleanup::clean_up_jumps(&mut compiler.insns, &mut compiler.insn_lines, &mut compiler.insn_sources);
+    if sanitize {
+        // Instruction for instruction, so jump targets stay.
+        for insn in compiler.insns.iter_mut() {
+            if super::sanitize::is_checked(insn) {
+                let inner = std::mem::replace(insn, Insn::Jump(0));
+                *insn = Insn::Checked(Box::new(inner));
+            }
+        }
+    }
     Ok(Code {
         insns: compiler.insns,
         lines: compiler.insn_lines,
@@ -552,7 +588,14 @@ fn compile_code(
 }
 
 /// Compiles `kernel`'s entry point and the functions of its module.
+#[cfg(test)]
 pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> {
+    compile(kernel, false)
+}
+
+/// Compiles `kernel`'s entry point and the functions of its module; with `sanitize`, as
+/// a sanitizing program ([`super::sanitize`]).
+pub(super) fn compile(kernel: &Kernel, sanitize: bool) -> Result<Program, BackendError> {
     let module = &kernel.module;
     let lines_of = &LineIndex::new(&kernel.source.text);
     let name = kernel.name();
@@ -594,6 +637,7 @@ pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> 
     // counts only what the entry point uses).
     let (mut workgroup_words, mut private_words) = (0u64, 0u64);
     let mut private_init = Vec::new();
+    let mut workgroup_variables = Vec::new();
     for (handle, variable) in module.global_variables.iter() {
         let inner = &module.types[variable.ty].inner;
         if contains_f16(module, inner) && !byte_addressed(variable.space) {
@@ -624,6 +668,7 @@ pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> 
                 let offset = workgroup_words as u32;
                 workgroup_words = add_words(name, Space::Workgroup, workgroup_words, u64::from(words))?;
                 check_space(name, Space::Workgroup, workgroup_words)?;
+                workgroup_variables.push((offset, words, variable.name.clone().unwrap_or_default()));
                 (memory::WORKGROUP, offset)
             }
             naga::AddressSpace::Private => {
@@ -655,7 +700,7 @@ pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> 
             &globals,
             &global_values,
             buffer_count,
-            kernel.name(),
+            (kernel.name(), sanitize),
             &mut names,
             &arguments,
         )?;
@@ -671,7 +716,7 @@ pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> 
         &globals,
         &global_values,
         buffer_count,
-        kernel.name(),
+        (kernel.name(), sanitize),
         &mut names,
         &arguments,
     )?;
@@ -687,6 +732,9 @@ pub(super) fn compile_program(kernel: &Kernel) -> Result<Program, BackendError> 
         // At most the cap (64 MiB, in words): fits in u32.
         workgroup_words: workgroup_words as u32,
         private_init,
+        binding_names: kernel.bindings.iter().map(|b| b.name.clone()).collect(),
+        workgroup_variables,
+        source: kernel.source.clone(),
     })
 }
 

@@ -9,7 +9,9 @@ use super::decode::Program;
 use super::error::{invalid, unsupported};
 use super::insn::Insn;
 use super::interp::{self, Batch, Invocation, Stop};
+use super::limit::{FUEL, Limit, abandoned};
 use super::memory::{FUNCTION, Frame};
+use super::sanitize::{FindingKind, Sanitizer};
 use crate::error::BackendError;
 use smallvec::SmallVec;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
@@ -31,12 +33,15 @@ struct Builtins {
 /// Runs `program` on `workgroups` with `buffers` bound (in the kernel's binding order).
 /// Independent workgroups run in parallel on the machine's cores; buffer words are
 /// atomics (relaxed loads and stores, real read-modify-write for WGSL atomics). Returns
-/// what the dispatch executed ([`DispatchCounts`]).
+/// what the dispatch executed ([`DispatchCounts`]). Every thread stops, and the
+/// dispatch fails, once it runs past `limit` ([`super::limit`]); with `sanitizer`,
+/// `program` is a sanitizing one and its findings go there ([`super::sanitize`]).
 pub(super) fn run(
     program: &Program,
     buffers: &mut [Vec<u32>],
     workgroups: [u32; 3],
     subgroup_size: u32,
+    (limit, sanitizer): (&Limit, Option<&Sanitizer>),
 ) -> Result<DispatchCounts, BackendError> {
     let instructions = AtomicU64::new(0);
     let warp_issues = AtomicU64::new(0);
@@ -69,13 +74,22 @@ pub(super) fn run(
                             private: Vec::new(),
                             private_words: program.private_init.len(),
                             shared: Vec::new(),
+                            fuel: FUEL,
+                            sanitizing: sanitizer.map(|_| Default::default()),
                         },
                         invocations: Vec::new(),
                         scratch: interp::Scratch::default(),
                     };
+                    // The sanitizer's counts of this thread, added to the dispatch's at its end.
+                    let flush = |worker: &mut Worker| {
+                        if let (Some(shared), Some(local)) = (sanitizer, worker.memory.sanitizing.as_mut()) {
+                            local.flush(shared, program);
+                        }
+                    };
                     loop {
                         let batch = next.fetch_add(1, Ordering::Relaxed);
                         if batch >= batches {
+                            flush(&mut worker);
                             return Ok(());
                         }
                         let first = batch * per_batch;
@@ -86,14 +100,24 @@ pub(super) fn run(
                             first..(first + per_batch).min(total),
                             workgroups,
                             subgroup_size,
+                            (limit, sanitizer),
                         ) {
                             Ok(counts) => {
                                 instructions.fetch_add(counts.instructions, Ordering::Relaxed);
                                 warp_issues.fetch_add(counts.warp_issues, Ordering::Relaxed);
                             }
+                            // Stopped because another thread failed: that thread's error is
+                            // the dispatch's.
+                            Err(error) if abandoned(&error) => {
+                                flush(&mut worker);
+                                return Ok(());
+                            }
                             Err(error) => {
-                                // Stop the other threads early.
+                                // Stop the other threads: those waiting for a batch, and
+                                // those running one at their next look at the limit.
                                 next.store(batches, Ordering::Relaxed);
+                                limit.fail();
+                                flush(&mut worker);
                                 return Err(error);
                             }
                         }
@@ -181,8 +205,10 @@ fn run_batch(
     batch: std::ops::Range<u64>,
     workgroups: [u32; 3],
     subgroup_size: u32,
+    (limit, sanitizer): (&Limit, Option<&Sanitizer>),
 ) -> Result<DispatchCounts, BackendError> {
     let Worker { memory, invocations, scratch } = worker;
+    let first_workgroup = batch.start;
     let [sx, sy, sz] = program.workgroup_size;
     let per_workgroup = sx * sy * sz;
     let subgroup_size = subgroup_size.max(1);
@@ -228,6 +254,13 @@ fn run_batch(
     memory.shared.clear();
     try_reserve(&mut memory.shared, shared_words, what("workgroup"))?;
     memory.shared.resize(shared_words, 0);
+    if let Some(local) = memory.sanitizing.as_mut() {
+        // Every word of the batch's workgroup memory unwritten, no access yet.
+        local.workgroup.clear();
+        try_reserve(&mut local.workgroup, shared_words, what("workgroup shadow"))?;
+        local.workgroup.resize(shared_words, Default::default());
+        local.start_batch(first_workgroup * u64::from(per_workgroup));
+    }
     enter_entry_point(program, &mut memory.files[program.entry as usize], &builtins)?;
     memory.private.clear();
     try_reserve(&mut memory.private, count * program.private_init.len(), what("private"))?;
@@ -239,7 +272,16 @@ fn run_batch(
     let mut stops = Vec::with_capacity(count);
     let mut reached = Vec::with_capacity(count);
     loop {
-        interp::run_until_sync(program, invocations, memory, scratch, buffers, &mut counts, &mut reached)?;
+        interp::run_until_sync(
+            program,
+            invocations,
+            memory,
+            scratch,
+            buffers,
+            &mut counts,
+            &mut reached,
+            (limit, sanitizer),
+        )?;
         stops.clear();
         stops.extend(reached.iter().map(|stop| stop.expect("every invocation stopped")));
         if stops.iter().all(|s| *s == Stop::Done) {
@@ -257,12 +299,21 @@ fn run_batch(
                     )
                 }
             };
+            let (first_at, other_at) = (describe(&first), describe(other));
+            // The sanitizer lists it with the rest (at the first place named).
+            let place = match (first, *other) {
+                (Stop::Sync(code, pc), _) | (_, Stop::Sync(code, pc)) => Some((code, pc)),
+                _ => None,
+            };
+            if let (Some(shared), Some(local), Some((code, pc))) = (sanitizer, memory.sanitizing.as_mut(), place) {
+                local.found(shared, program, (FindingKind::NonUniformBarrier, code, pc), || {
+                    format!("one invocation is at {first_at}, another at {other_at}")
+                });
+            }
             return Err(invalid(
                 &program.name,
                 format!(
-                    "a barrier or subgroup operation was reached in non-uniform control flow: one invocation is at {}, another at {}",
-                    describe(&first),
-                    describe(other)
+                    "a barrier or subgroup operation was reached in non-uniform control flow: one invocation is at {first_at}, another at {other_at}"
                 ),
             ));
         }
@@ -273,6 +324,11 @@ fn run_batch(
         match &program.codes[code as usize].insns[pc as usize] {
             Insn::Gather(gather) => self::gather(invocations, file, gather),
             Insn::Collective(collective) => self::collective(invocations, file, collective),
+            Insn::Barrier { workgroup, storage } => {
+                if let Some(local) = memory.sanitizing.as_mut() {
+                    local.barrier(*workgroup, *storage);
+                }
+            }
             _ => {}
         }
         for invocation in invocations.iter_mut() {

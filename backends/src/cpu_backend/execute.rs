@@ -242,7 +242,8 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
         | Insn::Switch { .. }
         | Insn::Call(_)
         | Insn::Return { .. }
-        | Insn::Barrier
+        | Insn::Barrier { .. }
+        | Insn::Checked(_)
         | Insn::Gather(_)
         | Insn::Collective(_)
         | Insn::Fail(_) => unreachable!("control flow is run by the group"),

@@ -330,8 +330,10 @@ pub(super) enum Insn {
     Call(Box<CallInsn>),
     /// Returns `len` words from `src` (`len` 0: no value).
     Return { src: Reg, len: u32 },
-    /// Workgroup control barrier.
-    Barrier,
+    /// Control barrier of the workgroup; `workgroup` and `storage`: whether it orders
+    /// workgroup memory and storage buffers (`workgroupBarrier`, `storageBarrier`;
+    /// read by the sanitizer only).
+    Barrier { workgroup: bool, storage: bool },
     /// Atomic read-modify-write.
     Atomic(Box<AtomicInsn>),
     /// Subgroup gather.
@@ -342,6 +344,9 @@ pub(super) enum Insn {
     Image(Box<super::image::ImageInsn>),
     /// An unsupported construct reached at run time: (what, WGSL line).
     Fail(Box<(String, u32)>),
+    /// An instruction whose accesses the sanitizer checks before running it (only in
+    /// a sanitizing program: [`super::sanitize`]).
+    Checked(Box<Insn>),
 }
 
 #[cfg(test)]

@@ -29,8 +29,10 @@ use super::error::{invalid, unsupported};
 use super::execute::execute;
 use super::insn::{BinOp, CallInsn, Insn, UnOp};
 use super::lanes::{LaneRegs, Members, N as LANES};
+use super::limit::{FUEL, Limit};
 use super::memory::{FUNCTION, Frame};
 use super::places::Places;
+use super::sanitize::{Sanitizer, Sanitizing};
 use crate::error::BackendError;
 use std::cmp::Ordering;
 use std::sync::atomic::AtomicU32;
@@ -79,6 +81,10 @@ pub(super) struct Batch {
     /// The workgroup memory of the batch's workgroups, the program's `workgroup_words`
     /// each, in order.
     pub shared: Vec<u32>,
+    /// Fuel left before the time limit is looked at ([`super::limit`]).
+    pub fuel: u32,
+    /// The worker's sanitizer state, when the dispatch sanitizes.
+    pub sanitizing: Option<super::sanitize::Local>,
 }
 
 /// The scheduler's working lists, kept from one synchronisation point to the next.
@@ -112,6 +118,12 @@ pub(super) struct GroupMemory<'a> {
     pub callers: &'a [u32],
     /// Lanes per register file (the batch's invocations).
     pub width: usize,
+    /// The dispatch's time limit.
+    pub limit: &'a Limit,
+    /// Fuel left before the limit is looked at.
+    pub fuel: u32,
+    /// The sanitizer, when the dispatch sanitizes.
+    pub sanitizer: Option<Sanitizing<'a>>,
 }
 
 /// `$body` with `$operator` a function computing the `BinOp` equal to `$op`: one copy of
@@ -189,7 +201,9 @@ fn meeting_point(leader: &Invocation, other: &Invocation) -> Option<u32> {
 
 /// Runs every invocation of a batch until it returns from the entry point or stops
 /// at a barrier or subgroup operation; `stops[i]` says where invocation `i` stopped.
-/// Counts what the groups executed into `counts`.
+/// Counts what the groups executed into `counts`. Fails when the dispatch runs past
+/// `limit`.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn run_until_sync(
     program: &Program,
     invocations: &mut [Invocation],
@@ -198,6 +212,7 @@ pub(super) fn run_until_sync(
     buffers: &[Vec<AtomicU32>],
     counts: &mut DispatchCounts,
     stops: &mut Vec<Option<Stop>>,
+    (limit, sanitizer): (&Limit, Option<&Sanitizer>),
 ) -> Result<(), BackendError> {
     stops.clear();
     stops.extend(invocations.iter().map(|inv| if inv.frame.is_some() { None } else { Some(Stop::Done) }));
@@ -270,10 +285,17 @@ pub(super) fn run_until_sync(
                 files: &mut memory.files,
                 callers: caller_codes,
                 width,
+                limit,
+                fuel: memory.fuel,
+                sanitizer: match (sanitizer, memory.sanitizing.as_mut()) {
+                    (Some(shared), Some(local)) => Some(Sanitizing { shared, local }),
+                    _ => None,
+                },
             };
             let mut steps = 0;
             let end =
                 run_group(program, code_index, pc, meet, group, &mut file, &mut group_memory, &mut steps, targets);
+            memory.fuel = group_memory.fuel;
             memory.files[code_index as usize] = file;
             counts.add_group(steps, members.iter().map(|&i| invocations[i].simt_index));
             end?
@@ -471,6 +493,22 @@ fn run_group(
     let width = memory.width;
     let mut pc = pc as usize;
     let mut count = 0u64;
+    // One unit of fuel per group started and per jump taken (every loop iteration
+    // takes one): when it is spent, whether the dispatch must stop (`limit`). `$at`: the
+    // instruction where the group is, named in the error.
+    macro_rules! burn {
+        ($at:expr) => {
+            memory.fuel -= 1;
+            if memory.fuel == 0 {
+                memory.fuel = FUEL;
+                if let Some(stop) = memory.limit.poll() {
+                    let (file, line, function) = program.place(code_index, $at as u32);
+                    return Err(memory.limit.error(stop, &program.kernel, &format!("{file}:{line}"), &function));
+                }
+            }
+        };
+    }
+    burn!(pc);
     let end = loop {
         // At or past an invocation that waits: let it catch up (and merge when equal).
         if pc >= meet as usize {
@@ -480,12 +518,16 @@ fn run_group(
         pc += 1;
         count += 1;
         match insn {
-            Insn::Jump(target) => pc = *target as usize,
+            Insn::Jump(target) => {
+                burn!(pc - 1);
+                pc = *target as usize;
+            }
             Insn::JumpUnless { cond, target } => {
                 let row = *cond as usize * width;
                 let mut taken = 0;
                 group.for_each(|l| taken += usize::from(file[row + l] == 0));
                 if taken == group.len() {
+                    burn!(pc - 1);
                     pc = *target as usize;
                 } else if taken > 0 {
                     targets.clear();
@@ -510,7 +552,7 @@ fn run_group(
             }
             Insn::Call(_) => break GroupEnd::Call(pc as u32),
             Insn::Return { src, len } => break GroupEnd::Return { src: *src, len: *len },
-            Insn::Barrier | Insn::Gather(_) | Insn::Collective(_) => break GroupEnd::Sync(pc as u32 - 1),
+            Insn::Barrier { .. } | Insn::Gather(_) | Insn::Collective(_) => break GroupEnd::Sync(pc as u32 - 1),
             Insn::Fail(failure) => return Err(unsupported(&failure.0, failure.1)),
             // Row operations: each register of the group's members at once (`lanes`).
             Insn::Copy1 { dst, src } => group.copy(file, *dst as usize, *src as usize, 1),
@@ -611,6 +653,9 @@ fn run_group(
                 group.copy(file, dst, base, 1);
             }
             Insn::Compute(compute) => compute(file, group),
+            Insn::Checked(checked) => {
+                super::sanitize::execute(checked, program, code_index, pc as u32 - 1, file, group, memory)
+            }
             _ => execute(insn, file, group, memory),
         }
     };

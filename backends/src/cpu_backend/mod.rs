@@ -31,6 +31,14 @@
 //! f32 without contraction. Out-of-bounds indices are clamped (naga's `Restrict` policy);
 //! out-of-bounds memory words read as 0 and are not written.
 //!
+//! A dispatch has a time limit (`limit`; [`CpuOptions::time_limit`], 60 s by default):
+//! a kernel that never ends fails with an error naming the kernel, the limit and the
+//! WGSL line and function where an invocation was, on every worker thread at once. With
+//! [`CpuOptions::sanitize`] the interpreter is also a sanitizer (`sanitize`): it
+//! reports out-of-range indices, accesses past a binding's end, reads of workgroup
+//! memory nobody wrote, data races on workgroup and storage memory, and barriers in
+//! non-uniform control flow, as [`Finding`]s ([`CpuBackend::take_findings`]).
+//!
 //! The interpreter's own memory is capped (`budget`): 64 MiB of private, function
 //! (registers) or workgroup memory per invocation or workgroup and of constants,
 //! checked from the types when a kernel is compiled; 1 GiB per batch (batches shrink to
@@ -75,6 +83,7 @@ mod interp;
 mod jump_cleanup;
 mod lanes;
 mod layout;
+mod limit;
 mod load_alias;
 mod load_fields;
 mod math_call;
@@ -82,6 +91,7 @@ mod matrix;
 mod memory;
 mod places;
 mod retarget;
+mod sanitize;
 mod statement;
 mod wide;
 
@@ -94,6 +104,8 @@ use crate::error::BackendError;
 use crate::texture::{SamplerDesc, SamplerId, TextureDesc, TextureId};
 pub use counts::{DispatchCounts, WARP_WIDTH};
 use decode::Program;
+pub use limit::DEFAULT_TIME_LIMIT;
+pub use sanitize::{Finding, FindingKind, MAX_FINDINGS};
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
 use strata_kernels::{Kernel, KernelId};
@@ -103,11 +115,17 @@ use strata_kernels::{Kernel, KernelId};
 pub struct CpuOptions {
     /// Subgroup size for kernels that use subgroup operations; `None`: no subgroups.
     pub subgroup_size: Option<u32>,
+    /// Wall time a dispatch may take before it fails naming where the kernel was
+    /// (default [`DEFAULT_TIME_LIMIT`]; `None`: no limit).
+    pub time_limit: Option<Duration>,
+    /// Run as a sanitizer ([`Finding`], [`CpuBackend::take_findings`]); off by default:
+    /// it costs several times the normal mode's time (docs/kernels.md).
+    pub sanitize: bool,
 }
 
 impl Default for CpuOptions {
     fn default() -> Self {
-        Self { subgroup_size: Some(8) }
+        Self { subgroup_size: Some(8), time_limit: Some(DEFAULT_TIME_LIMIT), sanitize: false }
     }
 }
 
@@ -161,8 +179,14 @@ pub struct CpuBackend {
     samplers: HashMap<u64, SamplerDesc>,
     next_buffer: u64,
     programs: HashMap<KernelId, Program>,
+    /// Sanitizing programs ([`CpuOptions::sanitize`]), compiled apart.
+    sanitizing: HashMap<KernelId, Program>,
     last_counts: DispatchCounts,
     counts_by_kernel: HashMap<KernelId, DispatchCounts>,
+    /// The sanitizer's findings since the last [`CpuBackend::take_findings`].
+    findings: Vec<Finding>,
+    /// Occurrences past [`MAX_FINDINGS`] sites per dispatch, since then.
+    findings_dropped: u64,
 }
 
 impl CpuBackend {
@@ -206,16 +230,31 @@ impl CpuBackend {
             samplers: HashMap::new(),
             next_buffer: 0,
             programs: HashMap::new(),
+            sanitizing: HashMap::new(),
             last_counts: DispatchCounts::default(),
             counts_by_kernel: HashMap::new(),
+            findings: Vec::new(),
+            findings_dropped: 0,
         })
     }
 
+    /// The program of `kernel` (the sanitizing one when the backend sanitizes), compiled
+    /// the first time.
     fn program(&mut self, kernel: &Kernel) -> Result<&Program, BackendError> {
-        if let std::collections::hash_map::Entry::Vacant(slot) = self.programs.entry(kernel.id) {
-            slot.insert(decode::compile_program(kernel)?);
+        let sanitize = self.options.sanitize;
+        let programs = if sanitize { &mut self.sanitizing } else { &mut self.programs };
+        if let std::collections::hash_map::Entry::Vacant(slot) = programs.entry(kernel.id) {
+            slot.insert(decode::compile(kernel, sanitize)?);
         }
-        Ok(&self.programs[&kernel.id])
+        Ok(&programs[&kernel.id])
+    }
+
+    /// What the sanitizer found ([`CpuOptions::sanitize`]) in the dispatches since the
+    /// last call, each dispatch's findings in WGSL line order (at most [`MAX_FINDINGS`]
+    /// sites per dispatch), and how many occurrences past that cap were only counted.
+    /// Taking them resets the list. Empty when the backend does not sanitize.
+    pub fn take_findings(&mut self) -> (Vec<Finding>, u64) {
+        (std::mem::take(&mut self.findings), std::mem::take(&mut self.findings_dropped))
     }
 
     /// Bytecode instructions the last dispatch executed (for ns-per-instruction
@@ -409,10 +448,21 @@ impl Backend for CpuBackend {
                 }
             }
         }
+        let program = if self.options.sanitize { &self.sanitizing[&kernel.id] } else { &self.programs[&kernel.id] };
+        let sanitizer = self.options.sanitize.then(|| {
+            let per_workgroup = kernel.workgroup_size.iter().product::<u32>();
+            sanitize::Sanitizer::new(per_workgroup, workgroups, bound.iter().map(Vec::len))
+        });
+        let limit = limit::Limit::starting_now(self.options.time_limit);
         let result = match taken {
-            Ok(()) => exec::run(&self.programs[&kernel.id], &mut bound, workgroups, subgroup_size),
+            Ok(()) => exec::run(program, &mut bound, workgroups, subgroup_size, (&limit, sanitizer.as_ref())),
             Err(error) => Err(error),
         };
+        if let Some(sanitizer) = sanitizer {
+            let (findings, dropped) = sanitizer.into_findings();
+            self.findings.extend(findings);
+            self.findings_dropped += dropped;
+        }
         for (index, (resource, words)) in resources.iter().zip(bound).enumerate() {
             if first_of(index).is_none() {
                 self.put_back(*resource, words);

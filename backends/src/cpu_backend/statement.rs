@@ -53,7 +53,8 @@ impl Compiler<'_> {
                 }
             }
             Statement::Block(block) => self.block(scope, block)?,
-            Statement::If { condition, accept, reject } if self.if_as_select(scope, *condition, accept, reject)? => {}
+            Statement::If { condition, accept, reject }
+                if !self.sanitize && self.if_as_select(scope, *condition, accept, reject)? => {}
             Statement::If { condition, accept, reject } => {
                 let cond = self.reg(scope, *condition);
                 self.line = line;
@@ -182,8 +183,14 @@ impl Compiler<'_> {
                     self.push(Insn::Return { src, len });
                 }
             }
-            Statement::ControlBarrier(_) => {
-                self.push(Insn::Barrier);
+            Statement::ControlBarrier(flags) => {
+                // A subgroup barrier orders both for the sanitizer: it cannot tell the
+                // subgroups apart, and an order too many misses a race rather than
+                // reporting one that is not.
+                use naga::Barrier as B;
+                let workgroup = flags.intersects(B::WORK_GROUP | B::SUB_GROUP);
+                let storage = flags.intersects(B::STORAGE | B::TEXTURE | B::SUB_GROUP);
+                self.push(Insn::Barrier { workgroup, storage });
             }
             // Memory barriers order memory only; one thread runs a workgroup in order.
             Statement::MemoryBarrier(_) => {}
@@ -200,12 +207,12 @@ impl Compiler<'_> {
             }
             Statement::Call { function, arguments, result } => self.call(scope, *function, arguments, *result)?,
             Statement::WorkGroupUniformLoad { pointer, result } => {
-                self.push(Insn::Barrier);
+                self.push(Insn::Barrier { workgroup: true, storage: false });
                 let dst = self.reg(scope, *result);
                 let len = scope.lens[result.index()];
                 self.line = line;
                 self.load(scope, *pointer, dst, len, None);
-                self.push(Insn::Barrier);
+                self.push(Insn::Barrier { workgroup: true, storage: false });
             }
             Statement::Atomic { pointer, fun, value, result } => {
                 let signed = matches!(self.ty(scope, *value), TypeInner::Scalar(s) if s.kind == naga::ScalarKind::Sint);

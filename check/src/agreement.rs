@@ -132,6 +132,23 @@ impl BufferAgreement {
         if self.differing == 0 {
             return format!("identical ({} words)", self.words);
         }
+        self.differences() + if self.passes() { ": within tolerance" } else { ": FAILS" }
+    }
+
+    /// One line for a buffer of a kernel whose results WGSL leaves undefined (`why`: the
+    /// sanitizer's finding, e.g. an index out of range): identical, within the bound,
+    /// or how it differs and why that is allowed, never a failure. Which words an
+    /// undefined access can reach is not computed (a value read out of range flows
+    /// anywhere), so any difference is allowed.
+    pub fn describe_undefined(&self, why: &impl std::fmt::Display) -> String {
+        if self.passes() {
+            return self.describe();
+        }
+        format!("{}: undefined by WGSL: {why}", self.differences())
+    }
+
+    /// How the buffer differs (when it does), without the verdict.
+    fn differences(&self) -> String {
         let mut text = format!("{} of {} words differ", self.differing, self.words);
         if self.max_ulp > 0 {
             text += &format!(", max {} ULP on floats (bound {}", ulp_text(self.max_ulp), self.bound.ulp);
@@ -152,7 +169,7 @@ impl BufferAgreement {
         if let Some((index, got, want)) = self.first_beyond {
             text += &format!("; first at word {index}: {got:#010x}, reference {want:#010x}");
         }
-        text + if self.passes() { ": within tolerance" } else { ": FAILS" }
+        text
     }
 }
 
@@ -331,6 +348,21 @@ mod tests {
         let judgement = judge(&[reference, wrong_id], None, &ulps(1000)).unwrap();
         assert_eq!(judgement.buffers[0].integers_differing, 1);
         assert!(judgement.buffers[0].describe().ends_with("FAILS"), "{}", judgement.buffers[0].describe());
+    }
+
+    #[test]
+    fn a_difference_wgsl_leaves_undefined_is_described_so_and_never_fails() {
+        let reference = run("cpu", &[7, 0, 0, 0]);
+        let judgement = judge(&[reference.clone(), run("gpu", &[0, 0, 0, 0])], None, &ulps(0)).unwrap();
+        let why = "out-of-range index at k.wgsl:3 in `main` (index 8, length 8)";
+        let text = judgement.buffers[0].describe_undefined(&why);
+        assert_eq!(
+            text,
+            "1 of 3 words differ, 1 integer words differ; first at word 0: 0x00000000, reference 0x00000007: \
+             undefined by WGSL: out-of-range index at k.wgsl:3 in `main` (index 8, length 8)"
+        );
+        let same = judge(&[reference, run("gpu", &[7, 0, 0, 0])], None, &ulps(0)).unwrap();
+        assert_eq!(same.buffers[0].describe_undefined(&why), "identical (3 words)");
     }
 
     #[test]

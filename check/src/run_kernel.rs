@@ -9,6 +9,7 @@ use crate::run_images::ImageSpec;
 use crate::{BackendSlot, backend_slots};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
+use strata_backends::cpu_backend::{CpuBackend, CpuOptions, DEFAULT_TIME_LIMIT, Finding};
 use strata_backends::{
     Backend, BackendError, Bind, BufferId, Resource, SamplerDesc, SamplerId, TextureDesc, TextureId,
 };
@@ -42,6 +43,12 @@ pub struct RunRequest {
     pub ulp: Vec<(Option<String>, u32)>,
     /// `--abs E` and `--abs BUFFER=E` flags, as `ulp`.
     pub abs: Vec<(Option<String>, f32)>,
+    /// `--time-limit`: the interpreter's limit per dispatch (`None`: its default,
+    /// [`strata_backends::cpu_backend::DEFAULT_TIME_LIMIT`]).
+    pub time_limit: Option<std::time::Duration>,
+    /// `--sanitize`: run the interpreter as a sanitizer even when no other path is
+    /// compared with it (it always is when one is: [`RunOutcome::findings`]).
+    pub sanitize: bool,
 }
 
 /// One writable buffer (or storage texture, its level 0) after a run.
@@ -441,6 +448,22 @@ pub struct RunOutcome {
     pub unavailable: Vec<(String, String)>,
     /// The tolerance `--ulp` and `--abs` gave, every buffer it names an output.
     pub tolerance: Tolerance,
+    /// Whether the interpreter ran as a sanitizer: with `--sanitize`, or whenever its
+    /// outputs are compared with another path's (so that a difference WGSL allows is
+    /// told from a bug).
+    pub sanitized: bool,
+    /// What the sanitizer found in the interpreter's run, and the occurrences past its
+    /// cap of sites.
+    pub findings: (Vec<Finding>, u64),
+}
+
+impl RunOutcome {
+    /// The first finding that makes the kernel's results undefined by WGSL (an index
+    /// out of range, a data race, ...), which explains a path that differs from the
+    /// interpreter ([`crate::agreement::BufferAgreement::describe_undefined`]).
+    pub fn undefined_behaviour(&self) -> Option<&Finding> {
+        self.findings.0.iter().find(|finding| finding.kind.undefined())
+    }
 }
 
 /// The math functions of the interpreter whose results differ from GPU drivers' within
@@ -562,10 +585,29 @@ pub fn run_kernel(request: &RunRequest) -> Result<RunOutcome> {
         .collect();
     let mut runs = Vec::new();
     let mut unavailable = Vec::new();
+    // The interpreter sanitizes when asked, or when another path is compared with it.
+    let sanitized = request.sanitize || (slots.len() > 1 && slots.iter().any(|slot| slot.name == "cpu"));
+    let mut findings = (Vec::new(), 0);
     for slot in &slots {
         let name = slot.name.to_string();
         if every && let Err(why) = (slot.toolchain)() {
             unavailable.push((name, why));
+            continue;
+        }
+        if slot.name == "cpu" {
+            let options = CpuOptions {
+                time_limit: Some(request.time_limit.unwrap_or(DEFAULT_TIME_LIMIT)),
+                sanitize: sanitized,
+                ..CpuOptions::default()
+            };
+            let outputs = CpuBackend::new(options).map_err(|e| e.to_string()).and_then(|mut cpu| {
+                let outputs =
+                    run_on(&mut cpu, &kernel, &inputs, &images, request.workgroups, &resolved.workgroup_flags)
+                        .map_err(|e| format!("{e:#}"));
+                findings = cpu.take_findings();
+                outputs
+            });
+            runs.push(BackendRun { backend: name, outputs });
             continue;
         }
         let outputs = match (slot.open)() {
@@ -600,5 +642,5 @@ pub fn run_kernel(request: &RunRequest) -> Result<RunOutcome> {
             }
         }
     }
-    Ok(RunOutcome { kernel, runs, unavailable, tolerance })
+    Ok(RunOutcome { kernel, runs, unavailable, tolerance, sanitized, findings })
 }

@@ -32,6 +32,8 @@ fn setup(name: &str) -> (PathBuf, RunRequest) {
         out: dir.join("out"),
         ulp: Vec::new(),
         abs: Vec::new(),
+        time_limit: None,
+        sanitize: false,
     };
     (dir, request)
 }
@@ -125,6 +127,8 @@ fn a_shader_with_overrides_runs_everywhere_with_and_without_override() {
             out: dir.join(format!("out{tile}")),
             ulp: Vec::new(),
             abs: Vec::new(),
+            time_limit: None,
+            sanitize: false,
         };
         let runs = run_kernel(&request).unwrap().runs;
         every_backend_agrees(&runs);
@@ -164,6 +168,8 @@ fn a_png_texture_and_a_sampler_run_everywhere_and_the_output_comes_back_as_png()
         out: dir.join("out"),
         ulp: Vec::new(),
         abs: Vec::new(),
+        time_limit: None,
+        sanitize: false,
     };
     let runs = run_kernel(&request).unwrap().runs;
     // A filtered value a device rounds with 8-bit weights may land one 1/255 step away.
@@ -189,4 +195,37 @@ fn a_png_texture_and_a_sampler_run_everywhere_and_the_output_comes_back_as_png()
     wrong.images[2] = ImageSpec::StorageTexture((0, 2), [4, 4, 1], Some(strata_kernels::TexelFormat::R32Float));
     let error = run_kernel(&wrong).unwrap_err().to_string();
     assert!(error.contains("half_size") && error.contains("r32float") && error.contains("rgba8unorm"), "{error}");
+}
+
+/// `xtask run`'s sanitizer: with `--sanitize` the interpreter's findings come back with
+/// the outcome (an index out of range, named by file and line), and `--time-limit`
+/// stops a kernel that never ends, naming where it was (issue 58).
+#[test]
+fn the_interpreter_sanitizes_and_stops_endless_kernels_for_xtask_run() {
+    let data = format!("{}/data/sanitizer", env!("CARGO_MANIFEST_DIR"));
+    let (folder, mut request) = setup("sanitize");
+    request.shader = format!("{data}/out_of_range.wgsl").into();
+    request.entry = "main".into();
+    request.workgroups = [1, 1, 1];
+    request.buffers.clear();
+    request.sizes = vec![(0, 0, 64), (0, 1, 64)];
+    request.backends = vec!["cpu".into()];
+    request.ulp.clear();
+    request.abs.clear();
+    request.out = folder.join("out");
+    // Alone, the interpreter sanitizes only when asked.
+    let outcome = run_kernel(&request).unwrap();
+    assert!(!outcome.sanitized && outcome.findings.0.is_empty());
+    request.sanitize = true;
+    let outcome = run_kernel(&request).unwrap();
+    let why = outcome.undefined_behaviour().expect("an undefined finding");
+    assert!(why.to_string().starts_with("out-of-range index at"), "{why}");
+    assert!(why.file.ends_with("out_of_range.wgsl") && why.line == 12, "{why}");
+    // A loop that never ends: the cpu run fails at the limit, naming the line.
+    request.shader = format!("{data}/endless.wgsl").into();
+    request.sizes = vec![(0, 0, 256)];
+    request.time_limit = Some(std::time::Duration::from_millis(100));
+    let outcome = run_kernel(&request).unwrap();
+    let error = outcome.runs[0].outputs.as_ref().expect_err("stopped");
+    assert!(error.contains("time limit of 100 ms") && error.contains("endless.wgsl:9 in `main`"), "{error}");
 }

@@ -72,6 +72,8 @@ fn request(folder: &Path, shader: &str) -> RunRequest {
         out: folder.join("out"),
         ulp: Vec::new(),
         abs: Vec::new(),
+        time_limit: None,
+        sanitize: false,
     }
 }
 

@@ -16,7 +16,8 @@
 //! * `cargo xtask run FILE.wgsl --entry NAME --workgroups X,Y,Z --buffer G:B=FILE ...
 //!   [--size G:B=BYTES] [--texture G:B=FILE] [--storage-texture G:B=WxH[:FORMAT]]
 //!   [--sampler G:B=FILTER,ADDRESS] [--override NAME=VALUE ...] [--ulp N | --ulp BUFFER=N ...] [--abs E | --abs BUFFER=E ...]
-//!   [--reference BACKEND] --backend cpu|wgpu|wgpu-gl|ash|ash-glsl|ash-hlsl|ash-slang|all [--out DIR]`:
+//!   [--reference BACKEND] [--time-limit SECONDS] [--sanitize]
+//!   --backend cpu|wgpu|wgpu-gl|ash|ash-glsl|ash-hlsl|ash-slang|all [--out DIR]`:
 //!   runs any WGSL compute shader, writes every writable buffer and storage texture to
 //!   `DIR/BACKEND/G_B_NAME.bin` (a storage texture also as `.png` or `.exr`), and with several backends reports per backend and
 //!   buffer whether it is identical to the reference backend's, or how many words
@@ -25,7 +26,12 @@
 //!   is checked first: a binding given twice, a backend named twice, a bound for a
 //!   buffer that is not an output, an override value its type or naga's workgroup size
 //!   cannot take, a size past 4 GiB are one-line errors naming the flag. `all` lists a
-//!   path whose toolchain is missing (or that has no device) as unavailable.
+//!   path whose toolchain is missing (or that has no device) as unavailable. The
+//!   interpreter (`cpu`) stops a dispatch past `--time-limit` (default 60 s) naming where
+//!   the kernel was, and runs as a sanitizer whenever another path is compared with it
+//!   (or with `--sanitize`): its findings are listed, and a buffer that differs from a
+//!   kernel WGSL leaves undefined (an index out of range, a data race) is reported as
+//!   `undefined by WGSL: ...`, which does not fail the run.
 //!
 //! * `cargo xtask fuzz [--target T,...] [--seconds N] [--executions N] [--seed S]
 //!   [--crash-dir DIR] [--hang-ms MS] [--no-shared]`: fuzzes the loaders (scene JSON, PLY,
@@ -172,6 +178,15 @@ struct RunArgs {
     /// The backend the others are compared with (default: the first that ran).
     #[arg(long)]
     reference: Option<String>,
+    /// The interpreter's time limit per dispatch, in seconds (default 60): a kernel
+    /// running longer (a loop that never ends) fails naming where it was.
+    #[arg(long = "time-limit", value_parser = parse_time_limit)]
+    time_limit: Option<std::time::Duration>,
+    /// Run the interpreter as a sanitizer and list its findings (out-of-range indices,
+    /// reads of unwritten workgroup memory, data races, barriers in non-uniform control
+    /// flow); on by itself whenever `cpu` is compared with another path.
+    #[arg(long)]
+    sanitize: bool,
     /// Output folder.
     #[arg(long, default_value = "target/run")]
     out: PathBuf,
@@ -212,6 +227,8 @@ fn execute(cli: Cli) -> Result<()> {
                 ulp,
                 abs,
                 reference,
+                time_limit,
+                sanitize,
                 out,
             } = *args;
             let images = images(&textures, &storage_textures, &samplers);
@@ -227,6 +244,8 @@ fn execute(cli: Cli) -> Result<()> {
                 out,
                 ulp,
                 abs,
+                time_limit,
+                sanitize,
             };
             run(request, reference.as_deref())
         }
@@ -414,6 +433,16 @@ fn parse_abs(text: &str) -> Result<(Option<String>, f32), String> {
     Ok((buffer, bound))
 }
 
+/// `--time-limit SECONDS`: a positive number of seconds, at most a day.
+fn parse_time_limit(text: &str) -> Result<std::time::Duration, String> {
+    match text.trim().parse::<f64>() {
+        Ok(seconds) if seconds.is_finite() && seconds > 0.0 && seconds <= 86_400.0 => {
+            Ok(std::time::Duration::from_secs_f64(seconds))
+        }
+        _ => Err(format!("`{text}`: the time limit must be a number of seconds above 0 and at most 86400")),
+    }
+}
+
 fn run(request: RunRequest, reference: Option<&str>) -> Result<()> {
     let reference = reference.map(|name| if name == "wgpu" { "wgpu-vulkan" } else { name });
     if let Some(name) = reference {
@@ -425,8 +454,8 @@ fn run(request: RunRequest, reference: Option<&str>) -> Result<()> {
     }
     let outcome = strata_check::run_kernel::run_kernel(&request)?;
     let tolerance = &outcome.tolerance;
-    let runs = outcome.runs;
-    for run in &runs {
+    let runs = &outcome.runs;
+    for run in runs {
         match &run.outputs {
             Ok(outputs) => println!(
                 "{:<12} ran: {} output buffer(s) in {}",
@@ -440,12 +469,31 @@ fn run(request: RunRequest, reference: Option<&str>) -> Result<()> {
     for (backend, why) in &outcome.unavailable {
         println!("{backend:<12} unavailable: {}", why.replace('\n', " "));
     }
+    let (findings, dropped) = &outcome.findings;
+    if outcome.sanitized {
+        match findings.len() {
+            0 => println!("sanitizer: no finding in the interpreter's run"),
+            n => println!("sanitizer: {n} finding(s) in the interpreter's run:"),
+        }
+        for finding in findings {
+            let what = if finding.kind.undefined() { "undefined by WGSL" } else { "note" };
+            println!("  {what}: {finding}");
+        }
+        if *dropped > 0 {
+            println!("  and {dropped} more occurrence(s) past the first {} places", findings.len());
+        }
+    }
+    let undefined = outcome.undefined_behaviour();
     let ran = runs.iter().filter(|r| r.outputs.is_ok()).count();
     if ran > 1 || reference.is_some() {
-        let judgement = judge(&runs, reference, tolerance).map_err(anyhow::Error::msg)?;
+        let judgement = judge(runs, reference, tolerance).map_err(anyhow::Error::msg)?;
         println!("against {}:", judgement.reference);
         for buffer in &judgement.buffers {
-            println!("{:<12} {} `{}`: {}", buffer.backend, buffer.binding, buffer.name, buffer.describe());
+            let verdict = match undefined {
+                Some(why) => buffer.describe_undefined(why),
+                None => buffer.describe(),
+            };
+            println!("{:<12} {} `{}`: {}", buffer.backend, buffer.binding, buffer.name, verdict);
         }
         let inexact = strata_check::run_kernel::inexact_functions(&outcome.kernel);
         let interpreter_compared = runs.iter().any(|r| r.backend == "cpu" && r.outputs.is_ok());
@@ -457,7 +505,10 @@ fn run(request: RunRequest, reference: Option<&str>) -> Result<()> {
                 inexact.join(", ")
             );
         }
-        let beyond = judgement.buffers.iter().filter(|b| !b.passes()).count();
+        // A kernel WGSL leaves undefined may give each path its own result: a difference
+        // is reported as such, not failed (docs/kernels.md, "The interpreter as a
+        // sanitizer").
+        let beyond = judgement.buffers.iter().filter(|b| !b.passes() && undefined.is_none()).count();
         if beyond > 0 {
             bail!("{beyond} output buffer(s) beyond the tolerance (integers exact, f32 within --ulp)");
         }

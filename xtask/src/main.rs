@@ -506,8 +506,8 @@ fn run(request: RunRequest, reference: Option<&str>) -> Result<()> {
             );
         }
         // A kernel WGSL leaves undefined may give each path its own result: a difference
-        // is reported as such, not failed (docs/kernels.md, "The interpreter as a
-        // sanitizer").
+        // is reported as such, not failed (docs/kernels.md, "The time limit and the
+        // interpreter as a sanitizer").
         let beyond = judgement.buffers.iter().filter(|b| !b.passes() && undefined.is_none()).count();
         if beyond > 0 {
             bail!("{beyond} output buffer(s) beyond the tolerance (integers exact, f32 within --ulp)");

@@ -17,8 +17,8 @@
 //! [`super::interp`]'s group loop: both take one unit of *fuel*, a counter of the
 //! worker thread; only when [`FUEL`] units are spent is the clock read (and the flag
 //! that stops every thread looked at). One decrement and one well-predicted branch per
-//! loop iteration of a whole group, not per invocation: not measurable on the
-//! interpreter's benchmarks (docs/kernels.md, "The interpreter as a sanitizer").
+//! loop iteration of a whole group, not per invocation: not measurable (docs/kernels.md,
+//! "The time limit and the interpreter as a sanitizer", gives the timings).
 //!
 //! Every worker thread stops: the first thread past the deadline raises the dispatch's
 //! stop flag and each other thread sees it at its next clock read; a thread that

@@ -6,7 +6,7 @@
 //! names how many words differ and the largest ULP distance, never only the first.
 
 use crate::compare::ulp_distance;
-use crate::run_kernel::BackendRun;
+use crate::run_data::BackendRun;
 use strata_kernels::WordKind;
 
 /// How far an `f32` word may be from the reference's.
@@ -47,7 +47,7 @@ impl Tolerance {
     /// buffer, `BUFFER=` ones for that buffer (whose other half falls back to the plain
     /// value). A bound given twice for the same target (two plain `--ulp`, or two
     /// `--abs out=...`) is refused naming both flags, never one of them silently kept;
-    /// whether a named buffer exists is the run's check ([`crate::run_kernel`]).
+    /// whether a named buffer exists is the run's check (in `run_kernel.rs`).
     pub fn from_flags(ulp: &[(Option<String>, u32)], abs: &[(Option<String>, f32)]) -> Result<Tolerance, String> {
         fn once<T: std::fmt::Display>(flag: &str, given: &[(Option<String>, T)]) -> Result<(), String> {
             for (index, (target, bound)) in given.iter().enumerate() {
@@ -302,7 +302,7 @@ fn halves_within_one_ulp(got: u32, want: u32) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::run_kernel::OutputBuffer;
+    use crate::run_data::OutputBuffer;
     use strata_kernels::WordKinds;
 
     fn ulps(ulp: u32) -> Tolerance {

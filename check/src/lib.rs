@@ -25,6 +25,7 @@ mod path;
 pub mod replay;
 mod report;
 mod restir;
+pub mod run_data;
 pub mod run_images;
 pub mod run_kernel;
 mod selection;

@@ -18,7 +18,7 @@
 //! `G` is the WGSL group: a kernel may bind several (wgpu bind groups, Vulkan descriptor
 //! sets; naga's GLSL, which has no sets, gets them flattened).
 
-use crate::run_kernel::{GroupedImages, ImageInput, OutputBuffer, Slot};
+use crate::run_data::{GroupedImages, ImageInput, MAX_INPUT_BYTES, OutputBuffer, Slot, read_input};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 pub use strata_backends::SamplerDesc;
@@ -104,10 +104,10 @@ fn texel_bytes(size: [u32; 3], format: TexelFormat) -> Option<u64> {
 }
 
 /// Whether a texture of `size` texels of `format` stays within what xtask run reads or
-/// makes ([`crate::run_kernel::MAX_INPUT_BYTES`]), checked before any file is read or
+/// makes ([`MAX_INPUT_BYTES`]), checked before any file is read or
 /// anything allocated; the error names `flag`.
 fn check_texels(flag: &str, size: [u32; 3], format: TexelFormat) -> Result<()> {
-    let cap = crate::run_kernel::MAX_INPUT_BYTES;
+    let cap = MAX_INPUT_BYTES;
     let [w, h, d] = size;
     match texel_bytes(size, format) {
         Some(bytes) if bytes <= cap => Ok(()),
@@ -204,7 +204,7 @@ fn read_picture(path: &Path) -> Result<([u32; 3], TexelFormat, Vec<u8>)> {
         let texels = image.pixels.iter().flat_map(|p| [p[0], p[1], p[2], 1.0]).flat_map(f32::to_le_bytes).collect();
         return Ok(([image.width, image.height, 1], TexelFormat::Rgba32Float, texels));
     }
-    let bytes = crate::run_kernel::read_input(path, crate::run_kernel::MAX_INPUT_BYTES)?;
+    let bytes = read_input(path, MAX_INPUT_BYTES)?;
     let image = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
         .with_context(|| format!("texture {}: not a PNG this reader understands", path.display()))?
         .to_rgba8();
@@ -248,7 +248,7 @@ pub fn image_inputs(kernel: &Kernel, specs: &[ImageSpec]) -> Result<GroupedImage
                 let (size, format, texels) = match file {
                     TextureFile::Picture(path) => read_picture(path)?,
                     TextureFile::Raw { path, size, format } => {
-                        let bytes = crate::run_kernel::read_input(path, crate::run_kernel::MAX_INPUT_BYTES)?;
+                        let bytes = read_input(path, MAX_INPUT_BYTES)?;
                         (*size, *format, bytes)
                     }
                 };

@@ -5,15 +5,17 @@
 //! own kernels.
 
 use crate::agreement::Tolerance;
+pub use crate::run_data::{
+    BackendRun, GroupedImages, GroupedInputs, ImageInput, ImageInputs, Inputs, MAX_INPUT_BYTES, OutputBuffer, Slot,
+    read_input,
+};
 use crate::run_images::ImageSpec;
 use crate::{BackendSlot, backend_slots};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions, DEFAULT_TIME_LIMIT, Finding};
-use strata_backends::{
-    Backend, BackendError, Bind, BufferId, Resource, SamplerDesc, SamplerId, TextureDesc, TextureId,
-};
-use strata_kernels::{BindingKind, Kernel, WordKinds};
+use strata_backends::{Backend, BackendError, Bind, BufferId, Resource, SamplerId, TextureId};
+use strata_kernels::{BindingKind, Kernel};
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -51,44 +53,8 @@ pub struct RunRequest {
     pub sanitize: bool,
 }
 
-/// One writable buffer (or storage texture, its level 0) after a run.
-#[derive(Clone, Debug)]
-pub struct OutputBuffer {
-    /// `@group` number.
-    pub group: u32,
-    /// `@binding` number.
-    pub binding: u32,
-    /// WGSL variable name.
-    pub name: String,
-    /// Contents.
-    pub bytes: Vec<u8>,
-    /// What each word holds (from the IR), for comparing.
-    pub kinds: WordKinds,
-}
-
-/// One backend's run.
-#[derive(Clone, Debug)]
-pub struct BackendRun {
-    /// Backend name.
-    pub backend: String,
-    /// Writable buffers after the run, or why the backend could not run the shader.
-    pub outputs: Result<Vec<OutputBuffer>, String>,
-}
-
 /// The largest shader file read (WGSL text).
 pub const MAX_SHADER_BYTES: u64 = 64 << 20;
-
-/// The largest buffer or texture file read, and the largest zero-filled buffer or
-/// texture made (`--size`, `--storage-texture`); a device's own limits are checked after,
-/// before anything of the size is allocated.
-pub const MAX_INPUT_BYTES: u64 = 4 << 30;
-
-/// The whole regular file `path` (a link to one is followed), at most `cap` bytes: a named
-/// pipe, a device (`/dev/zero`) or a link to one is refused at once by name, never waited on or read until memory runs
-/// out, and the size is checked before anything is allocated.
-pub fn read_input(path: &Path, cap: u64) -> Result<Vec<u8>> {
-    Ok(strata_files::read_named_regular_capped(path, cap)?)
-}
 
 /// Loads the shader with `overrides` (by name or `@id` number: [`crate::overrides`]);
 /// subgroup operations are allowed if the module needs them.
@@ -126,43 +92,12 @@ fn load_shader_resolved(
     }
 }
 
-/// Initial contents of every buffer binding of `kernel`: given bytes (rounded up to
-/// whole words), or zeros of the binding's minimum size.
-pub type Inputs = Vec<(u32, Vec<u8>)>;
-
-/// What a texture or sampler binding receives.
-#[derive(Clone, Debug)]
-pub enum ImageInput {
-    /// A texture: what it is and each mip level's bytes, in order (levels not given are
-    /// zero-filled; a storage texture the kernel only writes needs none).
-    Texture {
-        /// Its shape, size, levels and format.
-        desc: TextureDesc,
-        /// Bytes of levels 0, 1, ... (see `strata_backends::texture` for their order).
-        levels: Vec<Vec<u8>>,
-    },
-    /// A sampler.
-    Sampler(SamplerDesc),
-}
-
-/// The textures and samplers of a run, by binding (group 0).
-pub type ImageInputs = Vec<(u32, ImageInput)>;
-
 /// A resource created for one binding of a run.
 enum Created {
     Buffer(BufferId),
     Texture(TextureId),
     Sampler(SamplerId),
 }
-
-/// A binding's `(group, binding)`.
-pub type Slot = (u32, u32);
-
-/// Buffer contents by `(group, binding)`.
-pub type GroupedInputs = Vec<(Slot, Vec<u8>)>;
-
-/// Textures and samplers by `(group, binding)`.
-pub type GroupedImages = Vec<(Slot, ImageInput)>;
 
 /// Group 0's inputs as grouped ones.
 fn in_group_zero<T: Clone>(inputs: &[(u32, T)]) -> Vec<(Slot, T)> {

@@ -9,7 +9,9 @@ use std::process::Command;
 /// Which naga output glslang compiles.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum GlslangInput {
-    /// naga's GLSL 4.50 (`glslangValidator -V`).
+    /// naga's GLSL 4.50 (`glslangValidator -V`), its workgroup zero-initialisation
+    /// rewritten as loops, which compile in seconds where naga's constructors took
+    /// minutes ([`crate::glsl_zero_init`]).
     Glsl,
     /// naga's HLSL SM 6.0 (`glslangValidator -D -V`), its workgroup zero-initialisation
     /// rewritten as loops glslang accepts ([`crate::hlsl_zero_init`]).
@@ -60,6 +62,9 @@ pub fn compile(kernel: &Kernel, input: GlslangInput, dir: &Path) -> Result<(Vec<
         }
     };
     let mut translation = translation.map_err(|e| ToolError::Failed(e.to_string()))?;
+    if input == GlslangInput::Glsl {
+        translation.text = crate::glsl_zero_init::zero_init_as_loops(&translation.text);
+    }
     if input == GlslangInput::Hlsl {
         translation.text = byte_address_lengths_in_bytes(&translation.text)?;
         translation.text = crate::hlsl_samplers::plain_samplers(&translation.text).map_err(ToolError::Failed)?;

@@ -48,6 +48,7 @@ pub mod constants;
 pub mod denoise_types;
 pub mod embed_types;
 pub mod error;
+pub mod glsl_zero_init;
 pub mod glslang;
 pub mod hash;
 pub mod hlsl_samplers;

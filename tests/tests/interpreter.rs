@@ -292,6 +292,64 @@ fn padding_of_stored_structs_is_zero() {
     }
 }
 
+/// Bools in workgroup, private and function memory: naga lays a bool out in one byte
+/// (an `array<bool, 16>` has a stride of 1), while the interpreter holds each in a word
+/// of its own. Offsets taken from naga's layout once put every element of a bool array,
+/// and both bools of a struct, in word 0: a flag set by four invocations read as set at
+/// all sixteen (and as a race on word 0 that excused the difference). Written by a
+/// tester of issue 58 (fresh variants of the workgroup-zeroing class).
+const BOOLS: &str = r#"
+struct Pair { a: bool, b: bool, c: u32 }
+struct Cell { on: vec2<bool>, n: u32 }
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+var<workgroup> flags: array<bool, 16>;
+var<workgroup> cells: array<Cell, 4>;
+var<private> private_flags: array<bool, 8>;
+var<private> pair: Pair;
+
+@compute @workgroup_size(16)
+fn main(@builtin(local_invocation_index) i: u32) {
+    if i < 4u {
+        flags[i] = true;
+        cells[i].on.y = i == 2u;
+    }
+    var local = array<vec2<bool>, 3>();
+    local[2].y = true;
+    private_flags[5] = input[0] == 0u;
+    pair.b = true;
+    pair.c = 9u;
+    workgroupBarrier();
+    var count = 0u;
+    for (var k = 0u; k < 16u; k++) { if flags[k] { count += 1u; } }
+    var on = 0u;
+    for (var k = 0u; k < 4u; k++) { if cells[k].on.x { on += 10u; } if cells[k].on.y { on += 1u; } }
+    var private_set = 0u;
+    for (var k = 0u; k < 8u; k++) { if private_flags[k] { private_set += 1u; } }
+    var local_set = 0u;
+    for (var k = 0u; k < 3u; k++) { if local[k].x { local_set += 10u; } if local[k].y { local_set += 1u; } }
+    let at = i * 6u;
+    output[at] = count;
+    output[at + 1u] = on;
+    output[at + 2u] = private_set;
+    output[at + 3u] = local_set;
+    output[at + 4u] = select(0u, 1u, pair.a) * 10u + select(0u, 1u, pair.b);
+    output[at + 5u] = pair.c;
+}
+"#;
+
+#[test]
+fn bools_in_arrays_and_structs_each_take_their_own_word() {
+    let kernel = Kernel::from_wgsl("bools.wgsl", BOOLS.into(), "main", false).unwrap();
+    for sanitize in [false, true] {
+        let mut cpu = CpuBackend::new(CpuOptions { sanitize, ..CpuOptions::default() }).unwrap();
+        let got = run_words(&mut cpu, &kernel, &[0], 16 * 6, 1);
+        for (i, words) in got.chunks(6).enumerate() {
+            assert_eq!(words, [4, 1, 1, 1, 1, 9], "invocation {i}, sanitize {sanitize}");
+        }
+    }
+}
+
 /// Chains of functions deeper than the interpreter inlines (each function's code
 /// inlines 8 levels of callees, so `main` → `l8` → `l16` are real calls, and from the
 /// `l3` branch `main` → `l11` → `l19`): entered from divergent branches at two places,

@@ -75,15 +75,16 @@ pub(super) fn words_of(module: &Module, inner: &TypeInner) -> Result<u32, String
             let row_words = if rows == naga::VectorSize::Tri { 4 } else { rows as u32 };
             product(columns as u32, row_words)?
         }
-        // Register layout of composites holding f16: a word per f16, members and
-        // elements one after the other (naga's 2-byte layout is used in buffers only).
-        TypeInner::Array { base, size, .. } if contains_f16(module, &module.types[base].inner) => {
+        // Register layout of composites holding f16 or bool: a word per f16 or bool,
+        // members and elements one after the other (naga's layout, 2 bytes per f16 and
+        // 1 per bool, is used in buffers only, where bools never are).
+        TypeInner::Array { base, size, .. } if own_register_layout(module, &module.types[base].inner) => {
             match array_length(module, size)? {
                 Some(n) => product(n, words_of(module, &module.types[base].inner)?)?,
                 None => return Err("runtime-sized arrays as values".into()),
             }
         }
-        TypeInner::Struct { ref members, .. } if contains_f16(module, inner) => {
+        TypeInner::Struct { ref members, .. } if own_register_layout(module, inner) => {
             let mut words = 0u32;
             for member in members {
                 let member = words_of(module, &module.types[member.ty].inner)?;
@@ -134,7 +135,7 @@ pub(super) fn member_step(module: &Module, inner: &TypeInner, index: u32, bytes:
     let TypeInner::Struct { ref members, .. } = *inner else { return 0 };
     if bytes {
         members[index as usize].offset
-    } else if !contains_f16(module, inner) {
+    } else if !own_register_layout(module, inner) {
         members[index as usize].offset / 4
     } else {
         members[..index as usize].iter().map(|m| words_of(module, &module.types[m.ty].inner).unwrap_or(0)).sum()
@@ -147,7 +148,7 @@ pub(super) fn element_step(module: &Module, base: Handle<naga::Type>, stride: u3
     let inner = &module.types[base].inner;
     if bytes {
         stride
-    } else if !contains_f16(module, inner) {
+    } else if !own_register_layout(module, inner) {
         stride / 4
     } else {
         words_of(module, inner).unwrap_or(0)
@@ -214,6 +215,26 @@ pub(super) fn load_plan(module: &Module, inner: &TypeInner, memory: u32, reg: u3
             }
         }
         _ => {}
+    }
+}
+
+/// Whether a value of type `inner` is laid out in registers (and in function, private
+/// and workgroup memory) otherwise than naga lays it out: it holds an f16 (a word in
+/// registers, 2 bytes in naga's layout) or a bool (a word in registers, 1 byte in
+/// naga's: a stride of `/ 4` would put four bools, or all of a struct's, in one word).
+/// Such types take [`words_of`]'s member-by-member layout.
+pub(super) fn own_register_layout(module: &Module, inner: &TypeInner) -> bool {
+    match *inner {
+        TypeInner::Scalar(s) | TypeInner::Vector { scalar: s, .. } | TypeInner::Matrix { scalar: s, .. } => {
+            s.kind == naga::ScalarKind::Bool || (s.kind == naga::ScalarKind::Float && s.width == 2)
+        }
+        TypeInner::Array { base, .. } | TypeInner::BindingArray { base, .. } => {
+            own_register_layout(module, &module.types[base].inner)
+        }
+        TypeInner::Struct { ref members, .. } => {
+            members.iter().any(|m| own_register_layout(module, &module.types[m.ty].inner))
+        }
+        _ => false,
     }
 }
 

@@ -20,7 +20,7 @@
 //! - the words that are loaded are loaded as the whole load would (a word outside the
 //!   buffer reads 0 either way; [`super::execute`]).
 
-use super::layout::{contains_f16, member_step, words_of};
+use super::layout::{member_step, own_register_layout, words_of};
 use super::load_alias::nested;
 use naga::valid::{FunctionInfo, ModuleInfo};
 use naga::{Block, Expression, Function, Handle, Module, Statement, TypeInner};
@@ -78,11 +78,11 @@ pub(super) fn partial_loads(
         .collect()
 }
 
-/// Words of a struct type the analysis may split (no f16: register and memory layouts
-/// agree), `None` for other types.
+/// Words of a struct type the analysis may split (no f16 or bool: register and memory
+/// layouts agree), `None` for other types.
 fn struct_words(module: &Module, inner: &TypeInner) -> Option<u32> {
     match inner {
-        TypeInner::Struct { .. } if !contains_f16(module, inner) => words_of(module, inner).ok(),
+        TypeInner::Struct { .. } if !own_register_layout(module, inner) => words_of(module, inner).ok(),
         _ => None,
     }
 }

@@ -71,6 +71,7 @@ pub mod translate;
 pub mod types;
 pub mod validate;
 pub mod word_kinds;
+pub mod workgroup_zero_loops;
 
 pub use binding::{BindingAccess, BindingInfo, BindingKind, ElementLayout};
 pub use block_grid::{BlockGrid, BlockRect, GridError};

@@ -211,7 +211,27 @@ fn cached_kernel_pipeline(
     } else {
         None
     };
-    let naga_module = defined.map_or_else(|| kernel.module.clone(), |(module, _)| module);
+    let (mut naga_module, defined_info) = match defined {
+        Some((module, info)) => (module, Some(info)),
+        None => (kernel.module.clone(), None),
+    };
+    let info = defined_info.as_ref().unwrap_or(&kernel.info);
+    // On GL, wgpu's GLSL zeroes each workgroup array with one constructor of an argument
+    // per element, which Mesa compiled for about a minute per histogram kernel: zero in
+    // loops in the IR instead, and turn the writer's zeroing off.
+    let mut zero_in_writer = true;
+    if define_integer_division {
+        let rewritten = strata_kernels::workgroup_zero_loops::zero_in_loops(&naga_module, info, kernel.entry_point())
+            .map_err(|message| BackendError::Validation {
+            backend: "wgpu-gl".into(),
+            operation: format!("zeroing the workgroup memory of `{}` in loops", kernel.name()),
+            message,
+        })?;
+        if let Some((module, _)) = rewritten {
+            naga_module = module;
+            zero_in_writer = false;
+        }
+    }
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(kernel.name()),
         source: wgpu::ShaderSource::Naga(Cow::Owned(naga_module)),
@@ -221,7 +241,10 @@ fn cached_kernel_pipeline(
         layout: Some(&pipeline_layout),
         module: &module,
         entry_point: Some(kernel.entry_point()),
-        compilation_options: wgpu::PipelineCompilationOptions::default(),
+        compilation_options: wgpu::PipelineCompilationOptions {
+            zero_initialize_workgroup_memory: zero_in_writer,
+            ..Default::default()
+        },
         cache,
     });
     Ok((pipeline, layouts))

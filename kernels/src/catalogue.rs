@@ -2,7 +2,6 @@
 //! order), entry point, device features and cross-backend float tolerance. The
 //! [`crate::registry`] parses and validates what this declares.
 
-use crate::fragment;
 use crate::source::Fragment;
 use naga::valid::Capabilities;
 use std::borrow::Cow;
@@ -152,44 +151,17 @@ impl KernelId {
 
     /// What the registry knows of this kernel before parsing it.
     pub fn spec(self) -> Option<KernelSpec> {
-        // The paper's histogram (§4.1) with object masking (§4.3).
-        let histogram = || {
-            [fragment!("strata/candidate.wgsl"), fragment!("strata/masking.wgsl"), fragment!("strata/histogram.wgsl")]
+        // A kernel's WGSL: its entry file and what that imports (`crate::wgsl_imports`).
+        // The files are the crate's own, embedded at compile time, and every kernel is
+        // built by the tests, so an unknown import or a circle is a bug found there.
+        let entry = |path: &str| {
+            crate::wgsl_imports::kernel_fragments(path, &crate::wgsl_files::wgsl_file)
+                .unwrap_or_else(|error| panic!("{error}"))
         };
-        // The paper's selection (§4.2): positions from the blue-noise sampler, then the
-        // inverse-CDF resampling.
-        let selection = || {
-            vec![
-                fragment!("strata/blue_noise.wgsl"),
-                fragment!("strata/selection.wgsl"),
-                fragment!("strata/resampling.wgsl"),
-            ]
-        };
-        // Every ReSTIR pass: the scene and the path tracer's functions, the candidate
-        // records of the histogram, then its own entry point.
-        // The path tracer's functions, shared by path_trace and the ReSTIR passes.
-        let renderer = || {
-            vec![
-                fragment!("trace/bvh.wgsl"),
-                fragment!("trace/traverse.wgsl"),
-                fragment!("render/scene.wgsl"),
-                fragment!("render/random.wgsl"),
-                fragment!("render/environment.wgsl"),
-                fragment!("render/albedo.wgsl"),
-                fragment!("render/bsdf.wgsl"),
-                fragment!("render/lights.wgsl"),
-                fragment!("render/path.wgsl"),
-            ]
-        };
-        // A ReSTIR pass: the renderer, the shared records, then `pass` (its entry point last).
-        let restir = |name: &'static str, pass: &[Fragment]| KernelSpec {
+        // A ReSTIR pass: its entry file `restir/{entry}.wgsl` and what that imports.
+        let restir = |name: &'static str, entry_file: &str| KernelSpec {
             name: name.into(),
-            fragments: [
-                renderer(),
-                vec![fragment!("strata/candidate.wgsl"), fragment!("restir/reservoir.wgsl")],
-                pass.to_vec(),
-            ]
-            .concat(),
+            fragments: entry(&format!("restir/{entry_file}.wgsl")),
             entry_point: name.into(),
             features: KernelFeatures::empty(),
             // Checked pass by pass on identical inputs (the interpreter's, recorded):
@@ -202,10 +174,10 @@ impl KernelId {
             // environment room at 128²). 16384 ULP is 2e-3 relative.
             float_ulp_bound: Some(16384),
         };
-        // An SVGF pass: the guide, what the passes share, then its entry point.
-        let svgf = |name: &'static str, pass: Fragment| KernelSpec {
+        // An SVGF pass: its entry file `denoise/{entry}.wgsl` and what that imports.
+        let svgf = |name: &'static str, entry_file: &str| KernelSpec {
             name: name.into(),
-            fragments: vec![fragment!("denoise/guide.wgsl"), fragment!("denoise/svgf.wgsl"), pass],
+            fragments: entry(&format!("denoise/{entry_file}.wgsl")),
             entry_point: name.into(),
             features: KernelFeatures::empty(),
             // Checked against the Rust reference (reference/svgf.rs) on generated
@@ -219,43 +191,35 @@ impl KernelId {
         Some(match self {
             KernelId::BlockHistogram => KernelSpec {
                 name: "block_histogram".into(),
-                fragments: [histogram().to_vec(), vec![fragment!("strata/entry_histogram.wgsl")]].concat(),
+                fragments: entry("strata/entry_histogram.wgsl"),
                 entry_point: "block_histogram".into(),
                 features: KernelFeatures::empty(),
                 float_ulp_bound: None,
             },
             KernelId::BlockHistogramSubgroup => KernelSpec {
                 name: "block_histogram_subgroup".into(),
-                fragments: [histogram().to_vec(), vec![fragment!("strata/entry_histogram_subgroup.wgsl")]].concat(),
+                fragments: entry("strata/entry_histogram_subgroup.wgsl"),
                 entry_point: "block_histogram_subgroup".into(),
                 features: KernelFeatures::SUBGROUP,
                 float_ulp_bound: None,
             },
             KernelId::BlockHistogramRank => KernelSpec {
                 name: "block_histogram_rank".into(),
-                fragments: [
-                    histogram().to_vec(),
-                    vec![fragment!("strata/histogram_rank.wgsl"), fragment!("strata/entry_histogram_rank.wgsl")],
-                ]
-                .concat(),
+                fragments: entry("strata/entry_histogram_rank.wgsl"),
                 entry_point: "block_histogram_rank".into(),
                 features: KernelFeatures::empty(),
                 float_ulp_bound: None,
             },
             KernelId::Empty => KernelSpec {
                 name: "empty".into(),
-                fragments: vec![fragment!("util/empty.wgsl")],
+                fragments: entry("util/empty.wgsl"),
                 entry_point: "empty".into(),
                 features: KernelFeatures::empty(),
                 float_ulp_bound: None,
             },
             KernelId::BvhClosestHit => KernelSpec {
                 name: "bvh_closest_hit".into(),
-                fragments: vec![
-                    fragment!("trace/bvh.wgsl"),
-                    fragment!("trace/traverse.wgsl"),
-                    fragment!("trace/entry_closest_hit.wgsl"),
-                ],
+                fragments: entry("trace/entry_closest_hit.wgsl"),
                 entry_point: "bvh_closest_hit".into(),
                 features: KernelFeatures::empty(),
                 // Backends may contract products into fused multiply-adds; hits that change
@@ -264,7 +228,7 @@ impl KernelId {
             },
             KernelId::CameraRays => KernelSpec {
                 name: "camera_rays".into(),
-                fragments: vec![fragment!("trace/bvh.wgsl"), fragment!("trace/camera_rays.wgsl")],
+                fragments: entry("trace/camera_rays.wgsl"),
                 entry_point: "camera_rays_main".into(),
                 features: KernelFeatures::empty(),
                 // normalize() and the divisions may round differently (inverse square
@@ -273,7 +237,7 @@ impl KernelId {
             },
             KernelId::PathTrace => KernelSpec {
                 name: "path_trace".into(),
-                fragments: [renderer(), vec![fragment!("render/entry_path_trace.wgsl")]].concat(),
+                fragments: entry("render/entry_path_trace.wgsl"),
                 entry_point: "path_trace".into(),
                 features: KernelFeatures::empty(),
                 // Paths branch on float comparisons: a one-ULP difference can send a
@@ -284,58 +248,21 @@ impl KernelId {
                 // ~4300 ULP on identical inputs.
                 float_ulp_bound: Some(16384),
             },
-            KernelId::RestirCandidates => restir("restir_candidates", &[fragment!("restir/entry_candidates.wgsl")]),
-            KernelId::RestirSelect => restir(
-                "restir_select",
-                &[
-                    selection(),
-                    vec![
-                        fragment!("restir/reuse_slot.wgsl"),
-                        fragment!("restir/block_reuse.wgsl"),
-                        fragment!("restir/entry_select.wgsl"),
-                    ],
-                ]
-                .concat(),
-            ),
-            KernelId::RestirTemporalKeys => {
-                restir("restir_temporal_keys", &[fragment!("restir/entry_temporal_keys.wgsl")])
-            }
-            KernelId::RestirTemporal => restir(
-                "restir_temporal",
-                &[selection(), vec![fragment!("restir/reuse_slot.wgsl"), fragment!("restir/entry_temporal.wgsl")]]
-                    .concat(),
-            ),
-            KernelId::RestirReservoirKeys => {
-                restir("restir_reservoir_keys", &[fragment!("restir/entry_reservoir_keys.wgsl")])
-            }
-            KernelId::RestirSpatial => restir(
-                "restir_spatial",
-                &[
-                    selection(),
-                    vec![
-                        fragment!("restir/reuse_slot.wgsl"),
-                        fragment!("restir/block_reuse.wgsl"),
-                        fragment!("restir/entry_spatial.wgsl"),
-                    ],
-                ]
-                .concat(),
-            ),
-            KernelId::RestirShade => restir("restir_shade", &[fragment!("restir/entry_shade.wgsl")]),
-            KernelId::RestirGuide => {
-                restir("restir_guide", &[fragment!("denoise/guide.wgsl"), fragment!("restir/entry_guide.wgsl")])
-            }
-            KernelId::SvgfTemporal => svgf("svgf_temporal", fragment!("denoise/entry_temporal.wgsl")),
-            KernelId::SvgfVariance => svgf("svgf_variance", fragment!("denoise/entry_variance.wgsl")),
-            KernelId::SvgfAtrous => svgf("svgf_atrous", fragment!("denoise/entry_atrous.wgsl")),
-            KernelId::SvgfModulate => svgf("svgf_modulate", fragment!("denoise/entry_modulate.wgsl")),
+            KernelId::RestirCandidates => restir("restir_candidates", "entry_candidates"),
+            KernelId::RestirSelect => restir("restir_select", "entry_select"),
+            KernelId::RestirTemporalKeys => restir("restir_temporal_keys", "entry_temporal_keys"),
+            KernelId::RestirTemporal => restir("restir_temporal", "entry_temporal"),
+            KernelId::RestirReservoirKeys => restir("restir_reservoir_keys", "entry_reservoir_keys"),
+            KernelId::RestirSpatial => restir("restir_spatial", "entry_spatial"),
+            KernelId::RestirShade => restir("restir_shade", "entry_shade"),
+            KernelId::RestirGuide => restir("restir_guide", "entry_guide"),
+            KernelId::SvgfTemporal => svgf("svgf_temporal", "entry_temporal"),
+            KernelId::SvgfVariance => svgf("svgf_variance", "entry_variance"),
+            KernelId::SvgfAtrous => svgf("svgf_atrous", "entry_atrous"),
+            KernelId::SvgfModulate => svgf("svgf_modulate", "entry_modulate"),
             KernelId::StrataSelect => KernelSpec {
                 name: "strata_select".into(),
-                fragments: [
-                    vec![fragment!("strata/candidate.wgsl")],
-                    selection(),
-                    vec![fragment!("embed/contract.wgsl"), fragment!("embed/entry_select.wgsl")],
-                ]
-                .concat(),
+                fragments: entry("embed/entry_select.wgsl"),
                 entry_point: "strata_select".into(),
                 features: KernelFeatures::empty(),
                 // Payload indices are integers; the resampling number is the one float
@@ -344,11 +271,7 @@ impl KernelId {
             },
             KernelId::StrataResample => KernelSpec {
                 name: "strata_resample".into(),
-                fragments: vec![
-                    fragment!("strata/resampling.wgsl"),
-                    fragment!("embed/contract.wgsl"),
-                    fragment!("embed/entry_resample.wgsl"),
-                ],
+                fragments: entry("embed/entry_resample.wgsl"),
                 entry_point: "strata_resample".into(),
                 features: KernelFeatures::empty(),
                 // W = sum / target: one division after K + 1 additions.
@@ -385,7 +308,8 @@ impl KernelFeatures {
 pub struct KernelSpec {
     /// Registry name (also the name of translated files).
     pub name: Cow<'static, str>,
-    /// WGSL fragments, concatenated in order.
+    /// WGSL fragments, concatenated in order: the entry file last, each file after the
+    /// files it imports ([`crate::wgsl_imports`]).
     pub fragments: Vec<Fragment>,
     /// The compute entry point.
     pub entry_point: Cow<'static, str>,

@@ -93,9 +93,8 @@ pub struct ResampleOutput {
 /// `ResampleOutput`, `NO_PAYLOAD`, ...), for an engine's own shaders that read the
 /// selections and write the resampling inputs: prepend it to the shader source.
 pub fn contract_wgsl() -> String {
-    crate::source::ComposedSource::compose(&[
-        crate::fragment!("strata/candidate.wgsl"),
-        crate::fragment!("embed/contract.wgsl"),
-    ])
-    .text
+    // contract.wgsl imports the records of candidate.wgsl.
+    let fragments = crate::wgsl_imports::kernel_fragments("embed/contract.wgsl", &crate::wgsl_files::wgsl_file)
+        .unwrap_or_else(|error| panic!("{error}"));
+    crate::source::ComposedSource::compose(&fragments).text
 }

@@ -19,8 +19,9 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! * [`catalogue`]: every kernel the project ships, as declared (fragments, entry point,
-//!   features, float tolerance); [`registry`]: each parsed and validated by naga, with
+//! * [`catalogue`]: every kernel the project ships, as declared (entry file, entry point,
+//!   features, float tolerance), its fragments derived by [`wgsl_imports`] from the
+//!   `// #import` lines of the files ([`wgsl_files`]); [`registry`]: each parsed and validated by naga, with
 //!   its workgroup size and bindings read from naga's IR.
 //! * [`constants`]: the WGSL constants the host shares, checked against their twins.
 //! * [`types`]: the `#[repr(C)]` host twins of the structs the kernels share with the
@@ -70,6 +71,8 @@ pub mod trace_types;
 pub mod translate;
 pub mod types;
 pub mod validate;
+pub mod wgsl_files;
+pub mod wgsl_imports;
 pub mod word_kinds;
 pub mod workgroup_zero_loops;
 

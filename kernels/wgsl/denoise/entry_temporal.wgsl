@@ -22,6 +22,9 @@
 //
 // Dispatch: 8 x 8 pixels per workgroup.
 
+// #import denoise/guide.wgsl
+// #import denoise/svgf.wgsl
+
 @group(0) @binding(1) var<storage, read> colour: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> guides: array<DenoiseGuide>;
 @group(0) @binding(3) var<storage, read> previous_guides: array<DenoiseGuide>;

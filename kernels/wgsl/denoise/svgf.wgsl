@@ -17,6 +17,9 @@
 // Every pass: 8 x 8 pixels per workgroup, one invocation per pixel, binding 0 the
 // DenoiseParams below, buffers indexed y * width + x.
 
+// #import denoise/guide.wgsl
+// #requires var<storage, read> guides: array<DenoiseGuide>
+
 struct DenoiseParams {
     width: u32,
     height: u32,

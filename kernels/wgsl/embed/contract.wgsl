@@ -9,6 +9,8 @@
 // functions are in strata/selection.wgsl). Self-contained with strata/candidate.wgsl, so
 // that an engine can prepend both to its own shaders (strata_embed::wgsl::contract_source).
 
+// #import strata/candidate.wgsl
+
 // A slot without a candidate, or a pixel without a selection.
 const NO_PAYLOAD: u32 = 0xffffffffu;
 // ResampleOutput.slot: the pixel's own (canonical) sample was chosen (the slot after the

@@ -14,6 +14,9 @@
 //
 // Dispatch: 8 x 8 pixels per workgroup, ceil(width / 8) x ceil(height / 8) workgroups.
 
+// #import strata/resampling.wgsl
+// #import embed/contract.wgsl
+
 @group(0) @binding(0) var<uniform> params: SelectionParams;
 @group(0) @binding(1) var<storage, read> selections: array<SelectedCandidates>;
 @group(0) @binding(2) var<storage, read> resample_inputs: array<ResampleInput>;

@@ -18,6 +18,10 @@
 //
 // Dispatch: 8 x 8 pixels per workgroup, ceil(width / 8) x ceil(height / 8) workgroups.
 
+// #import strata/candidate.wgsl
+// #import strata/selection.wgsl
+// #import embed/contract.wgsl
+
 @group(0) @binding(0) var<uniform> params: SelectionParams;
 @group(0) @binding(1) var<storage, read> candidates: array<Candidate>;
 @group(0) @binding(2) var<storage, read> payloads: array<u32>;

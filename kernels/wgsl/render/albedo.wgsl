@@ -2,6 +2,8 @@
 // checkerboard, or a texture (linear RGB in `texels`, decoded from sRGB on the host),
 // filtered bilinearly with texel centres at (i + 0.5) / W and repeat wrap.
 
+// #import render/scene.wgsl
+
 fn texture_texel(material: Material, x: i32, y: i32) -> vec3<f32> {
     let width = i32(material.texture_width);
     let height = i32(material.texture_height);

@@ -4,6 +4,8 @@
 // dielectric Fresnel. `wo` points to the previous vertex, `wi` to the next; eval returns
 // f * |cos(wi)|, and sample returns that over the density (the path throughput factor).
 
+// #import render/scene.wgsl
+
 struct Frame {
     tangent: vec3<f32>,
     bitangent: vec3<f32>,

@@ -9,6 +9,10 @@
 //
 // Dispatch: 8 x 8 pixels per workgroup, ceil(width / 8) x ceil(height / 8) workgroups.
 
+// #import render/scene.wgsl
+// #import render/random.wgsl
+// #import render/path.wgsl
+
 @group(0) @binding(8) var<storage, read_write> accumulation: array<vec4<f32>>;
 
 fn is_finite(v: vec3<f32>) -> bool {

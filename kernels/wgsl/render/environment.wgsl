@@ -5,6 +5,8 @@
 // so every direction with radiance has a positive density. `environment_cdf` holds the
 // marginal CDF over rows (H + 1 entries) and then one CDF per row (W + 1 entries each).
 
+// #import render/scene.wgsl
+
 // (u, v) of a direction in the map's own frame.
 fn environment_uv(local: vec3<f32>) -> vec2<f32> {
     let u = fract(atan2(local.x, -local.z) / (2.0 * PI));

@@ -3,6 +3,12 @@
 // importance sampling) or an emissive triangle chosen in proportion to its power with a
 // point uniform on it; combined with BSDF sampling by the power heuristic.
 
+// #import trace/bvh.wgsl
+// #import render/scene.wgsl
+// #import render/random.wgsl
+// #import render/bsdf.wgsl
+// #import render/environment.wgsl
+
 // Power heuristic for a sample drawn with density `a` against the other strategy's `b`.
 fn mis_power(a: f32, b: f32) -> f32 {
     let a2 = a * a;

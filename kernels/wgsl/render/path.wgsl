@@ -3,6 +3,15 @@
 // the camera ray (emission found at the last hit still counts; NEE at the vertex before
 // it still runs). Mitsuba 3's `path` integrator computes the same expectation.
 
+// #import trace/bvh.wgsl
+// #import trace/traverse.wgsl
+// #import render/scene.wgsl
+// #import render/random.wgsl
+// #import render/environment.wgsl
+// #import render/albedo.wgsl
+// #import render/bsdf.wgsl
+// #import render/lights.wgsl
+
 // One path's radiance estimate; invalid = the traversal stack overflowed.
 struct PathSample {
     radiance: vec3<f32>,

@@ -13,6 +13,10 @@
 //   6 storage, read      array<vec4<f32>>          texels: textures, then the environment
 //   7 storage, read      array<f32>                environment CDFs (marginal, conditionals)
 
+// #import trace/bvh.wgsl
+// #import trace/traverse.wgsl
+// #import render/random.wgsl
+
 // RenderParams.flags
 const FLAG_SAMPLE_LIGHTS: u32 = 1u;      // next-event estimation
 const FLAG_HIT_LIGHTS: u32 = 2u;         // emission found by BSDF sampling counts

@@ -15,6 +15,15 @@
 // `random()`, drawn only by the baselines' streaming choice (one number per slot with a
 // positive weight, in slot order).
 
+// #import render/random.wgsl
+// #import strata/candidate.wgsl
+// #import strata/selection.wgsl
+// #import strata/resampling.wgsl
+// #import restir/reservoir.wgsl
+// #import restir/reuse_slot.wgsl
+// #requires var<storage, read> sorted_pixels: array<u32>
+// #requires var<storage, read> spans: array<ClusterSpan>
+
 // The pixel that reuse slot `slot` of pixel (x, y) takes, or NO_PIXEL for none.
 fn block_slot_pixel(x: u32, y: u32, pixel: u32, p: Primary, slot: u32, positions: vec4<f32>) -> u32 {
     if restir.method == METHOD_RESTIR_DISC {

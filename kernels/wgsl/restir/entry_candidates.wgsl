@@ -39,6 +39,18 @@
 // jitter, BSDF sampling and the rest of that path, the light sample, the RIS choice.
 // Dispatch: 8 x 8 pixels per workgroup.
 
+// #import trace/bvh.wgsl
+// #import trace/traverse.wgsl
+// #import render/scene.wgsl
+// #import render/random.wgsl
+// #import render/environment.wgsl
+// #import render/albedo.wgsl
+// #import render/bsdf.wgsl
+// #import render/lights.wgsl
+// #import render/path.wgsl
+// #import strata/candidate.wgsl
+// #import restir/reservoir.wgsl
+
 @group(0) @binding(9) var<storage, read_write> primary_out: array<Primary>;
 @group(0) @binding(10) var<storage, read_write> candidates_out: array<PathCandidate>;
 @group(0) @binding(11) var<storage, read_write> histogram_in: array<Candidate>;
@@ -84,7 +96,6 @@ fn vertex_candidate(vertex: Surface, origin: vec3<f32>, reflected: vec3<f32>) ->
         0.0,
     );
 }
-
 
 // What drawing the candidate of one resampling vertex gives.
 struct Drawn {

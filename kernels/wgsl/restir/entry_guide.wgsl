@@ -12,6 +12,11 @@
 //
 // Dispatch: 8 x 8 pixels per workgroup.
 
+// #import render/scene.wgsl
+// #import strata/candidate.wgsl
+// #import denoise/guide.wgsl
+// #import restir/reservoir.wgsl
+
 @group(0) @binding(9) var<storage, read> primaries: array<Primary>;
 @group(0) @binding(10) var<storage, read_write> guides_out: array<DenoiseGuide>;
 

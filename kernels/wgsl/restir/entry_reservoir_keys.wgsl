@@ -17,6 +17,10 @@
 //
 // Dispatch: 8 x 8 pixels per workgroup.
 
+// #import render/scene.wgsl
+// #import strata/candidate.wgsl
+// #import restir/reservoir.wgsl
+
 @group(0) @binding(9) var<storage, read> primaries: array<Primary>;
 @group(0) @binding(10) var<storage, read> merged_reservoirs: array<Reservoir>;
 @group(0) @binding(11) var<storage, read_write> histogram_in: array<Candidate>;

@@ -45,6 +45,14 @@
 // Dispatch: 8 x 8 pixels per workgroup. Shadow rays: up to 2K per pixel; a replay pixel
 // (reservoir.wgsl, "Random replay") traces up to 2K paths instead.
 
+// #import render/scene.wgsl
+// #import render/random.wgsl
+// #import strata/candidate.wgsl
+// #import strata/selection.wgsl
+// #import restir/reservoir.wgsl
+// #import restir/reuse_slot.wgsl
+// #import restir/block_reuse.wgsl
+
 @group(0) @binding(9) var<storage, read> primaries: array<Primary>;
 @group(0) @binding(10) var<storage, read> path_candidates: array<PathCandidate>;
 @group(0) @binding(11) var<storage, read> sorted_pixels: array<u32>;

@@ -16,6 +16,9 @@
 //
 // Dispatch: 8 x 8 pixels per workgroup.
 
+// #import render/scene.wgsl
+// #import restir/reservoir.wgsl
+
 @group(0) @binding(9) var<storage, read> primaries: array<Primary>;
 @group(0) @binding(10) var<storage, read> reservoirs: array<Reservoir>;
 @group(0) @binding(11) var<storage, read> base_in: array<vec4<f32>>;

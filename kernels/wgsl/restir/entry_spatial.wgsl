@@ -41,6 +41,14 @@
 // traces up to 2K paths instead (and one for its own sample's colour when it holds
 // another pixel's).
 
+// #import render/scene.wgsl
+// #import render/random.wgsl
+// #import strata/candidate.wgsl
+// #import strata/selection.wgsl
+// #import restir/reservoir.wgsl
+// #import restir/reuse_slot.wgsl
+// #import restir/block_reuse.wgsl
+
 @group(0) @binding(9) var<storage, read> primaries: array<Primary>;
 @group(0) @binding(10) var<storage, read> reservoirs_in: array<Reservoir>;
 @group(0) @binding(11) var<storage, read> sorted_pixels: array<u32>;

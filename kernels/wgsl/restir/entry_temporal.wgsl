@@ -45,6 +45,14 @@
 // replay pixel traces 2 paths per merged reservoir instead, and one more for the
 // expectation when select kept another pixel's sample.
 
+// #import render/scene.wgsl
+// #import render/random.wgsl
+// #import strata/candidate.wgsl
+// #import strata/selection.wgsl
+// #import strata/resampling.wgsl
+// #import restir/reservoir.wgsl
+// #import restir/reuse_slot.wgsl
+
 @group(0) @binding(9) var<storage, read> primaries: array<Primary>;
 @group(0) @binding(10) var<storage, read> previous_primaries: array<Primary>;
 @group(0) @binding(11) var<storage, read> current_reservoirs: array<Reservoir>;

@@ -19,6 +19,10 @@
 //
 // Dispatch: 8 x 8 pixels per workgroup.
 
+// #import render/scene.wgsl
+// #import strata/candidate.wgsl
+// #import restir/reservoir.wgsl
+
 @group(0) @binding(9) var<storage, read> primaries: array<Primary>;
 @group(0) @binding(10) var<storage, read> previous_primaries: array<Primary>;
 @group(0) @binding(11) var<storage, read> previous_reservoirs: array<Reservoir>;

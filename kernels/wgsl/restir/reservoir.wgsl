@@ -31,6 +31,9 @@
 // Bindings used with this fragment (group 0): 0-7 the scene (render/scene.wgsl) and
 //   8 uniform            RestirParams      the method and its settings
 
+// #import render/path.wgsl
+// #import strata/candidate.wgsl
+
 const KIND_NONE: u32 = 0u;
 const KIND_SURFACE: u32 = 1u;
 const KIND_ENVIRONMENT: u32 = 2u;

@@ -13,6 +13,10 @@
 // G-buffer, binding 9) and `random()`; random() is drawn only where the method needs it
 // (two numbers for the disc, one for restir), in that order.
 
+// #import strata/selection.wgsl
+// #import restir/reservoir.wgsl
+// #requires var<storage, read> primaries: array<Primary>
+
 // No pixel for this slot: the slot stays empty.
 const NO_PIXEL: u32 = 0xffffffffu;
 

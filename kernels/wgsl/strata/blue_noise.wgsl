@@ -13,6 +13,8 @@
 // Only dimensions 0-7 are optimised, as the pairs (0, 1), (2, 3), (4, 5), (6, 7); the
 // selection uses (0, 1) for its spatial slots and (2, 3) for its temporal ones.
 
+// #requires var<storage, read> blue_noise: array<u32>
+
 const BLUE_NOISE_TILE: u32 = 128u;
 const BLUE_NOISE_DIMENSIONS_PER_PIXEL: u32 = 8u;
 // Word offsets of the three tables in `blue_noise`.

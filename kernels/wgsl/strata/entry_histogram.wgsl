@@ -2,6 +2,8 @@
 // GL backend and the CPU interpreter included): paper §4.1. Bindings and dispatch:
 // strata/histogram.wgsl.
 
+// #import strata/histogram.wgsl
+
 // Never called: with zero lane bits every exchange stays in registers or workgroup memory.
 fn lane_exchange(value: vec4<u32>, mask: u32) -> vec4<u32> {
     return value;

@@ -2,6 +2,9 @@
 // the same outputs as block_histogram, no subgroup operations. Bindings and dispatch:
 // strata/histogram.wgsl.
 
+// #import strata/histogram.wgsl
+// #import strata/histogram_rank.wgsl
+
 // Never called: the ranking exchanges nothing between lanes.
 fn lane_exchange(value: vec4<u32>, mask: u32) -> vec4<u32> {
     return value;

@@ -6,6 +6,8 @@
 // the size is a power of two no larger than the workgroup; otherwise this entry point
 // sorts exactly like the portable one.
 
+// #import strata/histogram.wgsl
+
 var<workgroup> lane_mismatch: atomic<u32>;
 var<workgroup> lane_bits_chosen: u32;
 

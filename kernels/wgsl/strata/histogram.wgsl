@@ -36,6 +36,10 @@
 // Invalid inputs: see canonical_key (strata/candidate.wgsl). Every output element is
 // written for every pixel; sentinel slots past a partial block's pixels write nothing.
 
+// #import strata/candidate.wgsl
+// #import strata/masking.wgsl
+// #requires fn lane_exchange(value: vec4<u32>, mask: u32) -> vec4<u32>
+
 const ELEMS: u32 = 16u;
 const ELEM_BITS: u32 = 4u;
 const SLOTS: u32 = 1024u;

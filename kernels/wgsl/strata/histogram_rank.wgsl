@@ -9,6 +9,8 @@
 // row reads the same slot: on a CPU device (lavapipe), where a round trip through
 // workgroup memory costs one scalar access per lane and element, that is cheaper.
 
+// #import strata/histogram.wgsl
+
 // Count of (cluster, key) pairs `other` at or below / below each of q's four, as 0 or 1.
 fn at_or_below(other: vec2<u32>, q: Quad) -> vec4<u32> {
     let c = vec4<u32>(other.x);

@@ -11,6 +11,8 @@
 // Used by strata/histogram.wgsl when it loads a candidate; host twin:
 // strata_kernels::reference::block_histogram::cluster_of.
 
+// #import strata/candidate.wgsl
+
 fn cluster_of(candidate: Candidate, masking: bool) -> u32 {
     if masking || candidate.object_id == OBJECT_ID_NONE {
         return candidate.object_id;

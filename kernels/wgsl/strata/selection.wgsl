@@ -37,6 +37,10 @@
 //
 // Needs, from the including kernel: `blue_noise: array<u32>` (strata/blue_noise.wgsl).
 
+// #import strata/candidate.wgsl
+// #import strata/blue_noise.wgsl
+// #import strata/resampling.wgsl
+
 // Most slots a pixel selects (the per-slot values live in vec4s: registers on every
 // target, where local arrays would need array constructors that glslang's HLSL front end
 // rejects).

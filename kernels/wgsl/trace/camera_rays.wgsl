@@ -10,6 +10,8 @@
 //
 // Dispatch: 8 x 8 pixels per workgroup, ceil(width / 8) x ceil(height / 8) workgroups.
 
+// #import trace/bvh.wgsl
+
 struct CameraParams {
     origin: vec3<f32>,
     near_clip: f32,

@@ -13,6 +13,9 @@
 // registers, the rest in workgroup memory (TRACE_STACK_DEPTH - REGISTER_STACK = 40
 // entries per invocation): function-local arrays do not translate to every target.
 
+// #import trace/bvh.wgsl
+// #import trace/traverse.wgsl
+
 struct TraceParams {
     ray_count: u32,
     workgroups_x: u32,

@@ -1,0 +1,86 @@
+//! Every WGSL file of `kernels/wgsl/`, embedded at compile time and found by its path:
+//! what a kernel's imports ([`crate::wgsl_imports`]) are resolved against. A test checks
+//! the list against the folder, so a new file cannot be left out.
+
+use crate::fragment;
+use crate::source::Fragment;
+
+/// Every file of `kernels/wgsl/`, by path.
+pub static WGSL_FILES: &[Fragment] = &[
+    fragment!("denoise/entry_atrous.wgsl"),
+    fragment!("denoise/entry_modulate.wgsl"),
+    fragment!("denoise/entry_temporal.wgsl"),
+    fragment!("denoise/entry_variance.wgsl"),
+    fragment!("denoise/guide.wgsl"),
+    fragment!("denoise/svgf.wgsl"),
+    fragment!("embed/contract.wgsl"),
+    fragment!("embed/entry_resample.wgsl"),
+    fragment!("embed/entry_select.wgsl"),
+    fragment!("render/albedo.wgsl"),
+    fragment!("render/bsdf.wgsl"),
+    fragment!("render/entry_path_trace.wgsl"),
+    fragment!("render/environment.wgsl"),
+    fragment!("render/lights.wgsl"),
+    fragment!("render/path.wgsl"),
+    fragment!("render/random.wgsl"),
+    fragment!("render/scene.wgsl"),
+    fragment!("restir/block_reuse.wgsl"),
+    fragment!("restir/entry_candidates.wgsl"),
+    fragment!("restir/entry_guide.wgsl"),
+    fragment!("restir/entry_reservoir_keys.wgsl"),
+    fragment!("restir/entry_select.wgsl"),
+    fragment!("restir/entry_shade.wgsl"),
+    fragment!("restir/entry_spatial.wgsl"),
+    fragment!("restir/entry_temporal.wgsl"),
+    fragment!("restir/entry_temporal_keys.wgsl"),
+    fragment!("restir/reservoir.wgsl"),
+    fragment!("restir/reuse_slot.wgsl"),
+    fragment!("strata/blue_noise.wgsl"),
+    fragment!("strata/candidate.wgsl"),
+    fragment!("strata/entry_histogram.wgsl"),
+    fragment!("strata/entry_histogram_rank.wgsl"),
+    fragment!("strata/entry_histogram_subgroup.wgsl"),
+    fragment!("strata/histogram.wgsl"),
+    fragment!("strata/histogram_rank.wgsl"),
+    fragment!("strata/masking.wgsl"),
+    fragment!("strata/resampling.wgsl"),
+    fragment!("strata/selection.wgsl"),
+    fragment!("trace/bvh.wgsl"),
+    fragment!("trace/camera_rays.wgsl"),
+    fragment!("trace/entry_closest_hit.wgsl"),
+    fragment!("trace/traverse.wgsl"),
+    fragment!("util/empty.wgsl"),
+];
+
+/// The file of `kernels/wgsl/` at `path` (relative to that folder).
+pub fn wgsl_file(path: &str) -> Option<Fragment> {
+    WGSL_FILES.iter().find(|fragment| crate::wgsl_imports::wgsl_path(fragment) == path).cloned()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The list holds every `.wgsl` file under `kernels/wgsl/` and nothing else.
+    #[test]
+    fn the_list_is_the_folder() {
+        fn walk(folder: &std::path::Path, root: &std::path::Path, out: &mut Vec<String>) {
+            for entry in std::fs::read_dir(folder).unwrap() {
+                let path = entry.unwrap().path();
+                if path.is_dir() {
+                    walk(&path, root, out);
+                } else if path.extension().is_some_and(|e| e == "wgsl") {
+                    out.push(path.strip_prefix(root).unwrap().to_string_lossy().replace('\\', "/"));
+                }
+            }
+        }
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("wgsl");
+        let mut on_disk = Vec::new();
+        walk(&root, &root, &mut on_disk);
+        on_disk.sort();
+        let mut listed: Vec<String> =
+            WGSL_FILES.iter().map(|f| crate::wgsl_imports::wgsl_path(f).to_string()).collect();
+        listed.sort();
+        assert_eq!(listed, on_disk, "kernels/src/wgsl_files.rs must list every file of kernels/wgsl");
+    }
+}

@@ -69,7 +69,12 @@ fn load_shader_resolved(
     overrides: &[(String, f64)],
 ) -> Result<(Kernel, crate::overrides::ResolvedOverrides)> {
     let bytes = read_input(path, MAX_SHADER_BYTES)?;
-    let source = String::from_utf8(bytes).map_err(|_| anyhow::anyhow!("{}: is not UTF-8 text", path.display()))?;
+    let mut source = String::from_utf8(bytes).map_err(|_| anyhow::anyhow!("{}: is not UTF-8 text", path.display()))?;
+    // A leading byte order mark (some editors save one) is dropped, as by every text
+    // reader of `strata`; naga would refuse it as the first token.
+    if source.starts_with('\u{feff}') {
+        source.drain(..'\u{feff}'.len_utf8());
+    }
     let name = path.display().to_string();
     // A module that does not parse is left to the loader, whose error has the location.
     let resolved = match naga::front::wgsl::parse_str(&source) {

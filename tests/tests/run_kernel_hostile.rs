@@ -184,6 +184,24 @@ fn a_picture_with_an_at_sign_in_its_name_is_read_as_the_picture() {
     let _ = std::fs::remove_dir_all(&folder);
 }
 
+/// A shader saved with a UTF-8 byte order mark (as some Windows editors do) and CRLF
+/// line ends runs as without them: naga refused the mark ("expected global item ...,
+/// found \"\\u{feff}\""), while every text reader of `strata` drops it (issue 58, fresh
+/// variants).
+#[test]
+fn a_shader_with_a_byte_order_mark_and_crlf_runs() {
+    let folder = scratch("bom");
+    let text = format!("\u{feff}{}", SQUARE.replace('\n', "\r\n"));
+    std::fs::write(folder.join("bom.wgsl"), text).unwrap();
+    let mut request = request(&folder, "bom.wgsl");
+    request.buffers = vec![(0, 0, folder.join("in.bin"))];
+    request.sizes = vec![(0, 1, 256)];
+    let runs = run_kernel(&request).unwrap().runs;
+    let output = &runs[0].outputs.as_ref().unwrap()[0].bytes;
+    assert_eq!(output[..4], 0x0303_0303u32.wrapping_mul(0x0303_0303).to_le_bytes());
+    let _ = std::fs::remove_dir_all(&folder);
+}
+
 /// Runs in a child process with `STRATA_SLANG_DIR` naming an empty folder (Slang is not
 /// installed): `all` lists ash-slang as unavailable and the run passes; naming it fails.
 #[test]

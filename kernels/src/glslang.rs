@@ -13,8 +13,9 @@ pub enum GlslangInput {
     /// rewritten as loops, which compile in seconds where naga's constructors took
     /// minutes ([`crate::glsl_zero_init`]).
     Glsl,
-    /// naga's HLSL SM 6.0 (`glslangValidator -D -V`), its workgroup zero-initialisation
-    /// rewritten as loops glslang accepts ([`crate::hlsl_zero_init`]).
+    /// naga's HLSL SM 6.0 (`glslangValidator -D -V`), its zero-initialisation of
+    /// workgroup, private and function arrays rewritten as loops glslang accepts
+    /// ([`crate::hlsl_zero_init`]).
     Hlsl,
 }
 

@@ -390,3 +390,33 @@ fn workgroup_memory_starts_zeroed_everywhere() {
     assert_eq!(untouched, vec![0.0; groups as usize]);
     assert_corruption_caught(&runs, &Tolerance::default(), case.file);
 }
+
+/// Private and function `var`s without an initialiser must start zeroed on every path:
+/// private arrays (1-D, a non-square array of arrays, of structs), a private struct with
+/// an array member, and function-local arrays of arrays in the entry point and a helper.
+/// glslang refused naga's HLSL zeroing (`(uint[8])0`) of every such array and Slang the
+/// non-square ones, so both HLSL paths failed; they now get loops
+/// (`strata_kernels::hlsl_zero_init`).
+#[test]
+fn private_and_function_arrays_start_zeroed_everywhere() {
+    let invocations = 32u32;
+    let case = Case {
+        file: "private_zeroing.wgsl",
+        entry: "main",
+        overrides: Vec::new(),
+        workgroups: [invocations / 16, 1, 1],
+        inputs: vec![(0, vec![0xAB; (invocations * 4) as usize]), (1, vec![0xAB; (invocations * 4) as usize])],
+        bounds: Vec::new(),
+        normalise: None,
+    };
+    let slots = available_slots("the corpus");
+    let (_, runs, judgement) = run_case(&case, &slots);
+    let failures = failures(&judgement);
+    assert!(failures.is_empty(), "{}:\n{}", case.file, failures.join("\n"));
+    let sums: &[u32] = bytemuck::cast_slice(&runs[0].outputs.as_ref().unwrap()[0].bytes);
+    let exact: Vec<u32> = (0..invocations).map(|i| 2 * i + 16).collect();
+    assert_eq!(sums, exact, "the interpreter itself");
+    let weights: &[f32] = bytemuck::cast_slice(&runs[0].outputs.as_ref().unwrap()[1].bytes);
+    assert_eq!(weights, vec![1.75; invocations as usize]);
+    assert_corruption_caught(&runs, &Tolerance::default(), case.file);
+}

@@ -338,7 +338,8 @@ impl PipelineCache {
             .map_err(|e| failed(format!("cannot make a private work folder: {e}")))?;
         let file = dir.path().join(format!("{}.hlsl", kernel.name()));
         let text = hlsl_samplers::plain_samplers(&translation.text).map_err(failed)?;
-        // Slang refuses naga's zeroing of arrays of arrays (`(float3[4][128])0`).
+        // Slang refuses naga's zeroing of arrays of arrays (`(float3[4][128])0`), in
+        // workgroup, private and function memory alike.
         let text = strata_kernels::hlsl_zero_init::zero_init_as_loops(&text);
         std::fs::write(&file, &text).map_err(|e| failed(format!("{}: {e}", file.display())))?;
         let words =

@@ -51,6 +51,13 @@ const TEMPORAL_RENDERS: std::ops::Range<u32> = 1..65;
 // statistical tests' power"), rounded up; the tests now measure 0.5-0.8 times as much.
 /// Without temporal reuse, 8 renders of 64 frames (unchanged).
 const POWER_ACCUMULATED: f64 = 0.034;
+/// A method or shading paired with restir's expectation frame by frame, without temporal
+/// reuse ([`assert_same_mean_with_power`]): a bias one has and the other lacks, relative
+/// to the reference image (each method alone against the reference took 8 renders of 64
+/// frames and resolved 2.8 %, 5.0 % in the mirror-floor room with 32).
+const POWER_PAIRED: f64 = 0.010;
+/// The seeds of paired runs: 2 renders of 32 frames, 64 differences.
+const PAIRED_SEEDS: std::ops::Range<u32> = 1..3;
 /// restir-disc at disc radii 2 and 1000, temporal (256 renders' frame 6 before).
 const POWER_DISC_TEMPORAL: f64 = 0.041;
 /// The own temporal reservoir alone at cap 2 (128 renders' frame 6 before).
@@ -91,9 +98,16 @@ impl RegionStats {
         RegionStats { sum: vec![0.0; n], squares: vec![0.0; n], total_sum: 0.0, total_squares: 0.0, count: 0.0 }
     }
 
-    fn add(&mut self, image: &RgbImage) {
+    /// Statistics of a difference whose every estimate is exactly 0: a reference that
+    /// [`z_scores`] and [`pooled_z`] test a difference against.
+    fn zero() -> Self {
+        RegionStats { count: 2.0, ..RegionStats::new() }
+    }
+
+    /// The mean of each region and channel of `image`.
+    fn region_means(image: &RgbImage) -> Vec<f64> {
         let regions = SIZE / REGION;
-        let mut means = vec![0.0f64; self.sum.len()];
+        let mut means = vec![0.0f64; ((SIZE / REGION) * (SIZE / REGION) * 3) as usize];
         for y in 0..SIZE {
             for x in 0..SIZE {
                 let p = image.pixels[(y * SIZE + x) as usize];
@@ -103,6 +117,21 @@ impl RegionStats {
                 }
             }
         }
+        means
+    }
+
+    fn add(&mut self, image: &RgbImage) {
+        self.add_means(&Self::region_means(image));
+    }
+
+    /// One estimate of the difference `image - base`, region by region.
+    fn add_difference(&mut self, image: &RgbImage, base: &RgbImage) {
+        let means: Vec<f64> =
+            Self::region_means(image).iter().zip(Self::region_means(base)).map(|(a, b)| a - b).collect();
+        self.add_means(&means);
+    }
+
+    fn add_means(&mut self, means: &[f64]) {
         for (i, m) in means.iter().enumerate() {
             self.sum[i] += m;
             self.squares[i] += m * m;
@@ -230,6 +259,34 @@ fn detectable_bias(ours: &RegionStats, reference: &RegionStats) -> f64 {
     (4.5 + 2.33) * (var_a + var_b).sqrt() / b
 }
 
+/// Paired runs: `differences` (each estimate a frame of one setting less the same seed's
+/// and frame's image under another) have mean 0 by the same three tests
+/// [`assert_unbiased`] applies against a reference, and resolve a difference of
+/// `max_bias` of the reference image's total or less with probability 0.99. Without
+/// temporal reuse every method and shading traces the same paths and candidates from a
+/// seed and frame (only the selection and the shading of what it keeps differ), so the
+/// difference of two frames spreads far less than either: over 128 frames of the default
+/// room, 0.5 % (expectation) and 0.5-0.7 % (sample) of a frame's variance, strata or
+/// restir-disc less restir. A few paired frames then catch a bias of one method that the
+/// other lacks far more finely than the unpaired frames of each against the reference.
+fn assert_same_mean_with_power(what: &str, differences: &RegionStats, reference: &RegionStats, max_bias: f64) {
+    assert_unbiased(what, differences, &RegionStats::zero());
+    let (_, variance) = differences.total();
+    let (total, _) = reference.total();
+    let detectable = (4.5 + 2.33) * variance.sqrt() / total;
+    eprintln!(
+        "{what}: resolves a difference of {:.3} % of the image (power 0.99), stated {:.1} %",
+        100.0 * detectable,
+        100.0 * max_bias
+    );
+    assert!(
+        detectable <= max_bias,
+        "{what}: resolves only a difference of {:.3} % of the image with power 0.99, stated {:.1} %",
+        100.0 * detectable,
+        100.0 * max_bias
+    );
+}
+
 /// [`assert_unbiased`], and the test's power at least as stated: it catches a bias of the
 /// whole image of `max_bias` (relative) with probability 0.99 or more.
 fn assert_unbiased_with_power(what: &str, ours: &RegionStats, reference: &RegionStats, max_bias: f64) {
@@ -329,9 +386,55 @@ fn restir_frames_along(
     stats
 }
 
+/// Without temporal reuse: per seed and frame, each of `variants` less `base` (both
+/// rendered from that seed and frame, with `adjust` applied to the render settings).
+fn paired_differences(
+    backend: &mut dyn Backend,
+    scene: &Scene,
+    base: RestirSettings,
+    variants: &[RestirSettings],
+    seeds: std::ops::Range<u32>,
+    frames: u32,
+    adjust: impl Fn(RenderSettings) -> RenderSettings,
+) -> Vec<RegionStats> {
+    let gpu_scene = GpuScene::build(scene).unwrap();
+    let mut differences = vec![RegionStats::new(); variants.len()];
+    for seed in seeds {
+        let render = adjust(settings(scene, seed));
+        let mut renderers: Vec<RestirRenderer> = std::iter::once(&base)
+            .chain(variants)
+            .map(|restir| {
+                assert!(!restir.temporal, "paired differences are for frames without temporal reuse");
+                RestirRenderer::new(backend, &gpu_scene, &render, *restir, scene.extent()).unwrap()
+            })
+            .collect();
+        for _ in 0..frames {
+            let images: Vec<RgbImage> = renderers
+                .iter_mut()
+                .map(|renderer| {
+                    let (image, stats) = renderer.render_frame(backend, None).unwrap();
+                    assert_eq!(stats.invalid_pixels, 0);
+                    image
+                })
+                .collect();
+            for (difference, image) in differences.iter_mut().zip(&images[1..]) {
+                difference.add_difference(image, &images[0]);
+            }
+        }
+        for renderer in renderers {
+            renderer.destroy(backend).unwrap();
+        }
+    }
+    differences
+}
+
 /// Without temporal reuse every method converges to the path tracer's image, shading the
-/// final resampling's expectation (the default) and the kept sample, and the expectation
-/// (a conditional expectation of the sample's estimate) spreads less over frames.
+/// final resampling's expectation (the default) and the kept sample: restir against the
+/// reference over 8 renders of 64 frames, whose expectation (a conditional expectation of
+/// the sample's estimate) spreads less over frames, and strata and restir-disc paired
+/// with restir's expectation frame by frame ([`assert_same_mean_with_power`]): until
+/// 2026-11-28 each method ran 8 × 64 frames against the reference, resolving 2.8 % where
+/// the pairs now resolve about 0.5 %.
 #[test]
 fn every_method_converges_to_the_path_traced_reference() {
     let Some(mut backend) = strata_tests::vulkan_backend("every_method_converges_to_the_path_traced_reference") else {
@@ -340,29 +443,43 @@ fn every_method_converges_to_the_path_traced_reference() {
     };
     let scene = default_scene();
     let reference = default_reference(&mut backend);
-    for method in [Method::Strata, Method::Restir, Method::RestirDisc] {
-        let settings = |shading| RestirSettings {
-            method,
-            shading,
-            temporal: false,
-            selection: blocks_of_8(),
-            ..RestirSettings::default()
-        };
-        let expected = restir_frames(&mut backend, &scene, settings(Shading::Expectation), 1..9, 64);
-        let what = format!("{} expectation without temporal reuse", method.name());
-        assert_unbiased_with_power(&what, &expected, &reference, POWER_ACCUMULATED);
-        // The test can fail: the same frames 3 % too bright are caught.
-        let pooled = pooled_z(&expected.scaled(1.03), &reference);
-        assert!(pooled > 4.5, "{}: a 3 % bias gives pooled z {pooled:.2} only", method.name());
-        let sampled = restir_frames(&mut backend, &scene, settings(Shading::Sample), 1..9, 64);
-        let what = format!("{} sample without temporal reuse", method.name());
-        assert_unbiased_with_power(&what, &sampled, &reference, POWER_ACCUMULATED);
-        let spread = |stats: &RegionStats| (0..stats.sum.len()).map(|i| stats.variance_of_mean(i)).sum::<f64>();
-        assert!(
-            spread(&expected) < spread(&sampled),
-            "{}: the expectation's frames spread more than the sample's",
-            method.name()
-        );
+    let settings = |method, shading| RestirSettings {
+        method,
+        shading,
+        temporal: false,
+        selection: blocks_of_8(),
+        ..RestirSettings::default()
+    };
+    // restir, both shadings, against the reference.
+    let expected = restir_frames(&mut backend, &scene, settings(Method::Restir, Shading::Expectation), 1..9, 64);
+    assert_unbiased_with_power("restir expectation without temporal reuse", &expected, &reference, POWER_ACCUMULATED);
+    // The test can fail: the same frames 3 % too bright are caught.
+    let pooled = pooled_z(&expected.scaled(1.03), &reference);
+    assert!(pooled > 4.5, "restir: a 3 % bias gives pooled z {pooled:.2} only");
+    let sampled = restir_frames(&mut backend, &scene, settings(Method::Restir, Shading::Sample), 1..9, 64);
+    assert_unbiased_with_power("restir sample without temporal reuse", &sampled, &reference, POWER_ACCUMULATED);
+    let spread = |stats: &RegionStats| (0..stats.sum.len()).map(|i| stats.variance_of_mean(i)).sum::<f64>();
+    assert!(spread(&expected) < spread(&sampled), "restir: the expectation's frames spread more than the sample's");
+    // strata and restir-disc, both shadings, paired with restir's expectation frame by
+    // frame: a bias of theirs that restir lacks shows in the differences, one they share
+    // with restir in restir's runs above.
+    let variants = [
+        settings(Method::Strata, Shading::Expectation),
+        settings(Method::Strata, Shading::Sample),
+        settings(Method::RestirDisc, Shading::Expectation),
+        settings(Method::RestirDisc, Shading::Sample),
+    ];
+    let base = settings(Method::Restir, Shading::Expectation);
+    let differences = paired_differences(&mut backend, &scene, base, &variants, PAIRED_SEEDS, 32, |render| render);
+    for (variant, difference) in variants.iter().zip(&differences) {
+        let what =
+            format!("{} {:?} less restir expectation, without temporal reuse", variant.method.name(), variant.shading);
+        assert_same_mean_with_power(&what, difference, &reference, POWER_PAIRED);
+        // The paired test can fail: the variant's frames 1 % too bright are caught.
+        let mut brighter = difference.clone();
+        let (total, _) = reference.total();
+        brighter.total_sum += 0.01 * total * brighter.count;
+        assert!(pooled_z(&brighter, &RegionStats::zero()) > 4.5, "{what}: a 1 % difference goes unnoticed");
     }
 }
 
@@ -370,7 +487,9 @@ fn every_method_converges_to_the_path_traced_reference() {
 /// pixels (few neighbours, most of them rejected by the normal and depth tests) and one
 /// wider than the image (most draws land outside it and leave the slot empty), without
 /// temporal reuse (every frame scored) and with it (the own reservoir and 4 drawn from the
-/// disc, frames 3 to 8).
+/// disc, frames 3 to 8). Without temporal reuse each is paired with restir frame by frame
+/// ([`assert_same_mean_with_power`]; 8 renders of 64 frames each against the reference
+/// until 2026-11-28).
 #[test]
 fn restir_disc_stays_unbiased_for_any_disc_radius() {
     let test = "restir_disc_stays_unbiased_for_any_disc_radius";
@@ -388,9 +507,12 @@ fn restir_disc_stays_unbiased_for_any_disc_radius() {
             selection: blocks_of_8(),
             ..RestirSettings::default()
         };
-        let accumulated = restir_frames(&mut backend, &scene, restir, 1..9, 64);
-        let what = format!("restir-disc, disc radius {disc_radius}, no temporal reuse");
-        assert_unbiased_with_power(&what, &accumulated, &reference, POWER_ACCUMULATED);
+        // Without temporal reuse, paired frame by frame with restir (which
+        // every_method_converges_to_the_path_traced_reference holds to the reference).
+        let base = RestirSettings { method: Method::Restir, ..restir };
+        let differences = paired_differences(&mut backend, &scene, base, &[restir], PAIRED_SEEDS, 32, |r| r);
+        let what = format!("restir-disc, disc radius {disc_radius}, less restir, no temporal reuse");
+        assert_same_mean_with_power(&what, &differences[0], &reference, POWER_PAIRED);
         let temporal = RestirSettings { temporal: true, temporal_candidates: 4, ..restir };
         let scored = restir_frames(&mut backend, &scene, temporal, TEMPORAL_RENDERS, 8);
         let what = format!("restir-disc, disc radius {disc_radius}, temporal, frames 3-8");
@@ -1000,7 +1122,8 @@ fn pixels_share_candidates_only_at_the_same_segment() {
 /// Smooth chains on short paths stay unbiased: in the mirror-floor room with paths of 3
 /// segments (above), for every method without temporal reuse and with it (own and four
 /// drawn previous reservoirs), object masking off so that blocks mix pixels resampling at
-/// segments 1 and 2.
+/// segments 1 and 2. Without temporal reuse strata and restir-disc are paired with restir
+/// frame by frame ([`assert_same_mean_with_power`]).
 #[test]
 fn smooth_chains_on_short_paths_stay_unbiased() {
     let Some(mut backend) = strata_tests::vulkan_backend("smooth_chains_on_short_paths_stay_unbiased") else {
@@ -1009,12 +1132,21 @@ fn smooth_chains_on_short_paths_stay_unbiased() {
     };
     let scene = mirror_floor_short_paths_scene();
     let reference = reference(&mut backend, &scene, 2048);
+    let selection = SelectionSettings { masking: false, ..blocks_of_8() };
+    let accumulated = |method| RestirSettings { method, temporal: false, selection, ..RestirSettings::default() };
+    // Without temporal reuse: restir against the reference, strata and restir-disc paired
+    // with it frame by frame.
+    let ours = restir_frames(&mut backend, &scene, accumulated(Method::Restir), 1..9, 32);
+    assert_unbiased_with_power("restir, 3 segments, without temporal reuse", &ours, &reference, POWER_SHORT_PATHS);
+    let variants = [accumulated(Method::Strata), accumulated(Method::RestirDisc)];
+    let base = accumulated(Method::Restir);
+    let differences = paired_differences(&mut backend, &scene, base, &variants, PAIRED_SEEDS, 32, |r| r);
+    for (variant, difference) in variants.iter().zip(&differences) {
+        let what = format!("{} less restir, 3 segments, without temporal reuse", variant.method.name());
+        assert_same_mean_with_power(&what, difference, &reference, POWER_PAIRED);
+    }
     for method in [Method::Strata, Method::Restir, Method::RestirDisc] {
-        let selection = SelectionSettings { masking: false, ..blocks_of_8() };
-        let restir = RestirSettings { method, temporal: false, selection, ..RestirSettings::default() };
-        let ours = restir_frames(&mut backend, &scene, restir, 1..9, 32);
-        let what = format!("{}, 3 segments, without temporal reuse", method.name());
-        assert_unbiased_with_power(&what, &ours, &reference, POWER_SHORT_PATHS);
+        let restir = accumulated(method);
         // With temporal reuse, four drawn previous reservoirs besides the own one (their
         // histogram mixes segments too).
         let restir = RestirSettings { temporal: true, temporal_candidates: 4, ..restir };
@@ -1029,7 +1161,8 @@ fn smooth_chains_on_short_paths_stay_unbiased() {
 /// start), is what the other tests here and `reference` use; this one checks the white
 /// sequence (independent uniform points, the default before 2026-11-25) against that
 /// reference: the path tracer, and every method with temporal reuse over frames 3 to 6 of
-/// independent renders and accumulated over 64 frames. A start shared by every pixel
+/// independent renders, and accumulated over 64 frames (restir against the reference,
+/// strata and restir-disc paired with restir frame by frame). A start shared by every pixel
 /// and seed was seen to fail here (the references then disagree).
 #[test]
 fn both_film_sequences_stay_unbiased() {
@@ -1047,21 +1180,30 @@ fn both_film_sequences_stay_unbiased() {
         white_reference.add(&strata::render::render(&mut backend, &gpu_scene, &render, 4, |_| {}).unwrap());
     }
     assert_unbiased("path tracer, white film", &white_reference, &reference);
+    let white = |render| RenderSettings { film: Film::White, ..render };
+    let settings =
+        |method, temporal| RestirSettings { method, temporal, selection: blocks_of_8(), ..RestirSettings::default() };
     for method in [Method::Strata, Method::Restir, Method::RestirDisc] {
-        for temporal in [true, false] {
-            let restir = RestirSettings { method, temporal, selection: blocks_of_8(), ..RestirSettings::default() };
-            let (seeds, frames) = if temporal { (TEMPORAL_RENDERS, 6) } else { (1..9, 64) };
-            let ours =
-                restir_frames_along(&mut backend, &scene, restir, seeds, frames, &CameraPath::Static, |render| {
-                    RenderSettings { film: Film::White, ..render }
-                });
-            let what = format!(
-                "{} white film, {}",
-                method.name(),
-                if temporal { "temporal, frames 3-6" } else { "accumulated" }
-            );
-            let power = if temporal { POWER_FILM_TEMPORAL } else { POWER_ACCUMULATED };
-            assert_unbiased_with_power(&what, &ours, &reference, power);
-        }
+        let ours = restir_frames_along(
+            &mut backend,
+            &scene,
+            settings(method, true),
+            TEMPORAL_RENDERS,
+            6,
+            &CameraPath::Static,
+            white,
+        );
+        let what = format!("{} white film, temporal, frames 3-6", method.name());
+        assert_unbiased_with_power(&what, &ours, &reference, POWER_FILM_TEMPORAL);
+    }
+    // Accumulated: restir against the reference, strata and restir-disc paired with it.
+    let restir = settings(Method::Restir, false);
+    let ours = restir_frames_along(&mut backend, &scene, restir, 1..9, 64, &CameraPath::Static, white);
+    assert_unbiased_with_power("restir white film, accumulated", &ours, &reference, POWER_ACCUMULATED);
+    let variants = [settings(Method::Strata, false), settings(Method::RestirDisc, false)];
+    let differences = paired_differences(&mut backend, &scene, restir, &variants, PAIRED_SEEDS, 32, white);
+    for (variant, difference) in variants.iter().zip(&differences) {
+        let what = format!("{} less restir, white film, accumulated", variant.method.name());
+        assert_same_mean_with_power(&what, difference, &reference, POWER_PAIRED);
     }
 }

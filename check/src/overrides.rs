@@ -9,8 +9,11 @@
 //! into naga's key. It refuses by name, before the shader is specialised, what naga would
 //! refuse with a message naming neither the flag nor the limit: an override the shader
 //! lacks, one given twice (by name and by number), a value its type cannot hold (a
-//! fraction or a negative number for a `u32`), one without a default left unset, and a
-//! workgroup size outside naga's 1 to 16384 per axis.
+//! fraction or a negative number for a `u32`, `true` or `false` for a number), one
+//! without a default left unset, and a workgroup size outside naga's 1 to 16384 per
+//! axis. A `bool` override takes `true` and `false` (or 1 and 0). Every message quotes
+//! the flag as the user wrote it ([`OverrideFlag`]): `--override scale=1e39`, not the
+//! number's forty digits.
 
 use naga::{Expression, Handle, Module, Scalar, ScalarKind, TypeInner};
 
@@ -30,9 +33,54 @@ pub struct ResolvedOverrides {
     pub workgroup_flags: Vec<String>,
 }
 
-/// `--override KEY=VALUE` as the user wrote it.
-fn flag(key: &str, value: f64) -> String {
-    format!("--override {key}={value}")
+/// One `--override KEY=VALUE` flag: what it names, its value as the user wrote it, and
+/// that value as naga's pipeline constants take it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OverrideFlag {
+    /// The override's name or `@id` number (`tile`, `3` or `@3`), trimmed.
+    pub key: String,
+    /// The value as written (`1e39`, `false`), trimmed: what messages quote.
+    pub text: String,
+    /// The value: the number, or 1 for `true` and 0 for `false`.
+    pub value: f64,
+}
+
+impl OverrideFlag {
+    /// Parses `KEY=VALUE` as `--override` takes it: VALUE a number, or `true` or
+    /// `false` (for a `bool` override; [`resolve`] refuses them for numbers). The error
+    /// is one line quoting `text`.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let (key, value) = text.split_once('=').ok_or_else(|| format!("`{text}`: expected NAME=VALUE"))?;
+        let (key, written) = (key.trim(), value.trim());
+        if key.is_empty() {
+            return Err(format!("`{text}`: expected NAME=VALUE"));
+        }
+        let value = match written {
+            "true" => 1.0,
+            "false" => 0.0,
+            _ => written.parse::<f64>().map_err(|_| {
+                format!("`{text}`: value `{written}` is not a number (or `true`/`false` for a bool override)")
+            })?,
+        };
+        Ok(OverrideFlag { key: key.to_string(), text: written.to_string(), value })
+    }
+
+    /// A flag setting `key` to the number `value`, written as Rust prints it.
+    pub fn number(key: &str, value: f64) -> Self {
+        OverrideFlag { key: key.to_string(), text: value.to_string(), value }
+    }
+
+    /// Whether the value was written `true` or `false`.
+    fn is_boolean(&self) -> bool {
+        self.text == "true" || self.text == "false"
+    }
+}
+
+impl std::fmt::Display for OverrideFlag {
+    /// `--override KEY=VALUE` as the user wrote it.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "--override {}={}", self.key, self.text)
+    }
 }
 
 /// An override as people name it: `` `tile` (@id(3)) ``, `` `scale` `` or `@id(7)`.
@@ -71,7 +119,7 @@ fn fits(value: f64, scalar: Scalar) -> Result<(), String> {
     };
     match (scalar.kind, scalar.width) {
         (ScalarKind::Bool, _) if value == 0.0 || value == 1.0 => Ok(()),
-        (ScalarKind::Bool, _) => Err("0 (false) or 1 (true)".into()),
+        (ScalarKind::Bool, _) => Err("`true` or `false` (or 1 or 0)".into()),
         (ScalarKind::Uint, 2) => whole(0.0, f64::from(u16::MAX)),
         (ScalarKind::Sint, 2) => whole(f64::from(i16::MIN), f64::from(i16::MAX)),
         (ScalarKind::Uint, 4) => whole(0.0, f64::from(u32::MAX)),
@@ -101,39 +149,40 @@ fn type_name(scalar: Scalar) -> String {
 /// Resolves `given` (`(key, value)` as the flags say) against `module`'s overrides
 /// (module documentation); `entry` is the compute entry point whose workgroup size is
 /// checked. Each error is one line naming the flag.
-pub fn resolve(module: &Module, entry: &str, given: &[(String, f64)]) -> Result<ResolvedOverrides, String> {
-    let mut chosen: Vec<(Handle<naga::Override>, &str, f64)> = Vec::new();
-    for (key, value) in given {
-        let key = key.as_str();
+pub fn resolve(module: &Module, entry: &str, given: &[OverrideFlag]) -> Result<ResolvedOverrides, String> {
+    let mut chosen: Vec<(Handle<naga::Override>, &OverrideFlag)> = Vec::new();
+    for given in given {
+        let key = given.key.as_str();
         let Some(handle) = find(module, key) else {
             let what = match key.strip_prefix('@').unwrap_or(key).parse::<u16>() {
                 Ok(id) => format!("no override has @id({id})"),
                 Err(_) => format!("`{key}` is not an override of this shader"),
             };
-            return Err(format!("{}: {what} (it declares: {})", flag(key, *value), declared(module)));
+            return Err(format!("{given}: {what} (it declares: {})", declared(module)));
         };
-        if let Some((_, first, first_value)) = chosen.iter().find(|(h, ..)| *h == handle) {
-            return Err(format!(
-                "{}: {} is given twice ({} first): give it once",
-                flag(key, *value),
-                describe(module, handle),
-                flag(first, *first_value)
-            ));
+        if let Some((_, first)) = chosen.iter().find(|(h, _)| *h == handle) {
+            return Err(format!("{given}: {} is given twice ({first} first): give it once", describe(module, handle)));
         }
-        if let TypeInner::Scalar(scalar) = module.types[module.overrides[handle].ty].inner
-            && let Err(takes) = fits(*value, scalar)
-        {
-            return Err(format!(
-                "{}: {} is a {}, which takes {takes}",
-                flag(key, *value),
-                describe(module, handle),
-                type_name(scalar)
-            ));
+        if let TypeInner::Scalar(scalar) = module.types[module.overrides[handle].ty].inner {
+            let takes = if given.is_boolean() && scalar.kind != ScalarKind::Bool {
+                // `true` and `false` are for bools; the type's own range says what fits.
+                let takes = fits(f64::NAN, scalar).err().unwrap_or_else(|| "numbers".into());
+                Some(format!("{takes}, not `true` or `false`"))
+            } else {
+                fits(given.value, scalar).err()
+            };
+            if let Some(takes) = takes {
+                return Err(format!(
+                    "{given}: {} is a {}, which takes {takes}",
+                    describe(module, handle),
+                    type_name(scalar)
+                ));
+            }
         }
-        chosen.push((handle, key, *value));
+        chosen.push((handle, given));
     }
     if let Some((handle, _)) =
-        module.overrides.iter().find(|(handle, o)| o.init.is_none() && !chosen.iter().any(|(h, ..)| h == handle))
+        module.overrides.iter().find(|(handle, o)| o.init.is_none() && !chosen.iter().any(|(h, _)| h == handle))
     {
         let o = &module.overrides[handle];
         let key = o.name.clone().or(o.id.map(|id| id.to_string())).unwrap_or_default();
@@ -144,14 +193,14 @@ pub fn resolve(module: &Module, entry: &str, given: &[(String, f64)]) -> Result<
     }
     let constants = chosen
         .iter()
-        .map(|&(handle, _, value)| {
+        .map(|&(handle, given)| {
             let o = &module.overrides[handle];
             let key = match (o.id, &o.name) {
                 (Some(id), _) => id.to_string(),
                 (None, Some(name)) => name.clone(),
                 (None, None) => String::new(),
             };
-            (key, value)
+            (key, given.value)
         })
         .collect();
     let mut resolved = ResolvedOverrides { constants, workgroup_flags: Vec::new() };
@@ -162,7 +211,7 @@ pub fn resolve(module: &Module, entry: &str, given: &[(String, f64)]) -> Result<
     let Some(axes) = point.workgroup_size_overrides else {
         return Ok(resolved);
     };
-    let values: Vec<(Handle<naga::Override>, f64)> = chosen.iter().map(|&(h, _, v)| (h, v)).collect();
+    let values: Vec<(Handle<naga::Override>, f64)> = chosen.iter().map(|&(h, given)| (h, given.value)).collect();
     let mut used = Vec::new();
     let mut size: [Option<i128>; 3] = [None; 3];
     for (axis, expression) in axes.iter().enumerate() {
@@ -173,8 +222,8 @@ pub fn resolve(module: &Module, entry: &str, given: &[(String, f64)]) -> Result<
     }
     resolved.workgroup_flags = chosen
         .iter()
-        .filter(|(handle, ..)| used.contains(handle))
-        .map(|&(handle, key, value)| format!("{}, which sets {}", flag(key, value), describe(module, handle)))
+        .filter(|(handle, _)| used.contains(handle))
+        .map(|&(handle, given)| format!("{given}, which sets {}", describe(module, handle)))
         .collect();
     if let [Some(x), Some(y), Some(z)] = size
         && [x, y, z].iter().any(|&n| n < 1 || n > i128::from(NAGA_MAX_WORKGROUP_SIZE))
@@ -270,11 +319,11 @@ mod tests {
     fn names_and_numbers_become_naga_s_keys() {
         let m = module(TILE);
         for key in ["tile", "3", "@3"] {
-            let resolved = resolve(&m, "main", &[(key.into(), 4.0)]).unwrap();
+            let resolved = resolve(&m, "main", &[OverrideFlag::number(key, 4.0)]).unwrap();
             assert_eq!(resolved.constants, vec![("3".to_string(), 4.0)], "{key}");
             assert_eq!(resolved.workgroup_flags, vec![format!("--override {key}=4, which sets `tile` (@id(3))")]);
         }
-        let resolved = resolve(&m, "main", &[("scale".into(), 0.5)]).unwrap();
+        let resolved = resolve(&m, "main", &[OverrideFlag::number("scale", 0.5)]).unwrap();
         assert_eq!(resolved.constants, vec![("scale".to_string(), 0.5)]);
         assert!(resolved.workgroup_flags.is_empty());
     }
@@ -283,7 +332,7 @@ mod tests {
     fn what_naga_would_refuse_is_named() {
         let m = module(TILE);
         let error = |given: &[(&str, f64)]| {
-            let given: Vec<(String, f64)> = given.iter().map(|(k, v)| (k.to_string(), *v)).collect();
+            let given: Vec<OverrideFlag> = given.iter().map(|(k, v)| OverrideFlag::number(k, *v)).collect();
             resolve(&m, "main", &given).unwrap_err()
         };
         let e = error(&[("3", 100000.0)]);
@@ -301,5 +350,37 @@ mod tests {
         let m = module("override n: u32; @compute @workgroup_size(1) fn main() { _ = n; }");
         let e = resolve(&m, "main", &[]).unwrap_err();
         assert!(e.contains("`n` has no default") && e.contains("--override n=VALUE"), "{e}");
+    }
+
+    const FLAGS: &str = "
+        @id(0) override scale: f32 = 1.5;
+        @id(7) override enabled: bool = true;
+        override depth: i32 = -2;
+        @compute @workgroup_size(1)
+        fn main() { _ = scale; _ = enabled; _ = depth; }";
+
+    /// `true` and `false` set a bool override by name or number, and are refused, by
+    /// name, for a number; every message quotes the value as written.
+    #[test]
+    fn bools_take_true_and_false_and_messages_quote_the_flag() {
+        let m = module(FLAGS);
+        let parse = |text: &str| OverrideFlag::parse(text).unwrap();
+        for (text, value) in [("7=false", 0.0), ("enabled=true", 1.0), ("@7=0", 0.0), ("enabled = false", 0.0)] {
+            let resolved = resolve(&m, "main", &[parse(text)]).unwrap();
+            assert_eq!(resolved.constants, vec![("7".to_string(), value)], "{text}");
+        }
+        let e = resolve(&m, "main", &[parse("depth=true")]).unwrap_err();
+        assert!(e.starts_with("--override depth=true: `depth` is a i32") && e.contains("not `true` or `false`"), "{e}");
+        let e = resolve(&m, "main", &[parse("0=false")]).unwrap_err();
+        assert!(e.contains("--override 0=false") && e.contains("`scale` (@id(0)) is a f32"), "{e}");
+        let e = resolve(&m, "main", &[parse("enabled=2")]).unwrap_err();
+        assert!(e.contains("--override enabled=2") && e.contains("`true` or `false`"), "{e}");
+        let e = resolve(&m, "main", &[parse("scale=1e39")]).unwrap_err();
+        assert!(e.starts_with("--override scale=1e39: `scale` (@id(0)) is a f32"), "{e}");
+        let e = resolve(&m, "main", &[parse("scale=1e39"), parse("0=2")]).unwrap_err();
+        assert!(e.contains("1e39") && !e.contains("0000000000"), "{e}");
+        let e = OverrideFlag::parse("enabled=yes").unwrap_err();
+        assert!(e.contains("`enabled=yes`") && e.contains("`yes`") && e.contains("true"), "{e}");
+        assert!(OverrideFlag::parse("=1").is_err() && OverrideFlag::parse("scale").is_err());
     }
 }

@@ -32,7 +32,7 @@ pub struct RunRequest {
     pub sizes: Vec<(u32, u32, u64)>,
     /// Values of `override` constants, by name or by `@id` number (`3` or `@3`); the
     /// rest keep their WGSL defaults ([`crate::overrides`]).
-    pub overrides: Vec<(String, f64)>,
+    pub overrides: Vec<crate::overrides::OverrideFlag>,
     /// Textures and samplers (see [`crate::run_images`]).
     pub images: Vec<ImageSpec>,
     /// Backend names (`cpu`, `wgpu-vulkan`, `wgpu-gl`, `ash`, `ash-glsl`, `ash-hlsl`,
@@ -58,7 +58,7 @@ pub const MAX_SHADER_BYTES: u64 = 64 << 20;
 
 /// Loads the shader with `overrides` (by name or `@id` number: [`crate::overrides`]);
 /// subgroup operations are allowed if the module needs them.
-pub fn load_shader(path: &Path, entry: &str, overrides: &[(String, f64)]) -> Result<Kernel> {
+pub fn load_shader(path: &Path, entry: &str, overrides: &[crate::overrides::OverrideFlag]) -> Result<Kernel> {
     load_shader_resolved(path, entry, overrides).map(|(kernel, _)| kernel)
 }
 
@@ -66,7 +66,7 @@ pub fn load_shader(path: &Path, entry: &str, overrides: &[(String, f64)]) -> Res
 fn load_shader_resolved(
     path: &Path,
     entry: &str,
-    overrides: &[(String, f64)],
+    overrides: &[crate::overrides::OverrideFlag],
 ) -> Result<(Kernel, crate::overrides::ResolvedOverrides)> {
     let bytes = read_input(path, MAX_SHADER_BYTES)?;
     let mut source = String::from_utf8(bytes).map_err(|_| anyhow::anyhow!("{}: is not UTF-8 text", path.display()))?;
@@ -79,7 +79,10 @@ fn load_shader_resolved(
     // A module that does not parse is left to the loader, whose error has the location.
     let resolved = match naga::front::wgsl::parse_str(&source) {
         Ok(module) => crate::overrides::resolve(&module, entry, overrides).map_err(anyhow::Error::msg)?,
-        Err(_) => crate::overrides::ResolvedOverrides { constants: overrides.to_vec(), ..Default::default() },
+        Err(_) => crate::overrides::ResolvedOverrides {
+            constants: overrides.iter().map(|flag| (flag.key.clone(), flag.value)).collect(),
+            ..Default::default()
+        },
     };
     let constants = &resolved.constants;
     let loaded = match Kernel::from_wgsl_with_overrides(&name, source.clone(), entry, false, constants) {
@@ -90,7 +93,7 @@ fn load_shader_resolved(
     match loaded {
         Ok(kernel) => Ok((kernel, resolved)),
         Err(error) if !overrides.is_empty() => {
-            let flags: Vec<String> = overrides.iter().map(|(key, value)| format!("--override {key}={value}")).collect();
+            let flags: Vec<String> = overrides.iter().map(ToString::to_string).collect();
             Err(error.context(flags.join(", ")))
         }
         Err(error) => Err(error),

@@ -3,6 +3,7 @@
 
 use std::path::PathBuf;
 use strata_check::agreement::{FloatBound, Tolerance, judge};
+use strata_check::overrides::OverrideFlag;
 use strata_check::run_kernel::{RunRequest, run_kernel};
 
 const SQUARE: &str = r#"
@@ -89,7 +90,7 @@ fn bad_requests_are_named() {
     let error = run_kernel(&request).unwrap_err().to_string();
     assert!(error.contains("--size 0:9=16") && error.contains("no such binding"), "{error}");
     request.sizes = Vec::new();
-    request.overrides = vec![("width".into(), 3.0)];
+    request.overrides = vec![OverrideFlag::number("width", 3.0)];
     let error = run_kernel(&request).unwrap_err().to_string();
     assert!(error.contains("`width` is not an override"), "{error}");
     request.overrides = Vec::new();
@@ -114,7 +115,9 @@ fn a_shader_with_overrides_runs_everywhere_with_and_without_override() {
     std::fs::write(dir.join("cells.bin"), cells.iter().flat_map(|c| c.to_le_bytes()).collect::<Vec<u8>>()).unwrap();
     let shader = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data/corpus/life.wgsl");
     let mut live = Vec::new();
-    for (overrides, tile) in [(Vec::new(), 8), (vec![("tile".to_string(), 4.0), ("birth".to_string(), 2.0)], 4)] {
+    for (overrides, tile) in
+        [(Vec::new(), 8), (vec![OverrideFlag::number("tile", 4.0), OverrideFlag::number("birth", 2.0)], 4)]
+    {
         let request = RunRequest {
             shader: shader.clone(),
             entry: "main".into(),

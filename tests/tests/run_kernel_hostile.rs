@@ -6,6 +6,7 @@
 //! or a number the specification leaves undefined.
 
 use std::path::{Path, PathBuf};
+use strata_check::overrides::OverrideFlag;
 use strata_check::run_images::{ImageSpec, TextureFile, parse_sampler, parse_texture_file};
 use strata_check::run_kernel::{RunRequest, run_kernel};
 
@@ -104,10 +105,36 @@ fn an_override_past_a_device_limit_names_the_override() {
     let folder = scratch("override-limit");
     let mut request = request(&folder, "tile.wgsl");
     request.sizes = vec![(0, 0, 4 << 14)];
-    request.overrides = vec![("3".into(), 64.0)];
+    request.overrides = vec![OverrideFlag::number("3", 64.0)];
     let error = failure(&request);
     assert!(error.contains("invocations per workgroup") && error.contains("--override 3=64"), "{error}");
     assert!(error.contains("sets `tile` (@id(3))") && error.contains("64x64x1"), "{error}");
+    let _ = std::fs::remove_dir_all(&folder);
+}
+
+/// A `bool` override is set with `true` or `false`, by name or by `@id` number (they were
+/// refused as "invalid float literal"; only 1 and 0 worked); `true` for a number is
+/// refused naming the override, and a value is quoted as typed (`1e39`, not forty digits).
+#[test]
+fn a_bool_override_takes_true_and_false() {
+    let folder = scratch("bool-override");
+    let shader = "@id(0) override scale: f32 = 1.5;\n@id(7) override enabled: bool = true;\n\
+                  @group(0) @binding(0) var<storage, read_write> out: array<f32>;\n\
+                  @compute @workgroup_size(1) fn main() { out[0] = select(0.0, scale, enabled); }\n";
+    std::fs::write(folder.join("bool.wgsl"), shader).unwrap();
+    let mut request = request(&folder, "bool.wgsl");
+    request.sizes = vec![(0, 0, 4)];
+    for (flag, expected) in [("7=false", 0.0f32), ("enabled=false", 0.0), ("@7=true", 1.5), ("enabled=1", 1.5)] {
+        request.overrides = vec![OverrideFlag::parse(flag).unwrap()];
+        let runs = run_kernel(&request).unwrap().runs;
+        let output = &runs[0].outputs.as_ref().unwrap()[0].bytes;
+        assert_eq!(output[..], expected.to_le_bytes(), "--override {flag}");
+    }
+    for (flag, wanted) in [("scale=true", "`scale` (@id(0)) is a f32"), ("0=1e39", "--override 0=1e39: ")] {
+        request.overrides = vec![OverrideFlag::parse(flag).unwrap()];
+        let error = run_kernel(&request).unwrap_err().to_string();
+        assert!(error.contains(wanted) && !error.contains('\n'), "--override {flag}: {error}");
+    }
     let _ = std::fs::remove_dir_all(&folder);
 }
 

@@ -64,6 +64,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use strata_check::agreement::judge;
+use strata_check::overrides::OverrideFlag;
 use strata_check::run_images::{self, ImageSpec, SamplerDesc, StorageTextureSize, TextureFile};
 use strata_check::run_kernel::RunRequest;
 use strata_kernels::Registry;
@@ -157,8 +158,8 @@ struct RunArgs {
     /// `@id` number as ID=VALUE or @ID=VALUE, whether or not it has a name). Others keep
     /// their WGSL defaults. Applied once, by naga, before any backend sees the shader, so
     /// every backend runs the same specialisation.
-    #[arg(long = "override", value_parser = parse_override)]
-    overrides: Vec<(String, f64)>,
+    #[arg(long = "override", value_parser = OverrideFlag::parse)]
+    overrides: Vec<OverrideFlag>,
     /// Backends, comma-separated, each once, or `all` (cpu, wgpu-vulkan, wgpu-gl, ash,
     /// ash-glsl, ash-hlsl, ash-slang; `wgpu` means wgpu-vulkan). `all` runs every path
     /// available here and lists the others as unavailable (a missing toolchain such as
@@ -397,15 +398,6 @@ fn images(
         .chain(storage.iter().map(|(g, b, (size, format))| ImageSpec::StorageTexture((*g, *b), *size, *format)))
         .chain(samplers.iter().map(|(g, b, desc)| ImageSpec::Sampler((*g, *b), *desc)))
         .collect()
-}
-
-fn parse_override(text: &str) -> Result<(String, f64), String> {
-    let (name, value) = text.split_once('=').ok_or_else(|| format!("`{text}`: expected NAME=VALUE"))?;
-    let value: f64 = value.trim().parse().map_err(|e| format!("`{text}`: value `{value}`: {e}"))?;
-    if name.trim().is_empty() {
-        return Err(format!("`{text}`: expected NAME=VALUE"));
-    }
-    Ok((name.trim().to_string(), value))
 }
 
 /// `N` (every buffer) or `BUFFER=N` (one buffer).

@@ -150,22 +150,35 @@ pub fn check_binds(
             _ => return Err(wrong_kind()),
         }
     }
-    check_filtering(kernel, binds, lookup)
+    check_filtering(kernel, binds, device, lookup)
 }
 
 /// Whether every sampler that filters linearly (magnifying, minifying or between mip
-/// levels) samples only float textures. An integer texel cannot be filtered: Vulkan
-/// makes it undefined (VUID-vkCmdDispatch-magFilter-04553, -mipmapMode-04770) and
+/// levels) samples only textures it may filter. An integer texel cannot be filtered:
+/// Vulkan makes it undefined (VUID-vkCmdDispatch-magFilter-04553, -mipmapMode-04770) and
 /// lavapipe and the interpreter returned numbers, WebGPU refuses it; so every path
 /// refuses it here, naming the sampler binding, the texture binding and the format.
+/// `r32float` and `rgba32float` are filterable only where the device says so
+/// ([`DeviceInfo::float32_filterable`]; wgpu-gl on llvmpipe lacks `FLOAT32_FILTERABLE`
+/// and wgpu refused the bind group in its own words): elsewhere the kernel is refused
+/// as [`BackendError::MissingFeature`], naming both bindings, the format and the
+/// feature, which `xtask run --backend all` lists as the path being unavailable.
 /// `binds` are [`check_binds`]'s, already matched to the kernel's bindings.
-fn check_filtering(kernel: &Kernel, binds: &[Bind], lookup: &ResourceLookup) -> Result<(), BackendError> {
+fn check_filtering(
+    kernel: &Kernel,
+    binds: &[Bind],
+    device: &DeviceInfo,
+    lookup: &ResourceLookup,
+) -> Result<(), BackendError> {
     let info = |slot: (u32, u32)| kernel.binding(slot.0, slot.1);
     let bound = |slot: (u32, u32)| binds.iter().find(|b| b.slot() == slot).map(|b| b.resource);
-    // The IR walk only where an integer texture and a sampler are both bound.
-    let integer =
-        |b: &BindingInfo| matches!(b.kind, BindingKind::SampledTexture { kind, .. } if kind != TexelKind::Float);
-    if !kernel.bindings.iter().any(integer) || !kernel.bindings.iter().any(|b| b.kind == BindingKind::Sampler) {
+    // The IR walk only where a texture that may be unfilterable and a sampler are both
+    // bound.
+    let unfilterable = |b: &BindingInfo| match b.kind {
+        BindingKind::SampledTexture { kind, .. } => kind != TexelKind::Float || !device.float32_filterable,
+        _ => false,
+    };
+    if !kernel.bindings.iter().any(unfilterable) || !kernel.bindings.iter().any(|b| b.kind == BindingKind::Sampler) {
         return Ok(());
     }
     for pair in strata_kernels::combined_samplers::sampled_pairs(kernel) {
@@ -177,7 +190,9 @@ fn check_filtering(kernel: &Kernel, binds: &[Bind], lookup: &ResourceLookup) -> 
         let desc = (lookup.sampler)(sampler)?;
         let filters = [desc.mag_filter, desc.min_filter, desc.mipmap_filter].contains(&FilterMode::Linear);
         let texture_desc = (lookup.texture)(texture)?;
-        if !filters || texture_desc.format.kind() == TexelKind::Float {
+        let format = texture_desc.format;
+        let float = format.kind() == TexelKind::Float;
+        if !filters || (float && (format.filterable() || device.float32_filterable)) {
             continue;
         }
         let name = |slot: (u32, u32)| info(slot).map_or_else(String::new, |b| format!("`{}` ", b.name));
@@ -185,6 +200,21 @@ fn check_filtering(kernel: &Kernel, binds: &[Bind], lookup: &ResourceLookup) -> 
             (0, binding) => format!("binding {binding}"),
             (group, binding) => format!("group {group} binding {binding}"),
         };
+        if float {
+            return Err(BackendError::MissingFeature {
+                kernel: kernel.name().into(),
+                feature: format!(
+                    "linear filtering of {} (sampler {}({}) filters texture {}({})), the feature \
+                     FLOAT32_FILTERABLE (or give that sampler nearest filtering)",
+                    format.wgsl(),
+                    name(pair.sampler),
+                    at(pair.sampler),
+                    name(pair.texture),
+                    at(pair.texture),
+                ),
+                device: device.summary(),
+            });
+        }
         return Err(BackendError::Binding {
             kernel: kernel.name().into(),
             binding: pair.sampler.1,

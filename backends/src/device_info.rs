@@ -15,6 +15,12 @@ pub struct DeviceInfo {
     pub subgroup_sizes: Option<(u32, u32)>,
     /// Whether passes can be timed with timestamp queries.
     pub timestamps: bool,
+    /// Whether a sampler may filter `r32float` and `rgba32float` textures linearly:
+    /// wgpu's `FLOAT32_FILTERABLE` feature (requested where the adapter has it), the
+    /// formats' `SAMPLED_IMAGE_FILTER_LINEAR` feature on ash, always on the interpreter.
+    /// Where false, a linear sampler on such a texture is refused before binding
+    /// ([`crate::bindings_check::check_binds`]).
+    pub float32_filterable: bool,
     /// Limits the kernels must fit in.
     pub limits: DeviceLimits,
 }

@@ -386,8 +386,9 @@ pub struct RunOutcome {
     /// One run per backend, in the order named (under `all`, those available here).
     pub runs: Vec<BackendRun>,
     /// Under `--backend all`, the paths not available here and why: a toolchain not
-    /// installed (Slang, glslang), or no device (no Vulkan driver; with
-    /// `STRATA_REQUIRE_GPU=1` a Vulkan path without a device fails instead).
+    /// installed (Slang, glslang), no device (no Vulkan driver; with
+    /// `STRATA_REQUIRE_GPU=1` a Vulkan path without a device fails instead), or a device
+    /// without a feature the kernel needs (linear filtering of `rgba32float` on wgpu-gl).
     pub unavailable: Vec<(String, String)>,
     /// The tolerance `--ulp` and `--abs` gave, every buffer it names an output.
     pub tolerance: Tolerance,
@@ -498,8 +499,10 @@ fn check_tolerance_targets(kernel: &Kernel, request: &RunRequest) -> Result<()> 
 ///
 /// Every flag is checked before a file is read or a backend opened (module
 /// documentation of [`crate::overrides`], [`named_slots`], the buffer and image flags,
-/// [`Tolerance::from_flags`]). Under `all`, a path whose toolchain is not installed or
-/// that has no device here is listed in [`RunOutcome::unavailable`] instead of run.
+/// [`Tolerance::from_flags`]). Under `all`, a path whose toolchain is not installed, that
+/// has no device here, or whose device lacks a feature the kernel needs
+/// ([`BackendError::MissingFeature`]: subgroups, linear filtering of `rgba32float`) is
+/// listed in [`RunOutcome::unavailable`] instead of run.
 pub fn run_kernel(request: &RunRequest) -> Result<RunOutcome> {
     let every = request.backends.iter().any(|b| b == "all");
     let slots = named_slots(&request.backends)?;
@@ -555,8 +558,22 @@ pub fn run_kernel(request: &RunRequest) -> Result<RunOutcome> {
         }
         let outputs = match (slot.open)() {
             Ok(mut backend) => {
-                run_on(backend.as_mut(), &kernel, &inputs, &images, request.workgroups, &resolved.workgroup_flags)
-                    .map_err(|e| format!("{e:#}"))
+                match run_on(backend.as_mut(), &kernel, &inputs, &images, request.workgroups, &resolved.workgroup_flags)
+                {
+                    // A feature this kernel needs and this device lacks (FLOAT32_FILTERABLE
+                    // on wgpu-gl): the path is unavailable for it, as for a missing device.
+                    Err(error)
+                        if every
+                            && matches!(
+                                error.downcast_ref::<BackendError>(),
+                                Some(BackendError::MissingFeature { .. })
+                            ) =>
+                    {
+                        unavailable.push((name, format!("{error:#}")));
+                        continue;
+                    }
+                    outputs => outputs.map_err(|e| format!("{e:#}")),
+                }
             }
             Err(why) if every && !(slot.needs_vulkan && strata_backends::gpu_required()) => {
                 unavailable.push((name, why.to_string()));

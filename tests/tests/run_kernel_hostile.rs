@@ -186,6 +186,52 @@ fn a_linear_sampler_on_an_integer_texture_is_refused_on_every_path() {
     let _ = std::fs::remove_dir_all(&folder);
 }
 
+/// Linear sampling of an `rgba32float` texture (an EXR) needs wgpu's FLOAT32_FILTERABLE
+/// feature: wgpu-gl on llvmpipe lacks it, and wgpu refused the bind group in its own
+/// words ("Texture binding 1 expects sample type Float { filterable: true }"), failing
+/// `--backend all`. A device without it now refuses the kernel before binding, naming
+/// both bindings, the format and the feature, and `all` lists that path as unavailable;
+/// every other path runs (issue 58, fresh variants).
+#[test]
+fn linear_sampling_of_rgba32float_is_unavailable_without_the_feature() {
+    let folder = scratch("float32-filter");
+    let shader = "@group(0) @binding(0) var smp: sampler;\n@group(0) @binding(1) var img: texture_2d<f32>;\n\
+                  @group(0) @binding(2) var<storage, read_write> out: array<vec4<f32>>;\n\
+                  @compute @workgroup_size(8) fn main(@builtin(global_invocation_id) id: vec3<u32>) {\n\
+                  out[id.x] = textureSampleLevel(img, smp, vec2<f32>((f32(id.x) + 0.5) / 8.0, 0.5), 0.0);\n}\n";
+    std::fs::write(folder.join("sample.wgsl"), shader).unwrap();
+    let texels: Vec<u8> = (0..8 * 4 * 4).flat_map(|i| (i as f32 * 0.25).to_le_bytes()).collect();
+    std::fs::write(folder.join("texels.bin"), texels).unwrap();
+    let mut request = request(&folder, "sample.wgsl");
+    let texture = TextureFile::Raw {
+        path: folder.join("texels.bin"),
+        size: [8, 4, 1],
+        format: strata_kernels::TexelFormat::Rgba32Float,
+    };
+    let sampler = parse_sampler("linear,clamp").unwrap();
+    request.images = vec![ImageSpec::Texture((0, 1), texture), ImageSpec::Sampler((0, 0), sampler)];
+    request.sizes = vec![(0, 2, 128)];
+    request.backends = vec!["all".into()];
+    let outcome = run_kernel(&request).unwrap();
+    eprintln!("unavailable: {:?}", outcome.unavailable);
+    for run in &outcome.runs {
+        assert!(run.outputs.is_ok(), "{}: {:?}", run.backend, run.outputs);
+    }
+    let expected = ["linear filtering of rgba32float", "sampler `smp` (binding 0)", "texture `img` (binding 1)"];
+    for (path, why) in &outcome.unavailable {
+        if why.contains("linear filtering") {
+            assert!(expected.iter().all(|e| why.contains(e)) && why.contains("FLOAT32_FILTERABLE"), "{path}: {why}");
+            assert!(!why.contains('\n'), "{path}: {why}");
+            // Named on its own, the path fails with the same line.
+            request.backends = vec![path.clone()];
+            let error = failure(&request);
+            assert!(error.contains("FLOAT32_FILTERABLE") && !error.contains('\n'), "{path}: {error}");
+            request.backends = vec!["all".into()];
+        }
+    }
+    let _ = std::fs::remove_dir_all(&folder);
+}
+
 /// `my@photo.png`, a file that exists, is the picture, not raw texels `my` of size
 /// `photo.png`; raw texels are still `FILE@WxH[xD]:FORMAT`.
 #[test]

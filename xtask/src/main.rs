@@ -26,7 +26,8 @@
 //!   is checked first: a binding given twice, a backend named twice, a bound for a
 //!   buffer that is not an output, an override value its type or naga's workgroup size
 //!   cannot take, a size past 4 GiB are one-line errors naming the flag. `all` lists a
-//!   path whose toolchain is missing (or that has no device) as unavailable. The
+//!   path whose toolchain is missing (or that has no device, or whose device lacks a
+//!   feature the kernel needs) as unavailable. The
 //!   interpreter (`cpu`) stops a dispatch past `--time-limit` (default 60 s) naming where
 //!   the kernel was, and runs as a sanitizer whenever another path is compared with it
 //!   (or with `--sanitize`): its findings are listed, and a buffer that differs from a
@@ -163,7 +164,9 @@ struct RunArgs {
     /// Backends, comma-separated, each once, or `all` (cpu, wgpu-vulkan, wgpu-gl, ash,
     /// ash-glsl, ash-hlsl, ash-slang; `wgpu` means wgpu-vulkan). `all` runs every path
     /// available here and lists the others as unavailable (a missing toolchain such as
-    /// Slang's, or no device) without failing; a path named on its own must run.
+    /// Slang's, no device, or a device without a feature the kernel needs, such as
+    /// linear filtering of `rgba32float`) without failing; a path named on its own must
+    /// run.
     #[arg(long, default_value = "cpu", value_delimiter = ',')]
     backend: Vec<String>,
     /// Tolerance for f32 words: N units in the last place for every buffer, or

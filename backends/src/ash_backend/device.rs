@@ -274,6 +274,12 @@ impl VulkanDevice {
         let name = properties.device_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         let driver_name = driver.driver_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         let driver_info = driver.driver_info_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        // Linear filtering of the 32-bit float formats, in the optimal tiling images use.
+        let float32_filterable = [vk::Format::R32_SFLOAT, vk::Format::R32G32B32A32_SFLOAT].into_iter().all(|format| {
+            // SAFETY: Vulkan 1.0 core query on this instance's physical device.
+            let properties = unsafe { self.instance.get_physical_device_format_properties(self.physical, format) };
+            properties.optimal_tiling_features.contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR)
+        });
         DeviceInfo {
             backend: options.source.name().into(),
             adapter: name,
@@ -281,6 +287,7 @@ impl VulkanDevice {
             driver: format!("{driver_name} {driver_info}").trim().into(),
             subgroup_sizes: self.subgroup_size.map(|s| (s, s)),
             timestamps: self.query_pool.is_some(),
+            float32_filterable,
             limits: DeviceLimits {
                 max_workgroup_storage: u64::from(limits.max_compute_shared_memory_size),
                 max_invocations_per_workgroup: limits.max_compute_work_group_invocations,

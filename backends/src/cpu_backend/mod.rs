@@ -207,6 +207,7 @@ impl CpuBackend {
             driver: format!("strata {}", env!("CARGO_PKG_VERSION")),
             subgroup_sizes: options.subgroup_size.map(|s| (s, s)),
             timestamps: true,
+            float32_filterable: true,
             limits: DeviceLimits {
                 max_workgroup_storage: 64 * 1024,
                 max_invocations_per_workgroup: 1024,

@@ -151,6 +151,7 @@ impl WgpuBackend {
             driver: format!("{} {}", adapter_info.driver, adapter_info.driver_info).trim().into(),
             subgroup_sizes: subgroups.then_some((adapter_info.subgroup_min_size, adapter_info.subgroup_max_size)),
             timestamps,
+            float32_filterable: features.contains(wgpu::Features::FLOAT32_FILTERABLE),
             limits: DeviceLimits {
                 max_workgroup_storage: u64::from(limits.max_compute_workgroup_storage_size),
                 max_invocations_per_workgroup: limits.max_compute_invocations_per_workgroup,

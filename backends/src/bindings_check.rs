@@ -13,10 +13,34 @@ use crate::error::BackendError;
 use crate::texture::{FilterMode, SamplerDesc, SamplerId, TextureDesc, TextureId};
 use strata_kernels::{BindingInfo, BindingKind, Kernel, TexelKind};
 
-/// Whether `device` can run `kernel`: features, workgroup size, workgroup memory and
-/// storage buffer count.
+/// Bytes of private and function memory per invocation a CPU driver (lavapipe) is given
+/// a kernel with ([`Kernel::private_memory_bytes`]): llvmpipe compiles per-invocation
+/// arrays slowly and into much memory. Measured on Mesa 22.3.6 with its shader cache
+/// off, an `array<u32, N>` written at one index and read at another: 4 KiB compiled in
+/// 10.7 s, 16 KiB took over a minute, 64 KiB over 100 s, and 512 MiB took 23 GB of
+/// memory before it was killed (issue 58). The project's kernels take at most 1.3 KiB;
+/// the interpreter has its own, larger cap, and a GPU's compiler spills such arrays to
+/// memory.
+pub const CPU_DRIVER_PRIVATE_BYTES: u64 = 4096;
+
+/// Whether `device` can run `kernel`: features, workgroup size, workgroup memory, storage
+/// buffer count, and on a CPU driver the private and function memory per invocation.
 pub fn check_kernel_fits(kernel: &Kernel, device: &DeviceInfo) -> Result<(), BackendError> {
     let limits = &device.limits;
+    if device.is_cpu_driver() {
+        let requested = kernel.private_memory_bytes();
+        if requested > CPU_DRIVER_PRIVATE_BYTES {
+            return Err(BackendError::LimitExceeded {
+                what: format!(
+                    "kernel `{}` on a CPU driver, which compiles per-invocation arrays for minutes",
+                    kernel.name()
+                ),
+                limit: "private and function memory bytes per invocation",
+                requested,
+                available: CPU_DRIVER_PRIVATE_BYTES,
+            });
+        }
+    }
     if kernel.spec.features.subgroup && device.subgroup_sizes.is_none() {
         return Err(BackendError::MissingFeature {
             kernel: kernel.name().into(),

@@ -26,6 +26,12 @@ pub struct DeviceInfo {
 }
 
 impl DeviceInfo {
+    /// Whether this is a Vulkan or GL driver running on the CPU (lavapipe, llvmpipe), not
+    /// strata's interpreter.
+    pub fn is_cpu_driver(&self) -> bool {
+        self.device_type.eq_ignore_ascii_case("cpu") && !self.is_interpreter()
+    }
+
     /// Whether this is strata's CPU interpreter of naga IR (the `cpu` backend).
     pub fn is_interpreter(&self) -> bool {
         self.backend == "cpu"

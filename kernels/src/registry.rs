@@ -105,6 +105,34 @@ impl Kernel {
             .sum()
     }
 
+    /// Bytes of private and function memory an invocation may hold at once, bounded
+    /// from above: the `var<private>` variables the entry point uses, and the local
+    /// variables of every function of the module together (a chain of calls holds at
+    /// most those). CPU drivers compile large per-invocation arrays slowly and into
+    /// much memory (see `strata_backends::bindings_check`).
+    pub fn private_memory_bytes(&self) -> u64 {
+        let mut layouter = naga::proc::Layouter::default();
+        if layouter.update(self.module.to_ctx()).is_err() {
+            return 0;
+        }
+        let ep_info = self.info.get_entry_point(self.entry_index());
+        let private: u64 = self
+            .module
+            .global_variables
+            .iter()
+            .filter(|(handle, var)| var.space == naga::AddressSpace::Private && !ep_info[*handle].is_empty())
+            .map(|(_, var)| u64::from(layouter[var.ty].size))
+            .sum();
+        let functions = self.module.functions.iter().map(|(_, f)| f);
+        let entry = self.module.entry_points.iter().map(|ep| &ep.function);
+        let locals: u64 = functions
+            .chain(entry)
+            .flat_map(|f| f.local_variables.iter())
+            .map(|(_, local)| u64::from(layouter[local.ty].size))
+            .sum();
+        private.saturating_add(locals)
+    }
+
     /// Parses, validates and describes registry kernel `id`.
     pub fn load(id: KernelId) -> Result<Kernel, KernelError> {
         let spec = id.spec().ok_or_else(|| KernelError::MissingEntryPoint {
@@ -516,6 +544,20 @@ mod tests {
             ] {
                 result.unwrap_or_else(|e| panic!("{}: {e}", kernel.name()));
             }
+        }
+    }
+
+    /// Every registry kernel holds far less private and function memory per invocation
+    /// than CPU drivers are allowed (`strata_backends::bindings_check`), so the bound
+    /// never refuses the project's own kernels.
+    #[test]
+    fn registry_kernels_hold_little_private_memory() {
+        let registry = Registry::shared().unwrap();
+        for id in KernelId::ALL {
+            let kernel = registry.get(id);
+            let bytes = kernel.private_memory_bytes();
+            eprintln!("{}: {bytes} bytes of private and function memory", kernel.name());
+            assert!(bytes <= 2048, "{}: {bytes} bytes of private and function memory", kernel.name());
         }
     }
 

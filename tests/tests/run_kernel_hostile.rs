@@ -112,6 +112,42 @@ fn an_override_past_a_device_limit_names_the_override() {
     let _ = std::fs::remove_dir_all(&folder);
 }
 
+/// A kernel holding 16 KiB of private memory per invocation is refused on a CPU driver
+/// before its pipeline is compiled, naming the limit (lavapipe compiled 16 KiB for over a
+/// minute, and 512 MiB took 23 GB of memory before it was killed); the interpreter, whose
+/// own cap is far larger, runs it.
+#[test]
+fn large_private_arrays_are_refused_on_a_cpu_driver_before_compiling() {
+    let Some(backend) =
+        strata_tests::vulkan_backend("large_private_arrays_are_refused_on_a_cpu_driver_before_compiling")
+    else {
+        assert!(!strata_backends::gpu_required());
+        return;
+    };
+    let cpu_driver = strata_backends::Backend::info(&backend).is_cpu_driver();
+    drop(backend);
+    let folder = scratch("private-memory");
+    let shader = "var<private> big: array<u32, 4096>;\n\
+                  @group(0) @binding(0) var<storage, read_write> out: array<u32>;\n\
+                  @compute @workgroup_size(1) fn main() {\n\
+                      for (var i = 0u; i < 4096u; i++) { big[(i * 7u) % 4096u] = i + out[i % 4u]; }\n\
+                      out[0] = big[out[1] % 4096u];\n}\n";
+    std::fs::write(folder.join("private.wgsl"), shader).unwrap();
+    let mut request = request(&folder, "private.wgsl");
+    request.sizes = vec![(0, 0, 16)];
+    request.backends = vec!["cpu".into(), "wgpu".into()];
+    let started = std::time::Instant::now();
+    let runs = run_kernel(&request).unwrap().runs;
+    assert!(runs[0].outputs.is_ok(), "the interpreter runs it: {:?}", runs[0].outputs);
+    if cpu_driver {
+        let error = runs[1].outputs.as_ref().unwrap_err();
+        assert!(error.contains("private and function memory bytes per invocation"), "{error}");
+        assert!(error.contains("= 16388") && error.contains("at most 4096") && !error.contains('\n'), "{error}");
+        assert!(started.elapsed() < std::time::Duration::from_secs(20), "refused only after {:?}", started.elapsed());
+    }
+    let _ = std::fs::remove_dir_all(&folder);
+}
+
 /// A `bool` override is set with `true` or `false`, by name or by `@id` number (they were
 /// refused as "invalid float literal"; only 1 and 0 worked); `true` for a number is
 /// refused naming the override, and a value is quoted as typed (`1e39`, not forty digits).

@@ -144,7 +144,28 @@ fn an_endless_loop_ends_at_the_time_limit_naming_where_it_was() {
     let at = (line..=line + 2).any(|l| error.contains(&format!("at endless.wgsl:{l} in `main`")));
     assert!(at, "{error}: names a line of the loop ({line}..{})", line + 2);
     assert!(!error.contains('\n'), "one line: {error}");
+    assert!(error.contains("0 of 16 workgroups done (a loop that never ends?)"), "{error}");
     assert!(took < Duration::from_secs(10), "stopped soon after the limit: {took:?}");
+}
+
+/// A dispatch that is only large (4 million workgroups of a kernel that ends) past the time limit is
+/// told apart from an endless loop: the error counts the workgroups done (it suggested
+/// "a loop that never ends?" for 65535³ workgroups of a kernel that ends).
+#[test]
+fn a_large_dispatch_past_the_time_limit_says_how_far_it_got() {
+    let text = "@group(0) @binding(0) var<storage, read_write> data: array<u32>;\n\
+                @compute @workgroup_size(64) fn main(@builtin(global_invocation_id) id: vec3<u32>) {\n\
+                    var x = id.x;\n\
+                    for (var i = 0u; i < 256u; i++) { x = x * 1664525u + 1013904223u; }\n\
+                    data[id.x % 64u] = x;\n}\n";
+    let kernel = Kernel::from_wgsl("large.wgsl", text.to_string(), "main", false).unwrap();
+    let limit = Duration::from_millis(300);
+    let mut cpu = CpuBackend::new(CpuOptions { time_limit: Some(limit), ..CpuOptions::default() }).unwrap();
+    let data = upload(&mut cpu, "data", &[0u32; 64]).unwrap();
+    let error = cpu.dispatch(&kernel, &[Bind::new(0, data)], [65535, 64, 1]).unwrap_err().to_string();
+    eprintln!("{error}");
+    assert!(error.contains("of 4194240 workgroups done (a dispatch too large for the limit"), "{error}");
+    assert!(!error.contains(" 0 of 4194240"), "some workgroups finish: {error}");
 }
 
 /// A loop-heavy kernel: 256 invocations, 4 096 iterations each of a few arithmetic

@@ -46,6 +46,7 @@ pub(super) fn run(
     let instructions = AtomicU64::new(0);
     let warp_issues = AtomicU64::new(0);
     let total = u64::from(workgroups[0]) * u64::from(workgroups[1]) * u64::from(workgroups[2]);
+    limit.set_workgroups(total);
     // Batches and threads as the interpreter's memory caps allow (`budget`): each
     // invocation holds its private memory and a column of every code's registers.
     // Planned before the buffers are taken, so that a refusal leaves them as they were.
@@ -93,16 +94,18 @@ pub(super) fn run(
                             return Ok(());
                         }
                         let first = batch * per_batch;
+                        let last = (first + per_batch).min(total);
                         match run_batch(
                             program,
                             &shared,
                             &mut worker,
-                            first..(first + per_batch).min(total),
+                            first..last,
                             workgroups,
                             subgroup_size,
                             (limit, sanitizer),
                         ) {
                             Ok(counts) => {
+                                limit.finished(last - first);
                                 instructions.fetch_add(counts.instructions, Ordering::Relaxed);
                                 warp_issues.fetch_add(counts.warp_issues, Ordering::Relaxed);
                             }

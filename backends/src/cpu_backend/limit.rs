@@ -26,7 +26,7 @@
 
 use super::error::invalid;
 use crate::error::BackendError;
-use std::sync::atomic::{AtomicU8, Ordering};
+use std::sync::atomic::{AtomicU8, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 /// The interpreter's default time limit per dispatch (module documentation says why).
@@ -56,6 +56,10 @@ pub(super) struct Limit {
     limit: Option<Duration>,
     /// [`RUNNING`], [`EXPIRED`] or [`FAILED`].
     state: AtomicU8,
+    /// The dispatch's workgroups, and how many have finished (for the message: a dispatch
+    /// that is only large finishes some, an endless loop in every workgroup none).
+    workgroups: AtomicU64,
+    finished: AtomicU64,
 }
 
 /// Why a worker must stop, when its fuel is spent.
@@ -69,7 +73,23 @@ pub(super) enum Stop {
 impl Limit {
     /// The limit of a dispatch starting now (`None`: no limit).
     pub(super) fn starting_now(limit: Option<Duration>) -> Self {
-        Self { deadline: limit.and_then(|l| Instant::now().checked_add(l)), limit, state: AtomicU8::new(RUNNING) }
+        Self {
+            deadline: limit.and_then(|l| Instant::now().checked_add(l)),
+            limit,
+            state: AtomicU8::new(RUNNING),
+            workgroups: AtomicU64::new(0),
+            finished: AtomicU64::new(0),
+        }
+    }
+
+    /// The dispatch has `workgroups` workgroups.
+    pub(super) fn set_workgroups(&self, workgroups: u64) {
+        self.workgroups.store(workgroups, Ordering::Relaxed);
+    }
+
+    /// `count` more workgroups have finished.
+    pub(super) fn finished(&self, count: u64) {
+        self.finished.fetch_add(count, Ordering::Relaxed);
     }
 
     /// Whether the worker must stop (read when its fuel is spent).
@@ -100,12 +120,19 @@ impl Limit {
             Stop::Abandon => invalid(kernel, ABANDONED.into()),
             Stop::Expired => {
                 let limit = self.limit.map_or_else(|| "none".to_string(), describe);
+                let (finished, workgroups) =
+                    (self.finished.load(Ordering::Relaxed), self.workgroups.load(Ordering::Relaxed));
+                let hint = if finished == 0 {
+                    "a loop that never ends?"
+                } else {
+                    "a dispatch too large for the limit, or a loop that never ends in some workgroups?"
+                };
                 invalid(
                     kernel,
                     format!(
                         "the dispatch ran past the interpreter's time limit of {limit} (CpuOptions::time_limit, \
-                         `xtask run --time-limit`): an invocation was at {place} in `{function}` \
-                         (a loop that never ends?)"
+                         `xtask run --time-limit`): an invocation was at {place} in `{function}`, \
+                         {finished} of {workgroups} workgroups done ({hint})"
                     ),
                 )
             }

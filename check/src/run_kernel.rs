@@ -408,6 +408,29 @@ impl RunOutcome {
     pub fn undefined_behaviour(&self) -> Option<&Finding> {
         self.findings.0.iter().find(|finding| finding.kind.undefined())
     }
+
+    /// Why output buffer `name` may differ from the interpreter's, if the run did
+    /// something WGSL leaves undefined: the first such finding that names the buffer (an
+    /// index out of range in it, a race on its words, an access past its end), else the
+    /// run's first, said to be one of several when there are more (a value read out of
+    /// range or raced on can reach any buffer).
+    pub fn undefined_behaviour_for(&self, name: &str) -> Option<String> {
+        undefined_reason(&self.findings.0, name)
+    }
+}
+
+/// [`RunOutcome::undefined_behaviour_for`] over `findings`.
+fn undefined_reason(findings: &[Finding], name: &str) -> Option<String> {
+    let undefined: Vec<&Finding> = findings.iter().filter(|finding| finding.kind.undefined()).collect();
+    let quoted = format!("`{name}`");
+    if let Some(own) = undefined.iter().find(|finding| finding.detail.contains(&quoted)) {
+        return Some(own.to_string());
+    }
+    let first = undefined.first()?;
+    Some(match undefined.len() {
+        1 => first.to_string(),
+        n => format!("{first}, the first of {n} undefined findings listed above, none in {quoted}"),
+    })
 }
 
 /// The math functions of the interpreter whose results differ from GPU drivers' within
@@ -603,4 +626,39 @@ pub fn run_kernel(request: &RunRequest) -> Result<RunOutcome> {
         }
     }
     Ok(RunOutcome { kernel, runs, unavailable, tolerance, sanitized, findings })
+}
+
+#[cfg(test)]
+mod undefined_reason_tests {
+    use super::*;
+    use strata_backends::cpu_backend::FindingKind;
+
+    fn finding(kind: FindingKind, line: u32, detail: &str) -> Finding {
+        Finding {
+            kind,
+            kernel: "main".into(),
+            file: "k.wgsl".into(),
+            line,
+            function: "main".into(),
+            detail: detail.into(),
+            count: 1,
+        }
+    }
+
+    /// A differing buffer is explained by the finding that names it, not by the run's
+    /// first (which blamed a workgroup race for a difference an index out of range in
+    /// the buffer caused); without one, the first is said to be one of several.
+    #[test]
+    fn a_buffer_is_explained_by_its_own_finding() {
+        let findings = [
+            finding(FindingKind::WorkgroupRace, 4, "invocation 1 writes word 0 of `tile` that invocation 0 wrote"),
+            finding(FindingKind::OutOfRangeIndex, 9, "index 70, length 64 (elements in `out`)"),
+        ];
+        let out = undefined_reason(&findings, "out").unwrap();
+        assert!(out.contains("k.wgsl:9") && out.contains("`out`"), "{out}");
+        let other = undefined_reason(&findings, "other").unwrap();
+        assert!(other.contains("k.wgsl:4") && other.contains("the first of 2 undefined findings"), "{other}");
+        assert_eq!(undefined_reason(&findings[..1], "other").unwrap(), findings[0].to_string());
+        assert!(undefined_reason(&[], "out").is_none());
+    }
 }

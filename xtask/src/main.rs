@@ -484,8 +484,8 @@ fn run(request: RunRequest, reference: Option<&str>) -> Result<()> {
         let judgement = judge(runs, reference, tolerance).map_err(anyhow::Error::msg)?;
         println!("against {}:", judgement.reference);
         for buffer in &judgement.buffers {
-            let verdict = match undefined {
-                Some(why) => buffer.describe_undefined(why),
+            let verdict = match outcome.undefined_behaviour_for(&buffer.name) {
+                Some(why) => buffer.describe_undefined(&why),
                 None => buffer.describe(),
             };
             println!("{:<12} {} `{}`: {}", buffer.backend, buffer.binding, buffer.name, verdict);

@@ -227,7 +227,7 @@ fn a_linear_sampler_on_an_integer_texture_is_refused_on_every_path() {
 /// words ("Texture binding 1 expects sample type Float { filterable: true }"), failing
 /// `--backend all`. A device without it now refuses the kernel before binding, naming
 /// both bindings, the format and the feature, and `all` lists that path as unavailable;
-/// every other path runs (issue 58, fresh variants).
+/// every other path runs (issue 58, fresh variants). A nearest sampler runs everywhere.
 #[test]
 fn linear_sampling_of_rgba32float_is_unavailable_without_the_feature() {
     let folder = scratch("float32-filter");
@@ -264,6 +264,21 @@ fn linear_sampling_of_rgba32float_is_unavailable_without_the_feature() {
             assert!(error.contains("FLOAT32_FILTERABLE") && !error.contains('\n'), "{path}: {error}");
             request.backends = vec!["all".into()];
         }
+    }
+    // A nearest sampler gathers rgba32float on every path, those without the feature
+    // included (wgpu-gl refused it: its layout called every sampled float texture
+    // filterable), and every path agrees with the interpreter.
+    request.images[1] = ImageSpec::Sampler((0, 0), parse_sampler("nearest,clamp").unwrap());
+    let outcome = run_kernel(&request).unwrap();
+    assert!(outcome.unavailable.is_empty(), "{:?}", outcome.unavailable);
+    let reference = outcome.runs.iter().find(|run| run.backend == "cpu").unwrap().outputs.as_ref().unwrap();
+    for run in &outcome.runs {
+        let outputs = run.outputs.as_ref().unwrap_or_else(|e| panic!("{}: {e}", run.backend));
+        assert_eq!(
+            outputs[0].bytes, reference[0].bytes,
+            "{}: nearest samples differ from the interpreter's",
+            run.backend
+        );
     }
     let _ = std::fs::remove_dir_all(&folder);
 }

@@ -230,7 +230,28 @@ impl WgpuBackend {
             sampler: &|id| self.textures.sampler_desc(id),
         };
         check_binds(kernel, binds, &self.info, &lookup)?;
-        let pipeline = self.pipelines.get_or_create(&self.device, &self.errors, kernel)?;
+        // Sampled float textures bound with a format this device cannot filter get a
+        // layout of their own (`pipelines::layout_entries_with`).
+        let mut unfilterable: Vec<(u32, u32)> = binds
+            .iter()
+            .filter_map(|bind| match bind.resource {
+                Resource::Texture(id) => Some((bind, id)),
+                _ => None,
+            })
+            .filter(|(bind, _)| {
+                kernel.binding(bind.group, bind.binding).is_some_and(|info| {
+                    matches!(info.kind, BindingKind::SampledTexture { kind: strata_kernels::TexelKind::Float, .. })
+                })
+            })
+            .filter(|(_, id)| {
+                self.textures
+                    .get(*id)
+                    .is_ok_and(|entry| !entry.desc.format.filterable() && !self.info.float32_filterable)
+            })
+            .map(|(bind, _)| (bind.group, bind.binding))
+            .collect();
+        unfilterable.sort_unstable();
+        let pipeline = self.pipelines.get_or_create(&self.device, &self.errors, kernel, unfilterable)?;
         let scope = self.errors.scope(&self.device);
         // A storage texture binding sees one mip level (level 0); a sampled one all.
         let views = binds

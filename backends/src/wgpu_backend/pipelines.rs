@@ -19,8 +19,14 @@ pub(super) struct Pipeline {
     pub(super) layouts: Vec<wgpu::BindGroupLayout>,
 }
 
+/// A pipeline's key: the kernel, and the sampled float textures (group, binding) bound
+/// with a format this device cannot filter (each such set its own layout:
+/// [`layout_entries_with`]).
+type PipelineKey = (KernelId, Vec<(u32, u32)>);
+
 pub(super) struct PipelineCache {
-    pipelines: HashMap<KernelId, Arc<Pipeline>>,
+    /// By kernel and its unfilterable textures ([`PipelineKey`]).
+    pipelines: HashMap<PipelineKey, Arc<Pipeline>>,
     /// The driver's pipeline cache and the file it is kept in between runs, where the
     /// device has one (Vulkan) and a folder was given (`WgpuOptions::pipeline_cache`).
     driver_cache: Option<DriverCache>,
@@ -80,24 +86,28 @@ impl PipelineCache {
         Self { pipelines: HashMap::new(), driver_cache, define_integer_division }
     }
 
+    /// `kernel`'s pipeline for binds in which the sampled float textures `unfilterable`
+    /// have a format this device cannot filter (sorted; usually none).
     pub(super) fn get_or_create(
         &mut self,
         device: &wgpu::Device,
         errors: &ErrorSink,
         kernel: &Kernel,
+        unfilterable: Vec<(u32, u32)>,
     ) -> Result<Arc<Pipeline>, BackendError> {
-        if let Some(pipeline) = self.pipelines.get(&kernel.id) {
+        let key = (kernel.id, unfilterable);
+        if let Some(pipeline) = self.pipelines.get(&key) {
             return Ok(Arc::clone(pipeline));
         }
         let scope = errors.scope(device);
         let cache = self.driver_cache.as_ref().map(|d| &d.cache);
-        let (pipeline, layouts) = cached_kernel_pipeline(device, kernel, self.define_integer_division, cache)?;
+        let (pipeline, layouts) = cached_kernel_pipeline(device, kernel, self.define_integer_division, cache, &key.1)?;
         scope.finish(&format!("pipeline creation for `{}`", kernel.name()))?;
         if let Some(driver_cache) = &mut self.driver_cache {
             driver_cache.save();
         }
         let pipeline = Arc::new(Pipeline { pipeline, layouts });
-        self.pipelines.insert(kernel.id, Arc::clone(&pipeline));
+        self.pipelines.insert(key, Arc::clone(&pipeline));
         Ok(pipeline)
     }
 }
@@ -112,15 +122,32 @@ impl PipelineCache {
 /// whose texture in another was refused by wgpu ("Non-filterable float textures can't
 /// be sampled with a filtering sampler") when filterability was decided per group.
 pub fn layout_entries(kernel: &Kernel, group: u32) -> Vec<wgpu::BindGroupLayoutEntry> {
+    layout_entries_with(kernel, group, &[])
+}
+
+/// [`layout_entries`] for binds in which the sampled float textures `unfilterable` have
+/// a format the device cannot filter (`r32float`, `rgba32float` without
+/// `FLOAT32_FILTERABLE`): those textures unfilterable, and the samplers that sample them
+/// non-filtering (the bind check has refused a linear one), so that a nearest sampler
+/// gathers them (wgpu refused it: "Texture binding 1 expects sample type Float {
+/// filterable: true }").
+pub fn layout_entries_with(
+    kernel: &Kernel,
+    group: u32,
+    unfilterable: &[(u32, u32)],
+) -> Vec<wgpu::BindGroupLayoutEntry> {
     let pairs = strata_kernels::combined_samplers::sampled_pairs(kernel);
-    let sampled = |group, binding| pairs.iter().any(|p| p.texture == (group, binding));
+    let sampled = |group, binding| {
+        pairs.iter().any(|p| p.texture == (group, binding)) && !unfilterable.contains(&(group, binding))
+    };
     // A sampler that samples an integer texture cannot filter (the bind check refuses a
     // linear one first, naming both bindings), so its layout says non-filtering and a
     // nearest sampler gathers integer texels on wgpu as on every other path.
     let integer = |slot: (u32, u32)| {
-        kernel.binding(slot.0, slot.1).is_some_and(
-            |b| matches!(b.kind, BindingKind::SampledTexture { kind, .. } if kind != strata_kernels::TexelKind::Float),
-        )
+        unfilterable.contains(&slot)
+            || kernel.binding(slot.0, slot.1).is_some_and(
+                |b| matches!(b.kind, BindingKind::SampledTexture { kind, .. } if kind != strata_kernels::TexelKind::Float),
+            )
     };
     let sampler_type = |group, binding| {
         if pairs.iter().any(|p| p.sampler == (group, binding) && integer(p.texture)) {
@@ -174,7 +201,7 @@ pub fn kernel_pipeline(
     kernel: &Kernel,
     define_integer_division: bool,
 ) -> Result<(wgpu::ComputePipeline, Vec<wgpu::BindGroupLayout>), BackendError> {
-    cached_kernel_pipeline(device, kernel, define_integer_division, None)
+    cached_kernel_pipeline(device, kernel, define_integer_division, None, &[])
 }
 
 /// [`kernel_pipeline`] through the driver's pipeline `cache` where one is given.
@@ -183,11 +210,12 @@ fn cached_kernel_pipeline(
     kernel: &Kernel,
     define_integer_division: bool,
     cache: Option<&wgpu::PipelineCache>,
+    unfilterable: &[(u32, u32)],
 ) -> Result<(wgpu::ComputePipeline, Vec<wgpu::BindGroupLayout>), BackendError> {
     // One layout per group (a group the kernel skips gets an empty one).
     let layouts: Vec<wgpu::BindGroupLayout> = (0..kernel.group_count())
         .map(|group| {
-            let entries = layout_entries(kernel, group);
+            let entries = layout_entries_with(kernel, group, unfilterable);
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some(kernel.name()),
                 entries: &entries,

@@ -24,14 +24,14 @@ impl FileSource for DiskFiles {
     }
 }
 
-/// The most bytes strata reads from an input that is not a regular file (a device, a
-/// pipe): 1 GiB, above any of the shared scenes' files by a wide margin. An endless one
-/// such as `/dev/zero` is an error naming it, never read until memory runs out. A regular
+/// The most bytes strata reads from a pipe: 1 GiB, above any of the shared scenes' files
+/// by a wide margin. An endless one is an error naming it, never read until memory runs
+/// out; a device such as `/dev/zero` is refused before anything is read. A regular
 /// file is read whole: its size is known before reading.
 pub const MAX_INPUT_FILE_BYTES: u64 = 1 << 30;
 
-/// The whole contents of `path`: a regular file as it is, anything else (a device, a
-/// pipe) up to [`MAX_INPUT_FILE_BYTES`] and refused beyond it. Every file read is noted
+/// The whole contents of `path`: a regular file as it is, a pipe up to
+/// [`MAX_INPUT_FILE_BYTES`] and refused beyond it, a device or socket refused at once. Every file read is noted
 /// as an input of the run ([`crate::atomic_file::note_input`]).
 ///
 /// A named pipe is opened without waiting for a writer (`O_NONBLOCK`): one
@@ -43,6 +43,20 @@ pub fn read_capped(path: &Path) -> std::io::Result<Vec<u8>> {
     let metadata = file.metadata()?;
     if metadata.is_dir() {
         return Err(std::io::Error::new(std::io::ErrorKind::InvalidInput, "is a folder, not a file"));
+    }
+    // A device (`/dev/zero`, `/dev/urandom`) is never a scene, image or table: refused at
+    // once rather than read to the cap (a pipe may be one, `<(cat scene.json)`, and is
+    // read).
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let kind = metadata.file_type();
+        if kind.is_char_device() || kind.is_block_device() || kind.is_socket() {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "is a device, not a regular file: never read",
+            ));
+        }
     }
     // No output of this run may replace what it reads.
     crate::atomic_file::note_input(path);
@@ -57,10 +71,7 @@ pub fn read_capped(path: &Path) -> std::io::Result<Vec<u8>> {
     if bytes.len() as u64 > MAX_INPUT_FILE_BYTES {
         return Err(std::io::Error::new(
             std::io::ErrorKind::InvalidData,
-            format!(
-                "not a regular file, and more than the {} MiB read from a device or pipe",
-                MAX_INPUT_FILE_BYTES >> 20
-            ),
+            format!("not a regular file, and more than the {} MiB read from a pipe", MAX_INPUT_FILE_BYTES >> 20),
         ));
     }
     Ok(bytes)

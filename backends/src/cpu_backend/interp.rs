@@ -1,7 +1,7 @@
-//! The dispatch loop, a workgroup (or a batch of them, [`super::batch`]) at a time: runs
+//! The group loop, a workgroup (or a batch of them, [`super::batch`]) at a time: runs
 //! the bytecode of every invocation of the batch until each ends or reaches a barrier or
 //! subgroup operation, where it stops (that instruction still next) so that
-//! [`super::exec`] can synchronise them.
+//! [`super::dispatch`] can synchronise them.
 //!
 //! Invocations at the same place (the same instruction of the same call stack) run as
 //! one *group*: each instruction is decoded and dispatched once and executed for every
@@ -271,7 +271,7 @@ pub(super) fn run_until_sync(
         caller_codes.extend(invocations[leader].callers.iter().map(|f| f.code));
         // An invocation's position in the batch is its lane in the register files:
         // its workgroup's place in the batch times the workgroup's size, plus its local
-        // index (exec.rs).
+        // index (dispatch.rs).
         let group = group_of(members, mask, width);
         let end = {
             let mut file = std::mem::take(&mut memory.files[code_index as usize]);

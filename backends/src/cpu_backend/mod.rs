@@ -13,7 +13,7 @@
 //! to the next instruction are tidied away (`jump_cleanup`). `interp` runs it;
 //! `memory` is the pointer model (offsets in bytes into bound buffers, in register
 //! words elsewhere). Workgroups run in parallel on the machine's cores;
-//! the invocations of a workgroup run together from barrier to barrier (`exec`; the
+//! the invocations of a workgroup run together from barrier to barrier (`dispatch`; the
 //! workgroups of a kernel without barriers or subgroup operations several at a time as
 //! one batch, `batch`), each
 //! a resumable stack of frames, so every invocation reaches a barrier before any passes
@@ -70,9 +70,9 @@ mod budget;
 mod constant;
 mod counts;
 mod decode;
+mod dispatch;
 mod element_load;
 mod error;
-mod exec;
 mod execute;
 mod expression;
 mod if_conversion;
@@ -456,7 +456,7 @@ impl Backend for CpuBackend {
         });
         let limit = limit::Limit::starting_now(self.options.time_limit);
         let result = match taken {
-            Ok(()) => exec::run(program, &mut bound, workgroups, subgroup_size, (&limit, sanitizer.as_ref())),
+            Ok(()) => dispatch::run(program, &mut bound, workgroups, subgroup_size, (&limit, sanitizer.as_ref())),
             Err(error) => Err(error),
         };
         if let Some(sanitizer) = sanitizer {

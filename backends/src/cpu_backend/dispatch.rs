@@ -1,4 +1,4 @@
-//! Running a compiled kernel: workgroups in parallel on the machine's cores, the
+//! A dispatch of a compiled kernel: its workgroups in parallel on the machine's cores, the
 //! invocations of a workgroup together from barrier to barrier, each a resumable stack
 //! of frames (see [`super::interp`]); several workgroups together as one batch where
 //! the kernel cannot tell ([`super::batch`]).

@@ -31,6 +31,48 @@ pub struct Kernel {
     pub workgroup_size: [u32; 3],
     /// Bindings the entry point uses, sorted by (group, binding).
     pub bindings: Vec<BindingInfo>,
+    /// Its memory per workgroup and per invocation, sized once when it is loaded (the
+    /// backends check it before every dispatch).
+    memory: MemoryBytes,
+}
+
+/// A kernel's workgroup memory per workgroup and private and function memory per
+/// invocation, in bytes ([`Kernel::workgroup_memory_bytes`],
+/// [`Kernel::private_memory_bytes`]).
+#[derive(Clone, Copy, Debug, Default)]
+struct MemoryBytes {
+    workgroup: u64,
+    private: u64,
+}
+
+impl MemoryBytes {
+    /// Sizes the variables entry point `entry_index` of `module` uses with naga's layout
+    /// (0 for a module naga cannot lay out, which validation has refused before).
+    fn of(module: &naga::Module, info: &ModuleInfo, entry_index: usize) -> Self {
+        let mut layouter = naga::proc::Layouter::default();
+        if layouter.update(module.to_ctx()).is_err() {
+            return Self::default();
+        }
+        let ep_info = info.get_entry_point(entry_index);
+        let used = |space: naga::AddressSpace| -> u64 {
+            module
+                .global_variables
+                .iter()
+                .filter(|(handle, var)| var.space == space && !ep_info[*handle].is_empty())
+                .map(|(_, var)| u64::from(layouter[var.ty].size))
+                .sum()
+        };
+        let functions = module.functions.iter().map(|(_, f)| f);
+        let locals: u64 = functions
+            .chain([&module.entry_points[entry_index].function])
+            .flat_map(|f| f.local_variables.iter())
+            .map(|(_, local)| u64::from(layouter[local.ty].size))
+            .sum();
+        Self {
+            workgroup: used(naga::AddressSpace::WorkGroup),
+            private: used(naga::AddressSpace::Private).saturating_add(locals),
+        }
+    }
 }
 
 impl Kernel {
@@ -92,45 +134,16 @@ impl Kernel {
 
     /// Bytes of workgroup memory the entry point declares.
     pub fn workgroup_memory_bytes(&self) -> u64 {
-        let mut layouter = naga::proc::Layouter::default();
-        if layouter.update(self.module.to_ctx()).is_err() {
-            return 0;
-        }
-        let ep_info = self.info.get_entry_point(self.entry_index());
-        self.module
-            .global_variables
-            .iter()
-            .filter(|(handle, var)| var.space == naga::AddressSpace::WorkGroup && !ep_info[*handle].is_empty())
-            .map(|(_, var)| u64::from(layouter[var.ty].size))
-            .sum()
+        self.memory.workgroup
     }
 
     /// Bytes of private and function memory an invocation may hold at once, bounded
     /// from above: the `var<private>` variables the entry point uses, and the local
-    /// variables of every function of the module together (a chain of calls holds at
-    /// most those). CPU drivers compile large per-invocation arrays slowly and into
-    /// much memory (see `strata_backends::bindings_check`).
+    /// variables of its function and of every function of the module together (a chain
+    /// of calls holds at most those). CPU drivers compile large per-invocation arrays
+    /// slowly and into much memory (see `strata_backends::bindings_check`).
     pub fn private_memory_bytes(&self) -> u64 {
-        let mut layouter = naga::proc::Layouter::default();
-        if layouter.update(self.module.to_ctx()).is_err() {
-            return 0;
-        }
-        let ep_info = self.info.get_entry_point(self.entry_index());
-        let private: u64 = self
-            .module
-            .global_variables
-            .iter()
-            .filter(|(handle, var)| var.space == naga::AddressSpace::Private && !ep_info[*handle].is_empty())
-            .map(|(_, var)| u64::from(layouter[var.ty].size))
-            .sum();
-        let functions = self.module.functions.iter().map(|(_, f)| f);
-        let entry = self.module.entry_points.iter().map(|ep| &ep.function);
-        let locals: u64 = functions
-            .chain(entry)
-            .flat_map(|f| f.local_variables.iter())
-            .map(|(_, local)| u64::from(layouter[local.ty].size))
-            .sum();
-        private.saturating_add(locals)
+        self.memory.private
     }
 
     /// Parses, validates and describes registry kernel `id`.
@@ -222,7 +235,8 @@ impl Kernel {
         let workgroup_size = module.entry_points[entry_index].workgroup_size;
         let registry = !matches!(id, KernelId::External(_));
         let bindings = describe_bindings(&spec.name, &module, &info, entry_index, registry)?;
-        Ok(Kernel { id, spec, source, module, info, workgroup_size, bindings })
+        let memory = MemoryBytes::of(&module, &info, entry_index);
+        Ok(Kernel { id, spec, source, module, info, workgroup_size, bindings, memory })
     }
 }
 

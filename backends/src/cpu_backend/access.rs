@@ -3,10 +3,9 @@
 //! known when compiling, through a pointer register otherwise, and through a conversion
 //! plan where the pointee holds f16 in a buffer's layout.
 
-use super::decode::{Compiler, Scope};
-use super::insn::{Insn, Reg};
+use super::compiler::{Compiler, Scope};
+use super::insn::{Insn, Reg, Runs};
 use super::layout::{Piece, Place, byte_addressed, contains_f16, load_plan};
-use super::load_fields::Runs;
 use naga::{Expression, Handle, TypeInner};
 
 impl Compiler<'_> {

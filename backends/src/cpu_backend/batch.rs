@@ -21,8 +21,8 @@
 //! WGSL promises no forward progress between workgroups, so such a kernel is not
 //! portable; before batches it finished here because workgroups ran in index order.
 
-use super::decode::Program;
 use super::insn::Insn;
+use super::program::Program;
 
 /// How many invocations a batch holds at most: eight of the common 64-wide workgroups,
 /// where the path tracer's frame was fastest (128, 256 and 1 024 were slower:

@@ -1,591 +1,27 @@
-//! Compiling naga IR into the register bytecode ([`super::insn`]), once per kernel.
+//! Compiling a kernel into a [`Program`], once per kernel (and once more for a
+//! sanitizing run): the module's constants evaluated, its workgroup and private
+//! variables laid out and each global given its pointer ([`super::memory`]'s region
+//! tags), all held under [`super::budget`]'s caps before anything of that size is
+//! allocated; the entry point's builtin arguments placed; then every function lowered
+//! into a [`Code`] ([`compile_code`], callees first, as naga orders them), its jumps
+//! tidied ([`super::jump_cleanup`]) and, in a sanitizing program, each instruction the
+//! sanitizer checks wrapped in [`Insn::Checked`] ([`super::sanitize`]).
 //!
-//! Each function becomes a [`Code`]: its instructions, a register template with every
-//! value known at compile time filled in, and the registers that receive its arguments.
-//! Calls of small functions (at most [`INLINE_EXPRESSIONS`] IR expressions, up to
-//! [`INLINE_DEPTH`] levels deep) are inlined: the callee's expressions and local
-//! variables get registers of the caller's frame, its arguments are the caller's
-//! registers, its returns jump to the end of its body. Every expression gets its own
-//! register range (naga evaluates each expression once where it is emitted, and an
-//! expression's uses are dominated by its emission), so a field of a struct value, a
-//! component of a vector or a bitcast is the source's register range itself, not a copy.
-//!
-//! Expressions lower in [`super::expression`] (math builtins in [`super::math_call`]),
-//! statements in [`super::statement`], loads and stores in [`super::access`].
+//! Why a file of its own: this is the top of the compiler, the one place that knows
+//! the whole pipeline; how one function lowers sits below it ([`super::compiler`] and the
+//! files that add to its `Compiler`), and what comes out ([`Program`]) below both.
 
 use super::budget::{Space, add_words, check_space};
-use super::constant::{compose, global_value, literal};
+use super::compiler::{LineIndex, compile_code};
+use super::constant::global_value;
 use super::error::unsupported;
 use super::insn::{Insn, Reg};
-use super::layout::{Place, byte_addressed, contains_f16, member_step, words_of};
+use super::layout::{byte_addressed, contains_f16, member_step, words_of};
 use super::memory;
+use super::program::{Code, Program};
 use crate::error::BackendError;
-use naga::{Expression, Handle, Module, TypeInner};
+use naga::TypeInner;
 use strata_kernels::Kernel;
-
-/// Callees with at most this many IR expressions are inlined.
-pub(super) const INLINE_EXPRESSIONS: usize = 400;
-/// Inlining stops this many calls deep.
-pub(super) const INLINE_DEPTH: u32 = 8;
-/// Marks an expression without a register yet.
-pub(super) const NONE: Reg = Reg::MAX;
-
-/// Byte offsets where source lines start, for span → line lookups.
-pub(super) struct LineIndex(Vec<usize>);
-
-impl LineIndex {
-    /// The index of `source`'s lines.
-    pub(super) fn new(source: &str) -> Self {
-        Self(std::iter::once(0).chain(source.match_indices('\n').map(|(i, _)| i + 1)).collect())
-    }
-
-    /// 1-based line of a span's start (0 for spans without a position).
-    pub(super) fn line(&self, span: naga::Span) -> u32 {
-        span.to_range().map_or(0, |r| self.0.partition_point(|&start| start <= r.start) as u32)
-    }
-}
-
-/// One compiled function (with its inlined callees).
-pub(super) struct Code {
-    /// The bytecode.
-    pub insns: Vec<Insn>,
-    /// WGSL line of each instruction, for messages.
-    pub lines: Vec<u32>,
-    /// Per instruction: index in [`Program::names`] of the function it came from.
-    pub sources: Vec<u32>,
-    /// Initial register file: compile-time values filled in, zeros elsewhere.
-    pub template: Vec<u32>,
-    /// Registers of pointers to local variables: (register, variable's register), set
-    /// to (function tag | frame depth, variable's register) when a frame starts.
-    pub local_pointers: Vec<(Reg, u32)>,
-    /// The function's own local variables (register, words): set from the template
-    /// when a frame starts. Every other register is either a compile-time value (in
-    /// the template, never written) or an expression's, written where the expression
-    /// is evaluated before any use reads it (uses are dominated by the emission; a
-    /// struct load of some fields writes the words its uses read, [`super::load_fields`]), so
-    /// a register file is filled from the template once and then only these are reset
-    /// (inlined callees' variables are zeroed by instructions of their own).
-    pub locals: Vec<(Reg, u32)>,
-    /// Per argument read by the function: (argument index, register, words).
-    pub arguments: Vec<(u32, Reg, u32)>,
-}
-
-/// A kernel ready to run: its compiled functions and global layout.
-pub(super) struct Program {
-    /// The entry point's name.
-    pub name: String,
-    /// The kernel's name, for messages about its memory ([`super::budget`]).
-    pub kernel: String,
-    /// Per module function (by handle index), then the entry point.
-    pub codes: Vec<Code>,
-    /// Index of the entry point's code.
-    pub entry: u32,
-    /// Function names, for messages.
-    pub names: Vec<String>,
-    /// Per entry-point argument: its builtins and their register offsets in it (one at
-    /// offset 0 for a builtin argument, one per member for a struct of builtins).
-    pub entry_arguments: Vec<Vec<(naga::BuiltIn, u32)>>,
-    /// `@workgroup_size`.
-    pub workgroup_size: [u32; 3],
-    /// Words of workgroup memory.
-    pub workgroup_words: u32,
-    /// Initial contents of private memory.
-    pub private_init: Vec<u32>,
-    /// The bindings' WGSL names, in the kernel's binding order (for the sanitizer's
-    /// findings).
-    pub binding_names: Vec<String>,
-    /// Workgroup variables: (first word, words, WGSL name), for the sanitizer's findings.
-    pub workgroup_variables: Vec<(u32, u32, String)>,
-    /// The kernel's WGSL, whose lines [`Code::lines`] count (a registry kernel's is
-    /// composed of several files: [`Program::place`] names the file).
-    pub source: strata_kernels::source::ComposedSource,
-}
-
-impl Program {
-    /// Where instruction `pc` of code `code` came from: (WGSL file, line in it, function).
-    pub(super) fn place(&self, code: u32, pc: u32) -> (String, u32, String) {
-        let code = &self.codes[code as usize];
-        let line = code.lines.get(pc as usize).copied().unwrap_or(0);
-        let source = code.sources.get(pc as usize);
-        let function = source.and_then(|&s| self.names.get(s as usize)).cloned().unwrap_or_default();
-        if line == 0 {
-            return (String::new(), 0, function);
-        }
-        let (file, local) = self.source.locate(line as usize);
-        (file.to_string(), local as u32, function)
-    }
-}
-
-/// Per function being compiled into a code (the function itself or an inlined callee):
-/// where its expressions and variables live.
-pub(super) struct Scope<'a> {
-    /// The function.
-    pub function: &'a naga::Function,
-    /// Its validation info (expression types).
-    pub info: &'a naga::valid::FunctionInfo,
-    /// Index of its name in the program's names.
-    pub source: u32,
-    /// Per expression: its register (`NONE` until it has one).
-    pub regs: Vec<Reg>,
-    /// Per expression: its words.
-    pub lens: Vec<u32>,
-    /// Per expression: its line.
-    pub lines: Vec<u32>,
-    /// Per pointer expression whose target is known when compiling: that target.
-    pub places: Vec<Option<Place>>,
-    /// Per expression: whether its value is in the template (a compile-time constant).
-    pub constant: Vec<bool>,
-    /// Per expression: evaluated when the scope starts (not again where emitted).
-    pub pre_emitted: Vec<bool>,
-    /// Per expression: a load that reads its variable's registers in place
-    /// ([`super::load_alias`]).
-    pub in_place_loads: Vec<bool>,
-    /// Per expression: for a load whose uses read some of its words, those words
-    /// ([`super::load_fields`]).
-    pub partial_loads: Vec<Option<super::load_fields::Runs>>,
-    /// Per local variable: its register.
-    pub locals: Vec<Reg>,
-    /// Inlined: register and words that receive the return value.
-    pub result: Option<(Reg, u32)>,
-    /// Inlined: the body's return jumps, patched to its end.
-    pub returns: Vec<usize>,
-    /// Inlined into another function (returns are jumps).
-    pub inlined: bool,
-    /// Inlining depth.
-    pub depth: u32,
-    /// Per enclosing breakable construct: (break jumps, continue jumps).
-    pub(super) loops: Vec<(Vec<usize>, Vec<usize>)>,
-}
-
-/// Compiles one code: instructions, registers and the module context they need.
-pub(super) struct Compiler<'a> {
-    /// The kernel's module.
-    pub module: &'a Module,
-    /// Its validation info.
-    pub info: &'a naga::valid::ModuleInfo,
-    pub(super) lines_of: &'a LineIndex,
-    /// Per global variable: (region tag, word offset).
-    pub globals: &'a [(u32, u32)],
-    /// Values of the module's constant expressions.
-    pub global_values: &'a [Vec<u32>],
-    /// Bound buffers (for checking static buffer slots).
-    pub buffer_count: usize,
-    /// Compiling a sanitizing program ([`super::sanitize`]): no if-conversion, whose
-    /// speculated loads and indices would be reported although WGSL never makes them.
-    pub sanitize: bool,
-    /// The kernel's name, for messages.
-    kernel: &'a str,
-    /// Register words the scopes opened so far may take (their expressions' and
-    /// variables' words): an upper bound of the template's length, held under
-    /// [`super::budget::SPACE_CAP`] before any of it is allocated.
-    committed: u64,
-    names: &'a mut Vec<String>,
-    /// Per module function already compiled: its arguments' registers.
-    pub(super) arguments: &'a [Vec<(u32, Reg, u32)>],
-    /// The code being built.
-    pub insns: Vec<Insn>,
-    insn_lines: Vec<u32>,
-    insn_sources: Vec<u32>,
-    /// The register template being built.
-    pub template: Vec<u32>,
-    /// Local-variable pointer registers being built.
-    pub local_pointers: Vec<(Reg, u32)>,
-    /// Register ranges of inlined callees whose bodies are compiled, free for later
-    /// values (see [`Compiler::release`]).
-    free: Vec<(Reg, u32)>,
-    /// Ranges allocated for values computed at run time, in allocation order.
-    runtime: Vec<(Reg, u32)>,
-    /// Ranges holding values that are not computed where they are used: compile-time
-    /// values in the template, pointers set when a frame starts. Never reused.
-    permanent: std::collections::HashSet<Reg>,
-    /// Ranges handed out again from `free`.
-    reused: std::collections::HashSet<Reg>,
-    /// The register of each compile-time value in the template, by its words: equal
-    /// values share registers (never written at run time), so that a callee inlined
-    /// many times adds its constants once.
-    constants: std::collections::HashMap<Vec<u32>, Reg>,
-    /// Line of the instructions being pushed.
-    pub line: u32,
-    /// Source function of the instructions being pushed.
-    pub source: u32,
-    /// The expression compiled last, while the statement after it may store it
-    /// ([`super::retarget`]).
-    pub(super) last_value: Option<super::retarget::LastValue>,
-    /// The instruction that the expression being compiled took over instead of adding
-    /// its own (a fused element load, [`super::element_load`]): it computes the value.
-    pub(super) took_over: Option<usize>,
-}
-
-impl Compiler<'_> {
-    /// Allocates `len` registers for a value computed at run time: from the ranges of
-    /// inlined callees already compiled (first fit) if one is large enough, else new.
-    pub(super) fn alloc(&mut self, len: u32) -> Reg {
-        let at = match self.free.iter().position(|&(_, free)| free >= len && len > 0) {
-            Some(i) => {
-                let (at, free) = self.free[i];
-                if free == len {
-                    self.free.swap_remove(i);
-                } else {
-                    self.free[i] = (at + len, free - len);
-                }
-                self.reused.insert(at);
-                at
-            }
-            None => self.alloc_new(len),
-        };
-        self.runtime.push((at, len));
-        at
-    }
-
-    /// Allocates `len` new registers (never used before, never reused).
-    fn alloc_new(&mut self, len: u32) -> Reg {
-        let at = self.template.len() as Reg;
-        self.template.resize(self.template.len() + len as usize, 0);
-        at
-    }
-
-    /// The register of `handle`, a value that is not computed where it is used (a
-    /// compile-time value written into the template, a pointer set when the frame
-    /// starts): new registers, never reused, since the template and the frame start
-    /// write them once while the code using them may run many times.
-    pub(super) fn reg_permanent(&mut self, scope: &mut Scope, handle: Handle<Expression>) -> Reg {
-        let index = handle.index();
-        if scope.regs[index] == NONE {
-            scope.regs[index] = self.alloc_new(scope.lens[index]);
-        } else if self.reused.contains(&scope.regs[index]) {
-            // Not reached: these expressions get their register where they are compiled.
-            self.fail("internal: a compile-time value in a reused register".into(), self.line);
-        }
-        self.permanent.insert(scope.regs[index]);
-        scope.regs[index]
-    }
-
-    /// The register of `handle`, a compile-time value `value` (zero-extended to the
-    /// expression's words), written into the template: the register of an equal value
-    /// already there, or new ones.
-    pub(super) fn constant(&mut self, scope: &mut Scope, handle: Handle<Expression>, value: &[u32]) -> Reg {
-        let index = handle.index();
-        let len = scope.lens[index] as usize;
-        let mut words = value[..value.len().min(len)].to_vec();
-        words.resize(len, 0);
-        if scope.regs[index] == NONE {
-            if let Some(&reg) = self.constants.get(&words) {
-                scope.regs[index] = reg;
-                return reg;
-            }
-            let reg = self.reg_permanent(scope, handle);
-            self.template[reg as usize..reg as usize + len].copy_from_slice(&words);
-            self.constants.insert(words, reg);
-            reg
-        } else {
-            let reg = self.reg_permanent(scope, handle);
-            self.template[reg as usize..reg as usize + len].copy_from_slice(&words);
-            reg
-        }
-    }
-
-    /// The number of run-time ranges allocated so far: what [`Compiler::release`] takes.
-    pub(super) fn mark(&self) -> usize {
-        self.runtime.len()
-    }
-
-    /// Frees the run-time ranges allocated since `mark`, once an inlined callee's body is
-    /// compiled. Sound because a callee's values are dead after it returns (WGSL returns
-    /// no pointers, the caller receives the result in its own registers), every value is
-    /// written where it is evaluated before any use reads it, its variables are zeroed
-    /// when its body starts, and a register taken again afterwards belongs to an
-    /// expression whose uses end with its block, before the callee can run again (naga
-    /// scopes expressions to the block that emits them).
-    pub(super) fn release(&mut self, mark: usize) {
-        for (at, len) in self.runtime.drain(mark..) {
-            if !self.permanent.contains(&at) {
-                self.free.push((at, len));
-            }
-        }
-    }
-
-    /// Appends an instruction; returns its index.
-    pub(super) fn push(&mut self, insn: Insn) -> usize {
-        self.insns.push(insn);
-        self.insn_lines.push(self.line);
-        self.insn_sources.push(self.source);
-        self.insns.len() - 1
-    }
-
-    /// Removes the instructions from index `len` on (an undone compilation).
-    pub(super) fn truncate(&mut self, len: usize) {
-        self.insns.truncate(len);
-        self.insn_lines.truncate(len);
-        self.insn_sources.truncate(len);
-    }
-
-    /// Appends a copy of `len` words (nothing when `len` is 0 or source and target agree).
-    pub(super) fn copy(&mut self, dst: Reg, src: Reg, len: u32) {
-        if len == 0 || dst == src {
-            return;
-        }
-        self.push(match len {
-            1 => Insn::Copy1 { dst, src },
-            2 => Insn::Copy2 { dst, src },
-            3 => Insn::Copy3 { dst, src },
-            4 => Insn::Copy4 { dst, src },
-            _ => Insn::Copy { dst, src, len },
-        });
-    }
-
-    /// Appends a runtime failure for an unsupported construct.
-    pub(super) fn fail(&mut self, what: String, line: u32) {
-        self.push(Insn::Fail(Box::new((what, line))));
-    }
-
-    pub(super) fn here(&self) -> u32 {
-        self.insns.len() as u32
-    }
-
-    pub(super) fn patch(&mut self, at: usize, to: u32) {
-        match &mut self.insns[at] {
-            Insn::Jump(target) | Insn::JumpUnless { target, .. } => *target = to,
-            _ => unreachable!("only jumps are patched"),
-        }
-    }
-
-    /// The type of expression `handle` of `scope`.
-    pub(super) fn ty<'s>(&'s self, scope: &'s Scope, handle: Handle<Expression>) -> &'s TypeInner {
-        scope.info[handle].ty.inner_with(&self.module.types)
-    }
-
-    /// The register of expression `handle` (allocated, zero, if it has none yet).
-    pub(super) fn reg(&mut self, scope: &mut Scope, handle: Handle<Expression>) -> Reg {
-        let index = handle.index();
-        if scope.regs[index] == NONE {
-            scope.regs[index] = self.alloc(scope.lens[index]);
-        }
-        scope.regs[index]
-    }
-
-    /// Opens the scope of `function`: registers for its expressions and variables,
-    /// compile-time values into the template, the pre-emitted expressions (arguments,
-    /// variables, constants) and the variables' initialisation.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn open<'f>(
-        &mut self,
-        function: &'f naga::Function,
-        info: &'f naga::valid::FunctionInfo,
-        arguments: Option<&[(Reg, Option<Place>)]>,
-        result: Option<(Reg, u32)>,
-        depth: u32,
-        code_arguments: &mut Vec<(u32, Reg, u32)>,
-    ) -> Result<Scope<'f>, BackendError> {
-        let count = function.expressions.len();
-        // What the scope may take, checked against the cap before anything of that size
-        // is allocated: every expression and variable gets at most one register range.
-        let mut lens = Vec::with_capacity(count);
-        let mut lines = Vec::with_capacity(count);
-        let mut words = 0u64;
-        for (handle, _) in function.expressions.iter() {
-            let line = self.lines_of.line(function.expressions.get_span(handle));
-            let inner = info[handle].ty.inner_with(&self.module.types);
-            let len = words_of(self.module, inner).map_err(|what| unsupported(&what, line))?;
-            words = add_words(self.kernel, Space::Function, words, u64::from(len))?;
-            lines.push(line);
-            lens.push(len);
-        }
-        let mut local_words = Vec::with_capacity(function.local_variables.len());
-        for (handle, local) in function.local_variables.iter() {
-            let line = self.lines_of.line(function.local_variables.get_span(handle));
-            let len =
-                words_of(self.module, &self.module.types[local.ty].inner).map_err(|what| unsupported(&what, line))?;
-            words = add_words(self.kernel, Space::Function, words, u64::from(len))?;
-            local_words.push(len);
-        }
-        self.committed = add_words(self.kernel, Space::Function, self.committed, words)?;
-        check_space(self.kernel, Space::Function, self.committed)?;
-        let name = function.name.clone().unwrap_or_default();
-        let source = match self.names.iter().position(|n| *n == name) {
-            Some(at) => at as u32,
-            None => {
-                self.names.push(name);
-                self.names.len() as u32 - 1
-            }
-        };
-        let mut scope = Scope {
-            function,
-            info,
-            source,
-            regs: vec![NONE; count],
-            lens,
-            lines,
-            places: vec![None; count],
-            constant: vec![false; count],
-            pre_emitted: vec![false; count],
-            in_place_loads: super::load_alias::in_place_loads(function, info),
-            partial_loads: super::load_fields::partial_loads(self.module, self.info, function, info),
-            locals: Vec::new(),
-            result,
-            returns: Vec::new(),
-            inlined: arguments.is_some(),
-            depth,
-            loops: Vec::new(),
-        };
-        for words in local_words {
-            let reg = self.alloc(words);
-            scope.locals.push(reg);
-        }
-        let saved_source = self.source;
-        self.source = source;
-        // Constant expressions (literals, constants, and compositions of them) are never
-        // emitted: they are evaluated when the scope starts, like variables and arguments.
-        let kinds = naga::proc::ExpressionKindTracker::from_arena(&function.expressions);
-        for (handle, expression) in function.expressions.iter() {
-            let index = handle.index();
-            let pre_emit = kinds.is_const(handle)
-                || matches!(
-                    expression,
-                    Expression::Literal(_)
-                        | Expression::Constant(_)
-                        | Expression::ZeroValue(_)
-                        | Expression::FunctionArgument(_)
-                        | Expression::GlobalVariable(_)
-                        | Expression::LocalVariable(_)
-                );
-            if !pre_emit {
-                continue;
-            }
-            scope.pre_emitted[index] = true;
-            self.line = scope.lines[index];
-            match *expression {
-                Expression::FunctionArgument(i) => match arguments {
-                    Some(arguments) => {
-                        let (reg, place) = arguments[i as usize];
-                        scope.regs[index] = reg;
-                        scope.places[index] = place;
-                    }
-                    None => {
-                        let reg = self.reg(&mut scope, handle);
-                        code_arguments.push((i, reg, scope.lens[index]));
-                    }
-                },
-                Expression::GlobalVariable(g) => {
-                    let (tag, offset) = self.globals[g.index()];
-                    self.constant(&mut scope, handle, &[tag, offset]);
-                    scope.constant[index] = true;
-                    scope.places[index] = match tag & memory::TAG_MASK {
-                        memory::WORKGROUP => Some(Place::Workgroup(offset)),
-                        memory::PRIVATE => Some(Place::Private(offset)),
-                        memory::BUFFER if ((tag & !memory::TAG_MASK) as usize) < self.buffer_count => {
-                            Some(Place::Buffer(tag & !memory::TAG_MASK, offset))
-                        }
-                        _ => None,
-                    };
-                }
-                Expression::LocalVariable(l) => {
-                    let variable = scope.locals[l.index()];
-                    let reg = self.reg_permanent(&mut scope, handle);
-                    self.local_pointers.push((reg, variable));
-                    scope.places[index] = Some(Place::Local(variable));
-                }
-                _ => match const_value(self, &scope, handle) {
-                    Some(value) => {
-                        self.constant(&mut scope, handle, &value);
-                        scope.constant[index] = true;
-                    }
-                    None => self.expression(&mut scope, handle)?,
-                },
-            }
-        }
-        for (index, (_, local)) in function.local_variables.iter().enumerate() {
-            let variable = scope.locals[index];
-            let words = words_of(self.module, &self.module.types[local.ty].inner).unwrap_or(0);
-            let initialised = local.init.map_or(0, |init| scope.lens[init.index()].min(words));
-            if scope.inlined && words > initialised {
-                // A fresh frame's variables start zeroed; an inlined call's must be too
-                // (where no initialiser writes every word).
-                self.push(Insn::Zero { dst: variable, len: words });
-            }
-            if let Some(init) = local.init {
-                let src = self.reg(&mut scope, init);
-                self.copy(variable, src, initialised);
-            }
-        }
-        self.source = saved_source;
-        Ok(scope)
-    }
-}
-
-/// Compiles `function` into a code.
-#[allow(clippy::too_many_arguments)]
-fn compile_code(
-    module: &Module,
-    info: &naga::valid::ModuleInfo,
-    function: &naga::Function,
-    function_info: &naga::valid::FunctionInfo,
-    lines_of: &LineIndex,
-    globals: &[(u32, u32)],
-    global_values: &[Vec<u32>],
-    buffer_count: usize,
-    (kernel, sanitize): (&str, bool),
-    names: &mut Vec<String>,
-    arguments: &[Vec<(u32, Reg, u32)>],
-) -> Result<Code, BackendError> {
-    let mut compiler = Compiler {
-        module,
-        info,
-        lines_of,
-        globals,
-        global_values,
-        buffer_count,
-        sanitize,
-        kernel,
-        committed: 0,
-        names,
-        arguments,
-        insns: Vec::new(),
-        insn_lines: Vec::new(),
-        insn_sources: Vec::new(),
-        template: Vec::new(),
-        local_pointers: Vec::new(),
-        free: Vec::new(),
-        runtime: Vec::new(),
-        permanent: Default::default(),
-        reused: Default::default(),
-        constants: Default::default(),
-        line: 0,
-        source: 0,
-        last_value: None,
-        took_over: None,
-    };
-    let mut code_arguments = Vec::new();
-    let mut scope = compiler.open(function, function_info, None, None, 0, &mut code_arguments)?;
-    let locals = scope
-        .locals
-        .iter()
-        .zip(function.local_variables.iter())
-        .map(|(&reg, (_, local))| (reg, words_of(module, &module.types[local.ty].inner).unwrap_or(0)))
-        .collect();
-    compiler.block(&mut scope, &function.body)?;
-    compiler.line = 0;
-    compiler.source = scope.source;
-    compiler.push(Insn::Return { src: 0, len: 0 });
-    super::jump_cleanup::clean_up_jumps(&mut compiler.insns, &mut compiler.insn_lines, &mut compiler.insn_sources);
-    if sanitize {
-        // Instruction for instruction, so jump targets stay.
-        for insn in compiler.insns.iter_mut() {
-            if super::sanitize::is_checked(insn) {
-                let inner = std::mem::replace(insn, Insn::Jump(0));
-                *insn = Insn::Checked(Box::new(inner));
-            }
-        }
-    }
-    Ok(Code {
-        insns: compiler.insns,
-        lines: compiler.insn_lines,
-        sources: compiler.insn_sources,
-        template: compiler.template,
-        local_pointers: compiler.local_pointers,
-        locals,
-        arguments: code_arguments,
-    })
-}
 
 /// Compiles `kernel`'s entry point and the functions of its module.
 #[cfg(test)]
@@ -691,7 +127,7 @@ pub(super) fn compile(kernel: &Kernel, sanitize: bool) -> Result<Program, Backen
     let buffer_count = kernel.bindings.len();
     // naga orders functions so that callees come before their callers.
     for (handle, function) in module.functions.iter() {
-        let code = compile_code(
+        let mut code = compile_code(
             module,
             &kernel.info,
             function,
@@ -704,10 +140,11 @@ pub(super) fn compile(kernel: &Kernel, sanitize: bool) -> Result<Program, Backen
             &mut names,
             &arguments,
         )?;
+        finish_code(&mut code, sanitize);
         arguments.push(code.arguments.clone());
         codes.push(code);
     }
-    let entry = compile_code(
+    let mut entry = compile_code(
         module,
         &kernel.info,
         &entry_point.function,
@@ -720,6 +157,7 @@ pub(super) fn compile(kernel: &Kernel, sanitize: bool) -> Result<Program, Backen
         &mut names,
         &arguments,
     )?;
+    finish_code(&mut entry, sanitize);
     codes.push(entry);
     Ok(Program {
         name: kernel.entry_point().to_string(),
@@ -738,31 +176,41 @@ pub(super) fn compile(kernel: &Kernel, sanitize: bool) -> Result<Program, Backen
     })
 }
 
-/// The value of a constant expression of a function, if it can be computed from values
-/// already in the template (literals, constants, zero values, splats and compositions).
-pub(super) fn const_value(compiler: &Compiler, scope: &Scope, handle: Handle<Expression>) -> Option<Vec<u32>> {
-    let module = compiler.module;
-    let value_of = |h: Handle<Expression>| -> Option<&[u32]> {
-        let i = h.index();
-        if !scope.constant[i] {
-            return None;
+/// The steps after a function is lowered: its jumps tidied and, in a sanitizing
+/// program, every instruction the sanitizer checks wrapped in [`Insn::Checked`].
+fn finish_code(code: &mut Code, sanitize: bool) {
+    super::jump_cleanup::clean_up_jumps(&mut code.insns, &mut code.lines, &mut code.sources);
+    if sanitize {
+        // Instruction for instruction, so jump targets stay.
+        for insn in code.insns.iter_mut() {
+            if is_checked(insn) {
+                let inner = std::mem::replace(insn, Insn::Jump(0));
+                *insn = Insn::Checked(Box::new(inner));
+            }
         }
-        let reg = scope.regs[i] as usize;
-        Some(&compiler.template[reg..reg + scope.lens[i] as usize])
-    };
-    let len = scope.lens[handle.index()] as usize;
-    let value = match &scope.function.expressions[handle] {
-        Expression::Literal(value) => literal(value)?,
-        Expression::Constant(c) => compiler.global_values[module.constants[*c].init.index()].clone(),
-        Expression::ZeroValue(_) => vec![0; len],
-        Expression::Splat { size, value } => value_of(*value)?.repeat(*size as usize),
-        Expression::Compose { components, .. } => {
-            let parts: Option<Vec<&[u32]>> = components.iter().map(|c| value_of(*c)).collect();
-            compose(module, compiler.ty(scope, handle), &parts?).ok()?
-        }
-        _ => return None,
-    };
-    (value.len() == len).then_some(value)
+    }
+}
+
+/// Whether `insn` is checked in the sanitizing program: it indexes, or touches
+/// workgroup or buffer memory (what [`super::checked`] checks at run time).
+fn is_checked(insn: &Insn) -> bool {
+    matches!(
+        insn,
+        Insn::PtrIndex { .. }
+            | Insn::PtrIndexRt { .. }
+            | Insn::Extract { .. }
+            | Insn::Load { .. }
+            | Insn::LoadRuns { .. }
+            | Insn::LoadElement(_)
+            | Insn::Store { .. }
+            | Insn::LoadMixed { .. }
+            | Insn::StoreMixed { .. }
+            | Insn::LoadWorkgroup { .. }
+            | Insn::StoreWorkgroup { .. }
+            | Insn::LoadBuffer { .. }
+            | Insn::StoreBuffer { .. }
+            | Insn::Atomic(_)
+    )
 }
 
 #[cfg(test)]

@@ -5,12 +5,12 @@
 
 use super::budget::try_reserve;
 use super::counts::DispatchCounts;
-use super::decode::Program;
 use super::error::{invalid, unsupported};
 use super::insn::Insn;
 use super::interp::{self, Batch, Invocation, Stop};
 use super::limit::{FUEL, Limit, abandoned};
 use super::memory::{FUNCTION, Frame};
+use super::program::Program;
 use super::sanitize::{FindingKind, Sanitizer};
 use crate::error::BackendError;
 use smallvec::SmallVec;

@@ -13,62 +13,16 @@
 //! load (tracked by [`Compiler::last_value`], which every statement that may place a
 //! jump target clears), so the index register holds the same value at the load; and
 //! the fused instruction clamps the index and reads out-of-bounds words as 0 exactly as
-//! the two did ([`element_offset`], `execute.rs`).
+//! the two did ([`super::insn::element_offset`], `execute.rs`).
+//!
+//! Where: the instruction itself ([`ElementLoad`]) is defined with the others in
+//! [`super::insn`], which the executor reads; this file is the compiler's pass that
+//! makes it, called where a load is lowered ([`super::access`]).
 
-use super::decode::{Compiler, Scope};
-use super::insn::{Insn, Reg};
+use super::compiler::{Compiler, LastValue, Scope};
+use super::insn::{ElementLoad, Insn, Reg, Runs};
 use super::layout::Place;
-use super::load_fields::Runs;
-use super::retarget::LastValue;
 use naga::{Expression, Handle};
-
-/// Element `index` (clamped to the array's last, as WGSL does) of the runtime-sized array
-/// at byte `address` of bound buffer `buffer`, elements `stride` bytes apart, loaded
-/// into `dst`: `len` words, or only `runs` (first word, words) where given.
-pub(super) struct ElementLoad {
-    /// First register of the loaded value.
-    pub dst: Reg,
-    /// Index of the bound buffer.
-    pub buffer: u32,
-    /// Byte of the array's first element in the buffer.
-    pub address: u32,
-    /// Register of the element index.
-    pub index: Reg,
-    /// Bytes from one element to the next.
-    pub stride: u32,
-    /// Words of the value.
-    pub len: u32,
-    /// The runs of words its uses read ([`super::load_fields`]), or `None`: all.
-    pub runs: Option<Runs>,
-}
-
-impl ElementLoad {
-    /// The buffer word where the element of `index` starts, for a buffer of `bytes`
-    /// bytes: the element clamped as `PtrIndexRt` clamps it ([`element_offset`]).
-    #[inline(always)]
-    pub(super) fn first_word(&self, bytes: usize, index: u32) -> usize {
-        let address = self.address as usize;
-        let available = bytes.saturating_sub(address);
-        (address + element_offset(available, self.stride as usize, index as usize)) / 4
-    }
-}
-
-/// Where element `index` of an array of elements `stride` apart starts, in a region of
-/// `available` units from the array's start: the element clamped to the last one that
-/// fits (WGSL), element 0 where none fits (its words then read as 0). No division
-/// where the element lies inside (the common case).
-#[inline(always)]
-pub(super) fn element_offset(available: usize, stride: usize, index: usize) -> usize {
-    // `index` and `stride` come from the kernel and its data: the end is computed
-    // without wrapping (an end past usize::MAX is outside every region).
-    if stride == 0 {
-        0
-    } else if index.checked_add(1).and_then(|n| n.checked_mul(stride)).is_some_and(|end| end <= available) {
-        index * stride
-    } else {
-        ((available / stride).max(1) - 1) * stride
-    }
-}
 
 impl Compiler<'_> {
     /// The fused load of `pointer` (`len` words into `dst`), if `pointer` is an element

@@ -1,13 +1,47 @@
 //! The instructions that the group loop of [`super::interp`] runs member by member
 //! (memory through pointers, atomics, textures): decoded once for the group, then
-//! executed for each member in turn; never control flow.
+//! executed for each member in turn; never control flow. And [`GroupMemory`], what they
+//! reach besides the running code's registers.
+//!
+//! Why [`GroupMemory`] is defined here and not in the group loop that fills it: this
+//! file and the sanitizer's checked instructions ([`super::checked`]) take it, and both
+//! sit below the group loop, so that the loop's file imports them and none of them
+//! imports it back.
 
-use super::element_load::element_offset;
-use super::insn::Insn;
-use super::interp::GroupMemory;
+use super::insn::{Insn, element_offset};
 use super::lanes::{LaneRegs, Members};
+use super::limit::Limit;
 use super::memory::{BUFFER, Memory, TAG_MASK, WORKGROUP, read_mixed, write_buffer, write_mixed};
+use super::sanitize::Sanitizing;
 use std::sync::atomic::{AtomicU32, Ordering};
+
+/// What the members of a running group reach besides the running code's registers.
+pub(super) struct GroupMemory<'a> {
+    /// Bound buffers in the kernel's binding order.
+    pub buffers: &'a [Vec<AtomicU32>],
+    /// The batch's workgroup memory: `workgroup_words` per workgroup, in order.
+    pub workgroup: &'a mut [u32],
+    /// Words of workgroup memory per workgroup.
+    pub workgroup_words: usize,
+    /// Invocations per workgroup (lane `l` is in the batch's workgroup `l / per_workgroup`).
+    pub per_workgroup: usize,
+    /// Every invocation's private memory, `private_words` each.
+    pub private: &'a mut [u32],
+    /// Words of private memory per invocation.
+    pub private_words: usize,
+    /// Every code's register file (the running code's taken out).
+    pub files: &'a mut [Vec<u32>],
+    /// The codes of the group's callers, outermost first.
+    pub callers: &'a [u32],
+    /// Lanes per register file (the batch's invocations).
+    pub width: usize,
+    /// The dispatch's time limit.
+    pub limit: &'a Limit,
+    /// Fuel left before the limit is looked at.
+    pub fuel: u32,
+    /// The sanitizer, when the dispatch sanitizes.
+    pub sanitizer: Option<Sanitizing<'a>>,
+}
 
 /// Executes, for each member of `members` (lanes of the running file `file`), an
 /// instruction that `run_group` neither runs itself (control flow) nor runs as row

@@ -5,8 +5,8 @@
 //! [`Insn::Fail`] naming the construct and its line, reported only if reached.
 
 use super::arith;
+use super::compiler::{Compiler, NONE, Scope};
 use super::constant::{compose_offsets, literal};
-use super::decode::{Compiler, NONE, Scope};
 use super::insn::{BinOp, Insn, Reg, UnOp, per_lane};
 use super::lanes::LaneRegs;
 use super::layout::{

@@ -22,7 +22,7 @@
 //! unsupported construct, a jump), the compilation is undone and the `if` is compiled
 //! as a branch.
 
-use super::decode::{Compiler, Scope};
+use super::compiler::{Compiler, Scope};
 use super::error::unsupported;
 use super::insn::{Insn, Reg};
 use super::layout::Place;

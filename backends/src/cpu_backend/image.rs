@@ -24,9 +24,14 @@
 //!   mip blend to its `mipmapPrecisionBits`, so filtered values agree within
 //!   2^-bits of the blended texels' range per filtered axis, not bit for bit; that is the
 //!   bound the tests declare.
+//!
+//! Where: this file is the run-time side (the slots' words, bound by [`super`]'s
+//! backend, and the built-ins run for one invocation by [`super::execute`]). The
+//! instruction ([`ImageInsn`]) is defined with the others in [`super::insn`], and
+//! lowered from naga's IR in [`super::image_lower`].
 
 use super::arith::{f16_to_f32, f32_to_f16};
-use super::insn::Reg;
+use super::insn::{ImageInsn, ImageOp, Reg};
 use super::lanes::LaneRegs;
 use crate::texture::{AddressMode, FilterMode, SamplerDesc, TextureDesc};
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -69,48 +74,6 @@ pub(super) fn bind_sampler(desc: &SamplerDesc) -> Vec<u32> {
 
 const DIMENSIONS: [TextureDimension; 4] =
     [TextureDimension::D1, TextureDimension::D2, TextureDimension::D2Array, TextureDimension::D3];
-
-/// What an image instruction does.
-#[derive(Clone, Copy, Debug)]
-pub(super) enum ImageOp {
-    /// `textureLoad`: coordinate, optional layer and level; 4 words out.
-    Load,
-    /// `textureStore`: coordinate, optional layer, 4 words in.
-    Store,
-    /// `textureDimensions`: optional level; 1 to 3 words out.
-    Size,
-    /// `textureNumLevels`.
-    NumLevels,
-    /// `textureNumLayers`.
-    NumLayers,
-    /// `textureSampleLevel` (level register, or level 0 when absent).
-    SampleLevel,
-    /// `textureGather` of component 0 to 3 (level 0).
-    Gather(u8),
-}
-
-/// An image built-in, operands resolved to registers.
-pub(super) struct ImageInsn {
-    pub op: ImageOp,
-    /// Register of the image value (its slot in the first word's low 24 bits).
-    pub image: Reg,
-    /// Register of the sampler value (sampling only).
-    pub sampler: Reg,
-    /// Register of the coordinate (integers for loads and stores, f32 for sampling).
-    pub coordinate: Reg,
-    /// Its components (1 to 3).
-    pub coordinates: u8,
-    /// Register of the array layer, if the texture is arrayed.
-    pub layer: Option<Reg>,
-    /// Register of the mip level (an integer, or an f32 for sampling).
-    pub level: Option<Reg>,
-    /// Register of the value a store writes.
-    pub value: Reg,
-    /// A sampling offset in texels (a constant of the shader).
-    pub offset: [i32; 3],
-    /// Register of the result.
-    pub result: Reg,
-}
 
 /// A bound texture as its header describes it.
 struct Texture<'a> {

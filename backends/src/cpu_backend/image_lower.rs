@@ -2,9 +2,8 @@
 //! registers resolved and the texture's shape read from the IR once; what the built-ins
 //! do at run time is in [`super::image`].
 
-use super::decode::{Compiler, Scope};
-use super::image::{ImageInsn, ImageOp};
-use super::insn::Insn;
+use super::compiler::{Compiler, Scope};
+use super::insn::{ImageInsn, ImageOp, Insn};
 use crate::error::BackendError;
 use naga::{Expression, Handle, SampleLevel, TypeInner};
 

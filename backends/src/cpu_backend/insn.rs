@@ -7,6 +7,12 @@
 //! it), all as 32-bit words. Values that are known when the kernel is compiled
 //! (literals, constants, pointers to globals) are filled into each code's register
 //! template once and never recomputed.
+//!
+//! Why every instruction type sits here, the boxed operands of the rarer ones too
+//! ([`ElementLoad`], [`ImageInsn`], ...): this file is the contract between the compiler
+//! ([`super::decode`] and the passes, which write instructions) and the executor
+//! ([`super::interp`], [`super::execute`], [`super::image`], which run them). Neither
+//! side's code lives here, so both import it and it imports neither.
 
 use super::lanes::{LaneRegs, Members};
 use super::layout::Piece;
@@ -248,6 +254,103 @@ pub(super) struct CollectiveInsn {
     pub result: Reg,
 }
 
+/// Runs of words of a value (first word, words), in increasing order: the words of a
+/// load that its uses read ([`super::load_fields`]).
+pub(super) type Runs = Box<[(u32, u32)]>;
+
+/// Element `index` (clamped to the array's last, as WGSL does) of the runtime-sized array
+/// at byte `address` of bound buffer `buffer`, elements `stride` bytes apart, loaded
+/// into `dst`: `len` words, or only `runs` (first word, words) where given. A
+/// `PtrIndexRt` and a load fused into one instruction: why and when in
+/// [`super::element_load`].
+pub(super) struct ElementLoad {
+    /// First register of the loaded value.
+    pub dst: Reg,
+    /// Index of the bound buffer.
+    pub buffer: u32,
+    /// Byte of the array's first element in the buffer.
+    pub address: u32,
+    /// Register of the element index.
+    pub index: Reg,
+    /// Bytes from one element to the next.
+    pub stride: u32,
+    /// Words of the value.
+    pub len: u32,
+    /// The runs of words its uses read ([`super::load_fields`]), or `None`: all.
+    pub runs: Option<Runs>,
+}
+
+impl ElementLoad {
+    /// The buffer word where the element of `index` starts, for a buffer of `bytes`
+    /// bytes: the element clamped as `PtrIndexRt` clamps it ([`element_offset`]).
+    #[inline(always)]
+    pub(super) fn first_word(&self, bytes: usize, index: u32) -> usize {
+        let address = self.address as usize;
+        let available = bytes.saturating_sub(address);
+        (address + element_offset(available, self.stride as usize, index as usize)) / 4
+    }
+}
+
+/// Where element `index` of an array of elements `stride` apart starts, in a region of
+/// `available` units from the array's start: the element clamped to the last one that
+/// fits (WGSL), element 0 where none fits (its words then read as 0). No division
+/// where the element lies inside (the common case).
+#[inline(always)]
+pub(super) fn element_offset(available: usize, stride: usize, index: usize) -> usize {
+    // `index` and `stride` come from the kernel and its data: the end is computed
+    // without wrapping (an end past usize::MAX is outside every region).
+    if stride == 0 {
+        0
+    } else if index.checked_add(1).and_then(|n| n.checked_mul(stride)).is_some_and(|end| end <= available) {
+        index * stride
+    } else {
+        ((available / stride).max(1) - 1) * stride
+    }
+}
+
+/// What an image instruction does.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum ImageOp {
+    /// `textureLoad`: coordinate, optional layer and level; 4 words out.
+    Load,
+    /// `textureStore`: coordinate, optional layer, 4 words in.
+    Store,
+    /// `textureDimensions`: optional level; 1 to 3 words out.
+    Size,
+    /// `textureNumLevels`.
+    NumLevels,
+    /// `textureNumLayers`.
+    NumLayers,
+    /// `textureSampleLevel` (level register, or level 0 when absent).
+    SampleLevel,
+    /// `textureGather` of component 0 to 3 (level 0).
+    Gather(u8),
+}
+
+/// An image built-in, operands resolved to registers (by [`super::image_lower`]; run by
+/// [`super::image`]).
+pub(super) struct ImageInsn {
+    pub op: ImageOp,
+    /// Register of the image value (its slot in the first word's low 24 bits).
+    pub image: Reg,
+    /// Register of the sampler value (sampling only).
+    pub sampler: Reg,
+    /// Register of the coordinate (integers for loads and stores, f32 for sampling).
+    pub coordinate: Reg,
+    /// Its components (1 to 3).
+    pub coordinates: u8,
+    /// Register of the array layer, if the texture is arrayed.
+    pub layer: Option<Reg>,
+    /// Register of the mip level (an integer, or an f32 for sampling).
+    pub level: Option<Reg>,
+    /// Register of the value a store writes.
+    pub value: Reg,
+    /// A sampling offset in texels (a constant of the shader).
+    pub offset: [i32; 3],
+    /// Register of the result.
+    pub result: Reg,
+}
+
 /// One bytecode instruction. Unless said otherwise operands are registers, `n` counts
 /// components, and a `s*` stride is 1 for a vector operand and 0 for a scalar one
 /// broadcast over the components.
@@ -292,10 +395,10 @@ pub(super) enum Insn {
     /// Reads the words of `runs` (first word, words) of a `len`-word value through a
     /// pointer register: a struct whose other words are never read
     /// ([`super::load_fields`]).
-    LoadRuns { dst: Reg, pointer: Reg, len: u32, runs: super::load_fields::Runs },
+    LoadRuns { dst: Reg, pointer: Reg, len: u32, runs: Runs },
     /// An element of a runtime-sized array in a buffer known when compiling, loaded
     /// (`PtrIndexRt` and a load fused: [`super::element_load`]).
-    LoadElement(Box<super::element_load::ElementLoad>),
+    LoadElement(Box<ElementLoad>),
     /// Writes `len` words through a pointer register.
     Store { pointer: Reg, src: Reg, len: u32 },
     /// Reads a value holding f16 through a pointer into a buffer: naga's layout there,
@@ -341,7 +444,7 @@ pub(super) enum Insn {
     /// Subgroup ballot, reduction or scan.
     Collective(Box<CollectiveInsn>),
     /// A texture built-in (load, store, query, sample, gather).
-    Image(Box<super::image::ImageInsn>),
+    Image(Box<ImageInsn>),
     /// An unsupported construct reached at run time: (what, WGSL line).
     Fail(Box<(String, u32)>),
     /// An instruction whose accesses the sanitizer checks before running it (only in

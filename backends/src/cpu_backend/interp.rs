@@ -24,14 +24,14 @@
 //! contiguous words.
 
 use super::counts::DispatchCounts;
-use super::decode::Program;
 use super::error::{invalid, unsupported};
-use super::execute::execute;
+use super::execute::{GroupMemory, execute};
 use super::insn::{BinOp, CallInsn, Insn, UnOp};
 use super::lanes::{LaneRegs, Members, N as LANES};
 use super::limit::{FUEL, Limit};
 use super::memory::{FUNCTION, Frame};
 use super::places::Places;
+use super::program::Program;
 use super::sanitize::{Sanitizer, Sanitizing};
 use crate::error::BackendError;
 use std::cmp::Ordering;
@@ -96,34 +96,6 @@ pub(super) struct Scratch {
     targets: Vec<u32>,
     caller_codes: Vec<u32>,
     places: Places,
-}
-
-/// What the members of a running group reach besides the running code's registers.
-pub(super) struct GroupMemory<'a> {
-    /// Bound buffers in the kernel's binding order.
-    pub buffers: &'a [Vec<AtomicU32>],
-    /// The batch's workgroup memory: `workgroup_words` per workgroup, in order.
-    pub workgroup: &'a mut [u32],
-    /// Words of workgroup memory per workgroup.
-    pub workgroup_words: usize,
-    /// Invocations per workgroup (lane `l` is in the batch's workgroup `l / per_workgroup`).
-    pub per_workgroup: usize,
-    /// Every invocation's private memory, `private_words` each.
-    pub private: &'a mut [u32],
-    /// Words of private memory per invocation.
-    pub private_words: usize,
-    /// Every code's register file (the running code's taken out).
-    pub files: &'a mut [Vec<u32>],
-    /// The codes of the group's callers, outermost first.
-    pub callers: &'a [u32],
-    /// Lanes per register file (the batch's invocations).
-    pub width: usize,
-    /// The dispatch's time limit.
-    pub limit: &'a Limit,
-    /// Fuel left before the limit is looked at.
-    pub fuel: u32,
-    /// The sanitizer, when the dispatch sanitizes.
-    pub sanitizer: Option<Sanitizing<'a>>,
 }
 
 /// `$body` with `$operator` a function computing the `BinOp` equal to `$op`: one copy of
@@ -355,7 +327,7 @@ pub(super) fn run_until_sync(
 }
 
 /// Allocates a code's register file for `width` lanes, every register at its template
-/// value, the first time a worker thread runs the code (see [`super::decode::Code::locals`]);
+/// value, the first time a worker thread runs the code (see [`super::program::Code::locals`]);
 /// an error naming kernel `kernel` where the machine cannot give the memory (its size
 /// is within the caps of [`super::budget`]).
 pub(super) fn open_file(file: &mut Vec<u32>, template: &[u32], width: usize, kernel: &str) -> Result<(), BackendError> {
@@ -654,7 +626,7 @@ fn run_group(
             }
             Insn::Compute(compute) => compute(file, group),
             Insn::Checked(checked) => {
-                super::sanitize::execute(checked, program, code_index, pc as u32 - 1, file, group, memory)
+                super::checked::execute(checked, program, code_index, pc as u32 - 1, file, group, memory)
             }
             _ => execute(insn, file, group, memory),
         }

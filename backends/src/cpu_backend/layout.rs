@@ -1,7 +1,7 @@
 //! Where values live: the words a naga type takes in registers, the byte and word steps
 //! of fields, elements and components in each address space, how f16 values move
 //! between buffers and registers, and what a pointer points at when that is known at
-//! compile time. Shared by the compiler ([`super::decode`], [`super::expression`]), the
+//! compile time. Shared by the compiler ([`super::compiler`], [`super::expression`]), the
 //! instructions ([`super::insn`]) and memory access ([`super::memory`]), and dependent on
 //! none of them.
 //!

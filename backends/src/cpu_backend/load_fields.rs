@@ -8,7 +8,7 @@
 //!
 //! Sound because a word left unloaded is never read:
 //! - a field of a struct value is the value's own registers at the field's offset
-//!   ([`super::decode`]), so a use taking a field reads that field's words alone, and the
+//!   ([`super::compiler`]), so a use taking a field reads that field's words alone, and the
 //!   field's register layout is its memory layout (structs holding f16 are left whole);
 //! - the uses counted must add up to naga's reference count of the load, so a use of any
 //!   other kind (a store of the whole value, a return, a compose, ...) keeps the full
@@ -20,13 +20,11 @@
 //! - the words that are loaded are loaded as the whole load would (a word outside the
 //!   buffer reads 0 either way; [`super::execute`]).
 
+use super::insn::Runs;
 use super::layout::{member_step, own_register_layout, words_of};
 use super::load_alias::nested;
 use naga::valid::{FunctionInfo, ModuleInfo};
 use naga::{Block, Expression, Function, Handle, Module, Statement, TypeInner};
-
-/// Runs of words of a value (first word, words), in increasing order.
-pub(super) type Runs = Box<[(u32, u32)]>;
 
 /// Per expression of `function` (validated: `info`, the module's: `module_info`): for a
 /// load of a struct whose uses read only some of its words, those words.

@@ -3,7 +3,7 @@
 //! applied value by value, with f16 results rounded to binary16.
 
 use super::arith;
-use super::decode::{Compiler, Scope};
+use super::compiler::{Compiler, Scope};
 use super::insn::{Compute, Insn, Reg, per_lane};
 use super::lanes::{LaneRegs, Members, Words};
 use super::layout::{is_half, is_wide, member_step, scalar_shape, shape};

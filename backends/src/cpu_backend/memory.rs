@@ -8,9 +8,8 @@
 //!
 //! Out-of-bounds words read as 0 and are not written.
 
-use super::insn::Reg;
 use super::lanes::{LaneRegs, Words};
-use super::layout::Piece;
+use super::layout::{Piece, Reg};
 use smallvec::smallvec;
 use std::sync::atomic::{AtomicU32, Ordering};
 

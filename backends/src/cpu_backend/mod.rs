@@ -2,15 +2,17 @@
 //! kernels on the CPU. It is the reference executor of the cross-backend check and the
 //! command line's fallback when no GPU adapter exists.
 //!
-//! Each kernel is compiled once into a register bytecode (`insn`, compiled by
-//! `decode` and `expression`): instructions whose operands are word offsets in the
-//! frame's register file, small callees inlined, fields and bitcasts aliasing their
-//! source's registers, compile-time values in a register template. Four passes make
-//! the code shorter and less divergent: an `if` that only stores into locals becomes
-//! selects (`if_conversion`), a value stored right after it is computed goes straight
-//! into the variable (`retarget`), a local's load reads the variable's registers where
-//! nothing writes it before the value's last use (`load_alias`), and jumps to jumps or
-//! to the next instruction are tidied away (`jump_cleanup`). `interp` runs it;
+//! Each kernel is compiled once into a register bytecode (`insn`; a `program`, made by
+//! `decode` from the functions `compiler` and the lowering files compile): instructions
+//! whose operands are word offsets in the frame's register file, small callees inlined,
+//! fields and bitcasts aliasing their source's registers, compile-time values in a
+//! register template. Passes make the code shorter and less divergent: an `if` that
+//! only stores into locals becomes selects (`if_conversion`), a value stored right
+//! after it is computed goes straight into the variable (`retarget`), a local's load
+//! reads the variable's registers where nothing writes it before the value's last use
+//! (`load_alias`), an array element's pointer and its load become one instruction
+//! (`element_load`), and jumps to jumps or to the next instruction are tidied away
+//! (`jump_cleanup`). `interp` runs it;
 //! `memory` is the pointer model (offsets in bytes into bound buffers, in register
 //! words elsewhere). Workgroups run in parallel on the machine's cores;
 //! the invocations of a workgroup run together from barrier to barrier (`dispatch`; the
@@ -67,6 +69,8 @@ mod access;
 mod arith;
 mod batch;
 mod budget;
+mod checked;
+mod compiler;
 mod constant;
 mod counts;
 mod decode;
@@ -90,6 +94,7 @@ mod math_call;
 mod matrix;
 mod memory;
 mod places;
+mod program;
 mod retarget;
 mod sanitize;
 mod statement;
@@ -103,8 +108,8 @@ use crate::device_info::{DeviceInfo, DeviceLimits};
 use crate::error::BackendError;
 use crate::texture::{SamplerDesc, SamplerId, TextureDesc, TextureId};
 pub use counts::{DispatchCounts, WARP_WIDTH};
-use decode::Program;
 pub use limit::DEFAULT_TIME_LIMIT;
+use program::Program;
 pub use sanitize::{Finding, FindingKind, MAX_FINDINGS};
 use std::collections::HashMap;
 use std::time::{Duration, Instant};

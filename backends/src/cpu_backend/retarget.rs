@@ -15,27 +15,9 @@
 //! operand may equal the new destination but must not partly overlap it (checked per
 //! instruction kind, [`retargetable`]).
 
-use super::decode::{Compiler, Scope};
+use super::compiler::{Compiler, LastValue, Scope};
 use super::insn::{Insn, Reg};
 use naga::{Expression, Handle};
-
-/// The last expression compiled: its scope (the naga function and the inlining depth,
-/// as handles of different scopes collide), its handle and the index of its first
-/// instruction.
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub(super) struct LastValue {
-    function: *const naga::Function,
-    depth: u32,
-    handle: Handle<Expression>,
-    first_insn: usize,
-}
-
-impl LastValue {
-    /// `handle` of `scope`, compiled from instruction `first_insn` on.
-    pub(super) fn new(scope: &Scope, handle: Handle<Expression>, first_insn: usize) -> Self {
-        Self { function: scope.function, depth: scope.depth, handle, first_insn }
-    }
-}
 
 impl Compiler<'_> {
     /// Makes the instruction that computed `value` (`len` words) write `dst` instead, if

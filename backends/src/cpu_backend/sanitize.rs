@@ -24,11 +24,17 @@
 //! How: the sanitizing program is compiled apart (its own cache entry), without
 //! if-conversion (which evaluates both branches' loads and indices: their accesses would
 //! be reported although WGSL never makes them), and every instruction that indexes or
-//! touches workgroup or buffer memory is wrapped in [`Insn::Checked`]: the group loop
-//! calls [`execute`], which checks each member's access, records it in a shadow word
+//! touches workgroup or buffer memory is wrapped in [`Insn::Checked`](super::insn::Insn::Checked)
+//! ([`super::decode`]): the group loop calls [`super::checked::execute`], which checks
+//! each member's access ([`check_access`]), records it in a shadow word
 //! (the last write, the last two different readers, with the invocation, the barrier
 //! epoch and the instruction), then runs the instruction as usual. The normal program
 //! holds no checked instruction, so the normal mode pays nothing.
+//!
+//! Where: this file holds what the sanitizer knows (findings, shadows, the check of one
+//! access) and reads only the compiled [`Program`]; it sits below the executor, whose
+//! group memory carries a [`Sanitizing`]. The instructions are wrapped by the compiler
+//! ([`super::decode`]) and checked at run time in [`super::checked`].
 //!
 //! What it does not detect, and why:
 //! - function-space (`var` in a function) and private variables read before written:
@@ -46,12 +52,8 @@
 //!   storage words past the shadow's cap ([`SHADOW_CAP_WORDS`] words per dispatch): a
 //!   finding is always real, an absent one is not a proof.
 
-use super::decode::Program;
-use super::insn::Insn;
-use super::interp::GroupMemory;
-use super::lanes::{LaneRegs, Members};
-use super::layout::Piece;
 use super::memory::{BUFFER, TAG_MASK, WORKGROUP};
+use super::program::Program;
 use std::collections::HashMap;
 use std::fmt;
 use std::sync::Mutex;
@@ -174,14 +176,14 @@ pub(super) struct Shadow {
 
 /// How an instruction touches a word.
 #[derive(Clone, Copy, PartialEq, Eq)]
-enum Op {
+pub(super) enum Op {
     Read,
     Write,
     Atomic,
 }
 
 /// The instruction `pc` of code `code` in a shadow word (`u32::MAX` past its range).
-fn site_of(code: u32, pc: u32) -> u32 {
+pub(super) fn site_of(code: u32, pc: u32) -> u32 {
     if code < 1 << 12 && pc < 1 << 20 { code << 20 | pc } else { u32::MAX }
 }
 
@@ -367,178 +369,20 @@ pub(super) struct Sanitizing<'a> {
 }
 
 /// What one member's access touches, for [`check_access`].
-struct Touch {
-    op: Op,
+pub(super) struct Touch {
+    pub op: Op,
     /// A pointer tag's region ([`BUFFER`] with its binding, [`WORKGROUP`]), or another
     /// region (not checked).
-    tag: u32,
+    pub tag: u32,
     /// First word (in the region: a buffer's words, the workgroup's words).
-    word: usize,
+    pub word: usize,
     /// Words.
-    len: usize,
-}
-
-/// Runs checked instruction `insn` (instruction `pc` of code `code`) for `members`:
-/// each member's access checked and recorded, then the instruction as usual.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn execute(
-    insn: &Insn,
-    program: &Program,
-    code: u32,
-    pc: u32,
-    file: &mut [u32],
-    members: Members,
-    memory: &mut GroupMemory,
-) {
-    check(insn, program, code, pc, file, members, memory);
-    let width = memory.width;
-    match *insn {
-        Insn::PtrIndex { dst, base, index, count, stride } => members.for_each(|lane| {
-            let mut regs = LaneRegs::new(file, lane, width);
-            let (tag, offset, i) = (regs[base as usize], regs[base as usize + 1], regs[index as usize]);
-            let at = (i as usize).min(count.saturating_sub(1) as usize) * stride as usize;
-            regs[dst as usize] = tag;
-            regs[dst as usize + 1] = (offset as usize + at) as u32;
-        }),
-        Insn::Extract { dst, base, index, count, stride, len } => members.for_each(|lane| {
-            let mut regs = LaneRegs::new(file, lane, width);
-            let at = (regs[index as usize] as usize).min(count.saturating_sub(1) as usize) * stride as usize;
-            regs.copy(dst as usize, base as usize + at, len as usize);
-        }),
-        _ => super::execute::execute(insn, file, members, memory),
-    }
-}
-
-/// Checks and records each member's access of `insn`.
-#[allow(clippy::too_many_arguments)]
-fn check(
-    insn: &Insn,
-    program: &Program,
-    code: u32,
-    pc: u32,
-    file: &mut [u32],
-    members: Members,
-    memory: &mut GroupMemory,
-) {
-    let width = memory.width;
-    let (per_workgroup, workgroup_words) = (memory.per_workgroup, memory.workgroup_words);
-    let GroupMemory { buffers, sanitizer, .. } = memory;
-    let Some(Sanitizing { shared, local }) = sanitizer else { return };
-    let (shared, local): (&Sanitizer, &mut Local) = (shared, local);
-    let buffers: &[_] = buffers;
-    let buffer_words = |tag: u32| buffers.get((tag & !TAG_MASK) as usize).map_or(0, |b| b.len());
-    let binding = |slot: u32| {
-        program.binding_names.get(slot as usize).map_or_else(|| format!("binding {slot}"), |n| format!("`{n}`"))
-    };
-    let site = site_of(code, pc);
-    members.for_each(|lane| {
-        let regs = LaneRegs::new(file, lane, width);
-        let me = local.first_id + lane as u64;
-        // The lane's workgroup's region in the batch's workgroup memory (and shadows).
-        let region =
-            if workgroup_words == 0 || per_workgroup == width { 0 } else { lane / per_workgroup } * workgroup_words;
-        // An index check: `index` against `length` elements.
-        let index_check = |local: &mut Local, index: u64, length: u64, of: &dyn Fn() -> String| {
-            if index >= length {
-                local.found(shared, program, (FindingKind::OutOfRangeIndex, code, pc), || {
-                    format!("index {index}, length {length}{}", of())
-                });
-            }
-        };
-        let pointer = |reg: u32| (regs[reg as usize], regs[reg as usize + 1] as usize);
-        let mut touches: smallvec::SmallVec<[Touch; 2]> = smallvec::SmallVec::new();
-        let through = |op: Op, (tag, offset): (u32, usize), len: usize| match tag & TAG_MASK {
-            BUFFER => Touch { op, tag, word: offset / 4, len },
-            _ => Touch { op, tag, word: offset, len },
-        };
-        match insn {
-            Insn::PtrIndex { index, count, .. } | Insn::Extract { index, count, .. } => {
-                index_check(local, u64::from(regs[*index as usize]), u64::from(*count), &String::new);
-            }
-            Insn::PtrIndexRt { base, index, stride, .. } => {
-                let (tag, offset) = pointer(*base);
-                if tag & TAG_MASK == BUFFER {
-                    let available = (buffer_words(tag) * 4).saturating_sub(offset);
-                    let length = (available / (*stride).max(1) as usize) as u64;
-                    index_check(local, u64::from(regs[*index as usize]), length, &|| {
-                        format!(" (elements in {})", binding(tag & !TAG_MASK))
-                    });
-                }
-            }
-            Insn::LoadElement(load) => {
-                let bytes = buffer_words(BUFFER | load.buffer) * 4;
-                let available = bytes.saturating_sub(load.address as usize);
-                let length = (available / load.stride.max(1) as usize) as u64;
-                let index = regs[load.index as usize];
-                index_check(local, u64::from(index), length, &|| format!(" (elements in {})", binding(load.buffer)));
-                let first = load.first_word(bytes, index);
-                match &load.runs {
-                    Some(runs) => touches.extend(runs.iter().map(|&(start, words)| Touch {
-                        op: Op::Read,
-                        tag: BUFFER | load.buffer,
-                        word: first + start as usize,
-                        len: words as usize,
-                    })),
-                    None => touches.push(Touch {
-                        op: Op::Read,
-                        tag: BUFFER | load.buffer,
-                        word: first,
-                        len: load.len as usize,
-                    }),
-                }
-            }
-            Insn::Load { pointer: p, len, .. } => touches.push(through(Op::Read, pointer(*p), *len as usize)),
-            Insn::LoadRuns { pointer: p, runs, .. } => {
-                let (tag, offset) = pointer(*p);
-                for &(start, words) in runs.iter() {
-                    let mut touch = through(Op::Read, (tag, offset), words as usize);
-                    touch.word += start as usize;
-                    touches.push(touch);
-                }
-            }
-            Insn::Store { pointer: p, len, .. } => touches.push(through(Op::Write, pointer(*p), *len as usize)),
-            Insn::LoadMixed { pointer: p, plan, .. } | Insn::StoreMixed { pointer: p, plan, .. } => {
-                let op = if matches!(insn, Insn::LoadMixed { .. }) { Op::Read } else { Op::Write };
-                let (tag, offset) = pointer(*p);
-                // Whole words only: two halves of a word are different WGSL locations.
-                for piece in plan.iter() {
-                    match *piece {
-                        Piece::Words { memory: at, len, .. } => {
-                            touches.push(Touch { op, tag, word: (offset + at as usize) / 4, len: len as usize })
-                        }
-                        Piece::Half { memory: at, .. } => {
-                            let word = (offset + at as usize) / 4;
-                            if word >= buffer_words(tag) {
-                                touches.push(Touch { op, tag, word, len: 1 });
-                            }
-                        }
-                    }
-                }
-            }
-            Insn::LoadWorkgroup { address, len, .. } => {
-                touches.push(Touch { op: Op::Read, tag: WORKGROUP, word: *address as usize, len: *len as usize })
-            }
-            Insn::StoreWorkgroup { address, len, .. } => {
-                touches.push(Touch { op: Op::Write, tag: WORKGROUP, word: *address as usize, len: *len as usize })
-            }
-            Insn::LoadBuffer { buffer, address, len, .. } => {
-                touches.push(Touch { op: Op::Read, tag: BUFFER | buffer, word: *address as usize, len: *len as usize })
-            }
-            Insn::StoreBuffer { buffer, address, len, .. } => {
-                touches.push(Touch { op: Op::Write, tag: BUFFER | buffer, word: *address as usize, len: *len as usize })
-            }
-            Insn::Atomic(atomic) => touches.push(through(Op::Atomic, pointer(atomic.pointer), 1)),
-            _ => {}
-        }
-        for touch in touches {
-            check_access(shared, local, program, (code, pc, site), me, &touch, &buffer_words, &binding, region);
-        }
-    });
+    pub len: usize,
 }
 
 /// Checks one member's touch: past a binding's end, unwritten workgroup words, races.
 #[allow(clippy::too_many_arguments)]
-fn check_access(
+pub(super) fn check_access(
     shared: &Sanitizer,
     local: &mut Local,
     program: &Program,
@@ -657,26 +501,4 @@ fn workgroup_word(program: &Program, word: usize) -> String {
         Some((start, _, name)) => format!("word {} of `{name}`", word as u32 - start),
         None => format!("workgroup word {word}"),
     }
-}
-
-/// Whether `insn` is checked in the sanitizing program: it indexes, or touches
-/// workgroup or buffer memory.
-pub(super) fn is_checked(insn: &Insn) -> bool {
-    matches!(
-        insn,
-        Insn::PtrIndex { .. }
-            | Insn::PtrIndexRt { .. }
-            | Insn::Extract { .. }
-            | Insn::Load { .. }
-            | Insn::LoadRuns { .. }
-            | Insn::LoadElement(_)
-            | Insn::Store { .. }
-            | Insn::LoadMixed { .. }
-            | Insn::StoreMixed { .. }
-            | Insn::LoadWorkgroup { .. }
-            | Insn::StoreWorkgroup { .. }
-            | Insn::LoadBuffer { .. }
-            | Insn::StoreBuffer { .. }
-            | Insn::Atomic(_)
-    )
 }

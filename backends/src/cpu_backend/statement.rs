@@ -1,14 +1,13 @@
-//! Lowering naga statements to bytecode ([`super::decode`] compiles functions, this file
-//! their bodies): stores, control flow as jumps (`if` around its accept block, loops as
+//! Lowering naga statements to bytecode ([`super::compiler`] opens functions, this file
+//! compiles their bodies): stores, control flow as jumps (`if` around its accept block, loops as
 //! a backward jump, `break`/`continue` patched when the construct closes, `switch` as a
 //! table of (value, target)), barriers, atomics, subgroup operations and calls (small
 //! callees inlined into the caller's frame).
 
-use super::decode::{Compiler, INLINE_DEPTH, INLINE_EXPRESSIONS, Scope};
+use super::compiler::{Compiler, INLINE_DEPTH, INLINE_EXPRESSIONS, LastValue, Scope};
 use super::error::unsupported;
 use super::insn::{CallInsn, CollectiveFun, CollectiveInsn, GatherInsn, Insn, Reg};
 use super::layout::{Place, is_half, is_wide, shape};
-use super::retarget::LastValue;
 use crate::error::BackendError;
 use naga::{Expression, Handle, Statement, TypeInner};
 

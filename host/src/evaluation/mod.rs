@@ -6,9 +6,13 @@
 //! folder, and [`report`] runs a whole comparison from a plain options struct. It runs the renderer and the command line runs it, so it is
 //! a module of the host crate rather than a crate below it.
 
+pub mod bias_noise;
 pub mod block_structure;
 pub mod compare;
+pub mod correlation;
 pub mod crops;
+mod fft;
+pub mod flicker;
 pub mod flip;
 pub mod image_checks;
 pub mod metrics;
@@ -18,4 +22,6 @@ pub mod plot;
 pub mod record;
 pub mod report;
 pub mod summary;
+#[cfg(test)]
+mod test_noise;
 pub mod variance;

@@ -92,6 +92,10 @@ pub const KERNEL_PRIVATE: &[&str] = &[
     // "No temporal source" and "no pixel" between two ReSTIR passes' locals.
     "NO_SOURCE",
     "NO_PIXEL",
+    // The resampling core's slots and the id of its kept canonical sample
+    // (restir/resampling_core.wgsl).
+    "MAX_SLOTS",
+    "CANONICAL_KEPT",
     // How restir_candidates' walk along the camera path ended (restir/entry_candidates.wgsl).
     "EXIT_OTHER",
     "EXIT_REPLAY",

@@ -34,6 +34,7 @@ pub static WGSL_FILES: &[Fragment] = &[
     fragment!("restir/entry_temporal.wgsl"),
     fragment!("restir/entry_temporal_keys.wgsl"),
     fragment!("restir/reservoir.wgsl"),
+    fragment!("restir/resampling_core.wgsl"),
     fragment!("restir/reuse_slot.wgsl"),
     fragment!("strata/blue_noise.wgsl"),
     fragment!("strata/candidate.wgsl"),

@@ -15,8 +15,9 @@
 //
 // Weights: pairwise MIS with confidence weights between the canonical reservoir c (M_c)
 // and each drawn reservoir j (M_j), each pair sharing 1/K and counting neighbour j as K
-// copies of itself (with M = 1 everywhere this is restir_select's weighting), the
-// targets as densities and W the reservoirs' unbiased contribution weights:
+// copies of itself (restir/resampling_core.wgsl, stream_neighbour; with M = 1 everywhere
+// this is restir_select's weighting), the targets as densities and W the reservoirs'
+// unbiased contribution weights:
 //   w_c = sum_j (1/K) M_c p̂_i(y_c) / (M_c p̂_i(y_c) + K M_j p̂_j(y_c)) p̂_i(y_c) W_c
 //   w_j = (1/K) K M_j p̂_j(y_j) / (M_c p̂_i(y_j) + K M_j p̂_j(y_j)) p̂_i(y_j) W_j
 // with p̂_j = 0 where pixel j cannot reconnect to y or resamples another kind of integral
@@ -25,7 +26,7 @@
 // and j only (M comes from earlier frames and the geometry, never from this frame's
 // draws), and every drawing pattern gives each run member the expected count K/n
 // whatever the keys' order, so the sum of weights and the RIS estimate stay unbiased as
-// in restir_select (README, "Why the selection stays unbiased"). One sample is kept in
+// in restir_select (docs/restir.md, "Why the selection stays unbiased"). One sample is kept in
 // proportion to w, W = sum(w) / p̂_i(Y), M = M_c + the sum of the merged M_j (Bitterli et
 // al. 2020, Alg. 4; the next merge caps it at RestirParams.temporal_cap).
 //
@@ -48,6 +49,7 @@
 // #import restir/reservoir.wgsl
 // #import restir/reuse_slot.wgsl
 // #import restir/block_reuse.wgsl
+// #import restir/resampling_core.wgsl
 
 @group(0) @binding(9) var<storage, read> primaries: array<Primary>;
 @group(0) @binding(10) var<storage, read> reservoirs_in: array<Reservoir>;
@@ -58,10 +60,10 @@
 
 @compute @workgroup_size(8, 8)
 fn restir_spatial(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    if id.x >= params.width || id.y >= params.height {
+    let pixel = image_pixel(id);
+    if pixel == NO_PIXEL {
         return;
     }
-    let pixel = id.y * params.width + id.x;
     let p = primaries[pixel];
     let canonical = reservoirs_in[pixel];
     reservoirs_out[pixel] = canonical;
@@ -78,28 +80,20 @@ fn restir_spatial(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_i
         numbers = selection_numbers(id.xy, params.sample_index, params.seed, restir.sampler, k, 0u);
     }
     let positions = numbers.positions;
-    let c = canonical.sample;
-    let m_c = canonical.count;
-    // p̂_i(y_c) W_c, with p̂_i(y_c) the merge's (visibility included).
+    // p̂_i(y_c) W_c, with p̂_i(y_c) the merge's (visibility included), and f(y_c) here, for
+    // the pixel's own reservoir drawn again and for the expectation: one evaluation (a
+    // replayed candidate costs a traced path), compiled once.
     var target_c = 0.0;
     if canonical.weight > 0.0 {
         target_c = canonical.target_value;
     }
-    let c_shareable = target_c > 0.0 && reconnectable(p, c);
-    // f(y_c) here, for the pixel's own reservoir drawn again and for the expectation: one
-    // evaluation (a replayed candidate costs a traced path), compiled once.
     var colour_c = vec3<f32>(0.0);
     if target_c > 0.0 {
-        colour_c = integrand(p, c, lane);
+        colour_c = integrand(p, canonical.sample, lane);
     }
-    var weight_c = 0.0;
-    var m_sum = 0.0;
-    // Per slot: resampling weight, target p̂_i here, f here and the pixel it came from.
-    var weights = vec4<f32>(0.0);
-    var targets = vec4<f32>(0.0);
-    var sources = vec4<u32>(pixel);
-    // Written out element by element (see restir_select: naga's HLSL zero constructor).
-    var colours = array<vec3<f32>, MAX_SELECTED>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    let c = CanonicalSample(canonical.sample, target_c, canonical.weight, canonical.count, colour_c,
+        target_c > 0.0 && reconnectable(p, canonical.sample));
+    var state = resampling_start(k, pixel);
     for (var slot = 0u; slot < k; slot++) {
         let q = block_slot_pixel(id.x, id.y, pixel, p, slot, positions);
         var neighbour_reservoir = canonical;
@@ -108,75 +102,13 @@ fn restir_spatial(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_i
             neighbour_reservoir = reservoirs_in[q];
             neighbour = primaries[q];
         }
-        let m_j = neighbour_reservoir.count;
-        if q == NO_PIXEL || !(m_j > 0.0) || !may_share(p, neighbour) {
-            // Nothing to merge in this slot: the canonical reservoir covers its share,
-            // and no confidence is added.
-            weight_c += target_c * canonical.weight / f32(k);
-            continue;
-        }
-        sources[slot] = q;
-        m_sum += m_j;
-        if q == pixel {
-            // The pixel's own reservoir drawn again: both halves of the pair are c, its
-            // share M_c / (M_c + K M_c) = 1 / (1 + K).
-            if c_shareable {
-                let share = 1.0 / (1.0 + f32(k));
-                weight_c += share * target_c * canonical.weight / f32(k);
-                weights[slot] = (1.0 - share) * target_c * canonical.weight / f32(k);
-                targets[slot] = target_c;
-                colours[slot] = colour_c;
-            } else {
-                weight_c += target_c * canonical.weight / f32(k);
-            }
-            continue;
-        }
-        // The pair's two evaluations in one loop whose branches choose what to evaluate
-        // where, so that a driver compiles the integrand (which may re-trace a replayed
-        // path) and the visibility test once: step 0, the canonical half, p̂_j(y_c) at the
-        // neighbour's primary hit; step 1, the neighbour's half, y_j reconnected here
-        // (p̂_j(y_j) is its stored target); both with visibility included.
-        let y = neighbour_reservoir.sample;
-        let there = neighbour_reservoir.target_value;
-        var target_neighbour_c = 0.0;
-        for (var step = 0u; step < 2u; step++) {
-            var at = neighbour;
-            var candidate = c;
-            var wanted = c_shareable && reconnectable(neighbour, c);
-            if step == 1u {
-                at = p;
-                candidate = y;
-                wanted = neighbour_reservoir.weight > 0.0 && there > 0.0 && reconnectable(p, y)
-                    && reconnectable(neighbour, y);
-            }
-            if !wanted {
-                continue;
-            }
-            let colour = integrand(at, candidate, lane);
-            var value = luminance(colour);
-            if value > 0.0 && !candidate_visible(at, candidate, lane) {
-                value = 0.0;
-            }
-            if step == 0u {
-                target_neighbour_c = value;
-            } else if value > 0.0 {
-                let m = f32(k) * m_j * there / (m_c * value + f32(k) * m_j * there);
-                weights[slot] = m * value * neighbour_reservoir.weight / f32(k);
-                targets[slot] = value;
-                colours[slot] = colour;
-            }
-        }
-        if target_c > 0.0 {
-            let m = m_c * target_c / (m_c * target_c + f32(k) * m_j * target_neighbour_c);
-            weight_c += m * target_c * canonical.weight / f32(k);
-        }
+        // p̂_j(y_j) is the neighbour's stored target (this frame's, from the merge).
+        state = stream_neighbour(state, slot, k, pixel, p, c, q, neighbour, neighbour_reservoir.sample,
+            neighbour_reservoir.weight, neighbour_reservoir.count, neighbour_reservoir.target_value, false, lane);
     }
-    var total = weight_c;
-    for (var slot = 0u; slot < k; slot++) {
-        total += weights[slot];
-    }
+    let total = resampling_total(state);
     var result = canonical;
-    result.count = m_c + m_sum;
+    result.count = canonical.count + state.merged_count;
     if !(total > 0.0) || !(total < INFINITY) {
         result.weight = 0.0;
         result.target_value = 0.0;
@@ -184,24 +116,14 @@ fn restir_spatial(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_i
         reservoirs_out[pixel] = result;
         return;
     }
-    let chosen = resampled_slot(weight_c, weights, k, total, numbers.resample);
-    if chosen < MAX_SELECTED {
-        result.sample = reservoirs_in[sources[chosen]].sample;
-        result.target_value = targets[chosen];
+    let chosen = chosen_slot(state, total, numbers.resample, restir.method == METHOD_STRATA);
+    if chosen != CANONICAL_KEPT {
+        result.sample = reservoirs_in[state.sources[chosen]].sample;
+        result.target_value = state.targets[chosen];
     } else {
         result.target_value = target_c;
     }
     result.weight = total / result.target_value;
-    // The expectation over the choice: sum_i w_i f(y_i) / p̂_i(y_i), each f here.
-    var expected = vec3<f32>(0.0);
-    if weight_c > 0.0 && target_c > 0.0 {
-        expected += weight_c / target_c * colour_c;
-    }
-    for (var slot = 0u; slot < k; slot++) {
-        if weights[slot] > 0.0 && targets[slot] > 0.0 {
-            expected += weights[slot] / targets[slot] * colours[slot];
-        }
-    }
-    result.expected = expected;
+    result.expected = resampling_expectation(state, target_c, colour_c);
     reservoirs_out[pixel] = result;
 }

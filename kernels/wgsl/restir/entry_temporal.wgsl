@@ -52,6 +52,7 @@
 // #import strata/resampling.wgsl
 // #import restir/reservoir.wgsl
 // #import restir/reuse_slot.wgsl
+// #import restir/resampling_core.wgsl
 
 @group(0) @binding(9) var<storage, read> primaries: array<Primary>;
 @group(0) @binding(10) var<storage, read> previous_primaries: array<Primary>;
@@ -64,23 +65,6 @@
 @group(0) @binding(17) var<storage, read> blue_noise: array<u32>;
 
 const NO_SOURCE: u32 = 0xffffffffu;
-
-// The contribution of `y` at primary hit `p`, visibility included.
-fn contribution_at(p: Primary, y: PathCandidate, lane: u32) -> vec3<f32> {
-    if !reconnectable(p, y) {
-        return vec3<f32>(0.0);
-    }
-    let value = integrand(p, y, lane);
-    if luminance(value) > 0.0 && candidate_visible(p, y, lane) {
-        return value;
-    }
-    return vec3<f32>(0.0);
-}
-
-// p̂ of `y` at primary hit `p`: luminance of its contribution, visibility included.
-fn target_at(p: Primary, y: PathCandidate, lane: u32) -> f32 {
-    return luminance(contribution_at(p, y, lane));
-}
 
 // The previous frame's pixel whose reservoir drawn temporal slot `slot` of pixel (x, y)
 // merges, or NO_SOURCE for an empty slot (restir/reuse_slot.wgsl draws it like a
@@ -100,20 +84,15 @@ fn drawn_source(x: u32, y: u32, pixel: u32, p: Primary, slot: u32, positions: ve
     return temporal_sources[temporal_sorted_pixels[index]];
 }
 
-// One pair (current c, previous reservoir of source s) of the merge, each pair sharing
-// `share`: c's half goes to `current_part`, the previous sample's resampling weight and
-// target here to `weight` and `target_here` (its contribution here to `colour_here`), its
-// capped M to `m`.
-struct PairTerms {
-    current_part: f32,
-    weight: f32,
-    target_here: f32,
-    m: f32,
-    colour_here: vec3<f32>,
-}
-
-fn pair_terms(p: Primary, current: Reservoir, s: u32, share: f32, lane: u32) -> PairTerms {
-    var terms = PairTerms(0.0, 0.0, 0.0, 0.0, vec3<f32>(0.0));
+// Merges the previous reservoir of source pixel `s` (NO_SOURCE: an empty slot) into
+// `state` as slot `slot`: one pair (current c, previous j) of the merge, sharing `share`
+// = 1/S, with confidences M_c and the capped M_j (C_j = M_j). Slot 0 is the pixel's own
+// temporal source, slots 1..T the drawn ones. An empty slot, or a source reaching its
+// resampling vertex with another path segment or kind of shift (reservoir.wgsl,
+// may_share: p̂ is 0 both ways), gives c its share and merges nothing, so adds no M.
+fn merge_previous(state: Resampling, slot: u32, p: Primary, current: Reservoir, s: u32, share: f32, lane: u32) -> Resampling {
+    var next = state;
+    next.sources[slot] = s;
     var m_previous = 0.0;
     var previous = current;
     if s != NO_SOURCE {
@@ -122,56 +101,37 @@ fn pair_terms(p: Primary, current: Reservoir, s: u32, share: f32, lane: u32) -> 
     }
     let target_current = current.target_value;
     if !(m_previous > 0.0) {
-        // An empty slot: the current reservoir alone covers its share.
-        terms.current_part = share * target_current * current.weight;
-        return terms;
+        next.canonical_weight += share * target_current * current.weight;
+        return next;
     }
-    let m_current = current.count;
     let previous_primary = previous_primaries[s];
     if !may_share(p, previous_primary) {
-        // Another path segment or kind of shift (reservoir.wgsl, may_share): p̂ is 0 both ways, and c
-        // alone covers the pair, which merges nothing and so adds no confidence M.
-        terms.current_part = share * target_current * current.weight;
-        return terms;
+        next.canonical_weight += share * target_current * current.weight;
+        return next;
     }
-    terms.m = m_previous;
-    // The two halves in one loop whose branches choose what to evaluate where, so that a
-    // driver compiles contribution_at (which may re-trace a replayed path) once: half 0
-    // the current sample there (its target here is stored), half 1 the previous sample
-    // shifted here.
-    for (var half = 0u; half < 2u; half++) {
-        var at = previous_primary;
-        var y = current.sample;
-        var wanted = target_current > 0.0;
-        if half == 1u {
-            at = p;
-            y = previous.sample;
-            wanted = previous.target_value > 0.0;
-        }
-        if !wanted {
-            continue;
-        }
-        let colour = contribution_at(at, y, lane);
-        let value = luminance(colour);
-        if half == 0u {
-            let m = m_current * target_current / (m_current * target_current + m_previous * value);
-            terms.current_part = share * m * target_current * current.weight;
-        } else if value > 0.0 {
-            let m = m_previous * previous.target_value / (m_current * value + m_previous * previous.target_value);
-            terms.weight = share * m * value * previous.weight;
-            terms.target_here = value;
-            terms.colour_here = colour;
-        }
+    next.merged_count += m_previous;
+    // The current sample's target here is stored; the previous sample's there is too.
+    let e = pair_evaluations(p, previous_primary, current.sample, target_current > 0.0, previous.sample,
+        previous.target_value > 0.0, previous.target_value, false, lane);
+    if target_current > 0.0 {
+        let m = canonical_mis(current.count, target_current, m_previous, e.target_neighbour_at_c);
+        next.canonical_weight += share * m * target_current * current.weight;
     }
-    return terms;
+    if e.target_here > 0.0 {
+        let m = neighbour_mis(current.count, e.target_here, m_previous, previous.target_value);
+        next.weights[slot] = share * m * e.target_here * previous.weight;
+        next.targets[slot] = e.target_here;
+        next.colours[slot] = e.colour_here;
+    }
+    return next;
 }
 
 @compute @workgroup_size(8, 8)
 fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    if id.x >= params.width || id.y >= params.height {
+    let pixel = image_pixel(id);
+    if pixel == NO_PIXEL {
         return;
     }
-    let pixel = id.y * params.width + id.x;
     let p = primaries[pixel];
     let current = current_reservoirs[pixel];
     merged_reservoirs[pixel] = current;
@@ -181,111 +141,43 @@ fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
     rng_seed(pixel, params.sample_index, params.seed ^ 0x7e3907u);
     let drawn = min(restir.temporal_candidates, MAX_SELECTED);
     let share = 1.0 / f32(1u + drawn);
-    // The drawn previous reservoirs: per slot resampling weight, target here, source pixel.
     var numbers = SelectionNumbers(vec4<f32>(0.0), 0.0);
     if restir.method == METHOD_STRATA && drawn > 0u {
         numbers = selection_numbers(id.xy, params.sample_index, params.seed, restir.sampler, drawn, 1u);
     }
     let positions = numbers.positions;
-    var weights = vec4<f32>(0.0);
-    var targets = vec4<f32>(0.0);
-    var sources = vec4<u32>(NO_SOURCE);
-    // Per slot the previous sample's contribution here, for the expectation.
-    // Written out element by element: naga turns the zero-value constructor
-    // `array<vec3<f32>, 4>()` into an HLSL cast `(float3[4])0` that glslang's HLSL front
-    // end rejects. MAX_SELECTED is 4.
-    var colours = array<vec3<f32>, MAX_SELECTED>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
-    // Pair 0 is the pixel's own reprojected reservoir, pairs 1 to `drawn` the drawn slots:
-    // one loop, so that pair_terms is compiled once.
-    let own_source = temporal_sources[pixel];
-    var own = PairTerms(0.0, 0.0, 0.0, 0.0, vec3<f32>(0.0));
-    var weight_current = 0.0;
-    var m_sum = 0.0;
-    for (var pair = 0u; pair <= drawn; pair++) {
-        var s = own_source;
-        if pair > 0u {
-            s = drawn_source(id.x, id.y, pixel, p, pair - 1u, positions);
+    // Slot 0 is the pixel's own reprojected reservoir, slots 1 to `drawn` the drawn ones:
+    // one loop, so that merge_previous is compiled once.
+    var state = resampling_start(1u + drawn, NO_SOURCE);
+    for (var slot = 0u; slot <= drawn; slot++) {
+        var s = temporal_sources[pixel];
+        if slot > 0u {
+            s = drawn_source(id.x, id.y, pixel, p, slot - 1u, positions);
         }
-        let terms = pair_terms(p, current, s, share, lane);
-        if pair == 0u {
-            own = terms;
-            weight_current = terms.current_part;
-            m_sum = terms.m;
-            continue;
-        }
-        let slot = pair - 1u;
-        weight_current += terms.current_part;
-        m_sum += terms.m;
-        weights[slot] = terms.weight;
-        targets[slot] = terms.target_here;
-        colours[slot] = terms.colour_here;
-        sources[slot] = s;
+        state = merge_previous(state, slot, p, current, s, share, lane);
     }
-    var total = weight_current + own.weight;
-    for (var slot = 0u; slot < drawn; slot++) {
-        total += weights[slot];
-    }
+    let total = resampling_total(state);
     var merged = current;
-    merged.count = current.count + m_sum * share;
+    merged.count = current.count + state.merged_count * share;
     if !(total > 0.0) || !(total < INFINITY) {
         merged.weight = 0.0;
         merged.expected = vec3<f32>(0.0);
         merged_reservoirs[pixel] = merged;
         return;
     }
-    // The expectation over this merge's choice, sum_i w_i f(y_i) / p̂(y_i) (each y_i's f
-    // here; p̂ > 0 means it was visible): what SHADING_EXPECTATION adds in place of
+    // The expectation over this merge's choice: what SHADING_EXPECTATION adds in place of
     // f(Y) V W. The current reservoir's part uses its kept sample, not select's own
     // expectation: its MIS weight depends on which sample select kept.
-    var expected = vec3<f32>(0.0);
-    if weight_current > 0.0 && current.target_value > 0.0 {
-        expected += weight_current / current.target_value * integrand(p, current.sample, lane);
+    var colour_current = vec3<f32>(0.0);
+    if state.canonical_weight > 0.0 && current.target_value > 0.0 {
+        colour_current = integrand(p, current.sample, lane);
     }
-    if own.weight > 0.0 && own.target_here > 0.0 {
-        expected += own.weight / own.target_here * own.colour_here;
-    }
-    for (var slot = 0u; slot < drawn; slot++) {
-        if weights[slot] > 0.0 && targets[slot] > 0.0 {
-            expected += weights[slot] / targets[slot] * colours[slot];
-        }
-    }
-    merged.expected = expected;
-    // Choice among (current, own, drawn 0..T-1): OWN or a drawn slot, or none for current.
-    let OWN = MAX_SELECTED;
-    let NONE = MAX_SELECTED + 1u;
-    var chosen = NONE;
-    if restir.method == METHOD_STRATA && drawn > 0u {
-        // Inverse CDF with the temporal resampling number.
-        var choice = inverse_cdf_first(numbers.resample * total, weight_current, NONE);
-        choice = inverse_cdf_next(choice, own.weight, OWN);
-        for (var slot = 0u; slot < drawn; slot++) {
-            choice = inverse_cdf_next(choice, weights[slot], slot);
-        }
-        chosen = choice.chosen;
-    } else {
-        // Streaming weighted reservoir sampling: current, own, then the drawn slots.
-        var running = weight_current;
-        if own.weight > 0.0 {
-            running += own.weight;
-            if random() * running < own.weight {
-                chosen = OWN;
-            }
-        }
-        for (var slot = 0u; slot < drawn; slot++) {
-            if weights[slot] > 0.0 {
-                running += weights[slot];
-                if random() * running < weights[slot] {
-                    chosen = slot;
-                }
-            }
-        }
-    }
-    if chosen == OWN {
-        merged.sample = previous_reservoirs[own_source].sample;
-        merged.target_value = own.target_here;
-    } else if chosen < MAX_SELECTED {
-        merged.sample = previous_reservoirs[sources[chosen]].sample;
-        merged.target_value = targets[chosen];
+    merged.expected = resampling_expectation(state, current.target_value, colour_current);
+    // Strata with T > 0 chooses by inverse CDF with the temporal resampling number.
+    let chosen = chosen_slot(state, total, numbers.resample, restir.method == METHOD_STRATA && drawn > 0u);
+    if chosen != CANONICAL_KEPT {
+        merged.sample = previous_reservoirs[state.sources[chosen]].sample;
+        merged.target_value = state.targets[chosen];
     }
     merged.weight = total / merged.target_value;
     merged_reservoirs[pixel] = merged;

@@ -51,6 +51,9 @@ const PRIMARY_RESAMPLE: u32 = 2u;
 // by random replay (RestirParams.replay): it takes candidates of kind REPLAY only
 const PRIMARY_REPLAY: u32 = 4u;
 
+// No pixel for a reuse slot (restir/reuse_slot.wgsl): the slot stays empty.
+const NO_PIXEL: u32 = 0xffffffffu;
+
 // RestirParams.method
 const METHOD_STRATA: u32 = 0u;       // histogram + stratified selection, inverse-CDF resampling (ours)
 const METHOD_RESTIR: u32 = 1u;       // K uniformly random from the same cluster, streaming reservoir
@@ -190,6 +193,15 @@ fn image_position(
     let sx = dot(d, right) / (z * tan_half_x);
     let sy = dot(d, up) / (z * tan_half_y);
     return vec3<f32>((sx + 1.0) * 0.5 * f32(params.width), (1.0 - sy) * 0.5 * f32(params.height), z);
+}
+
+// The index of invocation `id`'s pixel in the image (rows of params.width), or NO_PIXEL
+// for an invocation past the image's edge (the last workgroups of a row or column).
+fn image_pixel(id: vec3<u32>) -> u32 {
+    if id.x >= params.width || id.y >= params.height {
+        return NO_PIXEL;
+    }
+    return id.y * params.width + id.x;
 }
 
 fn luminance(c: vec3<f32>) -> f32 {

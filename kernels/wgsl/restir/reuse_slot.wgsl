@@ -17,9 +17,6 @@
 // #import restir/reservoir.wgsl
 // #requires var<storage, read> primaries: array<Primary>
 
-// No pixel for this slot: the slot stays empty.
-const NO_PIXEL: u32 = 0xffffffffu;
-
 // The disc neighbour of pixel (x, y) with primary hit `p` (restir-disc), or NO_PIXEL.
 fn disc_neighbour(x: u32, y: u32, p: Primary) -> u32 {
     let r = restir.disc_radius * sqrt(random());

@@ -431,8 +431,9 @@ fn paired_differences(
 /// Without temporal reuse every method converges to the path tracer's image, shading the
 /// final resampling's expectation (the default) and the kept sample: restir against the
 /// reference over 8 renders of 64 frames, whose expectation (a conditional expectation of
-/// the sample's estimate) spreads less over frames, and strata and restir-disc paired
-/// with restir's expectation frame by frame ([`assert_same_mean_with_power`]): until
+/// the sample's estimate) spreads less over frames, and strata, restir-disc and ris (plain
+/// per-pixel RIS, no reuse) paired with restir's expectation frame by frame
+/// ([`assert_same_mean_with_power`]): until
 /// 2026-11-28 each method ran 8 × 64 frames against the reference, resolving 2.8 % where
 /// the pairs now resolve about 0.5 %.
 #[test]
@@ -468,6 +469,8 @@ fn every_method_converges_to_the_path_traced_reference() {
         settings(Method::Strata, Shading::Sample),
         settings(Method::RestirDisc, Shading::Expectation),
         settings(Method::RestirDisc, Shading::Sample),
+        settings(Method::Ris, Shading::Expectation),
+        settings(Method::Ris, Shading::Sample),
     ];
     let base = settings(Method::Restir, Shading::Expectation);
     let differences = paired_differences(&mut backend, &scene, base, &variants, PAIRED_SEEDS, 32, |render| render);

@@ -115,7 +115,7 @@ fn versus_baselines(method: Method, value: f64, of: impl Fn(Method) -> Option<f6
     if method != Method::Strata {
         return String::new();
     }
-    [Method::Restir, Method::RestirDisc]
+    Method::BASELINES
         .into_iter()
         .filter_map(|b| Some(format!("{} vs {}", relative_difference(value, of(b)?), b.name())))
         .collect::<Vec<_>>()

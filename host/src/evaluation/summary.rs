@@ -69,7 +69,7 @@ fn baselines(methods: &[Method]) -> Vec<Method> {
     if !methods.contains(&Method::Strata) {
         return Vec::new();
     }
-    [Method::Restir, Method::RestirDisc].into_iter().filter(|b| methods.contains(b)).collect()
+    Method::BASELINES.into_iter().filter(|b| methods.contains(b)).collect()
 }
 
 /// The frame columns' headers, "frame N" (1-based).
@@ -170,7 +170,7 @@ pub struct WholeRunRatio {
 
 /// strata ÷ each baseline the errors hold, over the whole run ([`relmse_ratio_over_frames`]).
 pub fn whole_run_ratios(errors: &[FrameError]) -> Vec<WholeRunRatio> {
-    [Method::Restir, Method::RestirDisc]
+    Method::BASELINES
         .into_iter()
         .filter_map(|baseline| {
             Some(WholeRunRatio { baseline, ratio: relmse_ratio_over_frames(errors, Method::Strata, baseline)? })
@@ -184,7 +184,7 @@ pub fn whole_run_ratios(errors: &[FrameError]) -> Vec<WholeRunRatio> {
 pub fn whole_run_lines(errors: &[FrameError], frames: u32) -> Vec<String> {
     let has = |m: Method| errors.iter().any(|e| e.method == m);
     let ratios = whole_run_ratios(errors);
-    [Method::Restir, Method::RestirDisc]
+    Method::BASELINES
         .into_iter()
         .filter(|&baseline| has(Method::Strata) && has(baseline))
         .map(|baseline| {

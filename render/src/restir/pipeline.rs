@@ -130,6 +130,7 @@ impl RestirRenderer {
         scene_extent: f32,
     ) -> Result<Self, PassError> {
         settings.check()?;
+        let settings = settings.as_run();
         let registry = Registry::shared()?;
         let kernels = [
             KernelId::RestirCandidates,

@@ -23,21 +23,39 @@ pub enum Method {
     /// Baseline: standard ReSTIR, K uniformly random pixels in a disc of
     /// `disc_radius` pixels, rejected unless normal and depth are similar.
     RestirDisc,
+    /// Baseline: plain per-pixel RIS, no reuse. Each pixel keeps its own canonical
+    /// candidate (the same initial candidates as every method: RIS over light and BSDF
+    /// samples, `restir/entry_candidates.wgsl`) and shades it, with no spatial or
+    /// temporal reuse and no histogram: what Bevy Solari ships by default since its v8
+    /// (bevyengine/bevy#25513), which turned ReSTIR off for the correlations and boiling
+    /// that confuse its denoiser. K, the temporal settings and the order of reuse do not
+    /// apply ([`RestirSettings::as_run`]).
+    Ris,
 }
 
 impl Method {
+    /// The baselines strata is compared with, in the order tables list them.
+    pub const BASELINES: [Method; 3] = [Method::Restir, Method::RestirDisc, Method::Ris];
+
     /// The name used on the command line and in CSV files.
     pub fn name(self) -> &'static str {
         match self {
             Method::Strata => "strata",
             Method::Restir => "restir",
             Method::RestirDisc => "restir-disc",
+            Method::Ris => "ris",
         }
     }
 
     /// Whether the method needs the block histogram.
     pub fn uses_histogram(self) -> bool {
-        !matches!(self, Method::RestirDisc)
+        matches!(self, Method::Strata | Method::Restir)
+    }
+
+    /// Whether the method reuses other pixels' or frames' samples (every method but
+    /// [`Method::Ris`]).
+    pub fn reuses(self) -> bool {
+        self != Method::Ris
     }
 }
 
@@ -265,8 +283,10 @@ impl RestirSettings {
                 Method::Strata => METHOD_STRATA,
                 Method::Restir => METHOD_RESTIR,
                 Method::RestirDisc => METHOD_RESTIR_DISC,
+                // No slot is drawn with K = 0, so no method's draw is read.
+                Method::Ris => METHOD_RESTIR,
             },
-            candidates: self.selection.candidates,
+            candidates: if self.method.reuses() { self.selection.candidates } else { 0 },
             sampler: self.selection.sampler.id(),
             temporal: u32::from(self.temporal),
             temporal_cap: self.temporal_cap,
@@ -283,6 +303,18 @@ impl RestirSettings {
             },
             ..RestirParams::default()
         }
+    }
+
+    /// What a frame runs of these settings: themselves, but for [`Method::Ris`], which
+    /// reuses nothing: no temporal reuse, no drawn previous reservoirs, and the paper's
+    /// order of passes (with K = 0 and no history both orders keep each pixel's canonical
+    /// candidate; the paper's runs two passes fewer). K stays as given, for the record;
+    /// [`RestirSettings::uniform`] gives the kernels K = 0.
+    pub fn as_run(self) -> RestirSettings {
+        if self.method.reuses() {
+            return self;
+        }
+        RestirSettings { temporal: false, temporal_candidates: 0, reuse_order: ReuseOrder::SpatialFirst, ..self }
     }
 
     /// Refuses settings the kernels cannot run, naming the field and value.

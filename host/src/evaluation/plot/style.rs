@@ -7,12 +7,14 @@ use plotters::style::RGBColor;
 
 /// One colour per method, the same in every plot and in the HTML report (CSS hex, e.g.
 /// "#1f77b4"). From the Okabe–Ito palette, which stays distinguishable under the common
-/// colour-vision deficiencies: strata vermillion, restir blue, restir-disc bluish green.
+/// colour-vision deficiencies: strata vermillion, restir blue, restir-disc bluish green,
+/// ris reddish purple.
 pub fn method_colour(method: Method) -> &'static str {
     match method {
         Method::Strata => "#d55e00",
         Method::Restir => "#0072b2",
         Method::RestirDisc => "#009e73",
+        Method::Ris => "#cc79a7",
     }
 }
 

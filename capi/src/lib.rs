@@ -43,11 +43,18 @@
 //! let mut error = StrataError { status: StrataStatus::Ok, message: [0; STRATA_ERROR_MESSAGE_BYTES] };
 //! let mut pass = std::ptr::null_mut();
 //! // SAFETY: null pointers are refused, never read.
-//! let status = unsafe { strata_vk_create(std::ptr::null(), std::ptr::null(), 16, 16, &mut pass, &mut error) };
+//! let status =
+//!     unsafe { strata_vk_create(LIBRARY_VERSION, std::ptr::null(), std::ptr::null(), 16, 16, &mut pass, &mut error) };
 //! assert_eq!(status, StrataStatus::InvalidArgument);
 //! // SAFETY: a static NUL-terminated string.
 //! let version = unsafe { std::ffi::CStr::from_ptr(strata_vk_version()) };
 //! assert_eq!(version.to_str()?, env!("CARGO_PKG_VERSION"));
+//! // Headers of another major version are refused before anything else.
+//! let [major, minor, patch] = version_parts(LIBRARY_VERSION);
+//! let newer = make_version(major + 1, minor, patch);
+//! // SAFETY: as above.
+//! let status = unsafe { strata_vk_create(newer, std::ptr::null(), std::ptr::null(), 16, 16, &mut pass, &mut error) };
+//! assert_eq!(status, StrataStatus::Version);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
@@ -95,6 +102,59 @@ pub enum StrataStatus {
     Vulkan = 6,
     /// A bug of this library: a panic caught at the boundary.
     Internal = 7,
+    /// The headers the caller compiled against (`STRATA_VERSION`, passed to
+    /// [`strata_vk_create`]) are of another major version than the library (before 1.0: of
+    /// another minor version), so their records and functions may not be the library's.
+    Version = 8,
+}
+
+/// A version as one number, as `STRATA_MAKE_VERSION` of `strata.h` packs it (Vulkan's
+/// packing): `major << 22 | minor << 12 | patch`.
+pub const fn make_version(major: u32, minor: u32, patch: u32) -> u32 {
+    (major << 22) | (minor << 12) | patch
+}
+
+/// The three numbers of a version packed by [`make_version`].
+pub const fn version_parts(version: u32) -> [u32; 3] {
+    [version >> 22, (version >> 12) & 0x3ff, version & 0xfff]
+}
+
+/// A decimal number of a `CARGO_PKG_VERSION_*` variable, at compile time.
+const fn decimal(text: &str) -> u32 {
+    let bytes = text.as_bytes();
+    let mut value = 0;
+    let mut i = 0;
+    while i < bytes.len() {
+        assert!(bytes[i].is_ascii_digit(), "a version number is decimal");
+        value = value * 10 + (bytes[i] - b'0') as u32;
+        i += 1;
+    }
+    value
+}
+
+/// The library's own version, packed by [`make_version`]: the workspace's version, as
+/// `STRATA_VERSION` of the `strata.h` exported beside it.
+pub const LIBRARY_VERSION: u32 = make_version(
+    decimal(env!("CARGO_PKG_VERSION_MAJOR")),
+    decimal(env!("CARGO_PKG_VERSION_MINOR")),
+    decimal(env!("CARGO_PKG_VERSION_PATCH")),
+);
+
+/// Whether headers of version `header` (packed) may be used with this library: the same
+/// major version and, before 1.0, the same minor version (semantic versioning, as Cargo
+/// reads it); otherwise a one-line message naming both versions.
+pub fn check_header_version(header: u32) -> Result<(), String> {
+    let [major, minor, patch] = version_parts(header);
+    let [own_major, own_minor, _] = version_parts(LIBRARY_VERSION);
+    if major == own_major && (own_major != 0 || minor == own_minor) {
+        return Ok(());
+    }
+    let which = if own_major == 0 { "another minor version before 1.0" } else { "another major version" };
+    Err(format!(
+        "header_version = {header} ({major}.{minor}.{patch}, STRATA_VERSION of the strata.h compiled against): this \
+         library is strata_vk {}, and headers of {which} do not match it; use the headers exported with the library",
+        env!("CARGO_PKG_VERSION")
+    ))
 }
 
 /// Bytes of [`StrataError::message`], its terminating NUL included.
@@ -244,6 +304,10 @@ fn settings_of(settings: &StrataSelectionSettings) -> Result<SelectionSettings, 
 /// buffers (about 1.3 MiB + 16 bytes per pixel). On success `*pass` holds it; destroy it
 /// with [`strata_vk_destroy`].
 ///
+/// `header_version` is `STRATA_VERSION` of the `strata.h` the caller compiled against:
+/// headers of another major version (before 1.0, of another minor version) are refused
+/// with `STRATA_STATUS_VERSION` before anything else is read.
+///
 /// # Safety
 /// `device`, `settings` and `pass` are null (refused) or valid; `device` holds handles
 /// of a live instance (`apiVersion` 1.1 or newer), one of its physical devices and a live
@@ -253,6 +317,7 @@ fn settings_of(settings: &StrataSelectionSettings) -> Result<SelectionSettings, 
 /// device; `error` is null or writable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn strata_vk_create(
+    header_version: u32,
     device: *const StrataVkDevice,
     settings: *const StrataSelectionSettings,
     width: u32,
@@ -263,8 +328,12 @@ pub unsafe extern "C" fn strata_vk_create(
     // SAFETY: per this function's contract.
     unsafe {
         guarded(error, || {
+            if let Some(out) = pass.as_mut() {
+                *out = std::ptr::null_mut();
+            }
+            check_header_version(header_version)
+                .map_err(|message| Failure { status: StrataStatus::Version, message })?;
             let out = pass.as_mut().ok_or_else(|| invalid("pass (the result pointer) is NULL"))?;
-            *out = std::ptr::null_mut();
             let device = device.as_ref().ok_or_else(|| invalid("device is NULL"))?;
             let settings = settings_of(settings.as_ref().ok_or_else(|| invalid("settings is NULL"))?)?;
             let get_instance_proc_addr =
@@ -518,6 +587,13 @@ pub unsafe extern "C" fn strata_vk_destroy(pass: *mut StrataVkPass, error: *mut 
 #[unsafe(no_mangle)]
 pub extern "C" fn strata_vk_version() -> *const c_char {
     concat!(env!("CARGO_PKG_VERSION"), "\0").as_ptr().cast()
+}
+
+/// The library's version as one number, packed as `STRATA_MAKE_VERSION` packs it
+/// (compare it with `STRATA_VERSION` of the headers).
+#[unsafe(no_mangle)]
+pub extern "C" fn strata_vk_version_number() -> u32 {
+    LIBRARY_VERSION
 }
 
 #[cfg(test)]

@@ -30,7 +30,7 @@ void route_library(Engine *engine, const Run *run) {
     device.device = engine->device;
     device.shader_zero_initialize_workgroup_memory = 0;
     StrataVkPass *pass = NULL;
-    check_strata(strata_vk_create(&device, &run->settings, run->width, run->height, &pass, &error), &error,
+    check_strata(strata_vk_create(STRATA_VERSION, &device, &run->settings, run->width, run->height, &pass, &error), &error,
                  "strata_vk_create");
     check_strata(strata_vk_set_seed(pass, run->seed, &error), &error, "strata_vk_set_seed");
 

@@ -8,7 +8,8 @@ use crate::ExportError;
 
 /// The names declared elsewhere (`vulkan.h`, `strata_frame.h`), which the header uses but
 /// must not declare again.
-const DECLARED_ELSEWHERE: [&str; 7] = [
+const DECLARED_ELSEWHERE: [&str; 8] = [
+    "LIBRARY_VERSION",
     "VkInstance",
     "VkPhysicalDevice",
     "VkDevice",

@@ -126,6 +126,36 @@ impl HeaderStruct {
     }
 }
 
+/// `MAJOR.MINOR.PATCH` (a pre-release or build suffix after `-` or `+` ignored) as three
+/// numbers; an error naming `version` otherwise.
+pub fn version_parts(version: &str) -> Result<[u32; 3], ExportError> {
+    let core = version.split(['-', '+']).next().unwrap_or(version);
+    let parts: Vec<Option<u32>> = core.split('.').map(|p| p.parse::<u32>().ok()).collect();
+    match parts.as_slice() {
+        [Some(major), Some(minor), Some(patch)] if *minor < 1024 && *patch < 4096 => Ok([*major, *minor, *patch]),
+        _ => Err(ExportError::Header(format!(
+            "version `{version}`: not MAJOR.MINOR.PATCH with MINOR < 1024 and PATCH < 4096 (STRATA_MAKE_VERSION's packing)"
+        ))),
+    }
+}
+
+/// The version macros of `strata.h` for the workspace's `version` (the export passes
+/// `CARGO_PKG_VERSION`: the workspace's version, so nothing here is written by hand).
+fn version_macros(version: &str) -> Result<String, ExportError> {
+    let [major, minor, patch] = version_parts(version)?;
+    Ok(format!(
+        "/* The strata version this package was exported from (semantic versioning). */\n\
+         #define STRATA_VERSION_MAJOR {major}\n#define STRATA_VERSION_MINOR {minor}\n#define STRATA_VERSION_PATCH {patch}\n\
+         /* A version as one number (Vulkan's packing): major << 22 | minor << 12 | patch. */\n\
+         #define STRATA_MAKE_VERSION(major, minor, patch) \\\n    \
+         ((((uint32_t)(major)) << 22) | (((uint32_t)(minor)) << 12) | ((uint32_t)(patch)))\n\
+         /*\n * The version of these headers, which strata_vk_create takes as its first argument: the\n \
+         * library refuses (STRATA_STATUS_VERSION) headers of another major version, or before 1.0\n \
+         * of another minor version, whose records and functions may differ from its own.\n */\n\
+         #define STRATA_VERSION STRATA_MAKE_VERSION(STRATA_VERSION_MAJOR, STRATA_VERSION_MINOR, STRATA_VERSION_PATCH)\n\n"
+    ))
+}
+
 /// The header's text.
 pub fn header(
     structs: &[HeaderStruct],
@@ -142,6 +172,7 @@ pub fn header(
          * the build where a compiler lays one out otherwise. manifest.json says which buffer holds which.\n */\n"
     );
     h += "#ifndef STRATA_H\n#define STRATA_H\n\n#include <stddef.h>\n#include <stdint.h>\n\n";
+    h += &version_macros(version)?;
     h += "/* C11's _Static_assert, C++'s static_assert. */\n#ifdef __cplusplus\n#define STRATA_STATIC_ASSERT \
           static_assert\n#else\n#define STRATA_STATIC_ASSERT _Static_assert\n#endif\n\n";
     h += "#ifdef __cplusplus\nextern \"C\" {\n#endif\n\n";
@@ -218,6 +249,26 @@ mod tests {
         // In the second source file too.
         assert!(doc_above("pub run_length:", Some("pub struct SelectedCandidates ")).is_some());
         assert!(doc_above("pub const OBJECT_ID_NONE:", None).is_some());
+    }
+
+    #[test]
+    fn the_version_macros_are_the_workspace_version() {
+        let [major, minor, patch] = version_parts(env!("CARGO_PKG_VERSION")).unwrap();
+        assert_eq!(major.to_string(), env!("CARGO_PKG_VERSION_MAJOR"));
+        assert_eq!(minor.to_string(), env!("CARGO_PKG_VERSION_MINOR"));
+        assert_eq!(patch.to_string(), env!("CARGO_PKG_VERSION_PATCH"));
+        let macros = version_macros("3.14.15-beta.1").unwrap();
+        for line in [
+            "#define STRATA_VERSION_MAJOR 3\n",
+            "#define STRATA_VERSION_MINOR 14\n",
+            "#define STRATA_VERSION_PATCH 15\n",
+        ] {
+            assert!(macros.contains(line), "{line:?} not in {macros}");
+        }
+        for broken in ["1.2", "1.x.3", "1.1024.0", ""] {
+            let error = version_parts(broken).unwrap_err().to_string();
+            assert!(error.contains(&format!("`{broken}`")) && !error.contains('\n'), "{error}");
+        }
     }
 
     #[test]

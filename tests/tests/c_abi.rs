@@ -44,9 +44,50 @@ fn create(device: &StrataVkDevice, settings: &StrataSelectionSettings) -> (Strat
     let mut error = no_error();
     let mut pass = std::ptr::null_mut();
     // SAFETY: valid pointers; the device's handles are live.
-    let status = unsafe { strata_vk_create(device, settings, 16, 8, &mut pass, &mut error) };
+    let status = unsafe { strata_vk_create(LIBRARY_VERSION, device, settings, 16, 8, &mut pass, &mut error) };
     assert_eq!(status, error.status, "the status returned and the one reported agree");
     (status, message(&error), pass)
+}
+
+#[test]
+fn headers_of_another_major_version_are_refused_at_create() {
+    let [major, minor, patch] = version_parts(LIBRARY_VERSION);
+    // SAFETY: a static NUL-terminated string.
+    let text = unsafe { CStr::from_ptr(strata_vk_version()) }.to_str().unwrap();
+    assert_eq!(text, format!("{major}.{minor}.{patch}"), "the two version queries agree");
+    assert_eq!(strata_vk_version_number(), LIBRARY_VERSION);
+    // Each header version with the status create gives it (a NULL device: refused as such
+    // once the version is accepted, so nothing needs a Vulkan device).
+    let mut cases = vec![
+        (LIBRARY_VERSION, StrataStatus::InvalidArgument),
+        (make_version(major, minor, patch + 1), StrataStatus::InvalidArgument),
+        (make_version(major + 1, minor, patch), StrataStatus::Version),
+        (make_version(major + 1, 0, 0), StrataStatus::Version),
+    ];
+    if major > 0 {
+        cases.push((make_version(major - 1, minor, patch), StrataStatus::Version));
+        cases.push((make_version(major, minor + 1, 0), StrataStatus::InvalidArgument));
+    } else {
+        // Before 1.0 a minor version is a major one (semantic versioning, as Cargo reads it).
+        cases.push((make_version(0, minor + 1, 0), StrataStatus::Version));
+    }
+    for (header, want) in cases {
+        let mut error = no_error();
+        let mut pass: *mut StrataVkPass = std::ptr::dangling_mut();
+        // SAFETY: a NULL device is refused, never read; the other pointers are valid.
+        let status = unsafe { strata_vk_create(header, std::ptr::null(), &settings(), 16, 8, &mut pass, &mut error) };
+        let text = message(&error);
+        let [h_major, h_minor, h_patch] = version_parts(header);
+        assert_eq!(status, want, "header {h_major}.{h_minor}.{h_patch}: {text}");
+        assert!(pass.is_null());
+        if want == StrataStatus::Version {
+            let named = format!("header_version = {header} ({h_major}.{h_minor}.{h_patch}");
+            assert!(text.starts_with(&named) && text.contains(env!("CARGO_PKG_VERSION")), "{text}");
+            assert!(!text.contains('\n'), "{text}");
+        } else {
+            assert_eq!(text, "device is NULL");
+        }
+    }
 }
 
 #[test]
@@ -57,10 +98,12 @@ fn bad_arguments_are_status_codes_with_messages() {
     let mut error = no_error();
     let mut pass = std::ptr::null_mut();
     // SAFETY: null pointers are what is under test; the function refuses them.
-    let status = unsafe { strata_vk_create(std::ptr::null(), &settings(), 16, 8, &mut pass, &mut error) };
+    let status =
+        unsafe { strata_vk_create(LIBRARY_VERSION, std::ptr::null(), &settings(), 16, 8, &mut pass, &mut error) };
     assert_eq!((status, message(&error).as_str()), (StrataStatus::InvalidArgument, "device is NULL"));
     // SAFETY: as above.
-    let status = unsafe { strata_vk_create(&good, std::ptr::null(), 16, 8, &mut pass, std::ptr::null_mut()) };
+    let status =
+        unsafe { strata_vk_create(LIBRARY_VERSION, &good, std::ptr::null(), 16, 8, &mut pass, std::ptr::null_mut()) };
     assert_eq!(status, StrataStatus::InvalidArgument, "a NULL error pointer is allowed");
     let missing_loader = StrataVkDevice { get_instance_proc_addr: None, ..good };
     assert!(create(&missing_loader, &settings()).1.contains("get_instance_proc_addr is NULL"));
@@ -83,7 +126,7 @@ fn bad_arguments_are_status_codes_with_messages() {
     // An image of no pixels.
     let mut error = no_error();
     // SAFETY: valid pointers.
-    let status = unsafe { strata_vk_create(&good, &settings(), 0, 8, &mut pass, &mut error) };
+    let status = unsafe { strata_vk_create(LIBRARY_VERSION, &good, &settings(), 0, 8, &mut pass, &mut error) };
     assert_eq!(status, StrataStatus::ImageSize, "{}", message(&error));
 
     // A pass, and what is refused once it exists.

@@ -160,6 +160,10 @@ fn run_c(
             &number(u32::from(settings.block_shift)),
         ])
         .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        // cargo's LD_LIBRARY_PATH names target/debug, whose libstrata_vk.so only a build of
+        // the workspace refreshes: the program finds the library by its rpath instead
+        // (`library_folder`, the one this test binary was built with).
+        .env_remove("LD_LIBRARY_PATH")
         .output()
         .unwrap();
     if !output.status.success() {
@@ -263,10 +267,33 @@ fn a_wrong_binding_number_in_the_manifest_or_offset_in_the_header_is_caught() {
     let swapped = run_c(&program, "package", &package, "block_histogram", settings, &folder)
         .expect("a swapped binding of two storage buffers still runs (the sizes fit): only its outputs are wrong");
     assert!(first_difference(&swapped, &want).is_some(), "a swapped binding went unnoticed");
+    // A manifest of another schema version: refused by the reader, naming it.
+    manifest["schema_version"] = serde_json::json!(strata_export::manifest::SCHEMA_VERSION + 1);
+    std::fs::write(&manifest_path, serde_json::to_string_pretty(&manifest).unwrap()).unwrap();
+    let error = run_c(&program, "package", &package, "block_histogram", settings, &folder)
+        .err()
+        .expect("a manifest of another schema version must be refused");
+    assert!(error.contains("schema_version"), "{error}");
     std::fs::write(&manifest_path, original).unwrap();
-    // A field of StrataSelectedCandidates moved in strata.h: the build fails on its assert.
+    // strata.h of another major version: the program builds, and the library refuses it
+    // at create, naming the header's version.
     let header_path = package.join("include/strata.h");
     let header = std::fs::read_to_string(&header_path).unwrap();
+    let major: u32 = env!("CARGO_PKG_VERSION_MAJOR").parse().unwrap();
+    let newer = header.replacen(
+        &format!("#define STRATA_VERSION_MAJOR {major}\n"),
+        &format!("#define STRATA_VERSION_MAJOR {}\n", major + 1),
+        1,
+    );
+    assert_ne!(newer, header, "strata.h declares STRATA_VERSION_MAJOR as the workspace's major version");
+    std::fs::write(&header_path, newer).unwrap();
+    let newer_program = build_c(&package, &folder).unwrap();
+    let error = run_c(&newer_program, "library", &package, "block_histogram", settings, &folder)
+        .err()
+        .expect("headers of another major version must be refused");
+    assert!(error.contains("header_version") && error.contains(env!("CARGO_PKG_VERSION")), "{error}");
+    std::fs::write(&header_path, &header).unwrap();
+    // A field of StrataSelectedCandidates moved in strata.h: the build fails on its assert.
     let moved = header.replacen("    uint32_t run_length;\n", "    uint32_t spare;\n    uint32_t run_length;\n", 1);
     assert_ne!(moved, header, "the header declares StrataSelectedCandidates.run_length");
     std::fs::write(&header_path, moved).unwrap();
@@ -282,7 +309,7 @@ fn the_manifest_is_naga_s_reflection_of_every_kernel() {
     let exported = strata_export::export(&package).unwrap();
     let manifest: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(package.join("manifest.json")).unwrap()).unwrap();
-    assert_eq!(manifest["schema_version"], 1);
+    assert_eq!(manifest["schema_version"], strata_export::manifest::SCHEMA_VERSION);
     let kernels = manifest["kernels"].as_array().unwrap();
     assert_eq!(kernels.len(), ModuleId::ALL.len());
     for id in ModuleId::ALL {

@@ -51,6 +51,13 @@ frame.addEventListener('load', () => {
       const filled = cells.filter(c => c.textContent.trim() !== '' || c.querySelector('img'));
       if (filled.length === 0) found.push('empty table ' + (table.caption ? table.caption.textContent : ''));
     }
+    const viewer = tables.filter(t => t.caption && t.caption.textContent.startsWith('What the viewer sees'));
+    found.push('viewer ' + viewer.length);
+    for (const table of viewer) {
+      const text = table.textContent;
+      if (/NaN|∞|\binf\b/.test(text)) found.push('viewer table with NaN or inf');
+      if (![...table.querySelectorAll('tr.ratio-row')].length) found.push('viewer table without ratio rows');
+    }
     const regimes = [...doc.querySelectorAll('#headline .ratio')].map(r =>
       r.textContent.includes('accumulated frames') ? 'accumulated' :
       r.textContent.includes('temporal reuse') ? 'temporal' : 'unlabelled');
@@ -133,9 +140,17 @@ fn the_report_page_shows_every_image_and_table_in_chromium() {
     // The headline gives strata ÷ each baseline in both regimes, side by side.
     let headline = found.iter().find_map(|l| l.strip_prefix("headline ")).expect("a headline");
     assert_eq!(headline, "temporal,temporal,accumulated,accumulated", "{found:?}");
+    // What the viewer sees: the raw frames' table, with strata's ratio rows.
+    let viewer: usize = found.iter().find_map(|l| l.strip_prefix("viewer ")?.parse().ok()).expect("a viewer count");
+    assert_eq!(viewer, 1, "one viewer table (raw frames, no denoiser): {found:?}");
     let problems: Vec<&String> = found
         .iter()
-        .filter(|l| !l.starts_with("images ") && !l.starts_with("tables ") && !l.starts_with("headline "))
+        .filter(|l| {
+            !l.starts_with("images ")
+                && !l.starts_with("tables ")
+                && !l.starts_with("headline ")
+                && !l.starts_with("viewer ")
+        })
         .collect();
     assert!(problems.is_empty(), "the page has problems: {problems:?}");
     assert!(console.is_empty(), "Chromium's console has errors: {console:?}");

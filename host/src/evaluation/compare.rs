@@ -12,6 +12,7 @@ use crate::scene::Camera;
 use strata_backends::Backend;
 use strata_backends::backend::download;
 use strata_kernels::block_grid::frame_shift;
+use strata_kernels::denoise_types::DenoiseGuide;
 
 /// One frame's errors against the reference.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -38,6 +39,26 @@ pub struct FrameError {
     /// ([`super::block_structure`]): 0 without block structure. `None` when it cannot be
     /// computed (no block edge inside the image) or was not measured.
     pub block_edge: Option<f64>,
+}
+
+/// One rendered frame as [`run_comparison`] hands it to its caller.
+#[derive(Clone, Copy, Debug)]
+pub struct SeenFrame<'a> {
+    /// The method that rendered it.
+    pub method: Method,
+    /// The render seed.
+    pub seed: u32,
+    /// The frame index (0-based).
+    pub frame: u32,
+    /// The frame as shown (accumulated without temporal reuse).
+    pub image: &'a RgbImage,
+    /// The frame after the denoiser, with one.
+    pub denoised: Option<&'a RgbImage>,
+    /// Wall time of rendering it.
+    pub took: std::time::Duration,
+    /// With a moving camera, per pixel the previous frame's image position minus this
+    /// frame's, in pixels (the denoiser guides' motion vectors); `None` for a still camera.
+    pub motion: Option<&'a [[f32; 2]]>,
 }
 
 /// What to compare.
@@ -107,8 +128,7 @@ fn measure(
 
 /// Renders every method × seed × frame of `comparison` and measures each frame against
 /// its reference (`references[frame]`, or `references[0]` for every frame); `on_frame`
-/// sees every image (method, seed, frame, image, the denoised image with a denoiser, the
-/// wall time of rendering it). The denoiser filters each frame as rendered, its history
+/// sees every frame ([`SeenFrame`]). The denoiser filters each frame as rendered, its history
 /// carried from frame to frame (also without temporal reuse, where the raw image scored
 /// is the mean of the frames so far).
 pub fn run_comparison(
@@ -118,7 +138,7 @@ pub fn run_comparison(
     scene_extent: f32,
     comparison: &Comparison,
     references: &[RgbImage],
-    mut on_frame: impl FnMut(Method, u32, u32, &RgbImage, Option<&RgbImage>, std::time::Duration),
+    mut on_frame: impl FnMut(SeenFrame<'_>),
 ) -> Result<ComparisonErrors, PassError> {
     let mut errors = ComparisonErrors::default();
     for &method in &comparison.methods {
@@ -129,6 +149,12 @@ pub fn run_comparison(
             let mut denoiser = None;
             let mut sum: Option<RgbImage> = None;
             let result = (|| {
+                // A moving camera's guides give the motion vectors the viewer's error
+                // change follows (super::viewer).
+                let moving = !comparison.cameras.is_empty();
+                if moving {
+                    renderer.enable_guides(backend)?;
+                }
                 if let Some(chosen) = comparison.denoise {
                     renderer.enable_guides(backend)?;
                     let (width, height) = (render.camera.width, render.camera.height);
@@ -185,7 +211,22 @@ pub fn run_comparison(
                         image
                     };
                     errors.raw.push(measure(method, frame, seed, &shown, reference, comparison)?);
-                    on_frame(method, seed, frame, &shown, denoised.as_ref(), render_time);
+                    let motion: Option<Vec<[f32; 2]>> = match renderer.denoiser_inputs() {
+                        Some(inputs) if moving => {
+                            let guides: Vec<DenoiseGuide> = download(backend, inputs.guides)?;
+                            Some(guides.iter().map(|g| g.motion).collect())
+                        }
+                        _ => None,
+                    };
+                    on_frame(SeenFrame {
+                        method,
+                        seed,
+                        frame,
+                        image: &shown,
+                        denoised: denoised.as_ref(),
+                        took: render_time,
+                        motion: motion.as_deref(),
+                    });
                 }
                 Ok(())
             })();

@@ -3,7 +3,8 @@
 //! without the reference), [`plot`] draws RelMSE and ratios over frames, [`summary`]
 //! makes the ratio and variance tables, [`crops`] picks close-ups, [`page`] writes
 //! `report.html`, [`record`] says what ran where, [`output_folder`] keeps one run per
-//! folder, and [`report`] runs a whole comparison from a plain options struct. It runs the renderer and the command line runs it, so it is
+//! folder, and [`report`] runs a whole comparison from a plain options struct, and [`viewer`] measures what
+//! the viewer sees (bias and residual noise, flicker, the error's correlation). It runs the renderer and the command line runs it, so it is
 //! a module of the host crate rather than a crate below it.
 
 pub mod bias_noise;
@@ -25,3 +26,4 @@ pub mod summary;
 #[cfg(test)]
 mod test_noise;
 pub mod variance;
+pub mod viewer;

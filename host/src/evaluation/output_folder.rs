@@ -11,6 +11,7 @@
 //! refused before anything is removed (it would replace it at the end), naming the file.
 //! The reference the new run reads is kept, wherever it lies.
 
+use crate::restir::Method;
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 
@@ -95,8 +96,9 @@ fn may_be_strata(pid: u32) -> bool {
 /// the report page and its plots and colour bar, the reference and every method's frame
 /// images and error maps.
 pub fn is_run_output(name: &str) -> bool {
-    const FIXED: [&str; 9] = [
+    const FIXED: [&str; 10] = [
         "errors.csv",
+        "viewer.csv",
         "errors_denoised.csv",
         "errors_accumulated.csv",
         "errors_temporal.csv",
@@ -122,8 +124,8 @@ pub fn is_run_output(name: &str) -> bool {
     let stem = stem.strip_suffix("_relmse").unwrap_or(stem);
     let Some((prefix, frame)) = stem.rsplit_once("_frame") else { return false };
     let prefix = prefix.strip_suffix("_denoised").unwrap_or(prefix);
-    let methods = ["reference", "strata", "restir", "restir-disc"];
-    methods.contains(&prefix) && !frame.is_empty() && frame.bytes().all(|b| b.is_ascii_digit())
+    let method = Method::BASELINES.iter().chain([&Method::Strata]).any(|m| m.name() == prefix);
+    (prefix == "reference" || method) && !frame.is_empty() && frame.bytes().all(|b| b.is_ascii_digit())
 }
 
 /// The names the folder's record lists ([`RECORD_NAME`]): plain file names only (no

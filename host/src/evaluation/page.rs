@@ -37,6 +37,9 @@ pub struct Page<'a> {
     pub plots: Vec<(String, String)>,
     /// The summary tables.
     pub tables: Vec<Table>,
+    /// Sentences shown after the tables (what the viewer sees: a denoiser hiding the
+    /// sampler, what was not measured).
+    pub notes: Vec<String>,
     /// The error maps' colour bar (a PNG of [`COLOUR_BAR_DECADES`] decades).
     pub colour_bar: String,
 }
@@ -311,6 +314,9 @@ impl Page<'_> {
             }
             html += "</table>\n";
         }
+        for note in &self.notes {
+            html += &format!("<p class=\"note\">{}</p>\n", escape(note));
+        }
         html + "</section>\n"
     }
 
@@ -352,6 +358,9 @@ impl Page<'_> {
                 html += "</tr>\n";
             }
             html += "</table>\n";
+        }
+        for note in &self.notes {
+            html += &format!("<p class=\"note\">{}</p>\n", escape(note));
         }
         html + "</section>\n"
     }

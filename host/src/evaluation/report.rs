@@ -6,7 +6,7 @@
 //! [`ReportOptions`], a plain struct: the command line fills it from its arguments, and
 //! anything else (a script, a test) can too.
 
-use super::compare::{Comparison, errors_csv, run_comparison};
+use super::compare::{Comparison, SeenFrame, errors_csv, run_comparison};
 use super::crops::{self, Crop};
 use super::metrics::{self, Metric};
 use super::page::{CropShown, FrameImages, MethodImage, Page, RegimeRatios};
@@ -106,46 +106,42 @@ pub fn run_and_report(
     let mut render_time: HashMap<Method, (Duration, u32)> = HashMap::new();
     // Frames black everywhere where their reference is not: scored, and said once.
     let mut black_frames: Vec<String> = Vec::new();
-    let measured = run_comparison(
-        backend,
-        gpu_scene,
-        render,
-        extent,
-        comparison,
-        references,
-        |method, seed, frame, image, denoised, took| {
-            progress.inc(1);
-            let reference = references.get(frame as usize).unwrap_or(&references[0]);
-            if super::image_checks::black_against(image, reference) {
-                black_frames.push(format!("{} frame {}, seed {seed}", method.name(), frame + 1));
-            }
-            let time = render_time.entry(method).or_default();
-            time.0 += took;
-            time.1 += 1;
-            if !shown.contains(&frame) {
-                return;
-            }
-            if seeds >= 3 {
-                seed_images.entry((method, frame)).or_default().push(image.clone());
-            }
-            if seed == 1 {
-                match write_frame(out, method.name(), frame, image, reference, options.exposure) {
-                    Ok(w) => {
-                        written.insert((method, frame), w);
-                    }
-                    Err(error) => {
-                        write_error.get_or_insert(error);
-                    }
+    let block_size = comparison.restir.selection.block_size;
+    let mut viewer = super::viewer::ViewerCollector::new(frames, block_size, !comparison.cameras.is_empty());
+    let measured = run_comparison(backend, gpu_scene, render, extent, comparison, references, |seen| {
+        let SeenFrame { method, seed, frame, image, denoised, took, .. } = seen;
+        viewer.add(seen, references);
+        progress.inc(1);
+        let reference = references.get(frame as usize).unwrap_or(&references[0]);
+        if super::image_checks::black_against(image, reference) {
+            black_frames.push(format!("{} frame {}, seed {seed}", method.name(), frame + 1));
+        }
+        let time = render_time.entry(method).or_default();
+        time.0 += took;
+        time.1 += 1;
+        if !shown.contains(&frame) {
+            return;
+        }
+        if seeds >= 3 {
+            seed_images.entry((method, frame)).or_default().push(image.clone());
+        }
+        if seed == 1 {
+            match write_frame(out, method.name(), frame, image, reference, options.exposure) {
+                Ok(w) => {
+                    written.insert((method, frame), w);
                 }
-                if let Some(denoised) = denoised {
-                    let name = format!("{}_denoised", method.name());
-                    if let Err(error) = write_frame(out, &name, frame, denoised, reference, options.exposure) {
-                        write_error.get_or_insert(error);
-                    }
+                Err(error) => {
+                    write_error.get_or_insert(error);
                 }
             }
-        },
-    )?;
+            if let Some(denoised) = denoised {
+                let name = format!("{}_denoised", method.name());
+                if let Err(error) = write_frame(out, &name, frame, denoised, reference, options.exposure) {
+                    write_error.get_or_insert(error);
+                }
+            }
+        }
+    })?;
     let errors = measured.raw;
     if let Some(error) = write_error {
         return Err(error);
@@ -157,7 +153,7 @@ pub fn run_and_report(
     }
     let other_errors = match &options.other_regime {
         Some(other) => {
-            let run = |_: Method, _: u32, _: u32, _: &RgbImage, _: Option<&RgbImage>, _: Duration| progress.inc(1);
+            let run = |_: SeenFrame<'_>| progress.inc(1);
             let measured =
                 run_comparison(backend, gpu_scene, &other.render, extent, &other.comparison, references, run)?;
             write(&out.join(other.csv_name()), errors_csv(&measured.raw))?;
@@ -218,7 +214,6 @@ pub fn run_and_report(
         text += &flip.to_text();
         tables.push(flip);
     }
-    let block_size = comparison.restir.selection.block_size;
     if let Some(blocks) = summary::block_edge_table(&errors, &options.methods, &shown, block_size) {
         text += &blocks.to_text();
         tables.push(blocks);
@@ -243,6 +238,11 @@ pub fn run_and_report(
             tables.push(table);
         }
     }
+    let last_reference = references.get(frames as usize - 1).unwrap_or(&references[0]);
+    let viewer = viewer.finish(&options.methods, last_reference)?;
+    write(&out.join("viewer.csv"), viewer.csv_text())?;
+    text += &viewer.to_text();
+    tables.extend(viewer.tables.iter().cloned());
     if seeds >= 3 {
         let (variance, csv) = summary::variance_tables(&options.methods, &shown, &seed_images, references)?;
         write(&out.join("variance.csv"), csv)?;
@@ -329,6 +329,7 @@ pub fn run_and_report(
         .collect(),
         plots,
         tables,
+        notes: viewer.notes.clone(),
         colour_bar: "relmse_colourbar.png".to_string(),
     };
     let report = out.join("report.html");

@@ -3,13 +3,13 @@
 //! within the registry's ULP bound, no outliers allowed.
 
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
-use strata::histogram_pass::PassError;
-use strata::scene::{CameraFrame, default_scene};
-use strata::trace_pass::camera_rays;
 use strata_backends::Backend;
 use strata_kernels::reference::camera_rays::camera_rays as reference_rays;
 use strata_kernels::trace_types::{CameraParams, Ray};
 use strata_kernels::{KernelId, Registry};
+use strata_render::histogram_pass::PassError;
+use strata_render::scene::{CameraFrame, default_scene};
+use strata_render::trace_pass::camera_rays;
 
 /// Checks [`KernelId::CameraRays`].
 pub struct CameraCheck;

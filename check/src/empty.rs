@@ -1,10 +1,10 @@
 //! Check of the empty kernel: it must leave its buffer exactly as it was.
 
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
-use strata::histogram_pass::PassError;
 use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, Bind};
 use strata_kernels::{KernelId, Registry};
+use strata_render::histogram_pass::PassError;
 
 /// Checks [`KernelId::Empty`].
 pub struct EmptyCheck;

@@ -5,12 +5,12 @@
 //! the reference bit for bit.
 
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
-use strata::histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};
-use strata::synthetic::{CandidateMix, candidate_image};
 use strata_backends::Backend;
 use strata_kernels::reference::block_histogram::{HistogramOutput, block_histogram, unmasked};
 use strata_kernels::types::{BLOCK_SIZES, Candidate, OBJECT_ID_NONE};
 use strata_kernels::{BlockGrid, KernelId};
+use strata_render::histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};
+use strata_render::synthetic::{CandidateMix, candidate_image};
 
 /// Checks one of the two histogram kernels.
 pub struct HistogramCheck(pub KernelId);

@@ -37,9 +37,9 @@ pub use backends::{BackendSlot, backend_slots};
 pub use compare::{Agreement, Compare, Mismatch, Output, compare_outputs};
 pub use report::{CellResult, CheckReport};
 
-use strata::histogram_pass::PassError;
 use strata_backends::Backend;
 use strata_kernels::KernelId;
+use strata_render::histogram_pass::PassError;
 
 /// How much to check.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

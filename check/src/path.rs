@@ -12,11 +12,11 @@
 use super::replay::{Recording, recorded, recorded_outputs, replayed_outputs};
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
 use std::sync::Arc;
-use strata::histogram_pass::PassError;
-use strata::render::{GpuScene, RenderSettings, render};
-use strata::scene::{Material, Scene, default_scene};
 use strata_backends::Backend;
 use strata_kernels::{KernelId, Registry};
+use strata_render::histogram_pass::PassError;
+use strata_render::render::{GpuScene, RenderSettings, render};
+use strata_render::scene::{Material, Scene, default_scene};
 
 /// Checks [`KernelId::PathTrace`].
 pub struct PathTraceCheck;

@@ -138,7 +138,7 @@ impl Backend for RecordingBackend<'_> {
 pub fn recorded(
     kernels: &[KernelId],
     key: &str,
-    run: impl FnOnce(&mut dyn Backend) -> Result<(), strata::histogram_pass::PassError>,
+    run: impl FnOnce(&mut dyn Backend) -> Result<(), strata_render::histogram_pass::PassError>,
 ) -> Arc<Recording> {
     static RECORDINGS: Mutex<Vec<(String, Arc<Recording>)>> = Mutex::new(Vec::new());
     let key = format!("{kernels:?} {key}");

@@ -16,13 +16,13 @@
 use super::replay::{Recording, recorded, recorded_outputs, replayed_outputs};
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
 use std::sync::Arc;
-use strata::histogram_pass::PassError;
-use strata::render::{GpuScene, RenderSettings};
-use strata::restir::{Method, RestirRenderer, RestirSettings, ReuseOrder};
-use strata::scene::Material;
 use strata_backends::Backend;
 use strata_kernels::selection::{SamplerVariant, SelectionSettings};
 use strata_kernels::{KernelId, Registry};
+use strata_render::histogram_pass::PassError;
+use strata_render::render::{GpuScene, RenderSettings};
+use strata_render::restir::{Method, RestirRenderer, RestirSettings, ReuseOrder};
+use strata_render::scene::Material;
 
 /// Checks one of the ReSTIR kernels ([`KernelId::RestirCandidates`] and the seven after it).
 pub struct RestirCheck(pub KernelId);

@@ -200,7 +200,7 @@ pub fn parse_sampler(text: &str) -> Result<SamplerDesc, String> {
 fn read_picture(path: &Path) -> Result<([u32; 3], TexelFormat, Vec<u8>)> {
     let lower = path.to_string_lossy().to_ascii_lowercase();
     if lower.ends_with(".exr") {
-        let image = strata::rgb_image::RgbImage::read_exr(path)?;
+        let image = strata_render::rgb_image::RgbImage::read_exr(path)?;
         let texels = image.pixels.iter().flat_map(|p| [p[0], p[1], p[2], 1.0]).flat_map(f32::to_le_bytes).collect();
         return Ok(([image.width, image.height, 1], TexelFormat::Rgba32Float, texels));
     }
@@ -311,12 +311,12 @@ pub fn write_picture(stem: &Path, output: &OutputBuffer, desc: &TextureDesc) -> 
             let image = image::RgbaImage::from_raw(width, height, bytes.to_vec())
                 .context("a storage texture's bytes do not fill its size")?;
             // Encoded in memory, then written whole or not at all, never through a link
-            // (strata's one writer: strata::atomic_file).
+            // (strata's one writer: strata_render::atomic_file).
             let mut png = Vec::new();
             image
                 .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
                 .with_context(|| format!("cannot encode {}", path.display()))?;
-            strata::atomic_file::write(&path, png)?;
+            strata_render::atomic_file::write(&path, png)?;
             return Ok(Some(path));
         }
         TexelFormat::Rgba16Float => floats(4, &f16_at),
@@ -325,7 +325,7 @@ pub fn write_picture(stem: &Path, output: &OutputBuffer, desc: &TextureDesc) -> 
         _ => return Ok(None),
     };
     let path = stem.with_extension("exr");
-    let picture = strata::rgb_image::RgbImage { width, height, pixels };
+    let picture = strata_render::rgb_image::RgbImage { width, height, pixels };
     picture.write_exr(&path)?;
     Ok(Some(path))
 }

@@ -614,7 +614,7 @@ pub fn run_kernel(request: &RunRequest) -> Result<RunOutcome> {
                 let stem = dir.join(format!("{}_{}_{}", output.group, output.binding, output.name));
                 let file = stem.with_extension("bin");
                 // Whole or not at all, never through a link at its or a temporary's name.
-                strata::atomic_file::write(&file, &output.bytes)?;
+                strata_render::atomic_file::write(&file, &output.bytes)?;
                 let texture = images.iter().find_map(|(slot, input)| match input {
                     ImageInput::Texture { desc, .. } if *slot == (output.group, output.binding) => Some(desc),
                     _ => None,

@@ -8,8 +8,6 @@
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg32;
-use strata::histogram_pass::PassError;
-use strata::synthetic::{CandidateMix, candidate_image};
 use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, Bind};
 use strata_kernels::blue_noise::BlueNoiseTables;
@@ -19,6 +17,8 @@ use strata_kernels::reference::stratified_selection::{resample, select};
 use strata_kernels::selection::{MAX_SELECTED, SamplerVariant};
 use strata_kernels::types::Candidate;
 use strata_kernels::{BlockGrid, KernelId, Registry};
+use strata_render::histogram_pass::PassError;
+use strata_render::synthetic::{CandidateMix, candidate_image};
 
 /// Checks [`KernelId::StrataSelect`] or [`KernelId::StrataResample`].
 pub struct SelectionCheck(pub KernelId);

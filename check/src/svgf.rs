@@ -9,12 +9,12 @@
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg32;
-use strata::histogram_pass::PassError;
 use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, Bind, BufferId};
 use strata_kernels::denoise_types::{DenoiseGuide, DenoiseParams};
 use strata_kernels::reference::svgf::{self, TemporalInputs};
 use strata_kernels::{KernelId, Registry};
+use strata_render::histogram_pass::PassError;
 
 /// Checks one SVGF kernel.
 pub struct SvgfCheck(pub KernelId);
@@ -162,7 +162,7 @@ fn inputs(kernel: KernelId, case: &Case) -> Inputs {
         .collect();
     let level = if kernel == KernelId::SvgfAtrous { (case.seed % 5) as u32 } else { 0 };
     // Object edges on for about half the cases (the seed's parity).
-    let settings = strata::denoise::SvgfSettings { object_edges: case.seed % 2 == 1, ..Default::default() };
+    let settings = strata_render::denoise::SvgfSettings { object_edges: case.seed % 2 == 1, ..Default::default() };
     let params = settings.params(width, height, level, case.family != 3);
     Inputs {
         params,

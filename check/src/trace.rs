@@ -5,13 +5,13 @@
 //! at a near-tie.
 
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
-use strata::histogram_pass::PassError;
-use strata::synthetic::{rays_into_cube, triangle_soup};
-use strata::trace_pass::{SceneBvh, TracePass};
 use strata_backends::Backend;
 use strata_kernels::reference::bvh_trace::closest_hit;
 use strata_kernels::trace_types::Hit;
 use strata_kernels::{KernelId, Registry};
+use strata_render::histogram_pass::PassError;
+use strata_render::synthetic::{rays_into_cube, triangle_soup};
+use strata_render::trace_pass::{SceneBvh, TracePass};
 
 /// Checks [`KernelId::BvhClosestHit`].
 pub struct TraceCheck;

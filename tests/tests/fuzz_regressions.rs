@@ -5,7 +5,8 @@
 //! are `cargo xtask fuzz`; RELIABILITY.md has their figures.
 
 use std::time::{Duration, Instant};
-use strata_check::fuzz::{self, Campaign, GuardedAllocator, Verdict};
+use strata::evaluation::compare::{FrameError, errors_csv, parse_errors_csv};
+use strata_check::fuzz::{self, Campaign, GuardedAllocator, Readers, Verdict};
 
 /// One allocation over the campaign's limit is a finding (the process exits naming it).
 #[global_allocator]
@@ -14,11 +15,36 @@ static ALLOCATOR: GuardedAllocator = GuardedAllocator;
 /// One allocation over this many bytes is a finding.
 const ALLOCATION_LIMIT: usize = 1 << 30;
 
+/// The evaluation's reader, which strata-check does not link (as `cargo xtask fuzz` hands
+/// it in).
+fn readers() -> Readers {
+    Readers {
+        errors_csv: |text| {
+            let rows = parse_errors_csv(text)?;
+            Ok(rows.iter().map(|e| [e.relmse, e.prelmse, e.mse, e.relmse_luminance.unwrap_or(0.0)]).collect())
+        },
+    }
+}
+
+/// `errors-csv`'s seeds, written in strata-check as text, are accepted by the reader it is
+/// handed, and the complete grid is byte for byte what `strata compare` writes for it.
+#[test]
+fn errors_csv_seeds_are_what_compare_writes() {
+    let target = fuzz::targets(readers()).into_iter().find(|t| t.name() == "errors-csv").unwrap();
+    let seeds = target.seeds(None);
+    for (index, seed) in seeds.iter().enumerate() {
+        assert_eq!(fuzz::execute(target.as_ref(), seed), Verdict::Accepted, "seed {index}");
+    }
+    let grid = std::str::from_utf8(&seeds[0]).unwrap();
+    let rows: Vec<FrameError> = parse_errors_csv(grid).unwrap();
+    assert_eq!(errors_csv(&rows), grid);
+}
+
 #[test]
 fn every_committed_finding_is_now_refused_cleanly() {
     let folder = fuzz::findings_folder();
     let previous = fuzz::set_allocation_limit(ALLOCATION_LIMIT);
-    let results = fuzz::replay_findings(&folder, Duration::from_secs(20)).unwrap();
+    let results = fuzz::replay_findings(&folder, readers(), Duration::from_secs(20)).unwrap();
     fuzz::set_allocation_limit(previous);
     assert!(results.len() >= 20, "{}: only {} findings", folder.display(), results.len());
     let mut failures = Vec::new();
@@ -44,7 +70,7 @@ fn a_short_fixed_seed_campaign_of_every_target_finds_nothing() {
     let crash_dir = std::env::temp_dir().join(format!("strata-fuzz-findings-{}", std::process::id()));
     let started = Instant::now();
     let mut failures = Vec::new();
-    for target in fuzz::targets() {
+    for target in fuzz::targets(readers()) {
         // About a second each in a debug build.
         let executions = match target.name() {
             "gltf" => 5000,
@@ -86,7 +112,7 @@ fn a_short_fixed_seed_campaign_of_every_target_finds_nothing() {
 /// The same seed runs the same inputs: two short campaigns agree on every figure.
 #[test]
 fn a_campaign_is_deterministic_from_its_seed() {
-    let target = fuzz::targets().into_iter().find(|t| t.name() == "ply").unwrap();
+    let target = fuzz::targets(readers()).into_iter().find(|t| t.name() == "ply").unwrap();
     let campaign = |seed| Campaign {
         seed,
         executions: Some(2000),

@@ -1,7 +1,8 @@
 //! `cargo xtask fuzz`: runs the loaders' fuzz targets (`strata_check::fuzz`) one after
 //! another and prints each campaign's figures; exits non-zero naming the input files of
 //! any crash. A hang or a huge allocation ends the process at once (status 2 or 3), after
-//! writing the input.
+//! writing the input. The evaluation's reader, which strata-check does not link, is
+//! handed in here ([`readers`]).
 
 use anyhow::{Context, Result, bail};
 use std::path::PathBuf;
@@ -40,9 +41,19 @@ pub struct FuzzArgs {
     outcomes: Option<PathBuf>,
 }
 
+/// The readers of the host crate that the harness fuzzes: `errors.csv`'s.
+pub fn readers() -> fuzz::Readers {
+    fuzz::Readers {
+        errors_csv: |text| {
+            let rows = strata::evaluation::compare::parse_errors_csv(text)?;
+            Ok(rows.iter().map(|e| [e.relmse, e.prelmse, e.mse, e.relmse_luminance.unwrap_or(0.0)]).collect())
+        },
+    }
+}
+
 /// Runs the campaigns of `args`.
 pub fn fuzz(args: FuzzArgs) -> Result<()> {
-    let targets = fuzz::targets();
+    let targets = fuzz::targets(readers());
     let names: Vec<&str> = targets.iter().map(|t| t.name()).collect();
     if let Some(unknown) = args.target.iter().find(|t| !names.contains(&t.as_str())) {
         bail!("--target {unknown}: no such fuzz target (targets: {})", names.join(", "));

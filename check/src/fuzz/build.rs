@@ -140,9 +140,9 @@ pub fn base64(bytes: &[u8]) -> String {
 /// A small generated environment map (8 x 4 texels of varied colours) at `scale`: the
 /// environment light of the glass/metal rooms that the cross-backend check and the
 /// unbiasedness tests render.
-pub fn generated_environment(scale: f32) -> strata::scene::Environment {
+pub fn generated_environment(scale: f32) -> strata_render::scene::Environment {
     let (width, height) = (8u32, 4u32);
-    strata::scene::Environment {
+    strata_render::scene::Environment {
         file: "generated".into(),
         width,
         height,

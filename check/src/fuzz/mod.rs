@@ -9,7 +9,7 @@
 //! | `gltf` | `scene::load_gltf_from` on `.gltf` JSON and `.glb` containers |
 //! | `obj` | `scene::load_obj_from` on an OBJ and its MTL library |
 //! | `exr` | `scene::Environment::from_exr_bytes` and `rgb_image::RgbImage::read_exr` (references) |
-//! | `errors-csv` | `evaluation::compare::parse_errors_csv` |
+//! | `errors-csv` | `evaluation::compare::parse_errors_csv` of the host crate, handed in ([`Readers`]) |
 //!
 //! Each target starts from small valid files written in code ([`build`]) plus, when the
 //! shared scenes are beside the checkout, their small real files; inputs are mutated byte
@@ -69,9 +69,21 @@ pub trait Target: Send + Sync {
     fn execute(&self, input: &[u8]) -> Outcome;
 }
 
-/// Every target, in a fixed order.
-pub fn targets() -> Vec<Box<dyn Target>> {
-    targets::all()
+/// The readers the harness fuzzes but does not link: the evaluation's, in the host crate
+/// `strata`, which stands beside this crate on strata-render, not below it. The program
+/// that runs the campaigns hands them in (`cargo xtask fuzz`, the `fuzz_regressions`
+/// test).
+#[derive(Clone, Copy, Debug)]
+pub struct Readers {
+    /// `errors.csv` as `strata plot` reads it (`strata::evaluation::compare::parse_errors_csv`):
+    /// each accepted row's RelMSE, pRelMSE, MSE and luminance RelMSE (0 when the file has
+    /// none).
+    pub errors_csv: fn(&str) -> Result<Vec<[f64; 4]>, String>,
+}
+
+/// Every target, in a fixed order: strata-render's loaders, then `readers`.
+pub fn targets(readers: Readers) -> Vec<Box<dyn Target>> {
+    targets::all(readers)
 }
 
 /// The folder of committed findings: `tests/data/fuzz` of the workspace.
@@ -89,8 +101,12 @@ pub fn shared_scenes() -> Option<PathBuf> {
 /// Runs every committed finding under `folder` (`<target>/<file>`) through its target
 /// again: each file with the verdict it gets now, a run over `hang_after` being a crash
 /// (its thread is left behind). A file in a folder that names no target is an error.
-pub fn replay_findings(folder: &Path, hang_after: std::time::Duration) -> Result<Vec<(PathBuf, Verdict)>, String> {
-    let targets = targets();
+pub fn replay_findings(
+    folder: &Path,
+    readers: Readers,
+    hang_after: std::time::Duration,
+) -> Result<Vec<(PathBuf, Verdict)>, String> {
+    let targets = targets(readers);
     let mut results = Vec::new();
     let Ok(entries) = std::fs::read_dir(folder) else { return Ok(results) };
     let mut folders: Vec<PathBuf> = entries.filter_map(Result::ok).map(|e| e.path()).filter(|p| p.is_dir()).collect();
@@ -109,7 +125,7 @@ pub fn replay_findings(folder: &Path, hang_after: std::time::Duration) -> Result
         files.sort();
         for file in files {
             let input = std::fs::read(&file).map_err(|e| format!("{}: {e}", file.display()))?;
-            let target = targets::all().into_iter().find(|t| t.name() == name).expect("the same targets");
+            let target = targets::all(readers).into_iter().find(|t| t.name() == name).expect("the same targets");
             let (sender, receiver) = std::sync::mpsc::channel();
             std::thread::spawn(move || sender.send(execute(target.as_ref(), &input)));
             let verdict = receiver.recv_timeout(hang_after).unwrap_or_else(|_| Verdict::Crash {

@@ -3,7 +3,7 @@
 //! panic. A loader must refuse (or clamp, documented) a NaN, infinite or negative number
 //! rather than hand it to the renderer, where it becomes a NaN image.
 
-use strata::scene::{Albedo, CameraFrame, Material, Scene};
+use strata_render::scene::{Albedo, CameraFrame, Material, Scene};
 
 /// The first number of `scene` that the renderer cannot use, described.
 pub fn check_scene(scene: &Scene) -> Result<(), String> {

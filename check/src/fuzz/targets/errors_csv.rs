@@ -2,21 +2,32 @@
 //! `strata plot` reads it: the bytes must be UTF-8 first). Structure-aware mutations
 //! replace one field with an edge value (`NaN`, `inf`, `-1`, `0`, empty, `4294967296`,
 //! an unknown method), or add or drop a field or line.
+//!
+//! The reader is the evaluation's (the host crate `strata`, which stands beside this one
+//! on strata-render, not below it), so the program that runs the campaign hands it in
+//! ([`Readers::errors_csv`](super::super::Readers::errors_csv)).
 
 use super::super::mutate::{EDGE_NUMBERS, FuzzRng, mutate_lines};
 use super::super::{Outcome, Target};
 use arbitrary::Unstructured;
 use rand::Rng;
 use std::path::Path;
-use strata::evaluation::compare::{FrameError, errors_csv, parse_errors_csv};
-use strata::restir::Method;
+use strata_render::restir::Method;
 
-/// The target.
-pub(super) struct ErrorsCsv;
+/// The target, over the reader it was handed.
+pub(super) struct ErrorsCsv {
+    /// `parse_errors_csv`: each accepted row's RelMSE, pRelMSE, MSE and luminance RelMSE.
+    pub(super) read: fn(&str) -> Result<Vec<[f64; 4]>, String>,
+}
 
-/// The two headers the parser reads.
+/// Two earlier headers, which the reader still reads: the generator's.
 const HEADERS: [&str; 2] =
     ["method,frame,seed,relmse,prelmse,mse,relmse_luminance", "method,frame,seed,relmse,prelmse,mse"];
+
+/// The header `strata compare` writes today (`evaluation::compare::errors_csv`), which
+/// the seeds carry; a test of the workspace (`fuzz_regressions`) holds the complete grid
+/// below to the bytes that writer gives for it.
+const WRITTEN_HEADER: &str = "method,frame,seed,relmse,prelmse,mse,relmse_luminance,flip,block_edge";
 
 impl Target for ErrorsCsv {
     fn name(&self) -> &'static str {
@@ -24,27 +35,22 @@ impl Target for ErrorsCsv {
     }
 
     fn seeds(&self, _shared: Option<&Path>) -> Vec<Vec<u8>> {
-        // Complete grids (every method at every frame and seed), as `compare` writes them.
-        let mut errors = Vec::new();
+        // A complete grid (every method at every frame and seed), as `compare` writes it:
+        // frames 1-based, errors as `{:.6e}`, an unknown value an empty field.
+        let mut grid = format!("{WRITTEN_HEADER}\n");
         for (index, method) in [Method::Strata, Method::Restir, Method::RestirDisc].into_iter().enumerate() {
-            for frame in 0..3 {
+            for frame in 0..3u32 {
                 for seed in 1..=2 {
-                    errors.push(FrameError {
-                        method,
-                        frame,
-                        seed,
-                        relmse: 0.5 / f64::from(frame + 1) + 0.01 * index as f64,
-                        prelmse: 0.25,
-                        mse: 1e-3,
-                        relmse_luminance: (frame != 1).then_some(0.125),
-                        flip: None,
-                        block_edge: None,
-                    });
+                    let relmse = 0.5 / f64::from(frame + 1) + 0.01 * index as f64;
+                    let luminance = if frame != 1 { format!("{:.6e}", 0.125) } else { String::new() };
+                    let (name, prelmse, mse) = (method.name(), 0.25, 1e-3);
+                    grid +=
+                        &format!("{name},{},{seed},{relmse:.6e},{prelmse:.6e},{mse:.6e},{luminance},,\n", frame + 1);
                 }
             }
         }
         let old = format!("{}\nrestir-disc,3,8,0.5,0.25,1e-3\nstrata,3,8,1,1,1\n\n", HEADERS[1]);
-        vec![errors_csv(&errors).into_bytes(), old.into_bytes()]
+        vec![grid.into_bytes(), old.into_bytes()]
     }
 
     fn generate(&self, u: &mut Unstructured) -> arbitrary::Result<Vec<u8>> {
@@ -92,11 +98,9 @@ impl Target for ErrorsCsv {
 
     fn execute(&self, input: &[u8]) -> Outcome {
         let Ok(text) = std::str::from_utf8(input) else { return Outcome::Refused("not UTF-8".into()) };
-        match parse_errors_csv(text) {
-            Ok(errors) => {
-                let values =
-                    errors.iter().flat_map(|e| [e.relmse, e.prelmse, e.mse, e.relmse_luminance.unwrap_or(0.0)]);
-                let values: Vec<f64> = values.collect();
+        match (self.read)(text) {
+            Ok(rows) => {
+                let values: Vec<f64> = rows.into_iter().flatten().collect();
                 if values.iter().any(|v| !v.is_finite()) {
                     Outcome::Noted("rows accepted with non-finite errors".into())
                 } else if values.iter().any(|v| *v < 0.0) {

@@ -11,8 +11,8 @@ use arbitrary::Unstructured;
 use exr::prelude::{Compression, Encoding, Image, Layer, LayerAttributes, SpecificChannels, WritableImage};
 use rand::Rng;
 use std::path::{Path, PathBuf};
-use strata::rgb_image::RgbImage;
-use strata::scene::{Environment, decode_rgb_exr};
+use strata_render::rgb_image::RgbImage;
+use strata_render::scene::{Environment, decode_rgb_exr};
 
 /// One attribute of an EXR header: where its size field and value lie.
 struct Attribute {

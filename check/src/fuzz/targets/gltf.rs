@@ -11,7 +11,7 @@ use arbitrary::Unstructured;
 use rand::Rng;
 use serde_json::{Value, json};
 use std::path::Path;
-use strata::scene::{MemoryFiles, load_gltf_from};
+use strata_render::scene::{MemoryFiles, load_gltf_from};
 
 /// Keys whose values the JSON mutations prefer.
 const FOCUS: &[&str] = &[

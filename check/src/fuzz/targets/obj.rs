@@ -10,7 +10,7 @@ use super::{count, number};
 use arbitrary::Unstructured;
 use rand::Rng;
 use std::path::Path;
-use strata::scene::{FileSource, MemoryFiles, load_obj_from};
+use strata_render::scene::{FileSource, MemoryFiles, load_obj_from};
 
 /// The line between the OBJ and the MTL text of an input.
 const SEPARATOR: &[u8] = b"\n#%MTL\n";

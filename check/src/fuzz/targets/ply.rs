@@ -10,7 +10,7 @@ use super::count;
 use arbitrary::Unstructured;
 use rand::Rng;
 use std::path::Path;
-use strata::scene::parse_ply;
+use strata_render::scene::parse_ply;
 
 /// The target.
 pub(super) struct Ply;

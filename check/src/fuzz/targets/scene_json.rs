@@ -9,7 +9,7 @@ use super::number;
 use arbitrary::Unstructured;
 use rand::Rng;
 use std::path::Path;
-use strata::scene::{FileSource, MemoryFiles, load_scene_from};
+use strata_render::scene::{FileSource, MemoryFiles, load_scene_from};
 
 /// Where the input lies in the in-memory file system.
 const SCENE: &str = "scene/fuzz.json";

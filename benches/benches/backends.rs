@@ -11,12 +11,12 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::Duration;
-use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
 use strata_backends::ash_backend::{AshBackend, AshOptions};
 use strata_backends::wgpu_backend::{WgpuBackend, WgpuOptions};
 use strata_backends::{Backend, BackendError, Bind};
 use strata_benches::benchmark_candidates;
 use strata_kernels::{BlockGrid, KernelId, Registry};
+use strata_render::histogram_pass::{BlockHistogramPass, HistogramVariant};
 
 /// A backend opened without API validation (it would distort timings), or why not.
 type Opened = Result<Box<dyn Backend>, BackendError>;

@@ -14,12 +14,12 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::time::Duration;
-use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
 use strata_backends::Backend;
 use strata_backends::wgpu_backend::{WgpuBackend, WgpuOptions};
 use strata_benches::benchmark_candidates;
 use strata_kernels::BlockGrid;
 use strata_kernels::reference::block_histogram::{block_histogram, sort_block};
+use strata_render::histogram_pass::{BlockHistogramPass, HistogramVariant};
 
 fn block_sort(c: &mut Criterion) {
     let (width, height, candidates) = benchmark_candidates();

@@ -10,12 +10,12 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::Duration;
-use strata::denoise::{SvgfDenoiser, SvgfSettings};
-use strata::render::{GpuScene, RenderSettings};
-use strata::restir::{RestirRenderer, RestirSettings};
-use strata::scene::default_scene;
 use strata_backends::Backend;
 use strata_backends::wgpu_backend::{WgpuBackend, WgpuOptions};
+use strata_render::denoise::{SvgfDenoiser, SvgfSettings};
+use strata_render::render::{GpuScene, RenderSettings};
+use strata_render::restir::{RestirRenderer, RestirSettings};
+use strata_render::scene::default_scene;
 
 fn svgf(c: &mut Criterion) {
     let mut backend = match WgpuBackend::new(WgpuOptions::default()) {

@@ -9,11 +9,11 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::{Duration, Instant};
-use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
-use strata::synthetic::{CandidateMix, candidate_image};
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_backends::wgpu_backend::{WgpuBackend, WgpuOptions};
 use strata_kernels::BlockGrid;
+use strata_render::histogram_pass::{BlockHistogramPass, HistogramVariant};
+use strata_render::synthetic::{CandidateMix, candidate_image};
 
 fn interpreter(c: &mut Criterion) {
     let grid = BlockGrid::new(128, 128, 16).expect("valid grid");

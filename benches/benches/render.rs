@@ -18,16 +18,16 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::Duration;
-use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
-use strata::render::{GpuScene, PathTracer, RenderSettings};
-use strata::restir::{Method, RestirRenderer, RestirSettings, ReuseOrder, Shading};
-use strata::scene::{Scene, default_scene};
-use strata::synthetic::{CandidateMix, candidate_image};
 use strata_backends::Backend;
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions, DispatchCounts, WARP_WIDTH};
 use strata_backends::wgpu_backend::{WgpuBackend, WgpuOptions};
 use strata_kernels::selection::SelectionSettings;
 use strata_kernels::{BlockGrid, Executor, KernelId};
+use strata_render::histogram_pass::{BlockHistogramPass, HistogramVariant};
+use strata_render::render::{GpuScene, PathTracer, RenderSettings};
+use strata_render::restir::{Method, RestirRenderer, RestirSettings, ReuseOrder, Shading};
+use strata_render::scene::{Scene, default_scene};
+use strata_render::synthetic::{CandidateMix, candidate_image};
 
 fn settings(scene: &Scene, size: u32) -> RenderSettings {
     RenderSettings::for_scene(scene, size, size, 1)

@@ -17,13 +17,13 @@ use glam::Vec3A;
 use obvhs::ray::{Ray as ObvhsRay, RayHit};
 use std::hint::black_box;
 use std::time::Duration;
-use strata::synthetic::{rays_into_cube, triangle_soup};
-use strata::trace_pass::SceneBvh;
 use strata_backends::backend::upload;
 use strata_backends::wgpu_backend::{WgpuBackend, WgpuOptions};
 use strata_backends::{Backend, Bind};
 use strata_kernels::trace_types::{Hit, TraceParams};
 use strata_kernels::{KernelId, Registry};
+use strata_render::synthetic::{rays_into_cube, triangle_soup};
+use strata_render::trace_pass::SceneBvh;
 
 fn trace(c: &mut Criterion) {
     // The test soup's triangles shrunk to a tenth around their centroids: a sparse scene
@@ -39,7 +39,7 @@ fn trace(c: &mut Criterion) {
     let mut group = c.benchmark_group("trace_50k_tris_262k_rays");
     group.sample_size(10).measurement_time(Duration::from_secs(10)).throughput(Throughput::Elements(rays.len() as u64));
 
-    let (tris, bvh) = strata::trace_pass::build_obvhs(&soup);
+    let (tris, bvh) = strata_render::trace_pass::build_obvhs(&soup);
     group.bench_function("obvhs_native", |b| {
         b.iter(|| {
             let mut hits = 0u32;

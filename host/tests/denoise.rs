@@ -39,7 +39,7 @@ fn compare_with_svgf_measures_every_frame_denoised_and_the_frames_are_smoother()
     // dominated by its blur; BENCHMARKS.md measures it at 256 wide.)
     for method in ["strata", "restir", "restir-disc"] {
         let roughness = |name: String| -> f64 {
-            let image = strata::rgb_image::RgbImage::read_exr(&out.join(name)).unwrap();
+            let image = strata_render::rgb_image::RgbImage::read_exr(&out.join(name)).unwrap();
             let luminance = |p: [f32; 3]| f64::from(0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]);
             let rows = image.pixels.chunks(image.width as usize);
             rows.flat_map(|row| row.windows(2).map(|w| (luminance(w[0]) - luminance(w[1])).abs())).sum()

@@ -10,7 +10,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use strata::rgb_image::RgbImage;
+use strata_render::rgb_image::RgbImage;
 
 /// The binary under test.
 fn binary() -> PathBuf {
@@ -351,7 +351,7 @@ fn radiance_that_overflows_is_refused_before_anything_is_scored() {
     let scene = cornell_box(&dir, "brightest-light", |scene| {
         for shape in scene["shapes"].as_array_mut().unwrap() {
             if shape.get("emitter").is_some() {
-                let most = f64::from(strata::scene::MAX_RADIANCE);
+                let most = f64::from(strata_render::scene::MAX_RADIANCE);
                 shape["emitter"]["radiance"] = serde_json::json!([most, most, most]);
             }
         }
@@ -746,7 +746,8 @@ fn gltf_scene(dir: &Path, name: &str, edit: impl FnOnce(&mut serde_json::Value))
     let mut bytes: Vec<u8> = positions.iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
     bytes.extend(uvs.iter().flatten().flat_map(|c| c.to_le_bytes()));
     std::fs::write(folder.join("triangle.bin"), &bytes).unwrap();
-    let png = strata::rgb_image::encode_png(&[200, 100, 50, 255], 1, 1, image::ExtendedColorType::Rgba8).unwrap();
+    let png =
+        strata_render::rgb_image::encode_png(&[200, 100, 50, 255], 1, 1, image::ExtendedColorType::Rgba8).unwrap();
     std::fs::write(folder.join("texture.png"), png).unwrap();
     let mut document = serde_json::json!({
         "asset": {"version": "2.0"},

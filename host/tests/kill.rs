@@ -44,7 +44,8 @@ fn assert_complete(folder: &Path) -> usize {
                 image::open(&path).unwrap_or_else(|e| panic!("{name} is truncated: {e}"));
             }
             Some("exr") => {
-                strata::rgb_image::RgbImage::read_exr(&path).unwrap_or_else(|e| panic!("{name} is truncated: {e}"));
+                strata_render::rgb_image::RgbImage::read_exr(&path)
+                    .unwrap_or_else(|e| panic!("{name} is truncated: {e}"));
             }
             Some("csv") if name == "errors.csv" => {
                 strata::evaluation::compare::parse_errors_csv(&text()).unwrap_or_else(|e| panic!("{name}: {e}"));

@@ -1,12 +1,12 @@
 //! The ash backend with `VK_LAYER_KHRONOS_validation` on: the histogram kernel gives the
 //! reference's output and the layer reports nothing; errors are typed, not panics.
 
-use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
-use strata::synthetic::{CandidateMix, candidate_image};
 use strata_backends::ash_backend::{AshBackend, AshOptions, SpirvSource};
 use strata_backends::{Backend, BackendError, Bind, gpu_required};
 use strata_kernels::reference::block_histogram::block_histogram;
 use strata_kernels::{BlockGrid, KernelId, Registry};
+use strata_render::histogram_pass::{BlockHistogramPass, HistogramVariant};
+use strata_render::synthetic::{CandidateMix, candidate_image};
 
 fn open(validation: bool, subgroups: bool) -> Option<AshBackend> {
     match AshBackend::new(AshOptions { validation, source: SpirvSource::Naga, subgroups, ..Default::default() }) {

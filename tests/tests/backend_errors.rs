@@ -1,11 +1,11 @@
 //! Bad input to the backend and the histogram pass becomes a typed error naming the
 //! problem, never a panic or a silent wrong result.
 
-use strata::histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};
 use strata_backends::wgpu_backend::{WgpuApi, WgpuOptions};
 use strata_backends::{Backend, BackendError, Bind};
 use strata_kernels::types::{Candidate, HistogramParams};
 use strata_kernels::{BlockGrid, Executor, GridError, KernelId, Registry};
+use strata_render::histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};
 use strata_tests::{open_or_skip, vulkan_backend};
 
 #[test]

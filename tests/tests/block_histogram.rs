@@ -2,12 +2,12 @@
 //! many equal keys, mixed object ids and every awkward value, at every block size and at
 //! image sizes with partial edge blocks; output buffers poisoned before every run.
 
-use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
-use strata::synthetic::{CandidateMix, candidate_image};
 use strata_backends::Backend;
 use strata_kernels::BlockGrid;
 use strata_kernels::reference::block_histogram::{HistogramOutput, block_histogram, unmasked};
 use strata_kernels::types::{BLOCK_SIZES, Candidate};
+use strata_render::histogram_pass::{BlockHistogramPass, HistogramVariant};
+use strata_render::synthetic::{CandidateMix, candidate_image};
 use strata_tests::{POISON, vulkan_backend};
 
 fn run_poisoned(

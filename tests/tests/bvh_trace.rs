@@ -3,14 +3,14 @@
 
 use glam::Vec3A;
 use obvhs::ray::{Ray as ObvhsRay, RayHit};
-use strata::synthetic::{rays_into_cube, triangle_soup};
-use strata::trace_pass::{SceneBvh, TracePass};
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_backends::{Backend, gpu_required};
 use strata_kernels::trace_types::{MISS, Ray};
+use strata_render::synthetic::{rays_into_cube, triangle_soup};
+use strata_render::trace_pass::{SceneBvh, TracePass};
 
 fn obvhs_closest(soup: &[[[f32; 3]; 3]], rays: &[Ray]) -> Vec<(u32, f32)> {
-    let (tris, bvh) = strata::trace_pass::build_obvhs(soup);
+    let (tris, bvh) = strata_render::trace_pass::build_obvhs(soup);
     rays.iter()
         .map(|r| {
             let ray = ObvhsRay::new(Vec3A::from(r.origin), Vec3A::from(r.direction), r.tmin, r.tmax);
@@ -78,9 +78,9 @@ fn bad_geometry_and_rays_are_named() {
 /// made every box count as hit (limit + 1 == limit) and half the rays missed on lavapipe.
 fn scene_camera_rays_agree_with_obvhs(backend: &mut dyn Backend) {
     let path = strata_tests::scenes_folder().join("matpreview/scene.json");
-    let scene = strata::scene::Scene::load(&path).unwrap();
+    let scene = strata_render::scene::Scene::load(&path).unwrap();
     let (soup, _) = scene.triangles_with_ids();
-    let frame = strata::scene::CameraFrame::new(&scene.camera).unwrap();
+    let frame = strata_render::scene::CameraFrame::new(&scene.camera).unwrap();
     let (w, h) = (40u32, 30u32);
     let mut rays = Vec::new();
     for y in 0..h {

@@ -4,13 +4,13 @@
 //! frame's guide there shows the same object at about the same depth, far more often
 //! than where the opposite vector leads. On the interpreter, so that it runs anywhere.
 
-use strata::render::{GpuScene, RenderSettings};
-use strata::restir::{RestirRenderer, RestirSettings};
-use strata::scene::{CameraPath, default_scene};
 use strata_backends::Backend;
 use strata_backends::backend::download;
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_kernels::denoise_types::DenoiseGuide;
+use strata_render::render::{GpuScene, RenderSettings};
+use strata_render::restir::{RestirRenderer, RestirSettings};
+use strata_render::scene::{CameraPath, default_scene};
 
 const SIZE: u32 = 32;
 

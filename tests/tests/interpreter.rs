@@ -2,8 +2,6 @@
 //! and atomics on hand-written kernels, WGSL integer semantics against lavapipe, and
 //! clear errors for what it does not support.
 
-use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
-use strata::synthetic::{CandidateMix, candidate_image};
 use strata_backends::ash_backend::{AshBackend, AshOptions, SpirvSource};
 use strata_backends::backend::{download, upload};
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
@@ -11,6 +9,8 @@ use strata_backends::{Backend, BackendError, Bind};
 use strata_kernels::reference::block_histogram::block_histogram;
 use strata_kernels::types::BLOCK_SIZES;
 use strata_kernels::{BlockGrid, Kernel};
+use strata_render::histogram_pass::{BlockHistogramPass, HistogramVariant};
+use strata_render::synthetic::{CandidateMix, candidate_image};
 use strata_tests::run_words;
 
 #[test]
@@ -1511,7 +1511,7 @@ fn a_buffer_bound_at_two_read_only_bindings_is_read_through_both_and_kept() {
     use strata_kernels::denoise_types::DenoiseGuide;
     let mut backend = CpuBackend::new(CpuOptions::default()).unwrap();
     let kernel = strata_kernels::Registry::shared().unwrap().get(strata_kernels::KernelId::SvgfModulate);
-    let params = strata::denoise::SvgfSettings::default().params(4, 1, 0, false);
+    let params = strata_render::denoise::SvgfSettings::default().params(4, 1, 0, false);
     let colour: Vec<[f32; 4]> = (0..4).map(|i| [i as f32 + 1.0; 4]).collect();
     let guide = DenoiseGuide { albedo: [1.0; 3], depth: 1.0, normal: [0.0, 0.0, 1.0], ..Default::default() };
     let buffers = [

@@ -6,12 +6,12 @@
 
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
-use strata::histogram_pass::{BlockHistogramPass, HistogramVariant};
-use strata::synthetic::{CandidateMix, candidate_image};
 use strata_backends::backend::{download, upload};
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions, Finding, FindingKind};
 use strata_backends::{Backend, Bind};
 use strata_kernels::{BlockGrid, Kernel};
+use strata_render::histogram_pass::{BlockHistogramPass, HistogramVariant};
+use strata_render::synthetic::{CandidateMix, candidate_image};
 
 fn source(file: &str) -> String {
     let path = format!("{}/data/sanitizer/{file}", env!("CARGO_MANIFEST_DIR"));

@@ -5,12 +5,12 @@
 //! With the validation layer on, which reports any misuse of the cache objects.
 
 use std::path::{Path, PathBuf};
-use strata::render::{GpuScene, RenderSettings};
-use strata::scene::default_scene;
 use strata_backends::ash_backend::{AshBackend, AshOptions, SpirvSource};
 use strata_backends::pipeline_cache_file::PipelineCacheFile;
 use strata_backends::wgpu_backend::{WgpuApi, WgpuOptions};
 use strata_backends::{Backend, BackendError, gpu_required};
+use strata_render::render::{GpuScene, RenderSettings};
+use strata_render::scene::default_scene;
 
 fn scratch(name: &str) -> PathBuf {
     let folder = std::env::temp_dir().join(format!("strata-pipeline-cache-{name}-{}", std::process::id()));
@@ -23,7 +23,7 @@ fn render(backend: &mut dyn Backend) -> Vec<[f32; 3]> {
     let scene = default_scene();
     let gpu_scene = GpuScene::build(&scene).unwrap();
     let settings = RenderSettings::for_scene(&scene, 8, 8, 1);
-    strata::render::render(backend, &gpu_scene, &settings, 2, |_| {}).unwrap().pixels
+    strata_render::render::render(backend, &gpu_scene, &settings, 2, |_| {}).unwrap().pixels
 }
 
 /// The one cache file in `folder`.

@@ -18,10 +18,10 @@
 
 use std::path::{Path, PathBuf};
 use strata::evaluation::metrics;
-use strata::render::{Film, GpuScene, LightSampling, RenderSettings, render};
-use strata::rgb_image::RgbImage;
-use strata::scene::{Camera, Environment, Material, Scene, Shape};
 use strata_backends::{Backend, gpu_required};
+use strata_render::render::{Film, GpuScene, LightSampling, RenderSettings, render};
+use strata_render::rgb_image::RgbImage;
+use strata_render::scene::{Camera, Environment, Material, Scene, Shape};
 
 fn shared_scene(name: &str) -> PathBuf {
     strata_tests::scenes_folder().join(name)

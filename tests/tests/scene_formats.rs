@@ -5,8 +5,8 @@
 use glam::Vec3;
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
-use strata::scene::{Albedo, CameraFrame, Material, Scene, SceneError, load_scene_file, srgb_to_linear};
 use strata_check::fuzz::build::base64;
+use strata_render::scene::{Albedo, CameraFrame, Material, Scene, SceneError, load_scene_file, srgb_to_linear};
 
 /// A fresh folder under the system's temporary folder.
 fn temp_folder(name: &str) -> PathBuf {
@@ -400,7 +400,7 @@ fn obj_and_mtl_give_shapes_materials_and_a_framing_camera() {
     // The framing camera sees every vertex and hits the floor through the image centre.
     assert_framed(&scene);
     let (triangles, ids) = scene.triangles_with_ids();
-    let (tris, bvh) = strata::trace_pass::build_obvhs(&triangles);
+    let (tris, bvh) = strata_render::trace_pass::build_obvhs(&triangles);
     let frame = CameraFrame::new(&scene.camera).unwrap();
     let (origin, direction) = frame.ray(0.5, 0.5);
     let ray = obvhs::ray::Ray::new(origin.into(), direction.into(), 0.0, scene.camera.far_clip);

@@ -2,7 +2,7 @@
 //! with errors that name the file and the field or element.
 
 use std::path::{Path, PathBuf};
-use strata::scene::{Material, Scene, SceneError, read_ply};
+use strata_render::scene::{Material, Scene, SceneError, read_ply};
 
 fn shared_scenes() -> PathBuf {
     strata_tests::scenes_folder()
@@ -127,8 +127,8 @@ fn bad_scene_files_name_the_field() {
 #[test]
 fn bad_environment_maps_and_textures_are_named() {
     use exr::prelude::WritableImage;
-    use strata::rgb_image::RgbImage;
-    use strata::scene::{Environment, Texture};
+    use strata_render::rgb_image::RgbImage;
+    use strata_render::scene::{Environment, Texture};
     let dir = std::env::temp_dir().join(format!("strata-bad-images-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let missing = dir.join("missing.exr");

@@ -17,12 +17,12 @@
 //! work in between grew host memory by megabytes each. Linux only (reads `/proc`);
 //! elsewhere the tests say so and pass.
 
-use strata::render::{GpuScene, RenderSettings};
-use strata::restir::{Method, RestirRenderer, RestirSettings};
-use strata::scene::default_scene;
 use strata_backends::gpu_required;
 use strata_embed::contract::{Candidate, SelectedCandidates};
 use strata_embed::{AshBufferSlice, AshBuffers, AshSelection, SelectionSettings, WgpuBuffers, WgpuSelection};
+use strata_render::render::{GpuScene, RenderSettings};
+use strata_render::restir::{Method, RestirRenderer, RestirSettings};
+use strata_render::scene::default_scene;
 use strata_tests::engine_device;
 use wgpu::util::DeviceExt;
 

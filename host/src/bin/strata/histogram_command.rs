@@ -3,12 +3,12 @@
 
 use anyhow::{Result, anyhow, bail};
 use std::time::Instant;
-use strata::backend_choice::{BackendChoice, open_backend};
-use strata::histogram_pass::{BlockHistogramPass, HistogramVariant, check_image_fits};
-use strata::synthetic::{CandidateMix, candidate_image};
 use strata_kernels::BlockGrid;
 use strata_kernels::reference::block_histogram::block_histogram;
 use strata_kernels::selection::{SelectionSettings, block_size_parser};
+use strata_render::backend_choice::{BackendChoice, open_backend};
+use strata_render::histogram_pass::{BlockHistogramPass, HistogramVariant, check_image_fits};
+use strata_render::synthetic::{CandidateMix, candidate_image};
 
 #[derive(clap::Args)]
 pub(crate) struct HistogramArgs {

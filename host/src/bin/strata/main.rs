@@ -18,12 +18,12 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use strata::backend_choice::{BackendChoice, open_backend};
 use strata::evaluation::metrics::{self, Metric};
-use strata::render::{GpuScene, LightSampling, RenderSettings};
-use strata::restir::{Method, RestirSettings};
-use strata::rgb_image::RgbImage;
-use strata::scene::{Scene, default_scene, load_scene_file};
+use strata_render::backend_choice::{BackendChoice, open_backend};
+use strata_render::render::{GpuScene, LightSampling, RenderSettings};
+use strata_render::restir::{Method, RestirSettings};
+use strata_render::rgb_image::RgbImage;
+use strata_render::scene::{Scene, default_scene, load_scene_file};
 
 /// strata: histogram-stratified ReSTIR.
 #[derive(Parser)]
@@ -259,8 +259,8 @@ pub(crate) fn scene_and_settings(
         if value == 0 {
             bail!("{flag} 0: the image must be at least 1x1 pixels");
         }
-        if value > strata::scene::MAX_IMAGE_SIDE {
-            bail!("{flag} {value}: each side of the image must be at most {}", strata::scene::MAX_IMAGE_SIDE);
+        if value > strata_render::scene::MAX_IMAGE_SIDE {
+            bail!("{flag} {value}: each side of the image must be at most {}", strata_render::scene::MAX_IMAGE_SIDE);
         }
     }
     let settings = RenderSettings::for_scene(&scene, width, height, 1);
@@ -320,7 +320,8 @@ fn plot(args: PlotArgs) -> Result<()> {
     let labels = if args.labels.is_empty() { default_labels(&args.csv) } else { args.labels.clone() };
     let mut runs = Vec::new();
     for (path, label) in args.csv.iter().zip(labels) {
-        let text = strata::scene::read_text_capped(path).with_context(|| format!("{}: cannot read", path.display()))?;
+        let text =
+            strata_render::scene::read_text_capped(path).with_context(|| format!("{}: cannot read", path.display()))?;
         let errors = compare::parse_errors_csv(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
         runs.push((label, errors));
     }
@@ -380,8 +381,8 @@ fn metrics(args: MetricsArgs) -> Result<()> {
         }
     }
     if let (Some(map), Some(png)) = (&args.map, &map_png) {
-        strata::atomic_file::check_target(map)?;
-        strata::atomic_file::check_target(png)?;
+        strata_render::atomic_file::check_target(map)?;
+        strata_render::atomic_file::check_target(png)?;
     }
     let image = RgbImage::read_exr(&args.image)?;
     let reference = RgbImage::read_exr(&args.reference)?;
@@ -447,8 +448,8 @@ fn render(args: RenderArgs) -> Result<()> {
     std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create the folder", args.out.display()))?;
     let stem = args.scene.as_ref().and_then(|p| scene_stem(p)).unwrap_or_else(|| "default".into());
     let (exr, png) = (args.out.join(with_extension(&stem, "exr")), args.out.join(with_extension(&stem, "png")));
-    strata::atomic_file::check_target(&exr)?;
-    strata::atomic_file::check_target(&png)?;
+    strata_render::atomic_file::check_target(&exr)?;
+    strata_render::atomic_file::check_target(&png)?;
     check_writable(&args.out, &exr)?;
     let gpu_scene = GpuScene::build(&scene)?;
     let mut backend = open_backend(args.backend)?;
@@ -466,9 +467,10 @@ fn render(args: RenderArgs) -> Result<()> {
     );
     let mut progress = strata::progress::Progress::new("render", u64::from(args.spp), "spp");
     let started = Instant::now();
-    let image =
-        strata::render::render(backend.as_mut(), &gpu_scene, &settings, args.spp, |done| progress.set(u64::from(done)))
-            .map_err(|e| name_the_size(e.into(), settings.camera.width, settings.camera.height))?;
+    let image = strata_render::render::render(backend.as_mut(), &gpu_scene, &settings, args.spp, |done| {
+        progress.set(u64::from(done))
+    })
+    .map_err(|e| name_the_size(e.into(), settings.camera.width, settings.camera.height))?;
     progress.finish();
     if strata::evaluation::image_checks::is_black(&image) {
         eprintln!(
@@ -513,8 +515,8 @@ fn check_writable(folder: &Path, target: &Path) -> Result<()> {
 /// `error` with the image size named first where the device refused a buffer as too
 /// large (the message otherwise names only an internal kernel binding).
 pub(crate) fn name_the_size(error: anyhow::Error, width: u32, height: u32) -> anyhow::Error {
-    use strata::histogram_pass::PassError;
     use strata_backends::BackendError;
+    use strata_render::histogram_pass::PassError;
     let limit = |b: &BackendError| matches!(b, BackendError::LimitExceeded { .. });
     let too_large = error.chain().any(|cause| {
         cause.downcast_ref::<BackendError>().is_some_and(limit)

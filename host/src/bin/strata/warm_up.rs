@@ -18,11 +18,11 @@ use anyhow::Result;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Barrier, Mutex};
 use std::thread::JoinHandle;
-use strata::backend_choice::BackendChoice;
-use strata::render::{GpuScene, RenderSettings};
-use strata::restir::{Method, RestirSettings};
-use strata::scene::Scene;
 use strata_kernels::KernelId;
+use strata_render::backend_choice::BackendChoice;
+use strata_render::render::{GpuScene, RenderSettings};
+use strata_render::restir::{Method, RestirSettings};
+use strata_render::scene::Scene;
 
 /// The warm-up running on its threads.
 pub struct WarmUp {
@@ -79,7 +79,7 @@ impl WarmUp {
                     threads.spawn(move || {
                         let opening = {
                             let _one_at_a_time = lifetime.lock();
-                            strata::backend_choice::open_backend_quietly(choice)
+                            strata_render::backend_choice::open_backend_quietly(choice)
                         };
                         opened.wait();
                         let mut backend = opening.ok();
@@ -127,12 +127,13 @@ fn render_share(
     // passes.
     let accumulated = RestirSettings { temporal: false, ..restir };
     let mut variants = vec![restir];
-    if restir.temporal && restir.reuse_order == strata::restir::ReuseOrder::TemporalFirst {
+    if restir.temporal && restir.reuse_order == strata_render::restir::ReuseOrder::TemporalFirst {
         variants.push(accumulated);
     }
     for (&method, variant) in methods.iter().flat_map(|m| variants.iter().map(move |v| (m, v))) {
         let settings = RestirSettings { method, ..*variant };
-        let mut renderer = strata::restir::RestirRenderer::new(backend, &gpu_scene, &render, settings, scene.extent())?;
+        let mut renderer =
+            strata_render::restir::RestirRenderer::new(backend, &gpu_scene, &render, settings, scene.extent())?;
         renderer.dispatch_only(Some(share.to_vec()));
         let frames = (0..2).try_for_each(|_| renderer.render_frame(backend, None).map(drop));
         renderer.destroy(backend)?;

@@ -6,6 +6,7 @@ use crate::ash_objects::{Created, OwnBuffer, Pipeline, descriptor_type, destroy_
 use crate::binding_plan::{EngineBuffers, OwnBuffers, ResampleBuffers, Resource};
 use crate::contract::check_size;
 use crate::error::EmbedError;
+use crate::frame::VulkanBarrier;
 use crate::frame::{FrameId, FrameParams, frame_params, max_blocks};
 use crate::limits::{DeviceLimits, VULKAN_NAMES, check_limits};
 use crate::wgsl::{ModuleId, module};
@@ -400,23 +401,19 @@ impl AshSelection {
         unsafe { self.device.destroy_descriptor_pool(bindings.pool, None) };
     }
 
-    fn barrier(&self, command_buffer: vk::CommandBuffer, src: vk::PipelineStageFlags, src_access: vk::AccessFlags) {
-        let barrier = vk::MemoryBarrier::default().src_access_mask(src_access).dst_access_mask(
-            vk::AccessFlags::SHADER_READ
-                | vk::AccessFlags::SHADER_WRITE
-                | vk::AccessFlags::UNIFORM_READ
-                | vk::AccessFlags::TRANSFER_READ
-                | vk::AccessFlags::TRANSFER_WRITE,
-        );
-        let dst = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER;
+    /// Records `barrier` (one of [`VulkanBarrier`]'s, which the export's manifest lists).
+    fn barrier(&self, command_buffer: vk::CommandBuffer, barrier: VulkanBarrier) {
+        let memory = vk::MemoryBarrier::default()
+            .src_access_mask(vk::AccessFlags::from_raw(barrier.src_access))
+            .dst_access_mask(vk::AccessFlags::from_raw(barrier.dst_access));
         // SAFETY: the caller of the recording functions guarantees a recording command buffer.
         unsafe {
             self.device.cmd_pipeline_barrier(
                 command_buffer,
-                src,
-                dst,
+                vk::PipelineStageFlags::from_raw(barrier.src_stages),
+                vk::PipelineStageFlags::from_raw(barrier.dst_stages),
                 vk::DependencyFlags::empty(),
-                &[barrier],
+                &[memory],
                 &[],
                 &[],
             )
@@ -443,7 +440,7 @@ impl AshSelection {
             );
             self.device.cmd_dispatch(command_buffer, groups[0], groups[1], groups[2]);
         }
-        self.barrier(command_buffer, vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE);
+        self.barrier(command_buffer, VulkanBarrier::AFTER_DISPATCH);
     }
 
     /// Records frame `frame`'s uniform updates, histogram and selection.
@@ -461,9 +458,7 @@ impl AshSelection {
         let params = self.frame_params(frame, bindings.identity_payload)?;
         // Earlier work (the engine's candidate writes, an earlier frame's reads of the
         // uniforms) before the updates and dispatches.
-        let everything = vk::PipelineStageFlags::ALL_COMMANDS;
-        let writes = vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE;
-        self.barrier(command_buffer, everything, writes);
+        self.barrier(command_buffer, VulkanBarrier::BEFORE_PASS);
         // SAFETY: per this function's contract.
         unsafe {
             self.device.cmd_update_buffer(
@@ -479,7 +474,7 @@ impl AshSelection {
                 bytemuck::bytes_of(&params.selection),
             );
         }
-        self.barrier(command_buffer, vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::TRANSFER_WRITE);
+        self.barrier(command_buffer, VulkanBarrier::AFTER_UPDATES);
         self.dispatch(command_buffer, &self.histogram, bindings.histogram, params.histogram_workgroups);
         self.dispatch(command_buffer, &self.select, bindings.select, params.pixel_workgroups);
         Ok(())
@@ -495,8 +490,7 @@ impl AshSelection {
         bindings: &AshBindings,
     ) -> Result<(), EmbedError> {
         let set = bindings.resample.ok_or(EmbedError::NoResampleBuffers)?;
-        let writes = vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE;
-        self.barrier(command_buffer, vk::PipelineStageFlags::ALL_COMMANDS, writes);
+        self.barrier(command_buffer, VulkanBarrier::BEFORE_PASS);
         let workgroups = crate::frame::pixel_workgroups(self.width, self.height)?;
         self.dispatch(command_buffer, &self.resample, set, workgroups);
         Ok(())

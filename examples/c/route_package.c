@@ -1,9 +1,12 @@
 /*
  * route_package.c: route 1 of the C example: the pass from the kernel package alone.
  * Pipelines, descriptor-set layouts, the pass's own buffers and every descriptor write are
- * made from manifest.json (read with Jansson): no binding number, buffer size or entry
- * point is written in this file. strata_frame.h computes each frame's uniforms and
- * dispatch sizes.
+ * made from manifest.json (read with Jansson): no binding number, buffer size, usage flag,
+ * entry point, barrier, dispatch formula or kernel-choice rule is written in this file. The
+ * buffers' sizes and the dispatches come from the manifest's expressions (`variables`,
+ * `size.expr`, `dispatch`), the barriers and the order of the commands from
+ * `frame.sequence`, the histogram kernel (`--histogram auto`) from `histogram_choice`.
+ * strata_frame.h computes each frame's uniforms (and its dispatch sizes, which must agree).
  *
  * Part of strata (MIT OR Apache-2.0).
  */
@@ -16,6 +19,10 @@
 
 #define MAX_BINDINGS 16
 #define MAX_BUFFERS 16
+#define MAX_VARIABLES 64
+
+/* The manifest's schema version this engine was written for. */
+#define SCHEMA_VERSION 2
 
 /* A buffer of the manifest's `buffers`, made here or handed over by the engine. */
 typedef struct NamedBuffer {
@@ -203,40 +210,250 @@ static void kernel_destroy(Engine *engine, Kernel *kernel) {
     vkDestroyShaderModule(engine->device, kernel->module, NULL);
 }
 
-/* The bytes the manifest's size rule gives a buffer for this run. */
-static uint64_t size_of_buffer(json_t *buffer, const Run *run) {
-    json_t *size = json_object_get(buffer, "size");
-    const char *rule = text_of(size, "rule");
-    uint64_t bytes = number_of(size, "bytes");
-    if (strcmp(rule, "fixed") == 0) {
-        return bytes;
+/* Named values of the manifest's `variables` for one frame. */
+typedef struct Variables {
+    const char *names[MAX_VARIABLES];
+    uint64_t values[MAX_VARIABLES];
+    size_t count;
+} Variables;
+
+static void variable_set(Variables *variables, const char *name, uint64_t value) {
+    for (size_t i = 0; i < variables->count; i++) {
+        if (strcmp(variables->names[i], name) == 0) {
+            variables->values[i] = value;
+            return;
+        }
     }
-    if (strcmp(rule, "per_pixel") == 0) {
-        return bytes * run->width * run->height;
+    if (variables->count == MAX_VARIABLES) {
+        fail("manifest.json: more variables than this engine's %d", MAX_VARIABLES);
     }
-    if (strcmp(rule, "per_block") == 0) {
-        return bytes * strata_max_blocks(&run->settings, run->width, run->height);
+    variables->names[variables->count] = name;
+    variables->values[variables->count++] = value;
+}
+
+static uint64_t variable_get(const Variables *variables, const char *name) {
+    for (size_t i = 0; i < variables->count; i++) {
+        if (strcmp(variables->names[i], name) == 0) {
+            return variables->values[i];
+        }
     }
-    fail("manifest.json: size rule `%s` of buffer `%s` is not one this engine knows", rule, text_of(buffer, "name"));
+    fail("manifest.json: an expression uses variable `%s`, which has no value", name);
     return 0;
 }
 
-/* A barrier from `source` writes to every read and write of compute and transfer. */
-static void barrier(VkCommandBuffer commands, VkPipelineStageFlags source, VkAccessFlags writes) {
+/* The value of a manifest expression: a number, a variable's name or {"op", "args"}. */
+static uint64_t evaluate(json_t *expr, const Variables *variables) {
+    if (json_is_integer(expr) && json_integer_value(expr) >= 0) {
+        return (uint64_t)json_integer_value(expr);
+    }
+    if (json_is_string(expr)) {
+        return variable_get(variables, json_string_value(expr));
+    }
+    const char *op = text_of(expr, "op");
+    json_t *args = json_object_get(expr, "args");
+    size_t count = json_array_size(args);
+    if (count == 0) {
+        fail("manifest.json: operation `%s` without arguments", op);
+    }
+    uint64_t result = evaluate(json_array_get(args, 0), variables);
+    for (size_t i = 1; i < count; i++) {
+        uint64_t value = evaluate(json_array_get(args, i), variables);
+        if (strcmp(op, "add") == 0) {
+            result += value;
+        } else if (strcmp(op, "mul") == 0) {
+            result *= value;
+        } else if (strcmp(op, "sub") == 0 && value <= result) {
+            result -= value;
+        } else if (strcmp(op, "div") == 0 && value != 0) {
+            result /= value;
+        } else if (strcmp(op, "ceil_div") == 0 && value != 0) {
+            result = result / value + (result % value != 0);
+        } else if (strcmp(op, "min") == 0) {
+            result = value < result ? value : result;
+        } else if (strcmp(op, "max") == 0) {
+            result = value > result ? value : result;
+        } else {
+            fail("manifest.json: operation `%s` of %llu and %llu is not one this engine can do", op,
+                 (unsigned long long)result, (unsigned long long)value);
+        }
+    }
+    return result;
+}
+
+/* The manifest constant `name`'s value. */
+static uint64_t constant_of(json_t *manifest, const char *name) {
+    size_t index;
+    json_t *constant;
+    json_array_foreach(json_object_get(manifest, "constants"), index, constant) {
+        if (strcmp(text_of(constant, "name"), name) == 0) {
+            return number_of(constant, "value");
+        }
+    }
+    fail("manifest.json: no constant named `%s`", name);
+    return 0;
+}
+
+/* Every variable of the manifest for frame `frame`: the inputs from the run, the settings,
+ * strata_grid_shift and the device, the constants and the derived values in order. */
+static Variables variables_of(json_t *manifest, const Engine *engine, const Run *run, uint32_t frame) {
+    Variables variables = {0};
+    uint32_t shift_x = 0, shift_y = 0;
+    strata_grid_shift(&run->settings, frame, run->seed, &shift_x, &shift_y);
+    const struct {
+        const char *name;
+        uint64_t value;
+    } inputs[] = {{"width", run->width},
+                  {"height", run->height},
+                  {"B", run->settings.block_size},
+                  {"block_shift", run->settings.block_shift},
+                  {"shift_x", shift_x},
+                  {"shift_y", shift_y},
+                  {"max_compute_work_group_count_x", engine->limits.maxComputeWorkGroupCount[0]},
+                  {"max_compute_work_group_count_y", engine->limits.maxComputeWorkGroupCount[1]},
+                  {"max_compute_work_group_count_z", engine->limits.maxComputeWorkGroupCount[2]}};
+    size_t index;
+    json_t *variable;
+    json_array_foreach(json_object_get(manifest, "variables"), index, variable) {
+        const char *name = text_of(variable, "name");
+        json_t *expr = json_object_get(variable, "expr");
+        json_t *constant = json_object_get(variable, "constant");
+        if (expr != NULL) {
+            variable_set(&variables, name, evaluate(expr, &variables));
+        } else if (constant != NULL) {
+            variable_set(&variables, name, constant_of(manifest, json_string_value(constant)));
+        } else {
+            int found = 0;
+            for (size_t i = 0; i < sizeof inputs / sizeof inputs[0]; i++) {
+                if (strcmp(inputs[i].name, name) == 0) {
+                    variable_set(&variables, name, inputs[i].value);
+                    found = 1;
+                }
+            }
+            if (!found) {
+                fail("manifest.json: input `%s` (%s) is not one this engine supplies", name,
+                     text_of(variable, "input"));
+            }
+        }
+    }
+    return variables;
+}
+
+/* A Vulkan flag by its name, from the names a manifest of this schema uses. */
+static uint32_t flag_named(const char *name) {
+    static const struct {
+        const char *name;
+        uint32_t bit;
+    } flags[] = {{"VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT", VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT},
+                 {"VK_PIPELINE_STAGE_TRANSFER_BIT", VK_PIPELINE_STAGE_TRANSFER_BIT},
+                 {"VK_PIPELINE_STAGE_ALL_COMMANDS_BIT", VK_PIPELINE_STAGE_ALL_COMMANDS_BIT},
+                 {"VK_ACCESS_UNIFORM_READ_BIT", VK_ACCESS_UNIFORM_READ_BIT},
+                 {"VK_ACCESS_SHADER_READ_BIT", VK_ACCESS_SHADER_READ_BIT},
+                 {"VK_ACCESS_SHADER_WRITE_BIT", VK_ACCESS_SHADER_WRITE_BIT},
+                 {"VK_ACCESS_TRANSFER_READ_BIT", VK_ACCESS_TRANSFER_READ_BIT},
+                 {"VK_ACCESS_TRANSFER_WRITE_BIT", VK_ACCESS_TRANSFER_WRITE_BIT},
+                 {"VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT", VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT},
+                 {"VK_BUFFER_USAGE_STORAGE_BUFFER_BIT", VK_BUFFER_USAGE_STORAGE_BUFFER_BIT},
+                 {"VK_BUFFER_USAGE_TRANSFER_DST_BIT", VK_BUFFER_USAGE_TRANSFER_DST_BIT}};
+    for (size_t i = 0; i < sizeof flags / sizeof flags[0]; i++) {
+        if (strcmp(flags[i].name, name) == 0) {
+            return flags[i].bit;
+        }
+    }
+    fail("manifest.json: flag `%s` is not one this engine knows", name);
+    return 0;
+}
+
+/* The flags an array of names of the manifest sets. */
+static uint32_t flags_of(json_t *object, const char *key) {
+    uint32_t flags = 0;
+    size_t index;
+    json_t *name;
+    json_array_foreach(json_object_get(object, key), index, name) {
+        if (!json_is_string(name)) {
+            fail("manifest.json: `%s` holds a flag that is not a string", key);
+        }
+        flags |= flag_named(json_string_value(name));
+    }
+    return flags;
+}
+
+/* A barrier step of `frame.sequence`: stages and access masks as the manifest gives them. */
+static void barrier(VkCommandBuffer commands, json_t *step) {
     VkMemoryBarrier memory = {0};
     memory.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-    memory.srcAccessMask = writes;
-    memory.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_UNIFORM_READ_BIT |
-                           VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
-    vkCmdPipelineBarrier(commands, source, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
-                         1, &memory, 0, NULL, 0, NULL);
+    memory.srcAccessMask = flags_of(step, "src_access");
+    memory.dstAccessMask = flags_of(step, "dst_access");
+    vkCmdPipelineBarrier(commands, flags_of(step, "src_stages"), flags_of(step, "dst_stages"), 0, 1, &memory, 0,
+                         NULL, 0, NULL);
+}
+
+/* The histogram kernel `histogram_choice` gives for this device and settings. */
+static const char *chosen_histogram(json_t *manifest, const Engine *engine, const Run *run) {
+    VkPhysicalDeviceSubgroupProperties subgroup = {0};
+    subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
+    VkPhysicalDeviceProperties2 properties = {0};
+    properties.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+    properties.pNext = &subgroup;
+    vkGetPhysicalDeviceProperties2(engine->physical_device, &properties);
+    VkSubgroupFeatureFlags needed = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_SHUFFLE_BIT;
+    int shuffles = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
+                   (subgroup.supportedOperations & needed) == needed;
+    const char *types[] = {"VK_PHYSICAL_DEVICE_TYPE_OTHER", "VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU",
+                           "VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU", "VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU",
+                           "VK_PHYSICAL_DEVICE_TYPE_CPU"};
+    uint32_t type = (uint32_t)properties.properties.deviceType;
+    const char *device_type = type < 5 ? types[type] : "unknown";
+    json_t *inputs = json_pack("{s:s, s:b, s:I}", "device_type", device_type, "subgroup_shuffles", shuffles, "B",
+                               (json_int_t)run->settings.block_size);
+    size_t index, c;
+    json_t *rule, *condition;
+    const char *kernel = NULL;
+    json_array_foreach(json_object_get(json_object_get(manifest, "histogram_choice"), "rules"), index, rule) {
+        int holds = 1;
+        json_array_foreach(json_object_get(rule, "when"), c, condition) {
+            json_t *value = json_object_get(inputs, text_of(condition, "input"));
+            json_t *wanted = json_object_get(condition, "value");
+            const char *test = text_of(condition, "test");
+            if (value == NULL) {
+                fail("manifest.json: histogram_choice tests input `%s`, which this engine does not supply",
+                     text_of(condition, "input"));
+            }
+            if (strcmp(test, "equals") == 0) {
+                holds &= json_equal(value, wanted);
+            } else if (strcmp(test, "at_most") == 0) {
+                holds &= json_is_integer(value) && json_is_integer(wanted) &&
+                         json_integer_value(value) <= json_integer_value(wanted);
+            } else {
+                fail("manifest.json: histogram_choice test `%s` is not one this engine knows", test);
+            }
+        }
+        if (holds) {
+            kernel = text_of(rule, "kernel");
+            break;
+        }
+    }
+    json_decref(inputs);
+    if (kernel == NULL) {
+        fail("manifest.json: no rule of histogram_choice holds");
+    }
+    return kernel;
+}
+
+/* The workgroups of `kernel`'s dispatch from its `dispatch` expressions. */
+static void workgroups_of(const Kernel *kernel, const Variables *variables, uint32_t workgroups[3]) {
+    json_t *dispatch = json_object_get(kernel->entry, "dispatch");
+    if (json_array_size(dispatch) != 3) {
+        fail("manifest.json: kernel `%s`: dispatch is not three expressions", text_of(kernel->entry, "name"));
+    }
+    for (int axis = 0; axis < 3; axis++) {
+        workgroups[axis] = (uint32_t)evaluate(json_array_get(dispatch, (size_t)axis), variables);
+    }
 }
 
 static void dispatch(VkCommandBuffer commands, const Kernel *kernel, const uint32_t workgroups[3]) {
     vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, kernel->pipeline);
     vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, kernel->layout, 0, 1, &kernel->set, 0, NULL);
     vkCmdDispatch(commands, workgroups[0], workgroups[1], workgroups[2]);
-    barrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
 }
 
 /* The buffer a kernel's uniform binding names. */
@@ -260,12 +477,17 @@ void route_package(Engine *engine, const Run *run) {
     if (manifest == NULL) {
         fail("%s: line %d: %s", path, parse_error.line, parse_error.text);
     }
-    if (number_of(manifest, "schema_version") != 1) {
-        fail("%s: schema_version %llu; this engine reads version 1", path,
-             (unsigned long long)number_of(manifest, "schema_version"));
+    if (number_of(manifest, "schema_version") != SCHEMA_VERSION) {
+        fail("%s: schema_version %llu; this engine reads version %d", path,
+             (unsigned long long)number_of(manifest, "schema_version"), SCHEMA_VERSION);
     }
     Kernel kernels[3] = {{0}};
-    const char *names[3] = {run->histogram, "strata_select", "strata_resample"};
+    const char *histogram =
+        strcmp(run->histogram, "auto") == 0 ? chosen_histogram(manifest, engine, run) : run->histogram;
+    if (strcmp(run->histogram, "auto") == 0) {
+        fprintf(stderr, "histogram_choice: %s\n", histogram);
+    }
+    const char *names[3] = {histogram, "strata_select", "strata_resample"};
     for (int k = 0; k < 3; k++) {
         kernels[k].entry = kernel_named(manifest, names[k]);
         kernel_create(engine, run->package, &kernels[k]);
@@ -276,6 +498,8 @@ void route_package(Engine *engine, const Run *run) {
     uint32_t identity_payload = engine_buffers.payloads.buffer == VK_NULL_HANDLE;
     NamedBuffer buffers[MAX_BUFFERS];
     memset(buffers, 0, sizeof buffers);
+    /* Sizes are the same for every frame (they use the largest grid, not the frame's). */
+    Variables sizes = variables_of(manifest, engine, run, 0);
     size_t buffer_count = 0;
     size_t index;
     json_t *entry;
@@ -286,7 +510,7 @@ void route_package(Engine *engine, const Run *run) {
         NamedBuffer *named = &buffers[buffer_count++];
         named->name = text_of(entry, "name");
         named->owned = strcmp(text_of(entry, "owner"), "pass") == 0;
-        uint64_t size = size_of_buffer(entry, run);
+        uint64_t size = evaluate(json_object_get(json_object_get(entry, "size"), "expr"), &sizes);
         const struct {
             const char *name;
             Buffer *buffer;
@@ -307,7 +531,7 @@ void route_package(Engine *engine, const Run *run) {
                     fail("%s: %zu bytes, the manifest says %llu", file, bytes, (unsigned long long)size);
                 }
             }
-            named->buffer = buffer_create(engine, size, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, contents);
+            named->buffer = buffer_create(engine, size, flags_of(entry, "vulkan_usage"), contents);
             free(contents);
             continue;
         }
@@ -367,6 +591,7 @@ void route_package(Engine *engine, const Run *run) {
             max_workgroups = engine->limits.maxComputeWorkGroupCount[axis];
         }
     }
+    const char *stages[3] = {"histogram", "select", "resample"};
     for (uint32_t frame = 0; frame < run->frames; frame++) {
         StrataFrameParams params;
         char message[256];
@@ -374,14 +599,47 @@ void route_package(Engine *engine, const Run *run) {
                                 max_workgroups, &params, message, sizeof message)) {
             fail("strata_frame_params: %s", message);
         }
+        Variables variables = variables_of(manifest, engine, run, frame);
         VkCommandBuffer commands = commands_begin(engine);
-        barrier(commands, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT);
-        vkCmdUpdateBuffer(commands, histogram_uniform->buffer.buffer, 0, sizeof params.histogram, &params.histogram);
-        vkCmdUpdateBuffer(commands, selection_uniform->buffer.buffer, 0, sizeof params.selection, &params.selection);
-        barrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
-        dispatch(commands, &kernels[0], params.histogram_workgroups);
-        dispatch(commands, &kernels[1], params.pixel_workgroups);
-        dispatch(commands, &kernels[2], params.pixel_workgroups);
+        /* frame.sequence, step by step (the engine's own writes and reads are its files,
+         * written and read between submissions). */
+        json_t *step;
+        json_array_foreach(json_object_get(json_object_get(manifest, "frame"), "sequence"), index, step) {
+            const char *op = text_of(step, "op");
+            if (strcmp(op, "barrier") == 0) {
+                barrier(commands, step);
+            } else if (strcmp(op, "update_uniform") == 0) {
+                NamedBuffer *uniform = buffer_named(buffers, buffer_count, text_of(step, "buffer"));
+                const char *value = text_of(step, "value");
+                if (strcmp(value, "histogram") == 0 && uniform->buffer.size == sizeof params.histogram) {
+                    vkCmdUpdateBuffer(commands, uniform->buffer.buffer, 0, sizeof params.histogram, &params.histogram);
+                } else if (strcmp(value, "selection") == 0 && uniform->buffer.size == sizeof params.selection) {
+                    vkCmdUpdateBuffer(commands, uniform->buffer.buffer, 0, sizeof params.selection, &params.selection);
+                } else {
+                    fail("manifest.json: update_uniform of `%s` with `%s`, which StrataFrameParams does not fit",
+                         uniform->name, value);
+                }
+            } else if (strcmp(op, "dispatch") == 0) {
+                const char *stage = text_of(step, "stage");
+                int k = 0;
+                while (k < 3 && strcmp(stages[k], stage) != 0) {
+                    k++;
+                }
+                if (k == 3) {
+                    fail("manifest.json: dispatch of stage `%s`, which this engine does not know", stage);
+                }
+                uint32_t workgroups[3];
+                workgroups_of(&kernels[k], &variables, workgroups);
+                const uint32_t *want = k == 0 ? params.histogram_workgroups : params.pixel_workgroups;
+                if (memcmp(workgroups, want, sizeof workgroups) != 0) {
+                    fail("frame %u: the manifest's dispatch of `%s` is %ux%ux%u, strata_frame_params's %ux%ux%u", frame,
+                         stage, workgroups[0], workgroups[1], workgroups[2], want[0], want[1], want[2]);
+                }
+                dispatch(commands, &kernels[k], workgroups);
+            } else if (strcmp(op, "engine_writes") != 0 && strcmp(op, "engine_reads") != 0) {
+                fail("manifest.json: frame.sequence step `%s` is not one this engine knows", op);
+            }
+        }
         commands_submit(engine, commands);
         engine_buffers_write(&engine_buffers, run, frame);
     }

@@ -66,7 +66,8 @@ pub fn c_name(name: &str) -> String {
 fn comment(text: &str, indent: &str) -> String {
     let mut lines = vec![String::new()];
     for word in text.split_whitespace() {
-        let word = word.replace("*/", "* /").replace('`', "").replace("[", "").replace("]", "");
+        // Rust's intra-doc links ([`Name`]) lose their brackets; other brackets ("in [0, 1)") stay.
+        let word = word.replace("*/", "* /").replace("[`", "`").replace("`]", "").replace('`', "");
         let line = lines.last_mut().expect("one line");
         if !line.is_empty() && line.len() + word.len() > 88 {
             lines.push(word);
@@ -269,6 +270,12 @@ mod tests {
             let error = version_parts(broken).unwrap_err().to_string();
             assert!(error.contains(&format!("`{broken}`")) && !error.contains('\n'), "{error}");
         }
+    }
+
+    #[test]
+    fn comments_drop_link_brackets_and_keep_intervals() {
+        let text = comment("The number in [0, 1) of [`ResampleOutput::slot`], or [`NO_SLOT`].", "");
+        assert_eq!(text, "/* The number in [0, 1) of ResampleOutput::slot, or NO_SLOT. */\n");
     }
 
     #[test]

@@ -26,7 +26,7 @@
 //! let package = strata_export::export(&out)?;
 //! assert!(package.files.iter().any(|f| f == "include/strata.h"));
 //! let manifest: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("manifest.json"))?)?;
-//! assert_eq!(manifest["schema_version"], 1);
+//! assert_eq!(manifest["schema_version"], 2);
 //! # std::fs::remove_dir_all(&out)?;
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -180,31 +180,21 @@ pub fn export(out: &Path) -> Result<Exported, ExportError> {
         blue_noise: manifest::BlueNoiseEntry {
             file: "data/blue_noise.bin".into(),
             bytes: blue_noise.len() as u64,
-            sobol_offset: strata_kernels::blue_noise::PACKED_SOBOL,
-            scrambling_offset: strata_kernels::blue_noise::PACKED_SCRAMBLING,
-            ranking_offset: strata_kernels::blue_noise::PACKED_RANKING,
+            sobol_word_offset: strata_kernels::blue_noise::PACKED_SOBOL,
+            scrambling_word_offset: strata_kernels::blue_noise::PACKED_SCRAMBLING,
+            ranking_word_offset: strata_kernels::blue_noise::PACKED_RANKING,
             origin: "Heitz et al. 2019, 'A Low-Discrepancy Sampler that Distributes Monte Carlo Errors as a Blue Noise \
                      in Screen Space', 256-spp tables (crate blue-noise-sampler, MIT)"
                 .into(),
         },
         frame: manifest::FrameEntry {
-            sequence: vec![
-                "the engine writes candidates (and payloads) for the frame".into(),
-                "update histogram_params and selection_params (strata_frame_params)".into(),
-                "barrier: transfer and shader writes -> uniform and storage reads of compute".into(),
-                "dispatch one histogram kernel (histogram_workgroups)".into(),
-                "barrier: compute writes -> compute reads".into(),
-                "dispatch strata_select (pixel_workgroups)".into(),
-                "barrier: compute writes -> the engine's reads of selections".into(),
-                "optional: the engine writes resample_inputs; barrier; dispatch strata_resample (pixel_workgroups); \
-                 barrier before the engine reads resampled"
-                    .into(),
-            ],
+            inputs: manifest::frame_inputs(),
+            sequence: manifest::sequence(),
             functions: "include/strata_frame.h: strata_frame_params, strata_max_blocks, strata_grid_shift".into(),
         },
         kernels,
-        dispatch_variables: manifest::DISPATCH_VARIABLES.to_vec(),
-        choosing_the_histogram: manifest::CHOOSING_THE_HISTOGRAM.to_vec(),
+        variables: manifest::variables("SLOTS"),
+        histogram_choice: manifest::histogram_choice(),
         device_requirements: device_requirements(registry),
     };
     let json = serde_json::to_string_pretty(&manifest).map_err(|e| ExportError::Header(e.to_string()))? + "\n";

@@ -169,12 +169,30 @@ fn run_c(
     if !output.status.success() {
         return Err(String::from_utf8_lossy(&output.stderr).into_owned());
     }
+    std::fs::write(out.join("stderr.txt"), &output.stderr).unwrap();
     Ok((0..FRAMES)
         .map(|frame| {
             let read = |name: &str| std::fs::read(out.join(format!("{name}_{frame}.bin"))).unwrap();
             (bytemuck::pod_collect_to_vec(&read("selections")), bytemuck::pod_collect_to_vec(&read("resampled")))
         })
         .collect())
+}
+
+/// The histogram kernel strata's rule (`KernelId::fastest_histogram`) picks for blocks of
+/// `block_size` on the Vulkan device the C program opens (the first one).
+fn fastest_histogram_of_the_device(block_size: u32) -> String {
+    use ash::vk;
+    let engine = strata_tests::AshEngine::open_plain("fastest_histogram_of_the_device").unwrap();
+    let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
+    let mut properties = vk::PhysicalDeviceProperties2::default().push_next(&mut subgroup);
+    // SAFETY: a live instance and one of its physical devices.
+    unsafe { engine.instance.get_physical_device_properties2(engine.physical_device, &mut properties) };
+    let device_type = properties.properties.device_type;
+    let shuffles = subgroup.supported_stages.contains(vk::ShaderStageFlags::COMPUTE)
+        && subgroup.supported_operations.contains(vk::SubgroupFeatureFlags::BASIC | vk::SubgroupFeatureFlags::SHUFFLE);
+    let executor = strata_kernels::Executor::of_device(&format!("{device_type:?}"), false);
+    let kernel = strata_kernels::KernelId::fastest_histogram(block_size, shuffles, executor);
+    strata_kernels::Registry::shared().unwrap().get(kernel).name().to_string()
 }
 
 /// The first frame and pixel where `got` and `want` differ, in words.
@@ -221,6 +239,15 @@ fn both_c_routes_equal_the_rust_pass_bit_for_bit() {
         }
     }
     assert_eq!(runs, 16);
+    // Route 1 choosing its histogram kernel by the manifest's `histogram_choice`: the
+    // kernel strata's own rule picks for this device, and the same output.
+    let settings = SelectionSettings { block_size: 8, candidates: 3, block_shift: true, ..Default::default() };
+    let want = wgpu_frames(&device, &queue, settings);
+    let auto = run_c(&program, "package", &package, "auto", settings, &folder).unwrap();
+    assert_eq!(first_difference(&auto, &want), None, "route 1, histogram_choice");
+    let said = std::fs::read_to_string(folder.join("package-auto-3-antithetic/stderr.txt")).unwrap();
+    let chosen = fastest_histogram_of_the_device(8);
+    assert!(said.contains(&format!("histogram_choice: {chosen}\n")), "{said} (strata's rule: {chosen})");
     // Without a payloads buffer (a pixel's payload is its index), by both routes.
     let bare = folder.join("no-payloads");
     std::fs::create_dir_all(&bare).unwrap();

@@ -208,6 +208,7 @@ impl ViewerCollector {
             for &method in methods {
                 if let Some(m) = measured.get(&method) {
                     report.csv += &m.csv_line(stage, frame_ms(method));
+                    report.curves.push(m.curves.clone());
                 }
             }
         }
@@ -230,6 +231,8 @@ pub struct ViewerReport {
     pub notes: Vec<String>,
     /// `viewer.csv`'s rows after its header ([`VIEWER_CSV_HEADER`]).
     pub csv: String,
+    /// Every method's correlation and spectrum curves, per stage.
+    pub curves: Vec<ViewerCurves>,
 }
 
 /// The header of `viewer.csv`.
@@ -252,10 +255,31 @@ impl ViewerReport {
     }
 }
 
+/// Radial bins of the error's power spectrum, from frequency 0 to ½ cycle per pixel.
+const SPECTRUM_BINS: usize = 8;
+
+/// One method's error correlation by lag and its radial power spectrum at one stage, for
+/// the report's figures.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewerCurves {
+    /// The method.
+    pub method: Method,
+    /// The stage.
+    pub stage: Stage,
+    /// Per lag 1..=B (pixels): the normalised autocorrelation of the error between pixels
+    /// of one block and across a block edge (horizontal and vertical pooled), mean and 95 %
+    /// interval over seeds; `None` where no pair of that kind exists.
+    pub lags: Vec<(u32, Option<MeanInterval>, Option<MeanInterval>)>,
+    /// Per radial bin: its centre frequency (cycles per pixel) and the normalised power
+    /// (1 for white noise).
+    pub spectrum: Vec<(f64, Option<MeanInterval>)>,
+}
+
 /// One method's measurements at one stage.
 #[derive(Clone, Debug)]
 struct MethodViewer {
     method: Method,
+    curves: ViewerCurves,
     split: BiasNoise,
     flicker: Option<MeanInterval>,
     change: Option<MeanInterval>,
@@ -308,10 +332,28 @@ fn measure(
             count: h.count.min(v.count),
         })
     };
-    let spectrum = radial_spectrum(&residuals, 8).map_err(|e| anyhow!("{what}: {e}"))?;
+    let spectrum = radial_spectrum(&residuals, SPECTRUM_BINS).map_err(|e| anyhow!("{what}: {e}"))?;
     let interval = |values: &[f64]| (!values.is_empty()).then(|| MeanInterval::of(values));
+    let pooled = |h: &super::correlation::LagCorrelation, v: &super::correlation::LagCorrelation| {
+        let pool = |a: Option<MeanInterval>, b: Option<MeanInterval>| {
+            let (a, b) = (a?, b?);
+            Some(MeanInterval {
+                mean: 0.5 * (a.mean + b.mean),
+                half_width: 0.5 * (a.half_width + b.half_width),
+                count: a.count.min(b.count),
+            })
+        };
+        (h.lag, pool(h.inside_block, v.inside_block), pool(h.across_edge, v.across_edge))
+    };
+    let curves = ViewerCurves {
+        method,
+        stage,
+        lags: correlation.horizontal.iter().zip(&correlation.vertical).map(|(h, v)| pooled(h, v)).collect(),
+        spectrum: spectrum.bins.iter().map(|b| (0.5 * (b.low + b.high), b.power)).collect(),
+    };
     Ok(MethodViewer {
         method,
+        curves,
         split,
         flicker: interval(&gathered.flicker),
         change: interval(&gathered.change),

@@ -11,6 +11,9 @@
 //! | `include/strata.h` | the records and constants as C11, generated from the Rust twins, with `_Static_assert` on every size and offset ([`c_header`]) |
 //! | `include/strata_frame.h` | the per-frame uniforms and dispatch sizes in plain C, as `strata-embed` computes them |
 //! | `include/strata_vk.h` | the C ABI of the `strata-vk` library (cbindgen, [`abi_header`]) |
+//! | `CMakeLists.txt`, `lib/cmake/strata/` | the CMake package (`add_subdirectory`, `find_package(strata CONFIG)`): targets `strata::headers`, `strata::vk`, the kernels' folders per language |
+//! | `lib/pkgconfig/strata.pc` | the pkg-config module |
+//! | `examples/cpp/` | a C++17 consumer built with CMake |
 //! | `kernels/{spirv,hlsl,msl,glsl,wgsl}/` | every kernel in every language ([`translations`]) |
 //! | `data/blue_noise.bin` | the blue-noise tables, uploaded once |
 //!
@@ -207,6 +210,9 @@ pub fn export(out: &Path) -> Result<Exported, ExportError> {
     files.push(("include/strata_frame.h".into(), include_bytes!("../package/strata_frame.h").to_vec()));
     files.push(("include/strata_vk.h".into(), abi_header::header(version)?.into_bytes()));
     files.push(("README.md".into(), include_bytes!("../package/README.md").to_vec()));
+    for (path, template) in BUILD_FILES {
+        files.push((path.into(), with_version(template, version)?.into_bytes()));
+    }
     write_package(out, &files)?;
     Ok(Exported { folder: out.to_path_buf(), files: files.into_iter().map(|(name, _)| name).collect() })
 }
@@ -257,8 +263,42 @@ fn manifest_struct(entry: &manifest::StructEntry) -> manifest::StructEntry {
 
 /// The files every package has besides those its manifest names (the kernels'
 /// translations and the blue-noise tables).
-pub const FIXED_FILES: [&str; 5] =
-    ["README.md", MANIFEST, "include/strata.h", "include/strata_frame.h", "include/strata_vk.h"];
+pub const FIXED_FILES: [&str; 12] = [
+    "README.md",
+    MANIFEST,
+    "include/strata.h",
+    "include/strata_frame.h",
+    "include/strata_vk.h",
+    "CMakeLists.txt",
+    "lib/cmake/strata/strataConfig.cmake",
+    "lib/cmake/strata/strataConfigVersion.cmake",
+    "lib/cmake/strata/strataTargets.cmake",
+    "lib/pkgconfig/strata.pc",
+    "examples/cpp/CMakeLists.txt",
+    "examples/cpp/main.cpp",
+];
+
+/// The package's build-system files (CMake package, pkg-config) and its C++ example: each
+/// path in the package with its template, in which `@STRATA_VERSION@`,
+/// `@STRATA_VERSION_MAJOR@` and `@STRATA_VERSION_MINOR@` become the workspace's version.
+const BUILD_FILES: [(&str, &str); 7] = [
+    ("CMakeLists.txt", include_str!("../package/CMakeLists.txt")),
+    ("lib/cmake/strata/strataConfig.cmake", include_str!("../package/cmake/strataConfig.cmake")),
+    ("lib/cmake/strata/strataConfigVersion.cmake", include_str!("../package/cmake/strataConfigVersion.cmake")),
+    ("lib/cmake/strata/strataTargets.cmake", include_str!("../package/cmake/strataTargets.cmake")),
+    ("lib/pkgconfig/strata.pc", include_str!("../package/pkgconfig/strata.pc")),
+    ("examples/cpp/CMakeLists.txt", include_str!("../package/examples/cpp/CMakeLists.txt")),
+    ("examples/cpp/main.cpp", include_str!("../package/examples/cpp/main.cpp")),
+];
+
+/// `template` with the version's placeholders filled in.
+fn with_version(template: &str, version: &str) -> Result<String, ExportError> {
+    let [major, minor, _] = c_header::version_parts(version)?;
+    Ok(template
+        .replace("@STRATA_VERSION_MAJOR@", &major.to_string())
+        .replace("@STRATA_VERSION_MINOR@", &minor.to_string())
+        .replace("@STRATA_VERSION@", version))
+}
 
 /// The largest manifest read from an earlier package.
 const MAX_MANIFEST_BYTES: u64 = 16 << 20;

@@ -519,10 +519,10 @@ fn the_export_refuses_a_folder_that_is_not_a_package() {
     strata_export::export(&package).unwrap();
     strata_export::export(&package).unwrap();
     assert!(package.join("manifest.json").is_file());
-    std::fs::write(package.join("CMakeLists.txt"), "the user's").unwrap();
+    std::fs::write(package.join("engine.cmake"), "the user's").unwrap();
     let message = strata_export::export(&package).unwrap_err().to_string();
-    assert!(message.contains("`CMakeLists.txt` added to it"), "{message}");
-    assert!(package.join("CMakeLists.txt").exists() && package.join("manifest.json").exists());
+    assert!(message.contains("`engine.cmake` added to it"), "{message}");
+    assert!(package.join("engine.cmake").exists() && package.join("manifest.json").exists());
     let message = strata_export::export(&package.join("..")).unwrap_err().to_string();
     assert!(message.contains("own name"), "{message}");
     let _ = std::fs::remove_dir_all(&folder);
@@ -788,4 +788,96 @@ fn the_exported_hlsl_compiled_by_slang_equals_the_rust_pass() {
         assert_eq!(first_difference(&got, &want), None, "Slang's SPIR-V, {histogram}, K = {candidates}, {sampler:?}");
     }
     let _ = std::fs::remove_dir_all(&folder);
+}
+
+/// Runs `command`; its stdout, or a panic with the command and its output.
+fn run_tool(command: &mut Command) -> String {
+    let output = command.output().unwrap_or_else(|e| panic!("{command:?}: {e}"));
+    let text = |bytes: &[u8]| String::from_utf8_lossy(bytes).into_owned();
+    assert!(output.status.success(), "{command:?}:\n{}\n{}", text(&output.stdout), text(&output.stderr));
+    text(&output.stdout)
+}
+
+/// Whether `tool` runs; if not, a panic where CI requires it (STRATA_REQUIRE_GPU, which
+/// CI sets for every test needing an outside tool), else false (the test is skipped).
+fn tool_present(tool: &str, test: &str) -> bool {
+    if Command::new(tool).arg("--version").output().is_ok_and(|o| o.status.success()) {
+        return true;
+    }
+    assert!(
+        std::env::var_os("STRATA_REQUIRE_GPU").is_none(),
+        "{test}: `{tool}` is not installed (STRATA_REQUIRE_GPU is set; apt-get install cmake pkgconf)"
+    );
+    eprintln!("SKIPPED {test}: `{tool}` is not installed");
+    false
+}
+
+#[test]
+fn the_package_builds_with_cmake_both_ways_and_pkg_config_resolves() {
+    let test = "the_package_builds_with_cmake_both_ways_and_pkg_config_resolves";
+    if !["cmake", "pkg-config", "c++"].iter().all(|tool| tool_present(tool, test)) {
+        return;
+    }
+    let scratch = strata_files::private_scratch_folder("strata-cmake-").unwrap();
+    let package = scratch.path().join("package");
+    strata_export::export(&package).unwrap();
+    let library = library_folder().join("libstrata_vk.so");
+    let source = package.join("examples/cpp");
+    let path = |p: &Path| p.to_str().unwrap().to_string();
+    // The C++17 consumer, configured by find_package and by add_subdirectory, built and run.
+    for (way, setting) in [
+        ("find_package", format!("-DCMAKE_PREFIX_PATH={}", path(&package))),
+        ("add_subdirectory", format!("-DSTRATA_PACKAGE={}", path(&package))),
+    ] {
+        let build = scratch.path().join(way);
+        run_tool(
+            Command::new("cmake")
+                .args(["-S", &path(&source), "-B", &path(&build), &setting])
+                .arg(format!("-DSTRATA_VK_LIBRARY={}", path(&library))),
+        );
+        run_tool(Command::new("cmake").args(["--build", &path(&build)]));
+        let said = run_tool(Command::new(build.join("strata_consumer")).env_remove("LD_LIBRARY_PATH"));
+        assert!(said.ends_with(": ok\n") && said.contains(env!("CARGO_PKG_VERSION")), "{way}: {said}");
+    }
+    // find_package asking for the next major version is refused by strataConfigVersion.cmake.
+    let newer = scratch.path().join("newer");
+    std::fs::create_dir(&newer).unwrap();
+    let major: u32 = env!("CARGO_PKG_VERSION_MAJOR").parse().unwrap();
+    std::fs::write(
+        newer.join("CMakeLists.txt"),
+        format!("cmake_minimum_required(VERSION 3.16)\nproject(newer LANGUAGES NONE)\nfind_package(strata {}.0 CONFIG REQUIRED)\n", major + 1),
+    )
+    .unwrap();
+    let refused = Command::new("cmake")
+        .args(["-S", &path(&newer), "-B", &path(&newer.join("build"))])
+        .arg(format!("-DCMAKE_PREFIX_PATH={}", path(&package)))
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success() && text.contains(env!("CARGO_PKG_VERSION")), "{text}");
+    // pkg-config resolves the flags, and they build the same consumer.
+    let flags = run_tool(
+        Command::new("pkg-config")
+            .args(["--cflags", "--libs", "strata"])
+            .env("PKG_CONFIG_PATH", package.join("lib/pkgconfig")),
+    );
+    let include = package.join("include").canonicalize().unwrap();
+    let includes = |flag: &str| flag.strip_prefix("-I").and_then(|p| Path::new(p).canonicalize().ok());
+    assert!(flags.split_whitespace().any(|f| includes(f).as_ref() == Some(&include)), "{flags}: no -I of include/");
+    assert!(flags.split_whitespace().any(|f| f == "-lstrata_vk"), "{flags}");
+    let program = scratch.path().join("pkg_config_consumer");
+    run_tool(
+        Command::new("c++")
+            .args(["-std=c++17", "-Wall", "-Wextra", "-Werror"])
+            .arg(source.join("main.cpp"))
+            .arg(format!("-DSTRATA_CONSUMER_SPIRV_DIR=\"{}\"", path(&package.join("kernels/spirv"))))
+            .arg(format!("-DSTRATA_CONSUMER_MANIFEST=\"{}\"", path(&package.join("manifest.json"))))
+            .args(flags.split_whitespace())
+            .arg(format!("-L{}", path(&library_folder())))
+            .arg(format!("-Wl,-rpath,{}", path(&library_folder())))
+            .arg("-o")
+            .arg(&program),
+    );
+    let said = run_tool(Command::new(&program).env_remove("LD_LIBRARY_PATH"));
+    assert!(said.ends_with(": ok\n"), "pkg-config: {said}");
 }

@@ -19,7 +19,7 @@ const TWIN_SOURCES: [&str; 2] =
 /// The doc comment above the item whose line (trimmed) starts with `start` in the twins'
 /// sources: `pub struct Name ` for a struct, `pub field:` after that struct's line for a
 /// field.
-fn doc_above(start: &str, after: Option<&str>) -> Option<String> {
+pub(crate) fn doc_above(start: &str, after: Option<&str>) -> Option<String> {
     for source in TWIN_SOURCES {
         let lines: Vec<&str> = source.lines().collect();
         let from = match after {
@@ -53,7 +53,7 @@ fn doc_above(start: &str, after: Option<&str>) -> Option<String> {
 const RENAMED: [(&str, &str); 1] = [("SLOTS", "HISTOGRAM_SLOTS_PER_WORKGROUP")];
 
 /// The Rust twin's name of the WGSL constant `name`.
-fn rust_name(name: &str) -> &str {
+pub(crate) fn rust_name(name: &str) -> &str {
     RENAMED.iter().find(|(wgsl, _)| *wgsl == name).map_or(name, |(_, rust)| rust)
 }
 
@@ -63,7 +63,7 @@ pub fn c_name(name: &str) -> String {
 }
 
 /// `text` as a C comment indented by `indent`, wrapped at about 96 columns.
-fn comment(text: &str, indent: &str) -> String {
+pub(crate) fn comment(text: &str, indent: &str) -> String {
     let mut lines = vec![String::new()];
     for word in text.split_whitespace() {
         // Rust's intra-doc links ([`Name`]) lose their brackets; other brackets ("in [0, 1)") stay.

@@ -9,6 +9,7 @@
 //! | `README.md` | per API (Vulkan, D3D12, Metal) how to bind, record and synchronise; what the engine writes when; what is tested where |
 //! | `manifest.json` | per kernel: entry points, workgroup size, features, per binding its set/binding, HLSL register and space, MSL buffer index, element type and stride; the buffers' size rules and writers; the structs' layouts; the constants; the dispatch formulas ([`manifest`]) |
 //! | `include/strata.h` | the records and constants as C11, generated from the Rust twins, with `_Static_assert` on every size and offset ([`c_header`]) |
+//! | `include/strata.glsl`, `include/strata.hlsli`, `include/strata.wgsl` | the same records and constants for the engine's own shaders ([`shader_headers`]) |
 //! | `include/strata_frame.h` | the per-frame uniforms and dispatch sizes in plain C, as `strata-embed` computes them |
 //! | `include/strata_vk.h` | the C ABI of the `strata-vk` library (cbindgen, [`abi_header`]) |
 //! | `CMakeLists.txt`, `lib/cmake/strata/` | the CMake package (`add_subdirectory`, `find_package(strata CONFIG)`): targets `strata::headers`, `strata::vk`, the kernels' folders per language |
@@ -37,6 +38,7 @@
 pub mod abi_header;
 pub mod c_header;
 pub mod manifest;
+pub mod shader_headers;
 pub mod translations;
 
 use std::path::{Path, PathBuf};
@@ -207,6 +209,12 @@ pub fn export(out: &Path) -> Result<Exported, ExportError> {
         "include/strata.h".into(),
         c_header::header(&structs, &constants, &workgroup_sizes, version)?.into_bytes(),
     ));
+    for language in shader_headers::Language::ALL {
+        files.push((
+            language.file().into(),
+            shader_headers::header(language, &structs, &constants, version)?.into_bytes(),
+        ));
+    }
     files.push(("include/strata_frame.h".into(), include_bytes!("../package/strata_frame.h").to_vec()));
     files.push(("include/strata_vk.h".into(), abi_header::header(version)?.into_bytes()));
     files.push(("README.md".into(), include_bytes!("../package/README.md").to_vec()));
@@ -263,10 +271,13 @@ fn manifest_struct(entry: &manifest::StructEntry) -> manifest::StructEntry {
 
 /// The files every package has besides those its manifest names (the kernels'
 /// translations and the blue-noise tables).
-pub const FIXED_FILES: [&str; 12] = [
+pub const FIXED_FILES: [&str; 15] = [
     "README.md",
     MANIFEST,
     "include/strata.h",
+    "include/strata.glsl",
+    "include/strata.hlsli",
+    "include/strata.wgsl",
     "include/strata_frame.h",
     "include/strata_vk.h",
     "CMakeLists.txt",

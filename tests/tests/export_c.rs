@@ -881,3 +881,202 @@ fn the_package_builds_with_cmake_both_ways_and_pkg_config_resolves() {
     let said = run_tool(Command::new(&program).env_remove("LD_LIBRARY_PATH"));
     assert!(said.ends_with(": ok\n"), "pkg-config: {said}");
 }
+
+/// Each record's size and its fields' (name, offset), in order, by struct name.
+type Layouts = std::collections::BTreeMap<String, (u64, Vec<(String, u64)>)>;
+
+/// The layouts `strata.h` asserts (`sizeof(StrataX) == N`, `offsetof(StrataX, f) == N`).
+fn strata_h_layouts(header: &str) -> Layouts {
+    let mut layouts = Layouts::new();
+    for line in header.lines().filter_map(|l| l.strip_prefix("STRATA_STATIC_ASSERT(")) {
+        let number = |text: &str| text.split(',').next().unwrap().trim().parse::<u64>().unwrap();
+        if let Some(rest) = line.strip_prefix("sizeof(") {
+            let (name, after) = rest.split_once(") == ").unwrap();
+            layouts.entry(name.into()).or_default().0 = number(after);
+        } else if let Some(rest) = line.strip_prefix("offsetof(") {
+            let (name, after) = rest.split_once(", ").unwrap();
+            let (field, after) = after.split_once(") == ").unwrap();
+            layouts.entry(name.into()).or_default().1.push((field.into(), number(after)));
+        }
+    }
+    layouts
+}
+
+/// The layouts of the `Strata*` structs of a SPIR-V module, from `spirv-dis`'s text:
+/// member names and `Offset`s, and the size as the `ArrayStride` of a runtime array of it.
+fn spirv_layouts(disassembly: &str) -> Layouts {
+    let mut names = std::collections::HashMap::new();
+    let mut members: std::collections::HashMap<(String, u64), String> = std::collections::HashMap::new();
+    let mut offsets: Vec<(String, u64, u64)> = Vec::new();
+    let mut arrays = std::collections::HashMap::new();
+    let mut strides = std::collections::HashMap::new();
+    for line in disassembly.lines() {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        match words.as_slice() {
+            ["OpName", id, name] => {
+                names.insert(id.to_string(), name.trim_matches('"').to_string());
+            }
+            ["OpMemberName", id, index, name] => {
+                members.insert((id.to_string(), index.parse().unwrap()), name.trim_matches('"').to_string());
+            }
+            ["OpMemberDecorate", id, index, "Offset", offset] => {
+                offsets.push((id.to_string(), index.parse().unwrap(), offset.parse().unwrap()));
+            }
+            ["OpDecorate", id, "ArrayStride", stride] => {
+                strides.insert(id.to_string(), stride.parse::<u64>().unwrap());
+            }
+            [array, "=", "OpTypeRuntimeArray", element] => {
+                arrays.insert(array.to_string(), element.to_string());
+            }
+            _ => {}
+        }
+    }
+    let mut layouts = Layouts::new();
+    for (id, index, offset) in offsets {
+        let Some(name) = names.get(&id).filter(|n| n.starts_with("Strata")) else { continue };
+        // A field named by a reserved word has `_` after it in GLSL and HLSL.
+        let field = members.get(&(id.clone(), index)).map_or("", |m| m.strip_suffix('_').unwrap_or(m)).to_string();
+        let entry = layouts.entry(name.clone()).or_default();
+        entry.1.push((field, offset));
+        if let Some(stride) = arrays.iter().find(|(_, element)| **element == id).and_then(|(a, _)| strides.get(a)) {
+            entry.0 = *stride;
+        }
+    }
+    layouts
+}
+
+/// The layouts naga gives the `Strata*` structs of a WGSL module.
+fn wgsl_layouts(source: &str) -> Result<Layouts, String> {
+    let module = naga::front::wgsl::parse_str(source).map_err(|e| e.emit_to_string(source))?;
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).map_err(|e| e.to_string())?;
+    let mut layouts = Layouts::new();
+    for (handle, ty) in module.types.iter() {
+        if let (Some(name), naga::TypeInner::Struct { members, span }) = (&ty.name, &ty.inner)
+            && name.starts_with("Strata")
+        {
+            let fields = members.iter().map(|m| (m.name.clone().unwrap_or_default(), u64::from(m.offset))).collect();
+            assert_eq!(layouter[handle].size, *span);
+            layouts.insert(name.clone(), (u64::from(*span), fields));
+        }
+    }
+    Ok(layouts)
+}
+
+/// The first difference between `got` (a shader include's layouts) and `want` (strata.h's).
+fn layout_difference(got: &Layouts, want: &Layouts) -> Option<String> {
+    for (name, (size, fields)) in want {
+        let Some((got_size, got_fields)) = got.get(name) else { return Some(format!("{name}: not declared")) };
+        if got_fields != fields {
+            return Some(format!("{name}: fields {got_fields:?}, strata.h {fields:?}"));
+        }
+        if got_size != size {
+            return Some(format!("{name}: {got_size} bytes, strata.h {size}"));
+        }
+    }
+    None
+}
+
+/// The layouts of the records as `language`'s include declares them, compiled by glslang
+/// (GLSL, HLSL: a compute shader with a storage buffer of each record, disassembled by
+/// spirv-dis) or naga (WGSL); `None` if a tool is missing and not required.
+fn include_layouts(
+    language: &str,
+    include: &Path,
+    structs: &[String],
+    folder: &Path,
+) -> Option<Result<Layouts, String>> {
+    let include_text = std::fs::read_to_string(include).unwrap();
+    if language == "wgsl" {
+        let mut shader = include_text;
+        for (i, name) in structs.iter().enumerate() {
+            shader += &format!("@group(0) @binding({i}) var<storage, read_write> b{i}: array<{name}>;\n");
+        }
+        let copies: String = (0..structs.len()).map(|i| format!("    b{i}[0] = b{i}[1];\n")).collect();
+        shader += &format!("@compute @workgroup_size(1)\nfn main() {{\n{copies}}}\n");
+        return Some(wgsl_layouts(&shader));
+    }
+    let file_name = include.file_name().unwrap().to_str().unwrap();
+    let (source, args): (String, Vec<&str>) = if language == "glsl" {
+        let buffers: String = structs
+            .iter()
+            .enumerate()
+            .map(|(i, n)| format!("layout(std430, set = 0, binding = {i}) buffer B{i} {{ {n} r[]; }} b{i};\n"))
+            .collect();
+        let copies: String = (0..structs.len()).map(|i| format!("    b{i}.r[0] = b{i}.r[1];\n")).collect();
+        (
+            format!(
+                "#version 450\n#extension GL_GOOGLE_include_directive : require\n#include \"{file_name}\"\n\
+                 layout(local_size_x = 1) in;\n{buffers}void main() {{\n{copies}}}\n"
+            ),
+            vec!["-V", "--target-env", "vulkan1.1", "-S", "comp"],
+        )
+    } else {
+        let buffers: String = structs
+            .iter()
+            .enumerate()
+            .map(|(i, n)| format!("RWStructuredBuffer<{n}> b{i} : register(u{i});\n"))
+            .collect();
+        let copies: String = (0..structs.len()).map(|i| format!("    b{i}[0] = b{i}[1];\n")).collect();
+        (
+            format!("#include \"{file_name}\"\n{buffers}[numthreads(1, 1, 1)]\nvoid main() {{\n{copies}}}\n"),
+            vec!["-D", "-V", "--target-env", "vulkan1.1", "-S", "comp", "-e", "main"],
+        )
+    };
+    let shader = include.with_file_name(format!("layout_{language}.comp"));
+    std::fs::write(&shader, source).unwrap();
+    let spirv = folder.join(format!("layout_{language}.spv"));
+    let text = folder.join(format!("layout_{language}.spvasm"));
+    let mut glslang: Vec<std::ffi::OsString> = args.iter().map(Into::into).collect();
+    glslang.extend([shader.clone().into_os_string(), "-o".into(), spirv.clone().into_os_string()]);
+    for (tool, args) in [
+        ("glslangValidator", glslang),
+        ("spirv-dis", vec![spirv.into_os_string(), "-o".into(), text.clone().into_os_string()]),
+    ] {
+        match strata_kernels::glslang::run_tool(tool, &args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>()) {
+            Ok(()) => {}
+            Err(strata_kernels::glslang::ToolError::Missing(tool))
+                if std::env::var_os("STRATA_REQUIRE_VALIDATORS").is_none() =>
+            {
+                eprintln!("SKIPPED the {language} include's layout: `{tool}` is not installed");
+                return None;
+            }
+            Err(error) => return Some(Err(format!("{language}: {error}"))),
+        }
+    }
+    std::fs::remove_file(&shader).unwrap();
+    Some(Ok(spirv_layouts(&std::fs::read_to_string(text).unwrap())))
+}
+
+#[test]
+fn the_shader_includes_lay_out_every_record_as_strata_h_does() {
+    let scratch = strata_files::private_scratch_folder("strata-includes-").unwrap();
+    let package = scratch.path().join("package");
+    strata_export::export(&package).unwrap();
+    let want = strata_h_layouts(&std::fs::read_to_string(package.join("include/strata.h")).unwrap());
+    assert!(want.len() >= 8 && want.contains_key("StrataSelectedCandidates"), "{want:?}");
+    let structs: Vec<String> = want.keys().cloned().collect();
+    let mut checked = 0;
+    for (language, file, field, spare) in [
+        ("glsl", "strata.glsl", "    uint run_length;\n", "    uint spare;\n"),
+        ("hlsl", "strata.hlsli", "    uint run_length;\n", "    uint spare;\n"),
+        ("wgsl", "strata.wgsl", "    run_length: u32,\n", "    spare: u32,\n"),
+    ] {
+        let include = package.join("include").join(file);
+        let Some(got) = include_layouts(language, &include, &structs, scratch.path()) else { continue };
+        let got = got.unwrap_or_else(|e| panic!("{file} does not compile: {e}"));
+        assert_eq!(layout_difference(&got, &want), None, "{file} against strata.h");
+        // One field moved (a spare word before StrataSelectedCandidates.run_length): seen.
+        let text = std::fs::read_to_string(&include).unwrap();
+        let moved = text.replacen(field, &format!("{spare}{field}"), 1);
+        assert_ne!(moved, text, "{file} declares StrataSelectedCandidates.run_length");
+        std::fs::write(&include, moved).unwrap();
+        let got = include_layouts(language, &include, &structs, scratch.path()).unwrap().unwrap();
+        let difference = layout_difference(&got, &want).unwrap_or_default();
+        assert!(difference.starts_with("StrataSelectedCandidates"), "{file} with a field moved: {difference:?}");
+        checked += 1;
+    }
+    if std::env::var_os("STRATA_REQUIRE_VALIDATORS").is_some() {
+        assert_eq!(checked, 3);
+    }
+}

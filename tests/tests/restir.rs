@@ -17,12 +17,12 @@
 
 use std::sync::OnceLock;
 
-use strata::render::{Film, GpuScene, PathTracer, RenderSettings};
-use strata::restir::{Method, RestirRenderer, RestirSettings, ReuseOrder, ShadedParts, Shading};
-use strata::rgb_image::RgbImage;
-use strata::scene::{Camera, CameraPath, Scene, default_scene};
 use strata_backends::{Backend, gpu_required};
 use strata_kernels::selection::SelectionSettings;
+use strata_render::render::{Film, GpuScene, PathTracer, RenderSettings};
+use strata_render::restir::{Method, RestirRenderer, RestirSettings, ReuseOrder, ShadedParts, Shading};
+use strata_render::rgb_image::RgbImage;
+use strata_render::scene::{Camera, CameraPath, Scene, default_scene};
 
 const SIZE: u32 = 32;
 const REGION: u32 = 8;
@@ -727,7 +727,7 @@ fn min_roughness_decides_which_conductors_resample() {
         return;
     };
     let mut scene = default_scene();
-    scene.materials[0] = strata::scene::Material::RoughConductor {
+    scene.materials[0] = strata_render::scene::Material::RoughConductor {
         alpha: 0.1,
         eta: [0.2, 0.9, 1.1],
         k: [3.9, 2.4, 2.2],
@@ -757,8 +757,13 @@ fn min_roughness_decides_which_conductors_resample() {
 
 /// A two-sided GGX conductor of alpha 0.01, below the default `min_roughness`: a smooth
 /// vertex that chains pass through.
-fn near_mirror() -> strata::scene::Material {
-    strata::scene::Material::RoughConductor { alpha: 0.01, eta: [0.2, 0.9, 1.1], k: [3.9, 2.4, 2.2], two_sided: true }
+fn near_mirror() -> strata_render::scene::Material {
+    strata_render::scene::Material::RoughConductor {
+        alpha: 0.01,
+        eta: [0.2, 0.9, 1.1],
+        k: [3.9, 2.4, 2.2],
+        two_sided: true,
+    }
 }
 
 /// `specular_chain` lets pixels whose primary hit is smooth resample at the first rough
@@ -775,7 +780,7 @@ fn specular_chains_let_smooth_primary_hits_resample() {
     };
     let mut scene = default_scene();
     scene.materials[0] = near_mirror();
-    scene.materials.push(strata::scene::Material::Dielectric { int_ior: 1.5, ext_ior: 1.0 });
+    scene.materials.push(strata_render::scene::Material::Dielectric { int_ior: 1.5, ext_ior: 1.0 });
     let glass = scene.materials.len() - 1;
     scene.shapes.iter_mut().filter(|shape| shape.name == "tall box").for_each(|shape| shape.material = glass);
     let gpu_scene = GpuScene::build(&scene).unwrap();
@@ -843,7 +848,7 @@ fn pixel_centres_remove_the_film_jitter() {
     // different at the light's edges with jitter.
     let mut emission = |seed: u32, pixel_centres: bool| {
         let render = RenderSettings { film: film(pixel_centres), max_depth: 1, ..settings(&scene, seed) };
-        strata::render::render(&mut backend, &gpu_scene, &render, 1, |_| {}).unwrap().pixels
+        strata_render::render::render(&mut backend, &gpu_scene, &render, 1, |_| {}).unwrap().pixels
     };
     let centres = emission(3, true);
     assert!(centres.iter().any(|p| p[0] > 0.0), "the light is in view");
@@ -868,7 +873,7 @@ fn stratified_film_averages_away_the_anti_aliasing_noise() {
         let images: Vec<RgbImage> = (0..32)
             .map(|seed| {
                 let render = RenderSettings { film, max_depth: 1, ..settings(&scene, 700 + seed) };
-                strata::render::render(&mut backend, &gpu_scene, &render, 16, |_| {}).unwrap()
+                strata_render::render::render(&mut backend, &gpu_scene, &render, 16, |_| {}).unwrap()
             })
             .collect();
         let n = images.len() as f64;
@@ -959,7 +964,7 @@ fn temporal_reuse_with_a_moving_camera_stays_unbiased() {
 /// vertex, resampled behind or path-traced alone like the glass), and an environment map
 /// shining in through the open front (candidates reconnected by direction).
 fn glass_metal_environment_scene() -> Scene {
-    use strata::scene::Material;
+    use strata_render::scene::Material;
     let mut scene = default_scene();
     let metal = |alpha| Material::RoughConductor { alpha, eta: [0.2, 0.9, 1.1], k: [3.9, 2.4, 2.2], two_sided: true };
     scene.materials.extend([Material::Dielectric { int_ior: 1.5, ext_ior: 1.0 }, metal(0.3), metal(0.1), metal(0.03)]);
@@ -1180,7 +1185,7 @@ fn both_film_sequences_stay_unbiased() {
     let mut white_reference = RegionStats::new();
     for batch in 0..512 {
         let render = RenderSettings { film: Film::White, ..settings(&scene, 90_000 + batch) };
-        white_reference.add(&strata::render::render(&mut backend, &gpu_scene, &render, 4, |_| {}).unwrap());
+        white_reference.add(&strata_render::render::render(&mut backend, &gpu_scene, &render, 4, |_| {}).unwrap());
     }
     assert_unbiased("path tracer, white film", &white_reference, &reference);
     let white = |render| RenderSettings { film: Film::White, ..render };

@@ -1,4 +1,4 @@
-//! The per-pixel blue-noise sampler (Heitz et al. 2019, `strata::sampler`): values from
+//! The per-pixel blue-noise sampler (Heitz et al. 2019, `strata_kernels::selection`): values from
 //! the tables by hand, stratification of each pixel's sequence, the blue-noise
 //! distribution over the tile, and `sampler.wgsl` returning the same bits as the host.
 

@@ -1,5 +1,5 @@
 //! [`SelectionSettings`]: every knob of the stratified selection in one struct, shared by
-//! the renderer (`strata::restir::RestirSettings`), the embeddable pass
+//! the renderer (`strata_render::restir::RestirSettings`), the embeddable pass
 //! (`strata_embed`) and the command line (`strata compare`, which flattens it into its
 //! arguments: the field docs below are its `--help`).
 

@@ -5,8 +5,6 @@
 use anyhow::{Result, bail};
 use std::path::PathBuf;
 use std::time::Instant;
-use strata::backend_choice::{BackendChoice, open_backend};
-use strata::denoise::Denoiser;
 use strata::evaluation::compare::Comparison;
 use strata::evaluation::crops::{self, Crop};
 use strata::evaluation::image_checks::check_reference;
@@ -14,10 +12,12 @@ use strata::evaluation::output_folder;
 use strata::evaluation::record::{self, RunRecord};
 use strata::evaluation::report::{OtherRegime, ReportOptions, run_and_report};
 use strata::progress::Progress;
-use strata::render::{Film, GpuScene, RenderSettings};
-use strata::restir::{Method, RestirSettings};
-use strata::rgb_image::RgbImage;
-use strata::scene::parse_camera_path;
+use strata_render::backend_choice::{BackendChoice, open_backend};
+use strata_render::denoise::Denoiser;
+use strata_render::render::{Film, GpuScene, RenderSettings};
+use strata_render::restir::{Method, RestirSettings};
+use strata_render::rgb_image::RgbImage;
+use strata_render::scene::parse_camera_path;
 
 use super::{scene_and_settings, scene_stem};
 
@@ -66,7 +66,7 @@ pub(crate) struct CompareArgs {
     #[arg(long)]
     height: Option<u32>,
     /// The ReSTIR settings every method shares (the selection's among them): declared,
-    /// documented and validated once, in `strata::restir::RestirSettings`.
+    /// documented and validated once, in `strata_render::restir::RestirSettings`.
     #[command(flatten)]
     restir: RestirSettings,
     /// Camera rays through pixel centres, no film jitter, for the methods and the
@@ -256,7 +256,7 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
                 film: reference_film(render.film),
                 ..render.clone()
             };
-            let image = strata::render::render(backend.as_mut(), &gpu_scene, &settings, reference_spp, |_| {})?;
+            let image = strata_render::render::render(backend.as_mut(), &gpu_scene, &settings, reference_spp, |_| {})?;
             check_reference(&image, &format!("the path-traced reference of frame {}", frame + 1))?;
             image.write_exr(&args.out.join(format!("reference_frame{:03}.exr", frame + 1)))?;
             references.push(image);
@@ -375,7 +375,7 @@ fn settings_record(
     };
     put("methods", args.methods.iter().map(|m| m.name()).collect::<Vec<_>>().join(",").into());
     // Every histogram kernel gives the same output; which one ran depends on the device.
-    let histogram = strata::histogram_pass::auto_kernel(device, restir.selection.block_size);
+    let histogram = strata_render::histogram_pass::auto_kernel(device, restir.selection.block_size);
     put("histogram_kernel", histogram.spec().map(|spec| spec.name.to_string()).into());
     put("film", clap::ValueEnum::to_possible_value(&film).map(|p| p.get_name().to_string()).into());
     put("camera_path", args.camera_path.to_string_lossy().into_owned().into());
@@ -401,7 +401,8 @@ fn rendered_reference(
     println!("rendering the reference: {spp} spp path tracing at {}x{}", render.camera.width, render.camera.height);
     let settings = RenderSettings { seed: 0x7ef, film: reference_film(render.film), ..render.clone() };
     let mut progress = Progress::new("reference", u64::from(spp), "spp");
-    let image = strata::render::render(backend, gpu_scene, &settings, spp, |done| progress.set(u64::from(done)))?;
+    let image =
+        strata_render::render::render(backend, gpu_scene, &settings, spp, |done| progress.set(u64::from(done)))?;
     progress.finish();
     check_reference(&image, "the path-traced reference")?;
     image.write_exr(&args.out.join("reference.exr"))?;

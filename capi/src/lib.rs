@@ -16,6 +16,13 @@
 //! or a pass destroyed while its bindings live are refused with
 //! [`StrataStatus::InvalidArgument`].
 //!
+//! Versions and validation: [`strata_vk_create`] takes `STRATA_VERSION` of the headers the
+//! caller compiled against and refuses another major version ([`StrataStatus::Version`]).
+//! In validation mode ([`strata_vk_set_validation`], on by default in a debug build) a
+//! frame index that does not advance by one is refused ([`StrataStatus::FrameIndex`]);
+//! [`strata_vk_check_frame`] checks a frame an engine records with the package's kernels
+//! itself (its dispatches and buffer sizes), without a device.
+//!
 //! Handles: a `StrataVkPass *` or `StrataVkBindings *` is an opaque value, not an
 //! address: each is a number handed out once and never again (a counter), looked up in a
 //! table of live handles; nothing is ever read through it. So a destroyed handle stays
@@ -64,6 +71,7 @@ use strata_embed::{AshBindings, AshBufferSlice, AshBuffers, AshDevice, AshResamp
 use strata_embed::{SamplerVariant, SelectionSettings};
 
 mod guard;
+mod validation;
 use guard::{Failure, NewHandle, bindings_of, guarded, invalid, pass_of, remove_bindings, remove_pass};
 
 /// `VkInstance` (from `vulkan.h`).
@@ -106,6 +114,11 @@ pub enum StrataStatus {
     /// [`strata_vk_create`]) are of another major version than the library (before 1.0: of
     /// another minor version), so their records and functions may not be the library's.
     Version = 8,
+    /// Validation: a frame index that does not advance by one from the previous frame's.
+    FrameIndex = 9,
+    /// Validation: a dispatch of other workgroup counts than the pass's (the message says
+    /// which, and the likely mistake).
+    Dispatch = 10,
 }
 
 /// A version as one number, as `STRATA_MAKE_VERSION` of `strata.h` packs it (Vulkan's
@@ -269,6 +282,8 @@ pub(crate) struct Pass {
     /// Kept for the pass's lifetime: the device's functions were loaded through it.
     _instance: ash::Instance,
     selection: AshSelection,
+    /// The validation mode and the last frame recorded ([`strata_vk_set_validation`]).
+    frames: validation::FrameOrder,
 }
 
 /// What the table shares between threads must be shareable.
@@ -278,7 +293,8 @@ const _: () = {
     shared::<AshBindings>();
 };
 
-fn settings_of(settings: &StrataSelectionSettings) -> Result<SelectionSettings, Failure> {
+/// The settings as the pass takes them; a `Settings` failure naming the field otherwise.
+pub(crate) fn settings_of(settings: &StrataSelectionSettings) -> Result<SelectionSettings, Failure> {
     let flag = |name: &str, value: u32| match value {
         0 => Ok(false),
         1 => Ok(true),
@@ -370,7 +386,7 @@ pub unsafe extern "C" fn strata_vk_create(
             // instance and device, which outlive the pass, and the feature flag is true
             // only where enabled (this function's contract).
             let selection = AshSelection::new(vulkan, settings, width, height)?;
-            *out = handle.insert_pass(Pass { _instance: instance, selection });
+            *out = handle.insert_pass(Pass { _instance: instance, selection, frames: validation::FrameOrder::new() });
             Ok(())
         })
     }
@@ -391,7 +407,9 @@ pub unsafe extern "C" fn strata_vk_set_seed(
     // SAFETY: per this function's contract.
     unsafe {
         guarded(error, || {
-            pass_of(pass, "pass")?.selection.set_seed(seed);
+            let owner = pass_of(pass, "pass")?;
+            owner.selection.set_seed(seed);
+            owner.frames.restart();
             Ok(())
         })
     }
@@ -470,6 +488,7 @@ unsafe fn recording(
     bindings: *const StrataVkBindings,
     command_buffer: VkCommandBuffer,
     error: *mut StrataError,
+    frame: Option<u32>,
     record: impl FnOnce(&AshSelection, &AshBindings) -> Result<(), EmbedError>,
 ) -> StrataStatus {
     // SAFETY: per this function's contract.
@@ -480,7 +499,13 @@ unsafe fn recording(
             if command_buffer.is_null() {
                 return Err(invalid("command_buffer is NULL"));
             }
-            Ok(record(&owner.selection, &bindings)?)
+            // The frame's order is taken only once the frame records.
+            let order = frame.map(|frame| owner.frames.check(frame)).transpose()?;
+            record(&owner.selection, &bindings)?;
+            if let Some(order) = order {
+                order.commit();
+            }
+            Ok(())
         })
     }
 }
@@ -506,7 +531,7 @@ pub unsafe extern "C" fn strata_vk_record_selection(
 ) -> StrataStatus {
     // SAFETY: per this function's contract; the command buffer is checked non-null first.
     unsafe {
-        recording(pass, bindings, command_buffer, error, |selection, bound| {
+        recording(pass, bindings, command_buffer, error, Some(frame), |selection, bound| {
             selection.record_selection(command_buffer, bound, frame)
         })
     }
@@ -526,7 +551,7 @@ pub unsafe extern "C" fn strata_vk_record_resampling(
 ) -> StrataStatus {
     // SAFETY: as above.
     unsafe {
-        recording(pass, bindings, command_buffer, error, |selection, bound| {
+        recording(pass, bindings, command_buffer, error, None, |selection, bound| {
             selection.record_resampling(command_buffer, bound)
         })
     }
@@ -579,6 +604,121 @@ pub unsafe extern "C" fn strata_vk_destroy(pass: *mut StrataVkPass, error: *mut 
             // command buffer uses it (this function's contract).
             remove_pass(pass)?.selection.destroy();
             Ok(())
+        })
+    }
+}
+
+/// Turns the pass's validation mode on (`enabled` 1) or off (0); it is on from
+/// [`strata_vk_create`] in a debug build of the library, off in a release build. With it,
+/// [`strata_vk_record_selection`] refuses with `STRATA_STATUS_FRAME_INDEX` a frame index
+/// other than the previous frame's plus one (the first frame after [`strata_vk_create`] or
+/// [`strata_vk_set_seed`] may be any): a frame index left at 0 repeats the first frame's
+/// selections every frame, silently. Frames recorded on several threads at once must then
+/// still be recorded in order.
+///
+/// # Safety
+/// `error` is null or writable (`pass` may be any value: it is looked up, never read).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn strata_vk_set_validation(
+    pass: *mut StrataVkPass,
+    enabled: u32,
+    error: *mut StrataError,
+) -> StrataStatus {
+    // SAFETY: per this function's contract.
+    unsafe {
+        guarded(error, || {
+            let owner = pass_of(pass, "pass")?;
+            let on = match enabled {
+                0 => false,
+                1 => true,
+                other => return Err(invalid(format!("enabled = {other}: must be 0 or 1"))),
+            };
+            owner.frames.set_enabled(on);
+            Ok(())
+        })
+    }
+}
+
+/// `StrataFrameCheck.previous_frame` when no frame was recorded before.
+pub const STRATA_NO_FRAME: u32 = u32::MAX;
+
+/// The bytes of each buffer an engine binds for one frame when it records the pass itself
+/// (route 1: the package's kernels), for [`strata_vk_check_frame`]; 0 for an optional
+/// buffer it does not bind (`payloads`; `resample_inputs` with `resampled`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct StrataBufferBytes {
+    /// `candidates`.
+    pub candidates: u64,
+    /// `payloads` (0: none, a pixel's payload is its index).
+    pub payloads: u64,
+    /// `selections`.
+    pub selections: u64,
+    /// `resample_inputs` (0 with `resampled`: no resampling).
+    pub resample_inputs: u64,
+    /// `resampled`.
+    pub resampled: u64,
+    /// `sorted_pixels`.
+    pub sorted_pixels: u64,
+    /// `spans`.
+    pub spans: u64,
+    /// `block_stats`.
+    pub block_stats: u64,
+    /// `blue_noise`.
+    pub blue_noise: u64,
+    /// `histogram_params`.
+    pub histogram_params: u64,
+    /// `selection_params`.
+    pub selection_params: u64,
+}
+
+/// What an engine that records the pass itself is about to record for one frame: the
+/// validation mode of route 1, [`strata_vk_check_frame`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct StrataFrameCheck {
+    /// The settings (`strata_frame.h`).
+    pub settings: StrataSelectionSettings,
+    /// The image's width in pixels.
+    pub width: u32,
+    /// The image's height in pixels.
+    pub height: u32,
+    /// The frame index passed to `strata_frame_params`.
+    pub frame: u32,
+    /// The previous frame's index, or `STRATA_NO_FRAME` for the first frame of a render.
+    pub previous_frame: u32,
+    /// The render's seed.
+    pub seed: u32,
+    /// The device's smallest `maxComputeWorkGroupCount` component.
+    pub max_workgroups: u32,
+    /// The histogram kernel's `vkCmdDispatch` (x, y, z).
+    pub histogram_workgroups: [u32; 3],
+    /// `strata_select`'s (and `strata_resample`'s) `vkCmdDispatch`.
+    pub pixel_workgroups: [u32; 3],
+    /// The bytes of each buffer bound.
+    pub buffer_bytes: StrataBufferBytes,
+}
+
+/// Checks one frame an engine records with the package's kernels itself (route 1; the
+/// library's own recording needs no such check) against what the pass needs: the settings,
+/// the frame index advancing by one, every buffer's size for the settings and the image
+/// (`STRATA_STATUS_BUFFER`), and both dispatches' workgroup counts
+/// (`STRATA_STATUS_DISPATCH`); each failure is a status and a one-line message naming the
+/// field, the values and the likely mistake (the kernels do not check: too few workgroups,
+/// or buffers too small, give silently wrong records). Needs no device.
+///
+/// # Safety
+/// `check` is null (refused) or valid; `error` is null or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn strata_vk_check_frame(
+    check: *const StrataFrameCheck,
+    error: *mut StrataError,
+) -> StrataStatus {
+    // SAFETY: per this function's contract.
+    unsafe {
+        guarded(error, || {
+            let check = check.as_ref().ok_or_else(|| invalid("check is NULL"))?;
+            validation::check_frame(check)
         })
     }
 }

@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "routes.h"
+#include "strata_vk.h"
 
 #define MAX_BINDINGS 16
 #define MAX_BUFFERS 16
@@ -600,6 +601,43 @@ void route_package(Engine *engine, const Run *run) {
             fail("strata_frame_params: %s", message);
         }
         Variables variables = variables_of(manifest, engine, run, frame);
+        /* The library's validation of what this engine is about to record (route 1 records
+         * the kernels itself: nothing else checks its dispatches and buffer sizes). */
+        StrataFrameCheck check;
+        memset(&check, 0, sizeof check);
+        check.settings = run->settings;
+        check.width = run->width;
+        check.height = run->height;
+        check.frame = frame;
+        check.previous_frame = frame == 0 ? STRATA_NO_FRAME : frame - 1;
+        check.seed = run->seed;
+        check.max_workgroups = max_workgroups;
+        workgroups_of(&kernels[0], &variables, check.histogram_workgroups);
+        workgroups_of(&kernels[1], &variables, check.pixel_workgroups);
+        const struct {
+            const char *name;
+            uint64_t *bytes;
+        } sized[] = {{"candidates", &check.buffer_bytes.candidates},
+                     {"payloads", &check.buffer_bytes.payloads},
+                     {"selections", &check.buffer_bytes.selections},
+                     {"resample_inputs", &check.buffer_bytes.resample_inputs},
+                     {"resampled", &check.buffer_bytes.resampled},
+                     {"sorted_pixels", &check.buffer_bytes.sorted_pixels},
+                     {"spans", &check.buffer_bytes.spans},
+                     {"block_stats", &check.buffer_bytes.block_stats},
+                     {"blue_noise", &check.buffer_bytes.blue_noise},
+                     {"histogram_params", &check.buffer_bytes.histogram_params},
+                     {"selection_params", &check.buffer_bytes.selection_params}};
+        for (size_t b = 0; b < sizeof sized / sizeof sized[0]; b++) {
+            *sized[b].bytes = buffer_named(buffers, buffer_count, sized[b].name)->buffer.size;
+        }
+        if (identity_payload) {
+            check.buffer_bytes.payloads = 0;
+        }
+        StrataError check_error;
+        if (strata_vk_check_frame(&check, &check_error) != STRATA_STATUS_OK) {
+            fail("strata_vk_check_frame: %s", check_error.message);
+        }
         VkCommandBuffer commands = commands_begin(engine);
         /* frame.sequence, step by step (the engine's own writes and reads are its files,
          * written and read between submissions). */

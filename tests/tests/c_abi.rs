@@ -590,6 +590,9 @@ fn two_threads_bind_and_record_on_one_pass_at_once() {
     let Some(engine) = AshEngine::open(test) else { return };
     let (status, text, pass) = create(&hooked_device(&engine), &settings());
     assert_eq!(status, StrataStatus::Ok, "{text}");
+    // Threads record frames in any order (and the same frame again): validation off.
+    // SAFETY: a live pass; a valid error.
+    assert_eq!(unsafe { strata_vk_set_validation(pass, 0, &mut no_error()) }, StrataStatus::Ok);
     let family = compute_family(&engine);
     let buffers = [EngineBuffers::new(&engine), EngineBuffers::new(&engine)];
     let _open = OpenOnDrop;
@@ -683,6 +686,9 @@ fn a_handle_in_use_by_a_call_on_another_thread_is_not_destroyed_under_it() {
     let Some(engine) = AshEngine::open(test) else { return };
     let (status, text, pass) = create(&hooked_device(&engine), &settings());
     assert_eq!(status, StrataStatus::Ok, "{text}");
+    // Threads record frames in any order (and the same frame again): validation off.
+    // SAFETY: a live pass; a valid error.
+    assert_eq!(unsafe { strata_vk_set_validation(pass, 0, &mut no_error()) }, StrataStatus::Ok);
     let buffers = EngineBuffers::new(&engine);
     let _open = OpenOnDrop;
     let shared = Shared(pass);
@@ -748,5 +754,199 @@ fn a_handle_in_use_by_a_call_on_another_thread_is_not_destroyed_under_it() {
     unsafe {
         assert_eq!(strata_vk_destroy_bindings(pass, bindings, &mut error), StrataStatus::Ok, "{}", message(&error));
         assert_eq!(strata_vk_destroy(pass, &mut error), StrataStatus::Ok, "{}", message(&error));
+    }
+}
+
+/// A frame an engine records itself (B = 16, K = 4, block shifting, 45 × 29), as the pass
+/// needs it: its dispatches and every buffer's size, for `frame` of seed 7.
+fn good_check(frame: u32) -> StrataFrameCheck {
+    use strata_embed::frame::{FrameId, frame_params, max_blocks};
+    let settings = StrataSelectionSettings { block_size: 16, candidates: 4, sampler: 4, masking: 1, block_shift: 1 };
+    let rust = strata_embed::SelectionSettings { block_size: 16, block_shift: true, ..Default::default() };
+    let (width, height) = (45, 29);
+    let id = FrameId { frame, seed: 7, identity_payload: false };
+    let params = frame_params(&rust, width, height, id, 65_535).unwrap();
+    let blocks = max_blocks(&rust, width, height);
+    let bytes = |buffer: strata_embed::PassBuffer| buffer.bytes(width, height, blocks);
+    use strata_embed::PassBuffer as B;
+    StrataFrameCheck {
+        settings,
+        width,
+        height,
+        frame,
+        previous_frame: frame.checked_sub(1).unwrap_or(STRATA_NO_FRAME),
+        seed: 7,
+        max_workgroups: 65_535,
+        histogram_workgroups: params.histogram_workgroups,
+        pixel_workgroups: params.pixel_workgroups,
+        buffer_bytes: StrataBufferBytes {
+            candidates: bytes(B::Candidates),
+            payloads: bytes(B::Payloads),
+            selections: bytes(B::Selections),
+            resample_inputs: bytes(B::ResampleInputs),
+            resampled: bytes(B::Resampled),
+            sorted_pixels: bytes(B::SortedPixels),
+            spans: bytes(B::Spans),
+            block_stats: bytes(B::BlockStats),
+            blue_noise: bytes(B::BlueNoise),
+            histogram_params: bytes(B::HistogramParams),
+            selection_params: bytes(B::SelectionParams),
+        },
+    }
+}
+
+/// `strata_vk_check_frame` of `check`: the status and the message.
+fn check_frame(check: &StrataFrameCheck) -> (StrataStatus, String) {
+    let mut error = no_error();
+    // SAFETY: valid pointers.
+    let status = unsafe { strata_vk_check_frame(check, &mut error) };
+    assert_eq!(status, error.status);
+    (status, message(&error))
+}
+
+#[test]
+fn the_validation_mode_names_each_misuse_of_a_frame_an_engine_records() {
+    // A frame whose block shift adds a workgroup to the histogram's dispatch.
+    let frame = (1..64)
+        .find(|&f| {
+            let unshifted = StrataFrameCheck {
+                settings: StrataSelectionSettings { block_shift: 0, ..good_check(f).settings },
+                ..good_check(f)
+            };
+            good_check(f).histogram_workgroups != unshifted_dispatch(&unshifted)
+        })
+        .expect("a frame whose shift changes the histogram's dispatch");
+    let good = good_check(frame);
+    assert_eq!(check_frame(&good), (StrataStatus::Ok, String::new()));
+    let [px, py, _] = good.pixel_workgroups;
+    let blocks = |c: &StrataFrameCheck| {
+        let (sx, sy) = strata_embed::frame::grid_shift(
+            &strata_embed::SelectionSettings { block_size: 16, block_shift: true, ..Default::default() },
+            c.frame,
+            c.seed,
+        );
+        [(c.width + sx).div_ceil(16), (c.height + sy).div_ceil(16), 1]
+    };
+    let half = good.buffer_bytes.selections / 2;
+    let smaller = 8 * 32 * 16;
+    let cases: Vec<(&str, StrataFrameCheck, StrataStatus, &str)> = vec![
+        (
+            "floor instead of ceil",
+            StrataFrameCheck { pixel_workgroups: [45 / 8, 29 / 8, 1], ..good },
+            StrataStatus::Dispatch,
+            "pixel_workgroups = 5x3x1: the pass needs 6x4x1; floor instead of ceil",
+        ),
+        (
+            "the histogram per block in 2-D",
+            StrataFrameCheck { histogram_workgroups: blocks(&good), ..good },
+            StrataStatus::Dispatch,
+            "one workgroup per block in 2-D",
+        ),
+        (
+            "the histogram ignoring the block shift",
+            StrataFrameCheck { histogram_workgroups: unshifted_dispatch(&good), ..good },
+            StrataStatus::Dispatch,
+            "block shift ignored",
+        ),
+        (
+            "selections at half size",
+            StrataFrameCheck { buffer_bytes: StrataBufferBytes { selections: half, ..good.buffer_bytes }, ..good },
+            StrataStatus::Buffer,
+            "buffer_bytes.selections = ",
+        ),
+        (
+            "candidates for a smaller image",
+            StrataFrameCheck { buffer_bytes: StrataBufferBytes { candidates: smaller, ..good.buffer_bytes }, ..good },
+            StrataStatus::Buffer,
+            "buffer_bytes.candidates = 4096: the pass needs 10440 (8 per pixel of 45x29)",
+        ),
+        (
+            "the frame index repeated",
+            StrataFrameCheck { previous_frame: frame, ..good },
+            StrataStatus::FrameIndex,
+            "repeated",
+        ),
+        (
+            "a frame skipped",
+            StrataFrameCheck { previous_frame: frame - 1, frame: frame + 1, ..good },
+            StrataStatus::FrameIndex,
+            "skipped",
+        ),
+        (
+            "a setting out of range",
+            StrataFrameCheck { settings: StrataSelectionSettings { candidates: 9, ..good.settings }, ..good },
+            StrataStatus::Settings,
+            "candidates = 9",
+        ),
+    ];
+    for (misuse, check, status, named) in cases {
+        let (got, text) = check_frame(&check);
+        assert_eq!(got, status, "{misuse}: {text}");
+        assert!(text.contains(named) && !text.contains('\n'), "{misuse}: {text}");
+    }
+    assert_eq!((px, py), (6, 4));
+    // Without payloads or resampling (the optional buffers at 0): still a good frame.
+    let bare = StrataBufferBytes { payloads: 0, resample_inputs: 0, resampled: 0, ..good.buffer_bytes };
+    assert_eq!(check_frame(&StrataFrameCheck { buffer_bytes: bare, ..good }).0, StrataStatus::Ok);
+    // SAFETY: a NULL check is refused, never read.
+    assert_eq!(unsafe { strata_vk_check_frame(std::ptr::null(), std::ptr::null_mut()) }, StrataStatus::InvalidArgument);
+}
+
+/// The histogram's dispatch of `check`'s frame without its block shift.
+fn unshifted_dispatch(check: &StrataFrameCheck) -> [u32; 3] {
+    let groups = check.width.div_ceil(16) * check.height.div_ceil(16);
+    let groups = groups.div_ceil(1024 / (16 * 16));
+    let x = groups.min(check.max_workgroups);
+    [x, groups.div_ceil(x), 1]
+}
+
+#[test]
+fn a_pass_in_validation_mode_refuses_a_frame_index_that_does_not_advance_by_one() {
+    let Some(engine) = AshEngine::open("a_pass_in_validation_mode_refuses_a_frame_index_that_does_not_advance_by_one")
+    else {
+        return;
+    };
+    let (status, text, pass) = create(&device(&engine), &settings());
+    assert_eq!(status, StrataStatus::Ok, "{text}");
+    let buffers = EngineBuffers::new(&engine);
+    let (status, text, bindings) = bind(pass, &buffers.slices());
+    assert_eq!(status, StrataStatus::Ok, "{text}");
+    let mut error = no_error();
+    // SAFETY: a live pass; validation is on by default only in a debug build.
+    assert_eq!(unsafe { strata_vk_set_validation(pass, 1, &mut error) }, StrataStatus::Ok);
+    let record = |frame: u32| {
+        let mut result = (StrataStatus::Ok, String::new());
+        engine.submit(|command_buffer| {
+            let mut error = no_error();
+            // SAFETY: a recording command buffer of the pass's device; waited for.
+            let status = unsafe { strata_vk_record_selection(pass, bindings, command_buffer, frame, &mut error) };
+            result = (status, message(&error));
+        });
+        result
+    };
+    assert_eq!(record(0).0, StrataStatus::Ok);
+    assert_eq!(record(1).0, StrataStatus::Ok);
+    let (status, text) = record(1);
+    assert_eq!(status, StrataStatus::FrameIndex, "{text}");
+    assert!(
+        text.starts_with("frame = 1: the previous frame was 1, so this one must be 2") && !text.contains('\n'),
+        "{text}"
+    );
+    let (status, text) = record(5);
+    assert!(status == StrataStatus::FrameIndex && text.contains("skipped"), "{text}");
+    assert_eq!(record(2).0, StrataStatus::Ok, "a refused frame is not taken as the last");
+    // A new render starts anywhere; with validation off any frame records.
+    // SAFETY: live handles, valid errors.
+    unsafe {
+        assert_eq!(strata_vk_set_seed(pass, 9, &mut error), StrataStatus::Ok);
+        assert_eq!(record(40).0, StrataStatus::Ok);
+        assert_eq!(strata_vk_set_validation(pass, 2, &mut error), StrataStatus::InvalidArgument);
+        assert_eq!(strata_vk_set_validation(pass, 0, &mut error), StrataStatus::Ok);
+    }
+    assert_eq!(record(40).0, StrataStatus::Ok);
+    // SAFETY: nothing pending (each submission was waited for).
+    unsafe {
+        assert_eq!(strata_vk_destroy_bindings(pass, bindings, &mut error), StrataStatus::Ok);
+        assert_eq!(strata_vk_destroy(pass, &mut error), StrataStatus::Ok);
     }
 }

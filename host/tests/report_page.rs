@@ -1,7 +1,9 @@
 //! `report.html` as a person sees it: a small `strata compare` runs, headless Chromium
 //! loads the page, and a check page beside it (an iframe of the report plus a script)
 //! reports every image that did not load (`naturalWidth` 0), every table without a
-//! filled cell, and the sections the page must have; Chromium's console (its log of
+//! filled cell, the viewer's figures that did load (correlation and spectrum, issue
+//! 55: a figure the page forgot to link is caught here, not only a broken one), and the
+//! sections the page must have; Chromium's console (its log of
 //! console messages and uncaught script errors) must stay empty. Headless Chromium does
 //! not log failed resource loads there, so a missing file is caught by the image check.
 //! A screenshot of the page is kept under `target/tmp/report-page/` as an artifact. A
@@ -53,6 +55,9 @@ frame.addEventListener('load', () => {
     }
     const viewer = tables.filter(t => t.caption && t.caption.textContent.startsWith('What the viewer sees'));
     found.push('viewer ' + viewer.length);
+    const figures = images.filter(img => (img.getAttribute('src') || '').startsWith('viewer_'));
+    const loaded = figures.filter(img => img.complete && img.naturalWidth > 0);
+    found.push('viewer figures ' + loaded.map(img => img.getAttribute('src')).join(','));
     for (const table of viewer) {
       const text = table.textContent;
       if (/NaN|∞|\binf\b/.test(text)) found.push('viewer table with NaN or inf');
@@ -74,6 +79,12 @@ frame.src = name;
 </script>
 </body></html>
 "#;
+
+/// The viewer's figures the check page found loaded (its `viewer figures` line).
+fn viewer_figures(found: &[String]) -> Vec<&str> {
+    let line = found.iter().find_map(|l| l.strip_prefix("viewer figures ")).expect("a viewer figures line");
+    line.split(',').filter(|name| !name.is_empty()).collect()
+}
 
 /// What the check page found on `page` (a file in `folder`), and Chromium's console
 /// errors (from its log on standard error).
@@ -132,7 +143,8 @@ fn the_report_page_shows_every_image_and_table_in_chromium() {
 
     let (found, console) = check(&browser, &folder, "report.html");
     // 4 frames written (1, 2, 4) → per frame a reference and 3 methods × (image + map),
-    // the colour bar, 2 plots, the marked reference and the close-ups.
+    // the colour bar, 4 plots (2 against frame, 2 of the viewer), the marked reference
+    // and the close-ups.
     let images: usize = found.iter().find_map(|l| l.strip_prefix("images ")?.parse().ok()).expect("an image count");
     assert!(images >= 3 * 7 + 3, "too few images ({images}): {found:?}");
     let tables: usize = found.iter().find_map(|l| l.strip_prefix("tables ")?.parse().ok()).expect("a table count");
@@ -143,6 +155,12 @@ fn the_report_page_shows_every_image_and_table_in_chromium() {
     // What the viewer sees: the raw frames' table, with strata's ratio rows.
     let viewer: usize = found.iter().find_map(|l| l.strip_prefix("viewer ")?.parse().ok()).expect("a viewer count");
     assert_eq!(viewer, 1, "one viewer table (raw frames, no denoiser): {found:?}");
+    // And its figures, loaded: the raw frames' correlation and spectrum (no denoiser, so
+    // no denoised ones).
+    let figures = viewer_figures(&found);
+    for figure in ["viewer_correlation_raw.svg", "viewer_spectrum_raw.svg"] {
+        assert!(figures.contains(&figure), "{figure} is not on the page, loaded: {found:?}");
+    }
     let problems: Vec<&String> = found
         .iter()
         .filter(|l| {
@@ -150,6 +168,7 @@ fn the_report_page_shows_every_image_and_table_in_chromium() {
                 && !l.starts_with("tables ")
                 && !l.starts_with("headline ")
                 && !l.starts_with("viewer ")
+                && !l.starts_with("viewer figures ")
         })
         .collect();
     assert!(problems.is_empty(), "the page has problems: {problems:?}");
@@ -169,8 +188,8 @@ fn the_report_page_shows_every_image_and_table_in_chromium() {
         String::from_utf8_lossy(&shot.stderr)
     );
 
-    // Negative control: one image gone, one table emptied and a script error must all be
-    // reported.
+    // Negative control: one image gone, one table emptied, a viewer figure gone and a
+    // script error must all be reported.
     let html = std::fs::read_to_string(folder.join("report.html")).unwrap();
     let table_start = html.find("<table class=\"summary\">").expect("a summary table");
     let table_end = table_start + html[table_start..].find("</table>").unwrap();
@@ -183,11 +202,14 @@ fn the_report_page_shows_every_image_and_table_in_chromium() {
         .collect();
     let broken = format!("{}{}{}", &html[..table_start], emptied, &html[table_end..])
         .replace("strata_frame001.png", "missing_frame001.png")
+        .replace("viewer_spectrum_raw.svg", "viewer_missing.svg")
         .replace("</body>", "<script>an_undefined_function();</script></body>");
     std::fs::write(folder.join("report_broken.html"), broken).unwrap();
     let (found, console) = check(&browser, &folder, "report_broken.html");
     assert!(found.iter().any(|l| l == "broken image missing_frame001.png"), "missing image not seen: {found:?}");
     assert!(found.iter().any(|l| l.starts_with("empty table")), "empty table not seen: {found:?}");
+    assert!(found.iter().any(|l| l == "broken image viewer_missing.svg"), "missing figure not seen: {found:?}");
+    assert_eq!(viewer_figures(&found), ["viewer_correlation_raw.svg"], "{found:?}");
     assert!(
         console.iter().any(|l| l.contains("an_undefined_function")),
         "the script error is not in the console: {console:?}"

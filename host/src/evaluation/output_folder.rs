@@ -119,6 +119,10 @@ pub fn is_run_output(name: &str) -> bool {
     if stem == "relmse" || stem == "relmse_ratio" || stem == "reference" {
         return true;
     }
+    // The viewer's figures: viewer_correlation_STAGE and viewer_spectrum_STAGE.
+    if let Some(stage) = stem.strip_prefix("viewer_correlation_").or_else(|| stem.strip_prefix("viewer_spectrum_")) {
+        return matches!(stage, "raw" | "denoised");
+    }
     // reference_frameNNN, METHOD_frameNNN, METHOD_frameNNN_relmse, and the same of
     // METHOD_denoised.
     let stem = stem.strip_suffix("_relmse").unwrap_or(stem);
@@ -248,6 +252,10 @@ mod tests {
             "reference_frame003.exr",
             "strata_frame001.png",
             "restir-disc_frame032_relmse.exr",
+            "viewer_correlation_raw.svg",
+            "viewer_correlation_denoised.png",
+            "viewer_spectrum_raw.png",
+            "viewer_spectrum_denoised.svg",
         ] {
             assert!(is_run_output(name), "{name}");
         }
@@ -258,6 +266,8 @@ mod tests {
             "strata_frame01a.png",
             "scene.json",
             "other_frame001.png",
+            "viewer_spectrum_other.png",
+            "viewer_correlation_raw.csv",
         ] {
             assert!(!is_run_output(name), "{name}");
         }

@@ -1,6 +1,7 @@
 //! What `strata compare` does once the reference exists: every method and seed rendered
 //! ([`super::compare::run_comparison`]) and, in the output folder, the first seed's
-//! images and error maps at the written frames, `errors.csv`, the plots, `variance.csv`
+//! images and error maps at the written frames, `errors.csv`, the plots (error against
+//! frame, and the viewer's correlation and spectrum figures), `variance.csv`
 //! (3 seeds or more), `summary.txt` (the printed summary), `run.json` (the run's
 //! record) and `report.html` (all of it on one page, [`super::page`]). Driven by
 //! [`ReportOptions`], a plain struct: the command line fills it from its arguments, and
@@ -241,6 +242,7 @@ pub fn run_and_report(
     let last_reference = references.get(frames as usize - 1).unwrap_or(&references[0]);
     let viewer = viewer.finish(&options.methods, last_reference)?;
     write(&out.join("viewer.csv"), viewer.csv_text())?;
+    plots.extend(write_viewer_plots(out, &viewer.curves, &title)?);
     text += &viewer.to_text();
     tables.extend(viewer.tables.iter().cloned());
     if seeds >= 3 {
@@ -336,6 +338,48 @@ pub fn run_and_report(
     write(&report, page.to_html())?;
     println!("wrote the report {} (with summary.txt, run.json, errors.csv, plots and images)", report.display());
     Ok(())
+}
+
+/// The viewer's figures (issue 55) per stage the curves hold, raw then denoised:
+/// `viewer_correlation_{stage}` and `viewer_spectrum_{stage}` as SVG and PNG. Returns
+/// each SVG's file name with its caption for the page, which says what to read from it.
+fn write_viewer_plots(
+    out: &Path,
+    curves: &[super::viewer::ViewerCurves],
+    title: &str,
+) -> Result<Vec<(String, String)>> {
+    use super::plot::{write_correlation_plot, write_spectrum_plot};
+    use super::viewer::Stage;
+    let mut plots = Vec::new();
+    for stage in [Stage::Raw, Stage::Denoised] {
+        let name = stage.name();
+        let frames = match stage {
+            Stage::Raw => "Raw frames",
+            Stage::Denoised => "Denoised frames",
+        };
+        let stem = format!("viewer_correlation_{name}");
+        if write_correlation_plot(curves, stage, title, &out.join(&stem))? {
+            plots.push((
+                format!("{stem}.svg"),
+                format!(
+                    "{frames}: correlation of the error between pixels k apart, inside a block (solid) and \
+                     across a block edge (dashed); below 0 inside a block, errors are negatively correlated and a \
+                     spatial filter cancels them"
+                ),
+            ));
+        }
+        let stem = format!("viewer_spectrum_{name}");
+        if write_spectrum_plot(curves, stage, title, &out.join(&stem))? {
+            plots.push((
+                format!("{stem}.svg"),
+                format!(
+                    "{frames}: the error's power against radial frequency, ÷ white noise's (dashed 1); below 1 \
+                     at low frequencies, the error is blue-noise-like and a blur removes it"
+                ),
+            ));
+        }
+    }
+    Ok(plots)
 }
 
 /// Writes `text` to `path`, complete or not at all; an error names the file.

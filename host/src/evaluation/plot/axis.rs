@@ -1,6 +1,6 @@
 //! The plots' axes as one plotters coordinate: frame on a log2 axis labelled at powers of
 //! two, RelMSE on a log10 axis labelled at 1-2-5 steps (decades over a wide range), a
-//! ratio on a linear axis at round steps. plotters' own log axis labels arbitrary
+//! ratio, a lag or a frequency on a linear axis at round steps. plotters' own log axis labels arbitrary
 //! intermediate values and knows no base 2, so the ticks are chosen here.
 
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
@@ -13,7 +13,7 @@ pub(super) enum Scale {
     Log2,
     /// log10 (errors).
     Log10,
-    /// Linear (ratios).
+    /// Linear (ratios, correlations, lags, frequencies).
     Linear,
 }
 
@@ -87,6 +87,12 @@ impl Axis {
 
     /// A linear axis just around `low..high`, ticks at round steps.
     pub fn linear(low: f64, high: f64) -> Axis {
+        Axis::linear_ticked(low, high, 0.0)
+    }
+
+    /// [`Axis::linear`] with ticks at least `least` apart (1 for a lag in whole pixels,
+    /// which a half-pixel tick would misstate).
+    pub fn linear_ticked(low: f64, high: f64, least: f64) -> Axis {
         let (mut lo, mut hi) = (low, high);
         if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
             (lo, hi) = (0.0, 1.0);
@@ -96,7 +102,7 @@ impl Axis {
         }
         let pad = (hi - lo) * 0.05;
         let (start, end) = (lo - pad, hi + pad);
-        let step = nice_step((end - start) / 6.0);
+        let step = nice_step((end - start) / 6.0).max(least);
         let decimals = (-step.log10().floor()).max(0.0) as usize;
         Axis {
             scale: Scale::Linear,
@@ -243,5 +249,15 @@ mod tests {
             assert!(axis.start < axis.end && axis.start.is_finite() && axis.end.is_finite());
             assert_eq!(axis.map(&f64::NAN, (0, 100)), 0);
         }
+    }
+
+    #[test]
+    fn a_lag_axis_ticks_whole_pixels() {
+        // Lags 1..=4 alone would tick every half pixel; at least 1 apart, whole ones.
+        assert_eq!(Axis::linear(1.0, 4.0).label(1.5), "1.5");
+        let lags = Axis::linear_ticked(1.0, 4.0, 1.0);
+        assert_eq!(lags.ticks.iter().map(|&t| lags.label(t)).collect::<Vec<_>>(), ["1", "2", "3", "4"]);
+        // A wide range keeps its own round step.
+        assert_eq!(Axis::linear_ticked(1.0, 64.0, 1.0).ticks[..2], [0.0, 10.0]);
     }
 }

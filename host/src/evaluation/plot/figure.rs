@@ -1,7 +1,9 @@
 //! One figure drawn on any plotters backend (the SVG and the PNG come from this same
-//! code): title, log2 frame axis, the y axis, light grid, each line's 95 % band under its
-//! line, an optional dashed reference line, and the legend in a column right of the plot
-//! so that it never hides a line.
+//! code): title, the x axis (frames on log2 for the error-against-frame plots, or a
+//! linear one for the viewer's lags and frequencies: one drawing code, so every figure of
+//! the report looks alike), the y axis, light grid, each line's 95 % band under its line,
+//! an optional dashed reference line, and the legend in a column right of the plot so
+//! that it never hides a line.
 
 use super::axis::Axis;
 use super::series::{Point, Series, band_segments, segments};
@@ -16,10 +18,60 @@ pub(super) const SIZE: (u32, u32) = (960, 540);
 /// How the y axis maps values.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum YScale {
-    /// log10 (RelMSE).
+    /// log10 (RelMSE, power spectra).
     Log,
-    /// Linear (ratios).
+    /// Linear over values that cannot be negative (ratios): a band never stretches the
+    /// axis below 0.
     Linear,
+    /// Linear over values of either sign (correlations).
+    LinearSigned,
+}
+
+/// What the x axis shows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum XAxis {
+    /// Frames 1..=N on a log2 axis, described "frame"; a line joins consecutive frames.
+    Frames(u32),
+    /// `low..=high` on a linear axis described `desc`, ticks at least `least_tick` apart;
+    /// a line joins points `step` apart (a lag in whole pixels, a frequency bin).
+    Linear {
+        /// The axis' description.
+        desc: &'static str,
+        /// The smallest value shown.
+        low: f64,
+        /// The largest value shown.
+        high: f64,
+        /// The distance of neighbouring points.
+        step: f64,
+        /// The least distance of two ticks (0: any round step).
+        least_tick: f64,
+    },
+}
+
+impl XAxis {
+    /// The axis as plotters' coordinate.
+    fn axis(&self) -> Axis {
+        match *self {
+            XAxis::Frames(frames) => Axis::frames(frames),
+            XAxis::Linear { low, high, least_tick, .. } => Axis::linear_ticked(low, high, least_tick),
+        }
+    }
+
+    /// The axis' description.
+    fn desc(&self) -> &'static str {
+        match *self {
+            XAxis::Frames(_) => "frame",
+            XAxis::Linear { desc, .. } => desc,
+        }
+    }
+
+    /// The distance of neighbouring points (one frame on the frame axis).
+    fn step(&self) -> f64 {
+        match *self {
+            XAxis::Frames(_) => 1.0,
+            XAxis::Linear { step, .. } => step,
+        }
+    }
 }
 
 /// What one plot shows.
@@ -31,8 +83,8 @@ pub(super) struct Figure {
     pub y_desc: &'static str,
     /// The y axis' scale.
     pub y_scale: YScale,
-    /// The x axis runs over frames 1..=frames.
-    pub frames: u32,
+    /// The x axis.
+    pub x: XAxis,
     /// The lines, drawn in order (the legend lists them in the same order).
     pub series: Vec<Series>,
     /// A horizontal dashed grey line at this value (1 for a ratio).
@@ -68,6 +120,10 @@ impl Figure {
                         take(low.max(p.mean - LINEAR_BAND_REACH).max(0.0));
                         take(high.min(p.mean + LINEAR_BAND_REACH));
                     }
+                    YScale::LinearSigned => {
+                        take(low.max(p.mean - LINEAR_BAND_REACH));
+                        take(high.min(p.mean + LINEAR_BAND_REACH));
+                    }
                 }
             }
         }
@@ -76,7 +132,7 @@ impl Figure {
         }
         match self.y_scale {
             YScale::Log => Axis::log10(lo, hi),
-            YScale::Linear => Axis::linear(lo, hi),
+            YScale::Linear | YScale::LinearSigned => Axis::linear(lo, hi),
         }
     }
 }
@@ -120,7 +176,8 @@ pub(super) fn draw<DB: DrawingBackend>(
     let legend_width = if shown.is_empty() { px(16.0) } else { (text_width + px(72.0)).min(width as i32 * 45 / 100) };
     let (plot_area, _) = root.split_horizontally(width as i32 - legend_width);
 
-    let x_axis = Axis::frames(figure.frames);
+    let x_axis = figure.x.axis();
+    let step = figure.x.step();
     let y_axis = figure.y_axis();
     // The y label area: the widest tick label, the tick, and the rotated description.
     let tick_label = font(14.0);
@@ -141,7 +198,7 @@ pub(super) fn draw<DB: DrawingBackend>(
     let y_label = |v: &f64| y_axis.label(*v);
     chart
         .configure_mesh()
-        .x_desc("frame")
+        .x_desc(figure.x.desc())
         .y_desc(figure.y_desc)
         .x_label_formatter(&x_label)
         .y_label_formatter(&y_label)
@@ -153,8 +210,8 @@ pub(super) fn draw<DB: DrawingBackend>(
         .set_all_tick_mark_size(px(5.0))
         .draw()?;
 
-    let at = |frame: f64, value: f64| -> (f64, f64) {
-        let (x, y) = chart.backend_coord(&(frame, y_axis.clamp(value)));
+    let at = |x: f64, value: f64| -> (f64, f64) {
+        let (x, y) = chart.backend_coord(&(x, y_axis.clamp(value)));
         (f64::from(x), f64::from(y))
     };
     let line_style = |colour: &str, width: f64| rgb(colour).stroke_width(px(width).max(1) as u32);
@@ -169,16 +226,13 @@ pub(super) fn draw<DB: DrawingBackend>(
     // Bands first, then the reference and the lines over them.
     for series in &shown {
         let fill = rgb(series.colour).mix(0.16).filled();
-        for run in band_segments(&series.points) {
+        for run in band_segments(&series.points, step) {
             let band = |p: &Point| p.band.unwrap_or((p.mean, p.mean));
             let mut outline: Vec<(i32, i32)> = Vec::new();
-            let points = run
-                .iter()
-                .map(|p| at(f64::from(p.frame), band(p).1))
-                .chain(run.iter().rev().map(|p| at(f64::from(p.frame), band(p).0)));
+            let points = run.iter().map(|p| at(p.x, band(p).1)).chain(run.iter().rev().map(|p| at(p.x, band(p).0)));
             outline.extend(points.map(|(x, y)| (x.round() as i32, y.round() as i32)));
             if run.len() == 1 {
-                // One frame: its interval as an error bar.
+                // One point: its interval as an error bar.
                 let (x, _) = outline[0];
                 root.draw(&PathElement::new(
                     vec![(x, outline[0].1), (x, outline[1].1)],
@@ -195,8 +249,8 @@ pub(super) fn draw<DB: DrawingBackend>(
         stroke(&ends, Dash::DASHED, BLACK.mix(0.55).stroke_width(px(1.5).max(1) as u32))?;
     }
     for series in &shown {
-        for segment in segments(&series.points) {
-            let points: Vec<(f64, f64)> = segment.iter().map(|p| at(f64::from(p.frame), p.mean)).collect();
+        for segment in segments(&series.points, step) {
+            let points: Vec<(f64, f64)> = segment.iter().map(|p| at(p.x, p.mean)).collect();
             if let [(x, y)] = points[..] {
                 root.draw(&Circle::new((x.round() as i32, y.round() as i32), px(3.5), rgb(series.colour).filled()))?;
             } else {

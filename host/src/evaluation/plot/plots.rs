@@ -1,7 +1,7 @@
 //! The three plots `strata compare`, `strata plot` and the report page draw: RelMSE per
 //! method, strata ÷ each baseline, and several runs overlaid.
 
-use super::figure::{Figure, YScale};
+use super::figure::{Figure, XAxis, YScale};
 use super::output::{self, with_suffix};
 use super::series::{Series, all_methods, baselines, frame_count, ratio_points, relmse_points};
 use super::style::{Dash, method_colour, run_dash};
@@ -29,7 +29,14 @@ pub(super) fn relmse_figure(errors: &[FrameError], methods: &[Method], frames: u
         })
         .filter(|s| !s.points.is_empty())
         .collect();
-    Figure { title: title.to_string(), y_desc: RELMSE_AXIS, y_scale: YScale::Log, frames, series, reference: None }
+    Figure {
+        title: title.to_string(),
+        y_desc: RELMSE_AXIS,
+        y_scale: YScale::Log,
+        x: XAxis::Frames(frames),
+        series,
+        reference: None,
+    }
 }
 
 /// strata ÷ each baseline the errors pair with it, labelled `{prefix}strata ÷ {baseline}`.
@@ -51,7 +58,7 @@ fn ratio_figure(series: Vec<Series>, frames: u32, title: &str) -> Figure {
         title: title.to_string(),
         y_desc: RATIO_AXIS,
         y_scale: YScale::Linear,
-        frames,
+        x: XAxis::Frames(frames),
         series,
         reference: Some(1.0),
     }

@@ -1,18 +1,19 @@
-//! The data of a plot: lines of (frame, mean, 95 % band) made from `errors.csv` rows,
-//! one per method (RelMSE over seeds) or per baseline (strata's paired ratio to it).
-//! Points that cannot be drawn (no rows, a mean that is NaN or infinite, or not positive
-//! on a log axis) are left out, and the line has a gap there.
+//! The data of a plot: lines of (x, mean, 95 % band) made from `errors.csv` rows, one
+//! per method (RelMSE over seeds) or per baseline (strata's paired ratio to it), or from
+//! the viewer's curves (x a lag or a frequency). Points that cannot be drawn (no rows, a
+//! mean that is NaN or infinite, or not positive on a log axis) are left out, and the
+//! line has a gap there: lines join only points one step of the x axis apart.
 
 use super::style::Dash;
 use crate::evaluation::compare::{FrameError, by_frame, relmse_over_seeds, relmse_ratio};
 use crate::evaluation::metrics::MeanInterval;
 use crate::restir::Method;
 
-/// One frame of a line.
+/// One point of a line.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Point {
-    /// Frame, counted from 1.
-    pub frame: u32,
+    /// Where along the x axis: the frame counted from 1, a lag in pixels, a frequency.
+    pub x: f64,
     /// The mean over seeds.
     pub mean: f64,
     /// The 95 % interval (low, high); `None` with fewer than two seeds.
@@ -28,7 +29,7 @@ pub(super) struct Series {
     pub colour: &'static str,
     /// Line style.
     pub dash: Dash,
-    /// The drawable points, by frame.
+    /// The drawable points, by x.
     pub points: Vec<Point>,
 }
 
@@ -54,7 +55,7 @@ pub(super) fn frame_count(errors: &[FrameError]) -> u32 {
 pub(super) fn relmse_points(errors: &[FrameError], method: Method, frames: u32) -> Vec<Point> {
     by_frame(errors)
         .range(..frames)
-        .filter_map(|(&f, rows)| point(f, relmse_over_seeds(rows, method, f)).filter(|p| p.mean > 0.0))
+        .filter_map(|(&f, rows)| point(frame_x(f), relmse_over_seeds(rows, method, f)).filter(|p| p.mean > 0.0))
         .collect()
 }
 
@@ -62,15 +63,19 @@ pub(super) fn relmse_points(errors: &[FrameError], method: Method, frames: u32) 
 pub(super) fn ratio_points(errors: &[FrameError], baseline: Method, frames: u32) -> Vec<Point> {
     by_frame(errors)
         .range(..frames)
-        .filter_map(|(&f, rows)| point(f, relmse_ratio(rows, Method::Strata, baseline, f)?))
+        .filter_map(|(&f, rows)| point(frame_x(f), relmse_ratio(rows, Method::Strata, baseline, f)?))
         .collect()
 }
 
-/// The point of 0-based `frame`, if its mean can be drawn; its band if the half-width is
-/// finite.
-fn point(frame: u32, interval: MeanInterval) -> Option<Point> {
+/// Where 0-based `frame` lies on the frame axis (frames are counted from 1 there).
+fn frame_x(frame: u32) -> f64 {
+    f64::from(frame) + 1.0
+}
+
+/// The point at `x`, if its mean can be drawn; its band if the half-width is finite.
+pub(super) fn point(x: f64, interval: MeanInterval) -> Option<Point> {
     (interval.count > 0 && interval.mean.is_finite()).then(|| Point {
-        frame: frame + 1,
+        x,
         mean: interval.mean,
         band: interval
             .half_width
@@ -79,14 +84,15 @@ fn point(frame: u32, interval: MeanInterval) -> Option<Point> {
     })
 }
 
-/// The runs of consecutive frames in `points` (a missing frame splits the line).
-pub(super) fn segments(points: &[Point]) -> Vec<&[Point]> {
-    points.chunk_by(|a, b| b.frame == a.frame + 1).collect()
+/// The runs of consecutive points in `points`, neighbours `step` apart on the x axis (a
+/// missing point, further on, splits the line; half a step of slack for rounding).
+pub(super) fn segments(points: &[Point], step: f64) -> Vec<&[Point]> {
+    points.chunk_by(|a, b| b.x - a.x <= 1.5 * step).collect()
 }
 
-/// The runs of consecutive frames that all have a band.
-pub(super) fn band_segments(points: &[Point]) -> Vec<&[Point]> {
-    segments(points)
+/// The runs of consecutive points that all have a band.
+pub(super) fn band_segments(points: &[Point], step: f64) -> Vec<&[Point]> {
+    segments(points, step)
         .into_iter()
         .flat_map(|segment| segment.split(|p| p.band.is_none()))
         .filter(|run| !run.is_empty())

@@ -29,7 +29,7 @@
 //! selected slot j, the engine evaluates its own shift mapping and target function and
 //! writes w = m · p̂_i · W with an MIS weight m whose pair terms depend only on (c, j), a
 //! fixed 1/K normalisation, and W the sample's unbiased contribution weight (strata's own
-//! renderer uses pairwise MIS; see the README's "Why the selection stays unbiased").
+//! renderer uses pairwise MIS; see docs/restir.md, "Why the selection stays unbiased").
 
 pub use strata_kernels::embed_types::{
     CANONICAL_SLOT, INVALID_SLOT, MAX_SELECTED, NO_PAYLOAD, NO_SLOT, ResampleInput, ResampleOutput, SelectedCandidates,

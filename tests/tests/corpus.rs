@@ -195,7 +195,7 @@ fn transcendental_case(entry: &'static str, bounds: Vec<(&'static str, FloatBoun
     }
 }
 
-/// The interpreter's bounds against lavapipe per function (README, "Running your own
+/// The interpreter's bounds against lavapipe per function (docs/kernels.md, "Running your own
 /// kernels"): measured on this corpus, within Vulkan's precision requirements.
 const NEAR_ONE: f32 = 4.8e-7; // 2^-21: Vulkan's absolute bound for log and log2 on [0.5, 2]
 

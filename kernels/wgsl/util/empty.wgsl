@@ -1,4 +1,4 @@
-// An empty kernel: measures a backend's fixed cost per dispatch (benches/backends.rs).
+// An empty kernel: measures a backend's fixed cost per dispatch (benches/benches/backends.rs).
 // It writes nothing (the condition never holds for a real dispatch), which the
 // cross-backend check verifies on every backend.
 //

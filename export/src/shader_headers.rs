@@ -126,7 +126,8 @@ const RESERVED: [&str; 24] = [
     "groupshared",
 ];
 
-/// Field `name`'s name in `language` ([`RESERVED`]).
+/// Field `name`'s name in `language`: with `_` after it where GLSL or HLSL reserve the word
+/// (`sampler`, `buffer`, `texture`, ...).
 pub fn field_name(language: Language, name: &str) -> String {
     if language != Language::Wgsl && RESERVED.contains(&name) { format!("{name}_") } else { name.to_string() }
 }

@@ -297,9 +297,9 @@ fn a_wrong_binding_number_in_the_manifest_or_offset_in_the_header_is_caught() {
     // A manifest of another schema version: refused by the reader, naming it.
     manifest["schema_version"] = serde_json::json!(strata_export::manifest::SCHEMA_VERSION + 1);
     std::fs::write(&manifest_path, serde_json::to_string_pretty(&manifest).unwrap()).unwrap();
-    let error = run_c(&program, "package", &package, "block_histogram", settings, &folder)
-        .err()
-        .expect("a manifest of another schema version must be refused");
+    let Err(error) = run_c(&program, "package", &package, "block_histogram", settings, &folder) else {
+        panic!("a manifest of another schema version must be refused");
+    };
     assert!(error.contains("schema_version"), "{error}");
     std::fs::write(&manifest_path, original).unwrap();
     // strata.h of another major version: the program builds, and the library refuses it
@@ -315,9 +315,9 @@ fn a_wrong_binding_number_in_the_manifest_or_offset_in_the_header_is_caught() {
     assert_ne!(newer, header, "strata.h declares STRATA_VERSION_MAJOR as the workspace's major version");
     std::fs::write(&header_path, newer).unwrap();
     let newer_program = build_c(&package, &folder).unwrap();
-    let error = run_c(&newer_program, "library", &package, "block_histogram", settings, &folder)
-        .err()
-        .expect("headers of another major version must be refused");
+    let Err(error) = run_c(&newer_program, "library", &package, "block_histogram", settings, &folder) else {
+        panic!("headers of another major version must be refused");
+    };
     assert!(error.contains("header_version") && error.contains(env!("CARGO_PKG_VERSION")), "{error}");
     std::fs::write(&header_path, &header).unwrap();
     // A field of StrataSelectedCandidates moved in strata.h: the build fails on its assert.

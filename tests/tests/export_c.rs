@@ -1080,3 +1080,56 @@ fn the_shader_includes_lay_out_every_record_as_strata_h_does() {
         assert_eq!(checked, 3);
     }
 }
+
+/// Runs route 1 of `program` over `package` with the Khronos validation layer and its
+/// synchronization validation on; the layer's output (it prints to stdout and stderr).
+fn run_synchronization_validated(program: &Path, package: &Path, inputs: &Path) -> String {
+    let out = inputs.join("validated");
+    std::fs::create_dir_all(&out).unwrap();
+    let output = Command::new(program)
+        .args(["package", inputs.to_str().unwrap(), out.to_str().unwrap(), "--package", package.to_str().unwrap()])
+        .args(["--width", &WIDTH.to_string(), "--height", &HEIGHT.to_string(), "--frames", "4"])
+        .args(["--block-size", "8", "--candidates", "4", "--block-shift", "1", "--histogram", "auto"])
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .env_remove("LD_LIBRARY_PATH")
+        .env("VK_INSTANCE_LAYERS", "VK_LAYER_KHRONOS_validation")
+        .env("VK_LAYER_ENABLES", "VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT")
+        .output()
+        .unwrap();
+    let text = format!("{}{}", String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr));
+    assert!(output.status.success(), "{text}");
+    text
+}
+
+#[test]
+fn the_manifest_route_is_clean_under_synchronization_validation() {
+    let test = "the_manifest_route_is_clean_under_synchronization_validation";
+    let Some(_) = engine_device(test, None) else { return };
+    let scratch = strata_files::private_scratch_folder("strata-sync-").unwrap();
+    let package = scratch.path().join("package");
+    strata_export::export(&package).unwrap();
+    let program = build_c(&package, scratch.path()).unwrap_or_else(|e| panic!("the C program does not build:\n{e}"));
+    write_inputs(scratch.path());
+    // The manifest with its barriers taken out: the layer must see the hazards, or it is not
+    // running (not installed: skipped unless CI's STRATA_REQUIRE_VALIDATORS).
+    let broken = scratch.path().join("no-barriers");
+    let manifest_text = std::fs::read_to_string(package.join("manifest.json")).unwrap();
+    let mut manifest: serde_json::Value = serde_json::from_str(&manifest_text).unwrap();
+    manifest["frame"]["sequence"].as_array_mut().unwrap().retain(|step| step["op"] != "barrier");
+    for file in &strata_export::export(&broken).unwrap().files {
+        assert!(broken.join(file).exists());
+    }
+    std::fs::write(broken.join("manifest.json"), serde_json::to_string(&manifest).unwrap()).unwrap();
+    let without = run_synchronization_validated(&program, &broken, scratch.path());
+    if !without.contains("SYNC-HAZARD") {
+        assert!(
+            std::env::var_os("STRATA_REQUIRE_VALIDATORS").is_none(),
+            "{test}: no hazard reported without barriers: the validation layer did not run (install \
+             vulkan-validationlayers)\n{without}"
+        );
+        eprintln!("SKIPPED {test}: the Khronos validation layer is not installed");
+        return;
+    }
+    let with = run_synchronization_validated(&program, &package, scratch.path());
+    assert!(!with.contains("SYNC-HAZARD") && !with.contains("Validation Error"), "{with}");
+}

@@ -25,15 +25,15 @@
 
 use super::bias_noise::{BiasNoise, bias_noise, compare_noise};
 use super::compare::SeenFrame;
-use super::correlation::{ErrorField, autocorrelation, radial_spectrum};
+use super::correlation::{CorrelationError, ErrorField, LagCorrelation, autocorrelation, radial_spectrum};
 use super::flicker::{PreviousPixels, flicker, temporal_error_change};
 use super::metrics::MeanInterval;
 use super::summary::{Row, Table};
-use crate::restir::Method;
-use crate::rgb_image::RgbImage;
 use anyhow::{Context, Result, anyhow};
 use std::collections::BTreeMap;
 use std::time::Duration;
+use strata_render::restir::Method;
+use strata_render::rgb_image::RgbImage;
 
 /// Which image of a frame a measurement is of.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -140,10 +140,10 @@ impl ViewerCollector {
                 self.window.frames.entry(Stage::Denoised).or_default().push(denoised.clone());
             }
         }
-        if seen.frame + 1 == self.frames {
-            if let Err(error) = self.end_seed(seen, references) {
-                self.failure.get_or_insert(error);
-            }
+        if seen.frame + 1 == self.frames
+            && let Err(error) = self.end_seed(seen, references)
+        {
+            self.failure.get_or_insert(error);
         }
     }
 
@@ -200,7 +200,8 @@ impl ViewerCollector {
             let mut measured: BTreeMap<Method, MethodViewer> = BTreeMap::new();
             for &method in methods {
                 let Some(gathered) = self.gathered.get(&(method, stage)) else { continue };
-                measured.insert(method, measure(method, stage, gathered, reference, self.block_size)?);
+                let m = measure(method, stage, gathered, reference, self.block_size, &mut report.notes)?;
+                measured.insert(method, m);
             }
             let table = stage_table(stage, methods, &measured, &self.gathered, reference, frame_ms, self.moving)?;
             report.notes.extend(table.1);
@@ -317,39 +318,28 @@ fn measure(
     gathered: &Gathered,
     reference: &RgbImage,
     block_size: u32,
+    unmeasured: &mut Vec<String>,
 ) -> Result<MethodViewer> {
     let what = format!("{} {} frames", method.name(), stage.name());
     let split = bias_noise(&gathered.last, reference).map_err(|e| anyhow!("{what}: {e}"))?;
     let residuals = ErrorField::seed_residuals(&gathered.last, reference).map_err(|e| anyhow!("{what}: {e}"))?;
-    let correlation = autocorrelation(&residuals, block_size, (0, 0)).map_err(|e| anyhow!("{what}: {e}"))?;
+    let correlation = measurable(autocorrelation(&residuals, block_size, (0, 0)), &what, unmeasured)?;
+    let spectrum = measurable(radial_spectrum(&residuals, SPECTRUM_BINS), &what, unmeasured)?;
     // Lag 1 in both directions, pooled as the mean of the two.
-    let lag_one = |pick: fn(&super::correlation::LagCorrelation) -> Option<MeanInterval>| {
-        let h = correlation.horizontal.first().and_then(pick)?;
-        let v = correlation.vertical.first().and_then(pick)?;
-        Some(MeanInterval {
-            mean: 0.5 * (h.mean + v.mean),
-            half_width: 0.5 * (h.half_width + v.half_width),
-            count: h.count.min(v.count),
-        })
+    let lag_one = |pick: fn(&LagCorrelation) -> Option<MeanInterval>| {
+        let correlation = correlation.as_ref()?;
+        pool(correlation.horizontal.first().and_then(pick), correlation.vertical.first().and_then(pick))
     };
-    let spectrum = radial_spectrum(&residuals, SPECTRUM_BINS).map_err(|e| anyhow!("{what}: {e}"))?;
     let interval = |values: &[f64]| (!values.is_empty()).then(|| MeanInterval::of(values));
-    let pooled = |h: &super::correlation::LagCorrelation, v: &super::correlation::LagCorrelation| {
-        let pool = |a: Option<MeanInterval>, b: Option<MeanInterval>| {
-            let (a, b) = (a?, b?);
-            Some(MeanInterval {
-                mean: 0.5 * (a.mean + b.mean),
-                half_width: 0.5 * (a.half_width + b.half_width),
-                count: a.count.min(b.count),
-            })
-        };
-        (h.lag, pool(h.inside_block, v.inside_block), pool(h.across_edge, v.across_edge))
-    };
     let curves = ViewerCurves {
         method,
         stage,
-        lags: correlation.horizontal.iter().zip(&correlation.vertical).map(|(h, v)| pooled(h, v)).collect(),
-        spectrum: spectrum.bins.iter().map(|b| (0.5 * (b.low + b.high), b.power)).collect(),
+        lags: correlation
+            .iter()
+            .flat_map(|c| c.horizontal.iter().zip(&c.vertical))
+            .map(|(h, v)| (h.lag, pool(h.inside_block, v.inside_block), pool(h.across_edge, v.across_edge)))
+            .collect(),
+        spectrum: spectrum.iter().flat_map(|s| &s.bins).map(|b| (0.5 * (b.low + b.high), b.power)).collect(),
     };
     Ok(MethodViewer {
         method,
@@ -359,7 +349,36 @@ fn measure(
         change: interval(&gathered.change),
         inside: lag_one(|l| l.inside_block),
         across: lag_one(|l| l.across_edge),
-        spectrum: Some(spectrum.low_high_ratio),
+        spectrum: spectrum.map(|s| s.low_high_ratio),
+    })
+}
+
+/// A correlation measurement, or `None` where the images cannot have one: no larger than a
+/// block, too small for the spectrum's bands, or a constant residual. The columns then
+/// stay empty and `notes` says why, rather than the whole run failing.
+fn measurable<T>(result: Result<T, CorrelationError>, what: &str, notes: &mut Vec<String>) -> Result<Option<T>> {
+    match result {
+        Ok(value) => Ok(Some(value)),
+        Err(
+            why @ (CorrelationError::BlockSize { .. }
+            | CorrelationError::Spectrum { .. }
+            | CorrelationError::Constant(_)),
+        ) => {
+            notes.push(format!("{what}: no correlation or spectrum ({why})"));
+            Ok(None)
+        }
+        Err(error) => Err(anyhow!("{what}: {error}")),
+    }
+}
+
+/// The horizontal and vertical values of one lag pooled as their mean (a mean of two
+/// correlated estimates: the half-widths are averaged, not combined as if independent).
+fn pool(a: Option<MeanInterval>, b: Option<MeanInterval>) -> Option<MeanInterval> {
+    let (a, b) = (a?, b?);
+    Some(MeanInterval {
+        mean: 0.5 * (a.mean + b.mean),
+        half_width: 0.5 * (a.half_width + b.half_width),
+        count: a.count.min(b.count),
     })
 }
 
@@ -598,5 +617,32 @@ mod tests {
         let report = collector.finish(&[Method::Strata], &reference).unwrap();
         assert!(report.tables.is_empty());
         assert!(report.to_text().contains("needs 2 seeds at least (strata raw frames have 1)"), "{}", report.to_text());
+    }
+
+    /// An image no larger than a block has no correlation: the run is measured without it
+    /// and a note names why (the golden runs are 16x16 with blocks of 16).
+    #[test]
+    fn an_image_no_larger_than_a_block_leaves_the_correlation_out() {
+        let reference = image(8, 8, |_, _| 1.0);
+        let mut collector = ViewerCollector::new(2, 8, false);
+        for seed in 1..=3 {
+            for frame in 0..2 {
+                let shown = image(8, 8, |x, y| 1.0 + ((x * 7 + y * 3 + seed * 5 + frame) % 11) as f32 * 0.01);
+                let seen = SeenFrame {
+                    method: Method::Strata,
+                    seed,
+                    frame,
+                    image: &shown,
+                    denoised: None,
+                    took: Duration::ZERO,
+                    motion: None,
+                };
+                collector.add(seen, std::slice::from_ref(&reference));
+            }
+        }
+        let report = collector.finish(&[Method::Strata], &reference).unwrap();
+        let row = &report.tables[0].rows[0];
+        assert!(row.cells[5].is_empty() && row.cells[6].is_empty(), "{:?}", row.cells);
+        assert!(report.to_text().contains("no correlation or spectrum (block size 8"), "{}", report.to_text());
     }
 }

@@ -350,9 +350,8 @@ fn plot(args: PlotArgs) -> Result<()> {
     };
     println!("wrote {}", written.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "));
     for (label, errors) in &runs {
-        let has_ratio = Method::BASELINES
-            .iter()
-            .any(|&b| compare::relmse_ratio_over_frames(errors, Method::Strata, b).is_some());
+        let has_ratio =
+            Method::BASELINES.iter().any(|&b| compare::relmse_ratio_over_frames(errors, Method::Strata, b).is_some());
         if several && has_ratio {
             println!("{label}:");
         }

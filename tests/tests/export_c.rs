@@ -37,11 +37,16 @@ fn scratch(name: &str) -> PathBuf {
 /// The engine's inputs: candidates over a few objects with some invalid keys, payloads,
 /// resampling weights.
 fn inputs() -> (Vec<Candidate>, Vec<u32>, Vec<ResampleInput>) {
-    let pixels = WIDTH * HEIGHT;
+    inputs_sized(WIDTH, HEIGHT)
+}
+
+/// [`inputs`] for a `width` × `height` image.
+fn inputs_sized(width: u32, height: u32) -> (Vec<Candidate>, Vec<u32>, Vec<ResampleInput>) {
+    let pixels = width * height;
     let candidates = (0..pixels)
         .map(|p| {
             let key = if p % 37 == 5 { f32::NAN } else { ((p * 7919) % 113) as f32 * 0.05 };
-            Candidate { key, object_id: if p % 53 == 0 { u32::MAX } else { (p % WIDTH) / 11 + 4 * (p / WIDTH / 8) } }
+            Candidate { key, object_id: if p % 53 == 0 { u32::MAX } else { (p % width) / 11 + 4 * (p / width / 8) } }
         })
         .collect();
     let payloads = (0..pixels).map(|p| p.wrapping_mul(2_654_435_761) >> 7).collect();
@@ -74,10 +79,21 @@ fn wgpu_frames_with(
     settings: SelectionSettings,
     with_payloads: bool,
 ) -> Frames {
-    let (candidates, payloads, resample) = inputs();
+    wgpu_frames_sized(device, queue, settings, with_payloads, (WIDTH, HEIGHT))
+}
+
+/// [`wgpu_frames_with`] for an image of `size`.
+fn wgpu_frames_sized(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    settings: SelectionSettings,
+    with_payloads: bool,
+    (width, height): (u32, u32),
+) -> Frames {
+    let (candidates, payloads, resample) = inputs_sized(width, height);
     let inputs = EmbedInputs {
-        width: WIDTH,
-        height: HEIGHT,
+        width,
+        height,
         candidates: &candidates,
         payloads: with_payloads.then_some(payloads.as_slice()),
         resample: &resample,
@@ -127,7 +143,12 @@ fn write_inputs(folder: &Path) {
 
 /// [`write_inputs`], with or without `payloads.bin`.
 fn write_inputs_with(folder: &Path, with_payloads: bool) {
-    let (candidates, payloads, resample) = inputs();
+    write_inputs_sized(folder, with_payloads, (WIDTH, HEIGHT));
+}
+
+/// [`write_inputs_with`] for an image of `size`.
+fn write_inputs_sized(folder: &Path, with_payloads: bool, (width, height): (u32, u32)) {
+    let (candidates, payloads, resample) = inputs_sized(width, height);
     std::fs::write(folder.join("candidates.bin"), bytemuck::cast_slice(&candidates)).unwrap();
     if with_payloads {
         std::fs::write(folder.join("payloads.bin"), bytemuck::cast_slice(&payloads)).unwrap();
@@ -144,13 +165,26 @@ fn run_c(
     settings: SelectionSettings,
     folder: &Path,
 ) -> Result<Frames, String> {
+    run_c_sized(program, route, package, histogram, settings, folder, (WIDTH, HEIGHT))
+}
+
+/// [`run_c`] for an image of `size`, whose inputs are in `folder`.
+fn run_c_sized(
+    program: &Path,
+    route: &str,
+    package: &Path,
+    histogram: &str,
+    settings: SelectionSettings,
+    folder: &Path,
+    (width, height): (u32, u32),
+) -> Result<Frames, String> {
     let out = folder.join(format!("{route}-{histogram}-{}-{}", settings.candidates, settings.sampler.name()));
     std::fs::create_dir_all(&out).unwrap();
     let number = |v: u32| v.to_string();
     let output = Command::new(program)
         .args([route, folder.to_str().unwrap(), out.to_str().unwrap()])
         .args(["--package", package.to_str().unwrap(), "--histogram", histogram])
-        .args(["--width", &number(WIDTH), "--height", &number(HEIGHT), "--frames", &number(FRAMES)])
+        .args(["--width", &number(width), "--height", &number(height), "--frames", &number(FRAMES)])
         .args(["--seed", &number(SEED), "--block-size", &number(settings.block_size)])
         .args(["--candidates", &number(settings.candidates), "--sampler", &number(settings.sampler.id())])
         .args([
@@ -218,27 +252,33 @@ fn both_c_routes_equal_the_rust_pass_bit_for_bit() {
     strata_export::export(&package).unwrap();
     let program = build_c(&package, &folder).unwrap_or_else(|e| panic!("the C program does not build:\n{e}"));
     write_inputs(&folder);
+    // A second image size, a multiple of the block (45 × 29 is not), in its own folder.
+    let multiple = (64, 32);
+    let second = folder.join("64x32");
+    std::fs::create_dir_all(&second).unwrap();
+    write_inputs_sized(&second, true, multiple);
     let mut runs = 0;
     for sampler in [SamplerVariant::Antithetic, SamplerVariant::Random] {
         for candidates in 1..=4 {
             let settings =
                 SelectionSettings { block_size: 8, candidates, sampler, block_shift: true, ..Default::default() };
-            let want = wgpu_frames(&device, &queue, settings);
-            let library = run_c(&program, "library", &package, "block_histogram", settings, &folder).unwrap();
-            assert_eq!(first_difference(&library, &want), None, "route 2 (library), K = {candidates}, {sampler:?}");
-            // Route 1 with each histogram kernel in turn (they give the same output).
-            let histogram =
-                ["block_histogram", "block_histogram_rank", "block_histogram_subgroup"][candidates as usize % 3];
-            let package_route = run_c(&program, "package", &package, histogram, settings, &folder).unwrap();
-            assert_eq!(
-                first_difference(&package_route, &want),
-                None,
-                "route 1 ({histogram}), K = {candidates}, {sampler:?}"
-            );
-            runs += 2;
+            for (size, inputs) in [((WIDTH, HEIGHT), &folder), (multiple, &second)] {
+                let want = wgpu_frames_sized(&device, &queue, settings, true, size);
+                let what = format!("K = {candidates}, {sampler:?}, {}x{}", size.0, size.1);
+                let library =
+                    run_c_sized(&program, "library", &package, "block_histogram", settings, inputs, size).unwrap();
+                assert_eq!(first_difference(&library, &want), None, "route 2 (library), {what}");
+                // Route 1 (the manifest alone) with every histogram kernel (the same output).
+                for histogram in ["block_histogram", "block_histogram_rank", "block_histogram_subgroup"] {
+                    let package_route = run_c_sized(&program, "package", &package, histogram, settings, inputs, size)
+                        .unwrap_or_else(|e| panic!("route 1 ({histogram}), {what}: {e}"));
+                    assert_eq!(first_difference(&package_route, &want), None, "route 1 ({histogram}), {what}");
+                    runs += 1;
+                }
+            }
         }
     }
-    assert_eq!(runs, 16);
+    assert_eq!(runs, 2 * 4 * 2 * 3);
     // Route 1 choosing its histogram kernel by the manifest's `histogram_choice`: the
     // kernel strata's own rule picks for this device, and the same output.
     let settings = SelectionSettings { block_size: 8, candidates: 3, block_shift: true, ..Default::default() };

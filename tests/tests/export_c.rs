@@ -34,13 +34,8 @@ fn scratch(name: &str) -> PathBuf {
     folder
 }
 
-/// The engine's inputs: candidates over a few objects with some invalid keys, payloads,
-/// resampling weights.
-fn inputs() -> (Vec<Candidate>, Vec<u32>, Vec<ResampleInput>) {
-    inputs_sized(WIDTH, HEIGHT)
-}
-
-/// [`inputs`] for a `width` × `height` image.
+/// The engine's inputs for a `width` × `height` image: candidates over a few objects with
+/// some invalid keys, payloads, resampling weights.
 fn inputs_sized(width: u32, height: u32) -> (Vec<Candidate>, Vec<u32>, Vec<ResampleInput>) {
     let pixels = width * height;
     let candidates = (0..pixels)

@@ -21,9 +21,3 @@
 
 pub mod evaluation;
 pub mod progress;
-
-// Transitional, not part of the crate's face: the evaluation (`crate::rgb_image`, ...)
-// still reaches these modules by the old second name; once it names them
-// `strata_render::...`, these lines go.
-#[doc(hidden)]
-pub use strata_render::{atomic_file, denoise, histogram_pass, render, restir, rgb_image, scene};

@@ -34,7 +34,7 @@
 //! not pixels, are the independent units).
 
 use crate::evaluation::metrics::{MeanInterval, student_t_975};
-use crate::rgb_image::RgbImage;
+use strata_render::rgb_image::RgbImage;
 
 /// The ε of the paper's RelMSE, (f − r)² / (r + ε).
 const EPSILON: f64 = 1e-4;

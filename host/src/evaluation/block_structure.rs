@@ -17,7 +17,7 @@
 //! frames (the mean of frames 1 to f, each on its own grid under block shifting), frame
 //! f's.
 
-use crate::rgb_image::RgbImage;
+use strata_render::rgb_image::RgbImage;
 
 /// The relative luminance error of each pixel of `image` against `reference`.
 fn relative_luminance_errors(image: &RgbImage, reference: &RgbImage) -> Vec<f64> {

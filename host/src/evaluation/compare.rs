@@ -2,17 +2,17 @@
 //! measured against a reference, with a CSV of every measurement and a summary of
 //! mean ± 95 % confidence interval over seeds.
 
-use crate::denoise::{Denoiser, SvgfDenoiser};
 use crate::evaluation::metrics::{self, MeanInterval};
-use crate::histogram_pass::PassError;
-use crate::render::{GpuScene, RenderSettings};
-use crate::restir::{Method, RestirRenderer, RestirSettings};
-use crate::rgb_image::RgbImage;
-use crate::scene::Camera;
 use strata_backends::Backend;
 use strata_backends::backend::download;
 use strata_kernels::block_grid::frame_shift;
 use strata_kernels::denoise_types::DenoiseGuide;
+use strata_render::denoise::{Denoiser, SvgfDenoiser};
+use strata_render::histogram_pass::PassError;
+use strata_render::render::{GpuScene, RenderSettings};
+use strata_render::restir::{Method, RestirRenderer, RestirSettings};
+use strata_render::rgb_image::RgbImage;
+use strata_render::scene::Camera;
 
 /// One frame's errors against the reference.
 #[derive(Clone, Copy, Debug, PartialEq)]

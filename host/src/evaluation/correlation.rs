@@ -39,7 +39,7 @@
 
 use crate::evaluation::fft::{Complex, dft_2d};
 use crate::evaluation::metrics::MeanInterval;
-use crate::rgb_image::RgbImage;
+use strata_render::rgb_image::RgbImage;
 
 /// Why a correlation or spectrum cannot be computed.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]

@@ -31,7 +31,7 @@
 //! left out and counted. The camera's motion is removed by following the motion vectors, so
 //! what is left is the error's own change: the flicker of a moving frame.
 
-use crate::rgb_image::RgbImage;
+use strata_render::rgb_image::RgbImage;
 
 /// Mean luminance at or below which a pixel has no flicker ratio (the ε of the paper's RelMSE).
 pub const DARK: f64 = 1e-4;

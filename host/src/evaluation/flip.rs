@@ -11,7 +11,7 @@
 //! default); without it every FLIP is `None` and says so.
 
 use crate::evaluation::metrics::MetricError;
-use crate::rgb_image::{RgbImage, linear_to_srgb8};
+use strata_render::rgb_image::{RgbImage, linear_to_srgb8};
 
 /// Whether this build computes FLIP (the `flip` feature).
 pub const AVAILABLE: bool = cfg!(feature = "flip");

@@ -11,7 +11,7 @@
 //!   happen; a renderer that lost every sample to overflow flags those samples as
 //!   invalid, which the comparison refuses, so black alone is not an error).
 
-use crate::rgb_image::{RgbImage, linear_to_srgb8};
+use strata_render::rgb_image::{RgbImage, linear_to_srgb8};
 
 /// Why an image cannot be scored; the message names the image and the pixel.
 #[derive(Debug, thiserror::Error)]

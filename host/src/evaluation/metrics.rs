@@ -15,7 +15,7 @@
 //! images. [`MeanInterval`] reports a mean with its 95 % confidence interval over
 //! independent seeds.
 
-use crate::rgb_image::RgbImage;
+use strata_render::rgb_image::RgbImage;
 
 /// Which per-pixel error a map or a mean is made of.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -184,7 +184,7 @@ pub fn false_colour(map: &[f64], width: u32, height: u32) -> RgbImage {
             let i = (position as usize).min(STOPS.len() - 2);
             let f = position - i as f32;
             let srgb: [f32; 3] = std::array::from_fn(|c| STOPS[i][c] * (1.0 - f) + STOPS[i + 1][c] * f);
-            srgb.map(|c| crate::scene::srgb_to_linear((c * 255.0).round() as u8))
+            srgb.map(|c| strata_render::scene::srgb_to_linear((c * 255.0).round() as u8))
         })
         .collect();
     RgbImage { width, height, pixels }

@@ -5,15 +5,15 @@
 //!
 //! Which files are an earlier run's is read from the folder's record ([`RECORD_NAME`]):
 //! every run appends the name of each file to it before the file appears
-//! ([`crate::atomic_file::record_outputs`]), so a killed run's files are listed too. A
+//! ([`strata_render::atomic_file::record_outputs`]), so a killed run's files are listed too. A
 //! name alone proves nothing: a user's own `variance.csv` or `strata_frame042.png` in the
 //! folder is never removed. Where such a file has a name this run may write, the run is
 //! refused before anything is removed (it would replace it at the end), naming the file.
 //! The reference the new run reads is kept, wherever it lies.
 
-use crate::restir::Method;
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
+use strata_render::restir::Method;
 
 /// The lock file's name in the folder.
 pub const LOCK_NAME: &str = ".strata-compare.lock";
@@ -62,7 +62,7 @@ pub fn lock(folder: &Path) -> Result<FolderLock> {
                     Err(_) => None,
                 };
                 match holder {
-                    Some(pid) if crate::atomic_file::process_is_running(pid) && may_be_strata(pid) => bail!(
+                    Some(pid) if strata_render::atomic_file::process_is_running(pid) && may_be_strata(pid) => bail!(
                         "{}: another strata compare (process {pid}) is writing into this folder; wait for it or \
                          choose another --out (if no such run is going on, remove {})",
                         folder.display(),
@@ -151,9 +151,9 @@ fn recorded(folder: &Path) -> Result<std::collections::BTreeSet<String>> {
 
 /// Creates `folder` if needed, takes its [`lock`] and removes the files an earlier run
 /// recorded there ([`RECORD_NAME`]) and temporary files a killed run left
-/// ([`crate::atomic_file`]), except `keep` (the reference this run reads, which may be an
+/// ([`strata_render::atomic_file`]), except `keep` (the reference this run reads, which may be an
 /// earlier run's `reference.exr`). Then starts this run's record
-/// ([`crate::atomic_file::record_outputs`]). Returns the lock, to hold until the run has
+/// ([`strata_render::atomic_file::record_outputs`]). Returns the lock, to hold until the run has
 /// written everything, and the names removed.
 ///
 /// Everything is checked before anything is removed: a file under a name the run writes
@@ -176,8 +176,8 @@ pub fn prepare(folder: &Path, keep: Option<&Path>) -> Result<(FolderLock, Vec<St
         let path = entry.path();
         let output = is_run_output(&name);
         let earlier = recorded.contains(&name);
-        let temporary = crate::atomic_file::is_temporary(&name);
-        if !(output || earlier || temporary) || (temporary && !crate::atomic_file::is_left_over(&name)) {
+        let temporary = strata_render::atomic_file::is_temporary(&name);
+        if !(output || earlier || temporary) || (temporary && !strata_render::atomic_file::is_left_over(&name)) {
             continue;
         }
         let regular = entry.file_type().is_ok_and(|t| t.is_file());
@@ -198,7 +198,7 @@ pub fn prepare(folder: &Path, keep: Option<&Path>) -> Result<(FolderLock, Vec<St
             );
         }
         if output {
-            crate::atomic_file::check_target(&path)?;
+            strata_render::atomic_file::check_target(&path)?;
             if regular && !earlier && !temporary {
                 bail!(
                     "{}: no earlier strata compare recorded writing this file (in {}), and this run may write a file \
@@ -223,8 +223,8 @@ pub fn prepare(folder: &Path, keep: Option<&Path>) -> Result<(FolderLock, Vec<St
     // The new record starts with what was kept of the earlier one.
     let record = folder.join(RECORD_NAME);
     let text: String = kept_names.iter().map(|name| format!("{name}\n")).collect();
-    crate::atomic_file::write(&record, text)?;
-    crate::atomic_file::record_outputs(folder, &record);
+    strata_render::atomic_file::write(&record, text)?;
+    strata_render::atomic_file::record_outputs(folder, &record);
     Ok((lock, removed))
 }
 
@@ -373,7 +373,7 @@ mod tests {
         std::fs::write(folder.join(RECORD_NAME), record).unwrap();
         // A scene file named like the run's record, read as an input.
         std::fs::write(folder.join("run.json"), b"{}").unwrap();
-        crate::atomic_file::note_input(&folder.join("run.json"));
+        strata_render::atomic_file::note_input(&folder.join("run.json"));
         let refused = prepare(&folder, None).unwrap_err().to_string();
         assert!(refused.contains("run.json") && refused.contains("input"), "{refused}");
         // A reference named like a frame the run writes.

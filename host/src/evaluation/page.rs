@@ -14,7 +14,7 @@ use super::crops::Crop;
 use super::plot::method_colour;
 use super::record::RunRecord;
 use super::summary::{Table, WholeRunRatio};
-use crate::restir::Method;
+use strata_render::restir::Method;
 
 /// Everything the page shows; file names are relative to the page's folder.
 pub struct Page<'a> {

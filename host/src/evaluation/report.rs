@@ -14,13 +14,13 @@ use super::page::{CropShown, FrameImages, MethodImage, Page, RegimeRatios};
 use super::record::{MethodTime, RunRecord};
 use super::summary::{self, SeedImages, Table};
 use crate::progress::Progress;
-use crate::render::{GpuScene, RenderSettings};
-use crate::restir::Method;
-use crate::rgb_image::RgbImage;
 use anyhow::Result;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
+use strata_render::render::{GpuScene, RenderSettings};
+use strata_render::restir::Method;
+use strata_render::rgb_image::RgbImage;
 
 /// The other regime of `strata compare --both-regimes`: every method and seed again with
 /// temporal reuse switched (accumulated frames for a temporal run, and the other way),
@@ -384,7 +384,7 @@ fn write_viewer_plots(
 
 /// Writes `text` to `path`, complete or not at all; an error names the file.
 fn write(path: &Path, text: String) -> Result<()> {
-    Ok(crate::atomic_file::write(path, text)?)
+    Ok(strata_render::atomic_file::write(path, text)?)
 }
 
 /// Writes one seed-1 frame of a method: EXR and PNG, and its RelMSE map as EXR and

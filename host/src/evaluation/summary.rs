@@ -9,9 +9,9 @@ use super::compare::{
     relmse_ratio_over_frames,
 };
 use super::metrics::{self, MeanInterval};
-use crate::restir::Method;
-use crate::rgb_image::RgbImage;
 use anyhow::Result;
+use strata_render::restir::Method;
+use strata_render::rgb_image::RgbImage;
 
 /// A table with a label column and one column per shown frame.
 #[derive(Clone, Debug, PartialEq)]

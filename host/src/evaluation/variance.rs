@@ -12,7 +12,7 @@
 //! each pixel, exactly as in RelMSE.
 
 use crate::evaluation::metrics::{MeanInterval, MetricError, student_t_975};
-use crate::rgb_image::RgbImage;
+use strata_render::rgb_image::RgbImage;
 
 /// Per pixel and channel: the sum and the sum of squares of the seeds' values.
 struct Moments {

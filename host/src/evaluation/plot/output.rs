@@ -76,18 +76,23 @@ pub(super) fn encode(figure: &Figure, stem: &Path) -> Result<Vec<(PathBuf, Vec<u
     let document = svg(figure).with_context(|| format!("{}: cannot write", svg_path.display()))?;
     let bytes = png(figure)
         .and_then(|image| {
-            crate::rgb_image::encode_png(image.as_raw(), image.width(), image.height(), image::ExtendedColorType::Rgb8)
-                .map_err(|e| anyhow!(e))
+            strata_render::rgb_image::encode_png(
+                image.as_raw(),
+                image.width(),
+                image.height(),
+                image::ExtendedColorType::Rgb8,
+            )
+            .map_err(|e| anyhow!(e))
         })
         .with_context(|| format!("{}: cannot write", png_path.display()))?;
     Ok(vec![(svg_path, document.into_bytes()), (png_path, bytes)])
 }
 
-/// Writes `files` as one set ([`crate::atomic_file::write_set`]: all of them or none);
+/// Writes `files` as one set ([`strata_render::atomic_file::write_set`]: all of them or none);
 /// returns their paths.
 pub(super) fn write_files(files: &[(PathBuf, Vec<u8>)]) -> Result<Vec<PathBuf>> {
     let set: Vec<(&Path, &[u8])> = files.iter().map(|(path, bytes)| (path.as_path(), bytes.as_slice())).collect();
-    crate::atomic_file::write_set(&set)?;
+    strata_render::atomic_file::write_set(&set)?;
     Ok(files.iter().map(|(path, _)| path.clone()).collect())
 }
 

@@ -6,9 +6,9 @@ use super::output::{self, with_suffix};
 use super::series::{Series, all_methods, baselines, frame_count, ratio_points, relmse_points};
 use super::style::{Dash, method_colour, run_dash};
 use crate::evaluation::compare::FrameError;
-use crate::restir::Method;
 use anyhow::Result;
 use std::path::{Path, PathBuf};
+use strata_render::restir::Method;
 
 /// The y axis of the RelMSE plots.
 const RELMSE_AXIS: &str = "RelMSE (mean, 95 % CI over seeds)";

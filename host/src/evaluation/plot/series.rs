@@ -7,7 +7,7 @@
 use super::style::Dash;
 use crate::evaluation::compare::{FrameError, by_frame, relmse_over_seeds, relmse_ratio};
 use crate::evaluation::metrics::MeanInterval;
-use crate::restir::Method;
+use strata_render::restir::Method;
 
 /// One point of a line.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -2,8 +2,8 @@
 //! report, so strata is never green in one figure and red in the next) and the dash
 //! patterns that tell overlaid runs apart.
 
-use crate::restir::Method;
 use plotters::style::RGBColor;
+use strata_render::restir::Method;
 
 /// One colour per method, the same in every plot and in the HTML report (CSS hex, e.g.
 /// "#1f77b4"). From the Okabe–Ito palette, which stays distinguishable under the common

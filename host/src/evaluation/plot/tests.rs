@@ -6,8 +6,8 @@ use super::plots::relmse_figure;
 use super::style::{Dash, dash_pieces};
 use super::*;
 use crate::evaluation::compare::FrameError;
-use crate::restir::Method;
 use std::path::{Path, PathBuf};
+use strata_render::restir::Method;
 
 /// Rows of `methods` at frames 0..frames and seeds 1..=seeds, RelMSE falling with frame.
 fn rows(methods: &[Method], frames: u32, seeds: u32) -> Vec<FrameError> {

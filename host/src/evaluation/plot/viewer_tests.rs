@@ -9,8 +9,8 @@ use super::viewer_plots::{correlation_figure, spectrum_figure};
 use super::*;
 use crate::evaluation::metrics::MeanInterval;
 use crate::evaluation::viewer::{Stage, ViewerCurves};
-use crate::restir::Method;
 use std::path::PathBuf;
+use strata_render::restir::Method;
 
 /// A measurement over 3 seeds.
 fn value(mean: f64) -> Option<MeanInterval> {

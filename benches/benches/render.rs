@@ -61,7 +61,10 @@ fn restir_frames(c: &mut Criterion, backend: &mut dyn Backend) {
     });
     let temporal_first = [Method::Strata, Method::Restir, Method::RestirDisc]
         .map(|method| (method, Shading::Expectation, ReuseOrder::TemporalFirst));
-    for (method, shading, reuse_order) in spatial_first.chain(temporal_first) {
+    // And plain per-pixel RIS, the equal-time baseline (no reuse: its frames run the
+    // paper's passes without temporal reuse and no histogram, whatever the order).
+    let ris = [(Method::Ris, Shading::Expectation, ReuseOrder::SpatialFirst)];
+    for (method, shading, reuse_order) in spatial_first.chain(temporal_first).chain(ris) {
         let restir = RestirSettings { method, shading, reuse_order, ..RestirSettings::default() };
         let mut renderer = RestirRenderer::new(backend, &gpu_scene, &render, restir, scene.extent()).expect("renderer");
         renderer.set_timed(true);

@@ -216,7 +216,8 @@ impl ViewerCollector {
         report.notes.extend(hidden_by_denoiser(methods, &self.gathered, reference)?);
         report.notes.push(
             "bias² is measured against the reference, whose own noise counts as bias alike for every method; after a \
-             denoiser it is mostly the filter's own bias"
+             denoiser it is mostly the filter's own bias; it is an unbiased estimate (the seeds' spread divided by \
+             their number taken off), so near 0 it can be slightly negative"
                 .to_string(),
         );
         Ok(report)
@@ -519,6 +520,12 @@ fn hidden_by_denoiser(
             notes.push(format!(
                 "the denoiser hides the sampler: strata ÷ {} residual noise is {raw} raw but {denoised} after it \
                  (no longer told apart)",
+                baseline.name()
+            ));
+        } else if raw.differ() && denoised.differ() && (raw.ratio < 1.0) != (denoised.ratio < 1.0) {
+            notes.push(format!(
+                "the denoiser reverses the sampler's order: strata ÷ {} residual noise is {raw} raw but {denoised} \
+                 after it",
                 baseline.name()
             ));
         } else if raw.differ() && denoised.differ() {

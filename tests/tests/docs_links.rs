@@ -23,8 +23,7 @@
 //! `backends/src/cpu_backend/limit.rs`, in a text that names the crate). Paths inside the
 //! folders of [`OUTSIDE_PREFIXES`] describe files outside the repository and are skipped.
 //!
-//! Failures name `file:line` and the missing target, all of them at once. A link to a
-//! file of [`BEING_WRITTEN`] may be missing.
+//! Failures name `file:line` and the missing target, all of them at once.
 //!
 //! A second test holds the README and BENCHMARKS.md to issue 57's limits: at most 250 words
 //! before "## Quick start" and 900 in all (words: whitespace-separated tokens outside
@@ -37,11 +36,6 @@ use std::process::Command;
 
 /// The extensions that make a backticked word a repository path.
 const PATH_EXTENSIONS: &[&str] = &["rs", "wgsl", "md", "json", "toml", "h", "c", "cpp", "cmake", "py", "sh", "ply"];
-
-/// Link targets another change is writing now, which may be missing until it lands: the
-/// viewer's topic of BENCHMARKS.md (issue 55). Once the file exists it is checked as any
-/// other; delete the entry then.
-const BEING_WRITTEN: &[&str] = &["docs/benchmarks/viewer.md"];
 
 /// Folders the docs describe that are not in the repository: the exported kernel package's
 /// `include/` and `lib/` (export/package/README.md, RELIABILITY.md), and mitsuba-data's
@@ -284,8 +278,7 @@ fn check_markdown(repo: &Repository, page: &str, findings: &mut Findings) {
             // The target relative to the repository root, then on disk.
             let relative = if file.is_empty() { PathBuf::from(page) } else { normalise(&folder.join(&file)) };
             let linked = repo.root.join(&relative);
-            let pending = BEING_WRITTEN.iter().any(|p| Path::new(p) == relative);
-            if !linked.exists() && !pending {
+            if !linked.exists() {
                 findings.problems.push(format!(
                     "{page}:{}: link `{target}`: no file {}",
                     line.number,

@@ -273,31 +273,32 @@ impl Default for RestirSettings {
 }
 
 impl RestirSettings {
-    /// The kernels' uniform as these settings fill it: everything but what changes frame
-    /// by frame (`temporal`, on from the second frame; the previous camera) and what the
-    /// renderer resolves against the scene (`min_distance` when 0), which the renderer
-    /// sets over it.
+    /// The kernels' uniform as these settings fill it ([`RestirSettings::as_run`]'s: ris
+    /// with K = 0 and no temporal reuse): everything but what changes frame by frame
+    /// (`temporal`, on from the second frame; the previous camera) and what the renderer
+    /// resolves against the scene (`min_distance` when 0), which the renderer sets over it.
     pub fn uniform(&self) -> RestirParams {
+        let run = self.as_run();
         RestirParams {
-            method: match self.method {
+            method: match run.method {
                 Method::Strata => METHOD_STRATA,
                 Method::Restir => METHOD_RESTIR,
                 Method::RestirDisc => METHOD_RESTIR_DISC,
                 // No slot is drawn with K = 0, so no method's draw is read.
                 Method::Ris => METHOD_RESTIR,
             },
-            candidates: if self.method.reuses() { self.selection.candidates } else { 0 },
-            sampler: self.selection.sampler.id(),
-            temporal: u32::from(self.temporal),
-            temporal_cap: self.temporal_cap,
-            disc_radius: self.disc_radius,
-            min_distance: self.min_distance,
-            min_roughness: self.min_roughness,
-            specular_chain: self.specular_chain,
-            replay: u32::from(self.glossy_replay),
-            temporal_candidates: self.temporal_candidates,
-            shaded_parts: self.shaded_parts.bits(),
-            shading: match self.shading {
+            candidates: run.selection.candidates,
+            sampler: run.selection.sampler.id(),
+            temporal: u32::from(run.temporal),
+            temporal_cap: run.temporal_cap,
+            disc_radius: run.disc_radius,
+            min_distance: run.min_distance,
+            min_roughness: run.min_roughness,
+            specular_chain: run.specular_chain,
+            replay: u32::from(run.glossy_replay),
+            temporal_candidates: run.temporal_candidates,
+            shaded_parts: run.shaded_parts.bits(),
+            shading: match run.shading {
                 Shading::Sample => SHADING_SAMPLE,
                 Shading::Expectation => SHADING_EXPECTATION,
             },
@@ -306,15 +307,23 @@ impl RestirSettings {
     }
 
     /// What a frame runs of these settings: themselves, but for [`Method::Ris`], which
-    /// reuses nothing: no temporal reuse, no drawn previous reservoirs, and the paper's
-    /// order of passes (with K = 0 and no history both orders keep each pixel's canonical
-    /// candidate; the paper's runs two passes fewer). K stays as given, for the record;
-    /// [`RestirSettings::uniform`] gives the kernels K = 0.
+    /// reuses nothing: K = 0 (no slot is drawn), no temporal reuse, no drawn previous
+    /// reservoirs, and the paper's order of passes (with K = 0 and no history both orders
+    /// keep each pixel's canonical candidate; the paper's runs two passes fewer). The one
+    /// place that says what ris leaves out; [`RestirSettings::check`] is for the settings
+    /// as given (K = 0 is no setting a user may choose).
     pub fn as_run(self) -> RestirSettings {
         if self.method.reuses() {
             return self;
         }
-        RestirSettings { temporal: false, temporal_candidates: 0, reuse_order: ReuseOrder::SpatialFirst, ..self }
+        let selection = SelectionSettings { candidates: 0, ..self.selection };
+        RestirSettings {
+            selection,
+            temporal: false,
+            temporal_candidates: 0,
+            reuse_order: ReuseOrder::SpatialFirst,
+            ..self
+        }
     }
 
     /// Refuses settings the kernels cannot run, naming the field and value.
@@ -439,5 +448,24 @@ mod tests {
         same_names::<Method>();
         same_names::<ShadedParts>();
         same_names::<Shading>();
+    }
+}
+
+#[cfg(test)]
+mod as_run_tests {
+    use super::*;
+
+    /// ris reuses nothing, whoever reads its settings: its uniform draws no slot and merges
+    /// no history, and its passes run in the paper's order; the other methods run as given.
+    #[test]
+    fn ris_runs_without_reuse() {
+        let ris = RestirSettings { method: Method::Ris, temporal_candidates: 2, ..RestirSettings::default() };
+        let uniform = ris.uniform();
+        assert_eq!((uniform.candidates, uniform.temporal, uniform.temporal_candidates), (0, 0, 0));
+        assert_eq!(ris.as_run().reuse_order, ReuseOrder::SpatialFirst);
+        ris.check().expect("ris with the default K is a valid setting");
+        let strata = RestirSettings { temporal_candidates: 2, ..RestirSettings::default() };
+        assert_eq!(strata.as_run(), strata);
+        assert_eq!(strata.uniform().candidates, strata.selection.candidates);
     }
 }

@@ -23,7 +23,7 @@
 //! Memory: each seed's frames after the first quarter (flicker), and the last frame of
 //! every seed; the rest is reduced as it arrives.
 
-use super::bias_noise::{BiasNoise, bias_noise, compare_noise};
+use super::bias_noise::{BiasNoise, NoiseRatio, bias_noise, compare_noise};
 use super::compare::SeenFrame;
 use super::correlation::{CorrelationError, ErrorField, LagCorrelation, autocorrelation, radial_spectrum};
 use super::flicker::{PreviousPixels, flicker, temporal_error_change};
@@ -196,6 +196,7 @@ impl ViewerCollector {
         let frame_ms = |m: Method| {
             self.times.get(&m).filter(|t| t.1 > 0).map(|(time, count)| time.as_secs_f64() * 1e3 / f64::from(*count))
         };
+        let noise = noise_ratios(&self.gathered, reference)?;
         for stage in stages {
             let mut measured: BTreeMap<Method, MethodViewer> = BTreeMap::new();
             for &method in methods {
@@ -203,7 +204,7 @@ impl ViewerCollector {
                 let m = measure(method, stage, gathered, reference, self.block_size, &mut report.notes)?;
                 measured.insert(method, m);
             }
-            let table = stage_table(stage, methods, &measured, &self.gathered, reference, frame_ms, self.moving)?;
+            let table = stage_table(stage, methods, &measured, &self.gathered, &noise, frame_ms, self.moving);
             report.notes.extend(table.1);
             report.tables.push(table.0);
             for &method in methods {
@@ -213,7 +214,7 @@ impl ViewerCollector {
                 }
             }
         }
-        report.notes.extend(hidden_by_denoiser(methods, &self.gathered, reference)?);
+        report.notes.extend(hidden_by_denoiser(methods, &noise));
         report.notes.push(
             "bias² is measured against the reference, whose own noise counts as bias alike for every method; after a \
              denoiser it is mostly the filter's own bias; it is an unbiased estimate (the seeds' spread divided by \
@@ -398,10 +399,10 @@ fn stage_table(
     methods: &[Method],
     measured: &BTreeMap<Method, MethodViewer>,
     gathered: &BTreeMap<(Method, Stage), Gathered>,
-    reference: &RgbImage,
+    noise: &BTreeMap<(Stage, Method), NoiseRatio>,
     frame_ms: impl Fn(Method) -> Option<f64>,
     moving: bool,
-) -> Result<(Table, Vec<String>)> {
+) -> (Table, Vec<String>) {
     let seeds = measured.values().map(|m| m.split.seeds).max().unwrap_or(0);
     let title = format!(
         "What the viewer sees, {} frames (the last frame over {seeds} seeds; RelMSE = bias² + residual noise, \
@@ -450,13 +451,7 @@ fn stage_table(
             else {
                 continue;
             };
-            let noise = if ours.last.len() >= 3 {
-                let ratio = compare_noise(&ours.last, &theirs.last, reference)
-                    .map_err(|e| anyhow!("strata ÷ {} residual noise: {e}", baseline.name()))?;
-                format!("{ratio}")
-            } else {
-                "needs 3 seeds".to_string()
-            };
+            let noise = noise.get(&(stage, baseline)).map_or_else(|| "needs 3 seeds".to_string(), |r| r.to_string());
             let relmse_ratio = strata.split.relmse.mean / base.split.relmse.mean;
             let equal_time = match (frame_ms(Method::Strata), frame_ms(baseline)) {
                 (Some(ts), Some(tb)) if tb > 0.0 && base.split.relmse.mean > 0.0 => {
@@ -490,32 +485,37 @@ fn stage_table(
         }
     }
     let table = Table { title, columns: columns.iter().map(|c| c.to_string()).collect(), rows };
-    Ok((table, notes))
+    (table, notes)
+}
+
+/// strata's residual noise ÷ each baseline's per stage ([`compare_noise`]), computed once
+/// for the tables and [`hidden_by_denoiser`]; left out with fewer than 3 seeds.
+fn noise_ratios(
+    gathered: &BTreeMap<(Method, Stage), Gathered>,
+    reference: &RgbImage,
+) -> Result<BTreeMap<(Stage, Method), NoiseRatio>> {
+    let mut ratios = BTreeMap::new();
+    for stage in [Stage::Raw, Stage::Denoised] {
+        let Some(ours) = gathered.get(&(Method::Strata, stage)).filter(|g| g.last.len() >= 3) else { continue };
+        for baseline in Method::BASELINES {
+            let Some(theirs) = gathered.get(&(baseline, stage)) else { continue };
+            let ratio = compare_noise(&ours.last, &theirs.last, reference)
+                .map_err(|e| anyhow!("strata ÷ {} residual noise, {} frames: {e}", baseline.name(), stage.name()))?;
+            ratios.insert((stage, baseline), ratio);
+        }
+    }
+    Ok(ratios)
 }
 
 /// Where the raw residual noise of strata and a baseline differs but the denoised does
-/// not: the denoiser hides the sampler, said in a sentence.
-fn hidden_by_denoiser(
-    methods: &[Method],
-    gathered: &BTreeMap<(Method, Stage), Gathered>,
-    reference: &RgbImage,
-) -> Result<Vec<String>> {
+/// not (the denoiser hides the sampler), or the order reverses, said in a sentence.
+fn hidden_by_denoiser(methods: &[Method], noise: &BTreeMap<(Stage, Method), NoiseRatio>) -> Vec<String> {
     let mut notes = Vec::new();
-    if !methods.contains(&Method::Strata) {
-        return Ok(notes);
-    }
     for baseline in Method::BASELINES.into_iter().filter(|b| methods.contains(b)) {
-        let ratio = |stage| -> Result<Option<super::bias_noise::NoiseRatio>> {
-            let (Some(ours), Some(theirs)) = (gathered.get(&(Method::Strata, stage)), gathered.get(&(baseline, stage)))
-            else {
-                return Ok(None);
-            };
-            if ours.last.len() < 3 {
-                return Ok(None);
-            }
-            Ok(Some(compare_noise(&ours.last, &theirs.last, reference).map_err(|e| anyhow!("{e}"))?))
+        let (Some(raw), Some(denoised)) = (noise.get(&(Stage::Raw, baseline)), noise.get(&(Stage::Denoised, baseline)))
+        else {
+            continue;
         };
-        let (Some(raw), Some(denoised)) = (ratio(Stage::Raw)?, ratio(Stage::Denoised)?) else { continue };
         if raw.differ() && !denoised.differ() {
             notes.push(format!(
                 "the denoiser hides the sampler: strata ÷ {} residual noise is {raw} raw but {denoised} after it \
@@ -535,7 +535,7 @@ fn hidden_by_denoiser(
             ));
         }
     }
-    Ok(notes)
+    notes
 }
 
 #[cfg(test)]
@@ -555,24 +555,12 @@ mod tests {
         let (width, height, frames, seeds) = (32, 32, 8, 6);
         let reference = image(width, height, |_, _| 1.0);
         let mut collector = ViewerCollector::new(frames, 8, false);
-        let mut state = 0x1234_5678_9abc_def0_u64;
-        let mut gaussian = move || {
-            // Box–Muller on a SplitMix64 stream.
-            let mut next = || {
-                state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-                let mut z = state;
-                z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-                z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-                ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-            };
-            let (u, v) = (next().max(1e-300), next());
-            (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
-        };
+        let mut rng = crate::evaluation::test_noise::Rng::new(0x1234_5678);
         for (method, sigma, offset) in [(Method::Restir, 0.2_f64, 0.0_f32), (Method::Strata, 0.2 / 2f64.sqrt(), 0.05)] {
             for seed in 1..=seeds {
                 for frame in 0..frames {
                     let noise: Vec<f32> =
-                        (0..width * height).map(|_| (1.0 + sigma * gaussian()) as f32 + offset).collect();
+                        (0..width * height).map(|_| (1.0 + sigma * rng.normal()) as f32 + offset).collect();
                     let shown = image(width, height, |x, y| noise[(y * width + x) as usize]);
                     let seen = SeenFrame {
                         method,

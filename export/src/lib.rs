@@ -43,12 +43,12 @@ pub mod translations;
 
 use std::path::{Path, PathBuf};
 use strata_embed::wgsl::ModuleId;
+use strata_kernels::Registry;
 use strata_kernels::constants::{ConstantValue, SHARED, module_constants};
 use strata_kernels::embed_types::{ResampleInput, ResampleOutput, SelectedCandidates, SelectionParams};
 use strata_kernels::pass_plan::PassBuffer;
 use strata_kernels::selection::SamplerVariant;
 use strata_kernels::types::{BlockStats, Candidate, ClusterSpan, HistogramParams};
-use strata_kernels::{KernelId, Registry};
 
 /// Why the package could not be written; each message is one line naming what is wrong.
 #[derive(Debug, thiserror::Error)]
@@ -99,21 +99,18 @@ pub struct Exported {
 /// The kernels the package carries, in run order (the three histogram variants first).
 pub const MODULES: [ModuleId; 5] = ModuleId::ALL;
 
-/// The structs the package declares, each with a kernel whose IR has it.
-fn structs(registry: &Registry) -> Vec<c_header::HeaderStruct> {
+/// The structs the package declares.
+fn structs() -> Vec<c_header::HeaderStruct> {
     use c_header::HeaderStruct;
-    let histogram = registry.get(KernelId::BlockHistogram);
-    let select = registry.get(KernelId::StrataSelect);
-    let resample = registry.get(KernelId::StrataResample);
     vec![
-        HeaderStruct::of::<Candidate>(histogram),
-        HeaderStruct::of::<ClusterSpan>(histogram),
-        HeaderStruct::of::<BlockStats>(histogram),
-        HeaderStruct::of::<HistogramParams>(histogram),
-        HeaderStruct::of::<SelectionParams>(select),
-        HeaderStruct::of::<SelectedCandidates>(select),
-        HeaderStruct::of::<ResampleInput>(resample),
-        HeaderStruct::of::<ResampleOutput>(resample),
+        HeaderStruct::of::<Candidate>(),
+        HeaderStruct::of::<ClusterSpan>(),
+        HeaderStruct::of::<BlockStats>(),
+        HeaderStruct::of::<HistogramParams>(),
+        HeaderStruct::of::<SelectionParams>(),
+        HeaderStruct::of::<SelectedCandidates>(),
+        HeaderStruct::of::<ResampleInput>(),
+        HeaderStruct::of::<ResampleOutput>(),
     ]
 }
 
@@ -149,7 +146,7 @@ pub fn export(out: &Path) -> Result<Exported, ExportError> {
         workgroup_sizes.push((kernel.name().to_string(), kernel.workgroup_size));
         kernels.push(entry);
     }
-    let structs = structs(registry);
+    let structs = structs();
     let constants = constants(registry);
     let packed = strata_kernels::blue_noise::BlueNoiseTables::new().packed();
     let blue_noise: Vec<u8> = packed.iter().flat_map(|w| w.to_le_bytes()).collect();

@@ -7,7 +7,7 @@
 use crate::translations::{MSL_SIZES_BUFFER, Translated};
 use serde::Serialize;
 use strata_embed::wgsl::ModuleId;
-use strata_kernels::layout::ShaderStruct;
+use strata_kernels::gpu::StructDeclaration;
 use strata_kernels::pass_plan::{PassBuffer, SizeRule, Stage, Writer};
 use strata_kernels::{BindingKind, Kernel};
 
@@ -848,31 +848,20 @@ pub fn kernel_entry(module: ModuleId, kernel: &Kernel, translated: &Translated) 
     }
 }
 
-/// The layout of `T` from its Rust twin, with each field's WGSL type from `kernel`'s IR.
-pub fn struct_entry<T: ShaderStruct>(kernel: &Kernel) -> StructEntry {
-    let module = &kernel.module;
-    let wgsl_types: Vec<(String, String)> = module
-        .types
-        .iter()
-        .find(|(_, ty)| ty.name.as_deref() == Some(T::WGSL_NAME))
-        .map(|(_, ty)| match &ty.inner {
-            naga::TypeInner::Struct { members, .. } => members
-                .iter()
-                .map(|m| (m.name.clone().unwrap_or_default(), strata_kernels::binding::type_name(module, m.ty)))
-                .collect(),
-            _ => Vec::new(),
-        })
-        .unwrap_or_default();
+/// The layout of a declared struct: its Rust offsets and sizes (which a test of
+/// strata-kernels holds equal to naga's layout of its WGSL) and its fields' WGSL types.
+pub fn struct_entry(declaration: &StructDeclaration) -> StructEntry {
     StructEntry {
-        name: T::WGSL_NAME,
-        size: size_of::<T>(),
-        fields: T::fields()
-            .into_iter()
+        name: declaration.name,
+        size: declaration.size,
+        fields: declaration
+            .fields
+            .iter()
             .map(|field| FieldEntry {
                 name: field.name,
                 offset: field.offset,
                 size: field.size,
-                wgsl_type: wgsl_types.iter().find(|(n, _)| n == field.name).map(|(_, t)| t.clone()).unwrap_or_default(),
+                wgsl_type: field.wgsl_type.to_string(),
             })
             .collect(),
     }

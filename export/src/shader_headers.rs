@@ -5,7 +5,7 @@
 //! `StrataSelectedCandidates`). They are generated from the same structs and constants as
 //! `strata.h` ([`crate::c_header`]), field for field in the same order; every field is a
 //! 4-byte scalar, an array of them, or a vec2 or vec4 at an offset its alignment divides
-//! (the Rust twins pad explicitly), so the records lay out the same in C, in GLSL's
+//! (the Rust declarations pad explicitly), so the records lay out the same in C, in GLSL's
 //! `std430` buffers, in HLSL's structured buffers and in WGSL's storage buffers (a test of
 //! strata's compiles a shader including each and compares every offset and size with
 //! `strata.h`'s).
@@ -185,13 +185,13 @@ pub fn header(
     for s in structs {
         let entry = &s.entry;
         h += "\n";
-        if let Some(doc) = doc_above(&format!("pub struct {} ", entry.name), None) {
-            h += &comment(&doc, "");
+        if !s.doc.is_empty() {
+            h += &comment(&s.doc, "");
         }
         h += &format!("struct Strata{} {{\n", entry.name);
-        for f in &entry.fields {
-            if let Some(doc) = doc_above(&format!("pub {}:", f.name), Some(&format!("pub struct {} ", entry.name))) {
-                h += &comment(&doc, "    ");
+        for (f, doc) in entry.fields.iter().zip(&s.field_docs) {
+            if !doc.is_empty() {
+                h += &comment(doc, "    ");
             }
             h += &format!("    {}\n", field(language, &f.wgsl_type, &field_name(language, f.name))?);
         }

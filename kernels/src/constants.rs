@@ -1,8 +1,12 @@
-//! The WGSL constants the host shares with the kernels, each beside its Rust twin, and
-//! a reader of the constants naga parsed from a module.
+//! The WGSL constants the host shares with the kernels, each with its Rust value, and a
+//! reader of the constants naga parsed from a module.
 //!
-//! Structs have layout twins (`layout.rs`); constants have values that must agree (an
-//! object id the histogram treats as "no object", a sampler id, a slot number). The test
+//! Constants have values that must agree (an object id the histogram treats as "no
+//! object", a sampler id, a slot number). Those declared with
+//! `gpu_constants!` ([`crate::gpu`]) are written into WGSL from their Rust declaration; the
+//! others (the selection's, the blue noise's, the histogram's `SLOTS`, `R2_STEP`) are
+//! written on both sides. [`SHARED`] lists both kinds, by WGSL name: the export package
+//! declares the ones its kernels use. The test
 //! below reads every `const` of every registry kernel from naga's IR and compares it
 //! with [`SHARED`]; a WGSL constant that is in neither [`SHARED`] nor [`KERNEL_PRIVATE`]
 //! fails it, so a new constant is classified when it is written.

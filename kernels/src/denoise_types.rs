@@ -1,66 +1,71 @@
-//! `#[repr(C)]` twins of the denoiser's WGSL structs (`kernels/wgsl/denoise/`): the
-//! per-pixel guide an engine supplies and the SVGF passes' settings. The registry's
-//! layout test holds each to its WGSL declaration.
+//! The denoiser's records and constants (`kernels/wgsl/denoise/`): the per-pixel guide
+//! an engine supplies and the SVGF passes' uniform, declared once ([`crate::gpu`]): the
+//! WGSL module `gpu/denoise.wgsl` is generated from them.
 
-use bytemuck::{Pod, Zeroable};
+use crate::gpu::{GpuModule, StructDeclaration, gpu_constants, gpu_struct};
 
-/// What the denoiser reads of a pixel's surface (WGSL `DenoiseGuide`, 48 bytes): an
-/// engine's G-buffer.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct DenoiseGuide {
-    /// Reflectance divided out before filtering and multiplied in after; components at
-    /// or below [`MIN_ALBEDO`] are left alone.
-    pub albedo: [f32; 3],
-    /// Linear depth of the surface (distance along the pixel's ray); 0: no surface,
-    /// passed through unfiltered.
-    pub depth: f32,
-    /// Unit world-space normal.
-    pub normal: [f32; 3],
-    /// Object id: history is taken only from a pixel that saw the same object.
-    pub mesh: u32,
-    /// The surface point's previous image position minus its current one, in pixels.
-    pub motion: [f32; 2],
-    /// Padding.
-    pub _pad: [u32; 2],
+gpu_struct! {
+    /// What the denoiser reads of a pixel's surface (WGSL `DenoiseGuide`, 48 bytes, std430):
+    /// its G-buffer, as engines already keep one (SVGF, Schied et al. 2017, §3 and §4.1).
+    /// The renderer writes it in `restir/entry_guide.wgsl`; an engine writes its own.
+    pub struct DenoiseGuide {
+        /// Reflectance divided out before filtering and multiplied in after (SVGF §4:
+        /// filtering untextured illumination keeps texture detail sharp); components at or
+        /// below [`MIN_ALBEDO`] are left alone.
+        pub albedo: [f32; 3] as "vec3<f32>",
+        /// Linear depth of the surface (distance along the pixel's ray; the renderer gives
+        /// the path length through a mirror chain, where SVGF uses clip-space depth); 0: no
+        /// surface (the sky): the pixel is passed through unfiltered and never used as a
+        /// neighbour.
+        pub depth: f32,
+        /// Unit world-space normal.
+        pub normal: [f32; 3] as "vec3<f32>",
+        /// Object id: history is taken only from a pixel that saw the same object.
+        pub mesh: u32,
+        /// The surface point's previous image position minus its current one, in pixels (a
+        /// motion vector without the camera's sub-pixel jitter).
+        pub motion: [f32; 2] as "vec2<f32>",
+        /// Padding.
+        pub _pad: [u32; 2] as "vec2<u32>",
+    }
 }
 
-/// The settings of one SVGF pass (WGSL `DenoiseParams`, a uniform).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct DenoiseParams {
-    /// Image width in pixels.
-    pub width: u32,
-    /// Image height in pixels.
-    pub height: u32,
-    /// 1: the history buffers hold the previous frame's.
-    pub history: u32,
-    /// À-trous: the distance in pixels between this level's taps.
-    pub step: u32,
-    /// Weight of the new frame in the colour's moving average.
-    pub alpha_colour: f32,
-    /// Weight of the new frame in the moments' moving average.
-    pub alpha_moments: f32,
-    /// σ_l of the luminance edge-stopping weight.
-    pub sigma_luminance: f32,
-    /// σ_z of the depth edge-stopping weight.
-    pub sigma_depth: f32,
-    /// The normal weight's exponent is 2 to this power.
-    pub normal_power_log2: u32,
-    /// History lengths stop growing here (frames).
-    pub max_history: f32,
-    /// Reprojection's relative depth tolerance.
-    pub depth_tolerance: f32,
-    /// Reprojection's least cosine between normals.
-    pub normal_tolerance: f32,
-    /// 1: the spatial filters also stop at object boundaries.
-    pub object_edges: u32,
-    /// Padding (a uniform is a multiple of 16 bytes).
-    pub _pad0: u32,
-    /// Padding.
-    pub _pad1: u32,
-    /// Padding.
-    pub _pad2: u32,
+gpu_struct! {
+    /// The settings of one SVGF pass (WGSL `DenoiseParams`, a uniform).
+    pub struct DenoiseParams {
+        /// Image width in pixels.
+        pub width: u32,
+        /// Image height in pixels.
+        pub height: u32,
+        /// 1: the history buffers hold the previous frame's.
+        pub history: u32,
+        /// À-trous: the distance in pixels between this level's taps.
+        pub step: u32,
+        /// Weight of the new frame in the colour's moving average.
+        pub alpha_colour: f32,
+        /// Weight of the new frame in the moments' moving average.
+        pub alpha_moments: f32,
+        /// σ_l of the luminance edge-stopping weight.
+        pub sigma_luminance: f32,
+        /// σ_z of the depth edge-stopping weight.
+        pub sigma_depth: f32,
+        /// The normal weight's exponent is 2 to this power.
+        pub normal_power_log2: u32,
+        /// History lengths stop growing here (frames).
+        pub max_history: f32,
+        /// Reprojection's relative depth tolerance.
+        pub depth_tolerance: f32,
+        /// Reprojection's least cosine between normals.
+        pub normal_tolerance: f32,
+        /// 1: the spatial filters also stop at object boundaries.
+        pub object_edges: u32,
+        /// Padding (a uniform is a multiple of 16 bytes).
+        pub _pad0: u32,
+        /// Padding.
+        pub _pad1: u32,
+        /// Padding.
+        pub _pad2: u32,
+    }
 }
 
 /// Levels of SVGF's à-trous filter in the paper (Schied et al. 2017): taps 1, 2, 4, 8
@@ -94,8 +99,22 @@ impl DenoiseParams {
     }
 }
 
-/// Albedo components at or below this are not divided out (WGSL `MIN_ALBEDO`).
-pub const MIN_ALBEDO: f32 = 1e-3;
-/// Histories shorter than this many frames take their variance from their neighbours
-/// (WGSL `SHORT_HISTORY`).
-pub const SHORT_HISTORY: f32 = 4.0;
+gpu_constants! {
+    fn constants;
+    /// Albedo components at or below this are not divided out (a black or nearly black
+    /// surface: its colour is its emission, which dividing would blow up).
+    pub const MIN_ALBEDO: f32 = 1e-3;
+    /// Histories shorter than this many frames take their variance from their neighbours
+    /// (SVGF §4.2).
+    pub const SHORT_HISTORY: f32 = 4.0;
+}
+
+/// The WGSL module `gpu/denoise.wgsl`: the constants and structs above.
+pub fn gpu_module() -> GpuModule {
+    GpuModule {
+        path: "gpu/denoise.wgsl",
+        source: "kernels/src/denoise_types.rs",
+        constants: constants(),
+        structs: vec![StructDeclaration::of::<DenoiseGuide>(), StructDeclaration::of::<DenoiseParams>()],
+    }
+}

@@ -23,9 +23,10 @@
 //!   features, float tolerance), its fragments derived by [`wgsl_imports`] from the
 //!   `// #import` lines of the files ([`wgsl_files`]); [`registry`]: each parsed and validated by naga, with
 //!   its workgroup size and bindings read from naga's IR.
-//! * [`constants`]: the WGSL constants the host shares, checked against their twins.
-//! * [`types`]: the `#[repr(C)]` host twins of the structs the kernels share with the
-//!   host, checked against naga's layout by [`layout`].
+//! * [`constants`]: the WGSL constants the host shares, checked against their Rust values.
+//! * [`gpu`]: the structs and constants the kernels share with the host, declared once in
+//!   Rust ([`types`], [`restir_types`], ...), which generates their WGSL modules
+//!   (`// #import gpu/strata.wgsl`); [`layout`] holds each struct to naga's layout of it.
 //! * [`translate`]: naga's SPIR-V, HLSL, MSL and GLSL back ends with the options every
 //!   backend of the project uses.
 //! * [`reference`](mod@reference): plain-Rust statements of what each kernel computes, the oracle of
@@ -51,6 +52,7 @@ pub mod embed_types;
 pub mod error;
 pub mod glsl_zero_init;
 pub mod glslang;
+pub mod gpu;
 pub mod hash;
 pub mod hlsl_samplers;
 pub mod hlsl_zero_init;

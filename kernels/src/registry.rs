@@ -419,8 +419,6 @@ impl Registry {
 mod tests {
     use super::*;
     use crate::fragment;
-    use crate::layout::check_struct;
-    use crate::types::{BlockStats, Candidate, ClusterSpan, HistogramParams};
 
     #[test]
     fn every_kernel_loads_with_bindings_from_the_ir() {
@@ -442,122 +440,6 @@ mod tests {
         assert!(kernel.workgroup_memory_bytes() <= 16 * 1024, "{}", kernel.workgroup_memory_bytes());
         for kernel in registry.kernels() {
             assert!(kernel.bindings.iter().all(|b| b.group == 0), "{}", kernel.name());
-        }
-    }
-
-    #[test]
-    fn host_structs_match_their_wgsl_twins() {
-        let registry = Registry::load().unwrap_or_else(|e| panic!("{e}"));
-        for kernel in registry.kernels() {
-            let module = &kernel.module;
-            if kernel.id == KernelId::CameraRays {
-                check_struct::<crate::trace_types::CameraParams>(module).unwrap_or_else(|e| panic!("{e}"));
-                continue;
-            }
-            if kernel.id == KernelId::BvhClosestHit {
-                use crate::trace_types::{GpuBvhNode, GpuTriangle, Hit, Ray, TraceParams};
-                for result in [
-                    check_struct::<GpuBvhNode>(module),
-                    check_struct::<GpuTriangle>(module),
-                    check_struct::<Ray>(module),
-                    check_struct::<Hit>(module),
-                    check_struct::<TraceParams>(module),
-                ] {
-                    result.unwrap_or_else(|e| panic!("{}: {e}", kernel.name()));
-                }
-                continue;
-            }
-            if kernel.id == KernelId::Empty {
-                continue;
-            }
-            if matches!(
-                kernel.id,
-                KernelId::SvgfTemporal | KernelId::SvgfVariance | KernelId::SvgfAtrous | KernelId::SvgfModulate
-            ) {
-                use crate::denoise_types::{DenoiseGuide, DenoiseParams};
-                for result in [check_struct::<DenoiseGuide>(module), check_struct::<DenoiseParams>(module)] {
-                    result.unwrap_or_else(|e| panic!("{}: {e}", kernel.name()));
-                }
-                continue;
-            }
-            if kernel.id == KernelId::RestirGuide {
-                use crate::denoise_types::DenoiseGuide;
-                use crate::restir_types::{Primary, RestirParams};
-                for result in [
-                    check_struct::<crate::render_types::RenderParams>(module),
-                    check_struct::<RestirParams>(module),
-                    check_struct::<Primary>(module),
-                    check_struct::<DenoiseGuide>(module),
-                ] {
-                    result.unwrap_or_else(|e| panic!("{}: {e}", kernel.name()));
-                }
-                continue;
-            }
-            if matches!(
-                kernel.id,
-                KernelId::RestirCandidates
-                    | KernelId::RestirSelect
-                    | KernelId::RestirTemporalKeys
-                    | KernelId::RestirTemporal
-                    | KernelId::RestirReservoirKeys
-                    | KernelId::RestirSpatial
-                    | KernelId::RestirShade
-            ) {
-                use crate::restir_types::{PathCandidate, Primary, Reservoir, RestirParams};
-                for result in [
-                    check_struct::<crate::render_types::RenderParams>(module),
-                    check_struct::<RestirParams>(module),
-                    check_struct::<Primary>(module),
-                    check_struct::<PathCandidate>(module),
-                    check_struct::<Reservoir>(module),
-                    check_struct::<Candidate>(module),
-                    check_struct::<ClusterSpan>(module),
-                ] {
-                    result.unwrap_or_else(|e| panic!("{}: {e}", kernel.name()));
-                }
-                continue;
-            }
-            if kernel.id == KernelId::PathTrace {
-                use crate::render_types::{EmissiveTriangle, GpuMaterial, RenderParams, TriangleInfo};
-                use crate::trace_types::{GpuBvhNode, GpuTriangle, Hit, Ray};
-                for result in [
-                    check_struct::<RenderParams>(module),
-                    check_struct::<TriangleInfo>(module),
-                    check_struct::<GpuMaterial>(module),
-                    check_struct::<EmissiveTriangle>(module),
-                    check_struct::<GpuBvhNode>(module),
-                    check_struct::<GpuTriangle>(module),
-                    check_struct::<Ray>(module),
-                    check_struct::<Hit>(module),
-                ] {
-                    result.unwrap_or_else(|e| panic!("{}: {e}", kernel.name()));
-                }
-                continue;
-            }
-            if matches!(kernel.id, KernelId::StrataSelect | KernelId::StrataResample) {
-                use crate::embed_types::{ResampleInput, ResampleOutput, SelectedCandidates, SelectionParams};
-                let mut results = vec![
-                    check_struct::<SelectionParams>(module),
-                    check_struct::<SelectedCandidates>(module),
-                    check_struct::<ResampleInput>(module),
-                    check_struct::<ResampleOutput>(module),
-                ];
-                if kernel.id == KernelId::StrataSelect {
-                    results.extend([check_struct::<Candidate>(module), check_struct::<ClusterSpan>(module)]);
-                }
-                for result in results {
-                    result.unwrap_or_else(|e| panic!("{}: {e}", kernel.name()));
-                }
-                continue;
-            }
-            for result in [
-                check_struct::<Candidate>(module),
-                check_struct::<ClusterSpan>(module),
-                check_struct::<BlockStats>(module),
-                check_struct::<HistogramParams>(module),
-            ] {
-                result.unwrap_or_else(|e| panic!("{}: {e}", kernel.name()));
-            }
         }
     }
 

@@ -1,6 +1,7 @@
-//! Every WGSL file of `kernels/wgsl/`, embedded at compile time and found by its path:
-//! what a kernel's imports ([`crate::wgsl_imports`]) are resolved against. A test checks
-//! the list against the folder, so a new file cannot be left out.
+//! Every WGSL file of `kernels/wgsl/`, embedded at compile time and found by its path,
+//! and the generated modules under `gpu/` ([`crate::gpu`]): what a kernel's imports
+//! ([`crate::wgsl_imports`]) are resolved against. A test checks the list against the
+//! folder, so a new file cannot be left out.
 
 use crate::fragment;
 use crate::source::Fragment;
@@ -11,7 +12,6 @@ pub static WGSL_FILES: &[Fragment] = &[
     fragment!("denoise/entry_modulate.wgsl"),
     fragment!("denoise/entry_temporal.wgsl"),
     fragment!("denoise/entry_variance.wgsl"),
-    fragment!("denoise/guide.wgsl"),
     fragment!("denoise/svgf.wgsl"),
     fragment!("embed/contract.wgsl"),
     fragment!("embed/entry_resample.wgsl"),
@@ -53,10 +53,18 @@ pub static WGSL_FILES: &[Fragment] = &[
     fragment!("util/empty.wgsl"),
 ];
 
-/// The file of `kernels/wgsl/` at `path` (relative to that folder).
+/// The file of `kernels/wgsl/` at `path` (relative to that folder), or the generated
+/// module `gpu/NAME.wgsl` of the structs and constants declared in Rust ([`crate::gpu`]).
 pub fn wgsl_file(path: &str) -> Option<Fragment> {
+    if path.starts_with(GENERATED) {
+        return crate::gpu::module(path)
+            .map(|module| Fragment { path: path.to_string().into(), text: module.wgsl().into() });
+    }
     WGSL_FILES.iter().find(|fragment| crate::wgsl_imports::wgsl_path(fragment) == path).cloned()
 }
+
+/// The folder of the generated modules' paths; `kernels/wgsl/` has no folder of that name.
+pub const GENERATED: &str = "gpu/";
 
 #[cfg(test)]
 mod tests {

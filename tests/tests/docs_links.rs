@@ -18,8 +18,9 @@
 //! A word holding `*`, `?`, `<`, `>`, `{`, `}`, `[`, `]`, `$`, `|`, `:`, `...`, `//`, or
 //! starting with `/` or `~`, is a pattern or placeholder, not a path. A path resolves if it
 //! exists relative to the repository root, to the citing file's folder, or (a `.wgsl` path)
-//! to `kernels/wgsl/`; a path whose first folder is not one of the repository's top-level
-//! entries may also be the tail of a tracked file (`cpu_backend/limit.rs` for
+//! to `kernels/wgsl/` or as a module the kernels crate generates (`gpu/restir.wgsl`); a
+//! path whose first folder is not one of the repository's top-level entries may also be
+//! the tail of a tracked file (`cpu_backend/limit.rs` for
 //! `backends/src/cpu_backend/limit.rs`, in a text that names the crate). Paths inside the
 //! folders of [`OUTSIDE_PREFIXES`] describe files outside the repository and are skipped.
 //!
@@ -252,6 +253,12 @@ impl Repository {
             return true;
         }
         if path.ends_with(".wgsl") && self.root.join("kernels/wgsl").join(path).exists() {
+            return true;
+        }
+        // A generated WGSL module (`gpu/restir.wgsl`): no file, but imported like one.
+        if path.starts_with(strata_kernels::wgsl_files::GENERATED)
+            && strata_kernels::wgsl_files::wgsl_file(path).is_some()
+        {
             return true;
         }
         let first = path.split('/').next().unwrap_or("");

@@ -11,7 +11,7 @@
 //
 // Dispatch: 8 x 8 pixels per workgroup.
 
-// #import denoise/guide.wgsl
+// #import gpu/denoise.wgsl
 // #import denoise/svgf.wgsl
 
 @group(0) @binding(1) var<storage, read> colour: array<vec4<f32>>;

@@ -16,7 +16,7 @@
 //
 // Dispatch: 8 x 8 pixels per workgroup.
 
-// #import denoise/guide.wgsl
+// #import gpu/denoise.wgsl
 // #import denoise/svgf.wgsl
 
 @group(0) @binding(1) var<storage, read> guides: array<DenoiseGuide>;

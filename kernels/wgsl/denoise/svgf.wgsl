@@ -15,53 +15,14 @@
 // modulated), and its 3 x 3 search for a history when no bilinear tap matches.
 //
 // Every pass: 8 x 8 pixels per workgroup, one invocation per pixel, binding 0 the
-// DenoiseParams below, buffers indexed y * width + x.
+// DenoiseParams (declared with DenoiseGuide in kernels/src/denoise_types.rs, which
+// generates gpu/denoise.wgsl), buffers indexed y * width + x.
 
-// #import denoise/guide.wgsl
+// #import gpu/denoise.wgsl
 // #requires var<storage, read> guides: array<DenoiseGuide>
-
-struct DenoiseParams {
-    width: u32,
-    height: u32,
-    // 1: the history buffers hold the previous frame's (0: the first frame, or a cut).
-    history: u32,
-    // À-trous: the distance in pixels between this level's taps (2^level).
-    step: u32,
-    // Weight of the new frame in the exponential moving averages of colour and of the
-    // moments (SVGF: 0.2 both); a history shorter than 1/alpha frames is averaged
-    // uniformly instead.
-    alpha_colour: f32,
-    alpha_moments: f32,
-    // σ_l of the luminance weight, in standard deviations (SVGF: 4).
-    sigma_luminance: f32,
-    // σ_z of the depth weight, in units of the depth's local slope (SVGF: 1).
-    sigma_depth: f32,
-    // The normal weight is max(0, n·n')^(2^normal_power_log2) (SVGF: 128, i.e. 7),
-    // computed by squaring: the same on every backend, where pow() is not.
-    normal_power_log2: u32,
-    // History lengths stop growing here (frames).
-    max_history: f32,
-    // Reprojection: a previous pixel shows the same surface if it saw the same object,
-    // at a depth within this fraction of the current one...
-    depth_tolerance: f32,
-    // ...with normals whose cosine is at least this.
-    normal_tolerance: f32,
-    // 1: the spatial filters (variance estimate and à-trous) also stop at object
-    // boundaries (DenoiseGuide.mesh), as the temporal pass does; 0: SVGF's own weights.
-    object_edges: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
 
 @group(0) @binding(0) var<uniform> params: DenoiseParams;
 
-// Albedo components at or below this are not divided out (a black or nearly black
-// surface: its colour is its emission, which dividing would blow up).
-const MIN_ALBEDO: f32 = 1e-3;
-// Histories shorter than this many frames get their variance from their neighbours
-// (§4.2).
-const SHORT_HISTORY: f32 = 4.0;
 // No pixel (outside the image).
 const NO_PIXEL: u32 = 0xffffffffu;
 

@@ -1,7 +1,8 @@
 // The scene as the path-tracing kernels see it: the frame's parameters, the BVH with its
 // triangles in leaf order, per-triangle attributes, materials, emissive triangles,
 // texels (textures and the environment map) and the environment's sampling CDFs.
-// Host twins: strata_kernels::render_types.
+// The records and their constants are declared once in Rust, kernels/src/render_types.rs,
+// which generates gpu/render.wgsl.
 //
 // Bindings (group 0), shared by every kernel that includes this fragment:
 //   0 uniform            RenderParams              image, camera, environment, flags
@@ -13,16 +14,10 @@
 //   6 storage, read      array<vec4<f32>>          texels: textures, then the environment
 //   7 storage, read      array<f32>                environment CDFs (marginal, conditionals)
 
+// #import gpu/render.wgsl
 // #import trace/bvh.wgsl
 // #import trace/traverse.wgsl
 // #import render/random.wgsl
-
-// RenderParams.flags
-const FLAG_SAMPLE_LIGHTS: u32 = 1u;      // next-event estimation
-const FLAG_HIT_LIGHTS: u32 = 2u;         // emission found by BSDF sampling counts
-const FLAG_RUSSIAN_ROULETTE: u32 = 4u;   // from depth rr_depth
-const FLAG_PIXEL_CENTRES: u32 = 8u;      // camera rays through pixel centres (no film jitter)
-const FLAG_STRATIFIED_FILM: u32 = 16u;   // film positions from the pixel's R2 sequence
 
 // The R2 sequence's step (Roberts 2018) in 0.32 fixed point.
 const R2_STEP_X: u32 = 3242174889u;
@@ -52,100 +47,8 @@ fn film_position(pixel: vec2<u32>, u: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(pixel) + u;
 }
 
-// Material.kind
-const MATERIAL_DIFFUSE: u32 = 0u;
-const MATERIAL_CONDUCTOR: u32 = 1u;
-const MATERIAL_DIELECTRIC: u32 = 2u;
-
-// Material.albedo_kind
-const ALBEDO_CONSTANT: u32 = 0u;
-const ALBEDO_CHECKERBOARD: u32 = 1u;
-const ALBEDO_TEXTURE: u32 = 2u;
-
-// TriangleInfo.light when the triangle does not emit.
-const NO_LIGHT: u32 = 0xffffffffu;
-
 const PI: f32 = 3.14159265358979;
 const INFINITY: f32 = 3.4028235e38;
-
-struct RenderParams {
-    width: u32,
-    height: u32,
-    // Index of the sample within the pixel's sequence (the frame, progressively).
-    sample_index: u32,
-    seed: u32,
-    // Path segments including the camera ray (CONVENTIONS.md).
-    max_depth: u32,
-    rr_depth: u32,
-    light_count: u32,
-    flags: u32,
-    camera_origin: vec3<f32>,
-    near_clip: f32,
-    camera_forward: vec3<f32>,
-    tan_half_x: f32,
-    camera_right: vec3<f32>,
-    tan_half_y: f32,
-    camera_up: vec3<f32>,
-    // Probability of sampling the environment rather than an area light in NEE.
-    environment_probability: f32,
-    // Rows of inverse(R): world direction -> environment direction.
-    env_from_world_0: vec3<f32>,
-    env_scale: f32,
-    env_from_world_1: vec3<f32>,
-    env_width: u32,
-    env_from_world_2: vec3<f32>,
-    env_height: u32,
-    // Rows of R: environment direction -> world direction.
-    env_to_world_0: vec3<f32>,
-    env_texel_offset: u32,
-    env_to_world_1: vec3<f32>,
-    _pad0: u32,
-    env_to_world_2: vec3<f32>,
-    // Scale of the ray-origin offset that avoids self-intersection (scene extent).
-    ray_epsilon: f32,
-}
-
-struct TriangleInfo {
-    object_id: u32,
-    material: u32,
-    light: u32,
-    // 1 when the mesh has UVs; otherwise the surface UV is the hit's barycentrics.
-    has_uv: u32,
-    uv0: vec2<f32>,
-    uv1: vec2<f32>,
-    uv2: vec2<f32>,
-    _pad0: u32,
-    _pad1: u32,
-}
-
-struct Material {
-    kind: u32,
-    two_sided: u32,
-    albedo_kind: u32,
-    texel_offset: u32,
-    // Diffuse reflectance, checkerboard colour 0, or the conductor's eta.
-    color0: vec3<f32>,
-    // GGX alpha of a conductor.
-    alpha: f32,
-    // Checkerboard colour 1, or the conductor's k.
-    color1: vec3<f32>,
-    // Interior / exterior IOR of a dielectric.
-    eta: f32,
-    uv_scale: vec2<f32>,
-    texture_width: u32,
-    texture_height: u32,
-}
-
-struct EmissiveTriangle {
-    radiance: vec3<f32>,
-    // Index into `triangles`.
-    triangle: u32,
-    // Inclusive CDF of selection (the last one is exactly 1).
-    cdf: f32,
-    probability: f32,
-    area: f32,
-    _pad: u32,
-}
 
 @group(0) @binding(0) var<uniform> params: RenderParams;
 @group(0) @binding(1) var<storage, read> nodes: array<BvhNode>;

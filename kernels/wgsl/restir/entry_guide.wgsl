@@ -1,4 +1,5 @@
-// ReSTIR pass 6 (only when a denoiser runs): the denoiser's guide (denoise/guide.wgsl)
+// ReSTIR pass 6 (only when a denoiser runs): the denoiser's guide (DenoiseGuide of
+// kernels/src/denoise_types.rs)
 // from the G-buffer, what an engine's G-buffer pass would give it. The surface is the
 // pixel's resampling vertex (through a smooth chain, the first rough vertex behind it,
 // as engines substitute the surface seen in a mirror), its albedo the vertex's times the
@@ -14,7 +15,7 @@
 
 // #import render/scene.wgsl
 // #import strata/candidate.wgsl
-// #import denoise/guide.wgsl
+// #import gpu/denoise.wgsl
 // #import restir/reservoir.wgsl
 
 @group(0) @binding(9) var<storage, read> primaries: array<Primary>;

@@ -1,6 +1,7 @@
 // Records shared by the ReSTIR passes (paper §4; reconnection shift of ReSTIR GI /
 // ReSTIR PT, Lin et al. 2022) and the functions every pass evaluates the same way.
-// Host twins: strata_kernels::restir_types (a test checks every offset).
+// The records (RestirParams, Primary, PathCandidate, Reservoir) and their constants are
+// declared once in Rust, kernels/src/restir_types.rs, which generates gpu/restir.wgsl.
 //
 // A pixel's candidate is the vertex x2 after its primary hit y1, with the radiance x2
 // emits and reflects towards y1: either the BSDF-sampled continuation of its path or its
@@ -31,147 +32,12 @@
 // Bindings used with this fragment (group 0): 0-7 the scene (render/scene.wgsl) and
 //   8 uniform            RestirParams      the method and its settings
 
+// #import gpu/restir.wgsl
 // #import render/path.wgsl
 // #import strata/candidate.wgsl
 
-const KIND_NONE: u32 = 0u;
-const KIND_SURFACE: u32 = 1u;
-const KIND_ENVIRONMENT: u32 = 2u;
-const KIND_PRIVATE: u32 = 3u;
-// The random numbers of a path's rest (PathCandidate.light), shared with other replay
-// pixels by random replay.
-const KIND_REPLAY: u32 = 4u;
-
-// Primary.flags
-const PRIMARY_HIT: u32 = 1u;       // the camera ray hit a surface
-// PRIMARY_RESAMPLE: the resampling vertex (y1, or the first rough vertex behind a smooth
-// chain) is rough enough to reconnect from: the pixel resamples
-const PRIMARY_RESAMPLE: u32 = 2u;
-// PRIMARY_REPLAY: with PRIMARY_RESAMPLE, the vertex is a glossy conductor that resamples
-// by random replay (RestirParams.replay): it takes candidates of kind REPLAY only
-const PRIMARY_REPLAY: u32 = 4u;
-
 // No pixel for a reuse slot (restir/reuse_slot.wgsl): the slot stays empty.
 const NO_PIXEL: u32 = 0xffffffffu;
-
-// RestirParams.method
-const METHOD_STRATA: u32 = 0u;       // histogram + stratified selection, inverse-CDF resampling (ours)
-const METHOD_RESTIR: u32 = 1u;       // K uniformly random from the same cluster, streaming reservoir
-const METHOD_RESTIR_DISC: u32 = 2u;  // K uniformly random in a disc, normal/depth rejection
-
-// RestirParams.shading: what restir_shade adds for the resampled part.
-const SHADING_SAMPLE: u32 = 0u;       // f(Y) V W of the kept sample, one shadow ray
-const SHADING_EXPECTATION: u32 = 1u;  // Reservoir.expected: the final resampling's expectation
-
-struct RestirParams {
-    method: u32,
-    // K: candidates selected per pixel (1 to 4; 0 in the temporal-first order's first
-    // pass: restir_select then writes each pixel's canonical candidate alone).
-    candidates: u32,
-    // strata's sampler variant (SAMPLER_* of strata/selection.wgsl, Table 2); object
-    // masking (§4.3) is the histogram's own setting (HistogramParams.masking).
-    sampler: u32,
-    // 1: merge with the previous frame's reservoir.
-    temporal: u32,
-    // Cap of the previous reservoir's M before a temporal merge (paper: 20).
-    temporal_cap: f32,
-    // Radius in pixels of restir-disc's neighbourhood.
-    disc_radius: f32,
-    // No reconnection to an x2 closer than this to either primary hit.
-    min_distance: f32,
-    // A conductor at y1 resamples only from this GGX alpha up.
-    min_roughness: f32,
-    // The previous frame's camera, for reprojection.
-    previous_origin: vec3<f32>,
-    previous_tan_half_x: f32,
-    previous_forward: vec3<f32>,
-    previous_tan_half_y: f32,
-    previous_right: vec3<f32>,
-    // T: previous reservoirs drawn per pixel from the block's histogram of reprojected
-    // reservoirs (Fig. 11), 0 to 4, merged besides the pixel's own reprojected one.
-    temporal_candidates: u32,
-    previous_up: vec3<f32>,
-    // What restir_shade writes: bit 0 the pixel's own estimate (base), bit 1 the
-    // reservoir's sample; 3 for the image, 1 or 2 to measure one part's variance.
-    shaded_parts: u32,
-    // SHADING_*: the resampled part as the kept sample or as the expectation of the
-    // frame's final resampling (Reservoir.expected).
-    shading: u32,
-    // Smooth vertices (dielectrics, conductors below min_roughness) a camera path may
-    // pass through to the vertex it resamples at; 0: only a rough primary hit resamples
-    // (or, with `replay`, a glossy conductor at it).
-    specular_chain: u32,
-    // 1: a glossy conductor (GGX alpha below min_roughness, otherwise a smooth vertex of
-    // the chain) resamples at its own vertex by random replay (KIND_REPLAY above).
-    replay: u32,
-    _pad2: u32,
-}
-
-// The G-buffer: the vertex a pixel resamples at. That is the camera ray's hit y1, or,
-// when y1 is smooth and RestirParams.specular_chain allows, the first rough vertex the
-// camera path reaches through smooth ones (restir/entry_candidates.wgsl): the pixel
-// then resamples the light that vertex reflects along the chain, and shading multiplies
-// by the chain's throughput.
-struct Primary {
-    position: vec3<f32>,
-    object_id: u32,
-    // Geometric normal, flipped towards `wo` for two-sided materials.
-    normal: vec3<f32>,
-    material: u32,
-    // Unit direction towards the previous vertex of the path (the camera, or the chain).
-    wo: vec3<f32>,
-    flags: u32,
-    albedo: vec3<f32>,
-    // Length of the path from the camera to `position`.
-    depth: f32,
-    // The chain's throughput: product of the BSDF sampling weights f cos / pdf of its
-    // smooth vertices (1 without a chain).
-    throughput: vec3<f32>,
-    // The number of the path segment that reached `position` (1: the camera ray). Pixels
-    // share candidates only with the same segment: a candidate's reflected radiance was
-    // estimated with the segments left after it (params.max_depth).
-    segment: u32,
-    // The camera ray's hit y1 (`position` without a chain): temporal reprojection
-    // follows the point the pixel sees.
-    camera_hit: vec3<f32>,
-    _pad: u32,
-}
-
-struct PathCandidate {
-    // x2, or the direction of an environment candidate; REPLAY: the vertex it was drawn at.
-    position: vec3<f32>,
-    kind: u32,
-    // x2's geometric normal, flipped towards the y1 that found it; REPLAY: the vertex's wo.
-    normal: vec3<f32>,
-    // x2's emissive triangle when y1 sees its emitting side, else NO_LIGHT; REPLAY: the
-    // PCG state the rest of the path starts from.
-    light: u32,
-    // Radiance x2 reflects towards y1 (emission excluded), one-sample estimate; REPLAY:
-    // Ĉ(y, u) at the vertex it was drawn at (what a replay there gives, kept so that its
-    // own pixel need not trace it again).
-    reflected: vec3<f32>,
-    // Unbiased contribution weight W of the candidate for its own pixel (RIS over its
-    // BSDF and light samples); 0 for none.
-    weight: f32,
-}
-
-struct Reservoir {
-    sample: PathCandidate,
-    // Unbiased contribution weight W of `sample` for this pixel.
-    weight: f32,
-    // M: canonical samples behind the reservoir (one per frame).
-    count: f32,
-    // p̂ of `sample` at this pixel (luminance of its contribution, visibility included).
-    target_value: f32,
-    _pad: u32,
-    // The expectation, over the choice alone, of this frame's final resampling at this
-    // pixel: sum_i w_i f(x_i) / p̂(x_i) over every candidate i it chose from (RGB,
-    // visibility included, as in p̂). E[f(Y) W | candidates] = this, so shading with it
-    // in place of f(Y) V W is unbiased and never noisier; it costs no ray (p̂ already
-    // traced each candidate's visibility). Not merged over frames: only `sample` is.
-    expected: vec3<f32>,
-    _pad_expected: f32,
-}
 
 @group(0) @binding(8) var<uniform> restir: RestirParams;
 

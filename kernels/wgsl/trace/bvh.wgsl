@@ -1,55 +1,15 @@
 // BVH2 closest-hit traversal with watertight ray-triangle intersection (the path
 // tracer's visibility query). The BVH is obvhs' Bvh2, uploaded as-is: its nodes and
-// triangles use glam's 16-byte Vec3A, hence the pad after every vec3 below.
+// triangles use glam's 16-byte Vec3A, hence the pad after every vec3 of BvhNode and
+// Triangle (declared with Ray, Hit and the traversal's constants in
+// kernels/src/trace_types.rs, which generates gpu/trace.wgsl).
 //
 // Determinism across backends: no division by a zero direction component (a tiny
 // signed substitute keeps every slab product finite, so min/max never see NaN), and
 // every float operation is written out in a fixed order. Backends may still contract
 // a * b + c into fused multiply-adds, so hits are compared with a ULP bound.
 
-// obvhs::bvh2::Bvh2Node (48 bytes).
-struct BvhNode {
-    aabb_min: vec3<f32>,
-    _pad0: u32,
-    aabb_max: vec3<f32>,
-    _pad1: u32,
-    // 0 for an inner node (children at first_index and first_index + 1); otherwise the
-    // leaf's primitive count, its primitives at primitive_indices[first_index..].
-    prim_count: u32,
-    first_index: u32,
-    meta1: u32,
-    meta2: u32,
-}
-
-// obvhs::triangle::Triangle (48 bytes), counter-clockwise.
-struct Triangle {
-    v0: vec3<f32>,
-    _pad0: u32,
-    v1: vec3<f32>,
-    _pad1: u32,
-    v2: vec3<f32>,
-    _pad2: u32,
-}
-
-struct Ray {
-    origin: vec3<f32>,
-    tmin: f32,
-    direction: vec3<f32>,
-    tmax: f32,
-}
-
-// Closest hit: t, barycentrics (u at v1, v at v2) and the input triangle index;
-// primitive = MISS when nothing was hit (t = tmax, u = v = 0), STACK_OVERFLOW when the
-// traversal stack overflowed (a BVH deeper than TRACE_STACK_DEPTH).
-struct Hit {
-    t: f32,
-    u: f32,
-    v: f32,
-    primitive: u32,
-}
-
-const MISS: u32 = 0xffffffffu;
-const STACK_OVERFLOW: u32 = 0xfffffffeu;
+// #import gpu/trace.wgsl
 
 // Per-ray constants of the watertight test (Woop, Benthin and Wald 2013).
 struct Shear {

@@ -10,23 +10,8 @@
 //
 // Dispatch: 8 x 8 pixels per workgroup, ceil(width / 8) x ceil(height / 8) workgroups.
 
+// #import gpu/trace.wgsl
 // #import trace/bvh.wgsl
-
-struct CameraParams {
-    origin: vec3<f32>,
-    near_clip: f32,
-    forward: vec3<f32>,
-    tan_half_x: f32,
-    right: vec3<f32>,
-    tan_half_y: f32,
-    up: vec3<f32>,
-    far_clip: f32,
-    width: u32,
-    height: u32,
-    // 0: pixel centres; otherwise the seed of the per-pixel jitter.
-    jitter_seed: u32,
-    _pad: u32,
-}
 
 @group(0) @binding(0) var<uniform> camera: CameraParams;
 @group(0) @binding(1) var<storage, read_write> camera_rays: array<Ray>;

@@ -13,15 +13,9 @@
 // registers, the rest in workgroup memory (TRACE_STACK_DEPTH - REGISTER_STACK = 40
 // entries per invocation): function-local arrays do not translate to every target.
 
+// #import gpu/trace.wgsl
 // #import trace/bvh.wgsl
 // #import trace/traverse.wgsl
-
-struct TraceParams {
-    ray_count: u32,
-    workgroups_x: u32,
-    _pad0: u32,
-    _pad1: u32,
-}
 
 @group(0) @binding(0) var<uniform> trace_params: TraceParams;
 @group(0) @binding(1) var<storage, read> nodes: array<BvhNode>;

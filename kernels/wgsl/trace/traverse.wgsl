@@ -6,13 +6,13 @@
 // to an index into `triangles` (through obvhs' primitive_indices, or the identity when
 // the triangles were reordered into leaf order on the host).
 
+// #import gpu/trace.wgsl
 // #import trace/bvh.wgsl
 // #requires var<storage, read> nodes: array<BvhNode>
 // #requires var<storage, read> triangles: array<Triangle>
 // #requires var<workgroup> trace_stack: array<u32, 2560>
 // #requires fn leaf_triangle(slot: u32) -> u32
 
-const TRACE_STACK_DEPTH: u32 = 48u;
 // How many of the stack's newest entries are kept in registers (top0 .. top7).
 const REGISTER_STACK: u32 = 8u;
 

@@ -1,0 +1,363 @@
+//! The structs and constants the kernels share with the host, each declared once, in
+//! Rust, from which their WGSL is generated.
+//!
+//! A struct is declared with `gpu_struct!`: doc comments, fields with their Rust type
+//! and, where a Rust type stands for more than one WGSL type, the WGSL one (`[f32; 3] as
+//! "vec3<f32>"`, with the padding after it written out as a field). The macro gives the
+//! `#[repr(C)]` Pod struct the host uploads, its field list ([`GpuStruct::fields`]: name,
+//! offset, size, WGSL type, doc) and so its WGSL declaration ([`StructDeclaration::wgsl`]).
+//! A constant is declared with `gpu_constants!`. Each `*_types.rs` module of this crate
+//! gathers its structs and constants into one generated WGSL module ([`GpuModule`]) with
+//! a path under `gpu/` (`gpu/restir.wgsl`): no such file exists; a WGSL file names it in
+//! its `// #import` lines like any other file, and [`crate::wgsl_files::wgsl_file`]
+//! gives its generated text. So the WGSL, the Rust struct, `strata.h` and the shader
+//! includes of the export package all come from one declaration, and a new field is one
+//! line of Rust.
+//!
+//! Why Rust is the source and not WGSL: generating Rust from WGSL would take naga as a
+//! build dependency, compiled a second time in every build, and generated Rust types lose
+//! their doc comments for rustdoc and IDEs; the C header and the shader includes were
+//! already written from the Rust side. What the macro cannot know is whether the layout
+//! it promises holds: naga's layout of the generated WGSL is compared with the Rust
+//! offsets and sizes of every declared struct by one test (`crate::layout`).
+
+use crate::constants::ConstantValue;
+use std::borrow::Cow;
+
+/// A Rust type with a WGSL type of the same size and layout by default: the scalars, arrays
+/// of them, and the structs of `gpu_struct!` (by their WGSL name). Vectors are not a
+/// default: `[f32; 3]` is `vec3<f32>` or `array<f32, 3>`, which lay out differently, so a
+/// field says `as "vec3<f32>"`.
+pub trait WgslType {
+    /// The WGSL type.
+    fn wgsl_type() -> Cow<'static, str>;
+}
+
+impl WgslType for u32 {
+    fn wgsl_type() -> Cow<'static, str> {
+        Cow::Borrowed("u32")
+    }
+}
+
+impl WgslType for i32 {
+    fn wgsl_type() -> Cow<'static, str> {
+        Cow::Borrowed("i32")
+    }
+}
+
+impl WgslType for f32 {
+    fn wgsl_type() -> Cow<'static, str> {
+        Cow::Borrowed("f32")
+    }
+}
+
+impl<T: WgslType, const N: usize> WgslType for [T; N] {
+    fn wgsl_type() -> Cow<'static, str> {
+        Cow::Owned(format!("array<{}, {N}>", T::wgsl_type()))
+    }
+}
+
+/// One field of a [`GpuStruct`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GpuField {
+    /// The field's name, the same in Rust and WGSL.
+    pub name: &'static str,
+    /// Its byte offset in the Rust struct.
+    pub offset: usize,
+    /// Its byte size in the Rust struct.
+    pub size: usize,
+    /// Its WGSL type (`u32`, `vec3<f32>`, `array<u32, 4>`, `PathCandidate`).
+    pub wgsl_type: Cow<'static, str>,
+    /// Its doc comment, one line per `///` line.
+    pub doc: &'static str,
+}
+
+/// A struct declared with `gpu_struct!`: a Pod Rust struct with a WGSL twin generated
+/// from the same declaration.
+pub trait GpuStruct: bytemuck::Pod + WgslType {
+    /// The WGSL struct's name (the Rust name unless declared `as "Name"`).
+    const WGSL_NAME: &'static str;
+    /// The struct's doc comment, one line per `///` line.
+    const DOC: &'static str;
+    /// The fields in declaration order.
+    fn fields() -> Vec<GpuField>;
+}
+
+/// A [`GpuStruct`] as data, so that one list holds structs of different types.
+#[derive(Clone, Debug)]
+pub struct StructDeclaration {
+    /// The WGSL name.
+    pub name: &'static str,
+    /// The doc comment.
+    pub doc: &'static str,
+    /// The Rust struct's size in bytes.
+    pub size: usize,
+    /// The fields in declaration order.
+    pub fields: Vec<GpuField>,
+}
+
+impl StructDeclaration {
+    /// The declaration of `T`.
+    pub fn of<T: GpuStruct>() -> StructDeclaration {
+        StructDeclaration { name: T::WGSL_NAME, doc: T::DOC, size: size_of::<T>(), fields: T::fields() }
+    }
+
+    /// The WGSL declaration, with the docs as comments.
+    pub fn wgsl(&self) -> String {
+        let mut text = wgsl_comment(self.doc, "");
+        text += &format!("struct {} {{\n", self.name);
+        for field in &self.fields {
+            text += &wgsl_comment(field.doc, "    ");
+            text += &format!("    {}: {},\n", field.name, field.wgsl_type);
+        }
+        text += "}\n";
+        text
+    }
+}
+
+/// A constant declared with `gpu_constants!`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GpuConstant {
+    /// The name, the same in Rust and WGSL.
+    pub name: &'static str,
+    /// The value.
+    pub value: ConstantValue,
+    /// The doc comment.
+    pub doc: &'static str,
+}
+
+impl GpuConstant {
+    /// The WGSL declaration, with the doc as a comment. An `f32` is written with the
+    /// fewest digits that read back as the same value, and the `f` suffix so that WGSL
+    /// reads it as an `f32` directly.
+    pub fn wgsl(&self) -> String {
+        let (ty, value) = match self.value {
+            ConstantValue::U32(v) => ("u32", format!("{v}u")),
+            ConstantValue::F32(v) => ("f32", format!("{v:?}f")),
+        };
+        format!("{}const {}: {ty} = {value};\n", wgsl_comment(self.doc, ""), self.name)
+    }
+}
+
+impl From<u32> for ConstantValue {
+    fn from(value: u32) -> Self {
+        ConstantValue::U32(value)
+    }
+}
+
+impl From<f32> for ConstantValue {
+    fn from(value: f32) -> Self {
+        ConstantValue::F32(value)
+    }
+}
+
+/// The generated WGSL module of one `*_types.rs` module: its constants and structs.
+#[derive(Clone, Debug)]
+pub struct GpuModule {
+    /// The path WGSL files import it by (`gpu/restir.wgsl`).
+    pub path: &'static str,
+    /// The Rust file that declares it, named in the module's first line.
+    pub source: &'static str,
+    /// Its constants.
+    pub constants: Vec<GpuConstant>,
+    /// Its structs, each after the structs its fields use.
+    pub structs: Vec<StructDeclaration>,
+}
+
+impl GpuModule {
+    /// The module's WGSL text.
+    pub fn wgsl(&self) -> String {
+        let mut text = format!(
+            "// {}: generated by strata-kernels from {} (strata_kernels::gpu); not a file.\n",
+            self.path, self.source
+        );
+        for constant in &self.constants {
+            text += "\n";
+            text += &constant.wgsl();
+        }
+        for declaration in &self.structs {
+            text += "\n";
+            text += &declaration.wgsl();
+        }
+        text
+    }
+}
+
+/// Every generated module.
+pub fn modules() -> [GpuModule; 6] {
+    [
+        crate::types::gpu_module(),
+        crate::embed_types::gpu_module(),
+        crate::trace_types::gpu_module(),
+        crate::render_types::gpu_module(),
+        crate::restir_types::gpu_module(),
+        crate::denoise_types::gpu_module(),
+    ]
+}
+
+/// The generated module imported as `path` (`gpu/restir.wgsl`).
+pub fn module(path: &str) -> Option<GpuModule> {
+    modules().into_iter().find(|module| module.path == path)
+}
+
+/// `doc` (lines of a doc comment) as `//` lines indented by `indent`; Rust's intra-doc
+/// links lose their brackets.
+fn wgsl_comment(doc: &str, indent: &str) -> String {
+    doc.lines()
+        .map(|line| {
+            let line = line.strip_prefix(' ').unwrap_or(line).replace("[`", "`").replace("`]", "`");
+            if line.is_empty() { format!("{indent}//\n") } else { format!("{indent}// {line}\n") }
+        })
+        .collect()
+}
+
+/// Declares a struct shared with the kernels, once: the `#[repr(C)]` Pod Rust struct
+/// (deriving `Clone, Copy, Debug, Default, PartialEq`, Pod and Zeroable, and what an
+/// optional `#[derive(...)]` after the doc comment adds) and its [`GpuStruct`]
+/// implementation, from which its WGSL is generated.
+///
+/// ```ignore
+/// gpu_struct! {
+///     /// Doc comment (also the WGSL's comment).
+///     #[derive(Eq, Hash)]
+///     pub struct Name as "WgslName" {
+///         /// A field.
+///         pub count: u32,
+///         /// A vector: the WGSL type is said where the Rust type does not decide it.
+///         pub position: [f32; 3] as "vec3<f32>",
+///         /// The padding WGSL puts after a vec3 before a 16-byte aligned field.
+///         pub _pad: u32,
+///     }
+/// }
+/// ```
+macro_rules! gpu_struct {
+    (
+        $(#[doc = $doc:literal])*
+        $(#[derive($($derive:ident),* $(,)?)])?
+        pub struct $name:ident $(as $wgsl_name:literal)? {
+            $(
+                $(#[doc = $field_doc:literal])*
+                pub $field:ident : $ty:ty $(as $wgsl_type:literal)?
+            ),* $(,)?
+        }
+    ) => {
+        $(#[doc = $doc])*
+        #[repr(C)]
+        #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable $($(, $derive)*)?)]
+        pub struct $name {
+            $(
+                $(#[doc = $field_doc])*
+                pub $field: $ty,
+            )*
+        }
+
+        impl $crate::gpu::WgslType for $name {
+            fn wgsl_type() -> std::borrow::Cow<'static, str> {
+                std::borrow::Cow::Borrowed(<$name as $crate::gpu::GpuStruct>::WGSL_NAME)
+            }
+        }
+
+        impl $crate::gpu::GpuStruct for $name {
+            const WGSL_NAME: &'static str = gpu_struct!(@first $($wgsl_name,)? stringify!($name));
+            const DOC: &'static str = concat!($($doc, "\n"),*);
+            fn fields() -> Vec<$crate::gpu::GpuField> {
+                vec![$(
+                    $crate::gpu::GpuField {
+                        name: stringify!($field),
+                        offset: core::mem::offset_of!($name, $field),
+                        size: size_of::<$ty>(),
+                        wgsl_type: gpu_struct!(@wgsl $ty $(, $wgsl_type)?),
+                        doc: concat!($($field_doc, "\n"),*),
+                    }
+                ),*]
+            }
+        }
+    };
+    (@first $first:expr $(, $rest:expr)*) => {
+        $first
+    };
+    (@wgsl $ty:ty) => {
+        <$ty as $crate::gpu::WgslType>::wgsl_type()
+    };
+    (@wgsl $ty:ty, $wgsl:literal) => {
+        std::borrow::Cow::Borrowed($wgsl)
+    };
+}
+pub(crate) use gpu_struct;
+
+/// Declares constants shared with the kernels, once: each a Rust `pub const` (`u32` or
+/// `f32`) and a [`GpuConstant`] of the list function named first, from which its WGSL is
+/// generated.
+///
+/// ```ignore
+/// gpu_constants! {
+///     fn constants;
+///     /// Doc comment (also the WGSL's comment).
+///     pub const NO_LIGHT: u32 = u32::MAX;
+/// }
+/// ```
+macro_rules! gpu_constants {
+    (
+        fn $list:ident;
+        $(
+            $(#[doc = $doc:literal])*
+            pub const $name:ident : $ty:ty = $value:expr;
+        )*
+    ) => {
+        $(
+            $(#[doc = $doc])*
+            pub const $name: $ty = $value;
+        )*
+
+        /// The constants above, for the generated WGSL module.
+        fn $list() -> Vec<$crate::gpu::GpuConstant> {
+            vec![$(
+                $crate::gpu::GpuConstant {
+                    name: stringify!($name),
+                    value: $crate::constants::ConstantValue::from($name),
+                    doc: concat!($($doc, "\n"),*),
+                }
+            ),*]
+        }
+    };
+}
+pub(crate) use gpu_constants;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    gpu_struct! {
+        /// A test struct:
+        /// two lines.
+        pub struct Sample as "SampleStruct" {
+            /// A vector.
+            pub position: [f32; 3] as "vec3<f32>",
+            /// An id.
+            pub id: u32,
+            /// Four words.
+            pub words: [u32; 4],
+        }
+    }
+
+    #[test]
+    fn a_declaration_gives_the_rust_layout_and_the_wgsl_text() {
+        let declaration = StructDeclaration::of::<Sample>();
+        assert_eq!(declaration.size, 32);
+        let offsets: Vec<_> = declaration.fields.iter().map(|f| (f.name, f.offset, f.size)).collect();
+        assert_eq!(offsets, [("position", 0, 12), ("id", 12, 4), ("words", 16, 16)]);
+        assert_eq!(
+            declaration.wgsl(),
+            "// A test struct:\n// two lines.\nstruct SampleStruct {\n    // A vector.\n    position: vec3<f32>,\n    \
+             // An id.\n    id: u32,\n    // Four words.\n    words: array<u32, 4>,\n}\n"
+        );
+    }
+
+    #[test]
+    fn constants_are_written_as_wgsl_reads_them() {
+        let constant = GpuConstant { name: "SMALL", value: ConstantValue::F32(1e-3), doc: " Small.\n" };
+        assert_eq!(constant.wgsl(), "// Small.\nconst SMALL: f32 = 0.001f;\n");
+        let module = naga::front::wgsl::parse_str(&constant.wgsl()).unwrap();
+        assert_eq!(crate::constants::module_constants(&module), [("SMALL".to_string(), ConstantValue::F32(1e-3))]);
+    }
+}

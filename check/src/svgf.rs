@@ -162,7 +162,7 @@ fn inputs(kernel: KernelId, case: &Case) -> Inputs {
         .collect();
     let level = if kernel == KernelId::SvgfAtrous { (case.seed % 5) as u32 } else { 0 };
     // Object edges on for about half the cases (the seed's parity).
-    let settings = strata_render::denoise::SvgfSettings { object_edges: case.seed % 2 == 1, ..Default::default() };
+    let settings = strata_render::denoise::SvgfSettings::default().with_object_edges(case.seed % 2 == 1);
     let params = settings.params(width, height, level, case.family != 3);
     Inputs {
         params,

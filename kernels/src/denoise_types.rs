@@ -31,35 +31,42 @@ gpu_struct! {
 }
 
 gpu_struct! {
-    /// The settings of one SVGF pass (WGSL `DenoiseParams`, a uniform).
-    pub struct DenoiseParams {
-        /// Image width in pixels.
-        pub width: u32,
-        /// Image height in pixels.
-        pub height: u32,
-        /// 1: the history buffers hold the previous frame's.
-        pub history: u32,
-        /// À-trous: the distance in pixels between this level's taps.
-        pub step: u32,
-        /// Weight of the new frame in the colour's moving average.
+    /// SVGF's filter settings: what a user chooses of [`DenoiseParams`], declared here
+    /// once; `strata_render::denoise::SvgfSettings` holds them as they are, and
+    /// [`SvgfFilter::paper`] gives the paper's (Schied et al. 2017, §4 and §5).
+    pub struct SvgfFilter {
+        /// Weight of the new frame in the colour's exponential moving average (SVGF:
+        /// 0.2), in (0, 1]; a history shorter than 1/alpha frames is averaged uniformly
+        /// instead.
         pub alpha_colour: f32,
-        /// Weight of the new frame in the moments' moving average.
+        /// Weight of the new frame in the luminance moments' moving average (SVGF: 0.2),
+        /// in (0, 1].
         pub alpha_moments: f32,
-        /// σ_l of the luminance edge-stopping weight.
+        /// σ_l: how many standard deviations of luminance apart two pixels may be before
+        /// the filter stops mixing them (SVGF: 4); finite and positive.
         pub sigma_luminance: f32,
-        /// σ_z of the depth edge-stopping weight.
+        /// σ_z: how many times the depth change its local slope predicts two pixels may
+        /// differ by before the filter stops mixing them (SVGF: 1); finite and positive.
         pub sigma_depth: f32,
-        /// The normal weight's exponent is 2 to this power.
+        /// The normal weight is max(0, n·n')^(2^normal_power_log2) (SVGF: σ_n = 128, i.e.
+        /// 7), 0 to 10; computed by squaring: the same on every backend, where pow() is
+        /// not.
         pub normal_power_log2: u32,
-        /// History lengths stop growing here (frames).
+        /// History lengths stop growing here (frames), 1 or more: after that the moving
+        /// averages weigh the new frame `alpha_*`.
         pub max_history: f32,
-        /// Reprojection's relative depth tolerance.
+        /// Reprojection: a previous pixel continues this one's history if it saw the same
+        /// object at a depth within this fraction (0.1, the renderer's own temporal test;
+        /// SVGF's implementation scales its depth test by screen-space derivatives), in
+        /// (0, 1]...
         pub depth_tolerance: f32,
-        /// Reprojection's least cosine between normals.
+        /// ...and its normal is within this cosine (0.906: 25 degrees), in [-1, 1].
         pub normal_tolerance: f32,
-        /// 1: the spatial filters also stop at object boundaries.
+        /// 1: the spatial filters (variance estimate, à-trous) also give weight 0 between
+        /// pixels of different objects (`DenoiseGuide::mesh`), as the temporal pass does;
+        /// 0: SVGF's own weights, which stop at depth, normal and luminance edges only.
         pub object_edges: u32,
-        /// Padding (a uniform is a multiple of 16 bytes).
+        /// Padding (the uniform is a multiple of 16 bytes).
         pub _pad0: u32,
         /// Padding.
         pub _pad1: u32,
@@ -68,21 +75,34 @@ gpu_struct! {
     }
 }
 
+gpu_struct! {
+    /// The uniform of one SVGF pass (WGSL `DenoiseParams`): the frame's and the level's
+    /// numbers, and the filter's settings as the user chose them.
+    pub struct DenoiseParams {
+        /// Image width in pixels.
+        pub width: u32,
+        /// Image height in pixels.
+        pub height: u32,
+        /// 1: the history buffers hold the previous frame's (0: the first frame, or a cut).
+        pub history: u32,
+        /// À-trous: the distance in pixels between this level's taps (2^level).
+        pub step: u32,
+        /// The filter's settings (at byte 16, where a uniform may hold a struct; not named
+        /// `filter`, a word WGSL reserves).
+        pub svgf: SvgfFilter,
+    }
+}
+
 /// Levels of SVGF's à-trous filter in the paper (Schied et al. 2017): taps 1, 2, 4, 8
 /// and 16 pixels apart.
 pub const PAPER_LEVELS: u32 = 5;
 
-impl DenoiseParams {
+impl SvgfFilter {
     /// The paper's settings (Schied et al. 2017: α = 0.2 for colour and moments, σ_l = 4,
     /// σ_z = 1, σ_n = 128, a history of at most 32 frames) with the renderer's
-    /// reprojection tolerances (depth within 10 %, normals within 25°), no object edges,
-    /// for the first level (step 1) of a frame without history.
-    pub fn paper(width: u32, height: u32) -> DenoiseParams {
-        DenoiseParams {
-            width,
-            height,
-            history: 0,
-            step: 1,
+    /// reprojection tolerances (depth within 10 %, normals within 25°), no object edges.
+    pub fn paper() -> SvgfFilter {
+        SvgfFilter {
             alpha_colour: 0.2,
             alpha_moments: 0.2,
             sigma_luminance: 4.0,
@@ -92,10 +112,16 @@ impl DenoiseParams {
             depth_tolerance: 0.1,
             normal_tolerance: 0.906,
             object_edges: 0,
-            _pad0: 0,
-            _pad1: 0,
-            _pad2: 0,
+            ..SvgfFilter::default()
         }
+    }
+}
+
+impl DenoiseParams {
+    /// [`SvgfFilter::paper`]'s settings for the first level (step 1) of a frame without
+    /// history.
+    pub fn paper(width: u32, height: u32) -> DenoiseParams {
+        DenoiseParams { width, height, history: 0, step: 1, svgf: SvgfFilter::paper() }
     }
 }
 
@@ -115,6 +141,10 @@ pub fn gpu_module() -> GpuModule {
         path: "gpu/denoise.wgsl",
         source: "kernels/src/denoise_types.rs",
         constants: constants(),
-        structs: vec![StructDeclaration::of::<DenoiseGuide>(), StructDeclaration::of::<DenoiseParams>()],
+        structs: vec![
+            StructDeclaration::of::<DenoiseGuide>(),
+            StructDeclaration::of::<SvgfFilter>(),
+            StructDeclaration::of::<DenoiseParams>(),
+        ],
     }
 }

@@ -28,7 +28,7 @@ fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
 /// SVGF's w_n: max(0, a·b)^(2^normal_power_log2), by squaring.
 pub fn normal_weight(params: &DenoiseParams, a: [f32; 3], b: [f32; 3]) -> f32 {
     let mut w = dot(a, b).max(0.0);
-    for _ in 0..params.normal_power_log2 {
+    for _ in 0..params.svgf.normal_power_log2 {
         w *= w;
     }
     w
@@ -60,11 +60,12 @@ fn depth_slope(params: &DenoiseParams, guides: &[DenoiseGuide], x: i32, y: i32, 
 }
 
 fn object_weight(params: &DenoiseParams, a: &DenoiseGuide, b: &DenoiseGuide) -> f32 {
-    if params.object_edges != 0 && a.mesh != b.mesh { 0.0 } else { 1.0 }
+    if params.svgf.object_edges != 0 && a.mesh != b.mesh { 0.0 } else { 1.0 }
 }
 
 fn depth_distance(params: &DenoiseParams, depth: f32, other: f32, slope: [f32; 2], offset: [f32; 2]) -> f32 {
-    let expected = params.sigma_depth * ((slope[0] * offset[0]).abs() + (slope[1] * offset[1]).abs()) + 1e-3 * depth;
+    let expected =
+        params.svgf.sigma_depth * ((slope[0] * offset[0]).abs() + (slope[1] * offset[1]).abs()) + 1e-3 * depth;
     (depth - other).abs() / expected
 }
 
@@ -130,8 +131,8 @@ pub fn temporal(params: &DenoiseParams, inputs: &TemporalInputs) -> (Image<[f32;
                     let previous = &inputs.previous_guides[q];
                     let same_surface = has_surface(previous)
                         && previous.mesh == g.mesh
-                        && (previous.depth - g.depth).abs() <= params.depth_tolerance * g.depth
-                        && dot(g.normal, previous.normal) >= params.normal_tolerance;
+                        && (previous.depth - g.depth).abs() <= params.svgf.depth_tolerance * g.depth
+                        && dot(g.normal, previous.normal) >= params.svgf.normal_tolerance;
                     if w > 0.0 && same_surface {
                         weight_sum += w;
                         add_weighted(&mut previous_illumination, w, &inputs.history[q][..3]);
@@ -144,10 +145,10 @@ pub fn temporal(params: &DenoiseParams, inputs: &TemporalInputs) -> (Image<[f32;
             if weight_sum > 1e-3 {
                 previous_illumination = previous_illumination.map(|v| v / weight_sum);
                 previous_moment = previous_moment.map(|v| v / weight_sum);
-                length = (previous_length / weight_sum + 1.0).min(params.max_history);
+                length = (previous_length / weight_sum + 1.0).min(params.svgf.max_history);
             }
-            let alpha_colour = params.alpha_colour.max(1.0 / length);
-            let alpha_moments = params.alpha_moments.max(1.0 / length);
+            let alpha_colour = params.svgf.alpha_colour.max(1.0 / length);
+            let alpha_moments = params.svgf.alpha_moments.max(1.0 / length);
             let l = luminance(illumination);
             let moment = [l, l * l];
             let mix = |old: f32, new: f32, alpha: f32| old * (1.0 - alpha) + new * alpha;
@@ -201,7 +202,7 @@ pub fn variance(
                     };
                     let other = integrated[q];
                     let exponent = depth_distance(params, g.depth, guides[q].depth, slope, [dx as f32, dy as f32])
-                        + (l - luminance(rgb(other))).abs() / params.sigma_luminance;
+                        + (l - luminance(rgb(other))).abs() / params.svgf.sigma_luminance;
                     let w = object_weight(params, g, &guides[q])
                         * normal_weight(params, g.normal, guides[q].normal)
                         * (-exponent).exp();
@@ -255,7 +256,7 @@ pub fn atrous(params: &DenoiseParams, guides: &[DenoiseGuide], level_in: &[[f32;
                     }
                 }
             }
-            let luminance_scale = params.sigma_luminance * (blurred / blur_weight).max(0.0).sqrt() + 1e-10;
+            let luminance_scale = params.svgf.sigma_luminance * (blurred / blur_weight).max(0.0).sqrt() + 1e-10;
             let mut weight_sum = 0.0f32;
             let mut illumination = [0.0f32; 3];
             let mut variance = 0.0f32;
@@ -396,7 +397,8 @@ mod tests {
         let (guides, levels) = split(near, plane(2.0, [0.0, 0.0, 1.0], 1), 0.0, 4.0);
         let out = atrous(&params(16, 8, 1, false), &guides, &levels);
         assert!(out[3 * 16 + 7][0] > 1.2, "{}", out[3 * 16 + 7][0]);
-        let objects = DenoiseParams { object_edges: 1, ..params(16, 8, 1, false) };
+        let mut objects = params(16, 8, 1, false);
+        objects.svgf.object_edges = 1;
         let out = atrous(&objects, &guides, &levels);
         let (left, right) = (mean_of_side(&out, false).0, mean_of_side(&out, true).0);
         assert!(left == 1.0 && right == 3.0, "object edge: {left} {right}");

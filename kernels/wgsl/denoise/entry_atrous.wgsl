@@ -6,7 +6,7 @@
 // one-sided difference per axis of the guide's depth, and ε is relative to the depth),
 //   w_n = max(0, n · n')^(2^normal_power_log2),
 //   w_l = exp(-|l - l'| / (σ_l sqrt(g(var)) + ε)),
-// and, with params.object_edges, 0 between different objects (not in SVGF: measured in
+// and, with svgf.object_edges, 0 between different objects (not in SVGF: measured in
 // BENCHMARKS.md),
 // where g(var) is the pixel's variance blurred by a 3 x 3 Gaussian (1/4, 1/2, 1/4 per
 // axis). The illumination is the weighted mean; the variance is filtered with the
@@ -69,7 +69,7 @@ fn svgf_atrous(@builtin(global_invocation_id) id: vec3<u32>) {
     let step = i32(params.step);
     let slope = depth_slope(x, y, g.depth);
     let l = luminance(own.xyz);
-    let luminance_scale = params.sigma_luminance * sqrt(max(blurred_variance(x, y), 0.0)) + 1e-10;
+    let luminance_scale = params.svgf.sigma_luminance * sqrt(max(blurred_variance(x, y), 0.0)) + 1e-10;
     var weight_sum = 0.0;
     var illumination = vec3<f32>(0.0);
     var variance = 0.0;

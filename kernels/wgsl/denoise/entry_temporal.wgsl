@@ -37,9 +37,9 @@
 // Whether the previous frame's guide `previous` shows the surface of `g`.
 fn same_surface(g: DenoiseGuide, previous: DenoiseGuide) -> bool {
     return has_surface(previous) && previous.mesh == g.mesh
-        && abs(previous.depth - g.depth) <= params.depth_tolerance * g.depth
+        && abs(previous.depth - g.depth) <= params.svgf.depth_tolerance * g.depth
         && g.normal.x * previous.normal.x + g.normal.y * previous.normal.y + g.normal.z * previous.normal.z
-            >= params.normal_tolerance;
+            >= params.svgf.normal_tolerance;
 }
 
 @compute @workgroup_size(8, 8)
@@ -91,11 +91,11 @@ fn svgf_temporal(@builtin(global_invocation_id) id: vec3<u32>) {
     if weight_sum > 1e-3 {
         previous_illumination = previous_illumination / weight_sum;
         previous_moment = previous_moment / weight_sum;
-        length = min(previous_length / weight_sum + 1.0, params.max_history);
+        length = min(previous_length / weight_sum + 1.0, params.svgf.max_history);
     }
     // A history of n frames averages them uniformly until 1/n drops below alpha.
-    let alpha_colour = max(params.alpha_colour, 1.0 / length);
-    let alpha_moments = max(params.alpha_moments, 1.0 / length);
+    let alpha_colour = max(params.svgf.alpha_colour, 1.0 / length);
+    let alpha_moments = max(params.svgf.alpha_moments, 1.0 / length);
     let l = luminance(illumination);
     let moment = vec2<f32>(l, l * l);
     integrated[pixel] = vec4<f32>(previous_illumination * (1.0 - alpha_colour) + illumination * alpha_colour, length);

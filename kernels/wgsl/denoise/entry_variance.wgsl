@@ -3,7 +3,7 @@
 // is the temporal moments' E[l²] - E[l]²; with fewer, the moments and the illumination
 // are averaged over a 7 x 7 neighbourhood weighted by the depth, normal and luminance
 // edge-stopping functions (the luminance one with σ_l alone, there being no variance
-// yet; and the object weight with params.object_edges), and the variance so found is multiplied by SHORT_HISTORY / length: a short
+// yet; and the object weight with svgf.object_edges), and the variance so found is multiplied by SHORT_HISTORY / length: a short
 // history is noisier than its neighbourhood says. Pixels without a surface pass through
 // with variance 0.
 //
@@ -57,7 +57,7 @@ fn svgf_variance(@builtin(global_invocation_id) id: vec3<u32>) {
             }
             let other = integrated[q];
             let exponent = depth_distance(g.depth, guides[q].depth, slope, vec2<f32>(f32(dx), f32(dy)))
-                + abs(l - luminance(other.xyz)) / params.sigma_luminance;
+                + abs(l - luminance(other.xyz)) / params.svgf.sigma_luminance;
             let w = object_weight(g, guides[q]) * normal_weight(g.normal, guides[q].normal) * exp(-exponent);
             weight_sum += w;
             illumination += w * other.xyz;

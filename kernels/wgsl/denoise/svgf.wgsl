@@ -47,7 +47,7 @@ fn luminance(c: vec3<f32>) -> f32 {
 // w_n (§4.3): max(0, n·n')^(2^normal_power_log2).
 fn normal_weight(a: vec3<f32>, b: vec3<f32>) -> f32 {
     var w = max(a.x * b.x + a.y * b.y + a.z * b.z, 0.0);
-    for (var i = 0u; i < params.normal_power_log2; i++) {
+    for (var i = 0u; i < params.svgf.normal_power_log2; i++) {
         w = w * w;
     }
     return w;
@@ -86,13 +86,13 @@ fn depth_slope(x: i32, y: i32, depth: f32) -> vec2<f32> {
 // the rim of a light sees it in some frames and the ceiling in others: its luminance
 // variance is then so large that w_l lets the light's radiance bleed into the ceiling.
 fn object_weight(a: DenoiseGuide, b: DenoiseGuide) -> f32 {
-    return select(1.0, 0.0, params.object_edges != 0u && a.mesh != b.mesh);
+    return select(1.0, 0.0, params.svgf.object_edges != 0u && a.mesh != b.mesh);
 }
 
 // The exponent of w_z (§4.3): |z - z'| over σ_z times the depth's change along the offset
 // predicted by its slope, plus a thousandth of the depth (SVGF's ε, made relative so
 // that it means the same at any scene scale).
 fn depth_distance(depth: f32, other: f32, slope: vec2<f32>, offset: vec2<f32>) -> f32 {
-    let expected = params.sigma_depth * (abs(slope.x * offset.x) + abs(slope.y * offset.y)) + 1e-3 * depth;
+    let expected = params.svgf.sigma_depth * (abs(slope.x * offset.x) + abs(slope.y * offset.y)) + 1e-3 * depth;
     return abs(depth - other) / expected;
 }

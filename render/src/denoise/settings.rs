@@ -2,7 +2,7 @@
 //! (Schied et al. 2017, §4 and §5).
 
 use crate::histogram_pass::PassError;
-use strata_kernels::denoise_types::{DenoiseParams, PAPER_LEVELS};
+use strata_kernels::denoise_types::{DenoiseParams, PAPER_LEVELS, SvgfFilter};
 
 /// Which denoiser filters the frames (`strata compare --denoise`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -33,141 +33,101 @@ impl Denoiser {
     pub fn settings(self) -> SvgfSettings {
         match self {
             Denoiser::Svgf => SvgfSettings::default(),
-            Denoiser::SvgfObjects => SvgfSettings { object_edges: true, ..SvgfSettings::default() },
+            Denoiser::SvgfObjects => SvgfSettings::default().with_object_edges(true),
         }
     }
 }
 
-/// SVGF's settings.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+/// SVGF's settings: the levels of its à-trous filter, and the filter's settings as the
+/// kernels read them ([`SvgfFilter`], each field declared there once).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SvgfSettings {
     /// Levels of the à-trous filter, their taps 1, 2, 4, ... pixels apart (SVGF: 5, a
     /// footprint of 2^levels * 2 + 1 = 65 pixels), 1 to 10.
     pub levels: u32,
-    /// Weight of the new frame in the colour's moving average (SVGF: 0.2), in (0, 1].
-    pub alpha_colour: f32,
-    /// Weight of the new frame in the luminance moments' moving average (SVGF: 0.2), in
-    /// (0, 1].
-    pub alpha_moments: f32,
-    /// σ_l: how many standard deviations of luminance apart two pixels may be before
-    /// the filter stops mixing them (SVGF: 4); finite and positive.
-    pub sigma_luminance: f32,
-    /// σ_z: how many times the depth change its local slope predicts two pixels may
-    /// differ by before the filter stops mixing them (SVGF: 1); finite and positive.
-    pub sigma_depth: f32,
-    /// The normal weight is cos^(2^normal_power_log2) of the angle between normals
-    /// (SVGF: σ_n = 128, i.e. 7); 0 to 10.
-    pub normal_power_log2: u32,
-    /// History lengths stop growing here (frames), 1 or more: after that the moving
-    /// averages weigh the new frame `alpha_*`.
-    pub max_history: f32,
-    /// Reprojection: a previous pixel continues this one's history if it saw the same
-    /// object at a depth within this fraction (0.1, the renderer's own temporal test;
-    /// SVGF's implementation scales its depth test by screen-space derivatives), in
-    /// (0, 1]...
-    pub depth_tolerance: f32,
-    /// ...and its normal is within this cosine (0.906: 25 degrees), in [-1, 1].
-    pub normal_tolerance: f32,
-    /// The spatial filters (variance estimate, à-trous) also give weight 0 between
-    /// pixels of different objects (not in SVGF, which stops at depth, normal and
-    /// luminance edges only; default off, as in the paper).
-    pub object_edges: bool,
+    /// The filter's settings, copied into every pass's uniform as they are.
+    pub filter: SvgfFilter,
 }
 
 impl Default for SvgfSettings {
-    /// The paper's settings ([`DenoiseParams::paper`]).
+    /// The paper's settings ([`SvgfFilter::paper`], [`PAPER_LEVELS`]).
     fn default() -> Self {
-        let paper = DenoiseParams::paper(0, 0);
-        SvgfSettings {
-            levels: PAPER_LEVELS,
-            alpha_colour: paper.alpha_colour,
-            alpha_moments: paper.alpha_moments,
-            sigma_luminance: paper.sigma_luminance,
-            sigma_depth: paper.sigma_depth,
-            normal_power_log2: paper.normal_power_log2,
-            max_history: paper.max_history,
-            depth_tolerance: paper.depth_tolerance,
-            normal_tolerance: paper.normal_tolerance,
-            object_edges: paper.object_edges != 0,
-        }
+        SvgfSettings { levels: PAPER_LEVELS, filter: SvgfFilter::paper() }
     }
 }
 
 impl SvgfSettings {
+    /// These settings with the spatial filters also stopping at object boundaries
+    /// ([`SvgfFilter::object_edges`]) or not.
+    pub fn with_object_edges(self, object_edges: bool) -> SvgfSettings {
+        SvgfSettings { filter: SvgfFilter { object_edges: u32::from(object_edges), ..self.filter }, ..self }
+    }
+
     /// Every field within its documented range; the error names the field and value.
     pub fn check(&self) -> Result<(), PassError> {
         let fail = |field: &str, value: String, rule: &str| {
             Err(PassError::Input(format!("SVGF setting {field} = {value}: must be {rule}")))
         };
+        let filter = &self.filter;
         if !(1..=10).contains(&self.levels) {
             return fail("levels", self.levels.to_string(), "1 to 10");
         }
-        for (field, value) in [("alpha_colour", self.alpha_colour), ("alpha_moments", self.alpha_moments)] {
+        for (field, value) in [("alpha_colour", filter.alpha_colour), ("alpha_moments", filter.alpha_moments)] {
             if !(value > 0.0 && value <= 1.0) {
                 return fail(field, value.to_string(), "in (0, 1]");
             }
         }
-        for (field, value) in [("sigma_luminance", self.sigma_luminance), ("sigma_depth", self.sigma_depth)] {
+        for (field, value) in [("sigma_luminance", filter.sigma_luminance), ("sigma_depth", filter.sigma_depth)] {
             if !(value.is_finite() && value > 0.0) {
                 return fail(field, value.to_string(), "finite and positive");
             }
         }
-        if self.normal_power_log2 > 10 {
-            return fail("normal_power_log2", self.normal_power_log2.to_string(), "0 to 10");
+        if filter.normal_power_log2 > 10 {
+            return fail("normal_power_log2", filter.normal_power_log2.to_string(), "0 to 10");
         }
-        if !(self.max_history.is_finite() && self.max_history >= 1.0) {
-            return fail("max_history", self.max_history.to_string(), "finite and 1 or more");
+        if !(filter.max_history.is_finite() && filter.max_history >= 1.0) {
+            return fail("max_history", filter.max_history.to_string(), "finite and 1 or more");
         }
-        if !(self.depth_tolerance > 0.0 && self.depth_tolerance <= 1.0) {
-            return fail("depth_tolerance", self.depth_tolerance.to_string(), "in (0, 1]");
+        if !(filter.depth_tolerance > 0.0 && filter.depth_tolerance <= 1.0) {
+            return fail("depth_tolerance", filter.depth_tolerance.to_string(), "in (0, 1]");
         }
-        if !(-1.0..=1.0).contains(&self.normal_tolerance) {
-            return fail("normal_tolerance", self.normal_tolerance.to_string(), "in [-1, 1]");
+        if !(-1.0..=1.0).contains(&filter.normal_tolerance) {
+            return fail("normal_tolerance", filter.normal_tolerance.to_string(), "in [-1, 1]");
+        }
+        if filter.object_edges > 1 {
+            return fail("object_edges", filter.object_edges.to_string(), "0 or 1");
         }
         Ok(())
     }
 
     /// The kernels' uniform for an image of `width` x `height` at à-trous `level`, with
-    /// or without history.
+    /// or without history: the one mapping from the settings to the uniform.
     pub fn params(&self, width: u32, height: u32, level: u32, history: bool) -> DenoiseParams {
-        DenoiseParams {
-            width,
-            height,
-            history: u32::from(history),
-            step: 1 << level,
-            alpha_colour: self.alpha_colour,
-            alpha_moments: self.alpha_moments,
-            sigma_luminance: self.sigma_luminance,
-            sigma_depth: self.sigma_depth,
-            normal_power_log2: self.normal_power_log2,
-            max_history: self.max_history,
-            depth_tolerance: self.depth_tolerance,
-            normal_tolerance: self.normal_tolerance,
-            object_edges: u32::from(self.object_edges),
-            _pad0: 0,
-            _pad1: 0,
-            _pad2: 0,
-        }
+        DenoiseParams { width, height, history: u32::from(history), step: 1 << level, svgf: self.filter }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::SvgfSettings;
+    use strata_kernels::denoise_types::SvgfFilter;
 
     #[test]
     fn the_defaults_pass_and_each_bad_value_is_named() {
         SvgfSettings::default().check().unwrap();
+        let paper = SvgfFilter::paper();
+        let filter = |filter: SvgfFilter| SvgfSettings { filter, ..Default::default() };
         let bad = [
             SvgfSettings { levels: 0, ..Default::default() },
-            SvgfSettings { alpha_colour: 0.0, ..Default::default() },
-            SvgfSettings { alpha_moments: f32::NAN, ..Default::default() },
-            SvgfSettings { sigma_luminance: f32::INFINITY, ..Default::default() },
-            SvgfSettings { sigma_depth: -1.0, ..Default::default() },
-            SvgfSettings { normal_power_log2: 11, ..Default::default() },
-            SvgfSettings { max_history: 0.5, ..Default::default() },
-            SvgfSettings { depth_tolerance: 0.0, ..Default::default() },
-            SvgfSettings { normal_tolerance: 2.0, ..Default::default() },
+            filter(SvgfFilter { alpha_colour: 0.0, ..paper }),
+            filter(SvgfFilter { alpha_moments: f32::NAN, ..paper }),
+            filter(SvgfFilter { sigma_luminance: f32::INFINITY, ..paper }),
+            filter(SvgfFilter { sigma_depth: -1.0, ..paper }),
+            filter(SvgfFilter { normal_power_log2: 11, ..paper }),
+            filter(SvgfFilter { max_history: 0.5, ..paper }),
+            filter(SvgfFilter { depth_tolerance: 0.0, ..paper }),
+            filter(SvgfFilter { normal_tolerance: 2.0, ..paper }),
+            filter(SvgfFilter { object_edges: 2, ..paper }),
         ];
         let fields = [
             "levels",
@@ -179,10 +139,22 @@ mod tests {
             "max_history",
             "depth_tolerance",
             "normal_tolerance",
+            "object_edges",
         ];
         for (settings, field) in bad.iter().zip(fields) {
             let message = settings.check().unwrap_err().to_string();
             assert!(message.contains(field), "{message}");
         }
+    }
+
+    /// The uniform is the settings' filter as it is, with the frame's and the level's
+    /// numbers.
+    #[test]
+    fn the_uniform_carries_the_filter_unchanged() {
+        let settings = SvgfSettings::default().with_object_edges(true);
+        let params = settings.params(640, 480, 3, true);
+        assert_eq!((params.width, params.height, params.step, params.history), (640, 480, 8, 1));
+        assert_eq!(params.svgf, settings.filter);
+        assert_eq!(params.svgf.object_edges, 1);
     }
 }

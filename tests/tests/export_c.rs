@@ -949,7 +949,9 @@ fn spirv_layouts(disassembly: &str) -> Layouts {
         let words: Vec<&str> = line.split_whitespace().collect();
         match words.as_slice() {
             ["OpName", id, name] => {
-                names.insert(id.to_string(), name.trim_matches('"').to_string());
+                // Slang names a record's copy laid out for a storage buffer `<name>_std430`.
+                let name = name.trim_matches('"');
+                names.insert(id.to_string(), name.strip_suffix("_std430").unwrap_or(name).to_string());
             }
             ["OpMemberName", id, index, name] => {
                 members.insert((id.to_string(), index.parse().unwrap()), name.trim_matches('"').to_string());
@@ -1014,6 +1016,7 @@ fn layout_difference(got: &Layouts, want: &Layouts) -> Option<String> {
 
 /// The layouts of the records as `language`'s include declares them, compiled by glslang
 /// (GLSL, HLSL: a compute shader with a storage buffer of each record, disassembled by
+/// spirv-dis), Slang (`hlsl-slang`: the same HLSL shader, Slang's SPIR-V disassembled by
 /// spirv-dis) or naga (WGSL); `None` if a tool is missing and not required.
 fn include_layouts(
     language: &str,
@@ -1062,12 +1065,25 @@ fn include_layouts(
     std::fs::write(&shader, source).unwrap();
     let spirv = folder.join(format!("layout_{language}.spv"));
     let text = folder.join(format!("layout_{language}.spvasm"));
-    let mut glslang: Vec<std::ffi::OsString> = args.iter().map(Into::into).collect();
-    glslang.extend([shader.clone().into_os_string(), "-o".into(), spirv.clone().into_os_string()]);
-    for (tool, args) in [
-        ("glslangValidator", glslang),
-        ("spirv-dis", vec![spirv.into_os_string(), "-o".into(), text.clone().into_os_string()]),
-    ] {
+    let mut tools = Vec::new();
+    if language == "hlsl-slang" {
+        match strata_kernels::slang::compile_hlsl(&shader, "main") {
+            Ok(words) => std::fs::write(&spirv, bytemuck::cast_slice::<u32, u8>(&words)).unwrap(),
+            Err(strata_kernels::glslang::ToolError::Missing(tool))
+                if std::env::var_os("STRATA_REQUIRE_VALIDATORS").is_none() =>
+            {
+                eprintln!("SKIPPED the {language} include's layout: {tool} is not installed");
+                return None;
+            }
+            Err(error) => return Some(Err(format!("{language}: {error}"))),
+        }
+    } else {
+        let mut glslang: Vec<std::ffi::OsString> = args.iter().map(Into::into).collect();
+        glslang.extend([shader.clone().into_os_string(), "-o".into(), spirv.clone().into_os_string()]);
+        tools.push(("glslangValidator", glslang));
+    }
+    tools.push(("spirv-dis", vec![spirv.into_os_string(), "-o".into(), text.clone().into_os_string()]));
+    for (tool, args) in tools {
         match strata_kernels::glslang::run_tool(tool, &args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>()) {
             Ok(()) => {}
             Err(strata_kernels::glslang::ToolError::Missing(tool))
@@ -1095,6 +1111,7 @@ fn the_shader_includes_lay_out_every_record_as_strata_h_does() {
     for (language, file, field, spare) in [
         ("glsl", "strata.glsl", "    uint run_length;\n", "    uint spare;\n"),
         ("hlsl", "strata.hlsli", "    uint run_length;\n", "    uint spare;\n"),
+        ("hlsl-slang", "strata.hlsli", "    uint run_length;\n", "    uint spare;\n"),
         ("wgsl", "strata.wgsl", "    run_length: u32,\n", "    spare: u32,\n"),
     ] {
         let include = package.join("include").join(file);
@@ -1109,10 +1126,11 @@ fn the_shader_includes_lay_out_every_record_as_strata_h_does() {
         let got = include_layouts(language, &include, &structs, scratch.path()).unwrap().unwrap();
         let difference = layout_difference(&got, &want).unwrap_or_default();
         assert!(difference.starts_with("StrataSelectedCandidates"), "{file} with a field moved: {difference:?}");
+        std::fs::write(&include, text).unwrap();
         checked += 1;
     }
     if std::env::var_os("STRATA_REQUIRE_VALIDATORS").is_some() {
-        assert_eq!(checked, 3);
+        assert_eq!(checked, 4);
     }
 }
 

@@ -34,6 +34,12 @@ fn strata_resample(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let pixel = id.y * params.width + id.x;
+    // Buffers too small for the image (an engine's mistake, named by the C ABI's
+    // validation mode): the pixels past their end are left alone, nothing outside a
+    // buffer is read or written.
+    if pixel >= arrayLength(&resampled) || pixel >= arrayLength(&selections) || pixel >= arrayLength(&resample_inputs) {
+        return;
+    }
     let selection = selections[pixel];
     let input = resample_inputs[pixel];
     let k = selection.selected;

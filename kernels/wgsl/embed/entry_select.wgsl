@@ -34,7 +34,19 @@ fn payload_of(pixel: u32) -> u32 {
     if params.identity_payload != 0u {
         return pixel;
     }
-    return payloads[pixel];
+    if pixel < arrayLength(&payloads) {
+        return payloads[pixel];
+    }
+    return NO_PAYLOAD;
+}
+
+// The pixel index at `entry` of the sorted list, or NO_PAYLOAD (past every image, so its
+// payload is NO_PAYLOAD too) for an entry past the end of the bound buffer.
+fn sorted_pixel(entry: u32) -> u32 {
+    if entry < arrayLength(&sorted_pixels) {
+        return sorted_pixels[entry];
+    }
+    return NO_PAYLOAD;
 }
 
 @compute @workgroup_size(8, 8)
@@ -43,6 +55,12 @@ fn strata_select(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let pixel = id.y * params.width + id.x;
+    // Buffers too small for the image (an engine's mistake, named by the C ABI's
+    // validation mode): the pixels past their end are left alone, nothing outside a
+    // buffer is read or written.
+    if pixel >= arrayLength(&selections) || pixel >= arrayLength(&candidates) || pixel >= arrayLength(&spans) {
+        return;
+    }
     let k = clamp(params.candidates, 1u, MAX_SELECTED);
     let numbers = selection_numbers(id.xy, params.frame, params.seed, params.sampler, k, 0u);
     var result = SelectedCandidates(vec4<u32>(NO_PAYLOAD), numbers.resample, 0u, 0u, 0u);
@@ -55,7 +73,7 @@ fn strata_select(@builtin(global_invocation_id) id: vec3<u32>) {
     result.run_valid = span.valid;
     result.selected = k;
     for (var slot = 0u; slot < k; slot++) {
-        result.payloads[slot] = payload_of(sorted_pixels[run_member(span, numbers.positions[slot])]);
+        result.payloads[slot] = payload_of(sorted_pixel(run_member(span, numbers.positions[slot])));
     }
     selections[pixel] = result;
 }

@@ -34,9 +34,18 @@ fn blue_noise_stratum(pixel: vec2<u32>, sample_index: u32, dimension: u32) -> u3
     let sample = sample_index & 255u;
     let dim = dimension & 255u;
     let ranking_index = (dim + tile_pixel * BLUE_NOISE_DIMENSIONS_PER_PIXEL) % BLUE_NOISE_RANKING_WORDS;
-    let ranked = sample ^ blue_noise[BLUE_NOISE_RANKING + ranking_index];
-    return blue_noise[BLUE_NOISE_SOBOL + dim + ranked * 256u]
-        ^ blue_noise[BLUE_NOISE_SCRAMBLING + (dim & 7u) + tile_pixel * BLUE_NOISE_DIMENSIONS_PER_PIXEL];
+    let ranked = sample ^ blue_noise_word(BLUE_NOISE_RANKING + ranking_index);
+    return blue_noise_word(BLUE_NOISE_SOBOL + dim + ranked * 256u)
+        ^ blue_noise_word(BLUE_NOISE_SCRAMBLING + (dim & 7u) + tile_pixel * BLUE_NOISE_DIMENSIONS_PER_PIXEL);
+}
+
+// Word `index` of the tables, or 0 past the end of a truncated buffer (an engine's
+// mistake: the samples are then wrong but nothing outside the buffer is read).
+fn blue_noise_word(index: u32) -> u32 {
+    if index < arrayLength(&blue_noise) {
+        return blue_noise[index];
+    }
+    return 0u;
 }
 
 // The sample in (0, 1): (0.5 + k) / 256 with k = blue_noise_stratum(...).

@@ -35,6 +35,9 @@
 //
 // Invalid inputs: see canonical_key (strata/candidate.wgsl). Every output element is
 // written for every pixel; sentinel slots past a partial block's pixels write nothing.
+// Every buffer access is guarded by the buffer's bound length (arrayLength): a buffer
+// too small for the image loses its entries past the end and nothing outside it is read
+// or written (tests/tests/kernel_guards.rs), on GPUs without robustBufferAccess too.
 
 // #import strata/candidate.wgsl
 // #import strata/masking.wgsl
@@ -314,11 +317,21 @@ fn pixel_of(rect: BlockRect, local: u32) -> u32 {
     return (rect.y + row_of(local)) * params.width + rect.x + column_of(local);
 }
 
+// The candidate of `pixel`, or none past the end of the bound `candidates` (a buffer
+// sized for a smaller image: the engine's mistake, which then reads as pixels without a
+// candidate instead of whatever memory lies beyond; the C ABI's validation mode names it).
+fn candidate_at(pixel: u32) -> Candidate {
+    if pixel < arrayLength(&candidates) {
+        return candidates[pixel];
+    }
+    return Candidate(0.0, OBJECT_ID_NONE);
+}
+
 // (cluster, canonical key, local) of a slot: the pixel's candidate, or a sentinel that
 // sorts after every real element when the position lies outside the block.
 fn load_element(rect: BlockRect, local: u32) -> vec3<u32> {
     if column_of(local) < rect.width && row_of(local) < rect.height {
-        let candidate = candidates[pixel_of(rect, local)];
+        let candidate = candidate_at(pixel_of(rect, local));
         return vec3<u32>(cluster_of(candidate, params.masking != 0u), canonical_key(candidate), local);
     }
     return vec3<u32>(OBJECT_ID_NONE, SENTINEL_KEY, local);
@@ -401,8 +414,15 @@ fn count16(v: U16) -> u32 {
 fn write_element(rect: BlockRect, begin: u32, position: u32, local: u32, run_begin: u32, run_end: u32, valid_end: u32) {
     if position < rect.width * rect.height {
         let pixel = pixel_of(rect, local);
-        sorted_pixels[rect.base + position] = pixel;
-        spans[pixel] = ClusterSpan(rect.base + run_begin - begin, run_end - run_begin, valid_end - run_begin);
+        // Guarded: buffers smaller than the image (an engine's mistake) lose the entries
+        // past their end rather than overwrite what lies beyond them.
+        let entry = rect.base + position;
+        if entry < arrayLength(&sorted_pixels) {
+            sorted_pixels[entry] = pixel;
+        }
+        if pixel < arrayLength(&spans) {
+            spans[pixel] = ClusterSpan(rect.base + run_begin - begin, run_end - run_begin, valid_end - run_begin);
+        }
     }
 }
 
@@ -570,7 +590,7 @@ fn finish_block_histogram(setup: BlockSetup, el: Elements) {
     let t = setup.base >> ELEM_BITS;
     for (var segment = t; segment < setup.segments; segment += INVOCATIONS) {
         let block = setup.first_block + segment;
-        if block < params.blocks_x * params.blocks_y {
+        if block < params.blocks_x * params.blocks_y && block < arrayLength(&block_stats) {
             block_stats[block] = BlockStats(
                 atomicLoad(&shared_stats[3u * segment]),
                 atomicLoad(&shared_stats[3u * segment + 1u]),

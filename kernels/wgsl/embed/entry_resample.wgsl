@@ -13,6 +13,8 @@
 //   3 storage, rw        array<ResampleOutput>      one per pixel
 //
 // Dispatch: 8 x 8 pixels per workgroup, ceil(width / 8) x ceil(height / 8) workgroups.
+// Every buffer access is guarded by the bound buffer's length (arrayLength): buffers too
+// small for the image lose the pixels past their end, nothing outside them is touched.
 
 // #import strata/resampling.wgsl
 // #import embed/contract.wgsl

@@ -17,6 +17,8 @@
 //   6 storage, rw        array<SelectedCandidates>  one per pixel
 //
 // Dispatch: 8 x 8 pixels per workgroup, ceil(width / 8) x ceil(height / 8) workgroups.
+// Every buffer access is guarded by the bound buffer's length (arrayLength): buffers too
+// small for the image lose the pixels past their end, nothing outside them is touched.
 
 // #import strata/candidate.wgsl
 // #import strata/selection.wgsl

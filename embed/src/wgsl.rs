@@ -142,5 +142,5 @@ pub fn module(id: ModuleId) -> Result<WgslModule, EmbedError> {
 /// WGSL declarations of the contract's records and constants, to prepend to the
 /// engine's own shaders that read `selections` or write `resample_inputs`.
 pub fn contract_source() -> String {
-    strata_kernels::embed_types::contract_wgsl()
+    strata_kernels::wgsl_files::contract_wgsl()
 }

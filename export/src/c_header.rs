@@ -9,7 +9,7 @@
 //! from their source.
 
 use crate::ExportError;
-use strata_kernels::constants::ConstantValue;
+use strata_kernels::gpu::ConstantValue;
 use strata_kernels::gpu::{GpuStruct, StructDeclaration};
 use strata_kernels::selection::SamplerVariant;
 

@@ -12,7 +12,7 @@
 
 use crate::ExportError;
 use crate::c_header::{HeaderStruct, c_name, comment, doc_above, rust_name, version_parts};
-use strata_kernels::constants::ConstantValue;
+use strata_kernels::gpu::ConstantValue;
 
 /// A shading language of the includes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -12,16 +12,8 @@
 //! fails it, so a new constant is classified when it is written.
 
 use crate::blue_noise::{OPTIMISED_DIMENSIONS, PACKED_RANKING, PACKED_SCRAMBLING, PACKED_SOBOL, TILE_SIZE};
+use crate::gpu::ConstantValue;
 use crate::{denoise_types, embed_types, render_types, restir_types, selection, trace_types, types};
-
-/// A constant's value, as WGSL types it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum ConstantValue {
-    /// `u32`.
-    U32(u32),
-    /// `f32` (compared bit for bit).
-    F32(f32),
-}
 
 /// Every WGSL constant the host also uses, by its WGSL name, with the Rust twin's value.
 pub const SHARED: &[(&str, ConstantValue)] = {

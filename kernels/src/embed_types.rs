@@ -94,17 +94,6 @@ gpu_struct! {
     }
 }
 
-/// WGSL declarations of the contract's records and constants (`Candidate`,
-/// `ClusterSpan`, `SelectionParams`, `SelectedCandidates`, `ResampleInput`,
-/// `ResampleOutput`, `NO_PAYLOAD`, ...), for an engine's own shaders that read the
-/// selections and write the resampling inputs: prepend it to the shader source.
-pub fn contract_wgsl() -> String {
-    // contract.wgsl imports the records of candidate.wgsl.
-    let fragments = crate::wgsl_imports::kernel_fragments("embed/contract.wgsl", &crate::wgsl_files::wgsl_file)
-        .unwrap_or_else(|error| panic!("{error}"));
-    crate::source::ComposedSource::compose(&fragments).text
-}
-
 /// The WGSL module `gpu/embed.wgsl`: the constants and structs above.
 pub fn gpu_module() -> GpuModule {
     GpuModule {

@@ -21,7 +21,6 @@
 //! it promises holds: naga's layout of the generated WGSL is compared with the Rust
 //! offsets and sizes of every declared struct by one test (`crate::layout`).
 
-use crate::constants::ConstantValue;
 use std::borrow::Cow;
 
 /// A Rust type with a WGSL type of the same size and layout by default: the scalars, arrays
@@ -139,6 +138,15 @@ impl GpuConstant {
     }
 }
 
+/// A constant's value, as WGSL types it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ConstantValue {
+    /// `u32`.
+    U32(u32),
+    /// `f32` (compared bit for bit).
+    F32(f32),
+}
+
 impl From<u32> for ConstantValue {
     fn from(value: u32) -> Self {
         ConstantValue::U32(value)
@@ -181,23 +189,6 @@ impl GpuModule {
         }
         text
     }
-}
-
-/// Every generated module.
-pub fn modules() -> [GpuModule; 6] {
-    [
-        crate::types::gpu_module(),
-        crate::embed_types::gpu_module(),
-        crate::trace_types::gpu_module(),
-        crate::render_types::gpu_module(),
-        crate::restir_types::gpu_module(),
-        crate::denoise_types::gpu_module(),
-    ]
-}
-
-/// The generated module imported as `path` (`gpu/restir.wgsl`).
-pub fn module(path: &str) -> Option<GpuModule> {
-    modules().into_iter().find(|module| module.path == path)
 }
 
 /// `doc` (lines of a doc comment) as `//` lines indented by `indent`; Rust's intra-doc
@@ -314,7 +305,7 @@ macro_rules! gpu_constants {
             vec![$(
                 $crate::gpu::GpuConstant {
                     name: stringify!($name),
-                    value: $crate::constants::ConstantValue::from($name),
+                    value: $crate::gpu::ConstantValue::from($name),
                     doc: concat!($($doc, "\n"),*),
                 }
             ),*]

@@ -62,7 +62,8 @@ pub fn check_struct(declaration: &StructDeclaration, module: &naga::Module) -> R
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gpu::{GpuField, modules};
+    use crate::gpu::GpuField;
+    use crate::wgsl_files::gpu_modules as modules;
 
     /// Every struct of every generated module lays out in naga as in Rust: all the
     /// modules, concatenated, parse, and each struct's size and fields' offsets and sizes

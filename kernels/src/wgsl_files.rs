@@ -4,6 +4,7 @@
 //! folder, so a new file cannot be left out.
 
 use crate::fragment;
+use crate::gpu::GpuModule;
 use crate::source::Fragment;
 
 /// Every file of `kernels/wgsl/`, by path.
@@ -53,12 +54,40 @@ pub static WGSL_FILES: &[Fragment] = &[
     fragment!("util/empty.wgsl"),
 ];
 
+/// Every generated module, one per `*_types.rs` file (listed here, above those files,
+/// rather than in [`crate::gpu`], which they use to declare themselves).
+pub fn gpu_modules() -> [GpuModule; 6] {
+    [
+        crate::types::gpu_module(),
+        crate::embed_types::gpu_module(),
+        crate::trace_types::gpu_module(),
+        crate::render_types::gpu_module(),
+        crate::restir_types::gpu_module(),
+        crate::denoise_types::gpu_module(),
+    ]
+}
+
+/// The generated module imported as `path` (`gpu/restir.wgsl`).
+pub fn gpu_module(path: &str) -> Option<GpuModule> {
+    gpu_modules().into_iter().find(|module| module.path == path)
+}
+
+/// WGSL declarations of the embedding contract's records and constants (`Candidate`,
+/// `ClusterSpan`, `SelectionParams`, `SelectedCandidates`, `ResampleInput`,
+/// `ResampleOutput`, `NO_PAYLOAD`, ...), for an engine's own shaders that read the
+/// selections and write the resampling inputs: prepend it to the shader source.
+pub fn contract_wgsl() -> String {
+    // contract.wgsl imports the records of candidate.wgsl.
+    let fragments = crate::wgsl_imports::kernel_fragments("embed/contract.wgsl", &wgsl_file)
+        .unwrap_or_else(|error| panic!("{error}"));
+    crate::source::ComposedSource::compose(&fragments).text
+}
+
 /// The file of `kernels/wgsl/` at `path` (relative to that folder), or the generated
 /// module `gpu/NAME.wgsl` of the structs and constants declared in Rust ([`crate::gpu`]).
 pub fn wgsl_file(path: &str) -> Option<Fragment> {
     if path.starts_with(GENERATED) {
-        return crate::gpu::module(path)
-            .map(|module| Fragment { path: path.to_string().into(), text: module.wgsl().into() });
+        return gpu_module(path).map(|module| Fragment { path: path.to_string().into(), text: module.wgsl().into() });
     }
     WGSL_FILES.iter().find(|fragment| crate::wgsl_imports::wgsl_path(fragment) == path).cloned()
 }

@@ -77,6 +77,10 @@ pub const SHARED: &[(&str, ConstantValue)] = {
 
 /// WGSL constants no host code reads: a kernel's own sizes and sentinels.
 pub const KERNEL_PRIVATE: &[&str] = &[
+    // Each ReSTIR pass's random stream (restir/resampling_core.wgsl).
+    "STREAM_SELECT",
+    "STREAM_SPATIAL",
+    "STREAM_TEMPORAL",
     // The histogram's register layout and its padding key (strata/histogram.wgsl).
     "ELEMS",
     "ELEM_BITS",

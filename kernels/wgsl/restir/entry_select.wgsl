@@ -69,11 +69,10 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
         return;
     }
     let p = primaries[pixel];
-    if (p.flags & PRIMARY_RESAMPLE) == 0u {
+    if !begin_resampling(pixel, p, true, STREAM_SELECT) {
         reservoirs_out[pixel] = empty_reservoir();
         return;
     }
-    rng_seed(pixel, params.sample_index, params.seed ^ 0x5e1ec7u);
     let k = min(restir.candidates, MAX_SELECTED);
     var numbers = SelectionNumbers(vec4<f32>(0.0), 0.0);
     if restir.method == METHOD_STRATA {

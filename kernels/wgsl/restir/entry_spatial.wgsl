@@ -61,19 +61,19 @@
 @compute @workgroup_size(8, 8)
 fn restir_spatial(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     let pixel = image_pixel(id);
-    if pixel == NO_PIXEL {
-        return;
+    if pixel != NO_PIXEL {
+        reservoirs_out[pixel] = spatial_reuse(id, pixel, lane);
     }
-    let p = primaries[pixel];
+}
+
+// The reservoir of `pixel` after spatial reuse; its own where it does not resample or
+// K = 0.
+fn spatial_reuse(id: vec3<u32>, pixel: u32, lane: u32) -> Reservoir {
     let canonical = reservoirs_in[pixel];
-    reservoirs_out[pixel] = canonical;
-    if (p.flags & PRIMARY_RESAMPLE) == 0u {
-        return;
-    }
-    rng_seed(pixel, params.sample_index, params.seed ^ 0x5fa71au);
+    let p = primaries[pixel];
     let k = min(restir.candidates, MAX_SELECTED);
-    if k == 0u {
-        return;
+    if !begin_resampling(pixel, p, k > 0u, STREAM_SPATIAL) {
+        return canonical;
     }
     var numbers = SelectionNumbers(vec4<f32>(0.0), 0.0);
     if restir.method == METHOD_STRATA {
@@ -113,8 +113,7 @@ fn restir_spatial(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_i
         result.weight = 0.0;
         result.target_value = 0.0;
         result.expected = vec3<f32>(0.0);
-        reservoirs_out[pixel] = result;
-        return;
+        return result;
     }
     let chosen = chosen_slot(state, total, numbers.resample, restir.method == METHOD_STRATA);
     if chosen != CANONICAL_KEPT {
@@ -125,5 +124,5 @@ fn restir_spatial(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_i
     }
     result.weight = total / result.target_value;
     result.expected = resampling_expectation(state, target_c, colour_c);
-    reservoirs_out[pixel] = result;
+    return result;
 }

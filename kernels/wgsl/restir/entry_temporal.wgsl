@@ -129,16 +129,19 @@ fn merge_previous(state: Resampling, slot: u32, p: Primary, current: Reservoir, 
 @compute @workgroup_size(8, 8)
 fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     let pixel = image_pixel(id);
-    if pixel == NO_PIXEL {
-        return;
+    if pixel != NO_PIXEL {
+        merged_reservoirs[pixel] = temporal_merge(id, pixel, lane);
     }
-    let p = primaries[pixel];
+}
+
+// This frame's reservoir of `pixel` merged with previous frames'; as it is without
+// temporal reuse or where the pixel does not resample.
+fn temporal_merge(id: vec3<u32>, pixel: u32, lane: u32) -> Reservoir {
     let current = current_reservoirs[pixel];
-    merged_reservoirs[pixel] = current;
-    if restir.temporal == 0u || (p.flags & PRIMARY_RESAMPLE) == 0u {
-        return;
+    let p = primaries[pixel];
+    if !begin_resampling(pixel, p, restir.temporal != 0u, STREAM_TEMPORAL) {
+        return current;
     }
-    rng_seed(pixel, params.sample_index, params.seed ^ 0x7e3907u);
     let drawn = min(restir.temporal_candidates, MAX_SELECTED);
     let share = 1.0 / f32(1u + drawn);
     var numbers = SelectionNumbers(vec4<f32>(0.0), 0.0);
@@ -162,8 +165,7 @@ fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
     if !(total > 0.0) || !(total < INFINITY) {
         merged.weight = 0.0;
         merged.expected = vec3<f32>(0.0);
-        merged_reservoirs[pixel] = merged;
-        return;
+        return merged;
     }
     // The expectation over this merge's choice: what SHADING_EXPECTATION adds in place of
     // f(Y) V W. The current reservoir's part uses its kept sample, not select's own
@@ -180,5 +182,5 @@ fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_
         merged.target_value = state.targets[chosen];
     }
     merged.weight = total / merged.target_value;
-    merged_reservoirs[pixel] = merged;
+    return merged;
 }

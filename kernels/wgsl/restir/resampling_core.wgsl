@@ -28,6 +28,7 @@
 //                       (strata/resampling.wgsl), streaming weighted reservoir sampling
 //                       in slot order for the baselines
 //   resampling_expectation
+//   begin_resampling    each pass's start at a pixel: whether it resamples, its random stream
 //
 // Needs from the kernel that includes it what reservoir.wgsl needs, and `random()`, drawn
 // only by the streaming choice (one number per slot with a positive weight, in slot order).
@@ -45,6 +46,24 @@ const MAX_SLOTS: u32 = 5u;
 
 // The id chosen_slot returns for the canonical sample.
 const CANONICAL_KEPT: u32 = MAX_SLOTS;
+
+// The random stream of each pass, XORed into the render seed (begin_resampling), so that
+// the numbers one pass draws for a pixel are independent of the other passes'.
+const STREAM_SELECT: u32 = 0x5e1ec7u;
+const STREAM_SPATIAL: u32 = 0x5fa71au;
+const STREAM_TEMPORAL: u32 = 0x7e3907u;
+
+// Whether `pixel`, with primary `p`, resamples in a pass that is `enabled`: only a pixel
+// whose primary hit can hold a reservoir does (PRIMARY_RESAMPLE); the others keep what
+// their pass wrote for them before this call. A pixel that resamples has its random
+// numbers seeded from the pass's own `stream`.
+fn begin_resampling(pixel: u32, p: Primary, enabled: bool, stream: u32) -> bool {
+    if !enabled || (p.flags & PRIMARY_RESAMPLE) == 0u {
+        return false;
+    }
+    rng_seed(pixel, params.sample_index, params.seed ^ stream);
+    return true;
+}
 
 // The running state of one resampling (see the top of the file). `slots` is how many of
 // the arrays are in use; `merged_count` the sum of M_j over the slots that merged.

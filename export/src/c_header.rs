@@ -1,6 +1,6 @@
 //! `strata.h`: the C11 declarations of the pass's records and constants, generated from
 //! the same Rust declarations the kernels' WGSL is generated from
-//! (`strata_kernels::gpu::GpuStruct`, `strata_kernels::constants::SHARED`): each
+//! (`strata_kernels::gpu::GpuStruct`, `strata_kernels::constants::shared`): each
 //! struct's fields in declaration order with the C type of the field's WGSL type, a
 //! `_Static_assert` on the struct's size and on every field's offset (Rust's, which a
 //! test of strata-kernels holds equal to naga's), the constants as `STRATA_` macros, the

@@ -44,7 +44,7 @@ pub mod translations;
 use std::path::{Path, PathBuf};
 use strata_embed::wgsl::ModuleId;
 use strata_kernels::Registry;
-use strata_kernels::constants::{SHARED, module_constants};
+use strata_kernels::constants::{module_constants, shared};
 use strata_kernels::embed_types::{ResampleInput, ResampleOutput, SelectedCandidates, SelectionParams};
 use strata_kernels::gpu::ConstantValue;
 use strata_kernels::pass_plan::PassBuffer;
@@ -116,14 +116,14 @@ fn structs() -> Vec<c_header::HeaderStruct> {
 }
 
 /// The shared constants the exported kernels use (names from naga's IR, values checked
-/// against [`SHARED`] by strata's constant test), in [`SHARED`]'s order.
+/// against [`shared`] by strata's constant test), in [`shared`]'s order.
 fn constants(registry: &Registry) -> Vec<(String, ConstantValue)> {
     let used: Vec<String> = MODULES
         .iter()
         .flat_map(|&id| module_constants(&registry.get(id.kernel()).module))
         .map(|(name, _)| name)
         .collect();
-    SHARED.iter().filter(|(name, _)| used.iter().any(|u| u == name)).map(|&(n, v)| (n.to_string(), v)).collect()
+    shared().into_iter().filter(|(name, _)| used.iter().any(|u| u == name)).map(|(n, v)| (n.to_string(), v)).collect()
 }
 
 /// Writes the package into `out` (module documentation).

@@ -13,23 +13,30 @@
 //! The selection (Table 2's temporal blue noise) uses the pair (0, 1) for its spatial
 //! slots and (2, 3) for its temporal ones, with sample index = frame mod 256.
 
-/// Side of the square pixel tile the tables cover (pixels wrap modulo it).
-pub const TILE_SIZE: u32 = 128;
 /// Samples per pixel in the tables (sample indices wrap modulo it).
 pub const SAMPLES: u32 = 256;
 /// Dimensions of the Sobol table (dimensions wrap modulo it).
 pub const DIMENSIONS: u32 = 256;
-/// Dimensions with an optimised scrambling and ranking (the pairs (0, 1) … (6, 7)).
-pub const OPTIMISED_DIMENSIONS: u32 = 8;
 
-/// Word offset of the Sobol table in [`BlueNoiseTables::packed`] (WGSL `BLUE_NOISE_SOBOL`).
-pub const PACKED_SOBOL: u32 = 0;
-/// Word offset of the scrambling table (WGSL `BLUE_NOISE_SCRAMBLING`).
-pub const PACKED_SCRAMBLING: u32 = SAMPLES * DIMENSIONS;
-/// Word offset of the ranking table (WGSL `BLUE_NOISE_RANKING`).
-pub const PACKED_RANKING: u32 = PACKED_SCRAMBLING + TILE_SIZE * TILE_SIZE * OPTIMISED_DIMENSIONS;
+crate::gpu::gpu_constants! {
+    fn constants;
+    /// Side of the square pixel tile the tables cover (pixels wrap modulo it).
+    pub const TILE_SIZE: u32 as "BLUE_NOISE_TILE" = 128;
+    /// Dimensions with an optimised scrambling and ranking (the pairs (0, 1) ... (6, 7)):
+    /// the entries per pixel of the scrambling and ranking tables.
+    pub const OPTIMISED_DIMENSIONS: u32 as "BLUE_NOISE_DIMENSIONS_PER_PIXEL" = 8;
+    /// Word offset of the Sobol table (entry dimension + sample * 256) in the packed
+    /// tables (`BlueNoiseTables::packed`).
+    pub const PACKED_SOBOL: u32 as "BLUE_NOISE_SOBOL" = 0;
+    /// Word offset of the scrambling table (entry dimension + pixel * 8, pixel = x + y * 128).
+    pub const PACKED_SCRAMBLING: u32 as "BLUE_NOISE_SCRAMBLING" = SAMPLES * DIMENSIONS;
+    /// Word offset of the ranking table (laid out as the scrambling table).
+    pub const PACKED_RANKING: u32 as "BLUE_NOISE_RANKING" = PACKED_SCRAMBLING + RANKING_WORDS;
+    /// Words of the ranking (and of the scrambling) table: 128 * 128 * 8.
+    pub const RANKING_WORDS: u32 as "BLUE_NOISE_RANKING_WORDS" = TILE_SIZE * TILE_SIZE * OPTIMISED_DIMENSIONS;
+}
 /// Words of [`BlueNoiseTables::packed`].
-pub const PACKED_WORDS: u32 = PACKED_RANKING + TILE_SIZE * TILE_SIZE * OPTIMISED_DIMENSIONS;
+pub const PACKED_WORDS: u32 = PACKED_RANKING + RANKING_WORDS;
 /// Name of the storage array `blue_noise.wgsl` reads the packed tables from.
 pub const WGSL_BUFFER_NAME: &str = "blue_noise";
 
@@ -103,6 +110,17 @@ impl BlueNoiseTables {
     /// with k = [`Self::stratum`], exact in `f32`.
     pub fn sample(&self, pixel_x: u32, pixel_y: u32, sample_index: u32, dimension: u32) -> f32 {
         (0.5 + self.stratum(pixel_x, pixel_y, sample_index, dimension) as f32) / 256.0
+    }
+}
+
+/// The WGSL module `gpu/blue_noise.wgsl`: where `strata/blue_noise.wgsl` finds each table
+/// in the packed buffer ([`crate::gpu`]).
+pub fn gpu_module() -> crate::gpu::GpuModule {
+    crate::gpu::GpuModule {
+        path: "gpu/blue_noise.wgsl",
+        source: "kernels/src/blue_noise.rs",
+        constants: constants(),
+        structs: Vec::new(),
     }
 }
 

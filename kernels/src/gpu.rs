@@ -117,7 +117,9 @@ impl StructDeclaration {
 /// A constant declared with `gpu_constants!`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GpuConstant {
-    /// The name, the same in Rust and WGSL.
+    /// The WGSL name (and C's, after `STRATA_`): the Rust name unless the declaration
+    /// gives one (`pub const TILE_SIZE: u32 as "BLUE_NOISE_TILE" = 128;`), for a Rust name
+    /// that its module's path already qualifies.
     pub name: &'static str,
     /// The value.
     pub value: ConstantValue,
@@ -277,22 +279,24 @@ macro_rules! gpu_struct {
 pub(crate) use gpu_struct;
 
 /// Declares constants shared with the kernels, once: each a Rust `pub const` (`u32` or
-/// `f32`) and a [`GpuConstant`] of the list function named first, from which its WGSL is
-/// generated.
+/// `f32`) and a [`GpuConstant`] of the list function named first (with its visibility),
+/// from which its WGSL is generated. A constant may give its WGSL name after its type.
 ///
 /// ```ignore
 /// gpu_constants! {
-///     fn constants;
+///     pub(crate) fn constants;
 ///     /// Doc comment (also the WGSL's comment).
 ///     pub const NO_LIGHT: u32 = u32::MAX;
+///     /// Side of the tile, `BLUE_NOISE_TILE` in WGSL.
+///     pub const TILE_SIZE: u32 as "BLUE_NOISE_TILE" = 128;
 /// }
 /// ```
 macro_rules! gpu_constants {
     (
-        fn $list:ident;
+        $vis:vis fn $list:ident;
         $(
             $(#[doc = $doc:literal])*
-            pub const $name:ident : $ty:ty = $value:expr;
+            pub const $name:ident : $ty:ty $(as $wgsl:literal)? = $value:expr;
         )*
     ) => {
         $(
@@ -301,16 +305,18 @@ macro_rules! gpu_constants {
         )*
 
         /// The constants above, for the generated WGSL module.
-        fn $list() -> Vec<$crate::gpu::GpuConstant> {
+        $vis fn $list() -> Vec<$crate::gpu::GpuConstant> {
             vec![$(
                 $crate::gpu::GpuConstant {
-                    name: stringify!($name),
+                    name: $crate::gpu::gpu_constants!(@wgsl_name $name $($wgsl)?),
                     value: $crate::gpu::ConstantValue::from($name),
                     doc: concat!($($doc, "\n"),*),
                 }
             ),*]
         }
     };
+    (@wgsl_name $name:ident) => { stringify!($name) };
+    (@wgsl_name $name:ident $wgsl:literal) => { $wgsl };
 }
 pub(crate) use gpu_constants;
 

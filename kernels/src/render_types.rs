@@ -6,6 +6,11 @@ use crate::gpu::{GpuModule, StructDeclaration, gpu_constants, gpu_struct};
 
 gpu_constants! {
     fn constants;
+    /// The R2 sequence's step along x (Roberts 2018: 1/φ₂, φ₂ the plastic number) in
+    /// 0.32 fixed point, so that every backend computes the same film position.
+    pub const R2_STEP_X: u32 = 3_242_174_889;
+    /// The R2 sequence's step along y (1/φ₂²) in 0.32 fixed point.
+    pub const R2_STEP_Y: u32 = 2_447_445_414;
     /// `RenderParams.flags`: next-event estimation (light sampling).
     pub const FLAG_SAMPLE_LIGHTS: u32 = 1;
     /// `RenderParams.flags`: emission found by BSDF sampling counts (MIS when both are set).
@@ -38,11 +43,6 @@ gpu_constants! {
     /// `TriangleInfo.light` of a triangle that does not emit.
     pub const NO_LIGHT: u32 = u32::MAX;
 }
-
-/// The R2 sequence's step (Roberts 2018: 1/φ₂ and 1/φ₂², φ₂ the plastic number) in
-/// 0.32 fixed point, so that every backend computes the same film position (WGSL
-/// `R2_STEP_X` and `R2_STEP_Y` in `render/scene.wgsl`, checked by [`crate::constants`]).
-pub const R2_STEP: [u32; 2] = [3_242_174_889, 2_447_445_414];
 
 gpu_struct! {
     /// Per-frame parameters of the path-tracing kernels (WGSL `RenderParams`).

@@ -54,11 +54,14 @@ pub static WGSL_FILES: &[Fragment] = &[
     fragment!("util/empty.wgsl"),
 ];
 
-/// Every generated module, one per `*_types.rs` file (listed here, above those files,
+/// Every generated module, one per `*_types.rs` file and the selection's and blue noise's
+/// (listed here, above those files,
 /// rather than in [`crate::gpu`], which they use to declare themselves).
-pub fn gpu_modules() -> [GpuModule; 6] {
+pub fn gpu_modules() -> [GpuModule; 8] {
     [
         crate::types::gpu_module(),
+        crate::selection::gpu_module(),
+        crate::blue_noise::gpu_module(),
         crate::embed_types::gpu_module(),
         crate::trace_types::gpu_module(),
         crate::render_types::gpu_module(),

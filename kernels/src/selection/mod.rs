@@ -19,3 +19,14 @@ pub use sampler::{
 #[cfg(feature = "clap")]
 pub use settings::block_size_parser;
 pub use settings::{SelectionSettings, SettingError};
+
+/// The WGSL module `gpu/selection.wgsl`: the sampler ids and the pattern table's limits
+/// declared in `sampler.rs` and `patterns.rs` ([`crate::gpu`]).
+pub fn gpu_module() -> crate::gpu::GpuModule {
+    crate::gpu::GpuModule {
+        path: "gpu/selection.wgsl",
+        source: "kernels/src/selection/",
+        constants: [patterns::pattern_constants(), sampler::sampler_constants()].concat(),
+        structs: Vec::new(),
+    }
+}

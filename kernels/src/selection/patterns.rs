@@ -23,12 +23,16 @@
 //! kernels' Rust reference ([`crate::reference::stratified_selection`]) and the 1-D
 //! estimator study (the `strata-estimator` crate, `estimator/`) evaluate this table rather than restating it.
 
-/// Most slots a pixel selects (WGSL `MAX_SELECTED`; the per-slot values live in `vec4`s).
-pub const MAX_SELECTED: u32 = 4;
-
-/// Largest `f32` below 1 (WGSL `BELOW_ONE`): positions are clamped to it so that they
-/// stay in [0, 1) after rounding.
-pub const BELOW_ONE: f32 = 0.999_999_94;
+crate::gpu::gpu_constants! {
+    pub(crate) fn pattern_constants;
+    /// Most slots a pixel selects (the kernels keep the per-slot values in `vec4`s:
+    /// registers on every target, where local arrays would need array constructors that
+    /// glslang's HLSL front end rejects).
+    pub const MAX_SELECTED: u32 = 4;
+    /// Largest `f32` below 1: positions are clamped to it so that they stay in [0, 1)
+    /// after rounding.
+    pub const BELOW_ONE: f32 = 0.999_999_94;
+}
 
 /// How a sampler variant draws the positions of a pixel's K slots in one frame.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -84,16 +84,19 @@ impl SamplerVariant {
     }
 }
 
-/// WGSL `SAMPLER_RANDOM`.
-pub const SAMPLER_RANDOM: u32 = 0;
-/// WGSL `SAMPLER_HEITZ`.
-pub const SAMPLER_HEITZ: u32 = 1;
-/// WGSL `SAMPLER_RANDOM_OFFSET`.
-pub const SAMPLER_RANDOM_OFFSET: u32 = 2;
-/// WGSL `SAMPLER_RANDOM_OFFSET_BLUE_NOISE`.
-pub const SAMPLER_RANDOM_OFFSET_BLUE_NOISE: u32 = 3;
-/// WGSL `SAMPLER_ANTITHETIC`.
-pub const SAMPLER_ANTITHETIC: u32 = 4;
+crate::gpu::gpu_constants! {
+    pub(crate) fn sampler_constants;
+    /// Sampler variant id of `SamplerVariant::Random` (`SelectionParams.sampler`).
+    pub const SAMPLER_RANDOM: u32 = 0;
+    /// Sampler variant id of `SamplerVariant::Heitz`.
+    pub const SAMPLER_HEITZ: u32 = 1;
+    /// Sampler variant id of `SamplerVariant::RandomOffset`.
+    pub const SAMPLER_RANDOM_OFFSET: u32 = 2;
+    /// Sampler variant id of `SamplerVariant::RandomOffsetBlueNoise`.
+    pub const SAMPLER_RANDOM_OFFSET_BLUE_NOISE: u32 = 3;
+    /// Sampler variant id of `SamplerVariant::Antithetic`.
+    pub const SAMPLER_ANTITHETIC: u32 = 4;
+}
 
 #[cfg(all(test, feature = "clap"))]
 mod tests {

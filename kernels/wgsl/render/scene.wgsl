@@ -19,10 +19,6 @@
 // #import trace/traverse.wgsl
 // #import render/random.wgsl
 
-// The R2 sequence's step (Roberts 2018) in 0.32 fixed point.
-const R2_STEP_X: u32 = 3242174889u;
-const R2_STEP_Y: u32 = 2447445414u;
-
 // The film position of pixel `pixel`'s camera ray: a uniform point of the pixel from
 // `u` in [0, 1)², or its centre with FLAG_PIXEL_CENTRES.
 //

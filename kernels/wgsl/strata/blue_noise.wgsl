@@ -13,16 +13,9 @@
 // Only dimensions 0-7 are optimised, as the pairs (0, 1), (2, 3), (4, 5), (6, 7); the
 // selection uses (0, 1) for its spatial slots and (2, 3) for its temporal ones.
 
+// #import gpu/blue_noise.wgsl
 // #requires var<storage, read> blue_noise: array<u32>
 
-const BLUE_NOISE_TILE: u32 = 128u;
-const BLUE_NOISE_DIMENSIONS_PER_PIXEL: u32 = 8u;
-// Word offsets of the three tables in `blue_noise`.
-const BLUE_NOISE_SOBOL: u32 = 0u;
-const BLUE_NOISE_SCRAMBLING: u32 = 65536u;
-const BLUE_NOISE_RANKING: u32 = 196608u;
-// Words of the ranking (and scrambling) table: 128 * 128 * 8.
-const BLUE_NOISE_RANKING_WORDS: u32 = 131072u;
 
 // The stratum k in 0..=255 of the sample of `dimension` at `sample_index` for `pixel`
 // (the sample is (0.5 + k) / 256). The pixel wraps to the tile, the sample index and

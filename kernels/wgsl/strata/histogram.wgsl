@@ -39,13 +39,13 @@
 // too small for the image loses its entries past the end and nothing outside it is read
 // or written (tests/tests/kernel_guards.rs), on GPUs without robustBufferAccess too.
 
+// #import gpu/strata.wgsl
 // #import strata/candidate.wgsl
 // #import strata/masking.wgsl
 // #requires fn lane_exchange(value: vec4<u32>, mask: u32) -> vec4<u32>
 
 const ELEMS: u32 = 16u;
 const ELEM_BITS: u32 = 4u;
-const SLOTS: u32 = 1024u;
 const INVOCATIONS: u32 = 64u;
 const MAX_SEGMENTS: u32 = 64u;
 // Key of the padding slots past a partial block's pixels: after every real element.

@@ -37,24 +37,10 @@
 //
 // Needs, from the including kernel: `blue_noise: array<u32>` (strata/blue_noise.wgsl).
 
+// #import gpu/selection.wgsl
 // #import strata/candidate.wgsl
 // #import strata/blue_noise.wgsl
 // #import strata/resampling.wgsl
-
-// Most slots a pixel selects (the per-slot values live in vec4s: registers on every
-// target, where local arrays would need array constructors that glslang's HLSL front end
-// rejects).
-const MAX_SELECTED: u32 = 4u;
-
-// The sampler variants of Table 2 (SelectionParams.sampler, RestirParams.sampler).
-const SAMPLER_RANDOM: u32 = 0u;
-const SAMPLER_HEITZ: u32 = 1u;
-const SAMPLER_RANDOM_OFFSET: u32 = 2u;
-const SAMPLER_RANDOM_OFFSET_BLUE_NOISE: u32 = 3u;
-const SAMPLER_ANTITHETIC: u32 = 4u;
-
-// Largest f32 below 1: positions stay in [0, 1) after rounding.
-const BELOW_ONE: f32 = 0.99999994;
 
 // PCG hash (Jarzynski and Olano 2020): the white noise of the selection.
 fn selection_hash(v: u32) -> u32 {

@@ -21,16 +21,12 @@
 @group(0) @binding(9) var<storage, read> primaries: array<Primary>;
 @group(0) @binding(10) var<storage, read_write> guides_out: array<DenoiseGuide>;
 
-@compute @workgroup_size(8, 8)
-fn restir_guide(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= params.width || id.y >= params.height {
-        return;
-    }
-    let pixel = id.y * params.width + id.x;
+// The denoiser's guide of `pixel`: albedo, depth, normal and object id of its primary
+// hit, and its motion since the previous frame's camera.
+fn guide_of(pixel: u32) -> DenoiseGuide {
     let p = primaries[pixel];
     if (p.flags & PRIMARY_HIT) == 0u {
-        guides_out[pixel] = DenoiseGuide(vec3<f32>(1.0), 0.0, vec3<f32>(0.0, 0.0, 1.0), OBJECT_ID_NONE, vec2<f32>(0.0), vec2<u32>(0u));
-        return;
+        return DenoiseGuide(vec3<f32>(1.0), 0.0, vec3<f32>(0.0, 0.0, 1.0), OBJECT_ID_NONE, vec2<f32>(0.0), vec2<u32>(0u));
     }
     let now = image_position(
         p.camera_hit, params.camera_origin, params.camera_forward, params.camera_right, params.camera_up,
@@ -45,5 +41,13 @@ fn restir_guide(@builtin(global_invocation_id) id: vec3<u32>) {
     if before.z > 0.0 && now.z > 0.0 {
         motion = before.xy - now.xy;
     }
-    guides_out[pixel] = DenoiseGuide(p.albedo * p.throughput, p.depth, p.normal, p.object_id, motion, vec2<u32>(0u));
+    return DenoiseGuide(p.albedo * p.throughput, p.depth, p.normal, p.object_id, motion, vec2<u32>(0u));
+}
+
+@compute @workgroup_size(8, 8)
+fn restir_guide(@builtin(global_invocation_id) id: vec3<u32>) {
+    let pixel = image_pixel(id);
+    if pixel != NO_PIXEL {
+        guides_out[pixel] = guide_of(pixel);
+    }
 }

@@ -25,22 +25,27 @@
 @group(0) @binding(10) var<storage, read> merged_reservoirs: array<Reservoir>;
 @group(0) @binding(11) var<storage, read_write> histogram_in: array<Candidate>;
 
+// The histogram's candidate of `pixel`: its merged reservoir's estimate p̂ W as the key
+// (0 where it is not finite and non-negative) under its object id; no candidate where the
+// pixel does not resample.
+fn reservoir_key(pixel: u32) -> Candidate {
+    let p = primaries[pixel];
+    if (p.flags & PRIMARY_RESAMPLE) == 0u {
+        return Candidate(0.0, OBJECT_ID_NONE);
+    }
+    let reservoir = merged_reservoirs[pixel];
+    let estimate = reservoir.target_value * reservoir.weight;
+    var key = 0.0;
+    if estimate >= 0.0 && estimate < INFINITY {
+        key = estimate;
+    }
+    return Candidate(key, p.object_id);
+}
+
 @compute @workgroup_size(8, 8)
 fn restir_reservoir_keys(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= params.width || id.y >= params.height {
-        return;
+    let pixel = image_pixel(id);
+    if pixel != NO_PIXEL {
+        histogram_in[pixel] = reservoir_key(pixel);
     }
-    let pixel = id.y * params.width + id.x;
-    let p = primaries[pixel];
-    var key = 0.0;
-    var object = OBJECT_ID_NONE;
-    if (p.flags & PRIMARY_RESAMPLE) != 0u {
-        object = p.object_id;
-        let reservoir = merged_reservoirs[pixel];
-        let estimate = reservoir.target_value * reservoir.weight;
-        if estimate >= 0.0 && estimate < INFINITY {
-            key = estimate;
-        }
-    }
-    histogram_in[pixel] = Candidate(key, object);
 }

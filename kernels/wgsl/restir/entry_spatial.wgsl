@@ -58,14 +58,6 @@
 @group(0) @binding(13) var<storage, read_write> reservoirs_out: array<Reservoir>;
 @group(0) @binding(14) var<storage, read> blue_noise: array<u32>;
 
-@compute @workgroup_size(8, 8)
-fn restir_spatial(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    let pixel = image_pixel(id);
-    if pixel != NO_PIXEL {
-        reservoirs_out[pixel] = spatial_reuse(id, pixel, lane);
-    }
-}
-
 // The reservoir of `pixel` after spatial reuse; its own where it does not resample or
 // K = 0.
 fn spatial_reuse(id: vec3<u32>, pixel: u32, lane: u32) -> Reservoir {
@@ -125,4 +117,12 @@ fn spatial_reuse(id: vec3<u32>, pixel: u32, lane: u32) -> Reservoir {
     result.weight = total / result.target_value;
     result.expected = resampling_expectation(state, target_c, colour_c);
     return result;
+}
+
+@compute @workgroup_size(8, 8)
+fn restir_spatial(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let pixel = image_pixel(id);
+    if pixel != NO_PIXEL {
+        reservoirs_out[pixel] = spatial_reuse(id, pixel, lane);
+    }
 }

@@ -126,14 +126,6 @@ fn merge_previous(state: Resampling, slot: u32, p: Primary, current: Reservoir, 
     return next;
 }
 
-@compute @workgroup_size(8, 8)
-fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    let pixel = image_pixel(id);
-    if pixel != NO_PIXEL {
-        merged_reservoirs[pixel] = temporal_merge(id, pixel, lane);
-    }
-}
-
 // This frame's reservoir of `pixel` merged with previous frames'; as it is without
 // temporal reuse or where the pixel does not resample.
 fn temporal_merge(id: vec3<u32>, pixel: u32, lane: u32) -> Reservoir {
@@ -183,4 +175,12 @@ fn temporal_merge(id: vec3<u32>, pixel: u32, lane: u32) -> Reservoir {
     }
     merged.weight = total / merged.target_value;
     return merged;
+}
+
+@compute @workgroup_size(8, 8)
+fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let pixel = image_pixel(id);
+    if pixel != NO_PIXEL {
+        merged_reservoirs[pixel] = temporal_merge(id, pixel, lane);
+    }
 }

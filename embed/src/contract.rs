@@ -1,6 +1,6 @@
 //! The buffer contract between an engine and the pass: which buffers exist, their record
-//! layouts (the `#[repr(C)]` twins of the WGSL structs, checked against naga's layout by
-//! a test), who writes each and when.
+//! layouts (the `#[repr(C)]` structs declared once in `strata_kernels`, from which the
+//! kernels' WGSL declarations are generated), who writes each and when.
 //!
 //! | buffer | record (bytes per pixel) | written by | read by |
 //! |---|---|---|---|

@@ -5,62 +5,21 @@
 //! `_Static_assert` on the struct's size and on every field's offset (Rust's, which a
 //! test of strata-kernels holds equal to naga's), the constants as `STRATA_` macros, the
 //! sampler variants as an enum, and the kernels' workgroup sizes. The doc comments are
-//! the Rust declarations' own: the structs' from the declarations, the constants' read
-//! from their source.
+//! the Rust declarations' own.
 
 use crate::ExportError;
-use strata_kernels::gpu::ConstantValue;
-use strata_kernels::gpu::{GpuStruct, StructDeclaration};
+use strata_kernels::gpu::{ConstantValue, GpuConstant, GpuStruct, StructDeclaration};
 use strata_kernels::selection::SamplerVariant;
 
-/// The Rust sources of the constants, whose `///` comments become the header's comments.
-const TWIN_SOURCES: [&str; 2] =
-    [include_str!("../../kernels/src/types.rs"), include_str!("../../kernels/src/embed_types.rs")];
-
-/// The doc comment above the item whose line (trimmed) starts with `start` in the
-/// constants' sources (`pub const NAME:`), or, with `after`, the first such item after
-/// the line starting with `after`.
-pub(crate) fn doc_above(start: &str, after: Option<&str>) -> Option<String> {
-    for source in TWIN_SOURCES {
-        let lines: Vec<&str> = source.lines().collect();
-        let from = match after {
-            Some(anchor) => match lines.iter().position(|l| l.trim_start().starts_with(anchor)) {
-                Some(line) => line,
-                None => continue,
-            },
-            None => 0,
-        };
-        let Some(at) = lines[from..].iter().position(|l| l.trim_start().starts_with(start)).map(|i| i + from) else {
-            continue;
-        };
-        let mut doc: Vec<&str> = Vec::new();
-        for line in lines[..at].iter().rev() {
-            let line = line.trim_start();
-            if let Some(text) = line.strip_prefix("///") {
-                doc.push(text.strip_prefix(' ').unwrap_or(text));
-            } else if line.starts_with("#[") {
-                continue;
-            } else {
-                break;
-            }
-        }
-        doc.reverse();
-        return (!doc.is_empty()).then(|| doc.join(" "));
-    }
-    None
-}
-
-/// WGSL constants whose names need their context in C (and whose Rust twins carry it).
-const RENAMED: [(&str, &str); 1] = [("SLOTS", "HISTOGRAM_SLOTS_PER_WORKGROUP")];
-
-/// The Rust twin's name of the WGSL constant `name`.
-pub(crate) fn rust_name(name: &str) -> &str {
-    RENAMED.iter().find(|(wgsl, _)| *wgsl == name).map_or(name, |(_, rust)| rust)
-}
-
-/// The C macro of the WGSL constant `name`: `STRATA_` and its Rust twin's name.
+/// The C macro of the WGSL constant `name`: `STRATA_` and its name.
 pub fn c_name(name: &str) -> String {
-    format!("STRATA_{}", rust_name(name))
+    format!("STRATA_{name}")
+}
+
+/// A constant's doc comment as one line of text (`None` if it has none).
+pub(crate) fn constant_doc(constant: &GpuConstant) -> Option<String> {
+    let text = constant.doc.split_whitespace().collect::<Vec<_>>().join(" ");
+    (!text.is_empty()).then_some(text)
 }
 
 /// `text` as a C comment indented by `indent`, wrapped at about 96 columns.
@@ -175,7 +134,7 @@ fn version_macros(version: &str) -> Result<String, ExportError> {
 /// The header's text.
 pub fn header(
     structs: &[HeaderStruct],
-    constants: &[(String, ConstantValue)],
+    constants: &[GpuConstant],
     workgroup_sizes: &[(String, [u32; 3])],
     version: &str,
 ) -> Result<String, ExportError> {
@@ -193,13 +152,14 @@ pub fn header(
           static_assert\n#else\n#define STRATA_STATIC_ASSERT _Static_assert\n#endif\n\n";
     h += "#ifdef __cplusplus\nextern \"C\" {\n#endif\n\n";
     h += "/* Constants the kernels and the host share (WGSL names with STRATA_ in front). */\n";
-    for (name, value) in constants {
+    for constant in constants {
+        let name = constant.name;
         // The sampler ids are the enum below.
         if name.starts_with("SAMPLER_") {
             continue;
         }
-        let doc = doc_above(&format!("pub const {}:", rust_name(name)), None);
-        let text = match *value {
+        let doc = constant_doc(constant);
+        let text = match constant.value {
             ConstantValue::U32(v) => format!("{v}u"),
             ConstantValue::F32(v) => format!("{v:?}f"),
         };
@@ -262,9 +222,11 @@ mod tests {
         let candidate = HeaderStruct::of::<strata_kernels::types::Candidate>();
         assert!(!candidate.doc.is_empty() && candidate.field_docs.iter().all(|d| !d.is_empty()));
         assert!(!candidate.doc.contains('\n'), "{}", candidate.doc);
-        assert!(doc_above("pub const OBJECT_ID_NONE:", None).is_some());
-        // In the second source file too.
-        assert!(doc_above("pub const NO_PAYLOAD:", None).is_some());
+        // Every shared constant carries its declaration's doc, on one line.
+        for constant in strata_kernels::constants::shared() {
+            let doc = constant_doc(&constant).unwrap_or_else(|| panic!("{} has no doc", constant.name));
+            assert!(!doc.contains('\n'), "{doc}");
+        }
     }
 
     #[test]

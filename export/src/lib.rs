@@ -8,7 +8,7 @@
 //! |---|---|
 //! | `README.md` | per API (Vulkan, D3D12, Metal) how to bind, record and synchronise; what the engine writes when; what is tested where |
 //! | `manifest.json` | per kernel: entry points, workgroup size, features, per binding its set/binding, HLSL register and space, MSL buffer index, element type and stride; the buffers' size rules and writers; the structs' layouts; the constants; the dispatch formulas ([`manifest`]) |
-//! | `include/strata.h` | the records and constants as C11, generated from the Rust twins, with `_Static_assert` on every size and offset ([`c_header`]) |
+//! | `include/strata.h` | the records and constants as C11, generated from the structs' single Rust declarations, with `_Static_assert` on every size and offset ([`c_header`]) |
 //! | `include/strata.glsl`, `include/strata.hlsli`, `include/strata.wgsl` | the same records and constants for the engine's own shaders ([`shader_headers`]) |
 //! | `include/strata_frame.h` | the per-frame uniforms and dispatch sizes in plain C, as `strata-embed` computes them |
 //! | `include/strata_vk.h` | the C ABI of the `strata-vk` library (cbindgen, [`abi_header`]) |
@@ -46,7 +46,7 @@ use strata_embed::wgsl::ModuleId;
 use strata_kernels::Registry;
 use strata_kernels::constants::{module_constants, shared};
 use strata_kernels::embed_types::{ResampleInput, ResampleOutput, SelectedCandidates, SelectionParams};
-use strata_kernels::gpu::ConstantValue;
+use strata_kernels::gpu::{ConstantValue, GpuConstant};
 use strata_kernels::pass_plan::PassBuffer;
 use strata_kernels::selection::SamplerVariant;
 use strata_kernels::types::{BlockStats, Candidate, ClusterSpan, HistogramParams};
@@ -117,13 +117,13 @@ fn structs() -> Vec<c_header::HeaderStruct> {
 
 /// The shared constants the exported kernels use (names from naga's IR, values checked
 /// against [`shared`] by strata's constant test), in [`shared`]'s order.
-fn constants(registry: &Registry) -> Vec<(String, ConstantValue)> {
+fn constants(registry: &Registry) -> Vec<GpuConstant> {
     let used: Vec<String> = MODULES
         .iter()
         .flat_map(|&id| module_constants(&registry.get(id.kernel()).module))
         .map(|(name, _)| name)
         .collect();
-    shared().into_iter().filter(|(name, _)| used.iter().any(|u| u == name)).map(|(n, v)| (n.to_string(), v)).collect()
+    shared().into_iter().filter(|c| used.iter().any(|u| u == c.name)).collect()
 }
 
 /// Writes the package into `out` (module documentation).
@@ -162,8 +162,8 @@ pub fn export(out: &Path) -> Result<Exported, ExportError> {
         structs: structs.iter().map(|s| manifest_struct(&s.entry)).collect(),
         constants: constants
             .iter()
-            .map(|(name, value)| manifest::ConstantEntry {
-                name: name.clone(),
+            .map(|&GpuConstant { name, value, .. }| manifest::ConstantEntry {
+                name: name.to_string(),
                 c_name: if name.starts_with("SAMPLER_") {
                     name.replacen("SAMPLER_", "STRATA_SAMPLER_", 1)
                 } else {
@@ -173,7 +173,7 @@ pub fn export(out: &Path) -> Result<Exported, ExportError> {
                     ConstantValue::U32(_) => "u32",
                     ConstantValue::F32(_) => "f32",
                 },
-                value: match *value {
+                value: match value {
                     ConstantValue::U32(v) => v.into(),
                     ConstantValue::F32(v) => serde_json::Number::from_f64(f64::from(v)).map_or(0.into(), Into::into),
                 },
@@ -196,7 +196,7 @@ pub fn export(out: &Path) -> Result<Exported, ExportError> {
             functions: "include/strata_frame.h: strata_frame_params, strata_max_blocks, strata_grid_shift".into(),
         },
         kernels,
-        variables: manifest::variables("SLOTS"),
+        variables: manifest::variables("HISTOGRAM_SLOTS_PER_WORKGROUP"),
         histogram_choice: manifest::histogram_choice(),
         device_requirements: device_requirements(registry),
     };

@@ -1,7 +1,7 @@
 //! `manifest.json`: everything an engine needs to create the pass's pipelines and bind
 //! its buffers without reading Rust, derived from naga's reflection of the kernels (the
 //! registry), the pass's buffer plan (`strata_kernels::pass_plan::Stage::bindings`,
-//! `PassBuffer::size_rule`) and the Rust twins of the structs: never written by hand.
+//! `PassBuffer::size_rule`) and the structs' single Rust declarations: never written by hand.
 //! Every field is documented here and, for readers of the package, in its README.
 
 use crate::translations::{MSL_SIZES_BUFFER, Translated};
@@ -900,7 +900,7 @@ mod tests {
         let registry = strata_kernels::Registry::shared().unwrap();
         let histogram = kernel_entry_dispatch(registry, ModuleId::Histogram);
         let select = kernel_entry_dispatch(registry, ModuleId::Select);
-        let variables = variables("SLOTS");
+        let variables = variables("HISTOGRAM_SLOTS_PER_WORKGROUP");
         let mut cases = 0;
         for block_size in [4, 8, 16, 32] {
             for block_shift in [false, true] {

@@ -11,8 +11,8 @@
 //! `strata.h`'s).
 
 use crate::ExportError;
-use crate::c_header::{HeaderStruct, c_name, comment, doc_above, rust_name, version_parts};
-use strata_kernels::gpu::ConstantValue;
+use crate::c_header::{HeaderStruct, c_name, comment, constant_doc, version_parts};
+use strata_kernels::gpu::{ConstantValue, GpuConstant};
 
 /// A shading language of the includes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -148,7 +148,7 @@ fn constant(language: Language, name: &str, value: ConstantValue) -> String {
 pub fn header(
     language: Language,
     structs: &[HeaderStruct],
-    constants: &[(String, ConstantValue)],
+    constants: &[GpuConstant],
     version: &str,
 ) -> Result<String, ExportError> {
     let file = language.file().trim_start_matches("include/");
@@ -175,12 +175,11 @@ pub fn header(
         h += &constant(language, &format!("STRATA_VERSION_{name}"), ConstantValue::U32(value));
     }
     h += "\n";
-    for (name, value) in constants {
-        let c = if name.starts_with("SAMPLER_") { format!("STRATA_{name}") } else { c_name(name) };
-        if let Some(doc) = doc_above(&format!("pub const {}:", rust_name(name)), None) {
+    for c in constants {
+        if let Some(doc) = constant_doc(c) {
             h += &comment(&doc, "");
         }
-        h += &constant(language, &c, *value);
+        h += &constant(language, &c_name(c.name), c.value);
     }
     for s in structs {
         let entry = &s.entry;

@@ -10,13 +10,13 @@
 //! size or sentinel), so a new constant is classified when it is written, and every
 //! shared constant is used by some kernel.
 
-use crate::gpu::ConstantValue;
+use crate::gpu::{ConstantValue, GpuConstant};
 
-/// Every constant the kernels share with the host, by its WGSL name, with its value: the
-/// constants of the generated modules ([`crate::wgsl_files::gpu_modules`]), each declared
-/// once in Rust with `gpu_constants!`, in the modules' order.
-pub fn shared() -> Vec<(&'static str, ConstantValue)> {
-    crate::wgsl_files::gpu_modules().iter().flat_map(|module| &module.constants).map(|c| (c.name, c.value)).collect()
+/// Every constant the kernels share with the host (WGSL name, value, doc): the constants
+/// of the generated modules ([`crate::wgsl_files::gpu_modules`]), each declared once in
+/// Rust with `gpu_constants!`, in the modules' order.
+pub fn shared() -> Vec<GpuConstant> {
+    crate::wgsl_files::gpu_modules().iter().flat_map(|module| module.constants.iter().copied()).collect()
 }
 
 /// WGSL constants no host code reads: a kernel's own sizes and sentinels.
@@ -85,7 +85,7 @@ mod tests {
                 if KERNEL_PRIVATE.contains(&name.as_str()) {
                     continue;
                 }
-                let Some(&(_, declared)) = shared.iter().find(|(shared, _)| *shared == name) else {
+                let Some(declared) = shared.iter().find(|c| c.name == name).map(|c| c.value) else {
                     panic!(
                         "{}: WGSL constant {name} is neither declared in Rust (gpu_constants!) nor listed in \
                          KERNEL_PRIVATE",
@@ -100,24 +100,25 @@ mod tests {
                 seen.insert(name);
             }
         }
-        for (name, _) in &shared {
-            assert!(seen.contains(*name), "{name}: no registry kernel uses it");
+        for constant in &shared {
+            assert!(seen.contains(constant.name), "{}: no registry kernel uses it", constant.name);
         }
     }
 
-    /// A WGSL constant that is neither shared nor kernel-private is found by the test's
-    /// lookup, as is a shared one: the names are compared, not assumed.
+    /// The reader gives each literal constant's name and value as WGSL wrote them, and
+    /// skips the others; no shared constant is also listed as kernel-private.
     #[test]
-    fn constants_are_found_by_their_wgsl_names() {
-        let shared = shared();
-        for name in ["SLOTS", "BLUE_NOISE_TILE", "MAX_SELECTED", "R2_STEP_X", "NO_PAYLOAD"] {
-            assert!(shared.iter().any(|(n, _)| *n == name), "{name}");
-        }
-        assert!(!shared.iter().any(|(n, _)| KERNEL_PRIVATE.contains(n)));
-        let module = naga::front::wgsl::parse_str("const INVALID_KEY: u32 = 7u;\nconst BELOW_ONE: f32 = 0.5;").unwrap();
-        for (name, value) in module_constants(&module) {
-            let declared = shared.iter().find(|(n, _)| *n == name).unwrap().1;
-            assert_ne!(value, declared, "{name}");
-        }
+    fn constants_are_read_by_name_and_value() {
+        let module = naga::front::wgsl::parse_str(
+            "const INVALID_KEY: u32 = 7u;\nconst BELOW_ONE: f32 = 0.5;\nconst V: vec2<u32> = vec2(1u);",
+        )
+        .unwrap();
+        let mut read = module_constants(&module);
+        read.sort_by(|a, b| a.0.cmp(&b.0));
+        assert_eq!(
+            read,
+            [("BELOW_ONE".to_string(), ConstantValue::F32(0.5)), ("INVALID_KEY".to_string(), ConstantValue::U32(7))]
+        );
+        assert!(!shared().iter().any(|c| KERNEL_PRIVATE.contains(&c.name)));
     }
 }

@@ -8,7 +8,7 @@ gpu_constants! {
     fn constants;
     /// Slots one workgroup of the histogram kernel sorts: 1024 / B² whole blocks per
     /// workgroup.
-    pub const HISTOGRAM_SLOTS_PER_WORKGROUP: u32 as "SLOTS" = 1024;
+    pub const HISTOGRAM_SLOTS_PER_WORKGROUP: u32 = 1024;
     /// `OBJECT_ID_NONE`: the pixel has no candidate (no hit and no environment, or no valid path).
     pub const OBJECT_ID_NONE: u32 = 0xffff_ffff;
     /// `OBJECT_ID_ENVIRONMENT`: the camera ray escaped; the environment is one cluster of its own.

@@ -80,10 +80,17 @@ pub fn gpu_module(path: &str) -> Option<GpuModule> {
 /// `ResampleOutput`, `NO_PAYLOAD`, ...), for an engine's own shaders that read the
 /// selections and write the resampling inputs: prepend it to the shader source.
 pub fn contract_wgsl() -> String {
-    // contract.wgsl imports the records of candidate.wgsl.
-    let fragments = crate::wgsl_imports::kernel_fragments("embed/contract.wgsl", &wgsl_file)
-        .unwrap_or_else(|error| panic!("{error}"));
-    crate::source::ComposedSource::compose(&fragments).text
+    // contract.wgsl imports the records of candidate.wgsl and the generated modules.
+    with_imports("embed/contract.wgsl").unwrap_or_else(|error| panic!("{error}"))
+}
+
+/// The WGSL file at `path` with every file it imports, directly or not, before it (the
+/// text a kernel of that entry file is made of): for a test or a tool that puts its own
+/// entry point after a file of `kernels/wgsl/`. An unknown path or a circle of imports is
+/// an error naming the files.
+pub fn with_imports(path: &str) -> Result<String, String> {
+    let fragments = crate::wgsl_imports::kernel_fragments(path, &wgsl_file)?;
+    Ok(crate::source::ComposedSource::compose(&fragments).text)
 }
 
 /// The file of `kernels/wgsl/` at `path` (relative to that folder), or the generated

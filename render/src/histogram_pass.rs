@@ -12,7 +12,7 @@ use strata_kernels::types::{BlockStats, Candidate, ClusterSpan};
 use strata_kernels::{BlockGrid, Executor, GridError, Kernel, KernelError, KernelId, Registry};
 use thiserror::Error;
 
-/// Slots one workgroup sorts (`SLOTS` in `strata/histogram.wgsl`).
+/// Slots one workgroup sorts (`HISTOGRAM_SLOTS_PER_WORKGROUP`, `strata/histogram.wgsl`).
 pub const SLOTS_PER_WORKGROUP: u32 = strata_kernels::types::HISTOGRAM_SLOTS_PER_WORKGROUP;
 
 /// Which entry point of the histogram kernel to run.

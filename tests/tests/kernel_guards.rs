@@ -4,8 +4,8 @@
 //! bound buffer's length (`arrayLength`).
 //!
 //! Each misuse of the package README's "Common mistakes" that shrinks a buffer (a
-//! candidate buffer sized for a smaller image, the selections at half size, ...) runs
-//! twice:
+//! candidate buffer sized for a smaller image, the selections at half size, ...), and
+//! selections left unwritten as the resampling's input, runs twice:
 //! - on the CPU interpreter with its sanitizer, which reports every access past a
 //!   buffer's end (what lies there is the guard area an engine's allocator would have
 //!   handed to something else). Without the guards each case below gives such findings:
@@ -208,6 +208,13 @@ fn misuses(cpu: &mut CpuBackend) -> Vec<Dispatch> {
     cases.push(resample("resampled at half size", &selected, n, n, n / 2));
     cases.push(resample("selections for a smaller image", &selected, smaller, n, n));
     cases.push(resample("inputs for a smaller image", &selected, n, smaller, n));
+    // Selections strata_select never wrote (the pixels its guards skip): their counts are
+    // whatever the buffer held, and must not become the resampling's loop bounds.
+    cases.push(resample("selections never written", &poisoned(n, 8), n, n, n));
+    // The right-sized runs that made the inputs above touched nothing outside either.
+    let (findings, dropped) = cpu.take_findings();
+    let undefined: Vec<String> = findings.iter().filter(|f| f.kind.undefined()).map(|f| f.to_string()).collect();
+    assert!(undefined.is_empty() && dropped == 0, "right-sized runs: {undefined:#?}");
     cases
 }
 
@@ -215,7 +222,6 @@ fn misuses(cpu: &mut CpuBackend) -> Vec<Dispatch> {
 fn no_kernel_of_the_package_reads_or_writes_past_a_buffer_too_small_for_its_image() {
     let mut cpu = sanitizing();
     let cases = misuses(&mut cpu);
-    let _ = cpu.take_findings();
     let mut lavapipe = ash();
     let mut outside = Vec::new();
     let mut disagree = Vec::new();
@@ -239,10 +245,9 @@ fn no_kernel_of_the_package_reads_or_writes_past_a_buffer_too_small_for_its_imag
     assert!(disagree.is_empty(), "the interpreter and lavapipe differ:\n{}", disagree.join("\n"));
 }
 
-/// The right-sized dispatches of the cases above give no finding either, and the
-/// shrunk ones leave the elements they still hold as a right-sized run writes them
-/// where the kernel's reads do not depend on the missing part: a guard drops what lies
-/// past the end, it does not change what lies inside.
+/// A shrunk buffer holds the elements a right-sized run writes there, where the kernel's
+/// reads do not depend on the missing part: a guard drops what lies past the end, it
+/// does not change what lies inside.
 #[test]
 fn a_guard_changes_nothing_inside_the_buffer() {
     let mut cpu = sanitizing();

@@ -212,7 +212,8 @@ fn queries() -> Vec<[u32; 4]> {
 
 /// Runs `strata/blue_noise.wgsl` (after the host) on `backend` and compares the bits.
 fn wgsl_matches_host(backend: &mut dyn Backend) {
-    let include = include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/../kernels/wgsl/strata/blue_noise.wgsl"));
+    // The file with what it imports (the table offsets of gpu/blue_noise.wgsl).
+    let include = strata_kernels::wgsl_files::with_imports("strata/blue_noise.wgsl").unwrap_or_else(|e| panic!("{e}"));
     let kernel = Kernel::from_wgsl("sampler_test.wgsl", format!("{include}\n{TEST_ENTRY}"), "sampler_test", false)
         .unwrap_or_else(|e| panic!("{e}"));
     let tables = BlueNoiseTables::new();

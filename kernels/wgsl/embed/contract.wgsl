@@ -6,8 +6,9 @@
 // index per pixel; the histogram pass sorts each block; strata_select gives every pixel K
 // payload indices of its own cluster's run at stratified positions; strata_resample,
 // given the engine's resampling weights, picks one by inverse CDF (paper §4.2, whose
-// functions are in strata/selection.wgsl). Self-contained with strata/candidate.wgsl, so
-// that an engine can prepend both to its own shaders (strata_embed::wgsl::contract_source).
+// functions are in strata/selection.wgsl). With what it imports (strata/candidate.wgsl and
+// the generated gpu/ modules) it is what an engine prepends to its own shaders
+// (strata_embed::wgsl::contract_source gives the whole text).
 
 // #import gpu/embed.wgsl
 // #import strata/candidate.wgsl

@@ -16,6 +16,7 @@
 // Every buffer access is guarded by the bound buffer's length (arrayLength): buffers too
 // small for the image lose the pixels past their end, nothing outside them is touched.
 
+// #import gpu/selection.wgsl
 // #import strata/resampling.wgsl
 // #import embed/contract.wgsl
 
@@ -44,7 +45,10 @@ fn strata_resample(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let selection = selections[pixel];
     let input = resample_inputs[pixel];
-    let k = selection.selected;
+    // At most MAX_SELECTED: a selection left unwritten (an engine's too-small buffers,
+    // whose pixels strata_select skips) must not make the loops below run for whatever
+    // its word holds.
+    let k = min(selection.selected, MAX_SELECTED);
     var ok = usable(input.canonical_weight) && usable(input.canonical_target);
     var total = input.canonical_weight;
     for (var slot = 0u; slot < k; slot++) {

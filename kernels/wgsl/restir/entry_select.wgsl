@@ -62,16 +62,12 @@ fn empty_reservoir() -> Reservoir {
     return Reservoir(PathCandidate(vec3<f32>(0.0), KIND_NONE, vec3<f32>(0.0), NO_LIGHT, vec3<f32>(0.0), 0.0), 0.0, 0.0, 0.0, 0u, vec3<f32>(0.0), 0.0);
 }
 
-@compute @workgroup_size(8, 8)
-fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    let pixel = image_pixel(id);
-    if pixel == NO_PIXEL {
-        return;
-    }
+// The reservoir `pixel` keeps from its own candidate and K selected ones; empty where it
+// does not resample.
+fn select_reservoir(id: vec3<u32>, pixel: u32, lane: u32) -> Reservoir {
     let p = primaries[pixel];
     if !begin_resampling(pixel, p, true, STREAM_SELECT) {
-        reservoirs_out[pixel] = empty_reservoir();
-        return;
+        return empty_reservoir();
     }
     let k = min(restir.candidates, MAX_SELECTED);
     var numbers = SelectionNumbers(vec4<f32>(0.0), 0.0);
@@ -105,9 +101,9 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
     // Pick one of {c, samples...} in proportion to its weight.
     let total = resampling_total(state);
     if !(total > 0.0) || !(total < INFINITY) {
-        reservoirs_out[pixel] = empty_reservoir();
-        reservoirs_out[pixel].count = 1.0;
-        return;
+        var none = empty_reservoir();
+        none.count = 1.0;
+        return none;
     }
     var chosen = c;
     var chosen_target = canonical.target_value;
@@ -122,5 +118,13 @@ fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_in
         result = Reservoir(chosen, total / chosen_target, 1.0, chosen_target, 0u, vec3<f32>(0.0), 0.0);
     }
     result.expected = resampling_expectation(state, canonical.target_value, colour_c);
-    reservoirs_out[pixel] = result;
+    return result;
+}
+
+@compute @workgroup_size(8, 8)
+fn restir_select(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let pixel = image_pixel(id);
+    if pixel != NO_PIXEL {
+        reservoirs_out[pixel] = select_reservoir(id, pixel, lane);
+    }
 }

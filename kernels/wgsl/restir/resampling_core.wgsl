@@ -54,9 +54,10 @@ const STREAM_SPATIAL: u32 = 0x5fa71au;
 const STREAM_TEMPORAL: u32 = 0x7e3907u;
 
 // Whether `pixel`, with primary `p`, resamples in a pass that is `enabled`: only a pixel
-// whose primary hit can hold a reservoir does (PRIMARY_RESAMPLE); the others keep what
-// their pass wrote for them before this call. A pixel that resamples has its random
-// numbers seeded from the pass's own `stream`.
+// whose primary hit can hold a reservoir does (PRIMARY_RESAMPLE); for the others the pass
+// returns what it gives a pixel that does not resample (its reservoir as it is, or an
+// empty one). A pixel that resamples has its random numbers seeded from the pass's own
+// `stream`.
 fn begin_resampling(pixel: u32, p: Primary, enabled: bool, stream: u32) -> bool {
     if !enabled || (p.flags & PRIMARY_RESAMPLE) == 0u {
         return false;

@@ -22,7 +22,7 @@
 //   3 storage, rw        array<ClusterSpan> per pixel: its own cluster's run
 //   4 storage, rw        array<BlockStats> per block
 //
-// Dispatch: 64 invocations per workgroup sort SLOTS = 1024 slots, i.e. 1024 / (B*B) whole
+// Dispatch: 64 invocations per workgroup sort HISTOGRAM_SLOTS_PER_WORKGROUP = 1024 slots, i.e. 1024 / (B*B) whole
 // blocks; workgroups = ceil(blocks / (1024 / (B*B))) in rows of params.workgroups_x.
 //
 // Sorting: bitonic, ELEMS = 16 elements per invocation held in vector registers.
@@ -58,8 +58,8 @@ const SENTINEL_KEY: u32 = 0xffffffffu;
 @group(0) @binding(4) var<storage, read_write> block_stats: array<BlockStats>;
 
 // The block's elements between relayouts: (cluster, key) and local pixel index.
-var<workgroup> shared_cluster_key: array<vec2<u32>, SLOTS>;
-var<workgroup> shared_local: array<u32, SLOTS>;
+var<workgroup> shared_cluster_key: array<vec2<u32>, HISTOGRAM_SLOTS_PER_WORKGROUP>;
+var<workgroup> shared_local: array<u32, HISTOGRAM_SLOTS_PER_WORKGROUP>;
 // Per segment (block of this workgroup): clusters, invalid, empty.
 var<workgroup> shared_stats: array<atomic<u32>, 192>;
 
@@ -557,7 +557,7 @@ struct BlockSetup {
 // Clears the workgroup's counters and places this invocation.
 fn setup_block_histogram(t: u32, workgroup_id: vec3<u32>) -> BlockSetup {
     let log_n = 2u * params.log2_block_size;
-    let segments = SLOTS >> log_n;
+    let segments = HISTOGRAM_SLOTS_PER_WORKGROUP >> log_n;
     let first_block = (workgroup_id.y * params.workgroups_x + workgroup_id.x) * segments;
     for (var i = t; i < 3u * MAX_SEGMENTS; i += INVOCATIONS) {
         atomicStore(&shared_stats[i], 0u);

@@ -67,6 +67,9 @@ pub struct GpuField {
     pub size: usize,
     /// Its WGSL type (`u32`, `vec3<f32>`, `array<u32, 4>`, `PathCandidate`).
     pub wgsl_type: Cow<'static, str>,
+    /// Its Rust type as declared (`[f32; 3]`), for the layout test to compare the scalar
+    /// a WGSL type given by hand holds with the Rust one's.
+    pub rust_type: &'static str,
     /// Its doc comment, one line per `///` line.
     pub doc: &'static str,
 }
@@ -260,6 +263,7 @@ macro_rules! gpu_struct {
                         offset: core::mem::offset_of!($name, $field),
                         size: size_of::<$ty>(),
                         wgsl_type: gpu_struct!(@wgsl $ty $(, $wgsl_type)?),
+                        rust_type: stringify!($ty),
                         doc: concat!($($field_doc, "\n"),*),
                     }
                 ),*]

@@ -11,8 +11,18 @@
 use crate::gpu::StructDeclaration;
 use naga::proc::Layouter;
 
+/// The scalar (`f32`, `u32`, `i32`) a type's text names, WGSL's or Rust's (`vec3<f32>`,
+/// `[u32; 4]`, `array<u32, 4>`); `None` for a struct or a type naming none or several.
+fn scalar_of(ty: &str) -> Option<&'static str> {
+    let words: Vec<&str> = ty.split(|c: char| !c.is_ascii_alphanumeric()).collect();
+    let mut found = ["f32", "u32", "i32"].into_iter().filter(|scalar| words.contains(scalar));
+    let scalar = found.next()?;
+    found.next().is_none().then_some(scalar)
+}
+
 /// Compares `declaration` with the struct of its name in `module`; the error lists every
-/// difference.
+/// difference, including a field whose WGSL type holds another scalar than its Rust type
+/// (same size, so only the values would be wrong).
 pub fn check_struct(declaration: &StructDeclaration, module: &naga::Module) -> Result<(), String> {
     let name = declaration.name;
     let (_, ty) = module
@@ -49,6 +59,14 @@ pub fn check_struct(declaration: &StructDeclaration, module: &naga::Module) -> R
             problems.push(format!(
                 "field `{}` ({}): WGSL size {wgsl_size}, Rust size {}",
                 field.name, field.wgsl_type, field.size
+            ));
+        }
+        if let (Some(wgsl), Some(rust)) = (scalar_of(&field.wgsl_type), scalar_of(field.rust_type))
+            && wgsl != rust
+        {
+            problems.push(format!(
+                "field `{}`: WGSL {} holds {wgsl}, Rust {} holds {rust}",
+                field.name, field.wgsl_type, field.rust_type
             ));
         }
     }
@@ -90,7 +108,7 @@ mod tests {
     /// `vec3<f32>` moves the next field, and a renamed or missing struct is named.
     #[test]
     fn a_wrong_wgsl_type_is_caught() {
-        let field = |name, offset, size, wgsl_type| GpuField { name, offset, size, wgsl_type, doc: "" };
+        let field = |name, offset, size, wgsl_type| GpuField { name, offset, size, wgsl_type, rust_type: "", doc: "" };
         let declaration = StructDeclaration {
             name: "Padded",
             doc: "",
@@ -107,5 +125,29 @@ mod tests {
         assert!(error.contains("field `position` (vec3<f32>): WGSL size 12, Rust size 16"), "{error}");
         let other = naga::front::wgsl::parse_str("struct Other { id: u32 }").unwrap();
         assert!(check_struct(&declaration, &other).unwrap_err().contains("no WGSL struct `Padded`"));
+    }
+
+    /// A field given the right size but another scalar by hand (`[f32; 4] as "vec4<u32>"`)
+    /// is caught; a struct field and an array of a struct are left to their own check.
+    #[test]
+    fn a_wgsl_type_of_another_scalar_is_caught() {
+        let declaration = StructDeclaration {
+            name: "Mixed",
+            doc: "",
+            size: 16,
+            fields: vec![GpuField {
+                name: "weights",
+                offset: 0,
+                size: 16,
+                wgsl_type: "vec4<u32>".into(),
+                rust_type: "[f32; 4]",
+                doc: "",
+            }],
+        };
+        let module = naga::front::wgsl::parse_str(&declaration.wgsl()).unwrap();
+        let error = check_struct(&declaration, &module).unwrap_err();
+        assert!(error.contains("field `weights`: WGSL vec4<u32> holds u32, Rust [f32; 4] holds f32"), "{error}");
+        assert_eq!(scalar_of("array<PathCandidate, 4>"), None);
+        assert_eq!(scalar_of("[u32; 2]"), Some("u32"));
     }
 }

@@ -15,7 +15,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::Duration;
-use strata_embed::contract::{Candidate, ResampleInput, ResampleOutput, SelectedCandidates};
+use strata_embed::contract::{ResampleInput, ResampleOutput, SelectedCandidates};
 use strata_embed::{SelectionSettings, WgpuBuffers, WgpuResampleBuffers, WgpuSelection};
 use wgpu::util::DeviceExt;
 
@@ -45,13 +45,7 @@ fn embed(c: &mut Criterion) {
         return;
     };
     let pixels = (WIDTH * HEIGHT) as usize;
-    // Keys with many levels, 6 objects in vertical bands, a few pixels without candidate.
-    let candidates: Vec<Candidate> = (0..pixels as u32)
-        .map(|p| Candidate {
-            key: ((p.wrapping_mul(2_654_435_761)) >> 20) as f32,
-            object_id: if p % 101 == 0 { u32::MAX } else { (p % WIDTH) / 214 },
-        })
-        .collect();
+    let candidates = strata_benches::engine_candidates(WIDTH, HEIGHT);
     let usage = wgpu::BufferUsages::STORAGE;
     let init =
         |contents: &[u8]| device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents, usage });

@@ -22,9 +22,9 @@ use strata_backends::ash_backend::{AshBackend, AshOptions, SpirvSource};
 use strata_backends::backend::upload;
 use strata_backends::{Backend, Bind};
 use strata_kernels::blue_noise::BlueNoiseTables;
-use strata_kernels::embed_types::{ResampleInput, SelectedCandidates, SelectionParams};
+use strata_kernels::embed_types::{SelectedCandidates, SelectionParams};
 use strata_kernels::selection::SamplerVariant;
-use strata_kernels::types::{BlockStats, Candidate, ClusterSpan};
+use strata_kernels::types::{BlockStats, ClusterSpan};
 use strata_kernels::{BlockGrid, Kernel, KernelId, Registry};
 
 const WIDTH: u32 = 1280;
@@ -58,14 +58,7 @@ fn guards(c: &mut Criterion) {
     };
     let registry = Registry::shared().expect("registry");
     let pixels = (WIDTH * HEIGHT) as usize;
-    // Keys with many levels, 6 objects in vertical bands, a few pixels without candidate
-    // (as the embed bench).
-    let candidates: Vec<Candidate> = (0..pixels as u32)
-        .map(|p| Candidate {
-            key: ((p.wrapping_mul(2_654_435_761)) >> 20) as f32,
-            object_id: if p % 101 == 0 { u32::MAX } else { (p % WIDTH) / 214 },
-        })
-        .collect();
+    let candidates = strata_benches::engine_candidates(WIDTH, HEIGHT);
     let grid = BlockGrid::new(WIDTH, HEIGHT, BLOCK).expect("grid");
     let workgroups = grid.histogram_workgroups(65_535);
     let histogram_params =
@@ -89,16 +82,7 @@ fn guards(c: &mut Criterion) {
     let payloads = upload(&mut backend, "payloads", &payloads).unwrap();
     let blue_noise = upload(&mut backend, "blue noise", &BlueNoiseTables::new().packed()).unwrap();
     let selections = zeroed(&mut backend, "selections", pixels * size_of::<SelectedCandidates>());
-    let inputs: Vec<ResampleInput> = (0..pixels as u32)
-        .map(|p| ResampleInput {
-            weights: [1.0, 0.5 * (p % 3) as f32, 2.0, 0.25],
-            targets: [1.0, 2.0, 3.0, 4.0],
-            canonical_weight: 0.25,
-            canonical_target: 0.5,
-            canonical_payload: p,
-            _pad: 0,
-        })
-        .collect();
+    let inputs = strata_tests::resample_inputs(pixels as u32, 0.25);
     let inputs = upload(&mut backend, "resample inputs", &inputs).unwrap();
     let resampled = zeroed(&mut backend, "resampled", pixels * 16);
 

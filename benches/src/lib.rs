@@ -9,3 +9,14 @@ pub fn benchmark_candidates() -> (u32, u32, Vec<Candidate>) {
     let (width, height) = (1024, 1024);
     (width, height, candidate_image(width, height, 2025, CandidateMix::default()))
 }
+
+/// The embedding benches' 1280 × 720 image: keys with many levels, 6 objects in vertical
+/// bands, a few pixels (one in 101) without a candidate.
+pub fn engine_candidates(width: u32, height: u32) -> Vec<Candidate> {
+    (0..width * height)
+        .map(|p| Candidate {
+            key: ((p.wrapping_mul(2_654_435_761)) >> 20) as f32,
+            object_id: if p % 101 == 0 { u32::MAX } else { (p % width) / 214 },
+        })
+        .collect()
+}

@@ -316,6 +316,22 @@ impl Drop for AshEngine {
     }
 }
 
+/// The resampling inputs the embedding tests and benches give pixel p of `count`: weights
+/// 1, 0.5 (p mod 3), 2 and `fourth_weight`, targets 1 to 4, a canonical sample of weight
+/// 0.25 and target 0.5 whose payload is p.
+pub fn resample_inputs(count: u32, fourth_weight: f32) -> Vec<strata_embed::contract::ResampleInput> {
+    (0..count)
+        .map(|p| strata_embed::contract::ResampleInput {
+            weights: [1.0, 0.5 * (p % 3) as f32, 2.0, fourth_weight],
+            targets: [1.0, 2.0, 3.0, 4.0],
+            canonical_weight: 0.25,
+            canonical_target: 0.5,
+            canonical_payload: p,
+            _pad: 0,
+        })
+        .collect()
+}
+
 /// The engine's inputs of one run of the embeddable pass.
 pub struct EmbedInputs<'a> {
     /// Image width.

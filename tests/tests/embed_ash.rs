@@ -17,16 +17,7 @@ fn inputs() -> (Vec<Candidate>, Vec<u32>, Vec<ResampleInput>) {
         .map(|p| Candidate { key: ((p * 7919) % 101) as f32 * 0.1, object_id: (p % WIDTH) / 17 + 3 * (p / WIDTH / 9) })
         .collect();
     let payloads = (0..pixels).map(|p| p ^ 0x55).collect();
-    let resample = (0..pixels)
-        .map(|p| ResampleInput {
-            weights: [1.0, 0.5 * (p % 3) as f32, 2.0, 0.0],
-            targets: [1.0, 2.0, 3.0, 4.0],
-            canonical_weight: 0.25,
-            canonical_target: 0.5,
-            canonical_payload: p,
-            _pad: 0,
-        })
-        .collect();
+    let resample = strata_tests::resample_inputs(pixels, 0.0);
     (candidates, payloads, resample)
 }
 

@@ -23,7 +23,7 @@ use strata_backends::backend::{download, upload};
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
 use strata_backends::{Backend, BackendError, Bind, gpu_required};
 use strata_kernels::blue_noise::BlueNoiseTables;
-use strata_kernels::embed_types::{ResampleInput, SelectionParams};
+use strata_kernels::embed_types::SelectionParams;
 use strata_kernels::selection::SamplerVariant;
 use strata_kernels::types::{BlockStats, Candidate, ClusterSpan};
 use strata_kernels::{BlockGrid, KernelId, Registry};
@@ -126,16 +126,7 @@ fn select(label: &str, histogram: &(Vec<u32>, Vec<u32>), sizes: [u32; 6], identi
 
 /// strata_resample with `selections`, `inputs` and `outputs` elements.
 fn resample(label: &str, selected: &[u32], selections: u32, inputs: u32, outputs: u32) -> Dispatch {
-    let resample_inputs: Vec<ResampleInput> = (0..inputs)
-        .map(|p| ResampleInput {
-            weights: [1.0, 0.5 * (p % 3) as f32, 2.0, 0.0],
-            targets: [1.0, 2.0, 3.0, 4.0],
-            canonical_weight: 0.25,
-            canonical_target: 0.5,
-            canonical_payload: p,
-            _pad: 0,
-        })
-        .collect();
+    let resample_inputs = strata_tests::resample_inputs(inputs, 0.0);
     Dispatch {
         label: format!("strata_resample: {label}"),
         kernel: KernelId::StrataResample,

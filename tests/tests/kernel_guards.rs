@@ -27,14 +27,14 @@ use strata_kernels::embed_types::SelectionParams;
 use strata_kernels::selection::SamplerVariant;
 use strata_kernels::types::{BlockStats, Candidate, ClusterSpan};
 use strata_kernels::{BlockGrid, KernelId, Registry};
+use strata_tests::POISON;
 
 const WIDTH: u32 = 20;
 const HEIGHT: u32 = 12;
 const BLOCK: u32 = 8;
-const POISON: u32 = 0xdead_beef;
 
-/// One dispatch: the kernel, its buffers as words by binding (`None`: a uniform given as
-/// words too, never shrunk), and the workgroups.
+/// One dispatch: the kernel, its buffers as words by binding (the uniform too, never
+/// shrunk), and the workgroups.
 struct Dispatch {
     label: String,
     kernel: KernelId,

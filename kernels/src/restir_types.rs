@@ -90,8 +90,21 @@ gpu_struct! {
         /// 1: a glossy conductor (GGX alpha below `min_roughness`) resamples at its own vertex
         /// by random replay instead of passing as a smooth vertex of the chain.
         pub replay: u32,
+        /// 1: permutation sampling of the temporal source (RTXDI's decorrelation): the
+        /// reprojected previous pixel is mirrored within its aligned 4 x 4 group, the
+        /// groups shifted by a per-frame random offset, so that neighbouring pixels take
+        /// their histories from each other's places (`restir/entry_temporal_keys.wgsl`).
+        pub permutation_sampling: u32,
+        /// Strength of the boiling filter in (0, 1] (RTXDI's; biased): after the temporal
+        /// merge a reservoir whose W exceeds the workgroup's mean nonzero W by the factor
+        /// 10 / strength - 9 is emptied (`restir/entry_temporal.wgsl`); 0: off.
+        pub boiling_filter: f32,
         /// Padding.
         pub _pad2: u32,
+        /// Padding.
+        pub _pad3: u32,
+        /// Padding.
+        pub _pad4: u32,
     }
 }
 

@@ -41,6 +41,15 @@
 //   16 storage, read     array<u32>          temporal sources (restir_temporal_keys)
 //   17 storage, read     array<u32>          blue_noise (BlueNoiseTables::packed)
 //
+// Boiling filter (RestirParams.boiling_filter > 0; RTXDI's, biased): a sample found with a
+// tiny source density carries a large W, and reuse spreads it over a neighbourhood, which
+// flashes ("boiling"). After the merge, every pixel of an 8 x 8 workgroup compares its W
+// with the mean W of the workgroup's nonzero reservoirs and empties its reservoir (no
+// sample, M = 0, no expectation) when W exceeds it by the factor 10 / strength - 9. The
+// sum runs over the workgroup in the same order on every lane (deterministic on every
+// backend). It removes light wherever such samples are the right answer: biased, measured
+// in BENCHMARKS.md ("What the viewer sees").
+//
 // Dispatch: 8 x 8 pixels per workgroup. Shadow rays: 2 per merged previous reservoir; a
 // replay pixel traces 2 paths per merged reservoir instead, and one more for the
 // expectation when select kept another pixel's sample.
@@ -177,10 +186,52 @@ fn temporal_merge(id: vec3<u32>, pixel: u32, lane: u32) -> Reservoir {
     return merged;
 }
 
+// The W of each lane's merged reservoir (0: none), for the boiling filter.
+var<workgroup> boiling_weights: array<f32, 64>;
+
+// `merged` as the boiling filter leaves it (see the header): emptied when its W exceeds
+// the workgroup's mean nonzero W by the strength's factor. Called by every lane of the
+// workgroup (it synchronizes them); `weight` is this lane's W, 0 past the image's edge.
+fn boiling_filter(merged: Reservoir, weight: f32, lane: u32) -> Reservoir {
+    boiling_weights[lane] = weight;
+    workgroupBarrier();
+    var sum = 0.0;
+    var nonzero = 0u;
+    for (var i = 0u; i < 64u; i++) {
+        let w = boiling_weights[i];
+        if w > 0.0 {
+            sum += w;
+            nonzero += 1u;
+        }
+    }
+    let factor = 10.0 / clamp(restir.boiling_filter, 1e-6, 1.0) - 9.0;
+    if nonzero == 0u || !(weight > factor * sum / f32(nonzero)) {
+        return merged;
+    }
+    var empty = merged;
+    empty.weight = 0.0;
+    empty.count = 0.0;
+    empty.target_value = 0.0;
+    empty.expected = vec3<f32>(0.0);
+    return empty;
+}
+
 @compute @workgroup_size(8, 8)
 fn restir_temporal(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     let pixel = image_pixel(id);
+    var merged: Reservoir;
+    var weight = 0.0;
     if pixel != NO_PIXEL {
-        merged_reservoirs[pixel] = temporal_merge(id, pixel, lane);
+        merged = temporal_merge(id, pixel, lane);
+        if merged.weight > 0.0 && merged.weight < INFINITY {
+            weight = merged.weight;
+        }
+    }
+    // A uniform condition: every lane of the workgroup reaches the filter's barrier.
+    if restir.temporal != 0u && restir.boiling_filter > 0.0 {
+        merged = boiling_filter(merged, weight, lane);
+    }
+    if pixel != NO_PIXEL {
+        merged_reservoirs[pixel] = merged;
     }
 }

@@ -10,6 +10,17 @@
 // an invalid key (it sorts last in the run; drawing it gives an empty slot), so a
 // disoccluded pixel can still draw its neighbours' histories.
 //
+// Permutation sampling (RestirParams.permutation_sampling; RTXDI's decorrelation of the
+// history): the reprojected pixel is replaced by its mirror image within an aligned 4 x 4
+// group of pixels (x -> x XOR 3, y -> y XOR 3), the groups shifted by an offset of 0-3
+// pixels per axis that changes every frame. Within a frame this is a permutation of the
+// image (mirroring is its own inverse), so each previous reservoir still feeds about one
+// pixel, but no longer the pixel at the same place: the chains of history that make
+// neighbouring pixels' errors alike are broken up frame by frame. The permuted pixel
+// must pass the same similarity test; otherwise the reprojected one is used. Unbiased:
+// which source a pixel takes depends on the G-buffers alone, and the temporal merge
+// weighs whatever source it is given by pairwise MIS with targets evaluated at both ends.
+//
 // Bindings (group 0): 0-7 the scene, 8 RestirParams, and
 //   9  storage, read     array<Primary>    this frame's G-buffer
 //   10 storage, read     array<Primary>    the previous frame's G-buffer
@@ -20,6 +31,7 @@
 // Dispatch: 8 x 8 pixels per workgroup.
 
 // #import render/scene.wgsl
+// #import render/random.wgsl
 // #import strata/candidate.wgsl
 // #import restir/reservoir.wgsl
 
@@ -48,6 +60,28 @@ fn reproject(position: vec3<f32>) -> u32 {
     return u32(py) * params.width + u32(px);
 }
 
+// Whether the previous frame's pixel `q` saw the same surface as `p` (not a disocclusion).
+fn same_surface(p: Primary, q: u32) -> bool {
+    let previous = previous_primaries[q];
+    return (previous.flags & PRIMARY_RESAMPLE) != 0u && previous.object_id == p.object_id && may_share(previous, p)
+        && dot(previous.normal, p.normal) >= 0.906 && abs(previous.depth - p.depth) <= 0.1 * p.depth;
+}
+
+// Pixel `q` of the previous frame permuted (see the header): mirrored within its 4 x 4
+// group, the groups shifted by this frame's offset; `q` itself where the mirror image
+// falls outside the image.
+fn permuted(q: u32) -> u32 {
+    let frame_bits = pcg_hash(params.seed ^ pcg_hash(params.sample_index + 0x9e3779b9u));
+    let offset = vec2<u32>(frame_bits & 3u, (frame_bits >> 2u) & 3u);
+    let position = vec2<u32>(q % params.width, q / params.width);
+    // Shift, mirror, shift back: + 4 keeps the shifted position from wrapping below 0.
+    let mirrored = (((position + 4u - offset) ^ vec2<u32>(3u)) + offset) - vec2<u32>(4u);
+    if mirrored.x >= params.width || mirrored.y >= params.height {
+        return q;
+    }
+    return mirrored.y * params.width + mirrored.x;
+}
+
 @compute @workgroup_size(8, 8)
 fn restir_temporal_keys(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= params.width || id.y >= params.height {
@@ -62,11 +96,15 @@ fn restir_temporal_keys(@builtin(global_invocation_id) id: vec3<u32>) {
         object = p.object_id;
         // The point the pixel sees: its resampling vertex, or the smooth surface in front
         // of it (Primary.camera_hit).
-        let q = reproject(p.camera_hit);
+        var q = reproject(p.camera_hit);
+        if q != NO_SOURCE && restir.permutation_sampling != 0u {
+            let swapped = permuted(q);
+            if same_surface(p, swapped) {
+                q = swapped;
+            }
+        }
         if q != NO_SOURCE {
-            let previous = previous_primaries[q];
-            if (previous.flags & PRIMARY_RESAMPLE) != 0u && previous.object_id == p.object_id && may_share(previous, p)
-                && dot(previous.normal, p.normal) >= 0.906 && abs(previous.depth - p.depth) <= 0.1 * p.depth {
+            if same_surface(p, q) {
                 source = q;
                 let reservoir = previous_reservoirs[q];
                 let estimate = reservoir.target_value * reservoir.weight;

@@ -250,6 +250,29 @@ pub struct RestirSettings {
     /// with the same weights, and the renderer runs the spatial-first passes (two fewer).
     #[cfg_attr(feature = "clap", arg(long, value_enum, default_value_t = RestirSettings::default().reuse_order))]
     pub reuse_order: ReuseOrder,
+    /// Permutation sampling of the temporal source, for every method that reuses history
+    /// (RTXDI's decorrelation, on by default there): each pixel takes the history of a
+    /// pixel up to 3 away from where it reprojects, a per-frame permutation of the image,
+    /// so that neighbours' histories stop chaining. Unbiased (the pairwise MIS weights
+    /// evaluate the target at the source actually used; tested).
+    ///
+    /// Within each aligned 4 x 4 group of pixels, shifted by a per-frame random offset,
+    /// x and y are mirrored; a permuted source on another surface (the same similarity
+    /// test as reprojection) falls back to the reprojected pixel.
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, default_value_t = RestirSettings::default().permutation_sampling, action = clap::ArgAction::Set)
+    )]
+    pub permutation_sampling: bool,
+    /// Strength of RTXDI's boiling filter after each temporal merge, 0 (off) to 1:
+    /// a reservoir whose contribution weight W exceeds its 8 x 8 workgroup's mean nonzero
+    /// W by the factor 10 / strength - 9 is emptied (at 1, anything above the mean).
+    ///
+    /// Biased by design: it removes rare bright samples (the "boiling" flashes reuse spreads
+    /// over a neighbourhood), so the image darkens where they carry light; BENCHMARKS.md
+    /// ("What the viewer sees") gives the measured bias.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = RestirSettings::default().boiling_filter))]
+    pub boiling_filter: f32,
 }
 
 impl Default for RestirSettings {
@@ -268,6 +291,8 @@ impl Default for RestirSettings {
             shaded_parts: ShadedParts::All,
             shading: Shading::Expectation,
             reuse_order: ReuseOrder::TemporalFirst,
+            permutation_sampling: false,
+            boiling_filter: 0.0,
         }
     }
 }
@@ -296,6 +321,8 @@ impl RestirSettings {
             min_roughness: run.min_roughness,
             specular_chain: run.specular_chain,
             replay: u32::from(run.glossy_replay),
+            permutation_sampling: u32::from(run.permutation_sampling),
+            boiling_filter: run.boiling_filter,
             temporal_candidates: run.temporal_candidates,
             shaded_parts: run.shaded_parts.bits(),
             shading: match run.shading {
@@ -308,7 +335,7 @@ impl RestirSettings {
 
     /// What a frame runs of these settings: themselves, but for [`Method::Ris`], which
     /// reuses nothing: K = 0 (no slot is drawn), no temporal reuse, no drawn previous
-    /// reservoirs, and the paper's order of passes (with K = 0 and no history both orders
+    /// reservoirs, no permutation or boiling filter (both act on the temporal merge), and the paper's order of passes (with K = 0 and no history both orders
     /// keep each pixel's canonical candidate; the paper's runs two passes fewer). The one
     /// place that says what ris leaves out; [`RestirSettings::check`] is for the settings
     /// as given (K = 0 is no setting a user may choose).
@@ -322,6 +349,8 @@ impl RestirSettings {
             temporal: false,
             temporal_candidates: 0,
             reuse_order: ReuseOrder::SpatialFirst,
+            permutation_sampling: false,
+            boiling_filter: 0.0,
             ..self
         }
     }
@@ -351,6 +380,12 @@ impl RestirSettings {
             return Err(PassError::Input(format!(
                 "min roughness {}: must be a GGX alpha of 0 or more",
                 self.min_roughness
+            )));
+        }
+        if !(0.0..=1.0).contains(&self.boiling_filter) {
+            return Err(PassError::Input(format!(
+                "boiling filter {}: must be 0 (off) to 1 (strongest)",
+                self.boiling_filter
             )));
         }
         if self.specular_chain > MAX_SPECULAR_CHAIN {
@@ -409,6 +444,10 @@ mod tests {
             "base",
             "--shading",
             "sample",
+            "--permutation-sampling",
+            "true",
+            "--boiling-filter",
+            "0.2",
         ])
         .unwrap()
         .restir;
@@ -424,6 +463,8 @@ mod tests {
             min_distance: 0.01,
             shaded_parts: ShadedParts::Base,
             shading: Shading::Sample,
+            permutation_sampling: true,
+            boiling_filter: 0.2,
             ..RestirSettings::default()
         };
         assert_eq!(moved, want);

@@ -7,7 +7,7 @@ use strata_backends::Backend;
 use strata_backends::backend::download;
 use strata_kernels::block_grid::frame_shift;
 use strata_kernels::denoise_types::DenoiseGuide;
-use strata_render::denoise::{Denoiser, SvgfDenoiser};
+use strata_render::denoise::{Denoiser, OidnDenoiser, OidnError, OidnLibrary, SvgfDenoiser};
 use strata_render::histogram_pass::PassError;
 use strata_render::render::{GpuScene, RenderSettings};
 use strata_render::restir::{Method, RestirRenderer, RestirSettings};
@@ -126,11 +126,24 @@ fn measure(
     })
 }
 
+/// The denoiser of one method and seed's frames.
+enum FrameDenoiser {
+    /// SVGF's kernels on the run's backend, its history carried from frame to frame.
+    Svgf(SvgfDenoiser),
+    /// OIDN on the CPU: each frame's colour and guides downloaded and filtered alone.
+    Oidn(OidnDenoiser),
+}
+
+/// `error` as the one line the command prints: `--denoise oidn: ...`.
+pub fn oidn_error(error: OidnError) -> PassError {
+    PassError::Input(format!("--denoise oidn: {error}"))
+}
+
 /// Renders every method × seed × frame of `comparison` and measures each frame against
 /// its reference (`references[frame]`, or `references[0]` for every frame); `on_frame`
-/// sees every frame ([`SeenFrame`]). The denoiser filters each frame as rendered, its history
-/// carried from frame to frame (also without temporal reuse, where the raw image scored
-/// is the mean of the frames so far).
+/// sees every frame ([`SeenFrame`]). The denoiser filters each frame as rendered (also
+/// without temporal reuse, where the raw image scored is the mean of the frames so far):
+/// SVGF with its history carried from frame to frame, OIDN each frame alone.
 pub fn run_comparison(
     backend: &mut dyn Backend,
     scene: &GpuScene,
@@ -141,6 +154,11 @@ pub fn run_comparison(
     mut on_frame: impl FnMut(SeenFrame<'_>),
 ) -> Result<ComparisonErrors, PassError> {
     let mut errors = ComparisonErrors::default();
+    // OIDN's library, found once for the whole run.
+    let oidn = match comparison.denoise {
+        Some(Denoiser::Oidn) => Some(OidnLibrary::find().map_err(oidn_error)?),
+        _ => None,
+    };
     for &method in &comparison.methods {
         for &seed in &comparison.seeds {
             let settings = RestirSettings { method, ..comparison.restir };
@@ -158,7 +176,16 @@ pub fn run_comparison(
                 if let Some(chosen) = comparison.denoise {
                     renderer.enable_guides(backend)?;
                     let (width, height) = (render.camera.width, render.camera.height);
-                    denoiser = Some(SvgfDenoiser::new(backend, width, height, chosen.settings())?);
+                    denoiser = Some(match chosen.svgf_settings() {
+                        Some(settings) => FrameDenoiser::Svgf(SvgfDenoiser::new(backend, width, height, settings)?),
+                        None => {
+                            let library = match oidn {
+                                Some(library) => library,
+                                None => OidnLibrary::find().map_err(oidn_error)?,
+                            };
+                            FrameDenoiser::Oidn(OidnDenoiser::new(library, width, height).map_err(oidn_error)?)
+                        }
+                    });
                 }
                 for frame in 0..comparison.frames {
                     let camera = comparison.cameras.get(frame as usize);
@@ -177,10 +204,19 @@ pub fn run_comparison(
                     }
                     let denoised = match (&mut denoiser, renderer.denoiser_inputs()) {
                         (Some(denoiser), Some(inputs)) => {
-                            let output =
-                                denoiser.denoise(backend, inputs.colour, inputs.guides, inputs.previous_guides)?;
-                            let pixels: Vec<[f32; 4]> = download(backend, output)?;
-                            let denoised = RgbImage::from_rgba(image.width, image.height, &pixels);
+                            let denoised = match denoiser {
+                                FrameDenoiser::Svgf(svgf) => {
+                                    let output =
+                                        svgf.denoise(backend, inputs.colour, inputs.guides, inputs.previous_guides)?;
+                                    let pixels: Vec<[f32; 4]> = download(backend, output)?;
+                                    RgbImage::from_rgba(image.width, image.height, &pixels)
+                                }
+                                FrameDenoiser::Oidn(oidn) => {
+                                    let colour: Vec<[f32; 4]> = download(backend, inputs.colour)?;
+                                    let guides: Vec<DenoiseGuide> = download(backend, inputs.guides)?;
+                                    oidn.denoise_frame(&colour, &guides).map_err(oidn_error)?
+                                }
+                            };
                             super::image_checks::check_frame(&denoised, &format!("{name}, denoised"))
                                 .map_err(|e| PassError::Input(e.to_string()))?;
                             errors.denoised.push(measure(method, frame, seed, &denoised, reference, comparison)?);
@@ -230,8 +266,8 @@ pub fn run_comparison(
                 }
                 Ok(())
             })();
-            if let Some(denoiser) = denoiser {
-                denoiser.destroy(backend)?;
+            if let Some(FrameDenoiser::Svgf(svgf)) = denoiser {
+                svgf.destroy(backend)?;
             }
             renderer.destroy(backend)?;
             result?;

@@ -221,20 +221,23 @@ pub fn run_and_report(
     }
     if !measured.denoised.is_empty() {
         let denoised = &measured.denoised;
-        let heading = "After SVGF denoising (each method's frames as rendered, filtered alike): RelMSE, mean ± 95% CI \
-                       over seeds:";
-        let relmse = summary::relmse_table(denoised, &options.methods, &shown, heading);
+        let filter = comparison.denoise.map_or("the denoiser", |d| d.title());
+        let heading = format!(
+            "After {filter} denoising (each method's frames as rendered, filtered alike): RelMSE, mean ± 95% CI over \
+             seeds:"
+        );
+        let relmse = summary::relmse_table(denoised, &options.methods, &shown, &heading);
         text += &relmse.to_text();
         tables.push(relmse);
         for line in summary::whole_run_lines(denoised, frames) {
-            text += &format!("after SVGF, {line}\n");
+            text += &format!("after {filter}, {line}\n");
         }
         let more = [
             summary::flip_table(denoised, &options.methods, &shown),
             summary::block_edge_table(denoised, &options.methods, &shown, block_size),
         ];
         for mut table in more.into_iter().flatten() {
-            table.title = format!("After SVGF denoising: {}", table.title);
+            table.title = format!("After {filter} denoising: {}", table.title);
             text += &table.to_text();
             tables.push(table);
         }

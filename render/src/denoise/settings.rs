@@ -18,6 +18,11 @@ pub enum Denoiser {
     /// as its temporal pass does: not in the paper; around lights it removes most of the
     /// paper's filter's error (BENCHMARKS.md).
     SvgfObjects,
+    /// Intel Open Image Denoise's `RT` filter (the neural denoiser of Blender/Cycles) on
+    /// the CPU, with the guides' albedo and normal: spatial only, each frame filtered on
+    /// its own with no history. Its library is opened at run time (`pip install
+    /// pyoidn==2.5.1.0`, or set STRATA_OIDN_LIBRARY to libOpenImageDenoise.so.2).
+    Oidn,
 }
 
 impl Denoiser {
@@ -26,14 +31,24 @@ impl Denoiser {
         match self {
             Denoiser::Svgf => "svgf",
             Denoiser::SvgfObjects => "svgf-objects",
+            Denoiser::Oidn => "oidn",
         }
     }
 
-    /// Its settings.
-    pub fn settings(self) -> SvgfSettings {
+    /// The filter's name in headings: `SVGF` (either configuration) or `OIDN`.
+    pub fn title(self) -> &'static str {
         match self {
-            Denoiser::Svgf => SvgfSettings::default(),
-            Denoiser::SvgfObjects => SvgfSettings::default().with_object_edges(true),
+            Denoiser::Svgf | Denoiser::SvgfObjects => "SVGF",
+            Denoiser::Oidn => "OIDN",
+        }
+    }
+
+    /// Its SVGF settings; `None` for OIDN, which is not SVGF and takes none.
+    pub fn svgf_settings(self) -> Option<SvgfSettings> {
+        match self {
+            Denoiser::Svgf => Some(SvgfSettings::default()),
+            Denoiser::SvgfObjects => Some(SvgfSettings::default().with_object_edges(true)),
+            Denoiser::Oidn => None,
         }
     }
 }

@@ -13,7 +13,7 @@ use strata::evaluation::record::{self, RunRecord};
 use strata::evaluation::report::{OtherRegime, ReportOptions, run_and_report};
 use strata::progress::Progress;
 use strata_render::backend_choice::{BackendChoice, open_backend};
-use strata_render::denoise::Denoiser;
+use strata_render::denoise::{Denoiser, OidnLibrary};
 use strata_render::render::{Film, GpuScene, RenderSettings};
 use strata_render::restir::{Method, RestirSettings};
 use strata_render::rgb_image::RgbImage;
@@ -94,9 +94,11 @@ pub(crate) struct CompareArgs {
     exposure: f32,
     /// Also measure every frame after a denoiser: `svgf` (Schied et al. 2017, with the
     /// paper's settings) or `svgf-objects` (its spatial filters also stop at object
-    /// boundaries), applied alike to every method's frames as rendered, its history
-    /// reprojected from frame to frame. Writes `errors_denoised.csv`, the denoised
-    /// previews and the same tables for them.
+    /// boundaries), its history reprojected from frame to frame, or `oidn` (Intel Open
+    /// Image Denoise on the CPU with the albedo and normal guides, each frame alone; `pip
+    /// install pyoidn==2.5.1.0`, or set STRATA_OIDN_LIBRARY to libOpenImageDenoise.so.2),
+    /// applied alike to every method's frames as rendered. Writes `errors_denoised.csv`,
+    /// the denoised previews and the same tables for them.
     #[arg(long, value_enum)]
     denoise: Option<Denoiser>,
     /// Also run every method and seed in the other regime, against the same reference:
@@ -191,6 +193,10 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
     let restir = args.restir;
     // Refused settings are said before the reference takes its minutes.
     restir.check()?;
+    if args.denoise == Some(Denoiser::Oidn) {
+        let library = OidnLibrary::find().map_err(strata::evaluation::compare::oidn_error)?;
+        println!("denoiser: Open Image Denoise, {}", library.path());
+    }
     let gpu_scene = GpuScene::build(&scene)?;
     let mut backend = open_backend(args.backend)?;
     println!("backend: {}", backend.info().summary());

@@ -121,7 +121,10 @@ pub struct DenoiserInputs {
 
 impl RestirRenderer {
     /// Uploads the scene and creates every buffer; `render` gives the camera (its image
-    /// size), seed, depths and Russian roulette (light sampling is always MIS).
+    /// size), seed, depths and Russian roulette (light sampling is always MIS). The
+    /// renderer is not told whether its camera will move: [`ReuseOrder::Auto`] runs the
+    /// still camera's order, so a caller whose camera moves resolves it first
+    /// ([`RestirSettings::for_camera`], as `strata compare` does).
     pub fn new(
         backend: &mut dyn Backend,
         scene: &GpuScene,
@@ -130,7 +133,7 @@ impl RestirRenderer {
         scene_extent: f32,
     ) -> Result<Self, PassError> {
         settings.check()?;
-        let settings = settings.as_run();
+        let settings = settings.as_run().for_camera(false);
         let registry = Registry::shared()?;
         let kernels = [
             KernelId::RestirCandidates,
@@ -175,7 +178,8 @@ impl RestirRenderer {
                     merged: backend.create_buffer("merged reservoirs", pixels * size_of::<Reservoir>() as u64)?,
                 })
             }
-            ReuseOrder::TemporalFirst | ReuseOrder::SpatialFirst => None,
+            // (Auto was resolved above.)
+            ReuseOrder::TemporalFirst | ReuseOrder::SpatialFirst | ReuseOrder::Auto => None,
         };
         let scene_buffers = SceneBuffers::upload(backend, scene)?;
         let mut params = render.params(&scene.params)?;

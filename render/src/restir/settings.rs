@@ -116,19 +116,27 @@ pub enum Shading {
 #[derive(serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ReuseOrder {
+    /// By the camera, the default since 2026-11-29: `temporal-first` while the camera
+    /// stands still, `spatial-first` when it moves. Measured (BENCHMARKS.md, "What the
+    /// viewer sees"): still, temporal-first lowers every method's error over frames 1-32
+    /// to 0.75-0.90 of the paper's order's; under an orbit spatial-first gives the same raw
+    /// RelMSE, 1 % less after SVGF, 8-11 % lower FLIP raw and after SVGF, and half the
+    /// correlated error after SVGF. A renderer not told whether its camera moves runs
+    /// `temporal-first` (`RestirRenderer::new`).
+    #[default]
+    Auto,
     /// The paper's (§5.1), and the default before 2026-11-27: the spatial selection on
     /// this frame's candidates, then the temporal merge of its result with the history.
     /// The stratification acts on the current frame's candidates only, whose share of
     /// each merge fades as the history grows.
     SpatialFirst,
-    /// The standard ReSTIR order (Bitterli et al. 2020), the default: each pixel's
-    /// candidate merges with its history first, then the histogram sorts the merged
-    /// reservoirs by their estimates p̂ W and the spatial selection reuses K of them
+    /// The standard ReSTIR order (Bitterli et al. 2020), the default for a still camera:
+    /// each pixel's candidate merges with its history first, then the histogram sorts the
+    /// merged reservoirs by their estimates p̂ W and the spatial selection reuses K of them
     /// (pairwise MIS with confidence weights: `restir/entry_spatial.wgsl`); the spatial
     /// result is the history of the next frame. Two more passes per frame, about 2 %
     /// more time, and every method's error lower over frames 1-32 (BENCHMARKS.md, "The
     /// temporal lever").
-    #[default]
     TemporalFirst,
 }
 
@@ -136,8 +144,19 @@ impl ReuseOrder {
     /// The name used on the command line.
     pub fn name(self) -> &'static str {
         match self {
+            ReuseOrder::Auto => "auto",
             ReuseOrder::SpatialFirst => "spatial-first",
             ReuseOrder::TemporalFirst => "temporal-first",
+        }
+    }
+
+    /// The order a render runs: [`ReuseOrder::Auto`] resolved by whether the camera
+    /// moves (spatial-first) or stands still (temporal-first); the others as they are.
+    pub fn for_camera(self, moving: bool) -> ReuseOrder {
+        match self {
+            ReuseOrder::Auto if moving => ReuseOrder::SpatialFirst,
+            ReuseOrder::Auto => ReuseOrder::TemporalFirst,
+            order => order,
         }
     }
 }
@@ -241,10 +260,11 @@ pub struct RestirSettings {
     #[cfg_attr(feature = "clap", arg(long, value_enum, default_value_t = RestirSettings::default().shading))]
     pub shading: Shading,
     /// The order of reuse, for every method alike: `temporal-first` (the standard ReSTIR
-    /// order, the default since 2026-11-27: merge the history into each pixel's
-    /// candidate, then select among the block's merged reservoirs, sorted by their
-    /// estimates) or `spatial-first` (the paper's: select among this frame's candidates,
-    /// then merge the history).
+    /// order: merge the history into each pixel's candidate, then select among the
+    /// block's merged reservoirs, sorted by their estimates), `spatial-first` (the
+    /// paper's: select among this frame's candidates, then merge the history) or `auto`
+    /// (the default: temporal-first for a still camera, spatial-first for a moving one,
+    /// which is where each measured better).
     ///
     /// Without temporal reuse (--accumulate) both orders resample this frame's candidates
     /// with the same weights, and the renderer runs the spatial-first passes (two fewer).
@@ -290,7 +310,7 @@ impl Default for RestirSettings {
             min_distance: 0.0,
             shaded_parts: ShadedParts::All,
             shading: Shading::Expectation,
-            reuse_order: ReuseOrder::TemporalFirst,
+            reuse_order: ReuseOrder::Auto,
             permutation_sampling: false,
             boiling_filter: 0.0,
         }
@@ -353,6 +373,12 @@ impl RestirSettings {
             boiling_filter: 0.0,
             ..self
         }
+    }
+
+    /// These settings for a camera that moves or stands still: [`ReuseOrder::Auto`]
+    /// resolved ([`ReuseOrder::for_camera`]).
+    pub fn for_camera(self, moving: bool) -> RestirSettings {
+        RestirSettings { reuse_order: self.reuse_order.for_camera(moving), ..self }
     }
 
     /// Refuses settings the kernels cannot run, naming the field and value.

@@ -200,10 +200,6 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
     let gpu_scene = GpuScene::build(&scene)?;
     let mut backend = open_backend(args.backend)?;
     println!("backend: {}", backend.info().summary());
-    // While the reference renders, two more devices build and run the methods' kernels
-    // (warm_up.rs: why, and why their devices come and go while this thread waits).
-    let warm_up = (!backend.info().is_interpreter())
-        .then(|| crate::warm_up::WarmUp::start(args.backend, scene.clone(), args.methods.clone(), restir));
     let reference_spp = args.reference_spp.unwrap_or_else(|| default_reference_spp(backend.as_ref()));
     let render = sized_to_backend(args, render, backend.as_ref(), reference_spp);
     *size = Some((render.camera.width, render.camera.height));
@@ -225,6 +221,9 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
             (render, cameras)
         }
     };
+    // `--reuse-order auto` (the default) by the camera: temporal-first still,
+    // spatial-first moving (RestirSettings::for_camera says why).
+    let restir = restir.for_camera(!cameras.is_empty());
     if !cameras.is_empty() && !args.restir.temporal {
         bail!(
             "--accumulate with {}: accumulated frames would average different viewpoints and be measured against \
@@ -235,6 +234,10 @@ fn compare_sized(args: &CompareArgs, size: &mut Option<(u32, u32)>) -> Result<()
     if !cameras.is_empty() && args.reference.is_some() {
         bail!("--reference: a moving camera ({}) needs a reference per frame", flag());
     }
+    // While the reference renders, two more devices build and run the methods' kernels
+    // (warm_up.rs: why, and why their devices come and go while this thread waits).
+    let warm_up = (!backend.info().is_interpreter())
+        .then(|| crate::warm_up::WarmUp::start(args.backend, scene.clone(), args.methods.clone(), restir));
     // Held until the report is written: a second run into the folder is refused meanwhile.
     let (_lock, removed) = output_folder::prepare(&args.out, args.reference.as_deref())?;
     if !removed.is_empty() {

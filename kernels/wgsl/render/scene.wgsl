@@ -44,7 +44,9 @@ fn film_position(pixel: vec2<u32>, u: vec2<f32>) -> vec2<f32> {
 }
 
 const PI: f32 = 3.14159265358979;
-const INFINITY: f32 = 3.4028235e38;
+// f32's largest finite value, written exactly: the decimal 3.4028235e38 lies above it,
+// which naga rounds down and WGSL (Tint) refuses as not representable.
+const INFINITY: f32 = 0x1.fffffep+127f;
 
 @group(0) @binding(0) var<uniform> params: RenderParams;
 @group(0) @binding(1) var<storage, read> nodes: array<BvhNode>;

@@ -484,13 +484,14 @@ fn finish_elements(rect: BlockRect, begin: u32, segment: u32, first: u32, el: El
     let limit = vec4(begin + count);
     let run_end = U16(min(unclamped_end.q0, limit), min(unclamped_end.q1, limit), min(unclamped_end.q2, limit), min(unclamped_end.q3, limit));
 
-    // Valid/invalid boundaries: the first invalid element of each run.
+    // Valid/invalid boundaries: the first invalid element of each run. (WGSL's grammar
+    // takes no comparison beside `&` or `|` without parentheses: naga did, Tint does not.)
     let invalid_left = from_left(invalid, select(0u, 1u, previous.y >= INVALID_KEY));
     let first_invalid = U16(
-        flag4(invalid.q0 != z & (starts.q0 != z | invalid_left.q0 == z)),
-        flag4(invalid.q1 != z & (starts.q1 != z | invalid_left.q1 == z)),
-        flag4(invalid.q2 != z & (starts.q2 != z | invalid_left.q2 == z)),
-        flag4(invalid.q3 != z & (starts.q3 != z | invalid_left.q3 == z)),
+        flag4((invalid.q0 != z) & ((starts.q0 != z) | (invalid_left.q0 == z))),
+        flag4((invalid.q1 != z) & ((starts.q1 != z) | (invalid_left.q1 == z))),
+        flag4((invalid.q2 != z) & ((starts.q2 != z) | (invalid_left.q2 == z))),
+        flag4((invalid.q3 != z) & ((starts.q3 != z) | (invalid_left.q3 == z))),
     );
     // Invalid elements: their run's boundary is the last one at or before them.
     var boundary_before = pick16(splat16(0u), slots, first_invalid);
@@ -522,10 +523,10 @@ fn finish_elements(rect: BlockRect, begin: u32, segment: u32, first: u32, el: El
         flag4(cluster.q3 == none) & real.q3,
     ));
     let invalid_keys = count16(U16(
-        flag4(cluster.q0 != none & key.q0 == vec4(INVALID_KEY)) & real.q0,
-        flag4(cluster.q1 != none & key.q1 == vec4(INVALID_KEY)) & real.q1,
-        flag4(cluster.q2 != none & key.q2 == vec4(INVALID_KEY)) & real.q2,
-        flag4(cluster.q3 != none & key.q3 == vec4(INVALID_KEY)) & real.q3,
+        flag4((cluster.q0 != none) & (key.q0 == vec4(INVALID_KEY))) & real.q0,
+        flag4((cluster.q1 != none) & (key.q1 == vec4(INVALID_KEY))) & real.q1,
+        flag4((cluster.q2 != none) & (key.q2 == vec4(INVALID_KEY))) & real.q2,
+        flag4((cluster.q3 != none) & (key.q3 == vec4(INVALID_KEY))) & real.q3,
     ));
     if clusters != 0u {
         atomicAdd(&shared_stats[3u * segment], clusters);
@@ -604,7 +605,10 @@ fn finish_block_histogram(setup: BlockSetup, el: Elements) {
 // subgroup size usable for shuffles (0: none). Must be called in uniform control flow.
 fn run_block_histogram(t: u32, workgroup_id: vec3<u32>, lane_bits: u32) {
     let setup = setup_block_histogram(t, workgroup_id);
-    let log_n = setup.log_n;
+    // From the uniform itself, not `setup.log_n`: WGSL's uniformity analysis does not
+    // follow a struct's fields, and `setup` holds per-invocation values, so a loop bound
+    // read from it is not uniform to Tint, which then refuses the barriers below.
+    let log_n = 2u * params.log2_block_size;
     var el = load_block_elements(setup);
 
     // Bitonic sort of every n-slot segment.

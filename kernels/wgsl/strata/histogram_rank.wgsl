@@ -14,12 +14,12 @@
 // Count of (cluster, key) pairs `other` at or below / below each of q's four, as 0 or 1.
 fn at_or_below(other: vec2<u32>, q: Quad) -> vec4<u32> {
     let c = vec4<u32>(other.x);
-    return select(vec4(0u), vec4(1u), c < q.cluster | (c == q.cluster & vec4<u32>(other.y) <= q.key));
+    return select(vec4(0u), vec4(1u), (c < q.cluster) | ((c == q.cluster) & (vec4<u32>(other.y) <= q.key)));
 }
 
 fn below(other: vec2<u32>, q: Quad) -> vec4<u32> {
     let c = vec4<u32>(other.x);
-    return select(vec4(0u), vec4(1u), c < q.cluster | (c == q.cluster & vec4<u32>(other.y) < q.key));
+    return select(vec4(0u), vec4(1u), (c < q.cluster) | ((c == q.cluster) & (vec4<u32>(other.y) < q.key)));
 }
 
 // Whether `other` (with block position `local`) precedes each of q's four.

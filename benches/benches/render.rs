@@ -77,6 +77,7 @@ fn restir_frames(c: &mut Criterion, backend: &mut dyn Backend) {
             (Shading::Expectation, ReuseOrder::TemporalFirst) => {
                 format!("{}/expectation/temporal-first", method.name())
             }
+            (Shading::Expectation, ReuseOrder::Auto) => unreachable!("the bench names each order it runs"),
         };
         let mut passes = PassTimes::default();
         group.bench_function(&name, |b| {

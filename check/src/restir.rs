@@ -70,9 +70,13 @@ fn frame(backend: &mut dyn Backend, case: &Case, order: ReuseOrder) -> Result<()
         temporal_candidates,
         glossy_replay: resamples_by_random_replay(case),
         // restir-disc's cases also permute the history and run the boiling filter (whose
-        // workgroup barrier and shared sum every backend must agree on).
+        // workgroup barrier and shared sum every backend must agree on). At 0.8 a
+        // reservoir is emptied above 3.5 times its workgroup's mean W, which the
+        // heavy-tailed W of two frames reaches; a W within rounding of that threshold
+        // could be emptied on one backend and kept on another (a few floats of one pixel,
+        // which the large cases' max_outside tolerates).
         permutation_sampling: method == Method::RestirDisc,
-        boiling_filter: if method == Method::RestirDisc { 0.5 } else { 0.0 },
+        boiling_filter: if method == Method::RestirDisc { 0.8 } else { 0.0 },
         reuse_order: order,
         ..RestirSettings::default()
     };
@@ -138,7 +142,7 @@ impl KernelCheck for RestirCheck {
                 let mut case = Case { label: String::new(), width, height, block_size, seed, family };
                 case.label = format!(
                     "{width}x{height} seed {seed} B{block_size} {} {}",
-                    ["strata T=4", "restir T=0", "restir-disc T=2 permuted, boiling 0.5"][(seed % 3) as usize],
+                    ["strata T=4", "restir T=0", "restir-disc T=2 permuted, boiling 0.8"][(seed % 3) as usize],
                     match (family, resamples_by_random_replay(&case)) {
                         (0, _) => "default scene",
                         (_, false) => "glass, metal, environment",

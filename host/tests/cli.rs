@@ -126,6 +126,27 @@ fn compare_without_a_vulkan_device_runs_on_the_interpreter_and_says_so() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
+/// `--reuse-order auto` (the default) is resolved by the camera path and recorded as the
+/// order that ran: temporal-first for a still camera, spatial-first for a moving one.
+#[test]
+fn the_default_reuse_order_follows_the_camera() {
+    for (path, order) in [("static", "temporal-first"), ("orbit:1", "spatial-first")] {
+        let out = scratch(&format!("order-{}", path.replace(':', "-")));
+        let output = Command::new(env!("CARGO_BIN_EXE_strata"))
+            .args(["compare", "--width", "8", "--height", "8", "--frames", "2", "--seeds", "2"])
+            .args(["--reference-spp", "1", "--methods", "strata", "--both-regimes", "false"])
+            .args(["--camera-path", path, "--out", out_str(&out)])
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{}", text(&output.stderr));
+        let record: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+        let recorded = record.pointer("/settings/reuse_order").and_then(|v| v.as_str());
+        assert_eq!(recorded, Some(order), "--camera-path {path}: {record}");
+        let _ = std::fs::remove_dir_all(&out);
+    }
+}
+
 #[test]
 fn bad_compare_arguments_are_refused_before_anything_renders() {
     let out = scratch("refused");

@@ -69,7 +69,8 @@ fn kill_at_several_points(name: &str, args: &[&str], warm_up: &[&str]) {
     // most of its time: in a CI run whose shader cache lacked two changed kernels this test
     // took 248 s, the runs below sleeping for fractions of it), so the second, timed run is
     // what a killed run repeats. The kernels do not depend on the image's size or the
-    // number of frames, seeds or samples, so the first run needs one of each.
+    // number of frames, seeds or samples, so the first run is the smallest that runs
+    // every pass (two frames, for the temporal passes; two seeds, which compare needs).
     let first = scratch(&format!("{name}-first"));
     assert!(strata(warm_up, &first).status().unwrap().success(), "the first uninterrupted run failed");
     let timing = scratch(&format!("{name}-timing"));

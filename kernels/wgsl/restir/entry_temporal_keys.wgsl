@@ -13,11 +13,14 @@
 // Permutation sampling (RestirParams.permutation_sampling; RTXDI's decorrelation of the
 // history): the reprojected pixel is replaced by its mirror image within an aligned 4 x 4
 // group of pixels (x -> x XOR 3, y -> y XOR 3), the groups shifted by an offset of 0-3
-// pixels per axis that changes every frame. Within a frame this is a permutation of the
-// image (mirroring is its own inverse), so each previous reservoir still feeds about one
-// pixel, but no longer the pixel at the same place: the chains of history that make
-// neighbouring pixels' errors alike are broken up frame by frame. The permuted pixel
-// must pass the same similarity test; otherwise the reprojected one is used. Unbiased:
+// pixels per axis that changes every frame, so a pixel's history comes from 1 or 3
+// pixels away on each axis. Within a frame `permuted` is a permutation of the image
+// (mirroring is its own inverse; pixels whose mirror image would leave the image stay
+// where they are), so each previous reservoir feeds one pixel, no longer the pixel at the
+// same place: the chains of history that make neighbouring pixels' errors alike are
+// broken up frame by frame. The permuted pixel must pass the same similarity test;
+// otherwise the reprojected one is used (then a previous pixel may feed two, and its
+// mirror image none: a few per cent of the pixels on the default scene). Unbiased:
 // which source a pixel takes depends on the G-buffers alone, and the temporal merge
 // weighs whatever source it is given by pairwise MIS with targets evaluated at both ends.
 //
@@ -74,7 +77,9 @@ fn permuted(q: u32) -> u32 {
     let frame_bits = pcg_hash(params.seed ^ pcg_hash(params.sample_index + 0x9e3779b9u));
     let offset = vec2<u32>(frame_bits & 3u, (frame_bits >> 2u) & 3u);
     let position = vec2<u32>(q % params.width, q / params.width);
-    // Shift, mirror, shift back: + 4 keeps the shifted position from wrapping below 0.
+    // Shift, mirror, shift back: + 4 keeps the shifted position from wrapping below 0. The
+    // result wraps (to about 2^32) where the mirror image falls left of or above the image,
+    // and the test below catches it with those past the right and bottom edges.
     let mirrored = (((position + 4u - offset) ^ vec2<u32>(3u)) + offset) - vec2<u32>(4u);
     if mirrored.x >= params.width || mirrored.y >= params.height {
         return q;

@@ -178,8 +178,8 @@ impl RestirRenderer {
                     merged: backend.create_buffer("merged reservoirs", pixels * size_of::<Reservoir>() as u64)?,
                 })
             }
-            // (Auto was resolved above.)
-            ReuseOrder::TemporalFirst | ReuseOrder::SpatialFirst | ReuseOrder::Auto => None,
+            ReuseOrder::TemporalFirst | ReuseOrder::SpatialFirst => None,
+            ReuseOrder::Auto => unreachable!("resolved by for_camera above"),
         };
         let scene_buffers = SceneBuffers::upload(backend, scene)?;
         let mut params = render.params(&scene.params)?;

@@ -272,9 +272,9 @@ pub struct RestirSettings {
     pub reuse_order: ReuseOrder,
     /// Permutation sampling of the temporal source, for every method that reuses history
     /// (RTXDI's decorrelation, on by default there): each pixel takes the history of a
-    /// pixel up to 3 away from where it reprojects, a per-frame permutation of the image,
-    /// so that neighbours' histories stop chaining. Unbiased (the pairwise MIS weights
-    /// evaluate the target at the source actually used; tested).
+    /// pixel 1 or 3 away on each axis from where it reprojects, a per-frame permutation
+    /// of the image, so that neighbours' histories stop chaining. Unbiased (the pairwise
+    /// MIS weights evaluate the target at the source actually used; tested).
     ///
     /// Within each aligned 4 x 4 group of pixels, shifted by a per-frame random offset,
     /// x and y are mirrored; a permuted source on another surface (the same similarity
@@ -355,7 +355,8 @@ impl RestirSettings {
 
     /// What a frame runs of these settings: themselves, but for [`Method::Ris`], which
     /// reuses nothing: K = 0 (no slot is drawn), no temporal reuse, no drawn previous
-    /// reservoirs, no permutation or boiling filter (both act on the temporal merge), and the paper's order of passes (with K = 0 and no history both orders
+    /// reservoirs, no permutation or boiling filter (both act on the temporal merge), and
+    /// the paper's order of passes (with K = 0 and no history both orders
     /// keep each pixel's canonical candidate; the paper's runs two passes fewer). The one
     /// place that says what ris leaves out; [`RestirSettings::check`] is for the settings
     /// as given (K = 0 is no setting a user may choose).
@@ -515,6 +516,7 @@ mod tests {
         same_names::<Method>();
         same_names::<ShadedParts>();
         same_names::<Shading>();
+        same_names::<ReuseOrder>();
     }
 }
 
@@ -526,9 +528,16 @@ mod as_run_tests {
     /// no history, and its passes run in the paper's order; the other methods run as given.
     #[test]
     fn ris_runs_without_reuse() {
-        let ris = RestirSettings { method: Method::Ris, temporal_candidates: 2, ..RestirSettings::default() };
+        let ris = RestirSettings {
+            method: Method::Ris,
+            temporal_candidates: 2,
+            permutation_sampling: true,
+            boiling_filter: 0.5,
+            ..RestirSettings::default()
+        };
         let uniform = ris.uniform();
         assert_eq!((uniform.candidates, uniform.temporal, uniform.temporal_candidates), (0, 0, 0));
+        assert_eq!((uniform.permutation_sampling, uniform.boiling_filter), (0, 0.0));
         assert_eq!(ris.as_run().reuse_order, ReuseOrder::SpatialFirst);
         ris.check().expect("ris with the default K is a valid setting");
         let strata = RestirSettings { temporal_candidates: 2, ..RestirSettings::default() };

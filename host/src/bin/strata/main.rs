@@ -155,8 +155,9 @@ fn main() -> std::process::ExitCode {
 type SetNumber = fn(&mut RestirSettings, f32);
 
 /// The ReSTIR settings' number flags of `compare`, each with the setter of its field.
-const RESTIR_NUMBER_FLAGS: [(&str, SetNumber); 4] = [
+const RESTIR_NUMBER_FLAGS: [(&str, SetNumber); 5] = [
     ("disc_radius", |s, v| s.disc_radius = v),
+    ("boiling_filter", |s, v| s.boiling_filter = v),
     ("temporal_cap", |s, v| s.temporal_cap = v),
     ("min_roughness", |s, v| s.min_roughness = v),
     ("min_distance", |s, v| s.min_distance = v),

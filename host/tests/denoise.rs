@@ -2,6 +2,8 @@
 //! denoiser too (`errors_denoised.csv`, the denoised previews, the same tables), and the
 //! denoiser doing its job: its frames are far smoother than the raw ones.
 
+mod support;
+
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -21,19 +23,7 @@ fn compare_with_svgf_measures_every_frame_denoised_and_the_frames_are_smoother()
         .env("XDG_RUNTIME_DIR", std::env::temp_dir())
         .output()
         .expect("the strata binary runs");
-    let (stdout, stderr) = (String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr));
-    assert!(output.status.success(), "compare --denoise svgf failed:\n{stdout}\n{stderr}");
-    assert!(stdout.contains("After SVGF denoising"), "no denoised table:\n{stdout}");
-    assert!(stdout.contains("after SVGF, strata ÷ restir over frames 1-6"), "no denoised whole-run ratio:\n{stdout}");
-    for file in ["errors_denoised.csv", "strata_denoised_frame006.png", "restir_denoised_frame001_relmse.exr"] {
-        assert!(out.join(file).is_file(), "{file} was not written");
-    }
-    let read = |name: &str| {
-        strata::evaluation::compare::parse_errors_csv(&std::fs::read_to_string(out.join(name)).unwrap()).unwrap()
-    };
-    let (raw, denoised) = (read("errors.csv"), read("errors_denoised.csv"));
-    assert_eq!(denoised.len(), raw.len(), "a denoised row for every raw one");
-    assert!(raw.iter().zip(&denoised).all(|(r, d)| r.relmse != d.relmse), "a denoised frame scored as the raw one");
+    support::denoised_run::assert_denoised_run(&output, &out, "SVGF", 6);
     // The denoiser removes noise: neighbouring pixels of seed 1's last frame differ far
     // less after it. (Its RelMSE at 32 x 24, where most pixels touch an edge, is
     // dominated by its blur; BENCHMARKS.md measures it at 256 wide.)

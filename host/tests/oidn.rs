@@ -6,6 +6,8 @@
 //! The tests that need the library (`pip install pyoidn==2.5.1.0`) say so and pass where
 //! it is missing, unless `STRATA_REQUIRE_OIDN=1` (CI sets it), where they fail.
 
+mod support;
+
 use std::path::PathBuf;
 use std::process::Command;
 use strata::evaluation::metrics::relmse;
@@ -132,19 +134,8 @@ fn compare_with_oidn_measures_every_frame_denoised() {
         .arg(&out)
         .output()
         .expect("the strata binary runs");
-    let (stdout, stderr) = (String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr));
-    assert!(output.status.success(), "compare --denoise oidn failed:\n{stdout}\n{stderr}");
-    assert!(stdout.contains("After OIDN denoising"), "no denoised table:\n{stdout}");
-    assert!(stdout.contains("after OIDN, strata ÷ restir over frames 1-3"), "no denoised whole-run ratio:\n{stdout}");
+    support::denoised_run::assert_denoised_run(&output, &out, "OIDN", 3);
+    let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(stdout.contains("What the viewer sees, denoised frames"), "no denoised viewer table:\n{stdout}");
-    for file in ["errors_denoised.csv", "strata_denoised_frame003.png", "restir_denoised_frame001_relmse.exr"] {
-        assert!(out.join(file).is_file(), "{file} was not written");
-    }
-    let read = |name: &str| {
-        strata::evaluation::compare::parse_errors_csv(&std::fs::read_to_string(out.join(name)).unwrap()).unwrap()
-    };
-    let (raw, denoised) = (read("errors.csv"), read("errors_denoised.csv"));
-    assert_eq!(denoised.len(), raw.len(), "a denoised row for every raw one");
-    assert!(raw.iter().zip(&denoised).all(|(r, d)| r.relmse != d.relmse), "a denoised frame scored as the raw one");
     let _ = std::fs::remove_dir_all(&out);
 }

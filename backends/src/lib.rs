@@ -4,6 +4,8 @@
 //! * [`wgpu_backend::WgpuBackend`]: wgpu on Vulkan (lavapipe included) or GL.
 //! * [`ash_backend::AshBackend`]: raw Vulkan through ash on naga's SPIR-V, or on SPIR-V
 //!   that glslang compiled from naga's GLSL or HLSL.
+//! * [`webgpu_backend::WebGpuBackend`]: WebGPU in headless Chromium (Dawn; Tint compiles
+//!   the WGSL), driven over a loopback bridge.
 //!
 //! Every failure is a [`BackendError`]: no adapter, a missing feature, a limit the device
 //! cannot meet, a binding that does not fit the kernel, a validation error, a lost
@@ -39,6 +41,7 @@ pub mod pipeline_cache_file;
 pub mod processes;
 pub mod require_gpu;
 pub mod texture;
+pub mod webgpu_backend;
 pub mod wgpu_backend;
 
 pub use ash_backend::{AshBackend, AshOptions, SpirvSource};
@@ -47,4 +50,5 @@ pub use device_info::{DeviceInfo, DeviceLimits};
 pub use error::BackendError;
 pub use require_gpu::{GPU_REQUIRED_VARIABLE, gpu_required};
 pub use texture::{AddressMode, FilterMode, SamplerDesc, SamplerId, TextureDesc, TextureId};
+pub use webgpu_backend::{WebGpuBackend, WebGpuOptions};
 pub use wgpu_backend::{WgpuBackend, WgpuOptions};

@@ -34,6 +34,8 @@ pub struct Kernel {
     /// Its memory per workgroup and per invocation, sized once when it is loaded (the
     /// backends check it before every dispatch).
     memory: MemoryBytes,
+    /// The values its `override` constants were given ([`Kernel::overrides`]).
+    overrides: Vec<(String, f64)>,
 }
 
 /// A kernel's workgroup memory per workgroup and private and function memory per
@@ -146,6 +148,16 @@ impl Kernel {
         self.memory.private
     }
 
+    /// The values given for its `override` constants when it was loaded
+    /// ([`Kernel::from_wgsl_with_overrides`]), keyed as naga's and WebGPU's pipeline
+    /// constants are (an `@id` number as text, or the name): [`Kernel::module`] is
+    /// already specialised with them, and a backend that compiles [`Kernel::source`]
+    /// itself (WebGPU's) passes them as its pipeline's constants. Empty for registry
+    /// kernels.
+    pub fn overrides(&self) -> &[(String, f64)] {
+        &self.overrides
+    }
+
     /// Parses, validates and describes registry kernel `id`.
     pub fn load(id: KernelId) -> Result<Kernel, KernelError> {
         let spec = id.spec().ok_or_else(|| KernelError::MissingEntryPoint {
@@ -236,7 +248,8 @@ impl Kernel {
         let registry = !matches!(id, KernelId::External(_));
         let bindings = describe_bindings(&spec.name, &module, &info, entry_index, registry)?;
         let memory = MemoryBytes::of(&module, &info, entry_index);
-        Ok(Kernel { id, spec, source, module, info, workgroup_size, bindings, memory })
+        let overrides = overrides.to_vec();
+        Ok(Kernel { id, spec, source, module, info, workgroup_size, bindings, memory, overrides })
     }
 }
 

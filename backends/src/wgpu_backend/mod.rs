@@ -8,6 +8,9 @@ mod pipelines;
 mod textures;
 
 pub use pipelines::{kernel_pipeline, layout_entries};
+// The WebGPU backend builds the same bind group layouts.
+pub(crate) use pipelines::layout_entries_with;
+pub(crate) use textures::wgpu_format;
 
 use crate::backend::{Backend, Bind, BufferId, Resource};
 use crate::bindings_check::{ResourceLookup, check_binds, check_kernel_fits, check_workgroups, check_write};

@@ -24,7 +24,7 @@ pub(super) struct TextureTable {
 }
 
 /// The wgpu format of a strata texel format.
-pub(super) fn wgpu_format(format: TexelFormat) -> wgpu::TextureFormat {
+pub(crate) fn wgpu_format(format: TexelFormat) -> wgpu::TextureFormat {
     match format {
         TexelFormat::Rgba8Unorm => wgpu::TextureFormat::Rgba8Unorm,
         TexelFormat::Rgba8Uint => wgpu::TextureFormat::Rgba8Uint,

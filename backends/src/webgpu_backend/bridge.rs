@@ -1,0 +1,260 @@
+//! The loopback HTTP server between the WebGPU backend and its page.
+//!
+//! It listens on `127.0.0.1` at a port the system picks, and answers only requests whose
+//! path starts with a random 128-bit token (from the operating system's generator) and
+//! whose `Host` is that address: the page (`/TOKEN/`), its script (`/TOKEN/page.js`) and
+//! the exchange (`POST /TOKEN/exchange`). Anything else gets a 404 and is forgotten. Every
+//! response closes its connection.
+//!
+//! The exchange is a long poll: the page posts its answer to the previous message, and
+//! the server holds that request open until the backend has its next message, which is
+//! the response. One thread accepts connections and one short-lived thread per
+//! connection reads its request (each read under a timeout), so that a connection that
+//! never sends anything (Chromium opens spare ones) blocks nobody; the backend's thread
+//! waits for exchanges on a channel, with a timeout.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::{Ipv4Addr, SocketAddr, TcpListener, TcpStream};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+/// The page and its script, written for strata (this folder).
+const PAGE_HTML: &str = include_str!("page.html");
+const PAGE_JS: &str = include_str!("page.js");
+
+/// The largest request body taken (an answer carrying a buffer's contents): WebGPU's
+/// buffers stay below 4 GiB on every device Chromium drives.
+const MAX_BODY: u64 = 4 << 30;
+
+/// How long one read of a request may wait (its headers, a piece of its body).
+const READ_TIMEOUT: Duration = Duration::from_secs(30);
+
+/// One exchange request of the page: its body, and the connection to answer on.
+struct Exchange {
+    body: Vec<u8>,
+    stream: TcpStream,
+}
+
+/// The server: its address and token, and the exchanges the page has posted.
+pub(super) struct Server {
+    address: SocketAddr,
+    token: String,
+    exchanges: mpsc::Receiver<Exchange>,
+    stop: Arc<AtomicBool>,
+    acceptor: Option<std::thread::JoinHandle<()>>,
+    /// The page's exchange waiting for the next message.
+    waiting: Option<TcpStream>,
+}
+
+/// Why no answer came.
+pub(super) enum WaitError {
+    /// None within the timeout.
+    Timeout,
+    /// `alive` said the other side is gone, and why.
+    Gone(String),
+}
+
+impl Server {
+    /// Binds a loopback port and starts accepting.
+    pub(super) fn start() -> Result<Self, String> {
+        let listener = TcpListener::bind((Ipv4Addr::LOCALHOST, 0))
+            .map_err(|e| format!("cannot listen on a loopback port: {e}"))?;
+        let address = listener.local_addr().map_err(|e| format!("cannot read the loopback port: {e}"))?;
+        let mut random = [0u8; 16];
+        getrandom::fill(&mut random).map_err(|e| format!("no random numbers for the page's token: {e}"))?;
+        let token: String = random.iter().map(|b| format!("{b:02x}")).collect();
+        let (sender, exchanges) = mpsc::channel();
+        let stop = Arc::new(AtomicBool::new(false));
+        let routes = Arc::new(Routes { token: token.clone(), host: address.to_string() });
+        let stopped = Arc::clone(&stop);
+        let acceptor = std::thread::Builder::new()
+            .name("strata-webgpu-accept".into())
+            .spawn(move || {
+                for stream in listener.incoming() {
+                    if stopped.load(Ordering::Acquire) {
+                        break;
+                    }
+                    let Ok(stream) = stream else { continue };
+                    let (routes, sender) = (Arc::clone(&routes), sender.clone());
+                    let _ = std::thread::Builder::new()
+                        .name("strata-webgpu-request".into())
+                        .spawn(move || routes.handle(stream, &sender));
+                }
+            })
+            .map_err(|e| format!("cannot start the bridge's thread: {e}"))?;
+        Ok(Self { address, token, exchanges, stop, acceptor: Some(acceptor), waiting: None })
+    }
+
+    /// The page's address.
+    pub(super) fn url(&self) -> String {
+        format!("http://{}/{}/", self.address, self.token)
+    }
+
+    /// Waits for the page's next exchange, up to `timeout`, asking `alive` every 100 ms
+    /// whether the page can still answer; returns its body and keeps the request open
+    /// for [`Server::send`].
+    pub(super) fn receive(
+        &mut self,
+        timeout: Duration,
+        alive: &mut dyn FnMut() -> Result<(), String>,
+    ) -> Result<Vec<u8>, WaitError> {
+        let deadline = Instant::now() + timeout;
+        loop {
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() {
+                return Err(WaitError::Timeout);
+            }
+            match self.exchanges.recv_timeout(left.min(Duration::from_millis(100))) {
+                Ok(exchange) => {
+                    self.waiting = Some(exchange.stream);
+                    return Ok(exchange.body);
+                }
+                Err(mpsc::RecvTimeoutError::Timeout) => alive().map_err(WaitError::Gone)?,
+                Err(mpsc::RecvTimeoutError::Disconnected) => {
+                    return Err(WaitError::Gone("the bridge's server stopped".into()));
+                }
+            }
+        }
+    }
+
+    /// Answers the waiting exchange with `message` (one framed message).
+    pub(super) fn send(&mut self, message: &[u8], timeout: Duration) -> Result<(), String> {
+        let mut stream = self.waiting.take().ok_or("the page is not waiting for a message")?;
+        stream.set_write_timeout(Some(timeout)).map_err(|e| e.to_string())?;
+        respond(&mut stream, "200 OK", "application/octet-stream", message)
+            .map_err(|e| format!("cannot send the page its message: {e}"))
+    }
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Release);
+        // Wakes the acceptor, which then sees the flag.
+        let _ = TcpStream::connect_timeout(&self.address, Duration::from_secs(1));
+        if let Some(acceptor) = self.acceptor.take() {
+            let _ = acceptor.join();
+        }
+    }
+}
+
+/// What the server answers, from the token and the address the page must use.
+struct Routes {
+    token: String,
+    host: String,
+}
+
+impl Routes {
+    fn handle(&self, mut stream: TcpStream, exchanges: &mpsc::Sender<Exchange>) {
+        if stream.set_read_timeout(Some(READ_TIMEOUT)).is_err() {
+            return;
+        }
+        let Ok(Some(request)) = read_request(&stream) else { return };
+        let page = format!("/{}/", self.token);
+        // A request for another host (a page elsewhere resolving its name to 127.0.0.1)
+        // or another path is not ours.
+        let path = if request.host == self.host { request.path.strip_prefix(&page) } else { None };
+        let _ = match (request.method.as_str(), path) {
+            ("GET", Some("")) => respond(&mut stream, "200 OK", "text/html; charset=utf-8", PAGE_HTML.as_bytes()),
+            ("GET", Some("page.js")) => {
+                respond(&mut stream, "200 OK", "text/javascript; charset=utf-8", PAGE_JS.as_bytes())
+            }
+            ("POST", Some("exchange")) => {
+                let _ = exchanges.send(Exchange { body: request.body, stream });
+                return;
+            }
+            _ => respond(&mut stream, "404 Not Found", "text/plain", b"not found"),
+        };
+    }
+}
+
+struct Request {
+    method: String,
+    path: String,
+    host: String,
+    body: Vec<u8>,
+}
+
+/// One HTTP/1.1 request: its line, `Host` and `Content-Length` headers and body; `None`
+/// for one that is malformed, too long or too slow.
+fn read_request(stream: &TcpStream) -> std::io::Result<Option<Request>> {
+    let mut reader = BufReader::new(stream);
+    let mut line = String::new();
+    let mut header_bytes = 0usize;
+    let mut read_line = |reader: &mut BufReader<&TcpStream>, line: &mut String| -> std::io::Result<bool> {
+        line.clear();
+        let n = reader.by_ref().take(8192).read_line(line)?;
+        header_bytes += n;
+        Ok(n > 0 && line.ends_with('\n') && header_bytes <= 65536)
+    };
+    if !read_line(&mut reader, &mut line)? {
+        return Ok(None);
+    }
+    let mut parts = line.split_whitespace();
+    let (Some(method), Some(path)) = (parts.next(), parts.next()) else { return Ok(None) };
+    let (method, path) = (method.to_string(), path.to_string());
+    let mut host = String::new();
+    let mut length = 0u64;
+    loop {
+        if !read_line(&mut reader, &mut line)? {
+            return Ok(None);
+        }
+        let header = line.trim_end();
+        if header.is_empty() {
+            break;
+        }
+        if let Some((name, value)) = header.split_once(':') {
+            if name.eq_ignore_ascii_case("host") {
+                host = value.trim().to_string();
+            } else if name.eq_ignore_ascii_case("content-length") {
+                match value.trim().parse::<u64>() {
+                    Ok(n) if n <= MAX_BODY => length = n,
+                    _ => return Ok(None),
+                }
+            } else if name.eq_ignore_ascii_case("transfer-encoding") {
+                // The page's fetch always sends a length.
+                return Ok(None);
+            }
+        }
+    }
+    let mut body = Vec::new();
+    reader.take(length).read_to_end(&mut body)?;
+    if body.len() as u64 != length {
+        return Ok(None);
+    }
+    Ok(Some(Request { method, path, host, body }))
+}
+
+fn respond(stream: &mut TcpStream, status: &str, content_type: &str, body: &[u8]) -> std::io::Result<()> {
+    let head = format!(
+        "HTTP/1.1 {status}\r\nContent-Type: {content_type}\r\nContent-Length: {}\r\nCache-Control: no-store\r\n\
+         Content-Security-Policy: default-src 'none'; script-src 'self'; connect-src 'self'\r\n\
+         X-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n",
+        body.len()
+    );
+    stream.write_all(head.as_bytes())?;
+    stream.write_all(body)?;
+    stream.flush()
+}
+
+/// One message in the bridge's framing: a little-endian `u32` with the header's length,
+/// the JSON header, the payload.
+pub(super) fn frame(header: &serde_json::Value, payload: &[u8]) -> Vec<u8> {
+    let json = header.to_string().into_bytes();
+    let mut bytes = Vec::with_capacity(4 + json.len() + payload.len());
+    bytes.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    bytes.extend_from_slice(&json);
+    bytes.extend_from_slice(payload);
+    bytes
+}
+
+/// A framed message's header and payload; the error says what is wrong with it.
+pub(super) fn unframe(bytes: &[u8]) -> Result<(serde_json::Value, &[u8]), String> {
+    let length = bytes.get(..4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
+    let Some(length) = length.filter(|&n| n <= bytes.len() - 4) else {
+        return Err(format!("a message of {} bytes has no whole header", bytes.len()));
+    };
+    let header = serde_json::from_slice(&bytes[4..4 + length]).map_err(|e| format!("its header is not JSON: {e}"))?;
+    Ok((header, &bytes[4 + length..]))
+}

@@ -1,0 +1,162 @@
+//! Headless Chromium for the WebGPU backend: finding it, starting it on the bridge's
+//! page with a profile of its own, and stopping it.
+//!
+//! The profile, Chromium's configuration and cache folders (where its crash reporter
+//! writes) and its log all live in one private scratch folder of this process (mode
+//! 0700, a random name made with `mkdir`: `strata_files::private_scratch_folder`),
+//! removed when the browser is dropped. Chromium runs in a process group of its own,
+//! killed whole on drop, so that no renderer or GPU process outlives the backend.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+
+/// The environment variable naming the Chromium binary to run (a path, used as it is);
+/// unset, the backend looks for `chromium`, `chromium-browser`, `google-chrome` and
+/// `google-chrome-stable` on `PATH`.
+pub const CHROMIUM_VARIABLE: &str = "STRATA_CHROMIUM";
+
+/// The environment variable that makes a missing browser or WebGPU adapter an error of
+/// the tests that need one, instead of a skip (CI sets it).
+pub const BROWSER_REQUIRED_VARIABLE: &str = "STRATA_REQUIRE_BROWSER";
+
+/// Whether `STRATA_REQUIRE_BROWSER` is set to anything but empty or `0`.
+pub fn browser_required() -> bool {
+    std::env::var(BROWSER_REQUIRED_VARIABLE).is_ok_and(|v| !v.is_empty() && v != "0")
+}
+
+/// The Chromium binary: `STRATA_CHROMIUM` where set (it must name a file), else the first
+/// of Chromium's usual names found on `PATH`. The error says what was looked for and how
+/// to install it.
+pub fn find_chromium() -> Result<PathBuf, String> {
+    if let Some(path) = std::env::var_os(CHROMIUM_VARIABLE).filter(|p| !p.is_empty()) {
+        let path = PathBuf::from(path);
+        return if path.is_file() {
+            Ok(path)
+        } else {
+            Err(format!("{CHROMIUM_VARIABLE}={}: no such file", path.display()))
+        };
+    }
+    let names = ["chromium", "chromium-browser", "google-chrome", "google-chrome-stable"];
+    let folders: Vec<PathBuf> =
+        std::env::var_os("PATH").map(|p| std::env::split_paths(&p).collect()).unwrap_or_default();
+    names.iter().find_map(|name| folders.iter().map(|folder| folder.join(name)).find(|path| path.is_file())).ok_or_else(
+        || {
+            format!(
+                "no Chromium found ({} on PATH; apt-get install chromium, or set {CHROMIUM_VARIABLE})",
+                names.join(", ")
+            )
+        },
+    )
+}
+
+/// A running headless Chromium and its private folder.
+pub(super) struct Browser {
+    child: Child,
+    folder: strata_files::TempDir,
+}
+
+/// Lines of Chromium's log that say nothing about WebGPU (no D-Bus in a container).
+fn noise(line: &str) -> bool {
+    line.contains("dbus") || line.contains("DBus") || line.trim().is_empty()
+}
+
+impl Browser {
+    /// Starts `binary` headless on `url`, with WebGPU on (SwiftShader's Vulkan where no
+    /// GPU is, as on CI).
+    pub(super) fn launch(binary: &Path, url: &str) -> Result<Self, String> {
+        let folder = strata_files::private_scratch_folder("strata-webgpu-")
+            .map_err(|e| format!("cannot create a private folder for Chromium's profile: {e}"))?;
+        let log = std::fs::File::create_new(folder.path().join("chromium.log"))
+            .map_err(|e| format!("cannot create Chromium's log file: {e}"))?;
+        let log_err = log.try_clone().map_err(|e| format!("cannot share Chromium's log file: {e}"))?;
+        let mut command = Command::new(binary);
+        command
+            .arg("--headless=new")
+            .arg(format!("--user-data-dir={}", folder.path().join("profile").display()))
+            .args([
+                "--enable-unsafe-webgpu",
+                "--enable-webgpu-developer-features",
+                "--enable-features=Vulkan",
+                "--use-vulkan=native",
+                "--disable-gpu-sandbox",
+                "--no-first-run",
+                "--no-default-browser-check",
+                "--disable-extensions",
+                "--disable-background-networking",
+                "--disable-component-update",
+                "--disable-sync",
+                "--disable-default-apps",
+                "--mute-audio",
+                "--enable-logging=stderr",
+                "--v=0",
+            ])
+            // Chromium refuses to run as root with its sandbox on.
+            .args(running_as_root().then_some("--no-sandbox"))
+            .arg(url)
+            .env("XDG_CONFIG_HOME", folder.path().join("config"))
+            .env("XDG_CACHE_HOME", folder.path().join("cache"))
+            // A Vulkan layer switched on for strata's own Vulkan work (`xtask validate`)
+            // is not Chromium's: its GPU process would load it and log into strata's log.
+            .env_remove("VK_INSTANCE_LAYERS")
+            .env_remove("VK_LOADER_LAYERS_ENABLE")
+            .env_remove("VK_LAYER_SETTINGS_PATH")
+            .stdin(Stdio::null())
+            .stdout(log)
+            .stderr(log_err);
+        #[cfg(unix)]
+        {
+            use std::os::unix::process::CommandExt;
+            command.process_group(0);
+        }
+        let child = command.spawn().map_err(|e| format!("{} does not start: {e}", binary.display()))?;
+        Ok(Self { child, folder })
+    }
+
+    /// Why the browser is no longer running, with the end of its log; `None` while it runs.
+    pub(super) fn exited(&mut self) -> Option<String> {
+        match self.child.try_wait() {
+            Ok(Some(status)) => Some(format!("Chromium exited ({status}){}", self.log_tail())),
+            Ok(None) => None,
+            Err(error) => Some(format!("Chromium cannot be waited for: {error}")),
+        }
+    }
+
+    /// The last lines of Chromium's log that are not noise, as `: line | line`, or
+    /// nothing.
+    pub(super) fn log_tail(&self) -> String {
+        let path = self.folder.path().join("chromium.log");
+        let bytes = strata_files::read_regular_capped(&path, 64 << 20).unwrap_or_default();
+        let text = String::from_utf8_lossy(&bytes);
+        let lines: Vec<&str> = text.lines().filter(|line| !noise(line)).collect();
+        let tail = &lines[lines.len().saturating_sub(4)..];
+        if tail.is_empty() { String::new() } else { format!("; its log ends: {}", tail.join(" | ")) }
+    }
+}
+
+#[cfg(unix)]
+fn running_as_root() -> bool {
+    // SAFETY: geteuid has no preconditions and cannot fail.
+    unsafe { libc::geteuid() == 0 }
+}
+
+#[cfg(not(unix))]
+fn running_as_root() -> bool {
+    false
+}
+
+impl Drop for Browser {
+    fn drop(&mut self) {
+        #[cfg(unix)]
+        if let Ok(group) = libc::pid_t::try_from(self.child.id()) {
+            // SAFETY: kill has no memory preconditions; the group is the one the child
+            // leads (process_group(0)), and the child is not waited for yet, so its id
+            // is not reused.
+            unsafe {
+                libc::kill(-group, libc::SIGKILL);
+            }
+        }
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+        // The folder goes with `self.folder`.
+    }
+}

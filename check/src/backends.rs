@@ -2,6 +2,7 @@
 
 use strata_backends::ash_backend::{AshBackend, AshOptions, SpirvSource};
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
+use strata_backends::webgpu_backend::{WebGpuBackend, WebGpuOptions, find_chromium};
 use strata_backends::wgpu_backend::{WgpuApi, WgpuBackend, WgpuOptions};
 use strata_backends::{Backend, BackendError};
 
@@ -42,6 +43,12 @@ fn slang() -> Result<(), String> {
         Err(missing @ strata_kernels::glslang::ToolError::Missing(_)) => Err(missing.to_string()),
         _ => Ok(()),
     }
+}
+
+/// Chromium (Debian's `chromium`, or `STRATA_CHROMIUM`), whose WebGPU the `webgpu` path
+/// runs on.
+fn chromium() -> Result<(), String> {
+    find_chromium().map(|_| ())
 }
 
 fn wgpu(api: WgpuApi) -> Result<Box<dyn Backend>, BackendError> {
@@ -89,6 +96,15 @@ pub fn backend_slots() -> Vec<BackendSlot> {
             open: || ash(SpirvSource::SlangFromHlsl),
             needs_vulkan: false,
             toolchain: slang,
+        },
+        // Chromium's WebGPU (Dawn; Tint compiles the WGSL, a front end other than naga)
+        // in a headless tab: a machine without Chromium reports the column unavailable
+        // (CI installs it).
+        BackendSlot {
+            name: "webgpu",
+            open: || Ok(Box::new(WebGpuBackend::new(WebGpuOptions::default())?)),
+            needs_vulkan: false,
+            toolchain: chromium,
         },
     ]
 }

@@ -219,7 +219,9 @@ pub fn run_checks_reporting(
 fn slot_weight(name: &str) -> u32 {
     match name {
         "ash-slang" => 6,
-        "wgpu-gl" => 5,
+        // Chromium's SwiftShader compiles fast, but the slot replays the whole-renderer
+        // kernels in the quick run too, through a browser: started early, it overlaps.
+        "wgpu-gl" | "webgpu" => 5,
         "ash-hlsl" | "ash-glsl" => 4,
         "wgpu-vulkan" | "ash" => 3,
         _ => 1,

@@ -107,7 +107,7 @@ impl KernelCheck for PathTraceCheck {
     }
 
     fn quick_slots(&self) -> Option<&'static [&'static str]> {
-        Some(&["cpu", "wgpu-vulkan", "ash"])
+        Some(&["cpu", "wgpu-vulkan", "ash", "webgpu"])
     }
 
     fn reference(&self, case: &Case) -> Vec<Output> {

@@ -63,7 +63,7 @@ fn frame(backend: &mut dyn Backend, case: &Case, order: ReuseOrder) -> Result<()
         selection: SelectionSettings {
             block_size: case.block_size,
             candidates: 1 + (case.seed / 3 % 4) as u32,
-            sampler: SamplerVariant::ALL[(case.seed / 3 % 5) as usize],
+            sampler: SamplerVariant::ALL[(case.seed / 3) as usize % SamplerVariant::ALL.len()],
             ..SelectionSettings::default()
         },
         disc_radius: 4.0,
@@ -170,7 +170,7 @@ impl KernelCheck for RestirCheck {
     }
 
     fn quick_slots(&self) -> Option<&'static [&'static str]> {
-        Some(&["cpu", "wgpu-vulkan", "ash"])
+        Some(&["cpu", "wgpu-vulkan", "ash", "webgpu"])
     }
 
     fn reference(&self, case: &Case) -> Vec<Output> {

@@ -584,13 +584,17 @@ pub fn run_kernel(request: &RunRequest) -> Result<RunOutcome> {
                 match run_on(backend.as_mut(), &kernel, &inputs, &images, request.workgroups, &resolved.workgroup_flags)
                 {
                     // A feature this kernel needs and this device lacks (FLOAT32_FILTERABLE
-                    // on wgpu-gl): the path is unavailable for it, as for a missing device.
+                    // on wgpu-gl): the path is unavailable for it, as for a missing device;
+                    // so is what the browser's WebGPU refuses by name (its limits).
                     Err(error)
                         if every
-                            && matches!(
-                                error.downcast_ref::<BackendError>(),
-                                Some(BackendError::MissingFeature { .. })
-                            ) =>
+                            && match error.downcast_ref::<BackendError>() {
+                                Some(BackendError::MissingFeature { .. }) => true,
+                                Some(BackendError::Unavailable { .. } | BackendError::LimitExceeded { .. }) => {
+                                    slot.name == "webgpu"
+                                }
+                                _ => false,
+                            } =>
                     {
                         unavailable.push((name, format!("{error:#}")));
                         continue;

@@ -461,7 +461,13 @@ impl TextureCase {
         runs.iter()
             .map(|run| {
                 let verdict = match &run.outputs {
-                    Err(why) if self.refused_by.contains(&run.backend.as_str()) && why.contains("is unavailable") => {
+                    // What the `webgpu` path refuses depends on the browser's adapter (its
+                    // per-stage limits, SwiftShader's known bug): any refusal by name is
+                    // taken from it, and the table lists it.
+                    Err(why)
+                        if (self.refused_by.contains(&run.backend.as_str()) || run.backend == "webgpu")
+                            && why.contains("is unavailable") =>
+                    {
                         Verdict::Refused(why.clone())
                     }
                     Err(why) => Verdict::Fails(why.clone()),

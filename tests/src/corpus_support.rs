@@ -2,6 +2,7 @@
 //! textures): the backends that can open here, one case at a time, the judgement's
 //! failures as lines, and the negative control that a corrupted output is caught.
 
+use strata_backends::webgpu_backend::{BROWSER_REQUIRED_VARIABLE, browser_required};
 use strata_backends::{BackendError, GPU_REQUIRED_VARIABLE, gpu_required};
 use strata_check::BackendSlot;
 use strata_check::agreement::{Judgement, Tolerance, judge};
@@ -14,7 +15,9 @@ use strata_kernels::WordKind;
 pub static ONE_CASE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 /// The slots that can open here; a slot without a device is skipped (with a note naming
-/// `what`), or fails the test under `STRATA_REQUIRE_GPU=1` when it needs Vulkan.
+/// `what`), or fails the test under `STRATA_REQUIRE_GPU=1` when it needs Vulkan; the
+/// `webgpu` slot without Chromium is skipped too, or fails under
+/// `STRATA_REQUIRE_BROWSER=1`.
 pub fn available_slots(what: &str) -> Vec<BackendSlot> {
     let _turn = ONE_CASE_AT_A_TIME.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     let mut slots = Vec::new();
@@ -23,6 +26,9 @@ pub fn available_slots(what: &str) -> Vec<BackendSlot> {
             Ok(_) => slots.push(slot),
             Err(error @ BackendError::NoAdapter { .. }) if !(gpu_required() && slot.needs_vulkan) => {
                 eprintln!("SKIPPED {} in {what}: {error} (see {GPU_REQUIRED_VARIABLE})", slot.name);
+            }
+            Err(error) if slot.name == "webgpu" && !browser_required() => {
+                eprintln!("SKIPPED {} in {what}: {error} (see {BROWSER_REQUIRED_VARIABLE})", slot.name);
             }
             Err(error) => panic!("{}: {error}", slot.name),
         }

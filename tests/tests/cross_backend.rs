@@ -1,6 +1,7 @@
 //! `cargo xtask check`'s default run under `cargo test`: every registry kernel on every
 //! backend, outputs identical to the reference. Under `STRATA_REQUIRE_GPU=1` every
-//! Vulkan backend must be available.
+//! Vulkan backend must be available, and under `STRATA_REQUIRE_BROWSER=1` the `webgpu`
+//! path (Chromium's WebGPU).
 
 use strata_backends::gpu_required;
 use strata_check::{CellResult, CheckConfig, backend_slots, kernel_checks, run_check};
@@ -23,6 +24,11 @@ fn every_kernel_is_identical_on_every_backend() {
                 );
             }
         }
+    }
+    // Tint's column is there where Chromium must be.
+    if strata_backends::webgpu_backend::browser_required() {
+        let cell = report.cell(strata_kernels::KernelId::BlockHistogram, "webgpu");
+        assert!(matches!(cell, Some(CellResult::Identical { .. })), "webgpu: {cell:?}");
     }
     // The portable kernel runs everywhere a Vulkan device exists.
     if gpu_required() {

@@ -7,7 +7,7 @@
 //!   exist on this machine is missing (CI uses this).
 //! * `cargo xtask check [--full] [--kernel NAME,...]`: runs every registry kernel on every available backend
 //!   (wgpu Vulkan and GL, ash on naga's SPIR-V and on glslang's compilation of naga's
-//!   GLSL and HLSL) with generated inputs and compares the outputs with the kernels'
+//!   GLSL and HLSL, Slang's of the HLSL, Chromium's WebGPU) with generated inputs and compares the outputs with the kernels'
 //!   references; prints a kernels × backends table, then the texture corpus's table
 //!   (`strata_check::texture_corpus`, against the interpreter; not with `--kernel`), and
 //!   exits non-zero on any mismatch. The backends run in parallel, one per core, and a
@@ -17,7 +17,7 @@
 //!   [--size G:B=BYTES] [--texture G:B=FILE] [--storage-texture G:B=WxH[:FORMAT]]
 //!   [--sampler G:B=FILTER,ADDRESS] [--override NAME=VALUE ...] [--ulp N | --ulp BUFFER=N ...] [--abs E | --abs BUFFER=E ...]
 //!   [--reference BACKEND] [--time-limit SECONDS] [--sanitize]
-//!   --backend cpu|wgpu|wgpu-gl|ash|ash-glsl|ash-hlsl|ash-slang|all [--out DIR]`:
+//!   --backend cpu|wgpu|wgpu-gl|ash|ash-glsl|ash-hlsl|ash-slang|webgpu|all [--out DIR]`:
 //!   runs any WGSL compute shader, writes every writable buffer and storage texture to
 //!   `DIR/BACKEND/G_B_NAME.bin` (a storage texture also as `.png` or `.exr`), and with several backends reports per backend and
 //!   buffer whether it is identical to the reference backend's, or how many words
@@ -158,15 +158,16 @@ struct RunArgs {
     /// NAME=VALUE: the value of an `override` constant (repeatable; by name, or by its
     /// `@id` number as ID=VALUE or @ID=VALUE, whether or not it has a name). Others keep
     /// their WGSL defaults. Applied once, by naga, before any backend sees the shader, so
-    /// every backend runs the same specialisation.
+    /// every backend runs the same specialisation (`webgpu`, which compiles the WGSL
+    /// itself, gets the same values as its pipeline's constants).
     #[arg(long = "override", value_parser = OverrideFlag::parse)]
     overrides: Vec<OverrideFlag>,
     /// Backends, comma-separated, each once, or `all` (cpu, wgpu-vulkan, wgpu-gl, ash,
-    /// ash-glsl, ash-hlsl, ash-slang; `wgpu` means wgpu-vulkan). `all` runs every path
-    /// available here and lists the others as unavailable (a missing toolchain such as
-    /// Slang's, no device, or a device without a feature the kernel needs, such as
-    /// linear filtering of `rgba32float`) without failing; a path named on its own must
-    /// run.
+    /// ash-glsl, ash-hlsl, ash-slang, webgpu; `wgpu` means wgpu-vulkan). `all` runs every
+    /// path available here and lists the others as unavailable (a missing toolchain such
+    /// as Slang's or Chromium, no device, a device without a feature the kernel needs,
+    /// such as linear filtering of `rgba32float`, or a WebGPU limit) without failing; a
+    /// path named on its own must run.
     #[arg(long, default_value = "cpu", value_delimiter = ',')]
     backend: Vec<String>,
     /// Tolerance for f32 words: N units in the last place for every buffer, or

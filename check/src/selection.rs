@@ -24,9 +24,9 @@ use strata_render::synthetic::{CandidateMix, candidate_image};
 pub struct SelectionCheck(pub KernelId);
 
 /// Every sampler variant of Table 2.
-const SAMPLERS: [SamplerVariant; 5] = SamplerVariant::ALL;
+const SAMPLERS: [SamplerVariant; 6] = SamplerVariant::ALL;
 
-/// The sampler variant and K of a case family: the 20 families are every variant × every
+/// The sampler variant and K of a case family: the 24 families are every variant × every
 /// K from 1 to 4 (each K has its own stratified pattern).
 fn sampler_and_k(family: u32) -> (SamplerVariant, u32) {
     (SAMPLERS[family as usize % SAMPLERS.len()], 1 + family / SAMPLERS.len() as u32 % MAX_SELECTED)
@@ -139,7 +139,7 @@ impl KernelCheck for SelectionCheck {
     }
 
     fn cases(&self, config: CheckConfig) -> Vec<Case> {
-        // Seed s runs family s mod 20 (every variant × K) at every size; the quick check
+        // Seed s runs family s mod 24 (every variant × K) at every size; the quick check
         // keeps the 1 x 1 image for one seed in five.
         let families = SAMPLERS.len() as u64 * u64::from(MAX_SELECTED);
         let sizes: &[(u32, u32, u32)] = if config.full {

@@ -702,7 +702,7 @@ int main(void) {
             candidates: 1 + case / 4 % 4,
             masking: case % 3 == 0,
             block_shift: case % 2 == 1,
-            sampler: SamplerVariant::ALL[case as usize % 5],
+            sampler: SamplerVariant::ALL[case as usize % SamplerVariant::ALL.len()],
         };
         let (width, height) = match case % 5 {
             0 => (1, 1),

@@ -18,7 +18,7 @@
 use std::sync::OnceLock;
 
 use strata_backends::{Backend, gpu_required};
-use strata_kernels::selection::SelectionSettings;
+use strata_kernels::selection::{SamplerVariant, SelectionSettings};
 use strata_render::render::{Film, GpuScene, PathTracer, RenderSettings};
 use strata_render::restir::{Method, RestirRenderer, RestirSettings, ReuseOrder, ShadedParts, Shading};
 use strata_render::rgb_image::RgbImage;
@@ -471,12 +471,21 @@ fn every_method_converges_to_the_path_traced_reference() {
         settings(Method::RestirDisc, Shading::Sample),
         settings(Method::Ris, Shading::Expectation),
         settings(Method::Ris, Shading::Sample),
+        // The quad-antithetic sampler (complementary strata across each 2 x 2 quad).
+        RestirSettings {
+            selection: SelectionSettings { sampler: SamplerVariant::QuadAntithetic, ..blocks_of_8() },
+            ..settings(Method::Strata, Shading::Expectation)
+        },
     ];
     let base = settings(Method::Restir, Shading::Expectation);
     let differences = paired_differences(&mut backend, &scene, base, &variants, PAIRED_SEEDS, 32, |render| render);
     for (variant, difference) in variants.iter().zip(&differences) {
-        let what =
-            format!("{} {:?} less restir expectation, without temporal reuse", variant.method.name(), variant.shading);
+        let what = format!(
+            "{} {:?} ({} sampler) less restir expectation, without temporal reuse",
+            variant.method.name(),
+            variant.shading,
+            variant.selection.sampler.name()
+        );
         assert_same_mean_with_power(&what, difference, &reference, POWER_PAIRED);
         // The paired test can fail: the variant's frames 1 % too bright are caught.
         let mut brighter = difference.clone();

@@ -56,10 +56,13 @@ pub fn selection_numbers(
         state = selection_hash(state);
         unit_float(state)
     };
-    let blue = |sample_index: u32, dimension: u32, white: &mut dyn FnMut() -> f32| {
+    let blue_at = |(x, y): (u32, u32), sample_index: u32, dimension: u32, white: &mut dyn FnMut() -> f32| {
         let shift = unit_float(selection_hash(seed ^ selection_hash(0x5eed_u32.wrapping_add(dimension))));
         let k = tables.stratum(x, y, sample_index, dimension) as f32;
         fract((k + white()) / 256.0 + shift).min(BELOW_ONE)
+    };
+    let blue = |sample_index: u32, dimension: u32, white: &mut dyn FnMut() -> f32| {
+        blue_at((x, y), sample_index, dimension, white)
     };
     let k = count.clamp(1, MAX_SELECTED);
     let (position_dimension, resample_dimension) = (2 * pair, 2 * pair + 1);
@@ -86,6 +89,12 @@ pub fn selection_numbers(
         }
         SamplerVariant::RandomOffsetBlueNoise | SamplerVariant::Antithetic => {
             let b = blue(sample_index, position_dimension, &mut white);
+            SelectionNumbers { positions: stratified(b), resample: blue(sample_index, resample_dimension, &mut white) }
+        }
+        SamplerVariant::QuadAntithetic => {
+            let place = ((x & 1) + 2 * (y & 1)).wrapping_add(frame) & 3;
+            let quad = blue_at((x / 2, y / 2), sample_index, position_dimension, &mut white);
+            let b = fract(quad + place as f32 * 0.25).min(BELOW_ONE);
             SelectionNumbers { positions: stratified(b), resample: blue(sample_index, resample_dimension, &mut white) }
         }
     }

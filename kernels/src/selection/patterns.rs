@@ -107,8 +107,12 @@ mod tests {
     use super::*;
     use crate::selection::SamplerVariant;
 
-    const STRATIFIED: [SamplerVariant; 3] =
-        [SamplerVariant::RandomOffset, SamplerVariant::RandomOffsetBlueNoise, SamplerVariant::Antithetic];
+    const STRATIFIED: [SamplerVariant; 4] = [
+        SamplerVariant::RandomOffset,
+        SamplerVariant::RandomOffsetBlueNoise,
+        SamplerVariant::Antithetic,
+        SamplerVariant::QuadAntithetic,
+    ];
 
     /// What makes the selection unbiased: the strata of every stratified pattern tile
     /// [0, 1) exactly once, so the K positions together have density K on [0, 1).

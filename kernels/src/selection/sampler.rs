@@ -32,16 +32,27 @@ pub enum SamplerVariant {
     /// u = b/4; see [`super::patterns`] for K < 4); resampling from its second dimension.
     #[default]
     Antithetic,
+    /// Antithetic + temporal blue noise with complementary strata across each 2 × 2 quad
+    /// of pixels (issue 55's lever against correlated error; not in the paper): the quad
+    /// shares one blue-noise value b_q (the blue noise of the quad's position) and its
+    /// pixels take b = b_q + q/4 mod 1, q the pixel's place in the quad turned by one every
+    /// frame. Within each stratum of the antithetic pattern the four pixels then sit a
+    /// quarter of the stratum apart, so neighbours take different members of a sorted run
+    /// (one darker, one brighter) and their errors can cancel under a spatial filter. Each
+    /// b is still uniform over renders (a shift mod 1 of a uniform number), so the
+    /// selection stays unbiased; resampling from the pixel's own second dimension.
+    QuadAntithetic,
 }
 
 impl SamplerVariant {
     /// Every variant, in Table 2's order.
-    pub const ALL: [SamplerVariant; 5] = [
+    pub const ALL: [SamplerVariant; 6] = [
         SamplerVariant::Random,
         SamplerVariant::Heitz,
         SamplerVariant::RandomOffset,
         SamplerVariant::RandomOffsetBlueNoise,
         SamplerVariant::Antithetic,
+        SamplerVariant::QuadAntithetic,
     ];
 
     /// The WGSL `SAMPLER_*` constant of the variant (`kernels/wgsl/strata/selection.wgsl`).
@@ -52,6 +63,7 @@ impl SamplerVariant {
             SamplerVariant::RandomOffset => SAMPLER_RANDOM_OFFSET,
             SamplerVariant::RandomOffsetBlueNoise => SAMPLER_RANDOM_OFFSET_BLUE_NOISE,
             SamplerVariant::Antithetic => SAMPLER_ANTITHETIC,
+            SamplerVariant::QuadAntithetic => SAMPLER_QUAD_ANTITHETIC,
         }
     }
 
@@ -64,6 +76,7 @@ impl SamplerVariant {
             SamplerVariant::RandomOffset => "random-offset",
             SamplerVariant::RandomOffsetBlueNoise => "random-offset-blue-noise",
             SamplerVariant::Antithetic => "antithetic",
+            SamplerVariant::QuadAntithetic => "quad-antithetic",
         }
     }
 
@@ -79,7 +92,9 @@ impl SamplerVariant {
             SamplerVariant::RandomOffset | SamplerVariant::RandomOffsetBlueNoise => {
                 Pattern::Stratified(StratifiedPattern::random_offset(count))
             }
-            SamplerVariant::Antithetic => Pattern::Stratified(StratifiedPattern::antithetic(count)),
+            SamplerVariant::Antithetic | SamplerVariant::QuadAntithetic => {
+                Pattern::Stratified(StratifiedPattern::antithetic(count))
+            }
         }
     }
 }
@@ -96,6 +111,8 @@ crate::gpu::gpu_constants! {
     pub const SAMPLER_RANDOM_OFFSET_BLUE_NOISE: u32 = 3;
     /// Sampler variant id of `SamplerVariant::Antithetic`.
     pub const SAMPLER_ANTITHETIC: u32 = 4;
+    /// Sampler variant id of `SamplerVariant::QuadAntithetic`.
+    pub const SAMPLER_QUAD_ANTITHETIC: u32 = 5;
 }
 
 #[cfg(all(test, feature = "clap"))]

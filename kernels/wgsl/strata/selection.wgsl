@@ -11,6 +11,9 @@
 //   heitz            K consecutive samples of the pixel's blue-noise sequence per frame
 //   random-offset    (j + b) / K, b white noise: one position per stratum of width 1/K
 //   random-offset-blue-noise  the same with b from the temporal blue noise
+//   quad-antithetic  antithetic, b = b_q + q/4 mod 1: the 2 x 2 quad's blue noise b_q,
+//                    q the pixel's place in the quad turned by one each frame, so the
+//                    quad's pixels take complementary quarters of every stratum
 //   antithetic       b from the temporal blue noise, mirrored pairs (Fig. 3):
 //                      K = 4: {b, 2 - b, 2 + b, 4 - b} / 4 (u, 1/2 - u, 1/2 + u, 1 - u)
 //                      K = 3: {b, 1 + b, 3 - b} / 3   (one pair on the outer strata,
@@ -77,7 +80,7 @@ fn selection_blue(pixel: vec2<u32>, sample_index: u32, dimension: u32, seed: u32
 fn stratified_positions(b: f32, sampler: u32, count: u32) -> vec4<f32> {
     var offsets = vec4<f32>(0.0, 1.0, 2.0, 3.0);
     var signs = vec4<f32>(1.0);
-    if sampler == SAMPLER_ANTITHETIC {
+    if sampler == SAMPLER_ANTITHETIC || sampler == SAMPLER_QUAD_ANTITHETIC {
         switch count {
             case 4u: {
                 offsets = vec4<f32>(0.0, 2.0, 2.0, 4.0);
@@ -134,6 +137,12 @@ fn selection_numbers(pixel: vec2<u32>, frame: u32, seed: u32, sampler: u32, coun
         case SAMPLER_RANDOM_OFFSET: {
             let b = selection_white();
             return SelectionNumbers(stratified_positions(b, sampler, k), selection_white());
+        }
+        case SAMPLER_QUAD_ANTITHETIC: {
+            let quad = pixel / 2u;
+            let place = ((pixel.x & 1u) + 2u * (pixel.y & 1u) + frame) & 3u;
+            let b = min(fract(selection_blue(quad, sample_index, position_dimension, seed) + f32(place) * 0.25), BELOW_ONE);
+            return SelectionNumbers(stratified_positions(b, sampler, k), selection_blue(pixel, sample_index, resample_dimension, seed));
         }
         default: {
             // SAMPLER_RANDOM_OFFSET_BLUE_NOISE and SAMPLER_ANTITHETIC.

@@ -258,3 +258,79 @@ pub(super) fn unframe(bytes: &[u8]) -> Result<(serde_json::Value, &[u8]), String
     let header = serde_json::from_slice(&bytes[4..4 + length]).map_err(|e| format!("its header is not JSON: {e}"))?;
     Ok((header, &bytes[4 + length..]))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Sends `request` to the server and returns its whole response.
+    fn ask(server: &Server, request: &str) -> String {
+        let mut stream = TcpStream::connect(server.address).unwrap();
+        stream.write_all(request.as_bytes()).unwrap();
+        let mut response = String::new();
+        stream.read_to_string(&mut response).unwrap();
+        response
+    }
+
+    #[test]
+    fn only_the_token_and_the_servers_own_host_are_answered() {
+        let server = Server::start().unwrap();
+        let (host, token) = (server.address.to_string(), server.token.clone());
+        assert_eq!(token.len(), 32, "128 random bits as hex");
+        let page = ask(&server, &format!("GET /{token}/ HTTP/1.1\r\nHost: {host}\r\n\r\n"));
+        assert!(page.starts_with("HTTP/1.1 200 OK") && page.contains("page.js"), "{page}");
+        let script = ask(&server, &format!("GET /{token}/page.js HTTP/1.1\r\nHost: {host}\r\n\r\n"));
+        assert!(script.starts_with("HTTP/1.1 200 OK") && script.contains("requestAdapter"), "{script}");
+        // Without the token, with another token, or through another name (a page of
+        // some site whose name resolves to 127.0.0.1): nothing.
+        for request in [
+            format!("GET / HTTP/1.1\r\nHost: {host}\r\n\r\n"),
+            format!("GET /{}/ HTTP/1.1\r\nHost: {host}\r\n\r\n", "0".repeat(32)),
+            format!("GET /{token}/ HTTP/1.1\r\nHost: attacker.example:{}\r\n\r\n", server.address.port()),
+            format!("GET /{token}/../page.js HTTP/1.1\r\nHost: {host}\r\n\r\n"),
+        ] {
+            let response = ask(&server, &request);
+            assert!(response.starts_with("HTTP/1.1 404"), "{request:?}: {response}");
+        }
+        // Two servers never share a token.
+        assert_ne!(Server::start().unwrap().token, token);
+    }
+
+    #[test]
+    fn an_exchange_waits_for_its_message_and_a_silent_page_times_out() {
+        let mut server = Server::start().unwrap();
+        let (address, host, token) = (server.address, server.address.to_string(), server.token.clone());
+        let page = std::thread::spawn(move || {
+            let mut stream = TcpStream::connect(address).unwrap();
+            let body = frame(&serde_json::json!({ "ready": true }), b"abc");
+            let head =
+                format!("POST /{token}/exchange HTTP/1.1\r\nHost: {host}\r\nContent-Length: {}\r\n\r\n", body.len());
+            stream.write_all(head.as_bytes()).unwrap();
+            stream.write_all(&body).unwrap();
+            let mut response = Vec::new();
+            stream.read_to_end(&mut response).unwrap();
+            response
+        });
+        let body = server.receive(Duration::from_secs(10), &mut || Ok(())).ok().expect("the page's exchange");
+        let (header, payload) = unframe(&body).unwrap();
+        assert_eq!((header["ready"].as_bool(), payload), (Some(true), &b"abc"[..]));
+        server.send(&frame(&serde_json::json!({ "ops": [] }), b"xyz"), Duration::from_secs(10)).unwrap();
+        let response = page.join().unwrap();
+        assert!(response.starts_with(b"HTTP/1.1 200 OK") && response.ends_with(b"xyz"));
+        let started = Instant::now();
+        assert!(matches!(server.receive(Duration::from_millis(300), &mut || Ok(())), Err(WaitError::Timeout)));
+        assert!(started.elapsed() < Duration::from_secs(5));
+        let gone = server.receive(Duration::from_secs(10), &mut || Err("the browser exited".into()));
+        assert!(matches!(gone, Err(WaitError::Gone(why)) if why == "the browser exited"));
+    }
+
+    #[test]
+    fn a_message_without_a_whole_header_is_refused() {
+        assert!(unframe(&[1, 0]).is_err());
+        assert!(unframe(&[9, 0, 0, 0, b'{', b'}']).is_err());
+        assert!(unframe(&[2, 0, 0, 0, b'{', b'x']).is_err());
+        let message = frame(&serde_json::json!({ "a": 1 }), b"");
+        let (header, payload) = unframe(&message).unwrap();
+        assert_eq!((header["a"].as_u64(), payload.len()), (Some(1), 0));
+    }
+}

@@ -17,20 +17,36 @@ pub static ONE_CASE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
 /// The slots that can open here; a slot without a device is skipped (with a note naming
 /// `what`), or fails the test under `STRATA_REQUIRE_GPU=1` when it needs Vulkan; the
 /// `webgpu` slot without Chromium is skipped too, or fails under
-/// `STRATA_REQUIRE_BROWSER=1`.
+/// `STRATA_REQUIRE_BROWSER=1`. Each slot is opened once per test process to find out
+/// (a browser start for `webgpu`), not once per test.
 pub fn available_slots(what: &str) -> Vec<BackendSlot> {
+    /// Per slot: opened, or whether it found no adapter and the error.
+    static PROBED: std::sync::OnceLock<Vec<(&'static str, Result<(), (bool, String)>)>> = std::sync::OnceLock::new();
     let _turn = ONE_CASE_AT_A_TIME.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let probed = PROBED.get_or_init(|| {
+        named_slots(&["all".to_string()])
+            .unwrap()
+            .iter()
+            .map(|slot| {
+                let opened = (slot.open)()
+                    .map(drop)
+                    .map_err(|error| (matches!(error, BackendError::NoAdapter { .. }), error.to_string()));
+                (slot.name, opened)
+            })
+            .collect()
+    });
     let mut slots = Vec::new();
     for slot in named_slots(&["all".to_string()]).unwrap() {
-        match (slot.open)() {
-            Ok(_) => slots.push(slot),
-            Err(error @ BackendError::NoAdapter { .. }) if !(gpu_required() && slot.needs_vulkan) => {
+        let opened = probed.iter().find(|(name, _)| *name == slot.name).map(|(_, opened)| opened.clone());
+        match opened.expect("every slot probed") {
+            Ok(()) => slots.push(slot),
+            Err((true, error)) if !(gpu_required() && slot.needs_vulkan) => {
                 eprintln!("SKIPPED {} in {what}: {error} (see {GPU_REQUIRED_VARIABLE})", slot.name);
             }
-            Err(error) if slot.name == "webgpu" && !browser_required() => {
+            Err((_, error)) if slot.name == "webgpu" && !browser_required() => {
                 eprintln!("SKIPPED {} in {what}: {error} (see {BROWSER_REQUIRED_VARIABLE})", slot.name);
             }
-            Err(error) => panic!("{}: {error}", slot.name),
+            Err((_, error)) => panic!("{}: {error}", slot.name),
         }
     }
     slots

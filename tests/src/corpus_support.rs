@@ -21,7 +21,8 @@ pub static ONE_CASE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
 /// (a browser start for `webgpu`), not once per test.
 pub fn available_slots(what: &str) -> Vec<BackendSlot> {
     /// Per slot: opened, or whether it found no adapter and the error.
-    static PROBED: std::sync::OnceLock<Vec<(&'static str, Result<(), (bool, String)>)>> = std::sync::OnceLock::new();
+    type Probed = Vec<(&'static str, Result<(), (bool, String)>)>;
+    static PROBED: std::sync::OnceLock<Probed> = std::sync::OnceLock::new();
     let _turn = ONE_CASE_AT_A_TIME.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     let probed = PROBED.get_or_init(|| {
         named_slots(&["all".to_string()])

@@ -161,9 +161,13 @@ fn inputs(kernel: KernelId, case: &Case) -> Inputs {
         })
         .collect();
     let level = if kernel == KernelId::SvgfAtrous { (case.seed % 5) as u32 } else { 0 };
-    // Object edges on for about half the cases (the seed's parity).
+    // Object edges on for about half the cases (the seed's parity), and the à-trous
+    // variance of correlated noise (`svgf-correlated`) in every third.
     let settings = strata_render::denoise::SvgfSettings::default().with_object_edges(case.seed % 2 == 1);
-    let params = settings.params(width, height, level, case.family != 3);
+    let mut params = settings.params(width, height, level, case.family != 3);
+    if case.seed % 3 == 2 {
+        params.svgf.error_correlation = 0.15;
+    }
     Inputs {
         params,
         colour,

@@ -66,8 +66,13 @@ gpu_struct! {
         /// pixels of different objects (`DenoiseGuide::mesh`), as the temporal pass does;
         /// 0: SVGF's own weights, which stop at depth, normal and luminance edges only.
         pub object_edges: u32,
-        /// Padding (the uniform is a multiple of 16 bytes).
-        pub _pad0: u32,
+        /// The correlation ρ in [0, 1) that the à-trous filter's variance propagation
+        /// assumes between the noise of the pixels it averages: 0 (SVGF's) treats each
+        /// pixel's noise as independent, Σ w² σ²; ReSTIR's reuse makes neighbours' errors
+        /// positively correlated (lag 1 up to 0.15-0.18 measured), so the filtered
+        /// variance is larger, ((1 - ρ) Σ w² σ² + ρ (Σ w σ)²) / (Σ w)², and the next
+        /// level's luminance weights are less strict (`denoise/entry_atrous.wgsl`).
+        pub error_correlation: f32,
         /// Padding.
         pub _pad1: u32,
         /// Padding.

@@ -260,6 +260,7 @@ pub fn atrous(params: &DenoiseParams, guides: &[DenoiseGuide], level_in: &[[f32;
             let mut weight_sum = 0.0f32;
             let mut illumination = [0.0f32; 3];
             let mut variance = 0.0f32;
+            let mut deviation = 0.0f32;
             for dy in -2..=2 {
                 for dx in -2..=2 {
                     let Some(q) = pixel_at(params, xi + dx * step, yi + dy * step).filter(|&q| has_surface(&guides[q]))
@@ -278,7 +279,12 @@ pub fn atrous(params: &DenoiseParams, guides: &[DenoiseGuide], level_in: &[[f32;
                     weight_sum += w;
                     add_weighted(&mut illumination, w, &other[..3]);
                     variance += w * w * other[3];
+                    deviation += w * other[3].max(0.0).sqrt();
                 }
+            }
+            let rho = params.svgf.error_correlation;
+            if rho > 0.0 {
+                variance = (1.0 - rho) * variance + rho * deviation * deviation;
             }
             let weight_sum = weight_sum.max(1e-20);
             out[pixel] = [

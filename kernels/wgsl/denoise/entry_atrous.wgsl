@@ -73,6 +73,8 @@ fn svgf_atrous(@builtin(global_invocation_id) id: vec3<u32>) {
     var weight_sum = 0.0;
     var illumination = vec3<f32>(0.0);
     var variance = 0.0;
+    // Σ w σ, for the correlated part of the variance (svgf.error_correlation).
+    var deviation = 0.0;
     for (var dy = -2; dy <= 2; dy++) {
         for (var dx = -2; dx <= 2; dx++) {
             let q = pixel_at(x + dx * step, y + dy * step);
@@ -88,7 +90,15 @@ fn svgf_atrous(@builtin(global_invocation_id) id: vec3<u32>) {
             weight_sum += w;
             illumination += w * other.xyz;
             variance += w * w * other.w;
+            deviation += w * sqrt(max(other.w, 0.0));
         }
+    }
+    // Neighbours' noise correlated with coefficient ρ: the filtered variance gains
+    // ρ ((Σ w σ)² - Σ w² σ²), the covariances of every pair (an equicorrelated model). ρ = 0
+    // leaves SVGF's formula (and its bits) unchanged.
+    let rho = params.svgf.error_correlation;
+    if rho > 0.0 {
+        variance = (1.0 - rho) * variance + rho * deviation * deviation;
     }
     // The pixel itself weighs about (3/8)² (its normal's length may round below 1).
     weight_sum = max(weight_sum, 1e-20);

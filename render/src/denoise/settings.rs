@@ -18,6 +18,11 @@ pub enum Denoiser {
     /// as its temporal pass does: not in the paper; around lights it removes most of the
     /// paper's filter's error (BENCHMARKS.md).
     SvgfObjects,
+    /// `svgf-objects` whose à-trous variance propagation assumes the noise of the pixels
+    /// it averages correlated with ρ = 0.15 ([`SvgfFilter::error_correlation`]), the lag-1
+    /// correlation of ReSTIR's error the viewer metrics measure: SVGF's own formula
+    /// assumes independent noise, which reuse breaks (issue 55's lever; not in the paper).
+    SvgfCorrelated,
     /// Intel Open Image Denoise's `RT` filter (the neural denoiser of Blender/Cycles) on
     /// the CPU, with the guides' albedo and normal: spatial only, each frame filtered on
     /// its own with no history. Its library is opened at run time (`pip install
@@ -31,6 +36,7 @@ impl Denoiser {
         match self {
             Denoiser::Svgf => "svgf",
             Denoiser::SvgfObjects => "svgf-objects",
+            Denoiser::SvgfCorrelated => "svgf-correlated",
             Denoiser::Oidn => "oidn",
         }
     }
@@ -38,7 +44,7 @@ impl Denoiser {
     /// The filter's name in headings: `SVGF` (either configuration) or `OIDN`.
     pub fn title(self) -> &'static str {
         match self {
-            Denoiser::Svgf | Denoiser::SvgfObjects => "SVGF",
+            Denoiser::Svgf | Denoiser::SvgfObjects | Denoiser::SvgfCorrelated => "SVGF",
             Denoiser::Oidn => "OIDN",
         }
     }
@@ -48,6 +54,10 @@ impl Denoiser {
         match self {
             Denoiser::Svgf => Some(SvgfSettings::default()),
             Denoiser::SvgfObjects => Some(SvgfSettings::default().with_object_edges(true)),
+            Denoiser::SvgfCorrelated => {
+                let objects = SvgfSettings::default().with_object_edges(true);
+                Some(SvgfSettings { filter: SvgfFilter { error_correlation: 0.15, ..objects.filter }, ..objects })
+            }
             Denoiser::Oidn => None,
         }
     }
@@ -112,6 +122,9 @@ impl SvgfSettings {
         if filter.object_edges > 1 {
             return fail("object_edges", filter.object_edges.to_string(), "0 or 1");
         }
+        if !(0.0..1.0).contains(&filter.error_correlation) {
+            return fail("error_correlation", filter.error_correlation.to_string(), "in [0, 1)");
+        }
         Ok(())
     }
 
@@ -143,6 +156,7 @@ mod tests {
             filter(SvgfFilter { depth_tolerance: 0.0, ..paper }),
             filter(SvgfFilter { normal_tolerance: 2.0, ..paper }),
             filter(SvgfFilter { object_edges: 2, ..paper }),
+            filter(SvgfFilter { error_correlation: 1.0, ..paper }),
         ];
         let fields = [
             "levels",
@@ -155,6 +169,7 @@ mod tests {
             "depth_tolerance",
             "normal_tolerance",
             "object_edges",
+            "error_correlation",
         ];
         for (settings, field) in bad.iter().zip(fields) {
             let message = settings.check().unwrap_err().to_string();

@@ -302,7 +302,11 @@ pub(crate) fn settings_of(settings: &StrataSelectionSettings) -> Result<Selectio
     };
     let sampler = SamplerVariant::from_id(settings.sampler).ok_or_else(|| Failure {
         status: StrataStatus::Settings,
-        message: format!("sampler = {}: must be a StrataSampler (0 to 4)", settings.sampler),
+        message: format!(
+            "sampler = {}: must be a StrataSampler (0 to {})",
+            settings.sampler,
+            SamplerVariant::ALL.len() - 1
+        ),
     })?;
     let settings = SelectionSettings {
         block_size: settings.block_size,

@@ -60,8 +60,8 @@ static inline int strata_check_settings(const StrataSelectionSettings *settings,
         field = "block_size", value = settings->block_size, expected = "4, 8, 16 or 32";
     } else if (settings->candidates < 1u || settings->candidates > STRATA_MAX_SELECTED) {
         field = "candidates", value = settings->candidates, expected = "1 to 4";
-    } else if (settings->sampler > STRATA_SAMPLER_ANTITHETIC) {
-        field = "sampler", value = settings->sampler, expected = "a StrataSampler (0 to 4)";
+    } else if (settings->sampler >= STRATA_SAMPLER_COUNT) {
+        field = "sampler", value = settings->sampler, expected = "a StrataSampler (" STRATA_SAMPLER_RANGE ")";
     } else if (settings->masking > 1u) {
         field = "masking", value = settings->masking, expected = "0 or 1";
     } else if (settings->block_shift > 1u) {

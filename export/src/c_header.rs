@@ -180,7 +180,10 @@ pub fn header(
         let name = variant.name().to_uppercase().replace('-', "_");
         h += &format!("    STRATA_SAMPLER_{name} = {},\n", variant.id());
     }
-    h += "} StrataSampler;\n\n";
+    h += "} StrataSampler;\n";
+    // How many there are, and their range as the settings' checks say it (strata_frame.h).
+    let count = SamplerVariant::ALL.len();
+    h += &format!("#define STRATA_SAMPLER_COUNT {count}u\n#define STRATA_SAMPLER_RANGE \"0 to {}\"\n\n", count - 1);
     for s in structs {
         let entry = &s.entry;
         if !s.doc.is_empty() {

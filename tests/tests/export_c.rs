@@ -767,7 +767,7 @@ int main(void) {
     let expected = [
         rust(SelectionSettings { block_size: 12, ..SelectionSettings::default() }),
         rust(SelectionSettings { block_size: 4, candidates: 5, ..SelectionSettings::default() }),
-        "error sampler = 9: must be a StrataSampler (0 to 4)".to_string(),
+        format!("error sampler = 9: must be a StrataSampler (0 to {})", SamplerVariant::ALL.len() - 1),
     ];
     let said: Vec<&str> = std::str::from_utf8(&refused.stdout).unwrap().lines().collect();
     assert_eq!(said, expected);

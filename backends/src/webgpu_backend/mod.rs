@@ -437,6 +437,18 @@ impl WebGpuBackend {
 
     /// Queues a dispatch of `kernel` (creating its pipeline first where the page has
     /// none); a timed one is sent at once, and its two timestamps returned.
+    /// Sends `op`, a read-back, at once and returns the page's bytes, which must be
+    /// `expected` long (`whose`: "the buffer's", "the level's", for the error).
+    fn read_back(&mut self, op: Value, what: String, expected: u64, whose: &str) -> Result<Vec<u8>, BackendError> {
+        self.link.queue(op, what.clone());
+        let bytes = self.flush(None)?.pop().filter(|bytes| bytes.len() as u64 == expected);
+        bytes.ok_or_else(|| BackendError::Validation {
+            backend: NAME.into(),
+            operation: what,
+            message: format!("the page sent other than {whose} {expected} bytes"),
+        })
+    }
+
     fn encode(
         &mut self,
         kernel: &Kernel,
@@ -634,6 +646,19 @@ fn device_info(device: &Value, binary: &std::path::Path) -> DeviceInfo {
     }
 }
 
+/// The page's operation `op` on level `level` of `texture` (a write or a read-back): its
+/// size and row pitch, tightly packed.
+fn level_op(op: &str, texture: TextureId, level: u32, desc: &TextureDesc) -> Value {
+    let size = desc.level_size(level);
+    json!({
+        "op": op,
+        "id": texture.0,
+        "level": level,
+        "size": size,
+        "bytesPerRow": size[0] * desc.format.bytes_per_texel(),
+    })
+}
+
 fn address_mode(mode: AddressMode) -> &'static str {
     match mode {
         AddressMode::ClampToEdge => "clamp-to-edge",
@@ -677,13 +702,7 @@ impl Backend for WebGpuBackend {
     fn read_buffer(&mut self, buffer: BufferId) -> Result<Vec<u8>, BackendError> {
         let (size, label) = self.buffer(buffer)?;
         let (size, what) = (*size, format!("read-back of buffer `{label}`"));
-        self.link.queue(json!({ "op": "readBuffer", "id": buffer.0 }), what.clone());
-        let bytes = self.flush(None)?.pop().filter(|bytes| bytes.len() as u64 == size);
-        bytes.ok_or_else(|| BackendError::Validation {
-            backend: NAME.into(),
-            operation: what,
-            message: format!("the page sent other than the buffer's {size} bytes"),
-        })
+        self.read_back(json!({ "op": "readBuffer", "id": buffer.0 }), what, size, "the buffer's")
     }
 
     fn destroy_buffer(&mut self, buffer: BufferId) -> Result<(), BackendError> {
@@ -717,14 +736,7 @@ impl Backend for WebGpuBackend {
     fn write_texture(&mut self, texture: TextureId, level: u32, data: &[u8]) -> Result<(), BackendError> {
         let desc = self.texture(texture)?;
         desc.check_level(level, data.len())?;
-        let size = desc.level_size(level);
-        let op = json!({
-            "op": "writeTexture",
-            "id": texture.0,
-            "level": level,
-            "size": size,
-            "bytesPerRow": size[0] * desc.format.bytes_per_texel(),
-        });
+        let op = level_op("writeTexture", texture, level, desc);
         let what = format!("write of texture `{}` level {level}", desc.label);
         self.link.queue_with(op, "data", data, what);
         Ok(())
@@ -734,22 +746,9 @@ impl Backend for WebGpuBackend {
         let desc = self.texture(texture)?;
         let expected = desc.level_bytes(level);
         desc.check_level(level, expected as usize)?;
-        let size = desc.level_size(level);
-        let op = json!({
-            "op": "readTexture",
-            "id": texture.0,
-            "level": level,
-            "size": size,
-            "bytesPerRow": size[0] * desc.format.bytes_per_texel(),
-        });
+        let op = level_op("readTexture", texture, level, desc);
         let what = format!("read-back of texture `{}` level {level}", desc.label);
-        self.link.queue(op, what.clone());
-        let bytes = self.flush(None)?.pop().filter(|bytes| bytes.len() as u64 == expected);
-        bytes.ok_or_else(|| BackendError::Validation {
-            backend: NAME.into(),
-            operation: what,
-            message: format!("the page sent other than the level's {expected} bytes"),
-        })
+        self.read_back(op, what, expected, "the level's")
     }
 
     fn destroy_texture(&mut self, texture: TextureId) -> Result<(), BackendError> {

@@ -90,7 +90,10 @@ fn svgf_atrous(@builtin(global_invocation_id) id: vec3<u32>) {
             weight_sum += w;
             illumination += w * other.xyz;
             variance += w * w * other.w;
-            deviation += w * sqrt(max(other.w, 0.0));
+            // (A uniform test: SVGF's own configurations take no square root per tap.)
+            if params.svgf.error_correlation > 0.0 {
+                deviation += w * sqrt(max(other.w, 0.0));
+            }
         }
     }
     // Neighbours' noise correlated with coefficient ρ: the filtered variance gains

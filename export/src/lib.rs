@@ -17,6 +17,7 @@
 //! | `examples/cpp/` | a C++17 consumer built with CMake |
 //! | `kernels/{spirv,hlsl,msl,glsl,wgsl}/` | every kernel in every language ([`translations`]) |
 //! | `data/blue_noise.bin` | the blue-noise tables, uploaded once |
+//! | `web/strata.js`, `web/strata.d.ts`, `web/example.html` | the pass for web engines: an ES module that runs it on a WebGPU `GPUDevice`, generated from the manifest, its TypeScript declarations and an example page ([`es_module`]) |
 //!
 //! `cargo xtask export --out DIR` runs it. The folder is written next to `DIR` first and
 //! moved into place whole; an existing `DIR` is replaced only if it is an earlier package
@@ -37,6 +38,7 @@
 
 pub mod abi_header;
 pub mod c_header;
+pub mod es_module;
 pub mod manifest;
 pub mod shader_headers;
 pub mod translations;
@@ -201,6 +203,11 @@ pub fn export(out: &Path) -> Result<Exported, ExportError> {
         device_requirements: device_requirements(registry),
     };
     let json = serde_json::to_string_pretty(&manifest).map_err(|e| ExportError::Header(e.to_string()))? + "\n";
+    let value: serde_json::Value = serde_json::from_str(&json).map_err(|e| ExportError::Header(e.to_string()))?;
+    let wgsl = |path: &str| {
+        files.iter().find(|(name, _)| name == path).and_then(|(_, bytes)| String::from_utf8(bytes.clone()).ok())
+    };
+    let web = es_module::files(&value, &wgsl)?;
     files.push((MANIFEST.into(), json.into_bytes()));
     files.push(("data/blue_noise.bin".into(), blue_noise));
     files.push((
@@ -216,6 +223,9 @@ pub fn export(out: &Path) -> Result<Exported, ExportError> {
     files.push(("include/strata_frame.h".into(), include_bytes!("../package/strata_frame.h").to_vec()));
     files.push(("include/strata_vk.h".into(), abi_header::header(version)?.into_bytes()));
     files.push(("README.md".into(), include_bytes!("../package/README.md").to_vec()));
+    for (path, text) in es_module::FILES.into_iter().zip(web) {
+        files.push((path.into(), text.into_bytes()));
+    }
     for (path, template) in BUILD_FILES {
         files.push((path.into(), with_version(template, version)?.into_bytes()));
     }
@@ -269,7 +279,7 @@ fn manifest_struct(entry: &manifest::StructEntry) -> manifest::StructEntry {
 
 /// The files every package has besides those its manifest names (the kernels'
 /// translations and the blue-noise tables).
-pub const FIXED_FILES: [&str; 15] = [
+pub const FIXED_FILES: [&str; 18] = [
     "README.md",
     MANIFEST,
     "include/strata.h",
@@ -285,6 +295,9 @@ pub const FIXED_FILES: [&str; 15] = [
     "lib/pkgconfig/strata.pc",
     "examples/cpp/CMakeLists.txt",
     "examples/cpp/main.cpp",
+    es_module::FILES[0],
+    es_module::FILES[1],
+    es_module::FILES[2],
 ];
 
 /// The package's build-system files (CMake package, pkg-config) and its C++ example: each

@@ -169,16 +169,21 @@ impl Routes {
     }
 }
 
-struct Request {
-    method: String,
-    path: String,
-    host: String,
-    body: Vec<u8>,
+/// One HTTP request as the bridge reads it.
+pub(super) struct Request {
+    /// `GET`, `POST`, ...
+    pub(super) method: String,
+    /// The path as sent.
+    pub(super) path: String,
+    /// The `Host` header.
+    pub(super) host: String,
+    /// The body.
+    pub(super) body: Vec<u8>,
 }
 
 /// One HTTP/1.1 request: its line, `Host` and `Content-Length` headers and body; `None`
 /// for one that is malformed, too long or too slow.
-fn read_request(stream: &TcpStream) -> std::io::Result<Option<Request>> {
+pub(super) fn read_request(stream: &TcpStream) -> std::io::Result<Option<Request>> {
     let mut reader = BufReader::new(stream);
     let mut line = String::new();
     let mut header_bytes = 0usize;
@@ -226,7 +231,9 @@ fn read_request(stream: &TcpStream) -> std::io::Result<Option<Request>> {
     Ok(Some(Request { method, path, host, body }))
 }
 
-fn respond(stream: &mut TcpStream, status: &str, content_type: &str, body: &[u8]) -> std::io::Result<()> {
+/// Writes one response that closes the connection (no caching, same-origin scripts and
+/// fetches only).
+pub(super) fn respond(stream: &mut TcpStream, status: &str, content_type: &str, body: &[u8]) -> std::io::Result<()> {
     let head = format!(
         "HTTP/1.1 {status}\r\nContent-Type: {content_type}\r\nContent-Length: {}\r\nCache-Control: no-store\r\n\
          Content-Security-Policy: default-src 'none'; script-src 'self'; connect-src 'self'\r\n\

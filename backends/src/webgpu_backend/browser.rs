@@ -49,8 +49,10 @@ pub fn find_chromium() -> Result<PathBuf, String> {
     )
 }
 
-/// A running headless Chromium and its private folder.
-pub(super) struct Browser {
+/// A running headless Chromium and its private folder: the WebGPU backend's page, or any
+/// page a test serves ([`super::page_server::PageServer`]). Killed with its whole process
+/// group, and its folder removed, on drop.
+pub struct Browser {
     child: Child,
     folder: strata_files::TempDir,
 }
@@ -63,7 +65,7 @@ fn noise(line: &str) -> bool {
 impl Browser {
     /// Starts `binary` headless on `url`, with WebGPU on (SwiftShader's Vulkan where no
     /// GPU is, as on CI).
-    pub(super) fn launch(binary: &Path, url: &str) -> Result<Self, String> {
+    pub fn launch(binary: &Path, url: &str) -> Result<Self, String> {
         let folder = strata_files::private_scratch_folder("strata-webgpu-")
             .map_err(|e| format!("cannot create a private folder for Chromium's profile: {e}"))?;
         let log = std::fs::File::create_new(folder.path().join("chromium.log"))
@@ -95,6 +97,11 @@ impl Browser {
             .arg(url)
             .env("XDG_CONFIG_HOME", folder.path().join("config"))
             .env("XDG_CACHE_HOME", folder.path().join("cache"))
+            // Chromium puts its profile lock's socket folder (org.chromium.Chromium.*) in
+            // the temporary folder and removes it only when it exits cleanly; it is
+            // killed here (Drop), so in the shared /tmp one folder stayed behind per
+            // launch (hundreds after a day of tests). In the private folder it goes with it.
+            .env("TMPDIR", folder.path())
             // A Vulkan layer switched on for strata's own Vulkan work (`xtask validate`)
             // is not Chromium's: its GPU process would load it and log into strata's log.
             .env_remove("VK_INSTANCE_LAYERS")
@@ -113,7 +120,7 @@ impl Browser {
     }
 
     /// Why the browser is no longer running, with the end of its log; `None` while it runs.
-    pub(super) fn exited(&mut self) -> Option<String> {
+    pub fn exited(&mut self) -> Option<String> {
         match self.child.try_wait() {
             Ok(Some(status)) => Some(format!("Chromium exited ({status}){}", self.log_tail())),
             Ok(None) => None,
@@ -123,7 +130,7 @@ impl Browser {
 
     /// The last lines of Chromium's log that are not noise, as `: line | line`, or
     /// nothing.
-    pub(super) fn log_tail(&self) -> String {
+    pub fn log_tail(&self) -> String {
         let path = self.folder.path().join("chromium.log");
         let bytes = strata_files::read_regular_capped(&path, 64 << 20).unwrap_or_default();
         let text = String::from_utf8_lossy(&bytes);

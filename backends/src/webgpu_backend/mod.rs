@@ -23,8 +23,9 @@
 
 mod bridge;
 mod browser;
+pub mod page_server;
 
-pub use browser::{BROWSER_REQUIRED_VARIABLE, CHROMIUM_VARIABLE, browser_required, find_chromium};
+pub use browser::{BROWSER_REQUIRED_VARIABLE, Browser, CHROMIUM_VARIABLE, browser_required, find_chromium};
 
 use crate::backend::{Backend, Bind, BufferId, Resource};
 use crate::bindings_check::{
@@ -34,7 +35,6 @@ use crate::device_info::{DeviceInfo, DeviceLimits};
 use crate::error::BackendError;
 use crate::texture::{AddressMode, FilterMode, SamplerDesc, SamplerId, TextureDesc, TextureId};
 use bridge::{Server, WaitError};
-use browser::Browser;
 use serde_json::{Value, json};
 use std::collections::{HashMap, HashSet};
 use std::path::PathBuf;

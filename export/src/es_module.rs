@@ -1,5 +1,6 @@
-//! `web/strata.js`, `web/strata.d.ts` and `web/example.html`: the pass for web engines,
-//! an ES module that runs it on a WebGPU `GPUDevice`.
+//! `web/strata.js`, `web/strata.d.ts`, `web/example.html` and `web/example.js`: the pass
+//! for web engines, an ES module that runs it on a WebGPU `GPUDevice`, its TypeScript
+//! declarations and an example page.
 //!
 //! The module's code is written by hand (`export/package/web/strata.js`); everything it
 //! knows of the kernels comes from the package's own `manifest.json`, serialised into it
@@ -24,14 +25,16 @@ use strata_kernels::types::BLOCK_SIZES;
 const TEMPLATE: &str = include_str!("../package/web/strata.js");
 /// The declarations' template.
 const DECLARATIONS: &str = include_str!("../package/web/strata.d.ts");
-/// The example page (no placeholders but the version).
+/// The example page and its script (no placeholders but the version).
 const EXAMPLE: &str = include_str!("../package/web/example.html");
+/// The example page's script.
+const EXAMPLE_SCRIPT: &str = include_str!("../package/web/example.js");
 
 /// Where the template takes the package object.
 const PACKAGE_PLACEHOLDER: &str = "/* @STRATA_PACKAGE@ */ null";
 
-/// The three files' paths in the package.
-pub const FILES: [&str; 3] = ["web/strata.js", "web/strata.d.ts", "web/example.html"];
+/// The files' paths in the package.
+pub const FILES: [&str; 4] = ["web/strata.js", "web/strata.d.ts", "web/example.html", "web/example.js"];
 
 fn field<'a>(value: &'a Value, path: &[&str]) -> Result<&'a Value, ExportError> {
     path.iter().try_fold(value, |value, key| {
@@ -85,6 +88,7 @@ pub fn package_object(manifest: &Value, wgsl: &dyn Fn(&str) -> Option<String>) -
             "entry_point": field(kernel, &["entry_point", "wgsl"])?,
             "workgroup_size": field(kernel, &["workgroup_size"])?,
             "workgroup_memory_bytes": field(kernel, &["workgroup_memory_bytes"])?,
+            "uniform": field(kernel, &["uniform"])?,
             "required_features": features,
             "bindings": bindings,
             "wgsl": webgpu_wgsl(&source, subgroups),
@@ -155,9 +159,8 @@ fn fill(template: &str, what: &str, values: &[(&str, String)]) -> Result<String,
     }
 }
 
-/// `web/strata.js`, `web/strata.d.ts` and `web/example.html` ([`FILES`]' order) for the
-/// package whose manifest is `manifest`.
-pub fn files(manifest: &Value, wgsl: &dyn Fn(&str) -> Option<String>) -> Result<[String; 3], ExportError> {
+/// The contents of [`FILES`], in its order, for the package whose manifest is `manifest`.
+pub fn files(manifest: &Value, wgsl: &dyn Fn(&str) -> Option<String>) -> Result<[String; 4], ExportError> {
     let package = package_object(manifest, wgsl)?;
     let version = field(manifest, &["strata_version"])?.as_str().unwrap_or_default().to_string();
     let object = serde_json::to_string_pretty(&package).map_err(|e| ExportError::Header(e.to_string()))?;
@@ -188,8 +191,9 @@ pub fn files(manifest: &Value, wgsl: &dyn Fn(&str) -> Option<String>) -> Result<
             ),
         ],
     )?;
-    let example = fill(EXAMPLE, "example.html", &[("STRATA_VERSION", version)])?;
-    Ok([module, declarations, example])
+    let example = fill(EXAMPLE, "example.html", &[("STRATA_VERSION", version.clone())])?;
+    let example_script = fill(EXAMPLE_SCRIPT, "example.js", &[("STRATA_VERSION", version)])?;
+    Ok([module, declarations, example, example_script])
 }
 
 #[cfg(test)]

@@ -17,7 +17,7 @@
 //! | `examples/cpp/` | a C++17 consumer built with CMake |
 //! | `kernels/{spirv,hlsl,msl,glsl,wgsl}/` | every kernel in every language ([`translations`]) |
 //! | `data/blue_noise.bin` | the blue-noise tables, uploaded once |
-//! | `web/strata.js`, `web/strata.d.ts`, `web/example.html` | the pass for web engines: an ES module that runs it on a WebGPU `GPUDevice`, generated from the manifest, its TypeScript declarations and an example page ([`es_module`]) |
+//! | `web/strata.js`, `web/strata.d.ts`, `web/example.html`, `web/example.js` | the pass for web engines: an ES module that runs it on a WebGPU `GPUDevice`, generated from the manifest, its TypeScript declarations and an example page ([`es_module`]) |
 //!
 //! `cargo xtask export --out DIR` runs it. The folder is written next to `DIR` first and
 //! moved into place whole; an existing `DIR` is replaced only if it is an earlier package
@@ -279,7 +279,7 @@ fn manifest_struct(entry: &manifest::StructEntry) -> manifest::StructEntry {
 
 /// The files every package has besides those its manifest names (the kernels'
 /// translations and the blue-noise tables).
-pub const FIXED_FILES: [&str; 18] = [
+pub const FIXED_FILES: [&str; 19] = [
     "README.md",
     MANIFEST,
     "include/strata.h",
@@ -298,6 +298,7 @@ pub const FIXED_FILES: [&str; 18] = [
     es_module::FILES[0],
     es_module::FILES[1],
     es_module::FILES[2],
+    es_module::FILES[3],
 ];
 
 /// The package's build-system files (CMake package, pkg-config) and its C++ example: each

@@ -8,7 +8,8 @@
 //! two sampler variants, block shifting; every histogram kernel the browser's device can
 //! run; without a payloads buffer), and every bad input (a setting out of range, an
 //! unknown setting, a buffer too small, without STORAGE usage, misaligned or
-//! overlapping, ...) must throw a `StrataError` whose message names the field.
+//! overlapping, ...) must throw a `StrataError` whose message names the field. The
+//! package's example page (`web/example.html`) runs beside them to its end.
 //!
 //! One browser launch for all cases. Without Chromium or a WebGPU adapter in it the test
 //! says so and passes, unless `STRATA_REQUIRE_BROWSER=1` (CI) makes that a failure.
@@ -101,6 +102,8 @@ fn run_page(
         ("index.html".into(), page.as_bytes().to_vec()),
         ("driver.js".into(), include_bytes!("es_module_page.js").to_vec()),
         ("web/strata.js".into(), read("web/strata.js")?),
+        ("web/example.html".into(), read("web/example.html")?),
+        ("web/example.js".into(), read("web/example.js")?),
         ("data/blue_noise.bin".into(), read("data/blue_noise.bin")?),
         ("cases.json".into(), cases.to_string().into_bytes()),
         ("inputs.bin".into(), inputs),
@@ -195,6 +198,15 @@ fn the_es_module_equals_strata_embed_bit_for_bit_in_chromium_and_names_bad_field
         header["features"]
     );
     assert_eq!(header["uncaptured"], serde_json::json!([]), "WebGPU validation errors in the page");
+    // The package's example page ran to its end, and gave most pixels a selection.
+    let example = header["example"].as_str().unwrap_or_default();
+    assert!(example.ends_with("\ndone"), "web/example.html: {example:?}");
+    let selected = example
+        .lines()
+        .find_map(|line| line.strip_prefix("pixels with a selection: "))
+        .and_then(|counts| counts.split_once(" of "))
+        .and_then(|(got, of)| Some((got.parse::<u32>().ok()?, of.parse::<u32>().ok()?)));
+    assert!(selected.is_some_and(|(got, of)| got > of / 2), "web/example.html: {example:?}");
     let subgroups = header["features"].as_array().is_some_and(|f| f.iter().any(|f| f == "subgroups"));
     let mut compared = 0;
     let mut kernels = std::collections::BTreeSet::new();

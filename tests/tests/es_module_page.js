@@ -21,7 +21,25 @@ function frame(header, chunks) {
   return bytes;
 }
 
+// The package's example page in a frame of this page (same origin), run alongside the
+// cases; its log once it says `done` or `error: ...`.
+function runExample() {
+  const frame = document.createElement('iframe');
+  frame.src = 'web/example.html';
+  document.body.append(frame);
+  return new Promise((resolve) => {
+    const started = performance.now();
+    const poll = () => {
+      const text = frame.contentDocument?.getElementById('log')?.textContent ?? '';
+      if (/\n(done|error: .*)$/.test(text) || performance.now() - started > 60000) resolve(text);
+      else setTimeout(poll, 100);
+    };
+    poll();
+  });
+}
+
 async function main() {
+  const example = runExample();
   const cases = await (await fetch('cases.json')).json();
   const inputs = new Uint8Array(await (await fetch('inputs.bin')).arrayBuffer());
   const adapter = navigator.gpu ? await navigator.gpu.requestAdapter() : null;
@@ -54,6 +72,7 @@ async function main() {
       runs.push({ skipped: 'the device has no subgroups' });
       continue;
     }
+    const started = performance.now();
     const pass = await strata.createStrataSelection(device, {
       width,
       height,
@@ -61,6 +80,7 @@ async function main() {
       seed,
       histogram: run.histogram,
     });
+    const created = performance.now();
     const selections = device.createBuffer({ size: pass.bufferSize('selections'), usage });
     const resampled = device.createBuffer({ size: pass.bufferSize('resampled'), usage });
     const bindings = pass.bind({
@@ -84,7 +104,7 @@ async function main() {
       readSelections.destroy();
       readResampled.destroy();
     }
-    runs.push({ histogram: pass.histogramKernel });
+    runs.push({ histogram: pass.histogramKernel, created_ms: created - started, ms: performance.now() - started });
     selections.destroy();
     resampled.destroy();
     pass.destroy();
@@ -123,6 +143,7 @@ async function main() {
   await attempt('good_bind', async () => good.bind({ candidates, selections }));
   await device.queue.onSubmittedWorkDone();
   const header = {
+    example: await example,
     runs,
     errors,
     uncaptured,

@@ -231,12 +231,26 @@ pub(super) fn read_request(stream: &TcpStream) -> std::io::Result<Option<Request
     Ok(Some(Request { method, path, host, body }))
 }
 
+/// The bridge's content security policy: its own scripts and exchanges only.
+const POLICY: &str = "default-src 'none'; script-src 'self'; connect-src 'self'";
+
 /// Writes one response that closes the connection (no caching, same-origin scripts and
 /// fetches only).
 pub(super) fn respond(stream: &mut TcpStream, status: &str, content_type: &str, body: &[u8]) -> std::io::Result<()> {
+    respond_with(stream, status, content_type, body, POLICY)
+}
+
+/// [`respond`] with the content security policy `policy`.
+pub(super) fn respond_with(
+    stream: &mut TcpStream,
+    status: &str,
+    content_type: &str,
+    body: &[u8],
+    policy: &str,
+) -> std::io::Result<()> {
     let head = format!(
         "HTTP/1.1 {status}\r\nContent-Type: {content_type}\r\nContent-Length: {}\r\nCache-Control: no-store\r\n\
-         Content-Security-Policy: default-src 'none'; script-src 'self'; connect-src 'self'\r\n\
+         Content-Security-Policy: {policy}\r\n\
          X-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n",
         body.len()
     );

@@ -5,16 +5,22 @@
 //! Like the WebGPU backend's bridge, it listens on `127.0.0.1` at a port the system picks
 //! and answers only requests whose `Host` is that address and whose path starts with a
 //! random 128-bit token: `GET /TOKEN/PATH` for one of its files, `POST /TOKEN/post/NAME`
-//! for a result (answered at once with an empty 200). Anything else gets a 404. Files
+//! for a result (answered at once with an empty 200). Anything else gets a 404. Its
+//! content security policy lets a page run only the server's own scripts, fetches and
+//! frames. Files
 //! are served from memory only, so no path the page asks for reaches the file system.
 
-use super::bridge::{read_request, respond};
+use super::bridge::{read_request, respond_with};
 use std::collections::HashMap;
 use std::net::{Ipv4Addr, SocketAddr, TcpListener, TcpStream};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
+
+/// The pages' content security policy: same-origin scripts, fetches and frames (a test
+/// page may run another page of the package in a frame), inline styles.
+const POLICY: &str = "default-src 'none'; script-src 'self'; connect-src 'self'; frame-src 'self'; img-src 'self'; style-src 'self' 'unsafe-inline'";
 
 /// How long one read of a request may wait.
 const READ_TIMEOUT: Duration = Duration::from_secs(30);
@@ -115,14 +121,14 @@ fn handle(
     let path = if request.host == host { request.path.strip_prefix(prefix) } else { None };
     let _ = match (request.method.as_str(), path) {
         ("GET", Some(path)) if files.contains_key(path) => {
-            respond(&mut stream, "200 OK", content_type(path), &files[path])
+            respond_with(&mut stream, "200 OK", content_type(path), &files[path], POLICY)
         }
         ("POST", Some(path)) if path.starts_with("post/") => {
             let name = path["post/".len()..].to_string();
             let _ = posts.send((name, request.body));
-            respond(&mut stream, "200 OK", "text/plain", b"")
+            respond_with(&mut stream, "200 OK", "text/plain", b"", POLICY)
         }
-        _ => respond(&mut stream, "404 Not Found", "text/plain", b"not found"),
+        _ => respond_with(&mut stream, "404 Not Found", "text/plain", b"not found", POLICY),
     };
 }
 

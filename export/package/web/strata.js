@@ -93,6 +93,16 @@ const bufferByName = new Map(PACKAGE.buffers.map((b) => [b.name, b]));
 const structByName = new Map(PACKAGE.structs.map((s) => [s.name, s]));
 const samplerByName = new Map(PACKAGE.samplers.map((s) => [s.name, s.id]));
 
+// The buffers bound as uniforms, and each stage's uniform: its buffer and struct.
+const UNIFORM_BUFFERS = new Set(
+  PACKAGE.kernels.flatMap((k) => k.bindings.filter((b) => b.descriptor_type === 'uniform_buffer').map((b) => b.buffer)),
+);
+function uniformOf(stage) {
+  const kernel = kernelOfStage(stage);
+  const binding = kernel.bindings.find((b) => b.descriptor_type === 'uniform_buffer');
+  return { buffer: binding.buffer, struct: kernel.uniform };
+}
+
 function kernelOfStage(stage) {
   const kernel = PACKAGE.kernels.find((k) => k.stage === stage);
   if (!kernel) throw new Error(`strata.js: the package has no ${stage} kernel`);
@@ -195,6 +205,7 @@ export function frameParams(settings, width, height, { frame, seed, identityPayl
   checkImage(width, height);
   checkU32('frame', frame);
   checkU32('seed', seed);
+  checkU32('maxWorkgroups', maxWorkgroups);
   const b = s.blockSize;
   const [shiftX, shiftY] = gridShift(s, frame, seed);
   const blocksX = ceilDiv(width + shiftX, b);
@@ -327,6 +338,47 @@ async function blueNoiseBytes(given) {
   return bytes;
 }
 
+// Each device's pipelines by kernel name, made once and shared by every pass on the
+// device (a pass per image size or setting costs its buffers only).
+const pipelineCache = new WeakMap();
+
+// The kernel's bind-group layout and compute pipeline on `device`.
+function pipelineOf(device, kernel) {
+  let pipelines = pipelineCache.get(device);
+  if (!pipelines) {
+    pipelines = new Map();
+    pipelineCache.set(device, pipelines);
+  }
+  let made = pipelines.get(kernel.name);
+  if (!made) {
+    made = makePipeline(device, kernel);
+    pipelines.set(kernel.name, made);
+    made.catch(() => pipelines.delete(kernel.name));
+  }
+  return made;
+}
+
+async function makePipeline(device, kernel) {
+  const label = `strata ${kernel.name}`;
+  device.pushErrorScope('validation');
+  const layout = device.createBindGroupLayout({ label, entries: layoutEntries(kernel) });
+  const module = device.createShaderModule({ label, code: kernel.wgsl });
+  const failed = await device.popErrorScope();
+  if (failed) {
+    throw new StrataError('device', `WebGPU error while creating the \`${kernel.name}\` shader: ${failed.message}`);
+  }
+  try {
+    const pipeline = await device.createComputePipelineAsync({
+      label,
+      layout: device.createPipelineLayout({ label, bindGroupLayouts: [layout] }),
+      compute: { module, entryPoint: kernel.entry_point },
+    });
+    return { kernel, layout, pipeline };
+  } catch (error) {
+    throw new StrataError('device', `WebGPU error while creating the \`${kernel.name}\` pipeline: ${error.message}`);
+  }
+}
+
 const OPTION_NAMES = ['width', 'height', 'settings', 'seed', 'histogram', 'blueNoise', 'label'];
 
 /**
@@ -381,7 +433,7 @@ export async function createStrataSelection(device, options) {
   device.pushErrorScope('validation');
   const own = {};
   for (const buffer of PACKAGE.buffers.filter((b) => b.owner === 'pass')) {
-    const uniform = buffer.size.rule === 'fixed' && buffer.name.endsWith('_params');
+    const uniform = UNIFORM_BUFFERS.has(buffer.name);
     const usage = uniform
       ? GPUBufferUsage.UNIFORM | GPUBufferUsage.COPY_DST
       : GPUBufferUsage.STORAGE | GPUBufferUsage.COPY_SRC | GPUBufferUsage.COPY_DST;
@@ -391,29 +443,19 @@ export async function createStrataSelection(device, options) {
   // Bound as `payloads` when the engine has none (never read then).
   own.unused_payloads = device.createBuffer({ label: `${label} unused payloads`, size: 4, usage: GPUBufferUsage.STORAGE });
   device.queue.writeBuffer(own.blue_noise, 0, noise);
-  const pipelines = kernels.map((kernel) => {
-    const layout = device.createBindGroupLayout({ label: `${label} ${kernel.name}`, entries: layoutEntries(kernel) });
-    const module = device.createShaderModule({ label: `${label} ${kernel.name}`, code: kernel.wgsl });
-    return { kernel, layout, module };
-  });
   const validation = await device.popErrorScope();
   const memory = await device.popErrorScope();
   const failed = validation ?? memory;
   if (failed) {
     Object.values(own).forEach((b) => b.destroy());
-    throw new StrataError('device', `WebGPU error while creating the pass's buffers and shaders: ${failed.message}`);
+    throw new StrataError('device', `WebGPU error while creating the pass's buffers: ${failed.message}`);
   }
-  for (const p of pipelines) {
-    try {
-      p.pipeline = await device.createComputePipelineAsync({
-        label: `${label} ${p.kernel.name}`,
-        layout: device.createPipelineLayout({ bindGroupLayouts: [p.layout] }),
-        compute: { module: p.module, entryPoint: p.kernel.entry_point },
-      });
-    } catch (error) {
-      Object.values(own).forEach((b) => b.destroy());
-      throw new StrataError('device', `WebGPU error while creating the \`${p.kernel.name}\` pipeline: ${error.message}`);
-    }
+  let pipelines;
+  try {
+    pipelines = await Promise.all(kernels.map((kernel) => pipelineOf(device, kernel)));
+  } catch (error) {
+    Object.values(own).forEach((b) => b.destroy());
+    throw error;
   }
   return new StrataSelection(device, { width, height, settings, seed, own, pipelines, label });
 }
@@ -620,8 +662,13 @@ export class StrataSelection {
     this.#checkBindings(bindings);
     const params = this.frameParams(frame, bindings.identityPayload);
     const queue = this.#device.queue;
-    queue.writeBuffer(this.#own.histogram_params, 0, pack('HistogramParams', params.histogram));
-    queue.writeBuffer(this.#own.selection_params, 0, pack('SelectionParams', params.selection));
+    for (const [stage, values] of [
+      ['histogram', params.histogram],
+      ['select', params.selection],
+    ]) {
+      const uniform = uniformOf(stage);
+      queue.writeBuffer(this.#own[uniform.buffer], 0, pack(uniform.struct, values));
+    }
     const pass = encoder.beginComputePass({ label: `${this.#label} histogram + selection` });
     pass.setPipeline(this.#pipelines[0].pipeline);
     pass.setBindGroup(0, bindings.groups[0]);

@@ -4,7 +4,7 @@
 //!
 //! The module's code is written by hand (`export/package/web/strata.js`); everything it
 //! knows of the kernels comes from the package's own `manifest.json`, serialised into it
-//! as one object (`PACKAGE`) by [`module`]: each kernel's WGSL, entry point, workgroup
+//! as one object (`PACKAGE`) by [`package_object`]: each kernel's WGSL, entry point, workgroup
 //! size and workgroup memory, each binding's number, buffer and access, each buffer's
 //! owner and size rule, the uniforms' field offsets, the constants, the sampler ids and
 //! the blue-noise file. No binding number or offset is written in the template: a kernel

@@ -11,6 +11,9 @@
 //! overlapping, ...) must throw a `StrataError` whose message names the field. The
 //! package's example page (`web/example.html`) runs beside them to its end.
 //!
+//! A second test, without a browser, checks that what the module carries (bindings,
+//! WGSL, size rules, layouts, constants) is the exported manifest's.
+//!
 //! One browser launch for all cases. Without Chromium or a WebGPU adapter in it the test
 //! says so and passes, unless `STRATA_REQUIRE_BROWSER=1` (CI) makes that a failure.
 
@@ -274,4 +277,66 @@ fn the_es_module_equals_strata_embed_bit_for_bit_in_chromium_and_names_bad_field
     expect("no_resample", "bindings.resample", "made without resampling buffers");
     expect("bad_frame", "frame", "frame = -1: must be an integer from 0 to 4294967295");
     assert_eq!(errors["good_bind"]["thrown"], false, "a good bind threw: {}", errors["good_bind"]);
+}
+
+/// The object `web/strata.js` carries (`const PACKAGE = {...};`), parsed.
+fn package_object(module: &str) -> serde_json::Value {
+    let start = module.find("const PACKAGE = ").expect("the module declares PACKAGE") + "const PACKAGE = ".len();
+    let end = start + module[start..].find("\n};\n").expect("PACKAGE ends") + 2;
+    serde_json::from_str(&module[start..end]).expect("PACKAGE is JSON")
+}
+
+/// Without a browser: everything the module knows of the kernels is the manifest's (each
+/// kernel's bindings by number, name and buffer, its WGSL file's text, workgroup size;
+/// the buffers' size rules; the structs' layouts; the constants and samplers), and the
+/// TypeScript declarations name every sampler and histogram kernel.
+#[test]
+fn the_module_s_data_is_the_manifest_s() {
+    let folder = strata_files::private_scratch_folder("strata-es-module-").unwrap();
+    let package = folder.path().join("package");
+    let exported = strata_export::export(&package).unwrap();
+    for file in strata_export::es_module::FILES {
+        assert!(exported.files.iter().any(|f| f == file), "{file} is not in the package");
+    }
+    let read = |path: &str| std::fs::read_to_string(package.join(path)).unwrap();
+    let manifest: serde_json::Value = serde_json::from_str(&read("manifest.json")).unwrap();
+    let module = read("web/strata.js");
+    assert!(!module.contains("@STRATA_"), "a placeholder is left in strata.js");
+    let object = package_object(&module);
+    let kernels = manifest["kernels"].as_array().unwrap();
+    assert_eq!(object["kernels"].as_array().unwrap().len(), kernels.len());
+    for (got, want) in object["kernels"].as_array().unwrap().iter().zip(kernels) {
+        let name = want["name"].as_str().unwrap();
+        assert_eq!(got["name"], want["name"]);
+        assert_eq!(got["entry_point"], want["entry_point"]["wgsl"], "{name}");
+        assert_eq!(got["workgroup_size"], want["workgroup_size"], "{name}");
+        let source = read(want["files"]["wgsl"].as_str().unwrap());
+        let wgsl = got["wgsl"].as_str().unwrap();
+        assert!(wgsl == source || wgsl == format!("enable subgroups;\n{source}"), "{name}: its WGSL is not the file's");
+        let bindings = want["bindings"].as_array().unwrap();
+        assert_eq!(got["bindings"].as_array().unwrap().len(), bindings.len(), "{name}");
+        for (g, w) in got["bindings"].as_array().unwrap().iter().zip(bindings) {
+            for key in ["name", "binding", "buffer", "descriptor_type", "access"] {
+                assert_eq!(g[key], w[key], "{name}: binding {}: {key}", w["name"]);
+            }
+        }
+    }
+    for (got, want) in object["buffers"].as_array().unwrap().iter().zip(manifest["buffers"].as_array().unwrap()) {
+        assert_eq!(
+            (&got["name"], &got["size"]["rule"], &got["size"]["bytes"]),
+            (&want["name"], &want["size"]["rule"], &want["size"]["bytes"])
+        );
+    }
+    assert_eq!(object["structs"], manifest["structs"]);
+    assert_eq!(object["samplers"], manifest["samplers"]);
+    for constant in manifest["constants"].as_array().unwrap() {
+        assert_eq!(object["constants"][constant["name"].as_str().unwrap()], constant["value"]);
+    }
+    let declarations = read("web/strata.d.ts");
+    for sampler in SamplerVariant::ALL {
+        assert!(declarations.contains(&format!("\"{}\"", sampler.name())), "strata.d.ts lacks {sampler:?}");
+    }
+    for kernel in ["block_histogram", "block_histogram_rank", "block_histogram_subgroup"] {
+        assert!(declarations.contains(&format!("\"{kernel}\"")), "strata.d.ts lacks {kernel}");
+    }
 }

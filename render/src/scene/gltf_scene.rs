@@ -178,7 +178,7 @@ fn load_buffers(
     document: &Document,
     mut blob: Option<Vec<u8>>,
     files: &dyn FileSource,
-) -> Result<Vec<gltf::buffer::Data>, SceneError> {
+) -> Result<Vec<Vec<u8>>, SceneError> {
     let mut buffers = Vec::new();
     for buffer in document.buffers() {
         let field = format!("buffers[{}]", buffer.index());
@@ -203,7 +203,7 @@ fn load_buffers(
                 format!("cannot load the buffer data: byteLength {} but only {} bytes", buffer.length(), data.len()),
             ));
         }
-        buffers.push(gltf::buffer::Data(data));
+        buffers.push(data);
     }
     Ok(buffers)
 }
@@ -227,7 +227,7 @@ struct Loader<'a> {
     /// The document as plain JSON.
     raw: serde_json::Value,
     /// Buffer contents, by index.
-    buffers: Vec<gltf::buffer::Data>,
+    buffers: Vec<Vec<u8>>,
     /// Renderer materials: the document's, by index, then the default one if needed.
     materials: Vec<Material>,
     /// Names of `materials`.
@@ -326,7 +326,7 @@ impl Loader<'_> {
                 let bytes = self
                     .buffers
                     .get(view.buffer().index())
-                    .and_then(|buffer| buffer.0.get(view.offset()..view.offset().checked_add(view.length())?));
+                    .and_then(|buffer| buffer.get(view.offset()..view.offset().checked_add(view.length())?));
                 bytes
                     .ok_or_else(|| self.error(field.clone(), "the image's buffer view lies outside its buffer"))?
                     .to_vec()
@@ -442,7 +442,7 @@ impl Loader<'_> {
         let (emission, textured_with) = info.map_or((None, None), |i| (i.emission, i.tex_coord));
         let tex_coord = textured_with.unwrap_or(0);
         let buffers = &self.buffers;
-        let reader = primitive.reader(|b| buffers.get(b.index()).map(|data| data.0.as_slice()));
+        let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
         let outside = |accessor: &Accessor| {
             self.error(format!("accessors[{}]", accessor.index()), "its data lies outside its buffer view")
         };

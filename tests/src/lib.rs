@@ -332,6 +332,37 @@ pub fn resample_inputs(count: u32, fourth_weight: f32) -> Vec<strata_embed::cont
         .collect()
 }
 
+/// The engine's buffers that the routes to the embeddable pass are compared on (the C
+/// program of the kernel package, the ES module in Chromium), for a `width` × `height`
+/// image: one candidate per pixel over a few objects, with some invalid keys (NaN) and
+/// pixels without a candidate (`u32::MAX`), payloads, and resampling inputs.
+#[allow(clippy::type_complexity)]
+pub fn engine_inputs(
+    width: u32,
+    height: u32,
+) -> (Vec<strata_embed::contract::Candidate>, Vec<u32>, Vec<strata_embed::contract::ResampleInput>) {
+    let pixels = width * height;
+    let candidates = (0..pixels)
+        .map(|p| {
+            let key = if p % 37 == 5 { f32::NAN } else { ((p * 7919) % 113) as f32 * 0.05 };
+            let object_id = if p % 53 == 0 { u32::MAX } else { (p % width) / 11 + 4 * (p / width / 8) };
+            strata_embed::contract::Candidate { key, object_id }
+        })
+        .collect();
+    let payloads = (0..pixels).map(|p| p.wrapping_mul(2_654_435_761) >> 7).collect();
+    let resample = (0..pixels)
+        .map(|p| strata_embed::contract::ResampleInput {
+            weights: [1.0 + (p % 5) as f32, 0.5 * (p % 3) as f32, 2.0, 0.25],
+            targets: [1.0, 2.0, 3.0, 4.0],
+            canonical_weight: 0.75,
+            canonical_target: 0.5,
+            canonical_payload: p,
+            _pad: 0,
+        })
+        .collect();
+    (candidates, payloads, resample)
+}
+
 /// The engine's inputs of one run of the embeddable pass.
 pub struct EmbedInputs<'a> {
     /// Image width.

@@ -20,38 +20,14 @@
 use std::time::Duration;
 use strata_backends::webgpu_backend::page_server::PageServer;
 use strata_backends::webgpu_backend::{Browser, browser_required, find_chromium};
-use strata_embed::contract::{Candidate, ResampleInput, ResampleOutput, SelectedCandidates};
+use strata_embed::contract::{Candidate, ResampleOutput, SelectedCandidates};
 use strata_embed::{SamplerVariant, SelectionSettings};
-use strata_tests::{EmbedFrames, EmbedInputs, engine_device, wgpu_embed_frames};
+use strata_tests::{EmbedFrames, EmbedInputs, engine_device, engine_inputs, wgpu_embed_frames};
 
 const WIDTH: u32 = 45;
 const HEIGHT: u32 = 29;
 const FRAMES: u32 = 4;
 const SEED: u32 = 7;
-
-/// The engine's inputs: candidates over a few objects with some invalid keys (NaN) and
-/// pixels without a candidate, payloads, resampling weights (`export_c.rs`'s).
-fn inputs() -> (Vec<Candidate>, Vec<u32>, Vec<ResampleInput>) {
-    let pixels = WIDTH * HEIGHT;
-    let candidates = (0..pixels)
-        .map(|p| {
-            let key = if p % 37 == 5 { f32::NAN } else { ((p * 7919) % 113) as f32 * 0.05 };
-            Candidate { key, object_id: if p % 53 == 0 { u32::MAX } else { (p % WIDTH) / 11 + 4 * (p / WIDTH / 8) } }
-        })
-        .collect();
-    let payloads = (0..pixels).map(|p| p.wrapping_mul(2_654_435_761) >> 7).collect();
-    let resample = (0..pixels)
-        .map(|p| ResampleInput {
-            weights: [1.0 + (p % 5) as f32, 0.5 * (p % 3) as f32, 2.0, 0.25],
-            targets: [1.0, 2.0, 3.0, 4.0],
-            canonical_weight: 0.75,
-            canonical_target: 0.5,
-            canonical_payload: p,
-            _pad: 0,
-        })
-        .collect();
-    (candidates, payloads, resample)
-}
 
 /// One run of the pass: its settings, histogram kernel (`auto` or a name) and whether the
 /// engine binds payloads.
@@ -165,7 +141,7 @@ fn the_es_module_equals_strata_embed_bit_for_bit_in_chromium_and_names_bad_field
     let folder = strata_files::private_scratch_folder("strata-es-module-").unwrap();
     let package = folder.path().join("package");
     strata_export::export(&package).unwrap();
-    let (candidates, payloads, resample) = inputs();
+    let (candidates, payloads, resample) = engine_inputs(WIDTH, HEIGHT);
     let mut bytes = Vec::new();
     let mut part = |data: &[u8]| {
         let at = bytes.len();
@@ -277,6 +253,11 @@ fn the_es_module_equals_strata_embed_bit_for_bit_in_chromium_and_names_bad_field
     expect("no_resample", "bindings.resample", "made without resampling buffers");
     expect("bad_frame", "frame", "frame = -1: must be an integer from 0 to 4294967295");
     assert_eq!(errors["good_bind"]["thrown"], false, "a good bind threw: {}", errors["good_bind"]);
+    assert_eq!(
+        errors["shared_buffer"]["thrown"], false,
+        "disjoint slices of one buffer threw: {}",
+        errors["shared_buffer"]
+    );
 }
 
 /// The object `web/strata.js` carries (`const PACKAGE = {...};`), parsed.

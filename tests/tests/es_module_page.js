@@ -141,6 +141,14 @@ async function main() {
     good.encodeSelection(device.createCommandEncoder(), good.bind({ candidates, selections }), -1),
   );
   await attempt('good_bind', async () => good.bind({ candidates, selections }));
+  // Two roles in one buffer at disjoint, aligned offsets: each is bound with the bytes it
+  // needs, so they neither overlap nor exceed the buffer.
+  const step = device.limits.minStorageBufferOffsetAlignment;
+  const second = Math.ceil(good.bufferSize('candidates') / step) * step;
+  const shared = device.createBuffer({ size: second + good.bufferSize('selections'), usage });
+  await attempt('shared_buffer', async () =>
+    good.bind({ candidates: { buffer: shared }, selections: { buffer: shared, offset: second } }),
+  );
   await device.queue.onSubmittedWorkDone();
   const header = {
     example: await example,

@@ -11,10 +11,10 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use strata_embed::contract::{Candidate, ResampleInput, ResampleOutput, SelectedCandidates};
+use strata_embed::contract::{ResampleInput, ResampleOutput, SelectedCandidates};
 use strata_embed::wgsl::{ModuleId, module};
 use strata_embed::{SamplerVariant, SelectionSettings};
-use strata_tests::{EmbedInputs, engine_device, wgpu_embed_frames};
+use strata_tests::{EmbedInputs, engine_device, engine_inputs, wgpu_embed_frames};
 
 const WIDTH: u32 = 45;
 const HEIGHT: u32 = 29;
@@ -32,30 +32,6 @@ fn scratch(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&folder);
     std::fs::create_dir_all(&folder).unwrap();
     folder
-}
-
-/// The engine's inputs for a `width` × `height` image: candidates over a few objects with
-/// some invalid keys, payloads, resampling weights.
-fn inputs_sized(width: u32, height: u32) -> (Vec<Candidate>, Vec<u32>, Vec<ResampleInput>) {
-    let pixels = width * height;
-    let candidates = (0..pixels)
-        .map(|p| {
-            let key = if p % 37 == 5 { f32::NAN } else { ((p * 7919) % 113) as f32 * 0.05 };
-            Candidate { key, object_id: if p % 53 == 0 { u32::MAX } else { (p % width) / 11 + 4 * (p / width / 8) } }
-        })
-        .collect();
-    let payloads = (0..pixels).map(|p| p.wrapping_mul(2_654_435_761) >> 7).collect();
-    let resample = (0..pixels)
-        .map(|p| ResampleInput {
-            weights: [1.0 + (p % 5) as f32, 0.5 * (p % 3) as f32, 2.0, 0.25],
-            targets: [1.0, 2.0, 3.0, 4.0],
-            canonical_weight: 0.75,
-            canonical_target: 0.5,
-            canonical_payload: p,
-            _pad: 0,
-        })
-        .collect();
-    (candidates, payloads, resample)
 }
 
 /// One run's per-frame outputs.
@@ -85,7 +61,7 @@ fn wgpu_frames_sized(
     with_payloads: bool,
     (width, height): (u32, u32),
 ) -> Frames {
-    let (candidates, payloads, resample) = inputs_sized(width, height);
+    let (candidates, payloads, resample) = engine_inputs(width, height);
     let inputs = EmbedInputs {
         width,
         height,
@@ -138,12 +114,12 @@ fn write_inputs(folder: &Path) {
 
 /// [`write_inputs`], with or without `payloads.bin`.
 fn write_inputs_with(folder: &Path, with_payloads: bool) {
-    write_inputs_sized(folder, with_payloads, (WIDTH, HEIGHT));
+    write_engine_inputs(folder, with_payloads, (WIDTH, HEIGHT));
 }
 
 /// [`write_inputs_with`] for an image of `size`.
-fn write_inputs_sized(folder: &Path, with_payloads: bool, (width, height): (u32, u32)) {
-    let (candidates, payloads, resample) = inputs_sized(width, height);
+fn write_engine_inputs(folder: &Path, with_payloads: bool, (width, height): (u32, u32)) {
+    let (candidates, payloads, resample) = engine_inputs(width, height);
     std::fs::write(folder.join("candidates.bin"), bytemuck::cast_slice(&candidates)).unwrap();
     if with_payloads {
         std::fs::write(folder.join("payloads.bin"), bytemuck::cast_slice(&payloads)).unwrap();
@@ -251,7 +227,7 @@ fn both_c_routes_equal_the_rust_pass_bit_for_bit() {
     let multiple = (64, 32);
     let second = folder.join("64x32");
     std::fs::create_dir_all(&second).unwrap();
-    write_inputs_sized(&second, true, multiple);
+    write_engine_inputs(&second, true, multiple);
     let mut runs = 0;
     for sampler in [SamplerVariant::Antithetic, SamplerVariant::Random] {
         for candidates in 1..=4 {

@@ -13,10 +13,9 @@
 //! never sends anything (Chromium opens spare ones) blocks nobody; the backend's thread
 //! waits for exchanges on a channel, with a timeout.
 
+use super::loopback::Acceptor;
 use std::io::{BufRead, BufReader, Read, Write};
-use std::net::{Ipv4Addr, SocketAddr, TcpListener, TcpStream};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::net::TcpStream;
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
@@ -39,11 +38,8 @@ struct Exchange {
 
 /// The server: its address and token, and the exchanges the page has posted.
 pub(super) struct Server {
-    address: SocketAddr,
-    token: String,
+    acceptor: Acceptor,
     exchanges: mpsc::Receiver<Exchange>,
-    stop: Arc<AtomicBool>,
-    acceptor: Option<std::thread::JoinHandle<()>>,
     /// The page's exchange waiting for the next message.
     waiting: Option<TcpStream>,
 }
@@ -59,37 +55,17 @@ pub(super) enum WaitError {
 impl Server {
     /// Binds a loopback port and starts accepting.
     pub(super) fn start() -> Result<Self, String> {
-        let listener = TcpListener::bind((Ipv4Addr::LOCALHOST, 0))
-            .map_err(|e| format!("cannot listen on a loopback port: {e}"))?;
-        let address = listener.local_addr().map_err(|e| format!("cannot read the loopback port: {e}"))?;
-        let mut random = [0u8; 16];
-        getrandom::fill(&mut random).map_err(|e| format!("no random numbers for the page's token: {e}"))?;
-        let token: String = random.iter().map(|b| format!("{b:02x}")).collect();
         let (sender, exchanges) = mpsc::channel();
-        let stop = Arc::new(AtomicBool::new(false));
-        let routes = Arc::new(Routes { token: token.clone(), host: address.to_string() });
-        let stopped = Arc::clone(&stop);
-        let acceptor = std::thread::Builder::new()
-            .name("strata-webgpu-accept".into())
-            .spawn(move || {
-                for stream in listener.incoming() {
-                    if stopped.load(Ordering::Acquire) {
-                        break;
-                    }
-                    let Ok(stream) = stream else { continue };
-                    let (routes, sender) = (Arc::clone(&routes), sender.clone());
-                    let _ = std::thread::Builder::new()
-                        .name("strata-webgpu-request".into())
-                        .spawn(move || routes.handle(stream, &sender));
-                }
-            })
-            .map_err(|e| format!("cannot start the bridge's thread: {e}"))?;
-        Ok(Self { address, token, exchanges, stop, acceptor: Some(acceptor), waiting: None })
+        let acceptor = Acceptor::start("bridge", "strata-webgpu", |route| {
+            let routes = Routes { prefix: route.prefix(), host: route.host() };
+            move |stream| routes.handle(stream, &sender)
+        })?;
+        Ok(Self { acceptor, exchanges, waiting: None })
     }
 
     /// The page's address.
     pub(super) fn url(&self) -> String {
-        format!("http://{}/{}/", self.address, self.token)
+        self.acceptor.route().url("")
     }
 
     /// Waits for the page's next exchange, up to `timeout`, asking `alive` every 100 ms
@@ -128,20 +104,10 @@ impl Server {
     }
 }
 
-impl Drop for Server {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Release);
-        // Wakes the acceptor, which then sees the flag.
-        let _ = TcpStream::connect_timeout(&self.address, Duration::from_secs(1));
-        if let Some(acceptor) = self.acceptor.take() {
-            let _ = acceptor.join();
-        }
-    }
-}
-
 /// What the server answers, from the token and the address the page must use.
 struct Routes {
-    token: String,
+    /// `/TOKEN/`.
+    prefix: String,
     host: String,
 }
 
@@ -151,10 +117,9 @@ impl Routes {
             return;
         }
         let Ok(Some(request)) = read_request(&stream) else { return };
-        let page = format!("/{}/", self.token);
         // A request for another host (a page elsewhere resolving its name to 127.0.0.1)
         // or another path is not ours.
-        let path = if request.host == self.host { request.path.strip_prefix(&page) } else { None };
+        let path = if request.host == self.host { request.path.strip_prefix(&self.prefix) } else { None };
         let _ = match (request.method.as_str(), path) {
             ("GET", Some("")) => respond(&mut stream, "200 OK", "text/html; charset=utf-8", PAGE_HTML.as_bytes()),
             ("GET", Some("page.js")) => {
@@ -286,7 +251,7 @@ mod tests {
 
     /// Sends `request` to the server and returns its whole response.
     fn ask(server: &Server, request: &str) -> String {
-        let mut stream = TcpStream::connect(server.address).unwrap();
+        let mut stream = TcpStream::connect(server.acceptor.route().address).unwrap();
         stream.write_all(request.as_bytes()).unwrap();
         let mut response = String::new();
         stream.read_to_string(&mut response).unwrap();
@@ -296,7 +261,7 @@ mod tests {
     #[test]
     fn only_the_token_and_the_servers_own_host_are_answered() {
         let server = Server::start().unwrap();
-        let (host, token) = (server.address.to_string(), server.token.clone());
+        let (host, token) = (server.acceptor.route().address.to_string(), server.acceptor.route().token.clone());
         assert_eq!(token.len(), 32, "128 random bits as hex");
         let page = ask(&server, &format!("GET /{token}/ HTTP/1.1\r\nHost: {host}\r\n\r\n"));
         assert!(page.starts_with("HTTP/1.1 200 OK") && page.contains("page.js"), "{page}");
@@ -307,20 +272,27 @@ mod tests {
         for request in [
             format!("GET / HTTP/1.1\r\nHost: {host}\r\n\r\n"),
             format!("GET /{}/ HTTP/1.1\r\nHost: {host}\r\n\r\n", "0".repeat(32)),
-            format!("GET /{token}/ HTTP/1.1\r\nHost: attacker.example:{}\r\n\r\n", server.address.port()),
+            format!(
+                "GET /{token}/ HTTP/1.1\r\nHost: attacker.example:{}\r\n\r\n",
+                server.acceptor.route().address.port()
+            ),
             format!("GET /{token}/../page.js HTTP/1.1\r\nHost: {host}\r\n\r\n"),
         ] {
             let response = ask(&server, &request);
             assert!(response.starts_with("HTTP/1.1 404"), "{request:?}: {response}");
         }
         // Two servers never share a token.
-        assert_ne!(Server::start().unwrap().token, token);
+        assert_ne!(Server::start().unwrap().acceptor.route().token, token);
     }
 
     #[test]
     fn an_exchange_waits_for_its_message_and_a_silent_page_times_out() {
         let mut server = Server::start().unwrap();
-        let (address, host, token) = (server.address, server.address.to_string(), server.token.clone());
+        let (address, host, token) = (
+            server.acceptor.route().address,
+            server.acceptor.route().address.to_string(),
+            server.acceptor.route().token.clone(),
+        );
         let page = std::thread::spawn(move || {
             let mut stream = TcpStream::connect(address).unwrap();
             let body = frame(&serde_json::json!({ "ready": true }), b"abc");

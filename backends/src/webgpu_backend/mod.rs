@@ -23,6 +23,7 @@
 
 mod bridge;
 mod browser;
+mod loopback;
 pub mod page_server;
 
 pub use browser::{BROWSER_REQUIRED_VARIABLE, Browser, CHROMIUM_VARIABLE, browser_required, find_chromium};

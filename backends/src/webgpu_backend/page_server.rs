@@ -11,10 +11,9 @@
 //! are served from memory only, so no path the page asks for reaches the file system.
 
 use super::bridge::{read_request, respond_with};
+use super::loopback::Acceptor;
 use std::collections::HashMap;
-use std::net::{Ipv4Addr, SocketAddr, TcpListener, TcpStream};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::net::TcpStream;
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
@@ -27,11 +26,8 @@ const READ_TIMEOUT: Duration = Duration::from_secs(30);
 
 /// A running server (stopped on drop).
 pub struct PageServer {
-    address: SocketAddr,
-    token: String,
+    acceptor: Acceptor,
     posts: mpsc::Receiver<(String, Vec<u8>)>,
-    stop: Arc<AtomicBool>,
-    acceptor: Option<std::thread::JoinHandle<()>>,
 }
 
 /// The content type of a file by its extension.
@@ -49,39 +45,18 @@ impl PageServer {
     /// Binds a loopback port and serves `files` (each a path below the page's folder, such
     /// as `index.html` or `web/strata.js`, and its bytes).
     pub fn start(files: Vec<(String, Vec<u8>)>) -> Result<Self, String> {
-        let listener = TcpListener::bind((Ipv4Addr::LOCALHOST, 0))
-            .map_err(|e| format!("cannot listen on a loopback port: {e}"))?;
-        let address = listener.local_addr().map_err(|e| format!("cannot read the loopback port: {e}"))?;
-        let mut random = [0u8; 16];
-        getrandom::fill(&mut random).map_err(|e| format!("no random numbers for the page's token: {e}"))?;
-        let token: String = random.iter().map(|b| format!("{b:02x}")).collect();
         let (sender, posts) = mpsc::channel();
-        let stop = Arc::new(AtomicBool::new(false));
-        let files: Arc<HashMap<String, Vec<u8>>> = Arc::new(files.into_iter().collect());
-        let (prefix, host) = (format!("/{token}/"), address.to_string());
-        let stopped = Arc::clone(&stop);
-        let acceptor = std::thread::Builder::new()
-            .name("strata-page-accept".into())
-            .spawn(move || {
-                for stream in listener.incoming() {
-                    if stopped.load(Ordering::Acquire) {
-                        break;
-                    }
-                    let Ok(stream) = stream else { continue };
-                    let (files, sender, prefix, host) =
-                        (Arc::clone(&files), sender.clone(), prefix.clone(), host.clone());
-                    let _ = std::thread::Builder::new()
-                        .name("strata-page-request".into())
-                        .spawn(move || handle(stream, &files, &sender, &prefix, &host));
-                }
-            })
-            .map_err(|e| format!("cannot start the page server's thread: {e}"))?;
-        Ok(Self { address, token, posts, stop, acceptor: Some(acceptor) })
+        let files: HashMap<String, Vec<u8>> = files.into_iter().collect();
+        let acceptor = Acceptor::start("page server", "strata-page", |route| {
+            let (prefix, host) = (route.prefix(), route.host());
+            move |stream| handle(stream, &files, &sender, &prefix, &host)
+        })?;
+        Ok(Self { acceptor, posts })
     }
 
     /// The address of the file `path` (`index.html`).
     pub fn url(&self, path: &str) -> String {
-        format!("http://{}/{}/{path}", self.address, self.token)
+        self.acceptor.route().url(path)
     }
 
     /// Waits up to `timeout` for the page's next post, asking `alive` every 100 ms whether
@@ -132,24 +107,13 @@ fn handle(
     };
 }
 
-impl Drop for PageServer {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Release);
-        // Wakes the acceptor, which then sees the flag.
-        let _ = TcpStream::connect_timeout(&self.address, Duration::from_secs(1));
-        if let Some(acceptor) = self.acceptor.take() {
-            let _ = acceptor.join();
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use std::io::{Read, Write};
 
     fn ask(server: &PageServer, request: &str) -> Vec<u8> {
-        let mut stream = TcpStream::connect(server.address).unwrap();
+        let mut stream = TcpStream::connect(server.acceptor.route().address).unwrap();
         stream.write_all(request.as_bytes()).unwrap();
         let mut response = Vec::new();
         stream.read_to_end(&mut response).unwrap();
@@ -159,7 +123,7 @@ mod tests {
     #[test]
     fn serves_its_files_under_the_token_and_takes_posts() {
         let server = PageServer::start(vec![("web/a.js".into(), b"export {};".to_vec())]).unwrap();
-        let (host, token) = (server.address.to_string(), server.token.clone());
+        let (host, token) = (server.acceptor.route().address.to_string(), server.acceptor.route().token.clone());
         let file = ask(&server, &format!("GET /{token}/web/a.js HTTP/1.1\r\nHost: {host}\r\n\r\n"));
         assert!(file.starts_with(b"HTTP/1.1 200 OK") && file.ends_with(b"export {};"));
         assert!(String::from_utf8_lossy(&file).contains("text/javascript"));

@@ -443,8 +443,9 @@ export async function createStrataSelection(device, options) {
   // Bound as `payloads` when the engine has none (never read then).
   own.unused_payloads = device.createBuffer({ label: `${label} unused payloads`, size: 4, usage: GPUBufferUsage.STORAGE });
   device.queue.writeBuffer(own.blue_noise, 0, noise);
-  const validation = await device.popErrorScope();
-  const memory = await device.popErrorScope();
+  // Both scopes popped at once, so that no other scope pushed meanwhile on this device
+  // (another pass being made, the engine's own) is popped in their place.
+  const [validation, memory] = await Promise.all([device.popErrorScope(), device.popErrorScope()]);
   const failed = validation ?? memory;
   if (failed) {
     Object.values(own).forEach((b) => b.destroy());
@@ -550,15 +551,19 @@ export class StrataSelection {
         `buffer \`${role}\` (${field}) is bound at offset ${offset}, which is not a multiple of ${alignment} (minStorageBufferOffsetAlignment)`,
       );
     }
-    const size = slice.buffer.size - offset;
+    const available = slice.buffer.size - offset;
     const needed = this.bufferSize(role);
-    if (size < needed) {
+    if (available < needed) {
       const perPixel = ruleBytes(role, 1, 0);
       throw new StrataError(
         field,
-        `buffer \`${role}\` (${field}) has ${Math.max(size, 0)} bytes from its offset, but a ${this.width}x${this.height} image needs ${needed} (${perPixel} bytes per pixel)`,
+        `buffer \`${role}\` (${field}) has ${Math.max(available, 0)} bytes from its offset, but a ${this.width}x${this.height} image needs ${needed} (${perPixel} bytes per pixel)`,
       );
     }
+    // Bound with the bytes the image needs, not the rest of the buffer: two roles may
+    // share one buffer at disjoint offsets, and a large buffer may exceed the binding
+    // limit where the part the pass uses does not.
+    const size = needed;
     const max = this.#device.limits.maxStorageBufferBindingSize;
     if (size > max) {
       throw new StrataError(
@@ -634,7 +639,7 @@ export class StrataSelection {
       const own = this.#own[name];
       if (own) return { buffer: own };
       const slice = slices[name];
-      return slice ? { buffer: slice.buffer, offset: slice.offset } : undefined;
+      return slice ? { buffer: slice.buffer, offset: slice.offset, size: slice.size } : undefined;
     };
     const group = (pipeline) =>
       this.#device.createBindGroup({

@@ -381,6 +381,20 @@ pub struct EmbedInputs<'a> {
 pub type EmbedFrames =
     Vec<(Vec<strata_embed::contract::SelectedCandidates>, Vec<strata_embed::contract::ResampleOutput>)>;
 
+/// The first frame and pixel where two routes' frames differ, in words (`None` when they
+/// are equal byte for byte).
+pub fn first_frame_difference(got: &EmbedFrames, want: &EmbedFrames) -> Option<String> {
+    for (frame, ((gs, gr), (ws, wr))) in got.iter().zip(want).enumerate() {
+        if let Some(p) = (0..ws.len()).find(|&p| bytemuck::bytes_of(&gs[p]) != bytemuck::bytes_of(&ws[p])) {
+            return Some(format!("frame {frame}, pixel {p}: selection {:?} against {:?}", gs[p], ws[p]));
+        }
+        if let Some(p) = (0..wr.len()).find(|&p| bytemuck::bytes_of(&gr[p]) != bytemuck::bytes_of(&wr[p])) {
+            return Some(format!("frame {frame}, pixel {p}: resampled {:?} against {:?}", gr[p], wr[p]));
+        }
+    }
+    (got.len() != want.len()).then(|| format!("{} frames against {}", got.len(), want.len()))
+}
+
 /// Frames `0..frames` of `strata_embed`'s wgpu flavour over `inputs`, with `settings` and
 /// render `seed`: what every other route to the pass (ash, the C ABI, the C program from
 /// the kernel package) must equal bit for bit.

@@ -22,7 +22,7 @@ use strata_backends::webgpu_backend::page_server::PageServer;
 use strata_backends::webgpu_backend::{Browser, browser_required, find_chromium};
 use strata_embed::contract::{Candidate, ResampleOutput, SelectedCandidates};
 use strata_embed::{SamplerVariant, SelectionSettings};
-use strata_tests::{EmbedFrames, EmbedInputs, engine_device, engine_inputs, wgpu_embed_frames};
+use strata_tests::{EmbedFrames, EmbedInputs, engine_device, engine_inputs, first_frame_difference, wgpu_embed_frames};
 
 const WIDTH: u32 = 45;
 const HEIGHT: u32 = 29;
@@ -116,19 +116,6 @@ fn page_frames(payload: &[u8], index: usize) -> EmbedFrames {
         .collect()
 }
 
-/// The first frame and pixel where `got` and `want` differ, in words.
-fn first_difference(got: &EmbedFrames, want: &EmbedFrames) -> Option<String> {
-    for (frame, ((gs, gr), (ws, wr))) in got.iter().zip(want).enumerate() {
-        if let Some(p) = (0..ws.len()).find(|&p| bytemuck::bytes_of(&gs[p]) != bytemuck::bytes_of(&ws[p])) {
-            return Some(format!("frame {frame}, pixel {p}: selection {:?} against {:?}", gs[p], ws[p]));
-        }
-        if let Some(p) = (0..wr.len()).find(|&p| bytemuck::bytes_of(&gr[p]) != bytemuck::bytes_of(&wr[p])) {
-            return Some(format!("frame {frame}, pixel {p}: resampled {:?} against {:?}", gr[p], wr[p]));
-        }
-    }
-    (got.len() != want.len()).then(|| format!("{} frames against {}", got.len(), want.len()))
-}
-
 #[test]
 fn the_es_module_equals_strata_embed_bit_for_bit_in_chromium_and_names_bad_fields() {
     let test = "the_es_module_equals_strata_embed_bit_for_bit_in_chromium_and_names_bad_fields";
@@ -210,7 +197,7 @@ fn the_es_module_equals_strata_embed_bit_for_bit_in_chromium_and_names_bad_field
             "K = {}, {:?}, B = {}, histogram {ran}, payloads {}",
             run.settings.candidates, run.settings.sampler, run.settings.block_size, run.payloads
         );
-        assert_eq!(first_difference(&got, &want), None, "{what}");
+        assert_eq!(first_frame_difference(&got, &want), None, "{what}");
         compared += 1;
     }
     assert_eq!(compared, runs.len() - usize::from(!subgroups));

@@ -14,7 +14,7 @@ use std::process::Command;
 use strata_embed::contract::{ResampleInput, ResampleOutput, SelectedCandidates};
 use strata_embed::wgsl::{ModuleId, module};
 use strata_embed::{SamplerVariant, SelectionSettings};
-use strata_tests::{EmbedInputs, engine_device, engine_inputs, wgpu_embed_frames};
+use strata_tests::{EmbedInputs, engine_device, engine_inputs, first_frame_difference, wgpu_embed_frames};
 
 const WIDTH: u32 = 45;
 const HEIGHT: u32 = 29;
@@ -200,19 +200,6 @@ fn fastest_histogram_of_the_device(block_size: u32) -> String {
     strata_kernels::Registry::shared().unwrap().get(kernel).name().to_string()
 }
 
-/// The first frame and pixel where `got` and `want` differ, in words.
-fn first_difference(got: &Frames, want: &Frames) -> Option<String> {
-    for (frame, ((gs, gr), (ws, wr))) in got.iter().zip(want).enumerate() {
-        if let Some(p) = (0..ws.len()).find(|&p| bytemuck::bytes_of(&gs[p]) != bytemuck::bytes_of(&ws[p])) {
-            return Some(format!("frame {frame}, pixel {p}: selection {:?} against {:?}", gs[p], ws[p]));
-        }
-        if let Some(p) = (0..wr.len()).find(|&p| bytemuck::bytes_of(&gr[p]) != bytemuck::bytes_of(&wr[p])) {
-            return Some(format!("frame {frame}, pixel {p}: resampled {:?} against {:?}", gr[p], wr[p]));
-        }
-    }
-    (got.len() != want.len()).then(|| format!("{} frames against {}", got.len(), want.len()))
-}
-
 #[test]
 fn both_c_routes_equal_the_rust_pass_bit_for_bit() {
     let Some((device, queue)) = engine_device("both_c_routes_equal_the_rust_pass_bit_for_bit", None) else {
@@ -238,12 +225,12 @@ fn both_c_routes_equal_the_rust_pass_bit_for_bit() {
                 let what = format!("K = {candidates}, {sampler:?}, {}x{}", size.0, size.1);
                 let library =
                     run_c_sized(&program, "library", &package, "block_histogram", settings, inputs, size).unwrap();
-                assert_eq!(first_difference(&library, &want), None, "route 2 (library), {what}");
+                assert_eq!(first_frame_difference(&library, &want), None, "route 2 (library), {what}");
                 // Route 1 (the manifest alone) with every histogram kernel (the same output).
                 for histogram in ["block_histogram", "block_histogram_rank", "block_histogram_subgroup"] {
                     let package_route = run_c_sized(&program, "package", &package, histogram, settings, inputs, size)
                         .unwrap_or_else(|e| panic!("route 1 ({histogram}), {what}: {e}"));
-                    assert_eq!(first_difference(&package_route, &want), None, "route 1 ({histogram}), {what}");
+                    assert_eq!(first_frame_difference(&package_route, &want), None, "route 1 ({histogram}), {what}");
                     runs += 1;
                 }
             }
@@ -255,7 +242,7 @@ fn both_c_routes_equal_the_rust_pass_bit_for_bit() {
     let settings = SelectionSettings { block_size: 8, candidates: 3, block_shift: true, ..Default::default() };
     let want = wgpu_frames(&device, &queue, settings);
     let auto = run_c(&program, "package", &package, "auto", settings, &folder).unwrap();
-    assert_eq!(first_difference(&auto, &want), None, "route 1, histogram_choice");
+    assert_eq!(first_frame_difference(&auto, &want), None, "route 1, histogram_choice");
     let said = std::fs::read_to_string(folder.join("package-auto-3-antithetic/stderr.txt")).unwrap();
     let chosen = fastest_histogram_of_the_device(8);
     assert!(said.contains(&format!("histogram_choice: {chosen}\n")), "{said} (strata's rule: {chosen})");
@@ -267,7 +254,7 @@ fn both_c_routes_equal_the_rust_pass_bit_for_bit() {
     let want = wgpu_frames_with(&device, &queue, settings, false);
     for route in ["library", "package"] {
         let got = run_c(&program, route, &package, "block_histogram", settings, &bare).unwrap();
-        assert_eq!(first_difference(&got, &want), None, "route {route} without payloads");
+        assert_eq!(first_frame_difference(&got, &want), None, "route {route} without payloads");
     }
     let _ = std::fs::remove_dir_all(&folder);
 }
@@ -287,7 +274,10 @@ fn a_wrong_binding_number_in_the_manifest_or_offset_in_the_header_is_caught() {
     let settings = SelectionSettings { block_size: 8, candidates: 4, ..Default::default() };
     let want = wgpu_frames(&device, &queue, settings);
     assert_eq!(
-        first_difference(&run_c(&program, "package", &package, "block_histogram", settings, &folder).unwrap(), &want),
+        first_frame_difference(
+            &run_c(&program, "package", &package, "block_histogram", settings, &folder).unwrap(),
+            &want
+        ),
         None
     );
     // strata_select's `sorted_pixels` and `spans` swap binding numbers in the manifest.
@@ -304,7 +294,7 @@ fn a_wrong_binding_number_in_the_manifest_or_offset_in_the_header_is_caught() {
     std::fs::write(&manifest_path, serde_json::to_string_pretty(&manifest).unwrap()).unwrap();
     let swapped = run_c(&program, "package", &package, "block_histogram", settings, &folder)
         .expect("a swapped binding of two storage buffers still runs (the sizes fit): only its outputs are wrong");
-    assert!(first_difference(&swapped, &want).is_some(), "a swapped binding went unnoticed");
+    assert!(first_frame_difference(&swapped, &want).is_some(), "a swapped binding went unnoticed");
     // A manifest of another schema version: refused by the reader, naming it.
     manifest["schema_version"] = serde_json::json!(strata_export::manifest::SCHEMA_VERSION + 1);
     std::fs::write(&manifest_path, serde_json::to_string_pretty(&manifest).unwrap()).unwrap();
@@ -796,7 +786,11 @@ fn the_exported_hlsl_compiled_by_slang_equals_the_rust_pass() {
         let histogram = histograms[candidates as usize % 3];
         let got = run_c(&program, "package", &package, histogram, settings, &folder)
             .unwrap_or_else(|e| panic!("Slang's SPIR-V of {histogram}: {e}"));
-        assert_eq!(first_difference(&got, &want), None, "Slang's SPIR-V, {histogram}, K = {candidates}, {sampler:?}");
+        assert_eq!(
+            first_frame_difference(&got, &want),
+            None,
+            "Slang's SPIR-V, {histogram}, K = {candidates}, {sampler:?}"
+        );
     }
     let _ = std::fs::remove_dir_all(&folder);
 }

@@ -50,13 +50,6 @@ fn array<'a>(value: &'a Value, path: &[&str]) -> Result<&'a Vec<Value>, ExportEr
         .ok_or_else(|| ExportError::Header(format!("strata.js: the manifest's `{}` is not a list", path.join("."))))
 }
 
-/// The WGSL WebGPU compiles for a kernel: its source, with `enable subgroups;` first where
-/// it needs subgroups and does not say so (naga needs no such line; WebGPU does).
-fn webgpu_wgsl(source: &str, subgroups: bool) -> String {
-    let enables = source.lines().any(|line| line.trim_start().starts_with("enable") && line.contains("subgroups"));
-    if subgroups && !enables { format!("enable subgroups;\n{source}") } else { source.to_string() }
-}
-
 /// The object the module's code reads (`PACKAGE`), from the manifest and the package's
 /// WGSL files (`wgsl(path)` gives a file's text).
 pub fn package_object(manifest: &Value, wgsl: &dyn Fn(&str) -> Option<String>) -> Result<Value, ExportError> {
@@ -91,7 +84,7 @@ pub fn package_object(manifest: &Value, wgsl: &dyn Fn(&str) -> Option<String>) -
             "uniform": field(kernel, &["uniform"])?,
             "required_features": features,
             "bindings": bindings,
-            "wgsl": webgpu_wgsl(&source, subgroups),
+            "wgsl": strata_kernels::source::webgpu_source(&source, subgroups).0,
         }));
     }
     let buffers: Vec<Value> = array(manifest, &["buffers"])?
@@ -213,12 +206,5 @@ mod tests {
         }
         assert!(fill("x @STRATA_NOT_A_NAME@", "t", &[]).is_err());
         assert_eq!(fill("a @STRATA_VERSION@", "t", &[("STRATA_VERSION", "1.2.3".into())]).unwrap(), "a 1.2.3");
-    }
-
-    #[test]
-    fn subgroup_kernels_enable_subgroups_once() {
-        assert_eq!(webgpu_wgsl("fn f() {}", true), "enable subgroups;\nfn f() {}");
-        assert_eq!(webgpu_wgsl("enable subgroups;\nfn f() {}", true), "enable subgroups;\nfn f() {}");
-        assert_eq!(webgpu_wgsl("fn f() {}", false), "fn f() {}");
     }
 }

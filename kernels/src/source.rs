@@ -69,6 +69,19 @@ impl ComposedSource {
     }
 }
 
+/// The WGSL a WebGPU implementation (Tint, in Chromium) compiles for a kernel: `source`,
+/// with `enable subgroups;` put first where the kernel uses subgroup operations
+/// (`subgroups`) and does not say so; naga needs no such line, WebGPU does. Returns the
+/// text and how many lines were put before the source (for mapping compiler lines back).
+/// The WebGPU backend and the kernel package's ES module both use it.
+pub fn webgpu_source(source: &str, subgroups: bool) -> (String, u64) {
+    let enables = source.lines().any(|line| {
+        let line = line.trim_start();
+        line.starts_with("enable") && line.contains("subgroups")
+    });
+    if subgroups && !enables { (format!("enable subgroups;\n{source}"), 1) } else { (source.to_string(), 0) }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -88,5 +101,20 @@ mod tests {
         let four = source.text.find("four").unwrap();
         assert_eq!(source.describe_offset(four), "b.wgsl:2");
         assert_eq!(source.describe_offset(0), "a.wgsl:1");
+    }
+}
+
+#[cfg(test)]
+mod webgpu_source_tests {
+    use super::webgpu_source;
+
+    #[test]
+    fn subgroup_kernels_enable_subgroups_once() {
+        assert_eq!(webgpu_source("fn f() {}", true), ("enable subgroups;\nfn f() {}".to_string(), 1));
+        assert_eq!(
+            webgpu_source("enable subgroups;\nfn f() {}", true),
+            ("enable subgroups;\nfn f() {}".to_string(), 0)
+        );
+        assert_eq!(webgpu_source("fn f() {}", false), ("fn f() {}".to_string(), 0));
     }
 }

@@ -260,16 +260,7 @@ fn pipeline_key(kernel: &Kernel, unfilterable: &[(u32, u32)]) -> String {
 /// uses subgroup operations and does not say so (naga needs no such line; WebGPU does).
 /// Returns the text and how many lines were put before the source.
 fn tint_source(kernel: &Kernel) -> (String, u64) {
-    let source = &kernel.source.text;
-    let enables = source.lines().any(|line| {
-        let line = line.trim_start();
-        line.starts_with("enable") && line.contains("subgroups")
-    });
-    if kernel.spec.features.subgroup && !enables {
-        (format!("enable subgroups;\n{source}"), 1)
-    } else {
-        (source.clone(), 0)
-    }
+    strata_kernels::source::webgpu_source(&kernel.source.text, kernel.spec.features.subgroup)
 }
 
 /// WebGPU's name of a texture view dimension.

@@ -92,8 +92,12 @@ fn run_page(
     let (name, body) = server.receive(Duration::from_secs(240), &mut || browser.exited().map_or(Ok(()), Err))?;
     match name.as_str() {
         "result" => {
-            let length = u32::from_le_bytes(body[..4].try_into().unwrap()) as usize;
-            let header = serde_json::from_slice(&body[4..4 + length]).map_err(|e| e.to_string())?;
+            // A 4-byte length, the JSON header, then the frames' bytes.
+            let short = || format!("the page's result has {} bytes: shorter than its header says", body.len());
+            let length = body.get(..4).ok_or_else(short)?;
+            let length = u32::from_le_bytes(length.try_into().unwrap()) as usize;
+            let header = body.get(4..4 + length).ok_or_else(short)?;
+            let header = serde_json::from_slice(header).map_err(|e| format!("the page's result header: {e}"))?;
             Ok(Some((header, body[4 + length..].to_vec())))
         }
         "skip" => Ok(None),
@@ -107,7 +111,9 @@ fn page_frames(payload: &[u8], index: usize) -> EmbedFrames {
     let (selection_bytes, resampled_bytes) =
         (pixels * size_of::<SelectedCandidates>(), pixels * size_of::<ResampleOutput>());
     let per_run = FRAMES as usize * (selection_bytes + resampled_bytes);
-    let run = &payload[index * per_run..(index + 1) * per_run];
+    let run = payload.get(index * per_run..(index + 1) * per_run).unwrap_or_else(|| {
+        panic!("the page sent {} bytes of frames: not {} runs of {per_run}", payload.len(), index + 1)
+    });
     run.chunks(selection_bytes + resampled_bytes)
         .map(|frame| {
             let (selections, resampled) = frame.split_at(selection_bytes);
@@ -240,6 +246,15 @@ fn the_es_module_equals_strata_embed_bit_for_bit_in_chromium_and_names_bad_field
     expect("no_resample", "bindings.resample", "made without resampling buffers");
     expect("bad_frame", "frame", "frame = -1: must be an integer from 0 to 4294967295");
     assert_eq!(errors["good_bind"]["thrown"], false, "a good bind threw: {}", errors["good_bind"]);
+    // What strata.d.ts declares readonly is: writing it throws (strict mode).
+    for case in ["set_width", "set_setting", "set_groups"] {
+        let got = &errors[case];
+        assert_eq!(
+            (&got["thrown"], &got["type"]),
+            (&serde_json::json!(true), &serde_json::json!("TypeError")),
+            "{case}: {got}"
+        );
+    }
     assert_eq!(
         errors["shared_buffer"]["thrown"], false,
         "disjoint slices of one buffer threw: {}",
@@ -289,7 +304,9 @@ fn the_module_s_data_is_the_manifest_s() {
             }
         }
     }
-    for (got, want) in object["buffers"].as_array().unwrap().iter().zip(manifest["buffers"].as_array().unwrap()) {
+    let buffers = manifest["buffers"].as_array().unwrap();
+    assert_eq!(object["buffers"].as_array().unwrap().len(), buffers.len());
+    for (got, want) in object["buffers"].as_array().unwrap().iter().zip(buffers) {
         assert_eq!(
             (&got["name"], &got["size"]["rule"], &got["size"]["bytes"]),
             (&want["name"], &want["size"]["rule"], &want["size"]["bytes"])
@@ -297,7 +314,9 @@ fn the_module_s_data_is_the_manifest_s() {
     }
     assert_eq!(object["structs"], manifest["structs"]);
     assert_eq!(object["samplers"], manifest["samplers"]);
-    for constant in manifest["constants"].as_array().unwrap() {
+    let constants = manifest["constants"].as_array().unwrap();
+    assert_eq!(object["constants"].as_object().unwrap().len(), constants.len());
+    for constant in constants {
         assert_eq!(object["constants"][constant["name"].as_str().unwrap()], constant["value"]);
     }
     let declarations = read("web/strata.d.ts");

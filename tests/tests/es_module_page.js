@@ -141,6 +141,17 @@ async function main() {
     good.encodeSelection(device.createCommandEncoder(), good.bind({ candidates, selections }), -1),
   );
   await attempt('good_bind', async () => good.bind({ candidates, selections }));
+  // The pass's image size and settings are fixed (its buffers were sized for them): a
+  // module's code is strict, so writing them throws.
+  await attempt('set_width', async () => {
+    good.width = 16;
+  });
+  await attempt('set_setting', async () => {
+    good.settings.blockSize = 4;
+  });
+  await attempt('set_groups', async () => {
+    good.bind({ candidates, selections }).groups[0] = null;
+  });
   // Two roles in one buffer at disjoint, aligned offsets: each is bound with the bytes it
   // needs, so they neither overlap nor exceed the buffer.
   const step = device.limits.minStorageBufferOffsetAlignment;

@@ -55,6 +55,29 @@ pub fn find_chromium() -> Result<PathBuf, String> {
 pub struct Browser {
     child: Child,
     folder: strata_files::TempDir,
+    /// Chromium's temporary folder where `folder` is too deep for it ([`temporary_folder`]).
+    _temporary: Option<strata_files::TempDir>,
+}
+
+/// The longest path a Unix socket may have (`sun_path` holds 108 bytes on Linux, 104 on
+/// macOS, with the terminating NUL).
+const SOCKET_PATH_MAX: usize = 103;
+/// What Chromium adds to its temporary folder for its profile lock's socket:
+/// `/org.chromium.Chromium.XXXXXX/SingletonSocket`.
+const CHROMIUM_SOCKET_TAIL: usize = "/org.chromium.Chromium.XXXXXX/SingletonSocket".len();
+
+/// Chromium's temporary folder: `private` (the launch's own folder), or where the system's
+/// temporary folder is deep enough that Chromium's socket path there would exceed what a
+/// Unix socket may have (Chromium then fails to start: "Failed to create socket
+/// directory"), a private folder of its own in `/tmp`, made the same way (mode 0700, a
+/// random name made with `mkdir`, so nothing planted there is used).
+fn temporary_folder(private: &Path) -> Result<Option<strata_files::TempDir>, String> {
+    if private.as_os_str().len() + CHROMIUM_SOCKET_TAIL <= SOCKET_PATH_MAX {
+        return Ok(None);
+    }
+    strata_files::private_scratch_folder_in(Path::new("/tmp"), "strata-cr-")
+        .map(Some)
+        .map_err(|e| format!("cannot create a private temporary folder for Chromium in /tmp: {e}"))
 }
 
 /// Lines of Chromium's log that say nothing about WebGPU (no D-Bus in a container).
@@ -71,6 +94,7 @@ impl Browser {
         let log = std::fs::File::create_new(folder.path().join("chromium.log"))
             .map_err(|e| format!("cannot create Chromium's log file: {e}"))?;
         let log_err = log.try_clone().map_err(|e| format!("cannot share Chromium's log file: {e}"))?;
+        let temporary = temporary_folder(folder.path())?;
         let mut command = Command::new(binary);
         command
             .arg("--headless=new")
@@ -100,8 +124,9 @@ impl Browser {
             // Chromium puts its profile lock's socket folder (org.chromium.Chromium.*) in
             // the temporary folder and removes it only when it exits cleanly; it is
             // killed here (Drop), so in the shared /tmp one folder stayed behind per
-            // launch (hundreds after a day of tests). In the private folder it goes with it.
-            .env("TMPDIR", folder.path())
+            // launch (hundreds after a day of tests). In the private folder it goes with it
+            // (or in a private one in /tmp where that is too deep for a socket).
+            .env("TMPDIR", temporary.as_ref().map_or(folder.path(), |t| t.path()))
             // A Vulkan layer switched on for strata's own Vulkan work (`xtask validate`)
             // is not Chromium's: its GPU process would load it and log into strata's log.
             .env_remove("VK_INSTANCE_LAYERS")
@@ -116,7 +141,7 @@ impl Browser {
             command.process_group(0);
         }
         let child = command.spawn().map_err(|e| format!("{} does not start: {e}", binary.display()))?;
-        Ok(Self { child, folder })
+        Ok(Self { child, folder, _temporary: temporary })
     }
 
     /// Why the browser is no longer running, with the end of its log; `None` while it runs.
@@ -165,5 +190,25 @@ impl Drop for Browser {
         let _ = self.child.kill();
         let _ = self.child.wait();
         // The folder goes with `self.folder`.
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A launch folder shallow enough keeps Chromium's temporary folder; one too deep for
+    /// Chromium's socket gets a private folder in /tmp, short enough, removed when dropped.
+    #[test]
+    fn chromium_s_socket_path_fits_whatever_the_temporary_folder() {
+        assert!(temporary_folder(Path::new("/tmp/strata-webgpu-0123456789")).unwrap().is_none());
+        let deep = PathBuf::from(format!("/home/{}/strata-webgpu-0123456789", "x".repeat(60)));
+        let temporary = temporary_folder(&deep).unwrap().expect("a folder in /tmp for a deep path");
+        let path = temporary.path().to_path_buf();
+        assert!(path.starts_with("/tmp") && path.is_dir(), "{}", path.display());
+        assert!(path.as_os_str().len() + CHROMIUM_SOCKET_TAIL <= SOCKET_PATH_MAX, "{}", path.display());
+        strata_files::check_private(&path).unwrap();
+        drop(temporary);
+        assert!(!path.exists(), "{} stays after the browser", path.display());
     }
 }

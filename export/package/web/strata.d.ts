@@ -134,6 +134,10 @@ export class StrataBindings {
   readonly identityPayload: boolean;
   /** Whether resampling buffers were bound. */
   readonly resample: boolean;
+  /** The bind groups of the histogram, the selection and the resampling (null without resampling buffers). */
+  readonly groups: readonly [GPUBindGroup, GPUBindGroup, GPUBindGroup | null];
+  /** Whether these bindings were made by `pass`'s bind(). */
+  belongsTo(pass: StrataSelection): boolean;
 }
 
 /** The pass on one device, image size and settings. */
@@ -143,8 +147,8 @@ export class StrataSelection {
   readonly width: number;
   /** The image's height. */
   readonly height: number;
-  /** The settings. */
-  readonly settings: WholeSettings;
+  /** The settings, whole and frozen. */
+  readonly settings: Readonly<WholeSettings>;
   /** The histogram kernel the pass runs. */
   readonly histogramKernel: HistogramKernel;
   /** The seed of the frames recorded from now on. */

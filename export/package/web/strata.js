@@ -468,11 +468,12 @@ export class StrataBindings {
   #pass;
   constructor(pass, groups, identityPayload, resample) {
     this.#pass = pass;
-    this.groups = groups;
+    this.groups = Object.freeze(groups);
     this.identityPayload = identityPayload;
     this.resample = resample;
     Object.freeze(this);
   }
+  /** Whether these bindings were made by `pass`'s bind(). */
   belongsTo(pass) {
     return this.#pass === pass;
   }
@@ -485,16 +486,39 @@ export class StrataSelection {
   #pipelines;
   #label;
   #seed;
+  #width;
+  #height;
+  #settings;
   constructor(device, { width, height, settings, seed, own, pipelines, label }) {
     this.#device = device;
-    this.width = width;
-    this.height = height;
-    this.settings = settings;
+    this.#width = width;
+    this.#height = height;
+    // Frozen: the pass's buffers and grid were sized for these settings and this image.
+    this.#settings = Object.freeze({ ...settings });
     this.#seed = seed;
     this.#own = own;
     this.#pipelines = pipelines;
     this.#label = label;
-    this.histogramKernel = pipelines[0].kernel.name;
+  }
+
+  /** The image's width (fixed: the pass's buffers are sized for it). */
+  get width() {
+    return this.#width;
+  }
+
+  /** The image's height. */
+  get height() {
+    return this.#height;
+  }
+
+  /** The settings, whole and frozen. */
+  get settings() {
+    return this.#settings;
+  }
+
+  /** The histogram kernel the pass runs. */
+  get histogramKernel() {
+    return this.#pipelines[0].kernel.name;
   }
 
   /** The seed of the frames recorded from now on. */

@@ -247,7 +247,7 @@ fn the_es_module_equals_strata_embed_bit_for_bit_in_chromium_and_names_bad_field
     expect("bad_frame", "frame", "frame = -1: must be an integer from 0 to 4294967295");
     assert_eq!(errors["good_bind"]["thrown"], false, "a good bind threw: {}", errors["good_bind"]);
     // What strata.d.ts declares readonly is: writing it throws (strict mode).
-    for case in ["set_width", "set_setting", "set_groups"] {
+    for case in ["set_width", "set_height", "set_settings", "set_setting", "set_kernel", "set_groups"] {
         let got = &errors[case];
         assert_eq!(
             (&got["thrown"], &got["type"]),

@@ -146,8 +146,17 @@ async function main() {
   await attempt('set_width', async () => {
     good.width = 16;
   });
+  await attempt('set_height', async () => {
+    good.height = 16;
+  });
+  await attempt('set_settings', async () => {
+    good.settings = { blockSize: 4 };
+  });
   await attempt('set_setting', async () => {
     good.settings.blockSize = 4;
+  });
+  await attempt('set_kernel', async () => {
+    good.histogramKernel = 'block_histogram';
   });
   await attempt('set_groups', async () => {
     good.bind({ candidates, selections }).groups[0] = null;

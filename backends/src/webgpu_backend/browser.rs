@@ -63,16 +63,17 @@ pub struct Browser {
 /// macOS, with the terminating NUL).
 const SOCKET_PATH_MAX: usize = 103;
 /// What Chromium adds to its temporary folder for its profile lock's socket:
-/// `/org.chromium.Chromium.XXXXXX/SingletonSocket`.
-const CHROMIUM_SOCKET_TAIL: usize = "/org.chromium.Chromium.XXXXXX/SingletonSocket".len();
+/// `/.org.chromium.Chromium.XXXXXX/SingletonSocket`.
+const CHROMIUM_SOCKET_TAIL: usize = "/.org.chromium.Chromium.XXXXXX/SingletonSocket".len();
 
 /// Chromium's temporary folder: `private` (the launch's own folder), or where the system's
 /// temporary folder is deep enough that Chromium's socket path there would exceed what a
 /// Unix socket may have (Chromium then fails to start: "Failed to create socket
 /// directory"), a private folder of its own in `/tmp`, made the same way (mode 0700, a
 /// random name made with `mkdir`, so nothing planted there is used).
+/// (Elsewhere than on Unix Chromium's lock is no socket: the launch folder always.)
 fn temporary_folder(private: &Path) -> Result<Option<strata_files::TempDir>, String> {
-    if private.as_os_str().len() + CHROMIUM_SOCKET_TAIL <= SOCKET_PATH_MAX {
+    if !cfg!(unix) || private.as_os_str().len() + CHROMIUM_SOCKET_TAIL <= SOCKET_PATH_MAX {
         return Ok(None);
     }
     strata_files::private_scratch_folder_in(Path::new("/tmp"), "strata-cr-")
@@ -127,6 +128,8 @@ impl Browser {
             // launch (hundreds after a day of tests). In the private folder it goes with it
             // (or in a private one in /tmp where that is too deep for a socket).
             .env("TMPDIR", temporary.as_ref().map_or(folder.path(), |t| t.path()))
+            // macOS's Chromium reads its temporary folder from this, not TMPDIR.
+            .env("MAC_CHROMIUM_TMPDIR", temporary.as_ref().map_or(folder.path(), |t| t.path()))
             // A Vulkan layer switched on for strata's own Vulkan work (`xtask validate`)
             // is not Chromium's: its GPU process would load it and log into strata's log.
             .env_remove("VK_INSTANCE_LAYERS")
@@ -193,7 +196,7 @@ impl Drop for Browser {
     }
 }
 
-#[cfg(test)]
+#[cfg(all(test, unix))]
 mod tests {
     use super::*;
 

@@ -162,7 +162,7 @@ fn settings_for(scene: &Scene, width: u32, height: u32, light_sampling: LightSam
 
 /// Renders shared scene `file` under each (strategy, Russian roulette) and checks each
 /// against Mitsuba reference `reference_name`.
-fn matches_mitsuba(test: &str, file: &str, reference_name: &str, variants: &[(LightSampling, bool)], spp: u32) {
+fn matches_mitsuba(test: &str, file: &str, reference_name: &str, variants: &[(LightSampling, bool)]) {
     let Some(mut backend) = strata_tests::vulkan_backend(test) else {
         assert!(!gpu_required());
         return;
@@ -173,30 +173,22 @@ fn matches_mitsuba(test: &str, file: &str, reference_name: &str, variants: &[(Li
         let settings = settings_for(&scene, reference.width, reference.height, light_sampling, rr);
         // BSDF sampling alone finds the lights by chance: its frames spread tens of times
         // more than MIS's, so it takes twice the samples for the same 3 % to show.
-        let spp = if light_sampling == LightSampling::Bsdf { 2 * spp } else { spp };
+        let spp = if light_sampling == LightSampling::Bsdf { 2 * MITSUBA_SPP } else { MITSUBA_SPP };
         let ours = estimate(&mut backend, &scene, &settings, 4, spp);
         let what = format!("{reference_name} {light_sampling:?}{}", if rr { "" } else { " without RR" });
         let result = agreement(&ours, &reference, &reference_variance);
         assert_agrees(&what, &result);
-        {
-            // The comparison can fail: the same render 3 % too bright is caught.
-            let brighter = Estimate {
-                mean: RgbImage {
-                    pixels: ours.mean.pixels.iter().map(|p| p.map(|c| c * 1.03)).collect(),
-                    ..ours.mean.clone()
-                },
-                variance_of_mean: ours.variance_of_mean.clone(),
-            };
-            let biased = agreement(&brighter, &reference, &reference_variance);
-            eprintln!(
-                "{what}, 3 % too bright: region mean z² {:.1}, max |z| {:.1}",
-                biased.mean_z_squared, biased.max_z
-            );
-            assert!(
-                biased.mean_z_squared >= 2.0 || biased.max_z >= 5.5,
-                "{what}: a 3 % bias went unnoticed: {biased:?}"
-            );
-        }
+        // The comparison can fail: the same render 3 % too bright is caught.
+        let brighter = Estimate {
+            mean: RgbImage {
+                pixels: ours.mean.pixels.iter().map(|p| p.map(|c| c * 1.03)).collect(),
+                ..ours.mean.clone()
+            },
+            variance_of_mean: ours.variance_of_mean.clone(),
+        };
+        let biased = agreement(&brighter, &reference, &reference_variance);
+        eprintln!("{what}, 3 % too bright: region mean z² {:.1}, max |z| {:.1}", biased.mean_z_squared, biased.max_z);
+        assert!(biased.mean_z_squared >= 2.0 || biased.max_z >= 5.5, "{what}: a 3 % bias went unnoticed: {biased:?}");
     }
 }
 
@@ -214,25 +206,13 @@ const ALL_STRATEGIES: [(LightSampling, bool); 4] =
 
 #[test]
 fn cornell_box_area_lights_match_mitsuba() {
-    matches_mitsuba(
-        "cornell_box_area_lights_match_mitsuba",
-        "cornell-box/scene.json",
-        "cornell-box",
-        &ALL_STRATEGIES,
-        MITSUBA_SPP,
-    );
+    matches_mitsuba("cornell_box_area_lights_match_mitsuba", "cornell-box/scene.json", "cornell-box", &ALL_STRATEGIES);
 }
 
 #[test]
 fn matpreview_environment_matches_mitsuba() {
     let variants = [(LightSampling::Mis, true), (LightSampling::Nee, true), (LightSampling::Bsdf, true)];
-    matches_mitsuba(
-        "matpreview_environment_matches_mitsuba",
-        "matpreview/scene.json",
-        "matpreview",
-        &variants,
-        MITSUBA_SPP,
-    );
+    matches_mitsuba("matpreview_environment_matches_mitsuba", "matpreview/scene.json", "matpreview", &variants);
 }
 
 #[test]
@@ -243,7 +223,6 @@ fn rough_conductor_matches_mitsuba() {
         "matpreview/scene-roughmetal.json",
         "matpreview-roughmetal",
         &variants,
-        MITSUBA_SPP,
     );
 }
 
@@ -254,7 +233,6 @@ fn objects_grid_textures_match_mitsuba() {
         "objects-grid/scene.json",
         "objects-grid",
         &[(LightSampling::Mis, true)],
-        MITSUBA_SPP,
     );
 }
 

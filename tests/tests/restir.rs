@@ -414,8 +414,8 @@ fn scored_mean(images: &[RgbImage], last: u32) -> RgbImage {
     mean_image(&images[FIRST_SCORED_FRAME as usize - 1..last as usize])
 }
 
-/// Frames a paired temporal variant renders ([`temporal_pairs`]): frame 3 alone, the first
-/// at which every cap here binds, is scored.
+/// Frames a paired temporal variant renders ([`temporal_pairs`]): frame 3 alone is scored,
+/// the first at which the own reservoir's cap and the temporal-first order's bind.
 const PAIRED_TEMPORAL_FRAMES: u32 = 3;
 
 /// With temporal reuse, `base` over `base_renders` of `base_frames` frames (each scored by
@@ -432,9 +432,10 @@ const PAIRED_TEMPORAL_FRAMES: u32 = 3;
 /// white film 0.09-0.17, the mirror-floor room with four drawn reservoirs 0.10-0.14; with
 /// four drawn reservoirs in the default room 0.48-0.57 over frames 3-8 (0.51-0.63 over
 /// 3-6). So a variant renders 3 frames where it rendered 6 (6 in the spatial-first order,
-/// whose history count keeps growing) and its bias (one restir lacks) is caught more finely; restir, held to the reference, catches a bias they share. In the
+/// whose history count keeps growing) and its bias (one restir lacks) is caught more
+/// finely; restir, held to the reference, catches a bias they share. In the
 /// glass/metal/environment room the difference spreads as much as the variant (0.7-1.7):
-/// no pairs there. (BENCHMARKS.md, "CI time".)
+/// no pairs there. (docs/benchmarks/ci-time.md, "Temporal pairs".)
 fn temporal_pairs(
     backend: &mut dyn Backend,
     scene: &Scene,
@@ -686,8 +687,9 @@ fn temporal_reuse_stays_unbiased_with_drawn_reservoirs() {
 }
 
 /// Both orders of reuse stay unbiased for every method over independent renders (restir
-/// over frames 3 to 6 against the reference, the others paired with it). The temporal-first order (the default: the history merged into each pixel's
-/// canonical candidate first, then K of the block's merged reservoirs reused under
+/// over frames 3 to 6 against the reference, the others paired with it). The
+/// temporal-first order (the default: the history merged into each pixel's canonical
+/// candidate first, then K of the block's merged reservoirs reused under
 /// pairwise MIS with confidence weights) is what every other temporal test here runs;
 /// these run it with the default cap and strata shading the kept sample too, whose W the
 /// next frame reuses. Its spatial pass sums the merged M (5 after the first frame at K =
@@ -1394,10 +1396,10 @@ fn smooth_chains_on_short_paths_stay_unbiased() {
 /// sequence (independent uniform points, the default before 2026-11-25) against that
 /// reference: the path tracer, and every method with temporal reuse over independent
 /// renders (restir's frames 3 to 6, the others paired with it on frame 3) and accumulated
-/// over 64 frames (restir against the reference,
-/// strata and restir-disc paired with restir: render by render with temporal reuse,
-/// [`temporal_pairs`], frame by frame without). A start shared by every pixel
-/// and seed was seen to fail here (the references then disagree).
+/// over 64 frames (restir against the reference, strata and restir-disc paired with
+/// restir: render by render with temporal reuse, [`temporal_pairs`], frame by frame
+/// without). A start shared by every pixel and seed was seen to fail here (the references
+/// then disagree).
 #[test]
 fn both_film_sequences_stay_unbiased() {
     let Some(mut backend) = strata_tests::vulkan_backend("both_film_sequences_stay_unbiased") else {

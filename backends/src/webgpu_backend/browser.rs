@@ -96,6 +96,7 @@ impl Browser {
             .map_err(|e| format!("cannot create Chromium's log file: {e}"))?;
         let log_err = log.try_clone().map_err(|e| format!("cannot share Chromium's log file: {e}"))?;
         let temporary = temporary_folder(folder.path())?;
+        let chromium_temporary = temporary.as_ref().map_or(folder.path(), |t| t.path());
         let mut command = Command::new(binary);
         command
             .arg("--headless=new")
@@ -127,9 +128,9 @@ impl Browser {
             // killed here (Drop), so in the shared /tmp one folder stayed behind per
             // launch (hundreds after a day of tests). In the private folder it goes with it
             // (or in a private one in /tmp where that is too deep for a socket).
-            .env("TMPDIR", temporary.as_ref().map_or(folder.path(), |t| t.path()))
+            .env("TMPDIR", chromium_temporary)
             // macOS's Chromium reads its temporary folder from this, not TMPDIR.
-            .env("MAC_CHROMIUM_TMPDIR", temporary.as_ref().map_or(folder.path(), |t| t.path()))
+            .env("MAC_CHROMIUM_TMPDIR", chromium_temporary)
             // A Vulkan layer switched on for strata's own Vulkan work (`xtask validate`)
             // is not Chromium's: its GPU process would load it and log into strata's log.
             .env_remove("VK_INSTANCE_LAYERS")

@@ -493,8 +493,8 @@ export class StrataSelection {
     this.#device = device;
     this.#width = width;
     this.#height = height;
-    // Frozen: the pass's buffers and grid were sized for these settings and this image.
-    this.#settings = Object.freeze({ ...settings });
+    // Frozen by checkSettings: the pass's buffers and grid were sized for these settings.
+    this.#settings = settings;
     this.#seed = seed;
     this.#own = own;
     this.#pipelines = pipelines;

@@ -102,11 +102,6 @@ mod tests {
         assert_eq!(source.describe_offset(four), "b.wgsl:2");
         assert_eq!(source.describe_offset(0), "a.wgsl:1");
     }
-}
-
-#[cfg(test)]
-mod webgpu_source_tests {
-    use super::webgpu_source;
 
     #[test]
     fn subgroup_kernels_enable_subgroups_once() {

@@ -385,6 +385,15 @@ pub type EmbedFrames =
 /// are equal byte for byte).
 pub fn first_frame_difference(got: &EmbedFrames, want: &EmbedFrames) -> Option<String> {
     for (frame, ((gs, gr), (ws, wr))) in got.iter().zip(want).enumerate() {
+        if (gs.len(), gr.len()) != (ws.len(), wr.len()) {
+            return Some(format!(
+                "frame {frame}: {} selections and {} resampled against {} and {}",
+                gs.len(),
+                gr.len(),
+                ws.len(),
+                wr.len()
+            ));
+        }
         if let Some(p) = (0..ws.len()).find(|&p| bytemuck::bytes_of(&gs[p]) != bytemuck::bytes_of(&ws[p])) {
             return Some(format!("frame {frame}, pixel {p}: selection {:?} against {:?}", gs[p], ws[p]));
         }

@@ -47,6 +47,19 @@ const FIRST_SCORED_FRAME: u32 = 3;
 /// tails faster than they save time.
 const TEMPORAL_RENDERS: std::ops::Range<u32> = 1..65;
 
+/// Frames of restir's temporal renders held to the reference at [`TEMPORAL_RENDERS`]
+/// renders (the own reservoir, both reuse orders, the mirror-floor room), scored 3-5.
+/// Six frames resolved 2.99-4.04 % against stated bounds of 5.8-7.7 %; five resolve
+/// 3.92-4.83 % (0.63-0.69 of each bound; docs/benchmarks/ci-time.md "Fewer frames where
+/// the power allows") for a sixth fewer frames.
+const BASE_TEMPORAL_FRAMES: u32 = 5;
+
+/// Frames of each variant paired with restir over four drawn temporal reservoirs, scored
+/// 3-6. Scored 3-4 they resolved as finely (1.35-1.58 % against 1.23-1.53 %, stated 2.0 %)
+/// but missed a bias that grows with the history: strata's canonical weight in
+/// `restir_spatial` 3 % too large gave pooled z 3.97 over frames 3-4 and 5.08 over 3-6.
+const DRAWN_PAIRED_FRAMES: u32 = 6;
+
 // The tests' stated power: the smallest bias of the whole image, relative to its total,
 // that each catches with probability 0.99 ([`detectable_bias`]). Each is what the test
 // measured before its renders were scored as above (2026-11-28, BENCHMARKS.md "The
@@ -464,6 +477,14 @@ fn temporal_pairs(
     (ours, differences)
 }
 
+/// What [`paired_differences`] rendered: `base` and each variant over the same seeds and
+/// frames, and each variant less `base`, frame by frame.
+struct PairedRuns {
+    base: RegionStats,
+    variants: Vec<RegionStats>,
+    differences: Vec<RegionStats>,
+}
+
 /// Without temporal reuse: per seed and frame, each of `variants` less `base` (both
 /// rendered from that seed and frame, with `adjust` applied to the render settings).
 fn paired_differences(
@@ -474,8 +495,10 @@ fn paired_differences(
     seeds: std::ops::Range<u32>,
     frames: u32,
     adjust: impl Fn(RenderSettings) -> RenderSettings,
-) -> Vec<RegionStats> {
+) -> PairedRuns {
     let gpu_scene = GpuScene::build(scene).unwrap();
+    let mut base_stats = RegionStats::new();
+    let mut variant_stats = vec![RegionStats::new(); variants.len()];
     let mut differences = vec![RegionStats::new(); variants.len()];
     for seed in seeds {
         let render = adjust(settings(scene, seed));
@@ -495,15 +518,17 @@ fn paired_differences(
                     image
                 })
                 .collect();
-            for (difference, image) in differences.iter_mut().zip(&images[1..]) {
+            base_stats.add(&images[0]);
+            for ((difference, own), image) in differences.iter_mut().zip(&mut variant_stats).zip(&images[1..]) {
                 difference.add_difference(image, &images[0]);
+                own.add(image);
             }
         }
         for renderer in renderers {
             renderer.destroy(backend).unwrap();
         }
     }
-    differences
+    PairedRuns { base: base_stats, variants: variant_stats, differences }
 }
 
 /// Without temporal reuse every method converges to the path tracer's image, shading the
@@ -529,20 +554,17 @@ fn every_method_converges_to_the_path_traced_reference() {
         selection: blocks_of_8(),
         ..RestirSettings::default()
     };
-    // restir, both shadings, against the reference.
+    // restir's expectation against the reference.
     let expected = restir_frames(&mut backend, &scene, settings(Method::Restir, Shading::Expectation), 1..9, 64);
     assert_unbiased_with_power("restir expectation without temporal reuse", &expected, &reference, POWER_ACCUMULATED);
     // The test can fail: the same frames 3 % too bright are caught.
     let pooled = pooled_z(&expected.scaled(1.03), &reference);
     assert!(pooled > 4.5, "restir: a 3 % bias gives pooled z {pooled:.2} only");
-    let sampled = restir_frames(&mut backend, &scene, settings(Method::Restir, Shading::Sample), 1..9, 64);
-    assert_unbiased_with_power("restir sample without temporal reuse", &sampled, &reference, POWER_ACCUMULATED);
-    let spread = |stats: &RegionStats| (0..stats.sum.len()).map(|i| stats.variance_of_mean(i)).sum::<f64>();
-    assert!(spread(&expected) < spread(&sampled), "restir: the expectation's frames spread more than the sample's");
-    // strata and restir-disc, both shadings, paired with restir's expectation frame by
-    // frame: a bias of theirs that restir lacks shows in the differences, one they share
-    // with restir in restir's runs above.
+    // restir's sample shading, strata and restir-disc with both, paired with restir's
+    // expectation frame by frame: a bias of theirs that restir's expectation lacks shows
+    // in the differences, one they share with it in its run above.
     let variants = [
+        settings(Method::Restir, Shading::Sample),
         settings(Method::Strata, Shading::Expectation),
         settings(Method::Strata, Shading::Sample),
         settings(Method::RestirDisc, Shading::Expectation),
@@ -556,8 +578,14 @@ fn every_method_converges_to_the_path_traced_reference() {
         },
     ];
     let base = settings(Method::Restir, Shading::Expectation);
-    let differences = paired_differences(&mut backend, &scene, base, &variants, PAIRED_SEEDS, 32, |render| render);
-    for (variant, difference) in variants.iter().zip(&differences) {
+    let paired = paired_differences(&mut backend, &scene, base, &variants, PAIRED_SEEDS, 32, |render| render);
+    // Over the same frames, restir's expectation spreads less than its sample.
+    let spread = |stats: &RegionStats| (0..stats.sum.len()).map(|i| stats.variance_of_mean(i)).sum::<f64>();
+    assert!(
+        spread(&paired.base) < spread(&paired.variants[0]),
+        "restir: the expectation's frames spread more than the sample's"
+    );
+    for (variant, difference) in variants.iter().zip(&paired.differences) {
         let what = format!(
             "{} {:?} ({} sampler) less restir expectation, without temporal reuse",
             variant.method.name(),
@@ -601,7 +629,8 @@ fn restir_disc_stays_unbiased_for_any_disc_radius() {
         // Without temporal reuse, paired frame by frame with restir (which
         // every_method_converges_to_the_path_traced_reference holds to the reference).
         let base = RestirSettings { method: Method::Restir, ..restir };
-        let differences = paired_differences(&mut backend, &scene, base, &[restir], PAIRED_SEEDS, 32, |r| r);
+        let differences =
+            paired_differences(&mut backend, &scene, base, &[restir], PAIRED_SEEDS, 32, |r| r).differences;
         let what = format!("restir-disc, disc radius {disc_radius}, less restir, no temporal reuse");
         assert_same_mean_with_power(&what, &differences[0], &reference, POWER_PAIRED);
     }
@@ -637,10 +666,16 @@ fn temporal_reuse_stays_unbiased_with_the_own_reservoir() {
         ..RestirSettings::default()
     };
     let variants = [(own(Method::Strata), PAIRED_TEMPORAL_FRAMES), (own(Method::RestirDisc), PAIRED_TEMPORAL_FRAMES)];
-    let (ours, differences) =
-        temporal_pairs(&mut backend, &scene, own(Method::Restir), (TEMPORAL_RENDERS, 6), &variants, |r| r);
-    let what = "restir with the own temporal reservoir alone, cap 2, frames 3-6";
-    assert_unbiased_with_power(what, &ours, &reference, POWER_TEMPORAL_OWN);
+    let (ours, differences) = temporal_pairs(
+        &mut backend,
+        &scene,
+        own(Method::Restir),
+        (TEMPORAL_RENDERS, BASE_TEMPORAL_FRAMES),
+        &variants,
+        |r| r,
+    );
+    let what = format!("restir with the own temporal reservoir alone, cap 2, frames 3-{BASE_TEMPORAL_FRAMES}");
+    assert_unbiased_with_power(&what, &ours, &reference, POWER_TEMPORAL_OWN);
     for ((variant, _), difference) in variants.iter().zip(&differences) {
         let what = format!("{} less restir, own temporal reservoir alone, cap 2, frame 3", variant.method.name());
         assert_same_mean_with_power(&what, difference, &reference, POWER_TEMPORAL_PAIRED);
@@ -669,7 +704,13 @@ fn temporal_reuse_stays_unbiased_with_drawn_reservoirs() {
         ..RestirSettings::default()
     };
     let disc = |disc_radius| RestirSettings { disc_radius, ..drawn(Method::RestirDisc) };
-    let variants = [(drawn(Method::Strata), 6), (drawn(Method::RestirDisc), 6), (disc(2.0), 6), (disc(1000.0), 6)];
+    let frames = DRAWN_PAIRED_FRAMES;
+    let variants = [
+        (drawn(Method::Strata), frames),
+        (drawn(Method::RestirDisc), frames),
+        (disc(2.0), frames),
+        (disc(1000.0), frames),
+    ];
     let (ours, differences) =
         temporal_pairs(&mut backend, &scene, drawn(Method::Restir), (1..129, 8), &variants, |r| r);
     let cap = RestirSettings::default().temporal_cap;
@@ -717,15 +758,17 @@ fn reuse_order_stays_unbiased() {
         // In the spatial-first order the merged M grows by one a frame (1 + min(M, 20)), so
         // its variants are scored over frames 3 to 6 as restir is, each frame's merge with
         // another history count; the temporal-first order's cap binds from frame 3.
-        let frames = if reuse_order == ReuseOrder::SpatialFirst { 6 } else { PAIRED_TEMPORAL_FRAMES };
+        let frames =
+            if reuse_order == ReuseOrder::SpatialFirst { BASE_TEMPORAL_FRAMES } else { PAIRED_TEMPORAL_FRAMES };
         let variants = [
             (settings(Method::Strata, Shading::Expectation), frames),
             (settings(Method::Strata, Shading::Sample), frames),
             (settings(Method::RestirDisc, Shading::Expectation), frames),
         ];
         let base = settings(Method::Restir, Shading::Expectation);
-        let (ours, differences) = temporal_pairs(&mut backend, &scene, base, (TEMPORAL_RENDERS, 6), &variants, |r| r);
-        let what = format!("restir {}, Expectation shading, frames 3-6", reuse_order.name());
+        let (ours, differences) =
+            temporal_pairs(&mut backend, &scene, base, (TEMPORAL_RENDERS, BASE_TEMPORAL_FRAMES), &variants, |r| r);
+        let what = format!("restir {}, Expectation shading, frames 3-{BASE_TEMPORAL_FRAMES}", reuse_order.name());
         assert_unbiased_with_power(&what, &ours, &reference, POWER_REUSE_ORDER);
         for ((variant, _), difference) in variants.iter().zip(&differences) {
             let scored =
@@ -1369,7 +1412,7 @@ fn smooth_chains_on_short_paths_stay_unbiased() {
     assert_unbiased_with_power("restir, 3 segments, without temporal reuse", &ours, &reference, POWER_SHORT_PATHS);
     let variants = [accumulated(Method::Strata), accumulated(Method::RestirDisc)];
     let base = accumulated(Method::Restir);
-    let differences = paired_differences(&mut backend, &scene, base, &variants, PAIRED_SEEDS, 32, |r| r);
+    let differences = paired_differences(&mut backend, &scene, base, &variants, PAIRED_SEEDS, 32, |r| r).differences;
     for (variant, difference) in variants.iter().zip(&differences) {
         let what = format!("{} less restir, 3 segments, without temporal reuse", variant.method.name());
         assert_same_mean_with_power(&what, difference, &reference, POWER_PAIRED);
@@ -1380,10 +1423,16 @@ fn smooth_chains_on_short_paths_stay_unbiased() {
     let temporal = |method| RestirSettings { temporal: true, temporal_candidates: 4, ..accumulated(method) };
     let variants =
         [(temporal(Method::Strata), PAIRED_TEMPORAL_FRAMES), (temporal(Method::RestirDisc), PAIRED_TEMPORAL_FRAMES)];
-    let (ours, differences) =
-        temporal_pairs(&mut backend, &scene, temporal(Method::Restir), (TEMPORAL_RENDERS, 6), &variants, |r| r);
-    let what = "restir, 3 segments, temporal reuse + 4 drawn, frames 3-6";
-    assert_unbiased_with_power(what, &ours, &reference, POWER_SHORT_PATHS_TEMPORAL);
+    let (ours, differences) = temporal_pairs(
+        &mut backend,
+        &scene,
+        temporal(Method::Restir),
+        (TEMPORAL_RENDERS, BASE_TEMPORAL_FRAMES),
+        &variants,
+        |r| r,
+    );
+    let what = format!("restir, 3 segments, temporal reuse + 4 drawn, frames 3-{BASE_TEMPORAL_FRAMES}");
+    assert_unbiased_with_power(&what, &ours, &reference, POWER_SHORT_PATHS_TEMPORAL);
     for ((variant, _), difference) in variants.iter().zip(&differences) {
         let what = format!("{} less restir, 3 segments, temporal reuse + 4 drawn, frame 3", variant.method.name());
         assert_same_mean_with_power(&what, difference, &reference, POWER_TEMPORAL_PAIRED);
@@ -1427,6 +1476,8 @@ fn both_film_sequences_stay_unbiased() {
     ];
     let (ours, differences) =
         temporal_pairs(&mut backend, &scene, settings(Method::Restir, true), (TEMPORAL_RENDERS, 6), &variants, white);
+    // Six frames, not BASE_TEMPORAL_FRAMES: at frames 3-5 this run resolved 4.16 % against
+    // its stated 5.2 (3.37 % at 3-6), too close to the bound to pass every run.
     assert_unbiased_with_power("restir white film, temporal, frames 3-6", &ours, &reference, POWER_FILM_TEMPORAL);
     for ((variant, _), difference) in variants.iter().zip(&differences) {
         let what = format!("{} less restir, white film, temporal, frame 3", variant.method.name());
@@ -1437,7 +1488,7 @@ fn both_film_sequences_stay_unbiased() {
     let ours = restir_frames_along(&mut backend, &scene, restir, 1..9, 64, &CameraPath::Static, white);
     assert_unbiased_with_power("restir white film, accumulated", &ours, &reference, POWER_ACCUMULATED);
     let variants = [settings(Method::Strata, false), settings(Method::RestirDisc, false)];
-    let differences = paired_differences(&mut backend, &scene, restir, &variants, PAIRED_SEEDS, 32, white);
+    let differences = paired_differences(&mut backend, &scene, restir, &variants, PAIRED_SEEDS, 32, white).differences;
     for (variant, difference) in variants.iter().zip(&differences) {
         let what = format!("{} less restir, white film, accumulated", variant.method.name());
         assert_same_mean_with_power(&what, difference, &reference, POWER_PAIRED);

@@ -31,6 +31,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+#[cfg(not(target_arch = "wasm32"))]
 pub mod ash_backend;
 pub mod backend;
 pub mod bindings_check;
@@ -44,6 +45,7 @@ pub mod texture;
 pub mod webgpu_backend;
 pub mod wgpu_backend;
 
+#[cfg(not(target_arch = "wasm32"))]
 pub use ash_backend::{AshBackend, AshOptions, SpirvSource};
 pub use backend::{Backend, Bind, BufferId, Resource};
 pub use device_info::{DeviceInfo, DeviceLimits};

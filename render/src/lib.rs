@@ -23,8 +23,11 @@
 //! ```
 
 pub mod atomic_file;
+// The command line's backends (ash, wgpu): native only.
+#[cfg(not(target_arch = "wasm32"))]
 pub mod backend_choice;
 pub mod denoise;
+pub mod error_metric;
 pub mod histogram_pass;
 pub mod render;
 pub mod restir;

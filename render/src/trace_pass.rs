@@ -63,10 +63,31 @@ pub fn build_obvhs(triangles: &[[[f32; 3]; 3]]) -> (Vec<Triangle>, Bvh2) {
         .iter()
         .map(|[a, b, c]| Triangle { v0: Vec3A::from(*a), v1: Vec3A::from(*b), v2: Vec3A::from(*c) })
         .collect();
-    let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(
+    // obvhs' `build_bvh2_from_tris` without its pre-split branch (off in the fast preset),
+    // step for step: PLOC, reinsertion, leaf collapse, reinsertion. Written out because
+    // that helper times itself with `Instant::now`, which panics in a web page (wasm32);
+    // obvhs offers the helper as an example to reimplement.
+    let params =
+        obvhs::BvhBuildParams { max_prims_per_leaf: MAX_TRIANGLES_PER_LEAF, ..obvhs::BvhBuildParams::fast_build() };
+    let mut bvh = obvhs::ploc::PlocBuilder::with_capacity(tris.len()).build(
+        params.ploc_search_distance,
         &tris,
-        obvhs::BvhBuildParams { max_prims_per_leaf: MAX_TRIANGLES_PER_LEAF, ..obvhs::BvhBuildParams::fast_build() },
-        &mut std::time::Duration::default(),
+        (0..tris.len() as u32).collect::<Vec<_>>(),
+        params.sort_precision,
+        params.search_depth_threshold,
+    );
+    bvh.uses_spatial_splits = false;
+    let mut reinsertion = obvhs::bvh2::reinsertion::ReinsertionOptimizer::default();
+    reinsertion.run(&mut bvh, params.reinsertion_batch_ratio, None);
+    obvhs::bvh2::leaf_collapser::collapse(
+        &mut bvh,
+        params.max_prims_per_leaf.clamp(1, 255),
+        params.collapse_traversal_cost,
+    );
+    reinsertion.run(
+        &mut bvh,
+        params.reinsertion_batch_ratio * params.post_collapse_reinsertion_batch_ratio_multiplier,
+        None,
     );
     (tris, bvh)
 }

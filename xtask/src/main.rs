@@ -60,6 +60,7 @@ mod fuzz;
 #[cfg(test)]
 mod tests;
 mod validate;
+mod web;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
@@ -118,6 +119,13 @@ enum Command {
         /// export by name).
         #[arg(long)]
         out: PathBuf,
+    },
+    /// Serve the live comparison page (ris, restir and strata in the browser on WebGPU):
+    /// builds its module for wasm32 and renders its reference first.
+    Web {
+        /// Stop after this many seconds (default: run until interrupted).
+        #[arg(long)]
+        seconds: Option<u64>,
     },
 }
 
@@ -212,6 +220,7 @@ fn execute(cli: Cli) -> Result<()> {
         Command::Check { full, kernel } => check(full, &kernel),
         Command::Validate => validate::validate(),
         Command::Fuzz(args) => fuzz::fuzz(args),
+        Command::Web { seconds } => web::web(seconds),
         Command::Export { out } => strata_export::export(&out)
             .map(|exported| {
                 println!("wrote the kernel package {} ({} files)", exported.folder.display(), exported.files.len())

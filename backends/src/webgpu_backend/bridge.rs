@@ -19,7 +19,7 @@ use std::net::TcpStream;
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-/// The page and its script, written for strata (this folder).
+/// The page and its scripts, written for strata (this folder).
 const PAGE_HTML: &str = include_str!("page.html");
 const PAGE_JS: &str = include_str!("page.js");
 
@@ -125,6 +125,9 @@ impl Routes {
             ("GET", Some("page.js")) => {
                 respond(&mut stream, "200 OK", "text/javascript; charset=utf-8", PAGE_JS.as_bytes())
             }
+            ("GET", Some("executor.js")) => {
+                respond(&mut stream, "200 OK", "text/javascript; charset=utf-8", super::EXECUTOR_JS.as_bytes())
+            }
             ("POST", Some("exchange")) => {
                 let _ = exchanges.send(Exchange { body: request.body, stream });
                 return;
@@ -205,7 +208,10 @@ pub(super) fn respond(stream: &mut TcpStream, status: &str, content_type: &str, 
     respond_with(stream, status, content_type, body, POLICY)
 }
 
-/// [`respond`] with the content security policy `policy`.
+/// [`respond`] with the content security policy `policy`. Every response also isolates
+/// its page from other origins (COOP and COEP): a page of these servers loads only their
+/// own files, and isolation is what lets the live comparison page's worker wait on
+/// shared memory (`SharedArrayBuffer`).
 pub(super) fn respond_with(
     stream: &mut TcpStream,
     status: &str,
@@ -216,6 +222,7 @@ pub(super) fn respond_with(
     let head = format!(
         "HTTP/1.1 {status}\r\nContent-Type: {content_type}\r\nContent-Length: {}\r\nCache-Control: no-store\r\n\
          Content-Security-Policy: {policy}\r\n\
+         Cross-Origin-Opener-Policy: same-origin\r\nCross-Origin-Embedder-Policy: require-corp\r\n\
          X-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n",
         body.len()
     );
@@ -224,29 +231,9 @@ pub(super) fn respond_with(
     stream.flush()
 }
 
-/// One message in the bridge's framing: a little-endian `u32` with the header's length,
-/// the JSON header, the payload.
-pub(super) fn frame(header: &serde_json::Value, payload: &[u8]) -> Vec<u8> {
-    let json = header.to_string().into_bytes();
-    let mut bytes = Vec::with_capacity(4 + json.len() + payload.len());
-    bytes.extend_from_slice(&(json.len() as u32).to_le_bytes());
-    bytes.extend_from_slice(&json);
-    bytes.extend_from_slice(payload);
-    bytes
-}
-
-/// A framed message's header and payload; the error says what is wrong with it.
-pub(super) fn unframe(bytes: &[u8]) -> Result<(serde_json::Value, &[u8]), String> {
-    let length = bytes.get(..4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
-    let Some(length) = length.filter(|&n| n <= bytes.len() - 4) else {
-        return Err(format!("a message of {} bytes has no whole header", bytes.len()));
-    };
-    let header = serde_json::from_slice(&bytes[4..4 + length]).map_err(|e| format!("its header is not JSON: {e}"))?;
-    Ok((header, &bytes[4 + length..]))
-}
-
 #[cfg(test)]
 mod tests {
+    use super::super::framing::{frame, unframe};
     use super::*;
 
     /// Sends `request` to the server and returns its whole response.
@@ -266,7 +253,10 @@ mod tests {
         let page = ask(&server, &format!("GET /{token}/ HTTP/1.1\r\nHost: {host}\r\n\r\n"));
         assert!(page.starts_with("HTTP/1.1 200 OK") && page.contains("page.js"), "{page}");
         let script = ask(&server, &format!("GET /{token}/page.js HTTP/1.1\r\nHost: {host}\r\n\r\n"));
-        assert!(script.starts_with("HTTP/1.1 200 OK") && script.contains("requestAdapter"), "{script}");
+        assert!(script.starts_with("HTTP/1.1 200 OK") && script.contains("executor.js"), "{script}");
+        let executor = ask(&server, &format!("GET /{token}/executor.js HTTP/1.1\r\nHost: {host}\r\n\r\n"));
+        assert!(executor.starts_with("HTTP/1.1 200 OK") && executor.contains("requestAdapter"), "{executor}");
+        assert!(executor.contains("Cross-Origin-Embedder-Policy: require-corp"), "{executor}");
         // Without the token, with another token, or through another name (a page of
         // some site whose name resolves to 127.0.0.1): nothing.
         for request in [

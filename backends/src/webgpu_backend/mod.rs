@@ -21,11 +21,25 @@
 //! page has a timeout, and a browser that exits ends the wait at once with the end of
 //! its log: a browser that never answers is an error, not a hang.
 
+#[cfg(not(target_arch = "wasm32"))]
 mod bridge;
+#[cfg(not(target_arch = "wasm32"))]
 mod browser;
+mod channel;
+mod framing;
+#[cfg(target_arch = "wasm32")]
+mod in_page;
+#[cfg(not(target_arch = "wasm32"))]
 mod loopback;
+#[cfg(not(target_arch = "wasm32"))]
 pub mod page_server;
 
+/// The script that runs the backend's messages on a `GPUDevice` (`executor.js`, an ES
+/// module exporting `run`, `frame` and `unframe`): the bridge's page imports it, and so
+/// does any page that holds the device for `WebGpuBackend::in_this_page` (wasm32).
+pub const EXECUTOR_JS: &str = include_str!("executor.js");
+
+#[cfg(not(target_arch = "wasm32"))]
 pub use browser::{BROWSER_REQUIRED_VARIABLE, Browser, CHROMIUM_VARIABLE, browser_required, find_chromium};
 
 use crate::backend::{Backend, Bind, BufferId, Resource};
@@ -35,7 +49,7 @@ use crate::bindings_check::{
 use crate::device_info::{DeviceInfo, DeviceLimits};
 use crate::error::BackendError;
 use crate::texture::{AddressMode, FilterMode, SamplerDesc, SamplerId, TextureDesc, TextureId};
-use bridge::{Server, WaitError};
+use channel::Channel;
 use serde_json::{Value, json};
 use std::collections::{HashMap, HashSet};
 use std::path::PathBuf;
@@ -130,11 +144,9 @@ pub struct WebGpuBackend {
     pipelines: HashSet<String>,
 }
 
-/// The page's side of the backend: the server, the browser, the queued operations.
+/// The page's side of the backend: the channel to it, the queued operations.
 struct Link {
-    // Dropped first: the page's request is answered (closed) before the browser goes.
-    server: Server,
-    browser: Browser,
+    channel: Box<dyn Channel>,
     ops: Vec<Value>,
     /// What each queued operation is, for its error.
     what: Vec<String>,
@@ -177,7 +189,7 @@ impl Link {
         let ops = std::mem::take(&mut self.ops);
         let what = std::mem::take(&mut self.what);
         let payload = std::mem::take(&mut self.payload);
-        let message = bridge::frame(&json!({ "ops": ops }), &payload);
+        let message = framing::frame(&json!({ "ops": ops }), &payload);
         drop(payload);
         let lost = |reason: String| PageError {
             kind: "lost".into(),
@@ -185,13 +197,10 @@ impl Link {
             what: what.last().cloned().unwrap_or_default(),
             location: None,
         };
-        if let Err(why) = self.server.send(&message, self.reply_timeout) {
-            return Err(lost(format!("{why}{}", self.browser.log_tail())));
-        }
+        let answer = self.channel.exchange(&message, self.reply_timeout).map_err(lost)?;
         drop(message);
-        let answer = self.wait(self.reply_timeout).map_err(lost)?;
         let (header, bytes) =
-            bridge::unframe(&answer).map_err(|e| lost(format!("the page's answer is broken: {e}")))?;
+            framing::unframe(&answer).map_err(|e| lost(format!("the page's answer is broken: {e}")))?;
         if let Some(message) = header.get("error").and_then(Value::as_str) {
             let index = header.get("op").and_then(Value::as_u64).unwrap_or(0) as usize;
             let location = header.get("line").and_then(Value::as_u64).map(|line| {
@@ -226,27 +235,6 @@ impl Link {
                     .ok_or_else(|| lost(format!("the page's answer has no bytes {start}+{length}")))
             })
             .collect()
-    }
-
-    /// The page's next message, or why none came within `timeout`.
-    fn wait(&mut self, timeout: Duration) -> Result<Vec<u8>, String> {
-        let browser = &mut self.browser;
-        match self.server.receive(timeout, &mut || browser.exited().map_or(Ok(()), Err)) {
-            Ok(body) => Ok(body),
-            Err(WaitError::Gone(why)) => Err(why),
-            Err(WaitError::Timeout) => Err(format!(
-                "no answer from the page in Chromium within {} s{}",
-                timeout.as_secs(),
-                self.browser.log_tail()
-            )),
-        }
-    }
-}
-
-impl Drop for Link {
-    fn drop(&mut self) {
-        // Tells the page to stop asking; the browser is killed right after anyway.
-        let _ = self.server.send(&bridge::frame(&json!({ "close": true }), &[]), Duration::from_secs(1));
     }
 }
 
@@ -336,6 +324,7 @@ impl WebGpuBackend {
     /// Starts headless Chromium on the bridge's page and opens its WebGPU device. A
     /// missing browser, a browser without WebGPU or without an adapter is
     /// [`BackendError::Unavailable`] or [`BackendError::NoAdapter`], saying which.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn new(options: WebGpuOptions) -> Result<Self, BackendError> {
         let unavailable = |why: String| BackendError::Unavailable {
             backend: NAME.into(),
@@ -347,26 +336,44 @@ impl WebGpuBackend {
             Some(path) => return Err(unavailable(format!("{}: no such browser", path.display()))),
             None => find_chromium().map_err(unavailable)?,
         };
-        let mut server = Server::start().map_err(unavailable)?;
-        let mut browser = Browser::launch(&binary, &server.url()).map_err(unavailable)?;
-        let ready = {
-            let browser = &mut browser;
-            server.receive(options.start_timeout, &mut || browser.exited().map_or(Ok(()), Err))
-        };
-        match ready {
+        let server = bridge::Server::start().map_err(unavailable)?;
+        let browser = Browser::launch(&binary, &server.url()).map_err(unavailable)?;
+        let mut channel = channel::BrowserChannel { server, browser };
+        match channel.wait(options.start_timeout) {
             Ok(_) => {}
-            Err(WaitError::Gone(why)) => return Err(unavailable(why)),
-            Err(WaitError::Timeout) => {
+            Err(bridge::WaitError::Gone(why)) => return Err(unavailable(why)),
+            Err(bridge::WaitError::Timeout) => {
                 return Err(unavailable(format!(
                     "the page did not load within {} s{}",
                     options.start_timeout.as_secs(),
-                    browser.log_tail()
+                    channel.browser.log_tail()
                 )));
             }
         }
+        let fallback_name = binary.display().to_string();
+        Self::open(Box::new(channel), &options, &fallback_name, unavailable)
+    }
+
+    /// Opens the WebGPU device of the page this module runs in (a web page's worker,
+    /// `web/page/` of the repository), as [`WebGpuBackend::new`] opens Chromium's.
+    /// Only `options.subgroups` and the timeouts apply.
+    #[cfg(target_arch = "wasm32")]
+    pub fn in_this_page(options: WebGpuOptions) -> Result<Self, BackendError> {
+        let unavailable =
+            |why: String| BackendError::Unavailable { backend: NAME.into(), what: "WebGPU in this page".into(), why };
+        Self::open(Box::new(in_page::PageChannel), &options, "this page", unavailable)
+    }
+
+    /// Opens the device of the page behind `channel` (`init`), which has loaded.
+    /// `fallback_name` names the browser where its user agent does not.
+    fn open(
+        channel: Box<dyn Channel>,
+        options: &WebGpuOptions,
+        fallback_name: &str,
+        unavailable: impl Fn(String) -> BackendError,
+    ) -> Result<Self, BackendError> {
         let mut link = Link {
-            server,
-            browser,
+            channel,
             ops: Vec::new(),
             what: Vec::new(),
             payload: Vec::new(),
@@ -387,7 +394,7 @@ impl WebGpuBackend {
         link.reply_timeout = options.reply_timeout;
         let device: Value = serde_json::from_slice(&header)
             .map_err(|e| unavailable(format!("the page's device description is not JSON: {e}")))?;
-        let info = device_info(&device, &binary);
+        let info = device_info(&device, fallback_name);
         let limit = |name: &str| device.get("limits").and_then(|l| l.get(name)).and_then(Value::as_u64).unwrap_or(0);
         let stage_limits = STAGE_LIMITS.iter().map(|&(what, name)| (what, name, limit(name))).collect();
         let swiftshader = device.get("architecture").and_then(Value::as_str) == Some("swiftshader");
@@ -587,7 +594,7 @@ fn convert(error: PageError, kernel: Option<(&Kernel, u64)>) -> BackendError {
 }
 
 /// The device the page opened, from its description (`init`'s answer).
-fn device_info(device: &Value, binary: &std::path::Path) -> DeviceInfo {
+fn device_info(device: &Value, fallback_name: &str) -> DeviceInfo {
     let text = |key: &str| device.get(key).and_then(Value::as_str).unwrap_or("").to_string();
     let limit = |name: &str| device.get("limits").and_then(|l| l.get(name)).and_then(Value::as_u64).unwrap_or(0);
     let limit32 = |name: &str| u32::try_from(limit(name)).unwrap_or(u32::MAX);
@@ -608,7 +615,7 @@ fn device_info(device: &Value, binary: &std::path::Path) -> DeviceInfo {
         .split_whitespace()
         .find(|word| word.starts_with("HeadlessChrome/") || word.starts_with("Chrome/"))
         .map(str::to_string)
-        .unwrap_or_else(|| binary.display().to_string());
+        .unwrap_or_else(|| fallback_name.to_string());
     DeviceInfo {
         backend: NAME.into(),
         adapter: if parts.is_empty() { "unnamed adapter".into() } else { parts.join(" ") },

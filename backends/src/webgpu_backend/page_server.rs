@@ -17,9 +17,10 @@ use std::net::TcpStream;
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-/// The pages' content security policy: same-origin scripts, fetches and frames (a test
-/// page may run another page of the package in a frame), inline styles.
-const POLICY: &str = "default-src 'none'; script-src 'self'; connect-src 'self'; frame-src 'self'; img-src 'self'; style-src 'self' 'unsafe-inline'";
+/// The pages' content security policy: same-origin scripts, workers, fetches and frames
+/// (a test page may run another page of the package in a frame), inline styles, and the
+/// compilation of same-origin WebAssembly (the live comparison page's module).
+const POLICY: &str = "default-src 'none'; script-src 'self' 'wasm-unsafe-eval'; worker-src 'self'; connect-src 'self'; frame-src 'self'; img-src 'self'; style-src 'self' 'unsafe-inline'";
 
 /// How long one read of a request may wait.
 const READ_TIMEOUT: Duration = Duration::from_secs(30);
@@ -36,6 +37,9 @@ fn content_type(path: &str) -> &'static str {
         Some("html") => "text/html; charset=utf-8",
         Some("js" | "mjs") => "text/javascript; charset=utf-8",
         Some("json") => "application/json",
+        Some("css") => "text/css; charset=utf-8",
+        // `WebAssembly.instantiateStreaming` takes nothing else.
+        Some("wasm") => "application/wasm",
         Some("ts") => "text/plain; charset=utf-8",
         _ => "application/octet-stream",
     }
@@ -93,7 +97,9 @@ fn handle(
         return;
     }
     let Ok(Some(request)) = read_request(&stream) else { return };
-    let path = if request.host == host { request.path.strip_prefix(prefix) } else { None };
+    // A page's query (`index.html?frames=12`) is the page's own business.
+    let path = request.path.split('?').next().unwrap_or_default();
+    let path = if request.host == host { path.strip_prefix(prefix) } else { None };
     let _ = match (request.method.as_str(), path) {
         ("GET", Some(path)) if files.contains_key(path) => {
             respond_with(&mut stream, "200 OK", content_type(path), &files[path], POLICY)

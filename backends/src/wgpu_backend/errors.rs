@@ -12,7 +12,9 @@ use std::sync::{Arc, Mutex};
 #[derive(Clone)]
 pub(super) struct ErrorSink {
     backend: String,
-    uncaptured: Arc<Mutex<Vec<wgpu::Error>>>,
+    /// Errors that escaped every scope, as (out of memory, message): kept as text, since
+    /// a `wgpu::Error` cannot cross threads on wasm32, where the handler must be `Send`.
+    uncaptured: Arc<Mutex<Vec<(bool, String)>>>,
     lost: Arc<Mutex<Option<String>>>,
 }
 
@@ -22,7 +24,7 @@ impl ErrorSink {
         let uncaptured = Arc::clone(&sink.uncaptured);
         device.on_uncaptured_error(Arc::new(move |error| {
             if let Ok(mut list) = uncaptured.lock() {
-                list.push(error);
+                list.push((matches!(error, wgpu::Error::OutOfMemory { .. }), error.to_string()));
             }
         }));
         let lost = Arc::clone(&sink.lost);
@@ -61,15 +63,15 @@ impl ErrorSink {
     }
 
     fn convert(&self, error: wgpu::Error, operation: &str) -> BackendError {
-        match error {
-            wgpu::Error::OutOfMemory { .. } => {
-                BackendError::OutOfMemory { backend: self.backend.clone(), operation: operation.into() }
-            }
-            other => BackendError::Validation {
-                backend: self.backend.clone(),
-                operation: operation.into(),
-                message: other.to_string(),
-            },
+        self.convert_escaped((matches!(error, wgpu::Error::OutOfMemory { .. }), error.to_string()), operation)
+    }
+
+    /// An error as the uncaptured-error handler keeps it: (out of memory, message).
+    fn convert_escaped(&self, (out_of_memory, message): (bool, String), operation: &str) -> BackendError {
+        if out_of_memory {
+            BackendError::OutOfMemory { backend: self.backend.clone(), operation: operation.into() }
+        } else {
+            BackendError::Validation { backend: self.backend.clone(), operation: operation.into(), message }
         }
     }
 }
@@ -93,7 +95,7 @@ impl Scope {
             return Err(self.sink.convert(error, operation));
         }
         if let Some(error) = self.sink.uncaptured.lock().ok().and_then(|mut list| list.pop()) {
-            return Err(self.sink.convert(error, operation));
+            return Err(self.sink.convert_escaped(error, operation));
         }
         self.sink.check_lost()
     }

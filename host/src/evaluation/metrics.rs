@@ -17,29 +17,7 @@
 
 use strata_render::rgb_image::RgbImage;
 
-/// Which per-pixel error a map or a mean is made of.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum Metric {
-    /// Squared error.
-    Mse,
-    /// (f − ref)² / (ref + 1e-4): the paper's RelMSE.
-    Relmse,
-    /// (f − ref)² / (ref² + 1e-2): the common RelMSE.
-    RelmseCommon,
-}
-
-impl Metric {
-    /// The error of one channel value `f` against the reference value `reference`.
-    pub fn of(self, f: f32, reference: f32) -> f64 {
-        let (f, r) = (f64::from(f), f64::from(reference));
-        let squared = (f - r) * (f - r);
-        match self {
-            Metric::Mse => squared,
-            Metric::Relmse => squared / (r + 1e-4),
-            Metric::RelmseCommon => squared / (r * r + 1e-2),
-        }
-    }
-}
+pub use strata_render::error_metric::Metric;
 
 /// Why two images cannot be compared.
 #[derive(Debug, thiserror::Error)]

@@ -5,10 +5,13 @@
 //! motion; [`strata_kernels::denoise_types::DenoiseGuide`]), which the ReSTIR renderer
 //! writes with [`crate::restir::RestirRenderer::enable_guides`].
 
+// Open Image Denoise is a native library opened at run time: not in a web page.
+#[cfg(not(target_arch = "wasm32"))]
 pub mod oidn;
 mod settings;
 mod svgf;
 
+#[cfg(not(target_arch = "wasm32"))]
 pub use oidn::{OidnDenoiser, OidnError, OidnLibrary};
 pub use settings::{Denoiser, SvgfSettings};
 pub use svgf::SvgfDenoiser;

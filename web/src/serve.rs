@@ -1,0 +1,66 @@
+//! Building the page's WebAssembly module and gathering the page's files: what `cargo
+//! xtask web` serves and what the page's test loads (native only).
+
+use crate::live::{LiveSettings, REFERENCE_SAMPLES, reference_bytes};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use strata_render::rgb_image::RgbImage;
+
+/// The target folder of the module's build, below the workspace's `target/`: a folder of
+/// its own, so that a build started while another cargo holds `target/` (the page's test
+/// runs inside `cargo test`) waits for nobody.
+pub const MODULE_TARGET_DIR: &str = "target/web";
+
+/// The command that builds the module, as [`build_module`] runs it in the workspace's
+/// root (CI runs the same one early, in the background). Debug build without debug info:
+/// it compiles in about a minute on two cores, and the page's host work is light (the
+/// frame's time is the GPU's).
+pub const BUILD_COMMAND: [&str; 10] = [
+    "rustc",
+    "--quiet",
+    "--package",
+    "strata-web",
+    "--target",
+    "wasm32-unknown-unknown",
+    "--crate-type",
+    "cdylib",
+    "--target-dir",
+    MODULE_TARGET_DIR,
+];
+
+/// Builds the module (cargo with [`BUILD_COMMAND`] in `workspace`, the repository's root)
+/// and returns its path. The error says what is missing: the wasm32 target first of all.
+pub fn build_module(workspace: &Path) -> Result<PathBuf, String> {
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let output = Command::new(&cargo)
+        .current_dir(workspace)
+        .args(BUILD_COMMAND)
+        .env("CARGO_PROFILE_DEV_DEBUG", "0")
+        .output()
+        .map_err(|e| format!("cannot run cargo ({}): {e}", Path::new(&cargo).display()))?;
+    if !output.status.success() {
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        if stderr.contains("wasm32-unknown-unknown") && stderr.contains("target may not be installed") {
+            return Err("the wasm32 target is not installed: rustup target add wasm32-unknown-unknown".into());
+        }
+        let last = stderr.lines().rfind(|l| l.starts_with("error")).unwrap_or("no message");
+        return Err(format!("building the page's module failed: {last}"));
+    }
+    let module = workspace.join(MODULE_TARGET_DIR).join("wasm32-unknown-unknown/debug/strata_web.wasm");
+    if module.is_file() { Ok(module) } else { Err(format!("{}: not built", module.display())) }
+}
+
+/// Every file of the page, by its path below the page's folder: the page's own
+/// ([`crate::PAGE_FILES`]), the executor, the module, the reference and `page.json`
+/// (the settings and the reference's samples).
+pub fn page_files(module: Vec<u8>, settings: &LiveSettings, reference: &RgbImage) -> Vec<(String, Vec<u8>)> {
+    let mut config = settings.to_json();
+    config["referenceSamples"] = REFERENCE_SAMPLES.into();
+    let mut files: Vec<(String, Vec<u8>)> =
+        crate::PAGE_FILES.iter().map(|(name, text)| (name.to_string(), text.as_bytes().to_vec())).collect();
+    files.push(("executor.js".into(), strata_backends::webgpu_backend::EXECUTOR_JS.as_bytes().to_vec()));
+    files.push(("strata_web.wasm".into(), module));
+    files.push(("reference.bin".into(), reference_bytes(reference)));
+    files.push(("page.json".into(), config.to_string().into_bytes()));
+    files
+}

@@ -444,8 +444,8 @@ const PAIRED_TEMPORAL_FRAMES: u32 = 3;
 /// orders at the defaults 0.12-0.20 (temporal-first) and 0.02-0.06 (spatial-first), the
 /// white film 0.09-0.17, the mirror-floor room with four drawn reservoirs 0.10-0.14; with
 /// four drawn reservoirs in the default room 0.48-0.57 over frames 3-8 (0.51-0.63 over
-/// 3-6). So a variant renders 3 frames where it rendered 6 (6 in the spatial-first order,
-/// whose history count keeps growing) and its bias (one restir lacks) is caught more
+/// 3-6). So a variant renders 3 frames where it rendered 6 (5 in the spatial-first order,
+/// whose history count keeps growing; 6 with four drawn reservoirs) and its bias (one restir lacks) is caught more
 /// finely; restir, held to the reference, catches a bias they share. In the
 /// glass/metal/environment room the difference spreads as much as the variant (0.7-1.7):
 /// no pairs there. (docs/benchmarks/ci-time.md, "Temporal pairs".)
@@ -532,10 +532,11 @@ fn paired_differences(
 }
 
 /// Without temporal reuse every method converges to the path tracer's image, shading the
-/// final resampling's expectation (the default) and the kept sample: restir against the
-/// reference over 8 renders of 64 frames, whose expectation (a conditional expectation of
-/// the sample's estimate) spreads less over frames, and strata, restir-disc and ris (plain
-/// per-pixel RIS, no reuse) paired with restir's expectation frame by frame
+/// final resampling's expectation (the default) and the kept sample: restir's expectation
+/// against the reference over 8 renders of 64 frames (a conditional expectation of the
+/// sample's estimate, it spreads less over frames than the sample: checked), and restir's
+/// sample, strata, restir-disc and ris (plain per-pixel RIS, no reuse) paired with
+/// restir's expectation frame by frame
 /// ([`assert_same_mean_with_power`]): until
 /// 2026-11-28 each method ran 8 × 64 frames against the reference, resolving 2.8 % where
 /// the pairs now resolve about 0.5 %.
@@ -637,7 +638,7 @@ fn restir_disc_stays_unbiased_for_any_disc_radius() {
 }
 
 /// With temporal reuse every method stays unbiased over independent renders with the
-/// reprojected previous reservoir alone (restir over frames 3 to 6, the others paired
+/// reprojected previous reservoir alone (restir over frames 3 to 5, the others paired
 /// with it on frame 3), then with four more drawn like
 /// spatial candidates (Fig. 11: strata from the temporal histogram, restir uniformly from
 /// the cluster, restir-disc from its disc): merging more history makes
@@ -728,7 +729,7 @@ fn temporal_reuse_stays_unbiased_with_drawn_reservoirs() {
 }
 
 /// Both orders of reuse stay unbiased for every method over independent renders (restir
-/// over frames 3 to 6 against the reference, the others paired with it). The
+/// over frames 3 to 5 against the reference, the others paired with it). The
 /// temporal-first order (the default: the history merged into each pixel's canonical
 /// candidate first, then K of the block's merged reservoirs reused under
 /// pairwise MIS with confidence weights) is what every other temporal test here runs;
@@ -756,7 +757,7 @@ fn reuse_order_stays_unbiased() {
             ..RestirSettings::default()
         };
         // In the spatial-first order the merged M grows by one a frame (1 + min(M, 20)), so
-        // its variants are scored over frames 3 to 6 as restir is, each frame's merge with
+        // its variants are scored over frames 3 to 5 as restir is, each frame's merge with
         // another history count; the temporal-first order's cap binds from frame 3.
         let frames =
             if reuse_order == ReuseOrder::SpatialFirst { BASE_TEMPORAL_FRAMES } else { PAIRED_TEMPORAL_FRAMES };

@@ -1,19 +1,21 @@
 //! The live comparison page (issue 60, `web/`) as a person opens it: its WebAssembly
 //! module built for wasm32 (strata's renderer, on the browser's WebGPU through
 //! `WebGpuBackend::in_this_page`), served over loopback with its reference, loaded in
-//! headless Chromium. The page renders ris, restir and strata for [`FRAMES`] frames, the
-//! SVGF denoiser on from frame [`DENOISE_FROM`], and posts what it showed: every image
-//! must have more than one value, every score must be finite, and its strata ÷ restir
-//! ratios (raw, and after the denoiser) must lie within the spread of the same
-//! comparison run natively on lavapipe from [`NATIVE_SEEDS`] seeds (the page's seed among
-//! them): the page computes what `strata-web`'s native run computes.
+//! headless Chromium, [`FRAMES`] frames.
 //!
-//! On a device whose WebGPU allows fewer storage buffers per shader stage than the ReSTIR
-//! kernels bind (Chrome exposes 10; `restir_candidates` binds 11, `restir_temporal` 16:
-//! docs/kernels.md), the page cannot render; it must then say so in one line naming the
-//! kernel and the limit, having got that far through every other part of its route (the
-//! module, the worker's channel, the executor, the device, the scene, the kernels'
-//! checks). The test checks that line instead, and the rest as soon as a device allows.
+//! Where the browser's device runs the ReSTIR kernels, the page renders ris, restir and
+//! strata, the SVGF denoiser on from frame [`DENOISE_FROM`], and posts what it showed:
+//! every image must have more than one value, every score must be finite, and its
+//! strata ÷ restir ratios (raw, and after the denoiser) must lie within the spread of the
+//! same comparison run natively on lavapipe from [`NATIVE_SEEDS`] seeds (the page's seed
+//! among them): the page computes what `strata-web`'s native run computes.
+//!
+//! Where it does not (Chrome allows 10 storage buffers per shader stage; the ReSTIR
+//! kernels bind 11 to 16: docs/web.md), the page must say why in one line naming the
+//! kernel and the limit, and show the path tracer converging instead: its image must have
+//! more than one value, its RelMSE must fall with the samples, and its last one must be
+//! the native path tracer's from the same seed within 2 %. The native
+//! comparison runs in both cases (the page's own code, `LiveComparison`, checked natively).
 //!
 //! Without Chromium or the wasm32 target the test says so and passes, unless
 //! `STRATA_REQUIRE_BROWSER=1` (CI) makes that a failure; without Vulkan likewise unless
@@ -23,7 +25,7 @@ use std::path::Path;
 use std::time::Duration;
 use strata_backends::webgpu_backend::page_server::PageServer;
 use strata_backends::webgpu_backend::{Browser, browser_required, find_chromium};
-use strata_web::live::{LiveComparison, LiveSettings};
+use strata_web::live::{LiveComparison, LivePathTracer, LiveSettings};
 use strata_web::serve::{build_module, page_files};
 
 /// Frames the page renders.
@@ -31,7 +33,7 @@ const FRAMES: u32 = 12;
 /// The first frame with the denoiser on.
 const DENOISE_FROM: u32 = 7;
 /// The native runs' seeds; the page runs the first.
-const NATIVE_SEEDS: std::ops::Range<u32> = 1..9;
+const NATIVE_SEEDS: std::ops::Range<u32> = 1..7;
 
 /// strata ÷ restir (raw, denoised) of one native run of the page's comparison from `seed`.
 fn native_ratios(
@@ -60,8 +62,8 @@ fn spread(values: &[f64]) -> (f64, f64) {
 }
 
 #[test]
-fn the_live_page_runs_as_natively_or_names_the_limit_that_stops_it() {
-    let test = "the_live_page_runs_as_natively_or_names_the_limit_that_stops_it";
+fn the_live_page_runs_as_natively_or_says_why_and_path_traces() {
+    let test = "the_live_page_runs_as_natively_or_says_why_and_path_traces";
     let chromium = match find_chromium() {
         Ok(chromium) => chromium,
         Err(error) => {
@@ -97,20 +99,36 @@ fn the_live_page_runs_as_natively_or_names_the_limit_that_stops_it() {
         .receive(Duration::from_secs(300), &mut || browser.exited().map_or(Ok(()), Err))
         .unwrap_or_else(|e| panic!("{e}{}", browser.log_tail()));
     let body: serde_json::Value = serde_json::from_slice(&body).unwrap();
-    let message = body["message"].as_str().unwrap_or_default();
-    if name == "error" && message.contains("storage buffers per stage") {
-        assert!(
-            message.starts_with("kernel `restir_") && message.contains("but the device allows at most"),
-            "the page's refusal does not name the kernel and the limit: {message}"
-        );
-        eprintln!("note: {test}: the page reached the device, which cannot run the ReSTIR kernels: {message}");
-        return;
-    }
     assert_eq!(name, "result", "the page failed: {body}{}", browser.log_tail());
     drop(browser);
-
     let scores = &body["scores"];
     assert_eq!(scores["frame"], FRAMES, "{body}");
+
+    if body["mode"] == "path-tracer" {
+        let why = body["unavailable"].as_str().unwrap_or_default();
+        assert!(
+            why.starts_with("kernel `restir_") && why.contains("but the device allows at most"),
+            "the page's reason for the path tracer does not name the kernel and the limit: {body}"
+        );
+        assert_eq!(body["varied"], serde_json::json!([true]), "a blank or flat image: {body}");
+        let errors: Vec<f64> =
+            body["relmse"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap_or(f64::NAN)).collect();
+        assert_eq!(errors.len(), FRAMES as usize, "{body}");
+        assert!(errors.iter().all(|e| e.is_finite() && *e > 0.0), "{errors:?}");
+        assert!(errors[errors.len() - 1] < 0.5 * errors[0], "the path tracer does not converge: {errors:?}");
+        let mut tracer = LivePathTracer::new(&mut backend, settings, reference.clone()).unwrap();
+        let native = (0..FRAMES).map(|_| tracer.frame(&mut backend).unwrap().relmse).last().unwrap();
+        tracer.destroy(&mut backend).unwrap();
+        let page = errors[errors.len() - 1];
+        eprintln!(
+            "note: {test}: {why}; the path tracer at {FRAMES} samples: RelMSE {page:.4e} in the page, {native:.4e} natively"
+        );
+        // The same kernel from the same seed on another compiler and device: measured
+        // 0.02 % apart (4.9977e-3 against 4.9985e-3, Chromium 156 on SwiftShader).
+        assert!((page / native - 1.0).abs() < 0.02, "the path tracer's RelMSE: {page} in the page, {native} natively");
+        return;
+    }
+    assert_eq!(body["mode"], "comparison", "{body}");
     assert_eq!(body["varied"], serde_json::json!([true, true, true]), "a blank or flat image: {body}");
     assert_eq!(body["checkbox"], true, "the denoiser's checkbox does not show it on: {body}");
     for method in scores["methods"].as_array().unwrap() {

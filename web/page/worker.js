@@ -9,13 +9,17 @@
 
 const NO_ANSWER = 0xFFFFFFFF;
 let exports = null;
-let control = null; // Int32Array: [0] 0 waiting, 1 answered, 2 failed; [1] the answer's length
+// Int32Array: [0] 0 waiting, 1 answered, 2 the page failed; [1] the answer's length;
+// [2] the exchange it answers (an answer to an earlier one, which timed out, is not taken).
+let control = null;
+let exchanges = 0;
 let answers = null; // SharedArrayBuffer (growable) holding the answer
 let denoise = false;
 let paused = false;
 let lastFrame = 0;
 let maxFrames = 0;
 let denoiseFrom = 0;
+let queued = false;
 
 const decoder = new TextDecoder();
 
@@ -24,22 +28,26 @@ function memory() {
 }
 
 function report() {
-  const bytes = new Uint8Array(memory(), exports.strata_web_report_ptr(), exports.strata_web_report_len());
+  const bytes = new Uint8Array(memory(), exports.strata_web_report_ptr() >>> 0, exports.strata_web_report_len() >>> 0);
   return JSON.parse(decoder.decode(bytes));
 }
 
 const imports = {
   strata_webgpu: {
     exchange(pointer, length, timeoutMs) {
-      const message = new Uint8Array(memory(), pointer, length).slice();
+      // Addresses and lengths arrive as signed 32-bit numbers: `>>> 0` reads them unsigned.
+      const message = new Uint8Array(memory(), pointer >>> 0, length >>> 0).slice();
+      const id = ++exchanges;
       Atomics.store(control, 0, 0);
-      postMessage({ kind: 'exchange', message }, [message.buffer]);
-      const outcome = Atomics.wait(control, 0, 0, timeoutMs);
-      if (outcome === 'timed-out' || Atomics.load(control, 0) !== 1) return NO_ANSWER;
+      postMessage({ kind: 'exchange', message, id }, [message.buffer]);
+      const outcome = Atomics.wait(control, 0, 0, timeoutMs >>> 0);
+      if (outcome === 'timed-out' || Atomics.load(control, 0) !== 1 || Atomics.load(control, 2) !== id) {
+        return NO_ANSWER;
+      }
       return Atomics.load(control, 1);
     },
     take_answer(pointer, length) {
-      new Uint8Array(memory(), pointer, length).set(new Uint8Array(answers, 0, length));
+      new Uint8Array(memory(), pointer >>> 0, length >>> 0).set(new Uint8Array(answers, 0, length >>> 0));
     },
   },
 };
@@ -69,9 +77,14 @@ function step() {
     return;
   }
   lastFrame = scores.frame;
-  const images = new Uint8Array(memory(), exports.strata_web_images_ptr(), exports.strata_web_images_len()).slice();
+  const images =
+    new Uint8Array(memory(), exports.strata_web_images_ptr() >>> 0, exports.strata_web_images_len() >>> 0).slice();
   postMessage({ kind: 'frame', scores, images }, [images.buffer]);
-  setTimeout(step, 0);
+  queued = true;
+  setTimeout(() => {
+    queued = false;
+    step();
+  }, 0);
 }
 
 async function start(message) {
@@ -84,7 +97,7 @@ async function start(message) {
   const response = await fetch('reference.bin');
   if (!response.ok) throw new Error(`reference.bin: HTTP ${response.status}`);
   const reference = new Uint8Array(await response.arrayBuffer());
-  const inbox = exports.strata_web_inbox(reference.length);
+  const inbox = exports.strata_web_inbox(reference.length) >>> 0;
   new Uint8Array(memory(), inbox, reference.length).set(reference);
   let failed;
   try {
@@ -110,6 +123,7 @@ onmessage = (event) => {
   } else if (message.kind === 'pause') {
     const resume = paused && !message.on;
     paused = message.on;
-    if (resume) step();
+    // A step still queued (paused and resumed within one frame) carries on by itself.
+    if (resume && !queued) step();
   }
 };

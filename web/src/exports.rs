@@ -6,14 +6,22 @@
 //! the inbox: `strata_web_inbox(length)` gives the address of `length` bytes it fills
 //! before `strata_web_start`. No function takes a raw pointer from the page.
 
-use crate::live::{LiveComparison, LiveSettings, reference_from_bytes};
+use crate::live::{LiveComparison, LivePathTracer, LiveSettings, reference_from_bytes};
 use std::cell::RefCell;
-use strata_backends::{WebGpuBackend, WebGpuOptions};
+use strata_backends::{BackendError, WebGpuBackend, WebGpuOptions};
+use strata_render::histogram_pass::PassError;
 
-/// The running comparison and the device it runs on.
+/// What the page runs: the comparison, or where the device cannot run the ReSTIR
+/// kernels the path tracer ([`LivePathTracer`]).
+enum Shown {
+    Comparison(LiveComparison),
+    PathTracer(Box<LivePathTracer>),
+}
+
+/// What the page runs and the device it runs on.
 struct Page {
     backend: WebGpuBackend,
-    live: LiveComparison,
+    shown: Shown,
 }
 
 thread_local! {
@@ -41,7 +49,16 @@ fn report_panics() {
     std::panic::set_hook(Box::new(|info| {
         let _ = REPORT.try_with(|r| {
             if let Ok(mut r) = r.try_borrow_mut() {
-                *r = serde_json::json!({ "error": format!("the module panicked: {info}") }).to_string().into_bytes();
+                // One line: the panic's place and message (its Display puts a newline between).
+                let place = info.location().map(|l| format!("{}:{}", l.file(), l.line())).unwrap_or_default();
+                let payload = info.payload();
+                let message = payload
+                    .downcast_ref::<&str>()
+                    .copied()
+                    .or_else(|| payload.downcast_ref::<String>().map(String::as_str))
+                    .unwrap_or("(no message)");
+                let text = format!("the module panicked at {place}: {message}").replace('\n', " ");
+                *r = serde_json::json!({ "error": text }).to_string().into_bytes();
             }
         });
     }));
@@ -62,7 +79,9 @@ pub extern "C" fn strata_web_inbox(length: u32) -> *mut u8 {
 
 /// Opens the page's WebGPU device and starts the comparison at `width` × `height` from
 /// `seed`, scored against the reference in the inbox ([`crate::live::reference_bytes`]).
-/// The report then holds the device (`{"adapter", "driver"}`).
+/// Where the device's limits refuse a ReSTIR kernel, the path tracer starts instead. The
+/// report then holds the device and, in that case, why (`{"adapter", "driver",
+/// "unavailable"}`, the last `null` when the comparison runs).
 #[unsafe(no_mangle)]
 pub extern "C" fn strata_web_start(width: u32, height: u32, seed: u32) -> u32 {
     let settings = LiveSettings { width, height, seed };
@@ -75,32 +94,43 @@ pub extern "C" fn strata_web_start(width: u32, height: u32, seed: u32) -> u32 {
         Ok(backend) => backend,
         Err(error) => return fail(error),
     };
-    let live = match LiveComparison::new(&mut backend, settings, reference) {
-        Ok(live) => live,
+    let (shown, unavailable) = match LiveComparison::new(&mut backend, settings, reference.clone()) {
+        Ok(live) => (Shown::Comparison(live), None),
+        Err(error @ PassError::Backend(BackendError::LimitExceeded { .. })) => {
+            match LivePathTracer::new(&mut backend, settings, reference) {
+                Ok(tracer) => (Shown::PathTracer(Box::new(tracer)), Some(error.to_string())),
+                Err(fallback) => return fail(format!("{error}; and the path tracer: {fallback}")),
+            }
+        }
         Err(error) => return fail(error),
     };
     let info = strata_backends::Backend::info(&backend).clone();
-    PAGE.with(|page| *page.borrow_mut() = Some(Page { backend, live }));
-    report(serde_json::json!({ "adapter": info.adapter, "driver": info.driver }))
+    PAGE.with(|page| *page.borrow_mut() = Some(Page { backend, shown }));
+    report(serde_json::json!({ "adapter": info.adapter, "driver": info.driver, "unavailable": unavailable }))
 }
 
 /// Renders the next frame of every method, with the denoiser on when `denoise` is not
 /// 0. The report holds the scores ([`crate::live::LiveFrame::to_json`]), the images
-/// (`strata_web_images_ptr` / `_len`) the shown images.
+/// (`strata_web_images_ptr` / `_len`) the shown images; for the path tracer its sample
+/// and its image ([`crate::live::PathTracerFrame`]; `denoise` does not apply).
 #[unsafe(no_mangle)]
 pub extern "C" fn strata_web_frame(denoise: u32) -> u32 {
     PAGE.with(|page| {
         let mut page = page.borrow_mut();
-        let Some(Page { backend, live }) = page.as_mut() else {
+        let Some(Page { backend, shown }) = page.as_mut() else {
             return fail("strata_web_start has not succeeded");
         };
-        if let Err(error) = live.set_denoiser(backend, denoise != 0) {
-            return fail(error);
-        }
-        match live.frame(backend) {
-            Ok(frame) => {
-                IMAGES.with(|images| *images.borrow_mut() = frame.rgba8());
-                report(frame.to_json())
+        let frame = match shown {
+            Shown::Comparison(live) => live
+                .set_denoiser(backend, denoise != 0)
+                .and_then(|()| live.frame(backend))
+                .map(|frame| (frame.to_json(), frame.rgba8())),
+            Shown::PathTracer(tracer) => tracer.frame(backend).map(|frame| (frame.to_json(), frame.rgba8())),
+        };
+        match frame {
+            Ok((scores, rgba)) => {
+                IMAGES.with(|images| *images.borrow_mut() = rgba);
+                report(scores)
             }
             Err(error) => fail(error),
         }

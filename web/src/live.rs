@@ -12,7 +12,7 @@ use strata_backends::backend::download;
 use strata_render::denoise::{SvgfDenoiser, SvgfSettings};
 use strata_render::error_metric::Metric;
 use strata_render::histogram_pass::PassError;
-use strata_render::render::{GpuScene, RenderSettings};
+use strata_render::render::{GpuScene, PathTracer, RenderSettings};
 use strata_render::restir::{Method, RestirRenderer, RestirSettings};
 use strata_render::rgb_image::{RgbImage, linear_to_srgb8};
 use strata_render::scene::{Scene, default_scene};
@@ -26,6 +26,7 @@ pub const REFERENCE_SAMPLES: u32 = 1024;
 
 /// The reference's seed: apart from every method's seed, so that its noise is
 /// independent of theirs.
+#[cfg(not(target_arch = "wasm32"))]
 const REFERENCE_SEED: u32 = 1_000_000;
 
 /// What the page runs.
@@ -47,7 +48,21 @@ impl Default for LiveSettings {
     }
 }
 
+/// The largest width or height the page renders: a page's comparison, not a benchmark
+/// (and its byte counts stay far inside a 32-bit `usize`).
+pub const MAX_SIZE: u32 = 1024;
+
 impl LiveSettings {
+    /// The size is 1 to [`MAX_SIZE`] pixels each way; the error names the value.
+    pub fn check(&self) -> Result<(), String> {
+        for (name, value) in [("width", self.width), ("height", self.height)] {
+            if !(1..=MAX_SIZE).contains(&value) {
+                return Err(format!("{name} {value}: the page renders 1 to {MAX_SIZE} pixels"));
+            }
+        }
+        Ok(())
+    }
+
     /// The settings as the page's `page.json` states them.
     pub fn to_json(&self) -> serde_json::Value {
         serde_json::json!({ "width": self.width, "height": self.height, "seed": self.seed })
@@ -59,7 +74,9 @@ impl LiveSettings {
 }
 
 /// The reference image the page is scored against: the path tracer at
-/// [`REFERENCE_SAMPLES`] samples per pixel, from a seed of its own.
+/// [`REFERENCE_SAMPLES`] samples per pixel, from a seed of its own. (Rendered where the
+/// page is served, not in it.)
+#[cfg(not(target_arch = "wasm32"))]
 pub fn reference(backend: &mut dyn Backend, settings: &LiveSettings) -> Result<RgbImage, PassError> {
     let scene = default_scene();
     let gpu_scene = GpuScene::build(&scene)?;
@@ -75,6 +92,7 @@ pub fn reference_bytes(reference: &RgbImage) -> Vec<u8> {
 
 /// [`reference_bytes`] read back; the error names what is wrong with them.
 pub fn reference_from_bytes(settings: &LiveSettings, bytes: &[u8]) -> Result<RgbImage, String> {
+    settings.check()?;
     let pixels = settings.width as usize * settings.height as usize;
     if bytes.len() != pixels * 12 {
         return Err(format!(
@@ -200,6 +218,7 @@ impl LiveComparison {
     /// Uploads the scene and creates each method's renderer; `reference` must be the
     /// settings' size.
     pub fn new(backend: &mut dyn Backend, settings: LiveSettings, reference: RgbImage) -> Result<Self, PassError> {
+        settings.check().map_err(PassError::Input)?;
         if (reference.width, reference.height) != (settings.width, settings.height) {
             return Err(PassError::Input(format!(
                 "the reference is {}x{}, the page renders {}x{}",
@@ -307,5 +326,76 @@ impl LiveComparison {
             }
         }
         Ok(())
+    }
+}
+
+/// What the page shows where the device cannot run the ReSTIR kernels (a browser's WebGPU
+/// allows fewer storage buffers per shader stage than they bind: docs/web.md): the path
+/// tracer converging, one sample per pixel a frame, scored against the same reference.
+/// It runs the page's whole route (the scene's upload, dispatches, read-backs) on the
+/// browser's device, and says plainly that ReSTIR is not what is shown.
+pub struct LivePathTracer {
+    tracer: PathTracer,
+    reference: RgbImage,
+}
+
+/// One frame of [`LivePathTracer`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct PathTracerFrame {
+    /// Samples per pixel so far (one a frame).
+    pub samples: u32,
+    /// The RelMSE of their mean against the reference.
+    pub relmse: f64,
+    /// Their mean.
+    pub image: RgbImage,
+}
+
+impl PathTracerFrame {
+    /// The frame's score as the page reads it (no image).
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({ "frame": self.samples, "pathTracer": { "samples": self.samples, "relmse": self.relmse } })
+    }
+
+    /// The image as 8-bit sRGB RGBA (alpha 255).
+    pub fn rgba8(&self) -> Vec<u8> {
+        self.image
+            .pixels
+            .iter()
+            .flat_map(|p| [linear_to_srgb8(p[0]), linear_to_srgb8(p[1]), linear_to_srgb8(p[2]), 255])
+            .collect()
+    }
+}
+
+impl LivePathTracer {
+    /// Uploads the scene for the path tracer at the settings' size and seed; `reference`
+    /// must be that size.
+    pub fn new(backend: &mut dyn Backend, settings: LiveSettings, reference: RgbImage) -> Result<Self, PassError> {
+        settings.check().map_err(PassError::Input)?;
+        if (reference.width, reference.height) != (settings.width, settings.height) {
+            return Err(PassError::Input(format!(
+                "the reference is {}x{}, the page renders {}x{}",
+                reference.width, reference.height, settings.width, settings.height
+            )));
+        }
+        let scene = default_scene();
+        let gpu_scene = GpuScene::build(&scene)?;
+        let tracer = PathTracer::new(backend, &gpu_scene, &settings.render(&scene, settings.seed))?;
+        Ok(Self { tracer, reference })
+    }
+
+    /// Adds one sample per pixel and scores the mean so far.
+    pub fn frame(&mut self, backend: &mut dyn Backend) -> Result<PathTracerFrame, PassError> {
+        self.tracer.add_sample(backend)?;
+        let image = self.tracer.image(backend)?;
+        let samples = self.tracer.samples();
+        let relmse = Metric::Relmse.mean(&image, &self.reference).ok_or_else(|| {
+            PassError::Input(format!("the path tracer at {samples} samples: no RelMSE (a pixel is not finite)"))
+        })?;
+        Ok(PathTracerFrame { samples, relmse, image })
+    }
+
+    /// Frees every buffer.
+    pub fn destroy(self, backend: &mut dyn Backend) -> Result<(), PassError> {
+        Ok(self.tracer.destroy(backend)?)
     }
 }

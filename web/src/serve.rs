@@ -43,8 +43,9 @@ pub fn build_module(workspace: &Path) -> Result<PathBuf, String> {
         if stderr.contains("wasm32-unknown-unknown") && stderr.contains("target may not be installed") {
             return Err("the wasm32 target is not installed: rustup target add wasm32-unknown-unknown".into());
         }
-        let last = stderr.lines().rfind(|l| l.starts_with("error")).unwrap_or("no message");
-        return Err(format!("building the page's module failed: {last}"));
+        // The first error is the cause; the last is cargo's "could not compile".
+        let first = stderr.lines().find(|l| l.starts_with("error")).unwrap_or("no message");
+        return Err(format!("building the page's module failed: {first}"));
     }
     let module = workspace.join(MODULE_TARGET_DIR).join("wasm32-unknown-unknown/debug/strata_web.wasm");
     if module.is_file() { Ok(module) } else { Err(format!("{}: not built", module.display())) }

@@ -2,7 +2,8 @@
 //!
 //! It listens on `127.0.0.1` at a port the system picks, and answers only requests whose
 //! path starts with a random 128-bit token (from the operating system's generator) and
-//! whose `Host` is that address: the page (`/TOKEN/`), its script (`/TOKEN/page.js`) and
+//! whose `Host` is that address: the page (`/TOKEN/`), its scripts (`/TOKEN/page.js`,
+//! `/TOKEN/executor.js`) and
 //! the exchange (`POST /TOKEN/exchange`). Anything else gets a 404 and is forgotten. Every
 //! response closes its connection.
 //!

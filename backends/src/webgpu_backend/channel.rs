@@ -4,8 +4,9 @@
 
 use std::time::Duration;
 
-/// One framed message to the page and its framed answer ([`super::framing`]).
-pub(super) trait Channel {
+/// One framed message to the page and its framed answer ([`super::framing`]). `Send`, so
+/// that the backend can move to another thread as it could before channels.
+pub(super) trait Channel: Send {
     /// Sends `message` and waits up to `timeout` for the page's answer; the error says
     /// why none came.
     fn exchange(&mut self, message: &[u8], timeout: Duration) -> Result<Vec<u8>, String>;

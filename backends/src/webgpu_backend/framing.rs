@@ -2,7 +2,7 @@
 //! it travels (the loopback bridge natively, the worker's channel in a web page): a
 //! little-endian `u32` with the length of a JSON header, the header, then raw bytes
 //! (buffer and texture contents, WGSL) that the header points into as `[offset, length]`
-//! pairs. `page.js` reads and writes the same.
+//! pairs. `executor.js` reads and writes the same.
 
 /// One message in the bridge's framing: a little-endian `u32` with the header's length,
 /// the JSON header, the payload.

@@ -1,12 +1,12 @@
 //! The WebGPU backend inside a web page (wasm32): the page that loaded this module holds
 //! the device, and [`PageChannel`] hands it each framed message through two functions
 //! the page imports into the module (module `strata_webgpu`), which run the message
-//! with the same executor as the bridge's page (`page.js`).
+//! with the same executor as the bridge's page (`executor.js`).
 //!
 //! The calls are synchronous, as [`crate::Backend`] is, so the module must run in a
 //! worker that may block: `exchange` posts the message to the page's thread and waits
 //! (`Atomics.wait`) until the answer is in shared memory; `take_answer` copies it in.
-//! The page's side is `web/page/worker.js` and `web/page/gpu.js` of the repository.
+//! The page's side is `web/page/worker.js` and `web/page/main.js` of the repository.
 
 use super::channel::Channel;
 use std::time::Duration;

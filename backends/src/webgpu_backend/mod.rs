@@ -3,9 +3,10 @@
 //! headless tab.
 //!
 //! [`WebGpuBackend::new`] starts a loopback server (`bridge`) and headless Chromium on its
-//! page (`browser`); the page (`page.js`, written for strata) opens the adapter and the
-//! device, and from then on every call of the [`Backend`] trait is a message the page
-//! runs and answers: buffers, textures and samplers created, written, read and
+//! page (`browser`); the page (`page.js` with `executor.js`, written for strata) opens the
+//! adapter and the device, and from then on every call of the [`Backend`] trait is a
+//! message the page runs and answers (in a web page, wasm32, the page the module runs in
+//! does the same: `in_page.rs`): buffers, textures and samplers created, written, read and
 //! destroyed, pipelines created from the kernel's own WGSL ([`Kernel::source`], with
 //! `enable subgroups;` put first for a kernel that uses them) and the bind group layouts
 //! the wgpu backend builds ([`crate::wgpu_backend::layout_entries`]), dispatches.

@@ -4,10 +4,10 @@
 //!
 //! Like the WebGPU backend's bridge, it listens on `127.0.0.1` at a port the system picks
 //! and answers only requests whose `Host` is that address and whose path starts with a
-//! random 128-bit token: `GET /TOKEN/PATH` for one of its files, `POST /TOKEN/post/NAME`
-//! for a result (answered at once with an empty 200). Anything else gets a 404. Its
-//! content security policy lets a page run only the server's own scripts, fetches and
-//! frames. Files
+//! random 128-bit token: `GET /TOKEN/PATH` for one of its files (a query string is
+//! ignored), `POST /TOKEN/post/NAME` for a result (answered at once with an empty 200).
+//! Anything else gets a 404. Its content security policy lets a page run only the
+//! server's own scripts, workers, fetches and frames, and compile WebAssembly. Files
 //! are served from memory only, so no path the page asks for reaches the file system.
 
 use super::bridge::{read_request, respond_with};
@@ -63,17 +63,18 @@ impl PageServer {
         self.acceptor.route().url(path)
     }
 
-    /// Waits up to `timeout` for the page's next post, asking `alive` every 100 ms whether
-    /// the page can still post (an error ends the wait with it); returns the post's `NAME`
-    /// and body.
+    /// Waits up to `timeout` for the page's next post (`Duration::MAX`: without end),
+    /// asking `alive` every 100 ms whether the page can still post (an error ends the wait
+    /// with it); returns the post's `NAME` and body.
     pub fn receive(
         &self,
         timeout: Duration,
         alive: &mut dyn FnMut() -> Result<(), String>,
     ) -> Result<(String, Vec<u8>), String> {
-        let deadline = Instant::now() + timeout;
+        // A timeout past what the clock can hold (Duration::MAX) waits without end.
+        let deadline = Instant::now().checked_add(timeout);
         loop {
-            let left = deadline.saturating_duration_since(Instant::now());
+            let left = deadline.map_or(Duration::MAX, |d| d.saturating_duration_since(Instant::now()));
             if left.is_zero() {
                 return Err(format!("the page posted nothing within {} s", timeout.as_secs()));
             }

@@ -77,10 +77,11 @@ pub fn error_map(image: &RgbImage, reference: &RgbImage, metric: Metric) -> Resu
         .collect())
 }
 
-/// The mean of [`error_map`].
+/// The mean of [`error_map`] ([`Metric::mean`], once the images' sizes and values have
+/// been checked: the error names what is wrong with them).
 pub fn mean_error(image: &RgbImage, reference: &RgbImage, metric: Metric) -> Result<f64, MetricError> {
-    let map = error_map(image, reference, metric)?;
-    Ok(map.iter().sum::<f64>() / map.len() as f64)
+    check(image, reference)?;
+    metric.mean(image, reference).ok_or(MetricError::Empty)
 }
 
 /// Mean squared error.

@@ -14,8 +14,9 @@ pub const MODULE_TARGET_DIR: &str = "target/web";
 /// The command that builds the module, as [`build_module`] runs it in the workspace's
 /// root (CI runs the same one early, in the background). Debug build without debug info:
 /// it compiles in about a minute on two cores, and the page's host work is light (the
-/// frame's time is the GPU's).
-pub const BUILD_COMMAND: [&str; 10] = [
+/// frame's time is the GPU's). Warnings in strata-web are errors here: its wasm32-only
+/// code is outside the workspace's (native) clippy step.
+pub const BUILD_COMMAND: [&str; 13] = [
     "rustc",
     "--quiet",
     "--package",
@@ -26,6 +27,9 @@ pub const BUILD_COMMAND: [&str; 10] = [
     "cdylib",
     "--target-dir",
     MODULE_TARGET_DIR,
+    "--",
+    "-D",
+    "warnings",
 ];
 
 /// Builds the module (cargo with [`BUILD_COMMAND`] in `workspace`, the repository's root)

@@ -111,6 +111,26 @@ pub fn reference_from_bytes(settings: &LiveSettings, bytes: &[u8]) -> Result<Rgb
     Ok(RgbImage { width: settings.width, height: settings.height, pixels })
 }
 
+/// The built-in scene and its GPU form, once `settings` and `reference` have been checked
+/// (the size in range, the reference that size).
+fn scene_for(settings: &LiveSettings, reference: &RgbImage) -> Result<(Scene, GpuScene), PassError> {
+    settings.check().map_err(PassError::Input)?;
+    if (reference.width, reference.height) != (settings.width, settings.height) {
+        return Err(PassError::Input(format!(
+            "the reference is {}x{}, the page renders {}x{}",
+            reference.width, reference.height, settings.width, settings.height
+        )));
+    }
+    let scene = default_scene();
+    let gpu_scene = GpuScene::build(&scene)?;
+    Ok((scene, gpu_scene))
+}
+
+/// `image` as the page's canvases draw it: 8-bit sRGB RGBA, alpha 255.
+fn rgba8(image: &RgbImage) -> impl Iterator<Item = u8> + '_ {
+    image.pixels.iter().flat_map(|p| [linear_to_srgb8(p[0]), linear_to_srgb8(p[1]), linear_to_srgb8(p[2]), 255])
+}
+
 /// A RelMSE summed over frames, for a running mean and a ratio of sums.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct Running {
@@ -196,11 +216,7 @@ impl LiveFrame {
     /// The shown images as 8-bit sRGB RGBA (alpha 255), one after the other in
     /// [`METHODS`]' order: what the page's canvases draw.
     pub fn rgba8(&self) -> Vec<u8> {
-        self.methods
-            .iter()
-            .flat_map(|m| m.shown.pixels.iter())
-            .flat_map(|p| [linear_to_srgb8(p[0]), linear_to_srgb8(p[1]), linear_to_srgb8(p[2]), 255])
-            .collect()
+        self.methods.iter().flat_map(|m| rgba8(&m.shown)).collect()
     }
 }
 
@@ -218,15 +234,7 @@ impl LiveComparison {
     /// Uploads the scene and creates each method's renderer; `reference` must be the
     /// settings' size.
     pub fn new(backend: &mut dyn Backend, settings: LiveSettings, reference: RgbImage) -> Result<Self, PassError> {
-        settings.check().map_err(PassError::Input)?;
-        if (reference.width, reference.height) != (settings.width, settings.height) {
-            return Err(PassError::Input(format!(
-                "the reference is {}x{}, the page renders {}x{}",
-                reference.width, reference.height, settings.width, settings.height
-            )));
-        }
-        let scene = default_scene();
-        let gpu_scene = GpuScene::build(&scene)?;
+        let (scene, gpu_scene) = scene_for(&settings, &reference)?;
         let render = settings.render(&scene, settings.seed);
         let mut runs = Vec::new();
         for method in METHODS {
@@ -358,11 +366,7 @@ impl PathTracerFrame {
 
     /// The image as 8-bit sRGB RGBA (alpha 255).
     pub fn rgba8(&self) -> Vec<u8> {
-        self.image
-            .pixels
-            .iter()
-            .flat_map(|p| [linear_to_srgb8(p[0]), linear_to_srgb8(p[1]), linear_to_srgb8(p[2]), 255])
-            .collect()
+        rgba8(&self.image).collect()
     }
 }
 
@@ -370,15 +374,7 @@ impl LivePathTracer {
     /// Uploads the scene for the path tracer at the settings' size and seed; `reference`
     /// must be that size.
     pub fn new(backend: &mut dyn Backend, settings: LiveSettings, reference: RgbImage) -> Result<Self, PassError> {
-        settings.check().map_err(PassError::Input)?;
-        if (reference.width, reference.height) != (settings.width, settings.height) {
-            return Err(PassError::Input(format!(
-                "the reference is {}x{}, the page renders {}x{}",
-                reference.width, reference.height, settings.width, settings.height
-            )));
-        }
-        let scene = default_scene();
-        let gpu_scene = GpuScene::build(&scene)?;
+        let (scene, gpu_scene) = scene_for(&settings, &reference)?;
         let tracer = PathTracer::new(backend, &gpu_scene, &settings.render(&scene, settings.seed))?;
         Ok(Self { tracer, reference })
     }

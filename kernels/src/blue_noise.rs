@@ -119,6 +119,7 @@ pub fn gpu_module() -> crate::gpu::GpuModule {
     crate::gpu::GpuModule {
         path: "gpu/blue_noise.wgsl",
         source: "kernels/src/blue_noise.rs",
+        readers: None,
         constants: constants(),
         structs: Vec::new(),
     }

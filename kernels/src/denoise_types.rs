@@ -145,6 +145,7 @@ pub fn gpu_module() -> GpuModule {
     GpuModule {
         path: "gpu/denoise.wgsl",
         source: "kernels/src/denoise_types.rs",
+        readers: None,
         constants: constants(),
         structs: vec![
             StructDeclaration::of::<DenoiseGuide>(),

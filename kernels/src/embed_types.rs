@@ -99,6 +99,7 @@ pub fn gpu_module() -> GpuModule {
     GpuModule {
         path: "gpu/embed.wgsl",
         source: "kernels/src/embed_types.rs",
+        readers: None,
         constants: constants(),
         structs: vec![
             StructDeclaration::of::<SelectionParams>(),

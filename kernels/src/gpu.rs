@@ -175,6 +175,120 @@ pub struct GpuModule {
     pub constants: Vec<GpuConstant>,
     /// Its structs, each after the structs its fields use.
     pub structs: Vec<StructDeclaration>,
+    /// Functions that read structs (of this module or those it imports) out of a storage
+    /// array of 16-byte rows: a module of readers names that array in a `// #requires`
+    /// line and the structs' modules in `// #import` lines ([`RowReaders`]).
+    pub readers: Option<RowReaders>,
+}
+
+/// Readers of structs packed in one storage array of 16-byte rows (`array<vec4<u32>>`),
+/// generated from the structs' declarations, for kernels that bind several arrays of
+/// records as one buffer (WebGPU allows a stage 8 to 10 storage buffers). Each struct is
+/// laid out in its rows exactly as in its own array (the Rust layout: every
+/// `gpu_struct!` is a whole number of rows), so the host appends each array's bytes as
+/// they are.
+#[derive(Clone, Debug)]
+pub struct RowReaders {
+    /// The required array's declaration without `@group`/`@binding`
+    /// (`var<storage, read> scene_rows: array<vec4<u32>>`).
+    pub array: &'static str,
+    /// The generated modules that declare the structs (`gpu/render.wgsl`).
+    pub imports: Vec<&'static str>,
+    /// The structs read.
+    pub structs: Vec<StructDeclaration>,
+}
+
+impl RowReaders {
+    /// The array's name: the word before the `:` of its declaration.
+    fn array_name(&self) -> &'static str {
+        let before_colon = self.array.split(':').next().unwrap_or(self.array);
+        before_colon.rsplit(|c: char| c.is_whitespace() || c == '>').next().unwrap_or(before_colon)
+    }
+
+    /// The module's directive lines and one function per struct:
+    /// `fn read_<snake name>(first_row: u32, index: u32) -> Name` reads record `index` of
+    /// the section that starts at row `first_row`.
+    pub fn wgsl(&self) -> String {
+        let mut text = String::new();
+        for import in &self.imports {
+            text += &format!("// #import {import}\n");
+        }
+        text += &format!("// #requires {}\n", self.array);
+        for declaration in &self.structs {
+            text += "\n";
+            text += &row_reader(declaration, self.array_name());
+        }
+        text
+    }
+}
+
+/// The WGSL reader of `declaration` from `array` (see [`RowReaders::wgsl`]). Every field
+/// is a scalar or vector of `u32`, `i32` or `f32` within one row; a declaration that has
+/// another (an array, a struct, a vector across rows) cannot be packed this way, and the
+/// panic names it (the module tests generate every reader, so that cannot reach a user).
+fn row_reader(declaration: &StructDeclaration, array: &str) -> String {
+    assert!(
+        declaration.size % 16 == 0,
+        "struct {} is {} bytes, not a whole number of rows",
+        declaration.name,
+        declaration.size
+    );
+    let rows = declaration.size / 16;
+    let mut text = format!(
+        "// The {name} at `index` of the section of `{array}` that starts at row `first_row` ({rows} row{s} each).\n\
+         fn read_{snake}(first_row: u32, index: u32) -> {name} {{\n    let row = first_row + index * {rows}u;\n",
+        name = declaration.name,
+        snake = snake_case(declaration.name),
+        s = if rows == 1 { "" } else { "s" },
+    );
+    for row in 0..rows {
+        let at = if row == 0 { String::new() } else { format!(" + {row}u") };
+        text += &format!("    let r{row} = {array}[row{at}];\n");
+    }
+    let fields: Vec<String> = declaration.fields.iter().map(|field| field_from_row(declaration.name, field)).collect();
+    text += &format!("    return {}({});\n}}\n", declaration.name, fields.join(", "));
+    text
+}
+
+/// The expression of `field` read from its row variable (`r1.yzw`, `bitcast<f32>(r0.w)`).
+fn field_from_row(name: &str, field: &GpuField) -> String {
+    let unreadable =
+        || panic!("field `{}` of {name} ({}) cannot be read from 16-byte rows", field.name, field.wgsl_type);
+    let (width, scalar) = match field.wgsl_type.as_ref() {
+        scalar @ ("u32" | "i32" | "f32") => (1, scalar),
+        vector => {
+            let Some((width, scalar)) = vector
+                .strip_prefix("vec")
+                .and_then(|rest| rest.split_once('<'))
+                .and_then(|(width, scalar)| Some((width.parse::<usize>().ok()?, scalar.strip_suffix('>')?)))
+            else {
+                unreadable()
+            };
+            (width, scalar)
+        }
+    };
+    let lane = field.offset % 16 / 4;
+    if !matches!(scalar, "u32" | "i32" | "f32") || field.offset % 4 != 0 || lane + width > 4 {
+        unreadable();
+    }
+    let words = format!("r{}.{}", field.offset / 16, &"xyzw"[lane..lane + width]);
+    match (scalar, width) {
+        ("u32", _) => words,
+        (_, 1) => format!("bitcast<{scalar}>({words})"),
+        _ => format!("bitcast<vec{width}<{scalar}>>({words})"),
+    }
+}
+
+/// `TriangleInfo` → `triangle_info`.
+fn snake_case(name: &str) -> String {
+    let mut snake = String::new();
+    for (i, c) in name.chars().enumerate() {
+        if c.is_uppercase() && i > 0 {
+            snake.push('_');
+        }
+        snake.push(c.to_ascii_lowercase());
+    }
+    snake
 }
 
 impl GpuModule {
@@ -191,6 +305,9 @@ impl GpuModule {
         for declaration in &self.structs {
             text += "\n";
             text += &declaration.wgsl();
+        }
+        if let Some(readers) = &self.readers {
+            text += &readers.wgsl();
         }
         text
     }
@@ -352,6 +469,57 @@ mod tests {
             "// A test struct:\n// two lines.\nstruct SampleStruct {\n    // A vector.\n    position: vec3<f32>,\n    \
              // An id.\n    id: u32,\n    // Four words.\n    words: array<u32, 4>,\n}\n"
         );
+    }
+
+    gpu_struct! {
+        /// A record of two rows.
+        pub struct Packed {
+            /// Three floats.
+            pub position: [f32; 3] as "vec3<f32>",
+            /// A word.
+            pub id: u32,
+            /// Two floats.
+            pub uv: [f32; 2] as "vec2<f32>",
+            /// A signed word.
+            pub offset: i32,
+            /// A float.
+            pub scale: f32,
+        }
+    }
+
+    /// A reader takes each field from its row and lanes, reinterpreting the words as the
+    /// field's scalar, and parses with the struct and the array it requires.
+    #[test]
+    fn a_row_reader_reads_each_field_from_its_lanes() {
+        let readers = RowReaders {
+            array: "var<storage, read> rows: array<vec4<u32>>",
+            imports: vec!["gpu/test.wgsl"],
+            structs: vec![StructDeclaration::of::<Packed>()],
+        };
+        let text = readers.wgsl();
+        assert!(text.starts_with("// #import gpu/test.wgsl\n// #requires var<storage, read> rows: array<vec4<u32>>\n"));
+        assert!(text.contains(
+            "fn read_packed(first_row: u32, index: u32) -> Packed {\n    let row = first_row + index * 2u;\n"
+        ));
+        assert!(text.contains("let r1 = rows[row + 1u];"), "{text}");
+        assert!(
+            text.contains(
+                "return Packed(bitcast<vec3<f32>>(r0.xyz), r0.w, bitcast<vec2<f32>>(r1.xy), bitcast<i32>(r1.z), \
+                 bitcast<f32>(r1.w));"
+            ),
+            "{text}"
+        );
+        let source =
+            format!("{}@group(0) @binding(0) {};\n{text}", StructDeclaration::of::<Packed>().wgsl(), readers.array);
+        naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source)));
+        assert_eq!(snake_case("EmissiveTriangle"), "emissive_triangle");
+    }
+
+    /// A field that cannot come from one row's lanes is refused by name.
+    #[test]
+    #[should_panic(expected = "field `words` of SampleStruct (array<u32, 4>) cannot be read from 16-byte rows")]
+    fn a_row_reader_refuses_an_array_field() {
+        row_reader(&StructDeclaration::of::<Sample>(), "rows");
     }
 
     #[test]

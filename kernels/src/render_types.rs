@@ -2,7 +2,8 @@
 //! declared once ([`crate::gpu`]): the WGSL module `gpu/render.wgsl` is generated from
 //! them.
 
-use crate::gpu::{GpuModule, StructDeclaration, gpu_constants, gpu_struct};
+use crate::gpu::{GpuModule, RowReaders, StructDeclaration, gpu_constants, gpu_struct};
+use crate::trace_types::{GpuBvhNode, GpuTriangle};
 
 gpu_constants! {
     fn constants;
@@ -103,6 +104,22 @@ gpu_struct! {
         pub env_to_world_2: [f32; 3] as "vec3<f32>",
         /// Ray-origin offset relative to max(|p|, 1), which avoids self-intersection.
         pub ray_epsilon: f32,
+        /// First row of the BVH nodes in the scene's rows (`gpu/scene_rows.wgsl`).
+        pub nodes_row: u32,
+        /// First row of the leaf-ordered triangles.
+        pub triangles_row: u32,
+        /// First row of the triangles' attributes.
+        pub triangle_info_row: u32,
+        /// First row of the materials.
+        pub materials_row: u32,
+        /// First row of the emissive triangles.
+        pub lights_row: u32,
+        /// First row of the texels (one per row).
+        pub texels_row: u32,
+        /// First row of the environment's CDFs (four per row).
+        pub environment_cdf_row: u32,
+        /// Padding.
+        pub _pad1: u32,
     }
 }
 
@@ -177,11 +194,38 @@ gpu_struct! {
     }
 }
 
+/// The WGSL module `gpu/scene_rows.wgsl`: readers of the scene's records from the one
+/// storage buffer the path-tracing kernels bind for the whole scene, `scene_rows`
+/// (`render/scene.wgsl`). One buffer instead of seven keeps every ReSTIR pass within the
+/// 10 storage buffers per stage a browser's WebGPU allows (the temporal pass binds 9 of
+/// its own). The host appends the arrays in 16-byte rows and gives where each starts in
+/// `RenderParams.*_row`.
+pub fn scene_rows_module() -> GpuModule {
+    GpuModule {
+        path: "gpu/scene_rows.wgsl",
+        source: "kernels/src/render_types.rs",
+        readers: Some(RowReaders {
+            array: "var<storage, read> scene_rows: array<vec4<u32>>",
+            imports: vec!["gpu/trace.wgsl", "gpu/render.wgsl"],
+            structs: vec![
+                StructDeclaration::of::<GpuBvhNode>(),
+                StructDeclaration::of::<GpuTriangle>(),
+                StructDeclaration::of::<TriangleInfo>(),
+                StructDeclaration::of::<GpuMaterial>(),
+                StructDeclaration::of::<EmissiveTriangle>(),
+            ],
+        }),
+        constants: Vec::new(),
+        structs: Vec::new(),
+    }
+}
+
 /// The WGSL module `gpu/render.wgsl`: the constants and structs above.
 pub fn gpu_module() -> GpuModule {
     GpuModule {
         path: "gpu/render.wgsl",
         source: "kernels/src/render_types.rs",
+        readers: None,
         constants: constants(),
         structs: vec![
             StructDeclaration::of::<RenderParams>(),

@@ -200,6 +200,7 @@ pub fn gpu_module() -> GpuModule {
     GpuModule {
         path: "gpu/restir.wgsl",
         source: "kernels/src/restir_types.rs",
+        readers: None,
         constants: constants(),
         structs: vec![
             StructDeclaration::of::<RestirParams>(),

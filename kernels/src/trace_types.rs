@@ -136,6 +136,7 @@ pub fn gpu_module() -> GpuModule {
     GpuModule {
         path: "gpu/trace.wgsl",
         source: "kernels/src/trace_types.rs",
+        readers: None,
         constants: constants(),
         structs: vec![
             StructDeclaration::of::<GpuBvhNode>(),

@@ -116,6 +116,7 @@ pub fn gpu_module() -> GpuModule {
     GpuModule {
         path: "gpu/strata.wgsl",
         source: "kernels/src/types.rs",
+        readers: None,
         constants: constants(),
         structs: vec![
             StructDeclaration::of::<Candidate>(),

@@ -25,6 +25,7 @@ pub static WGSL_FILES: &[Fragment] = &[
     fragment!("render/path.wgsl"),
     fragment!("render/random.wgsl"),
     fragment!("render/scene.wgsl"),
+    fragment!("render/turns.wgsl"),
     fragment!("restir/block_reuse.wgsl"),
     fragment!("restir/entry_candidates.wgsl"),
     fragment!("restir/entry_guide.wgsl"),
@@ -54,10 +55,10 @@ pub static WGSL_FILES: &[Fragment] = &[
     fragment!("util/empty.wgsl"),
 ];
 
-/// Every generated module, one per `*_types.rs` file and the selection's and blue noise's
-/// (listed here, above those files,
-/// rather than in [`crate::gpu`], which they use to declare themselves).
-pub fn gpu_modules() -> [GpuModule; 8] {
+/// Every generated module, one per `*_types.rs` file, the scene's row readers, and the
+/// selection's and blue noise's (listed here, above those files, rather than in
+/// [`crate::gpu`], which they use to declare themselves).
+pub fn gpu_modules() -> [GpuModule; 9] {
     [
         crate::types::gpu_module(),
         crate::selection::gpu_module(),
@@ -65,6 +66,7 @@ pub fn gpu_modules() -> [GpuModule; 8] {
         crate::embed_types::gpu_module(),
         crate::trace_types::gpu_module(),
         crate::render_types::gpu_module(),
+        crate::render_types::scene_rows_module(),
         crate::restir_types::gpu_module(),
         crate::denoise_types::gpu_module(),
     ]

@@ -466,3 +466,52 @@ fn bad_render_settings_are_errors() {
     let error = GpuScene::build(&dark).err().unwrap().to_string();
     assert!(error.contains("no light"), "{error}");
 }
+
+/// The kernels' `sin_cos_turns` (`render/turns.wgsl`) against f64 on the interpreter and on
+/// Vulkan: within 1.5e-7 absolute (about an ULP at 1) at every angle of a fine grid
+/// and at the quadrant boundaries, where the builtins may err by 2^-11 (SwiftShader:
+/// 1.9e-4).
+#[test]
+fn sin_cos_turns_is_within_an_ulp_on_every_backend() {
+    const ENTRY: &str = "@group(0) @binding(0) var<storage, read> turns: array<f32>;
+@group(0) @binding(1) var<storage, read_write> sin_cos: array<vec2<f32>>;
+@compute @workgroup_size(64)
+fn turns_test(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x < arrayLength(&turns) {
+        sin_cos[id.x] = sin_cos_turns(turns[id.x]);
+    }
+}
+";
+    let file = strata_kernels::wgsl_files::with_imports("render/turns.wgsl").unwrap();
+    let kernel = strata_kernels::Kernel::from_wgsl("turns_test.wgsl", format!("{file}\n{ENTRY}"), "turns_test", false)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut turns: Vec<f32> = (0..=8192).map(|i| i as f32 / 8192.0).collect();
+    turns.extend((0..=8).flat_map(|q| [q as f32 / 8.0 - 1e-7, q as f32 / 8.0 + 1e-7]).filter(|t| *t >= 0.0));
+    turns.extend([0.3183099, 0.1591549, 0.9999999, 0.5000001, 0.2499999, 0.7500001]);
+    turns.resize(turns.len().next_multiple_of(64), 0.37);
+    let mut backends: Vec<(&str, Box<dyn Backend>)> = vec![(
+        "cpu",
+        Box::new(
+            strata_backends::cpu_backend::CpuBackend::new(strata_backends::cpu_backend::CpuOptions::default()).unwrap(),
+        ),
+    )];
+    if let Some(vulkan) = strata_tests::vulkan_backend("sin_cos_turns_is_within_an_ulp_on_every_backend") {
+        backends.push(("vulkan", Box::new(vulkan)));
+    }
+    for (name, mut backend) in backends {
+        let words = bytemuck::cast_slice::<f32, u32>(&turns);
+        let got = strata_tests::run_words(backend.as_mut(), &kernel, words, 2 * turns.len(), turns.len() as u32 / 64);
+        let mut worst = (0.0f64, 0.0f32);
+        for (&t, pair) in turns.iter().zip(got.chunks_exact(2)) {
+            let angle = 2.0 * std::f64::consts::PI * f64::from(t);
+            for (value, exact) in [(pair[0], angle.sin()), (pair[1], angle.cos())] {
+                let error = (f64::from(f32::from_bits(value)) - exact).abs();
+                if error > worst.0 {
+                    worst = (error, t);
+                }
+            }
+        }
+        eprintln!("sin_cos_turns on {name}: largest error {:.3e} (at {} turns)", worst.0, worst.1);
+        assert!(worst.0 <= 1.5e-7, "sin_cos_turns on {name}: error {:.3e} at {} turns", worst.0, worst.1);
+    }
+}

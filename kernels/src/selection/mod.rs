@@ -26,6 +26,7 @@ pub fn gpu_module() -> crate::gpu::GpuModule {
     crate::gpu::GpuModule {
         path: "gpu/selection.wgsl",
         source: "kernels/src/selection/",
+        readers: None,
         constants: [patterns::pattern_constants(), sampler::sampler_constants()].concat(),
         structs: Vec::new(),
     }

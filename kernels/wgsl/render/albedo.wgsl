@@ -9,7 +9,7 @@ fn texture_texel(material: Material, x: i32, y: i32) -> vec3<f32> {
     let height = i32(material.texture_height);
     let column = u32(((x % width) + width) % width);
     let row = u32(((y % height) + height) % height);
-    return texels[material.texel_offset + row * material.texture_width + column].xyz;
+    return scene_texel(material.texel_offset + row * material.texture_width + column).xyz;
 }
 
 fn albedo_at(material: Material, uv: vec2<f32>) -> vec3<f32> {

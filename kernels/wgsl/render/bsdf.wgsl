@@ -5,6 +5,7 @@
 // f * |cos(wi)|, and sample returns that over the density (the path throughput factor).
 
 // #import render/scene.wgsl
+// #import render/turns.wgsl
 
 struct Frame {
     tangent: vec3<f32>,
@@ -57,10 +58,10 @@ fn sample_ggx_visible(wo: vec3<f32>, alpha: f32, u: vec2<f32>) -> vec3<f32> {
     }
     let t2 = cross(vh, t1);
     let r = sqrt(u.x);
-    let phi = 2.0 * PI * u.y;
-    let p1 = r * cos(phi);
+    let phi = sin_cos_turns(u.y);
+    let p1 = r * phi.y;
     let s = 0.5 * (1.0 + vh.z);
-    let p2 = (1.0 - s) * sqrt(max(0.0, 1.0 - p1 * p1)) + s * r * sin(phi);
+    let p2 = (1.0 - s) * sqrt(max(0.0, 1.0 - p1 * p1)) + s * r * phi.x;
     let nh = p1 * t1 + p2 * t2 + sqrt(max(0.0, 1.0 - p1 * p1 - p2 * p2)) * vh;
     return normalize(vec3<f32>(alpha * nh.x, alpha * nh.y, max(1e-6, nh.z)));
 }
@@ -169,8 +170,8 @@ fn bsdf_sample(material: Material, albedo: vec3<f32>, wo: vec3<f32>, u: vec2<f32
         return BsdfSample(wi, f * ggx_g1(wi, m, material.alpha), bsdf_pdf(material, wo, wi), false);
     }
     let r = sqrt(u.x);
-    let phi = 2.0 * PI * u.y;
-    let wi = vec3<f32>(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - u.x)));
+    let phi = sin_cos_turns(u.y);
+    let wi = vec3<f32>(r * phi.y, r * phi.x, sqrt(max(0.0, 1.0 - u.x)));
     if wi.z <= 0.0 {
         return none;
     }

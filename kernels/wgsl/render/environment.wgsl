@@ -6,6 +6,7 @@
 // marginal CDF over rows (H + 1 entries) and then one CDF per row (W + 1 entries each).
 
 // #import render/scene.wgsl
+// #import render/turns.wgsl
 
 // (u, v) of a direction in the map's own frame.
 fn environment_uv(local: vec3<f32>) -> vec2<f32> {
@@ -24,7 +25,7 @@ fn environment_local(direction: vec3<f32>) -> vec3<f32> {
 }
 
 fn environment_texel(x: u32, y: u32) -> vec3<f32> {
-    return texels[params.env_texel_offset + y * params.env_width + x].xyz;
+    return scene_texel(params.env_texel_offset + y * params.env_width + x).xyz;
 }
 
 // Radiance arriving from world direction `direction` (bilinear: texel-centred phi,
@@ -54,7 +55,7 @@ fn find_cell(base: u32, entries: u32, u: f32) -> u32 {
     var high = entries - 1u;
     while high - low > 1u {
         let middle = (low + high) / 2u;
-        if environment_cdf[base + middle] <= u {
+        if scene_environment_cdf(base + middle) <= u {
             low = middle;
         } else {
             high = middle;
@@ -75,9 +76,9 @@ fn environment_pdf(direction: vec3<f32>) -> f32 {
     let height = params.env_height;
     let column = min(u32(uv.x * f32(width)), width - 1u);
     let row = min(u32(uv.y * f32(height)), height - 1u);
-    let p_row = environment_cdf[row + 1u] - environment_cdf[row];
+    let p_row = scene_environment_cdf(row + 1u) - scene_environment_cdf(row);
     let base = height + 1u + row * (width + 1u);
-    let p_column = environment_cdf[base + column + 1u] - environment_cdf[base + column];
+    let p_column = scene_environment_cdf(base + column + 1u) - scene_environment_cdf(base + column);
     return p_row * p_column * f32(width * height) / (2.0 * PI * PI * sin_theta);
 }
 
@@ -86,16 +87,16 @@ fn sample_environment(u: vec2<f32>) -> vec3<f32> {
     let width = params.env_width;
     let height = params.env_height;
     let row = find_cell(0u, height + 1u, u.x);
-    let row_low = environment_cdf[row];
-    let dv = clamp((u.x - row_low) / (environment_cdf[row + 1u] - row_low), 0.0, 1.0);
+    let row_low = scene_environment_cdf(row);
+    let dv = clamp((u.x - row_low) / (scene_environment_cdf(row + 1u) - row_low), 0.0, 1.0);
     let base = height + 1u + row * (width + 1u);
     let column = find_cell(base, width + 1u, u.y);
-    let column_low = environment_cdf[base + column];
-    let du = clamp((u.y - column_low) / (environment_cdf[base + column + 1u] - column_low), 0.0, 1.0);
-    let theta = (f32(row) + dv) / f32(height) * PI;
-    let phi = (f32(column) + du) / f32(width) * 2.0 * PI;
-    let sin_theta = sin(theta);
-    let local = vec3<f32>(sin_theta * sin(phi), cos(theta), -sin_theta * cos(phi));
+    let column_low = scene_environment_cdf(base + column);
+    let du = clamp((u.y - column_low) / (scene_environment_cdf(base + column + 1u) - column_low), 0.0, 1.0);
+    // θ = π v and φ = 2π u, in turns.
+    let theta = sin_cos_turns(0.5 * (f32(row) + dv) / f32(height));
+    let phi = sin_cos_turns((f32(column) + du) / f32(width));
+    let local = vec3<f32>(theta.x * phi.x, theta.y, -theta.x * phi.y);
     let world = vec3<f32>(
         dot(params.env_to_world_0, local),
         dot(params.env_to_world_1, local),

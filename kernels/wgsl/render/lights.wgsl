@@ -25,7 +25,7 @@ fn find_light(u: f32) -> u32 {
     var high = params.light_count - 1u;
     while low < high {
         let middle = (low + high) / 2u;
-        if lights[middle].cdf > u {
+        if scene_light(middle).cdf > u {
             high = middle;
         } else {
             low = middle + 1u;
@@ -37,7 +37,7 @@ fn find_light(u: f32) -> u32 {
 // Solid-angle density with which NEE picks a point on emissive triangle `light` seen at
 // `distance` under cosine `cos_light` at the light.
 fn area_light_pdf(light: u32, distance: f32, cos_light: f32) -> f32 {
-    let entry = lights[light];
+    let entry = scene_light(light);
     return (1.0 - params.environment_probability) * entry.probability / entry.area * distance * distance / cos_light;
 }
 
@@ -83,8 +83,8 @@ fn direct_light(
             return vec3<f32>(0.0);
         }
         let light = find_light(random());
-        let entry = lights[light];
-        let tri = triangles[entry.triangle];
+        let entry = scene_light(light);
+        let tri = bvh_triangle(entry.triangle);
         let su = sqrt(u.x);
         let point = (1.0 - su) * tri.v0 + (u.y * su) * tri.v1 + (su - u.y * su) * tri.v2;
         let light_normal = normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));

@@ -34,7 +34,7 @@ fn trace_path_from(start: Ray, first_depth: u32, start_pdf: f32, start_specular:
 // `wo_world` by reflection or refraction, emission excluded: next-event estimation there
 // and one BSDF-sampled continuation, exactly as trace_path_from does at that vertex.
 fn scatter_from(surface: Surface, wo_world: vec3<f32>, depth: u32, lane: u32) -> PathSample {
-    let material = materials[surface.material];
+    let material = scene_material(surface.material);
     let cos_out = dot(surface.normal, wo_world);
     var shading_normal = surface.normal;
     if material.kind != MATERIAL_DIELECTRIC && cos_out < 0.0 {
@@ -147,12 +147,12 @@ fn path_from(
                 if sample_lights && !previous_specular {
                     weight = mis_power(previous_pdf, area_light_pdf(surface.light, hit.t, cos_out));
                 }
-                radiance += throughput * lights[surface.light].radiance * weight;
+                radiance += throughput * scene_light(surface.light).radiance * weight;
             }
             if depth == params.max_depth {
                 break;
             }
-            material = materials[surface.material];
+            material = scene_material(surface.material);
             shading_normal = surface.normal;
             if material.kind != MATERIAL_DIELECTRIC && cos_out < 0.0 {
                 if material.two_sided == 0u {

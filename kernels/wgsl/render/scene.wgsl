@@ -2,19 +2,27 @@
 // triangles in leaf order, per-triangle attributes, materials, emissive triangles,
 // texels (textures and the environment map) and the environment's sampling CDFs.
 // The records and their constants are declared once in Rust, kernels/src/render_types.rs,
-// which generates gpu/render.wgsl.
+// which generates gpu/render.wgsl and the records' readers gpu/scene_rows.wgsl.
+//
+// The seven arrays lie end to end in one storage buffer of 16-byte rows, each record in
+// its rows as in an array of its own, each array from the row RenderParams names
+// (`nodes_row`, `triangles_row`, ...; the host's GpuScene::rows). One buffer, not seven,
+// because a browser's WebGPU allows a stage 10 storage buffers, and the ReSTIR passes
+// bind up to 9 of their own. The accessors below are all that reads it.
 //
 // Bindings (group 0), shared by every kernel that includes this fragment:
-//   0 uniform            RenderParams              image, camera, environment, flags
-//   1 storage, read      array<BvhNode>            obvhs Bvh2 nodes (root at 0)
-//   2 storage, read      array<Triangle>           triangles in BVH leaf order
-//   3 storage, read      array<TriangleInfo>       object id, material, light, UVs
-//   4 storage, read      array<Material>           materials
-//   5 storage, read      array<EmissiveTriangle>   area lights with their selection CDF
-//   6 storage, read      array<vec4<f32>>          texels: textures, then the environment
-//   7 storage, read      array<f32>                environment CDFs (marginal, conditionals)
+//   0 uniform            RenderParams              image, camera, environment, flags, rows
+//   1 storage, read      array<vec4<u32>>          the scene's rows:
+//                          BvhNode (2 rows)          obvhs Bvh2 nodes (root at 0)
+//                          Triangle (3 rows)         triangles in BVH leaf order
+//                          TriangleInfo (3 rows)     object id, material, light, UVs
+//                          Material (4 rows)         materials
+//                          EmissiveTriangle (2 rows) area lights with their selection CDF
+//                          vec4<f32> (1 row)         texels: textures, then the environment
+//                          f32 (4 per row)           environment CDFs (marginal, conditionals)
 
 // #import gpu/render.wgsl
+// #import gpu/scene_rows.wgsl
 // #import trace/bvh.wgsl
 // #import trace/traverse.wgsl
 // #import render/random.wgsl
@@ -49,13 +57,35 @@ const PI: f32 = 3.14159265358979;
 const INFINITY: f32 = 0x1.fffffep+127f;
 
 @group(0) @binding(0) var<uniform> params: RenderParams;
-@group(0) @binding(1) var<storage, read> nodes: array<BvhNode>;
-@group(0) @binding(2) var<storage, read> triangles: array<Triangle>;
-@group(0) @binding(3) var<storage, read> triangle_info: array<TriangleInfo>;
-@group(0) @binding(4) var<storage, read> materials: array<Material>;
-@group(0) @binding(5) var<storage, read> lights: array<EmissiveTriangle>;
-@group(0) @binding(6) var<storage, read> texels: array<vec4<f32>>;
-@group(0) @binding(7) var<storage, read> environment_cdf: array<f32>;
+@group(0) @binding(1) var<storage, read> scene_rows: array<vec4<u32>>;
+
+fn bvh_node(index: u32) -> BvhNode {
+    return read_bvh_node(params.nodes_row, index);
+}
+
+fn bvh_triangle(index: u32) -> Triangle {
+    return read_triangle(params.triangles_row, index);
+}
+
+fn scene_triangle_info(index: u32) -> TriangleInfo {
+    return read_triangle_info(params.triangle_info_row, index);
+}
+
+fn scene_material(index: u32) -> Material {
+    return read_material(params.materials_row, index);
+}
+
+fn scene_light(index: u32) -> EmissiveTriangle {
+    return read_emissive_triangle(params.lights_row, index);
+}
+
+fn scene_texel(index: u32) -> vec4<f32> {
+    return bitcast<vec4<f32>>(scene_rows[params.texels_row + index]);
+}
+
+fn scene_environment_cdf(index: u32) -> f32 {
+    return bitcast<f32>(scene_rows[params.environment_cdf_row + index / 4u][index % 4u]);
+}
 
 var<workgroup> trace_stack: array<u32, 2560>;
 
@@ -76,8 +106,8 @@ struct Surface {
 }
 
 fn surface_at(hit: Hit) -> Surface {
-    let tri = triangles[hit.primitive];
-    let info = triangle_info[hit.primitive];
+    let tri = bvh_triangle(hit.primitive);
+    let info = scene_triangle_info(hit.primitive);
     let w = 1.0 - hit.u - hit.v;
     let position = w * tri.v0 + hit.u * tri.v1 + hit.v * tri.v2;
     let normal = normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));

@@ -62,7 +62,7 @@ fn no_candidate() -> PathCandidate {
 
 // Area density with which next-event estimation picks a point on emissive triangle `light`.
 fn light_area_density(light: u32) -> f32 {
-    let entry = lights[light];
+    let entry = scene_light(light);
     return (1.0 - params.environment_probability) * entry.probability / entry.area;
 }
 
@@ -86,7 +86,7 @@ fn ris_weight(primary: Primary, candidate: PathCandidate, light_density: f32) ->
 // the emitting side, shareable when Lambertian.
 fn vertex_candidate(vertex: Surface, origin: vec3<f32>, reflected: vec3<f32>) -> PathCandidate {
     let seen_front = dot(vertex.normal, origin - vertex.position) > 0.0;
-    let kind = select(KIND_PRIVATE, KIND_SURFACE, materials[vertex.material].kind == MATERIAL_DIFFUSE);
+    let kind = select(KIND_PRIVATE, KIND_SURFACE, scene_material(vertex.material).kind == MATERIAL_DIFFUSE);
     return PathCandidate(
         vertex.position,
         kind,
@@ -115,7 +115,7 @@ struct Drawn {
 // "First run on a fresh machine"). The random numbers are drawn in the order of the two
 // techniques one after the other.
 fn draw_candidate(primary: Primary, surface: Surface, lane: u32) -> Drawn {
-    let material = materials[primary.material];
+    let material = scene_material(primary.material);
     let albedo = primary.albedo;
     let normal = primary.normal;
     let next_segment = primary.segment + 1u;
@@ -163,13 +163,13 @@ fn draw_candidate(primary: Primary, surface: Surface, lane: u32) -> Drawn {
                 }
             } else if params.light_count > 0u {
                 let light = find_light(random());
-                let entry = lights[light];
-                let tri = triangles[entry.triangle];
+                let entry = scene_light(light);
+                let tri = bvh_triangle(entry.triangle);
                 let su = sqrt(u_light.x);
                 let b1 = u_light.y * su;
                 let b2 = su - u_light.y * su;
                 let point = (1.0 - su) * tri.v0 + b1 * tri.v1 + b2 * tri.v2;
-                let info = triangle_info[entry.triangle];
+                let info = scene_triangle_info(entry.triangle);
                 var uv = vec2<f32>(b1, b2);
                 if info.has_uv != 0u {
                     uv = (1.0 - su) * info.uv0 + b1 * info.uv1 + b2 * info.uv2;
@@ -219,7 +219,7 @@ fn draw_candidate(primary: Primary, surface: Surface, lane: u32) -> Drawn {
                 to_primary = normalize(surface.position - vertex.position);
                 found = true;
                 // What the light reflects towards y (nothing for a black fixture).
-                let light_material = materials[vertex.material];
+                let light_material = scene_material(vertex.material);
                 scatters = light_material.kind != MATERIAL_DIFFUSE
                     || any(albedo_at(light_material, vertex.uv) != vec3<f32>(0.0));
             }
@@ -336,10 +336,10 @@ fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
         var exit = EXIT_OTHER;
         let camera_hit = surface.position;
         if surface.light != NO_LIGHT && cos_out > 0.0 {
-            base = lights[surface.light].radiance;
+            base = scene_light(surface.light).radiance;
         }
         loop {
-            let material = materials[surface.material];
+            let material = scene_material(surface.material);
             var normal = surface.normal;
             if material.kind != MATERIAL_DIELECTRIC && cos_out < 0.0 && material.two_sided != 0u {
                 normal = -normal;
@@ -422,7 +422,7 @@ fn restir_candidates(@builtin(global_invocation_id) id: vec3<u32>, @builtin(loca
                 if sample_lights && !sample.specular {
                     weight = mis_power(sample.pdf, area_light_pdf(surface.light, next.t, cos_out));
                 }
-                base += throughput * lights[surface.light].radiance * weight;
+                base += throughput * scene_light(surface.light).radiance * weight;
             }
         }
         if exit != EXIT_OTHER {

@@ -104,7 +104,7 @@ fn geometry_factor(x: PathCandidate, direction: vec3<f32>, distance: f32) -> f32
 fn replayed_sample(p: Primary, seed: u32, lane: u32) -> PathSample {
     let saved = rng_state;
     rng_state = seed;
-    let sample = scatter_at(p.position, p.normal, materials[p.material], p.albedo, p.wo, p.segment, lane);
+    let sample = scatter_at(p.position, p.normal, scene_material(p.material), p.albedo, p.wo, p.segment, lane);
     rng_state = saved;
     return sample;
 }
@@ -150,7 +150,7 @@ fn integrand(p: Primary, x: PathCandidate, lane: u32) -> vec3<f32> {
 fn reconnection_integrand(p: Primary, x: PathCandidate) -> vec3<f32> {
     let t = towards(p, x);
     let direction = t.xyz;
-    let material = materials[p.material];
+    let material = scene_material(p.material);
     let frame = make_frame(p.normal);
     let f = bsdf_eval(material, p.albedo, to_local(frame, p.wo), to_local(frame, direction));
     if all(f == vec3<f32>(0.0)) {
@@ -162,7 +162,7 @@ fn reconnection_integrand(p: Primary, x: PathCandidate) -> vec3<f32> {
             emitted = environment_radiance(direction);
         }
     } else if x.light != NO_LIGHT && -dot(x.normal, direction) > 0.0 {
-        emitted = lights[x.light].radiance;
+        emitted = scene_light(x.light).radiance;
     }
     return f * (emitted + x.reflected) * geometry_factor(x, direction, t.w);
 }
@@ -177,7 +177,7 @@ fn target_function(p: Primary, x: PathCandidate, lane: u32) -> f32 {
 fn bsdf_density(p: Primary, x: PathCandidate) -> f32 {
     let t = towards(p, x);
     let frame = make_frame(p.normal);
-    let pdf = bsdf_pdf(materials[p.material], to_local(frame, p.wo), to_local(frame, t.xyz));
+    let pdf = bsdf_pdf(scene_material(p.material), to_local(frame, p.wo), to_local(frame, t.xyz));
     return pdf * geometry_factor(x, t.xyz, t.w);
 }
 

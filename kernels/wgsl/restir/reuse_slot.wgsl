@@ -15,14 +15,15 @@
 
 // #import strata/selection.wgsl
 // #import restir/reservoir.wgsl
+// #import render/turns.wgsl
 // #requires var<storage, read> primaries: array<Primary>
 
 // The disc neighbour of pixel (x, y) with primary hit `p` (restir-disc), or NO_PIXEL.
 fn disc_neighbour(x: u32, y: u32, p: Primary) -> u32 {
     let r = restir.disc_radius * sqrt(random());
-    let phi = 2.0 * PI * random();
-    let qx = i32(floor(f32(x) + 0.5 + r * cos(phi)));
-    let qy = i32(floor(f32(y) + 0.5 + r * sin(phi)));
+    let phi = sin_cos_turns(random());
+    let qx = i32(floor(f32(x) + 0.5 + r * phi.y));
+    let qy = i32(floor(f32(y) + 0.5 + r * phi.x));
     if qx < 0 || qy < 0 || qx >= i32(params.width) || qy >= i32(params.height) {
         return NO_PIXEL;
     }

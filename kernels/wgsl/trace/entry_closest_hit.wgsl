@@ -41,3 +41,11 @@ fn bvh_closest_hit(
 fn leaf_triangle(slot: u32) -> u32 {
     return primitive_indices[slot];
 }
+
+fn bvh_node(index: u32) -> BvhNode {
+    return nodes[index];
+}
+
+fn bvh_triangle(index: u32) -> Triangle {
+    return triangles[index];
+}

@@ -1,15 +1,16 @@
 // BVH2 traversal shared by every kernel that traces rays (closest hit and any hit).
 //
-// Needs, from the including kernel: the storage arrays `nodes` (BvhNode) and `triangles`
-// (Triangle), the workgroup array `trace_stack` with TRACE_STACK_DEPTH - REGISTER_STACK
-// words per invocation, and `fn leaf_triangle(slot: u32) -> u32` mapping a leaf's primitive slot
-// to an index into `triangles` (through obvhs' primitive_indices, or the identity when
-// the triangles were reordered into leaf order on the host).
+// Needs, from the including kernel: `fn bvh_node(index: u32) -> BvhNode` and
+// `fn bvh_triangle(index: u32) -> Triangle` (from arrays of their own, or from the
+// scene's one buffer of rows), the workgroup array `trace_stack` with TRACE_STACK_DEPTH -
+// REGISTER_STACK words per invocation, and `fn leaf_triangle(slot: u32) -> u32` mapping a
+// leaf's primitive slot to a triangle index (through obvhs' primitive_indices, or the
+// identity when the triangles were reordered into leaf order on the host).
 
 // #import gpu/trace.wgsl
 // #import trace/bvh.wgsl
-// #requires var<storage, read> nodes: array<BvhNode>
-// #requires var<storage, read> triangles: array<Triangle>
+// #requires fn bvh_node(index: u32) -> BvhNode
+// #requires fn bvh_triangle(index: u32) -> Triangle
 // #requires var<workgroup> trace_stack: array<u32, 2560>
 // #requires fn leaf_triangle(slot: u32) -> u32
 
@@ -38,15 +39,15 @@ fn traverse(ray: Ray, lane: u32, any_hit: bool) -> Hit {
     var top6 = 0u;
     var top7 = 0u;
     var node_index = 0u;
-    if enter_box(nodes[0], ray.origin, inv_dir, ray.tmin, best.t) < 0.0 {
+    if enter_box(bvh_node(0u), ray.origin, inv_dir, ray.tmin, best.t) < 0.0 {
         return best;
     }
     loop {
-        let node = nodes[node_index];
+        let node = bvh_node(node_index);
         if node.prim_count > 0u {
             for (var i = 0u; i < node.prim_count; i++) {
                 let primitive = leaf_triangle(node.first_index + i);
-                let hit = intersect_triangle(ray, shear, triangles[primitive]);
+                let hit = intersect_triangle(ray, shear, bvh_triangle(primitive));
                 if hit.x > ray.tmin && hit.x < best.t {
                     best = Hit(hit.x, hit.y, hit.z, primitive);
                     if any_hit {
@@ -57,8 +58,8 @@ fn traverse(ray: Ray, lane: u32, any_hit: bool) -> Hit {
         } else {
             let left = node.first_index;
             let right = left + 1u;
-            let t_left = enter_box(nodes[left], ray.origin, inv_dir, ray.tmin, best.t);
-            let t_right = enter_box(nodes[right], ray.origin, inv_dir, ray.tmin, best.t);
+            let t_left = enter_box(bvh_node(left), ray.origin, inv_dir, ray.tmin, best.t);
+            let t_right = enter_box(bvh_node(right), ray.origin, inv_dir, ray.tmin, best.t);
             let hit_left = t_left >= 0.0;
             let hit_right = t_right >= 0.0;
             if hit_left && hit_right {

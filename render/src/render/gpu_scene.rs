@@ -207,7 +207,7 @@ impl GpuScene {
         if cdf.is_empty() {
             cdf.push(0.0);
         }
-        Ok(GpuScene {
+        let mut gpu = GpuScene {
             nodes: bytemuck::cast_slice(&bvh.nodes).to_vec(),
             triangles: leaf_triangles,
             triangle_info,
@@ -216,7 +216,64 @@ impl GpuScene {
             texels,
             environment_cdf: cdf,
             params,
-        })
+        };
+        let [nodes_row, triangles_row, triangle_info_row, materials_row, lights_row, texels_row, environment_cdf_row] =
+            gpu.first_rows().map_err(|rows| {
+                PassError::Input(format!(
+                    "scene `{}` is too large: its arrays take {rows} rows of 16 bytes, more than a u32 counts",
+                    scene.name
+                ))
+            })?;
+        gpu.params = RenderParams {
+            nodes_row,
+            triangles_row,
+            triangle_info_row,
+            materials_row,
+            lights_row,
+            texels_row,
+            environment_cdf_row,
+            ..gpu.params
+        };
+        Ok(gpu)
+    }
+
+    /// The arrays as bytes, in the order they lie in the rows, with their names for errors.
+    pub fn sections(&self) -> [(&'static str, &[u8]); 7] {
+        [
+            ("BVH nodes", bytemuck::cast_slice(&self.nodes)),
+            ("triangles", bytemuck::cast_slice(&self.triangles)),
+            ("triangle attributes", bytemuck::cast_slice(&self.triangle_info)),
+            ("materials", bytemuck::cast_slice(&self.materials)),
+            ("emissive triangles", bytemuck::cast_slice(&self.lights)),
+            ("texels", bytemuck::cast_slice(&self.texels)),
+            ("environment CDF", bytemuck::cast_slice(&self.environment_cdf)),
+        ]
+    }
+
+    /// The row at which each of [`Self::sections`] starts, or the total row count when it
+    /// does not fit a `u32`.
+    fn first_rows(&self) -> Result<[u32; 7], u64> {
+        let mut first = [0u32; 7];
+        let mut rows = 0u64;
+        for (slot, (_, bytes)) in first.iter_mut().zip(self.sections()) {
+            *slot = u32::try_from(rows).map_err(|_| rows)?;
+            rows += (bytes.len() as u64).div_ceil(16);
+        }
+        u32::try_from(rows).map_err(|_| rows)?;
+        Ok(first)
+    }
+
+    /// The scene's one storage buffer (`scene_rows` of `render/scene.wgsl`): every array of
+    /// [`Self::sections`] in 16-byte rows from the row `params` gives it, each record laid
+    /// out as in its own array (the CDF's last row padded with zeros).
+    pub fn rows(&self) -> Vec<[u32; 4]> {
+        let mut rows = Vec::new();
+        for (_, bytes) in self.sections() {
+            let start = rows.len();
+            rows.resize(start + bytes.len().div_ceil(16), [0u32; 4]);
+            bytemuck::cast_slice_mut::<[u32; 4], u8>(&mut rows[start..])[..bytes.len()].copy_from_slice(bytes);
+        }
+        rows
     }
 
     /// Number of emissive triangles.

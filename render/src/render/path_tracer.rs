@@ -137,61 +137,45 @@ impl RenderSettings {
     }
 }
 
-/// The scene's device buffers, bound at 1–7 of every path-tracing kernel.
+/// The scene's device buffer ([`GpuScene::rows`]), bound at 1 of every path-tracing kernel.
 pub struct SceneBuffers {
-    buffers: [BufferId; 7],
+    rows: BufferId,
 }
 
 impl SceneBuffers {
-    /// Uploads `scene`; a buffer larger than the device's storage-binding limit is
-    /// refused with its name and both sizes (splitting across bindings is not done).
+    /// Uploads `scene`; a scene larger than the device's storage-binding limit is refused
+    /// with both sizes and its largest array (splitting across bindings is not done).
     pub fn upload(backend: &mut dyn Backend, scene: &GpuScene) -> Result<SceneBuffers, PassError> {
         let limit = backend.info().limits.max_storage_binding;
-        let sizes = [
-            ("BVH nodes", std::mem::size_of_val(scene.nodes.as_slice())),
-            ("triangles", std::mem::size_of_val(scene.triangles.as_slice())),
-            ("triangle attributes", std::mem::size_of_val(scene.triangle_info.as_slice())),
-            ("materials", std::mem::size_of_val(scene.materials.as_slice())),
-            ("emissive triangles", std::mem::size_of_val(scene.lights.as_slice())),
-            ("texels", std::mem::size_of_val(scene.texels.as_slice())),
-            ("environment CDF", std::mem::size_of_val(scene.environment_cdf.as_slice())),
-        ];
-        for (name, size) in sizes {
-            if size as u64 > limit {
-                return Err(PassError::Input(format!(
-                    "the scene is too large for this device: its {name} take {:.1} MiB, and the device binds at \
-                     most {:.1} MiB per storage buffer",
-                    size as f64 / 1048576.0,
-                    limit as f64 / 1048576.0
-                )));
-            }
+        let rows = scene.rows();
+        let size = std::mem::size_of_val(rows.as_slice()) as u64;
+        if size > limit {
+            let (largest, largest_size) = scene
+                .sections()
+                .into_iter()
+                .map(|(name, bytes)| (name, bytes.len()))
+                .max_by_key(|&(_, len)| len)
+                .unwrap_or(("", 0));
+            return Err(PassError::Input(format!(
+                "the scene is too large for this device: its arrays take {:.1} MiB in one storage buffer (the \
+                 largest, its {largest}, {:.1} MiB), and the device binds at most {:.1} MiB per storage buffer",
+                size as f64 / 1048576.0,
+                largest_size as f64 / 1048576.0,
+                limit as f64 / 1048576.0
+            )));
         }
-        Ok(SceneBuffers {
-            buffers: [
-                upload(backend, "bvh nodes", &scene.nodes)?,
-                upload(backend, "triangles", &scene.triangles)?,
-                upload(backend, "triangle attributes", &scene.triangle_info)?,
-                upload(backend, "materials", &scene.materials)?,
-                upload(backend, "emissive triangles", &scene.lights)?,
-                upload(backend, "texels", &scene.texels)?,
-                upload(backend, "environment cdf", &scene.environment_cdf)?,
-            ],
-        })
+        Ok(SceneBuffers { rows: upload(backend, "scene rows", &rows)? })
     }
 
-    /// The scene's buffers and the parameters `params` under their WGSL names
+    /// The scene's buffer and the parameters `params` under their WGSL names
     /// (`render/scene.wgsl`), for [`Bind::named`].
     pub fn named(&self, params: BufferId) -> Vec<(&'static str, BufferId)> {
-        const NAMES: [&str; 7] =
-            ["nodes", "triangles", "triangle_info", "materials", "lights", "texels", "environment_cdf"];
-        let mut named = vec![("params", params)];
-        named.extend(NAMES.into_iter().zip(self.buffers));
-        named
+        vec![("params", params), ("scene_rows", self.rows)]
     }
 
-    /// Frees the buffers.
+    /// Frees the buffer.
     pub fn destroy(self, backend: &mut dyn Backend) -> Result<(), BackendError> {
-        self.buffers.into_iter().try_for_each(|b| backend.destroy_buffer(b))
+        backend.destroy_buffer(self.rows)
     }
 }
 

@@ -228,7 +228,7 @@ impl RowReaders {
 /// panic names it (the module tests generate every reader, so that cannot reach a user).
 fn row_reader(declaration: &StructDeclaration, array: &str) -> String {
     assert!(
-        declaration.size % 16 == 0,
+        declaration.size.is_multiple_of(16),
         "struct {} is {} bytes, not a whole number of rows",
         declaration.name,
         declaration.size
@@ -268,7 +268,7 @@ fn field_from_row(name: &str, field: &GpuField) -> String {
         }
     };
     let lane = field.offset % 16 / 4;
-    if !matches!(scalar, "u32" | "i32" | "f32") || field.offset % 4 != 0 || lane + width > 4 {
+    if !matches!(scalar, "u32" | "i32" | "f32") || !field.offset.is_multiple_of(4) || lane + width > 4 {
         unreadable();
     }
     let words = format!("r{}.{}", field.offset / 16, &"xyzw"[lane..lane + width]);

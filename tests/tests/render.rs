@@ -487,7 +487,14 @@ fn turns_test(@builtin(global_invocation_id) id: vec3<u32>) {
         .unwrap_or_else(|e| panic!("{e}"));
     let mut turns: Vec<f32> = (0..=8192).map(|i| i as f32 / 8192.0).collect();
     turns.extend((0..=8).flat_map(|q| [q as f32 / 8.0 - 1e-7, q as f32 / 8.0 + 1e-7]).filter(|t| *t >= 0.0));
-    turns.extend([0.3183099, 0.1591549, 0.9999999, 0.5000001, 0.2499999, 0.7500001]);
+    turns.extend([
+        std::f32::consts::FRAC_1_PI,
+        0.5 * std::f32::consts::FRAC_1_PI,
+        0.9999999,
+        0.5000001,
+        0.2499999,
+        0.7500001,
+    ]);
     turns.resize(turns.len().next_multiple_of(64), 0.37);
     let mut backends: Vec<(&str, Box<dyn Backend>)> = vec![(
         "cpu",

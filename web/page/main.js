@@ -146,11 +146,17 @@ async function showPathTracer(scores, images, settings) {
 async function showComparison(scores, images, settings) {
   const size = settings.width * settings.height * 4;
   const shown = [];
+  const maps = [];
   METHODS.forEach((name, i) => {
     const pixels = new Uint8ClampedArray(images.buffer, i * size, size);
     const context = document.getElementById(`image-${name}`).getContext('2d');
     context.putImageData(new ImageData(pixels, settings.width, settings.height), 0, 0);
     shown.push(varied(pixels));
+    // The error maps follow the three images in the module's buffer.
+    const map = new Uint8ClampedArray(images.buffer, (METHODS.length + i) * size, size);
+    const mapContext = document.getElementById(`error-${name}`).getContext('2d');
+    mapContext.putImageData(new ImageData(map, settings.width, settings.height), 0, 0);
+    maps.push(varied(map));
     const m = scores.methods[i];
     const denoised = m.denoisedRelmse !== null
       ? `; denoised ${formatted(m.denoisedRelmse)}, mean ${formatted(m.meanDenoisedRelmse)}` : '';
@@ -165,7 +171,7 @@ async function showComparison(scores, images, settings) {
   // In the test the worker turns the denoiser on by itself; the checkbox follows.
   if (testing && denoiseFrom > 0 && scores.frame >= denoiseFrom) checkbox.checked = true;
   if (testing && scores.frame === maxFrames) {
-    await post('result', { mode: 'comparison', scores, varied: shown, ratios, checkbox: checkbox.checked });
+    await post('result', { mode: 'comparison', scores, varied: shown, mapsVaried: maps, ratios, checkbox: checkbox.checked });
   }
 }
 
@@ -173,8 +179,8 @@ async function main() {
   const settings = await (await fetch('page.json')).json();
   document.getElementById('reference').textContent =
     `${settings.referenceSamples} samples per pixel, ${settings.width}×${settings.height}`;
-  for (const name of [...METHODS, 'path']) {
-    const canvas = document.getElementById(`image-${name}`);
+  for (const id of [...METHODS.flatMap((name) => [`image-${name}`, `error-${name}`]), 'image-path']) {
+    const canvas = document.getElementById(id);
     canvas.width = settings.width;
     canvas.height = settings.height;
   }
@@ -211,7 +217,7 @@ async function main() {
         unavailable = message.device.unavailable;
         if (unavailable) {
           // The fallback: the path tracer, and why ReSTIR is not shown.
-          for (const id of ['methods', 'ratio-line', 'ratio-plot']) document.getElementById(id).hidden = true;
+          for (const id of ['methods', 'colour-bar', 'ratio-line', 'ratio-plot']) document.getElementById(id).hidden = true;
           document.getElementById('path-tracer').hidden = false;
           checkbox.disabled = true;
           device += `. ReSTIR cannot run on this device (${message.device.unavailable}); `

@@ -10,7 +10,7 @@
 use strata_backends::Backend;
 use strata_backends::backend::download;
 use strata_render::denoise::{SvgfDenoiser, SvgfSettings};
-use strata_render::error_metric::Metric;
+use strata_render::error_metric::{Metric, false_colour};
 use strata_render::histogram_pass::PassError;
 use strata_render::render::{GpuScene, PathTracer, RenderSettings};
 use strata_render::restir::{Method, RestirRenderer, RestirSettings};
@@ -173,6 +173,9 @@ pub struct MethodFrame {
     pub mean_denoised_relmse: Option<f64>,
     /// The image shown: the denoised one while the denoiser is on, else the raw one.
     pub shown: RgbImage,
+    /// The shown image's RelMSE per pixel against the reference, in false colour
+    /// ([`strata_render::error_metric::false_colour`]: 1e-4 black to 1 white, log scale).
+    pub error_map: RgbImage,
 }
 
 /// Everything one frame of the comparison gives.
@@ -213,10 +216,11 @@ impl LiveFrame {
         })
     }
 
-    /// The shown images as 8-bit sRGB RGBA (alpha 255), one after the other in
-    /// [`METHODS`]' order: what the page's canvases draw.
+    /// The shown images, then their error maps, as 8-bit sRGB RGBA (alpha 255), one
+    /// after the other in [`METHODS`]' order: what the page's canvases draw.
     pub fn rgba8(&self) -> Vec<u8> {
-        self.methods.iter().flat_map(|m| rgba8(&m.shown)).collect()
+        let images = self.methods.iter().map(|m| &m.shown);
+        images.chain(self.methods.iter().map(|m| &m.error_map)).flat_map(rgba8).collect()
     }
 }
 
@@ -301,6 +305,8 @@ impl LiveComparison {
                 denoised_relmse = Some(value);
                 shown = denoised;
             }
+            let map = Metric::Relmse.map(&shown, &self.reference).unwrap_or_default();
+            let error_map = false_colour(&map, shown.width, shown.height);
             methods.push(MethodFrame {
                 method: run.method,
                 relmse,
@@ -308,6 +314,7 @@ impl LiveComparison {
                 denoised_relmse,
                 mean_denoised_relmse: run.denoised.mean(),
                 shown,
+                error_map,
             });
         }
         let sums = |pick: fn(&MethodRun) -> Running| {

@@ -7,6 +7,7 @@
 //! removed when the browser is dropped. Chromium runs in a process group of its own,
 //! killed whole on drop, so that no renderer or GPU process outlives the backend.
 
+use super::devtools::{BrowserEnds, DevTools};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 
@@ -90,6 +91,18 @@ impl Browser {
     /// Starts `binary` headless on `url`, with WebGPU on (SwiftShader's Vulkan where no
     /// GPU is, as on CI).
     pub fn launch(binary: &Path, url: &str) -> Result<Self, String> {
+        Self::start(binary, url, None)
+    }
+
+    /// [`Self::launch`] with the DevTools protocol on a pipe of its own (no port) and a
+    /// 1280 × 1240 window: for what a test asks of the browser rather than the page, such
+    /// as a screenshot ([`DevTools::screenshot`]).
+    pub fn launch_with_devtools(binary: &Path, url: &str) -> Result<(Self, DevTools), String> {
+        let (devtools, ends) = DevTools::pipes()?;
+        Ok((Self::start(binary, url, Some(ends))?, devtools))
+    }
+
+    fn start(binary: &Path, url: &str, devtools: Option<BrowserEnds>) -> Result<Self, String> {
         let folder = strata_files::private_scratch_folder("strata-webgpu-")
             .map_err(|e| format!("cannot create a private folder for Chromium's profile: {e}"))?;
         let log = std::fs::File::create_new(folder.path().join("chromium.log"))
@@ -120,6 +133,7 @@ impl Browser {
             ])
             // Chromium refuses to run as root with its sandbox on.
             .args(running_as_root().then_some("--no-sandbox"))
+            .args(devtools.as_ref().map_or(&[][..], |_| &["--remote-debugging-pipe", "--window-size=1280,1240"][..]))
             .arg(url)
             .env("XDG_CONFIG_HOME", folder.path().join("config"))
             .env("XDG_CACHE_HOME", folder.path().join("cache"))
@@ -143,8 +157,41 @@ impl Browser {
         {
             use std::os::unix::process::CommandExt;
             command.process_group(0);
+            if let Some(ends) = &devtools {
+                use std::os::fd::AsRawFd;
+                let (reads, writes) = (ends.reads.as_raw_fd(), ends.writes.as_raw_fd());
+                // SAFETY: the closure runs in the child between fork and exec, where only
+                // async-signal-safe functions may be called: it calls fcntl, dup2 and
+                // close alone and allocates nothing (the error is built from errno). Both
+                // descriptors are open: `ends` owns them until after `spawn` returns. Each
+                // is first copied above 9, so that moving one to 3 or 4 cannot close the
+                // other, and the copies dup2 makes have no close-on-exec flag.
+                unsafe {
+                    command.pre_exec(move || {
+                        let high_reads = libc::fcntl(reads, libc::F_DUPFD, 10);
+                        let high_writes = libc::fcntl(writes, libc::F_DUPFD, 10);
+                        if high_reads < 0
+                            || high_writes < 0
+                            || libc::dup2(high_reads, 3) < 0
+                            || libc::dup2(high_writes, 4) < 0
+                        {
+                            return Err(std::io::Error::last_os_error());
+                        }
+                        libc::close(high_reads);
+                        libc::close(high_writes);
+                        Ok(())
+                    });
+                }
+            }
+        }
+        #[cfg(not(unix))]
+        if devtools.is_some() {
+            return Err("the DevTools pipe needs a Unix system (Chromium's descriptors 3 and 4)".into());
         }
         let child = command.spawn().map_err(|e| format!("{} does not start: {e}", binary.display()))?;
+        // The browser's ends now live in the browser; this process's copies go, so that
+        // the reader sees the pipe close when the browser exits.
+        drop(devtools);
         Ok(Self { child, folder, _temporary: temporary })
     }
 

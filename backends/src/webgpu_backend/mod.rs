@@ -27,6 +27,8 @@ mod bridge;
 #[cfg(not(target_arch = "wasm32"))]
 mod browser;
 mod channel;
+#[cfg(not(target_arch = "wasm32"))]
+mod devtools;
 mod framing;
 #[cfg(target_arch = "wasm32")]
 mod in_page;
@@ -42,6 +44,8 @@ pub const EXECUTOR_JS: &str = include_str!("executor.js");
 
 #[cfg(not(target_arch = "wasm32"))]
 pub use browser::{BROWSER_REQUIRED_VARIABLE, Browser, CHROMIUM_VARIABLE, browser_required, find_chromium};
+#[cfg(not(target_arch = "wasm32"))]
+pub use devtools::DevTools;
 
 use crate::backend::{Backend, Bind, BufferId, Resource};
 use crate::bindings_check::{

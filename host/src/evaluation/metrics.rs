@@ -69,12 +69,7 @@ pub(crate) fn check(image: &RgbImage, reference: &RgbImage) -> Result<(), Metric
 /// The per-pixel error of `image` against `reference` (mean over R, G, B), row-major.
 pub fn error_map(image: &RgbImage, reference: &RgbImage, metric: Metric) -> Result<Vec<f64>, MetricError> {
     check(image, reference)?;
-    Ok(image
-        .pixels
-        .iter()
-        .zip(&reference.pixels)
-        .map(|(f, r)| (0..3).map(|c| metric.of(f[c], r[c])).sum::<f64>() / 3.0)
-        .collect())
+    metric.map(image, reference).ok_or(MetricError::Empty)
 }
 
 /// The mean of [`error_map`] ([`Metric::mean`], once the images' sizes and values have
@@ -150,24 +145,7 @@ pub fn gaussian_blur(image: &RgbImage, sigma: f32) -> RgbImage {
     RgbImage { width: image.width, height: image.height, pixels: pass(&horizontal, false) }
 }
 
-/// A false-colour picture of a per-pixel error map (row-major, `width` × `height`):
-/// log10 of the error from 1e-4 (black) through blue, red and yellow to 1 and above
-/// (white), as linear RGB whose sRGB PNG at exposure 1 shows that ramp.
-pub fn false_colour(map: &[f64], width: u32, height: u32) -> RgbImage {
-    const STOPS: [[f32; 3]; 5] = [[0.0, 0.0, 0.0], [0.2, 0.1, 0.6], [0.8, 0.15, 0.3], [1.0, 0.8, 0.1], [1.0, 1.0, 1.0]];
-    let pixels = map
-        .iter()
-        .map(|&e| {
-            let t = if e > 0.0 { ((e.log10() + 4.0) / 4.0).clamp(0.0, 1.0) as f32 } else { 0.0 };
-            let position = t * (STOPS.len() - 1) as f32;
-            let i = (position as usize).min(STOPS.len() - 2);
-            let f = position - i as f32;
-            let srgb: [f32; 3] = std::array::from_fn(|c| STOPS[i][c] * (1.0 - f) + STOPS[i + 1][c] * f);
-            srgb.map(|c| strata_render::scene::srgb_to_linear((c * 255.0).round() as u8))
-        })
-        .collect();
-    RgbImage { width, height, pixels }
-}
+pub use strata_render::error_metric::false_colour;
 
 /// A mean over independent samples with its 95 % confidence half-width (Student t).
 #[derive(Clone, Copy, Debug, PartialEq)]

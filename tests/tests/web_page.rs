@@ -170,6 +170,7 @@ fn the_live_page_runs_as_natively_or_says_why_and_path_traces() {
         return;
     }
     assert_eq!(body["mode"], "comparison", "{body}");
+    eprintln!("the page showed its frames at (ms since it started): {}", body["frameTimes"]);
     assert_eq!(body["varied"], serde_json::json!([true, true, true]), "a blank or flat image: {body}");
     assert_eq!(body["mapsVaried"], serde_json::json!([true, true, true]), "a blank or flat error map: {body}");
     assert_eq!(body["checkbox"], true, "the denoiser's checkbox does not show it on: {body}");

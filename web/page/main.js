@@ -27,6 +27,8 @@ const checkbox = document.getElementById('denoise');
 const pause = document.getElementById('pause');
 const ratios = [];
 const pathErrors = [];
+// When each frame was shown (ms since the page started), for the test's account of time.
+const frameTimes = [];
 let worker = null;
 let failed = false;
 let unavailable = null;
@@ -170,8 +172,11 @@ async function showComparison(scores, images, settings) {
   plot();
   // In the test the worker turns the denoiser on by itself; the checkbox follows.
   if (testing && denoiseFrom > 0 && scores.frame >= denoiseFrom) checkbox.checked = true;
+  frameTimes.push(Math.round(performance.now()));
   if (testing && scores.frame === maxFrames) {
-    await post('result', { mode: 'comparison', scores, varied: shown, mapsVaried: maps, ratios, checkbox: checkbox.checked });
+    await post('result', {
+      mode: 'comparison', scores, varied: shown, mapsVaried: maps, ratios, checkbox: checkbox.checked, frameTimes,
+    });
   }
 }
 

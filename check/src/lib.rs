@@ -151,7 +151,7 @@ impl Progress<'_> {
 /// own device: most of a first run is a CPU driver (lavapipe) compiling every kernel
 /// once per slot, one pipeline per core at a time (Vulkan lets pipelines be created
 /// from several threads; each slot's device is its own anyway). A slot may be shared out
-/// over several devices ([`slot_parts`]: `webgpu`, two browsers). `progress` is called
+/// over several devices (`slot_parts`: `webgpu`, two browsers). `progress` is called
 /// after every cell, from the worker that ran it.
 pub fn run_checks_reporting(
     config: CheckConfig,

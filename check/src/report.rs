@@ -47,7 +47,14 @@ impl CheckReport {
     }
 
     pub(super) fn set_device(&mut self, backend: &str, device: String) {
-        self.devices.insert(backend.to_string(), device);
+        // A slot shared out over several devices (`slot_parts`) names each that differs.
+        match self.devices.get_mut(backend) {
+            Some(known) if *known != device => *known = format!("{known}; {device}"),
+            Some(_) => {}
+            None => {
+                self.devices.insert(backend.to_string(), device);
+            }
+        }
     }
 
     /// The result of `kernel` on `backend`.

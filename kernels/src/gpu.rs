@@ -184,9 +184,9 @@ pub struct GpuModule {
 /// Readers of structs packed in one storage array of 16-byte rows (`array<vec4<u32>>`),
 /// generated from the structs' declarations, for kernels that bind several arrays of
 /// records as one buffer (WebGPU allows a stage 8 to 10 storage buffers). Each struct is
-/// laid out in its rows exactly as in its own array (the Rust layout: every
-/// `gpu_struct!` is a whole number of rows), so the host appends each array's bytes as
-/// they are.
+/// laid out in its rows exactly as in its own array (the Rust layout; a struct read this
+/// way must be a whole number of rows, which [`RowReaders::wgsl`] checks), so the host
+/// appends each array's bytes as they are.
 #[derive(Clone, Debug)]
 pub struct RowReaders {
     /// The required array's declaration without `@group`/`@binding`
@@ -201,7 +201,7 @@ pub struct RowReaders {
 impl RowReaders {
     /// The array's name: the word before the `:` of its declaration.
     fn array_name(&self) -> &'static str {
-        let before_colon = self.array.split(':').next().unwrap_or(self.array);
+        let before_colon = self.array.split(':').next().unwrap_or(self.array).trim_end();
         before_colon.rsplit(|c: char| c.is_whitespace() || c == '>').next().unwrap_or(before_colon)
     }
 

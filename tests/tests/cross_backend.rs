@@ -25,10 +25,16 @@ fn every_kernel_is_identical_on_every_backend() {
             }
         }
     }
-    // Tint's column is there where Chromium must be.
+    // Tint's column is there where Chromium must be: from both browsers the slot is
+    // shared out over, no cell is unavailable but for a limit or feature the device lacks.
     if strata_backends::webgpu_backend::browser_required() {
         let cell = report.cell(strata_kernels::KernelId::BlockHistogram, "webgpu");
         assert!(matches!(cell, Some(CellResult::Identical { .. })), "webgpu: {cell:?}");
+        for check in kernel_checks() {
+            if let Some(CellResult::Unavailable(why)) = report.cell(check.kernel(), "webgpu") {
+                assert!(why.contains("needs"), "webgpu is unavailable for {:?}: {why}", check.kernel());
+            }
+        }
     }
     // The portable kernel runs everywhere a Vulkan device exists.
     if gpu_required() {

@@ -189,7 +189,9 @@ fn the_live_page_runs_as_natively_or_says_why_and_path_traces() {
     let same_seed = &runs[0];
     let mut pairs = vec![("strata ÷ restir raw".to_string(), page.0, native[0].0)];
     pairs.push(("strata ÷ restir after SVGF".to_string(), page.1, native[0].1));
-    for (method, native) in scores["methods"].as_array().unwrap().iter().zip(&same_seed.methods) {
+    let page_methods = scores["methods"].as_array().unwrap();
+    assert_eq!(page_methods.len(), same_seed.methods.len(), "the page's methods: {body}");
+    for (method, native) in page_methods.iter().zip(&same_seed.methods) {
         assert_eq!(method["name"], native.method.name(), "{body}");
         let name = native.method.name();
         pairs.push((format!("{name}'s mean RelMSE"), method["meanRelmse"].as_f64().unwrap(), native.mean_relmse));

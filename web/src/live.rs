@@ -305,7 +305,9 @@ impl LiveComparison {
                 denoised_relmse = Some(value);
                 shown = denoised;
             }
-            let map = Metric::Relmse.map(&shown, &self.reference).unwrap_or_default();
+            let map = Metric::Relmse
+                .map(&shown, &self.reference)
+                .ok_or_else(|| PassError::Input(format!("{name}: the image and the reference differ in size")))?;
             let error_map = false_colour(&map, shown.width, shown.height);
             methods.push(MethodFrame {
                 method: run.method,

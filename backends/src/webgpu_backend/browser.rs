@@ -165,7 +165,9 @@ impl Browser {
                 // close alone and allocates nothing (the error is built from errno). Both
                 // descriptors are open: `ends` owns them until after `spawn` returns. Each
                 // is first copied above 9, so that moving one to 3 or 4 cannot close the
-                // other, and the copies dup2 makes have no close-on-exec flag.
+                // other, and the copies dup2 makes have no close-on-exec flag. (Were std's
+                // own exec-error pipe at 3 or 4, dup2 would close it and a failed exec
+                // would show as the browser exiting at once, which `exited` reports.)
                 unsafe {
                     command.pre_exec(move || {
                         let high_reads = libc::fcntl(reads, libc::F_DUPFD, 10);

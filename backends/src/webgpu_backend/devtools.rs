@@ -67,7 +67,9 @@ impl DevTools {
 
     /// Sends `method` with `params` (to the page attached as `session`, or to the browser)
     /// and returns its result; an error answer, a closed pipe or no answer within a minute
-    /// is an error naming the method. Events that arrive meanwhile are skipped.
+    /// of sending (events that arrive meanwhile are skipped, and do not extend it) is an
+    /// error naming the method. (The write itself has no timeout: the pipe's buffer takes a
+    /// command whole unless the browser has stopped reading, which its exit ends.)
     pub fn call(
         &mut self,
         session: Option<&str>,
@@ -83,8 +85,10 @@ impl DevTools {
         let mut bytes = command.to_string().into_bytes();
         bytes.push(0);
         self.to_browser.write_all(&bytes).map_err(|e| format!("DevTools {method}: cannot write to Chromium: {e}"))?;
+        let deadline = std::time::Instant::now() + ANSWER_TIMEOUT;
         loop {
-            let message = match self.messages.recv_timeout(ANSWER_TIMEOUT) {
+            let left = deadline.saturating_duration_since(std::time::Instant::now());
+            let message = match self.messages.recv_timeout(left) {
                 Ok(message) => message.map_err(|e| format!("DevTools {method}: {e}"))?,
                 Err(RecvTimeoutError::Timeout) => {
                     return Err(format!("DevTools {method}: no answer within {} s", ANSWER_TIMEOUT.as_secs()));

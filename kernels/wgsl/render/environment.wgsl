@@ -1,8 +1,8 @@
 // The lat-long environment map (CONVENTIONS.md "Emitters"): lookup and importance
-// sampling. Texels live in `texels` from params.env_texel_offset, row 0 = the +Y pole.
+// sampling. Texels are read with `scene_texel` from params.env_texel_offset, row 0 = the +Y pole.
 // Sampling is piecewise constant over W x H cells in (u, v), each weighted on the host by
 // the largest luminance its bilinear footprint can take times sin(theta) at its centre,
-// so every direction with radiance has a positive density. `environment_cdf` holds the
+// so every direction with radiance has a positive density. `scene_environment_cdf` reads the
 // marginal CDF over rows (H + 1 entries) and then one CDF per row (W + 1 entries each).
 
 // #import render/scene.wgsl

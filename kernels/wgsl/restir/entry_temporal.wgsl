@@ -30,7 +30,7 @@
 // M = M_c + mean_j M_j.
 // The shift is the identity on x2 (area measure) or on the direction (environment).
 //
-// Bindings (group 0): 0-7 the scene, 8 RestirParams, and
+// Bindings (group 0): 0-1 the scene (2-7 unused), 8 RestirParams, and
 //   9  storage, read     array<Primary>      this frame's G-buffer
 //   10 storage, read     array<Primary>      the previous frame's G-buffer
 //   11 storage, read     array<Reservoir>    this frame's reservoirs (restir_select)

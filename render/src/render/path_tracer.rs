@@ -147,8 +147,8 @@ impl SceneBuffers {
     /// with both sizes and its largest array (splitting across bindings is not done).
     pub fn upload(backend: &mut dyn Backend, scene: &GpuScene) -> Result<SceneBuffers, PassError> {
         let limit = backend.info().limits.max_storage_binding;
-        let rows = scene.rows();
-        let size = std::mem::size_of_val(rows.as_slice()) as u64;
+        // The size from the sections, before the rows copy the scene.
+        let size: u64 = scene.sections().iter().map(|(_, bytes)| (bytes.len() as u64).div_ceil(16) * 16).sum();
         if size > limit {
             let (largest, largest_size) = scene
                 .sections()
@@ -164,7 +164,7 @@ impl SceneBuffers {
                 limit as f64 / 1048576.0
             )));
         }
-        Ok(SceneBuffers { rows: upload(backend, "scene rows", &rows)? })
+        Ok(SceneBuffers { rows: upload(backend, "scene rows", &scene.rows())? })
     }
 
     /// The scene's buffer and the parameters `params` under their WGSL names

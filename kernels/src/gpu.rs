@@ -189,8 +189,8 @@ pub struct GpuModule {
 /// appends each array's bytes as they are.
 #[derive(Clone, Debug)]
 pub struct RowReaders {
-    /// The required array's declaration without `@group`/`@binding`
-    /// (`var<storage, read> scene_rows: array<vec4<u32>>`).
+    /// The name of the required array, `var<storage, read> NAME: array<vec4<u32>>`
+    /// ([`Self::declaration`]).
     pub array: &'static str,
     /// The generated modules that declare the structs (`gpu/render.wgsl`).
     pub imports: Vec<&'static str>,
@@ -199,10 +199,10 @@ pub struct RowReaders {
 }
 
 impl RowReaders {
-    /// The array's name: the word before the `:` of its declaration.
-    fn array_name(&self) -> &'static str {
-        let before_colon = self.array.split(':').next().unwrap_or(self.array).trim_end();
-        before_colon.rsplit(|c: char| c.is_whitespace() || c == '>').next().unwrap_or(before_colon)
+    /// The array's declaration without `@group`/`@binding`, as its `// #requires` line
+    /// and the including kernel write it.
+    pub fn declaration(&self) -> String {
+        format!("var<storage, read> {}: array<vec4<u32>>", self.array)
     }
 
     /// The module's directive lines and one function per struct:
@@ -213,10 +213,10 @@ impl RowReaders {
         for import in &self.imports {
             text += &format!("// #import {import}\n");
         }
-        text += &format!("// #requires {}\n", self.array);
+        text += &format!("// #requires {}\n", self.declaration());
         for declaration in &self.structs {
             text += "\n";
-            text += &row_reader(declaration, self.array_name());
+            text += &row_reader(declaration, self.array);
         }
         text
     }
@@ -492,7 +492,7 @@ mod tests {
     #[test]
     fn a_row_reader_reads_each_field_from_its_lanes() {
         let readers = RowReaders {
-            array: "var<storage, read> rows: array<vec4<u32>>",
+            array: "rows",
             imports: vec!["gpu/test.wgsl"],
             structs: vec![StructDeclaration::of::<Packed>()],
         };
@@ -509,8 +509,11 @@ mod tests {
             ),
             "{text}"
         );
-        let source =
-            format!("{}@group(0) @binding(0) {};\n{text}", StructDeclaration::of::<Packed>().wgsl(), readers.array);
+        let source = format!(
+            "{}@group(0) @binding(0) {};\n{text}",
+            StructDeclaration::of::<Packed>().wgsl(),
+            readers.declaration()
+        );
         naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source)));
         assert_eq!(snake_case("EmissiveTriangle"), "emissive_triangle");
     }

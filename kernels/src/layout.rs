@@ -93,7 +93,7 @@ mod tests {
         let mut text: String = modules.iter().map(|module| module.wgsl()).collect();
         // The row readers' arrays, declared as the kernels that import them do.
         for (binding, readers) in modules.iter().filter_map(|m| m.readers.as_ref()).enumerate() {
-            text += &format!("@group(63) @binding({binding}) {};\n", readers.array);
+            text += &format!("@group(63) @binding({binding}) {};\n", readers.declaration());
         }
         let module = naga::front::wgsl::parse_str(&text).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&text)));
         let mut failures = Vec::new();

@@ -205,7 +205,7 @@ pub fn scene_rows_module() -> GpuModule {
         path: "gpu/scene_rows.wgsl",
         source: "kernels/src/render_types.rs",
         readers: Some(RowReaders {
-            array: "var<storage, read> scene_rows: array<vec4<u32>>",
+            array: "scene_rows",
             imports: vec!["gpu/trace.wgsl", "gpu/render.wgsl"],
             structs: vec![
                 StructDeclaration::of::<GpuBvhNode>(),

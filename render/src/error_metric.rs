@@ -49,9 +49,13 @@ impl Metric {
     /// (the mean of [`Self::map`]), or `None` when their sizes differ, they are empty, or
     /// a value is not finite (a number that cannot be computed is not a score).
     pub fn mean(self, image: &RgbImage, reference: &RgbImage) -> Option<f64> {
-        let map = self.map(image, reference)?;
-        Some(map.iter().sum::<f64>() / map.len() as f64).filter(|mean| mean.is_finite())
+        map_mean(&self.map(image, reference)?)
     }
+}
+
+/// The mean of an error map ([`Metric::map`]), or `None` when it is empty or not finite.
+pub fn map_mean(map: &[f64]) -> Option<f64> {
+    (!map.is_empty()).then(|| map.iter().sum::<f64>() / map.len() as f64).filter(|mean| mean.is_finite())
 }
 
 /// The error maps' colours, sRGB: log10 of the error from 1e-4 (black) through blue, red

@@ -111,8 +111,8 @@ pub extern "C" fn strata_web_start(width: u32, height: u32, seed: u32) -> u32 {
 
 /// Renders the next frame of every method, with the denoiser on when `denoise` is not
 /// 0. The report holds the scores ([`crate::live::LiveFrame::to_json`]), the images
-/// (`strata_web_images_ptr` / `_len`) the shown images; for the path tracer its sample
-/// and its image ([`crate::live::PathTracerFrame`]; `denoise` does not apply).
+/// (`strata_web_images_ptr` / `_len`) the shown images and then their error maps
+/// ([`crate::live::LiveFrame::rgba8`]); for the path tracer its sample and its image ([`crate::live::PathTracerFrame`]; `denoise` does not apply).
 #[unsafe(no_mangle)]
 pub extern "C" fn strata_web_frame(denoise: u32) -> u32 {
     PAGE.with(|page| {
@@ -149,7 +149,7 @@ pub extern "C" fn strata_web_report_len() -> u32 {
     REPORT.with(|r| r.borrow().len() as u32)
 }
 
-/// The address of the last frame's images (RGBA8, one method after the other), valid
+/// The address of the last frame's images (RGBA8, one after the other), valid
 /// until the next call into the module.
 #[unsafe(no_mangle)]
 pub extern "C" fn strata_web_images_ptr() -> *const u8 {

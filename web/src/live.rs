@@ -10,7 +10,7 @@
 use strata_backends::Backend;
 use strata_backends::backend::download;
 use strata_render::denoise::{SvgfDenoiser, SvgfSettings};
-use strata_render::error_metric::{Metric, false_colour};
+use strata_render::error_metric::{Metric, false_colour, map_mean};
 use strata_render::histogram_pass::PassError;
 use strata_render::render::{GpuScene, PathTracer, RenderSettings};
 use strata_render::restir::{Method, RestirRenderer, RestirSettings};
@@ -284,12 +284,17 @@ impl LiveComparison {
             if stats.invalid_pixels > 0 {
                 return Err(PassError::Input(format!("{name}: {} pixels had invalid samples", stats.invalid_pixels)));
             }
+            // The image's RelMSE and its per-pixel map (the shown image's is drawn).
             let score = |image: &RgbImage, what: &str| {
-                Metric::Relmse.mean(image, &self.reference).ok_or_else(|| {
-                    PassError::Input(format!("{name}{what}: no RelMSE (a pixel is not a finite number)"))
-                })
+                let map = Metric::Relmse.map(image, &self.reference).unwrap_or_default();
+                match map_mean(&map) {
+                    Some(mean) => Ok((mean, map)),
+                    None => Err(PassError::Input(format!(
+                        "{name}{what}: no RelMSE (a pixel is not a finite number, or the sizes differ)"
+                    ))),
+                }
             };
-            let relmse = score(&image, "")?;
+            let (relmse, mut map) = score(&image, "")?;
             run.raw.add(relmse);
             let mut denoised_relmse = None;
             let mut shown = image;
@@ -300,14 +305,12 @@ impl LiveComparison {
                 let output = denoiser.denoise(backend, inputs.colour, inputs.guides, inputs.previous_guides)?;
                 let pixels: Vec<[f32; 4]> = download(backend, output)?;
                 let denoised = RgbImage::from_rgba(shown.width, shown.height, &pixels);
-                let value = score(&denoised, ", denoised")?;
+                let (value, denoised_map) = score(&denoised, ", denoised")?;
                 run.denoised.add(value);
                 denoised_relmse = Some(value);
                 shown = denoised;
+                map = denoised_map;
             }
-            let map = Metric::Relmse
-                .map(&shown, &self.reference)
-                .ok_or_else(|| PassError::Input(format!("{name}: the image and the reference differ in size")))?;
             let error_map = false_colour(&map, shown.width, shown.height);
             methods.push(MethodFrame {
                 method: run.method,

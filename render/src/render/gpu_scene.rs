@@ -250,14 +250,24 @@ impl GpuScene {
         ]
     }
 
+    /// How many 16-byte rows each of [`Self::sections`] takes (its last one padded).
+    fn section_rows(&self) -> [u64; 7] {
+        self.sections().map(|(_, bytes)| (bytes.len() as u64).div_ceil(16))
+    }
+
+    /// The size in bytes of [`Self::rows`], without building it.
+    pub fn rows_size(&self) -> u64 {
+        self.section_rows().iter().sum::<u64>() * 16
+    }
+
     /// The row at which each of [`Self::sections`] starts, or the total row count when it
     /// does not fit a `u32`.
     fn first_rows(&self) -> Result<[u32; 7], u64> {
         let mut first = [0u32; 7];
         let mut rows = 0u64;
-        for (slot, (_, bytes)) in first.iter_mut().zip(self.sections()) {
+        for (slot, count) in first.iter_mut().zip(self.section_rows()) {
             *slot = u32::try_from(rows).map_err(|_| rows)?;
-            rows += (bytes.len() as u64).div_ceil(16);
+            rows += count;
         }
         u32::try_from(rows).map_err(|_| rows)?;
         Ok(first)
@@ -268,9 +278,9 @@ impl GpuScene {
     /// out as in its own array (the CDF's last row padded with zeros).
     pub fn rows(&self) -> Vec<[u32; 4]> {
         let mut rows = Vec::new();
-        for (_, bytes) in self.sections() {
+        for ((_, bytes), count) in self.sections().into_iter().zip(self.section_rows()) {
             let start = rows.len();
-            rows.resize(start + bytes.len().div_ceil(16), [0u32; 4]);
+            rows.resize(start + count as usize, [0u32; 4]);
             bytemuck::cast_slice_mut::<[u32; 4], u8>(&mut rows[start..])[..bytes.len()].copy_from_slice(bytes);
         }
         rows

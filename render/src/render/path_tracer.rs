@@ -147,8 +147,7 @@ impl SceneBuffers {
     /// with both sizes and its largest array (splitting across bindings is not done).
     pub fn upload(backend: &mut dyn Backend, scene: &GpuScene) -> Result<SceneBuffers, PassError> {
         let limit = backend.info().limits.max_storage_binding;
-        // The size from the sections, before the rows copy the scene.
-        let size: u64 = scene.sections().iter().map(|(_, bytes)| (bytes.len() as u64).div_ceil(16) * 16).sum();
+        let size = scene.rows_size();
         if size > limit {
             let (largest, largest_size) = scene
                 .sections()

@@ -60,6 +60,18 @@ fn ash(source: SpirvSource) -> Result<Box<dyn Backend>, BackendError> {
     Ok(Box::new(AshBackend::new(AshOptions { validation: false, source, subgroups: true, ..Default::default() })?))
 }
 
+/// The backends of the check named in `names` (report names, `cpu`, `ash-glsl`, ...), in
+/// report order; every backend when `names` is empty. An unknown name is an error naming
+/// it and the known ones.
+pub fn backend_slots_named(names: &[String]) -> Result<Vec<BackendSlot>, String> {
+    let slots = backend_slots();
+    if let Some(unknown) = names.iter().find(|name| !slots.iter().any(|slot| slot.name == name.as_str())) {
+        let known: Vec<&str> = slots.iter().map(|slot| slot.name).collect();
+        return Err(format!("{unknown}: no such backend (backends: {})", known.join(", ")));
+    }
+    Ok(slots.into_iter().filter(|slot| names.is_empty() || names.iter().any(|name| name == slot.name)).collect())
+}
+
 /// Every backend of the check, in report order.
 pub fn backend_slots() -> Vec<BackendSlot> {
     vec![
@@ -107,4 +119,27 @@ pub fn backend_slots() -> Vec<BackendSlot> {
             toolchain: chromium,
         },
     ]
+}
+
+#[cfg(test)]
+mod named_tests {
+    use super::backend_slots_named;
+
+    fn names(asked: &[&str]) -> Result<Vec<&'static str>, String> {
+        let asked: Vec<String> = asked.iter().map(|name| name.to_string()).collect();
+        backend_slots_named(&asked).map(|slots| slots.iter().map(|slot| slot.name).collect())
+    }
+
+    #[test]
+    fn the_named_backends_come_in_report_order_and_none_named_is_all() {
+        assert_eq!(names(&["ash-slang", "cpu", "ash"]).unwrap(), ["cpu", "ash", "ash-slang"]);
+        assert_eq!(names(&[]).unwrap().len(), super::backend_slots().len());
+    }
+
+    #[test]
+    fn an_unknown_backend_is_an_error_naming_it_and_the_known_ones() {
+        let why = names(&["ash", "vulkan"]).unwrap_err();
+        assert!(why.starts_with("vulkan: no such backend (backends: cpu, wgpu-vulkan,"), "{why}");
+        assert!(why.ends_with("webgpu)"), "{why}");
+    }
 }

@@ -33,7 +33,7 @@ mod svgf;
 pub mod texture_corpus;
 mod trace;
 
-pub use backends::{BackendSlot, backend_slots};
+pub use backends::{BackendSlot, backend_slots, backend_slots_named};
 pub use compare::{Agreement, Compare, Mismatch, Output, compare_outputs};
 pub use report::{CellResult, CheckReport};
 
@@ -158,7 +158,17 @@ pub fn run_checks_reporting(
     checks: Vec<Box<dyn KernelCheck>>,
     progress: &(dyn Fn(&Progress) + Sync),
 ) -> CheckReport {
-    let slots = backend_slots();
+    run_checks_reporting_on(config, checks, backend_slots(), progress)
+}
+
+/// [`run_checks_reporting`] on `slots` only (`backend_slots_named`): the report has their
+/// columns alone.
+pub fn run_checks_reporting_on(
+    config: CheckConfig,
+    checks: Vec<Box<dyn KernelCheck>>,
+    slots: Vec<BackendSlot>,
+    progress: &(dyn Fn(&Progress) + Sync),
+) -> CheckReport {
     let references = ReferenceCache::default();
     let total = checks.len() * slots.len();
     let done = std::sync::atomic::AtomicUsize::new(0);

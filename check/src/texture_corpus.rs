@@ -516,7 +516,15 @@ impl Verdict {
 /// worker per core, each on its own device ([`crate::parallel`]); the verdicts come in
 /// the slots' order.
 pub fn run_texture_corpus() -> Vec<(String, Vec<(String, Verdict)>)> {
-    let slots = crate::backend_slots();
+    run_texture_corpus_on(crate::backend_slots())
+}
+
+/// [`run_texture_corpus`] on `slots` only (`backend_slots_named`), and on the interpreter
+/// (`cpu`) in any case: its outputs are what the others are judged against.
+pub fn run_texture_corpus_on(mut slots: Vec<crate::BackendSlot>) -> Vec<(String, Vec<(String, Verdict)>)> {
+    if !slots.iter().any(|slot| slot.name == "cpu") {
+        slots.splice(0..0, crate::backend_slots().into_iter().filter(|slot| slot.name == "cpu"));
+    }
     let cases = texture_cases();
     // Per slot: its runs of every case, or why it did not open.
     let per_slot: Vec<Result<Vec<BackendRun>, String>> = crate::parallel::map(&slots, |slot| {

@@ -104,6 +104,11 @@ enum Command {
         /// Only these kernels (registry names, comma-separated); all when left out.
         #[arg(long, value_delimiter = ',')]
         kernel: Vec<String>,
+        /// Only these backends (report names: cpu, wgpu-vulkan, wgpu-gl, ash, ash-glsl,
+        /// ash-hlsl, ash-slang, webgpu; comma-separated), for the kernels and the texture
+        /// corpus; all when left out.
+        #[arg(long, value_delimiter = ',')]
+        backend: Vec<String>,
     },
     /// Fuzz the scene, image and CSV loaders (structure-aware mutation, fixed seed).
     Fuzz(fuzz::FuzzArgs),
@@ -217,7 +222,7 @@ fn main() {
 fn execute(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Shaders { strict, out } => shaders(strict, out),
-        Command::Check { full, kernel } => check(full, &kernel),
+        Command::Check { full, kernel, backend } => check(full, &kernel, &backend),
         Command::Validate => validate::validate(),
         Command::Fuzz(args) => fuzz::fuzz(args),
         Command::Web { seconds } => web::web(seconds),
@@ -266,8 +271,10 @@ fn execute(cli: Cli) -> Result<()> {
     }
 }
 
-fn check(full: bool, only: &[String]) -> Result<()> {
+fn check(full: bool, only: &[String], backends: &[String]) -> Result<()> {
     let registry = Registry::shared()?;
+    let slots = || strata_check::backend_slots_named(backends).map_err(|why| anyhow::anyhow!("--backend {why}"));
+    slots()?;
     let mut checks = strata_check::kernel_checks();
     if let Some(unknown) = only.iter().find(|name| !checks.iter().any(|c| registry.get(c.kernel()).name() == *name)) {
         let names: Vec<&str> = checks.iter().map(|c| registry.get(c.kernel()).name()).collect();
@@ -290,13 +297,15 @@ fn check(full: bool, only: &[String]) -> Result<()> {
             minutes(p.remaining())
         );
     };
-    let report = strata_check::run_checks_reporting(strata_check::CheckConfig { full }, checks, &progress);
+    let report = strata_check::run_checks_reporting_on(strata_check::CheckConfig { full }, checks, slots()?, &progress);
     print!("{}", report.render());
     // The texture corpus (kernels outside the registry) unless only some kernels were asked for.
     if only.is_empty() {
-        eprintln!("check: the texture corpus on every backend");
+        let on = if backends.is_empty() { "every backend".to_string() } else { backends.join(", ") };
+        eprintln!("check: the texture corpus on {on}");
     }
-    let textures = if only.is_empty() { strata_check::texture_corpus::run_texture_corpus() } else { Vec::new() };
+    let textures =
+        if only.is_empty() { strata_check::texture_corpus::run_texture_corpus_on(slots()?) } else { Vec::new() };
     if !textures.is_empty() {
         print!("\n{}", strata_check::texture_corpus::render_table(&textures));
     }

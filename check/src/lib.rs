@@ -33,7 +33,7 @@ mod svgf;
 pub mod texture_corpus;
 mod trace;
 
-pub use backends::{BackendSlot, backend_slots, backend_slots_named};
+pub use backends::{BackendSlot, HOST_VULKAN_SLOTS, backend_slots, backend_slots_named};
 pub use compare::{Agreement, Compare, Mismatch, Output, compare_outputs};
 pub use report::{CellResult, CheckReport};
 

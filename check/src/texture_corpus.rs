@@ -552,7 +552,13 @@ pub fn run_texture_corpus_on(mut slots: Vec<crate::BackendSlot>) -> Vec<(String,
 /// The corpus as a table (cases × backends), then one line per distinct refusal or
 /// failure.
 pub fn render_table(results: &[(String, Vec<(String, Verdict)>)]) -> String {
-    let backends: Vec<String> = crate::backend_slots().iter().map(|s| s.name.to_string()).collect();
+    // The backends the corpus ran on (every one has a verdict per case, a refusal at
+    // least), in report order.
+    let backends: Vec<String> = crate::backend_slots()
+        .iter()
+        .map(|s| s.name.to_string())
+        .filter(|name| results.iter().any(|(_, verdicts)| verdicts.iter().any(|(b, _)| b == name)))
+        .collect();
     let width = results.iter().map(|(name, _)| name.len()).max().unwrap_or(4).max(12);
     let mut text = format!("{:<width$}", "texture corpus");
     for backend in &backends {

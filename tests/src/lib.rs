@@ -41,7 +41,8 @@ pub fn scenes_folder() -> std::path::PathBuf {
 /// "The validation layer where nothing reads it"). wgpu still validates every call itself.
 /// The layer's verdict on the wgpu route is read where it counts: `cargo xtask validate`
 /// runs `strata render` and `strata compare` (every method, with temporal reuse and
-/// accumulated) under it with synchronization validation and fails on any message, and
+/// accumulated) under it with synchronization validation and fails on any error or
+/// warning, and
 /// the ash backend's tests assert on the messages they collect.
 pub fn vulkan_backend(test: &str) -> Option<WgpuBackend> {
     open_or_skip(test, WgpuOptions { api: WgpuApi::Vulkan, validation: false, subgroups: true, ..Default::default() })

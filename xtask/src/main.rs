@@ -106,7 +106,7 @@ enum Command {
         kernel: Vec<String>,
         /// Only these backends (report names: cpu, wgpu-vulkan, wgpu-gl, ash, ash-glsl,
         /// ash-hlsl, ash-slang, webgpu; comma-separated), for the kernels and the texture
-        /// corpus; all when left out.
+        /// corpus (which runs cpu, its reference, in any case); all when left out or `all`.
         #[arg(long, value_delimiter = ',')]
         backend: Vec<String>,
     },
@@ -301,7 +301,15 @@ fn check(full: bool, only: &[String], backends: &[String]) -> Result<()> {
     print!("{}", report.render());
     // The texture corpus (kernels outside the registry) unless only some kernels were asked for.
     if only.is_empty() {
-        let on = if backends.is_empty() { "every backend".to_string() } else { backends.join(", ") };
+        let on = if backends.is_empty() {
+            "every backend".to_string()
+        } else {
+            let mut names: Vec<&str> = slots()?.iter().map(|slot| slot.name).collect();
+            if !names.contains(&"cpu") {
+                names.insert(0, "cpu (the reference)");
+            }
+            names.join(", ")
+        };
         eprintln!("check: the texture corpus on {on}");
     }
     let textures =

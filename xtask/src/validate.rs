@@ -117,15 +117,15 @@ pub fn validate() -> Result<()> {
         Step { name: "wgpu_embed", program: debug.join("examples").join("wgpu_embed"), args: vec![] },
         Step { name: "ash_embed", program: debug.join("examples").join("ash_embed"), args: vec![] },
         // The xtask the build above made (it may have replaced the running one), on the
-        // backends that make Vulkan calls of this machine's loader: the layer sees nothing
-        // of the interpreter, wgpu's GL backend or Chromium's WebGPU (its own SwiftShader),
-        // and with them this step took 66 s (23 s without), the whole command's 77 s (33 s)
-        // on the 2-core VM, all of it on CI's path (tests/tests/cross_backend.rs checks
-        // every column, without the layer).
+        // columns that make Vulkan calls through this machine's loader (HOST_VULKAN_SLOTS):
+        // the layer sees nothing of the interpreter, wgpu's GL backend or Chromium's WebGPU
+        // (its own SwiftShader); with them this step took 66 s (23 s without), the whole
+        // command 77 s (33 s) on the 2-core VM, all of it on CI's path.
+        // tests/tests/cross_backend.rs checks every column, without the layer.
         Step {
             name: "xtask-check",
             program: debug.join("xtask"),
-            args: ["check", "--backend", "wgpu-vulkan,ash,ash-glsl,ash-hlsl,ash-slang"].map(String::from).to_vec(),
+            args: vec!["check".into(), "--backend".into(), strata_check::HOST_VULKAN_SLOTS.join(",")],
         },
     ];
     // The steps are independent processes, mostly on one core each (pipeline compilation

@@ -33,7 +33,7 @@ mod svgf;
 pub mod texture_corpus;
 mod trace;
 
-pub use backends::{BackendSlot, HOST_VULKAN_SLOTS, backend_slots, backend_slots_named};
+pub use backends::{BackendSlot, backend_slots};
 pub use compare::{Agreement, Compare, Mismatch, Output, compare_outputs};
 pub use report::{CellResult, CheckReport};
 
@@ -161,8 +161,8 @@ pub fn run_checks_reporting(
     run_checks_reporting_on(config, checks, backend_slots(), progress)
 }
 
-/// [`run_checks_reporting`] on `slots` only (`backend_slots_named`): the report has their
-/// columns alone.
+/// [`run_checks_reporting`] on `slots` only (`run_kernel::named_slots`): the report has
+/// their columns alone.
 pub fn run_checks_reporting_on(
     config: CheckConfig,
     checks: Vec<Box<dyn KernelCheck>>,

@@ -298,12 +298,7 @@ pub fn named_slots(names: &[String]) -> Result<Vec<BackendSlot>> {
         if chosen.iter().any(|c| c.name == slot.name) {
             bail!("--backend {}: `{}` is named twice: name each path once", names.join(","), slot.name);
         }
-        chosen.push(BackendSlot {
-            name: slot.name,
-            open: slot.open,
-            needs_vulkan: slot.needs_vulkan,
-            toolchain: slot.toolchain,
-        });
+        chosen.push(*slot);
     }
     Ok(chosen)
 }

@@ -519,12 +519,19 @@ pub fn run_texture_corpus() -> Vec<(String, Vec<(String, Verdict)>)> {
     run_texture_corpus_on(crate::backend_slots())
 }
 
-/// [`run_texture_corpus`] on `slots` only (`backend_slots_named`), and on the interpreter
-/// (`cpu`) in any case: its outputs are what the others are judged against.
-pub fn run_texture_corpus_on(mut slots: Vec<crate::BackendSlot>) -> Vec<(String, Vec<(String, Verdict)>)> {
+/// `slots` with the interpreter (`cpu`) first where it is missing: the corpus's outputs are
+/// judged against its.
+pub fn with_reference(mut slots: Vec<crate::BackendSlot>) -> Vec<crate::BackendSlot> {
     if !slots.iter().any(|slot| slot.name == "cpu") {
         slots.splice(0..0, crate::backend_slots().into_iter().filter(|slot| slot.name == "cpu"));
     }
+    slots
+}
+
+/// [`run_texture_corpus`] on `slots` only (`run_kernel::named_slots`) and the interpreter
+/// ([`with_reference`]).
+pub fn run_texture_corpus_on(slots: Vec<crate::BackendSlot>) -> Vec<(String, Vec<(String, Verdict)>)> {
+    let slots = with_reference(slots);
     let cases = texture_cases();
     // Per slot: its runs of every case, or why it did not open.
     let per_slot: Vec<Result<Vec<BackendRun>, String>> = crate::parallel::map(&slots, |slot| {

@@ -42,8 +42,7 @@ pub fn scenes_folder() -> std::path::PathBuf {
 /// The layer's verdict on the wgpu route is read where it counts: `cargo xtask validate`
 /// runs `strata render` and `strata compare` (every method, with temporal reuse and
 /// accumulated) under it with synchronization validation and fails on any error or
-/// warning, and
-/// the ash backend's tests assert on the messages they collect.
+/// warning, and the ash backend's tests assert on the messages they collect.
 pub fn vulkan_backend(test: &str) -> Option<WgpuBackend> {
     open_or_skip(test, WgpuOptions { api: WgpuApi::Vulkan, validation: false, subgroups: true, ..Default::default() })
 }

@@ -105,8 +105,9 @@ enum Command {
         #[arg(long, value_delimiter = ',')]
         kernel: Vec<String>,
         /// Only these backends (report names: cpu, wgpu-vulkan, wgpu-gl, ash, ash-glsl,
-        /// ash-hlsl, ash-slang, webgpu; comma-separated), for the kernels and the texture
-        /// corpus (which runs cpu, its reference, in any case); all when left out or `all`.
+        /// ash-hlsl, ash-slang, webgpu, or wgpu for wgpu-vulkan; comma-separated), for the
+        /// kernels and the texture corpus (which runs cpu, its reference, in any case); all
+        /// when left out or `all`.
         #[arg(long, value_delimiter = ',')]
         backend: Vec<String>,
     },
@@ -273,8 +274,11 @@ fn execute(cli: Cli) -> Result<()> {
 
 fn check(full: bool, only: &[String], backends: &[String]) -> Result<()> {
     let registry = Registry::shared()?;
-    let slots = || strata_check::backend_slots_named(backends).map_err(|why| anyhow::anyhow!("--backend {why}"));
-    slots()?;
+    let slots = if backends.is_empty() {
+        strata_check::backend_slots()
+    } else {
+        strata_check::run_kernel::named_slots(backends)?
+    };
     let mut checks = strata_check::kernel_checks();
     if let Some(unknown) = only.iter().find(|name| !checks.iter().any(|c| registry.get(c.kernel()).name() == *name)) {
         let names: Vec<&str> = checks.iter().map(|c| registry.get(c.kernel()).name()).collect();
@@ -297,23 +301,18 @@ fn check(full: bool, only: &[String], backends: &[String]) -> Result<()> {
             minutes(p.remaining())
         );
     };
-    let report = strata_check::run_checks_reporting_on(strata_check::CheckConfig { full }, checks, slots()?, &progress);
+    let report =
+        strata_check::run_checks_reporting_on(strata_check::CheckConfig { full }, checks, slots.clone(), &progress);
     print!("{}", report.render());
     // The texture corpus (kernels outside the registry) unless only some kernels were asked for.
-    if only.is_empty() {
-        let on = if backends.is_empty() {
-            "every backend".to_string()
-        } else {
-            let mut names: Vec<&str> = slots()?.iter().map(|slot| slot.name).collect();
-            if !names.contains(&"cpu") {
-                names.insert(0, "cpu (the reference)");
-            }
-            names.join(", ")
-        };
-        eprintln!("check: the texture corpus on {on}");
-    }
-    let textures =
-        if only.is_empty() { strata_check::texture_corpus::run_texture_corpus_on(slots()?) } else { Vec::new() };
+    let textures = if only.is_empty() {
+        let slots = strata_check::texture_corpus::with_reference(slots);
+        let names: Vec<&str> = slots.iter().map(|slot| slot.name).collect();
+        eprintln!("check: the texture corpus on {}", names.join(", "));
+        strata_check::texture_corpus::run_texture_corpus_on(slots)
+    } else {
+        Vec::new()
+    };
     if !textures.is_empty() {
         print!("\n{}", strata_check::texture_corpus::render_table(&textures));
     }

@@ -339,6 +339,14 @@ impl RestirRenderer {
         let first = self.temporal_first.as_ref();
         let select_restir = first.map_or(self.restir_params, |f| f.canonical_params);
         let merged_out = first.map_or(self.reservoirs[current], |f| f.merged);
+        // A frame without a temporal merge (no temporal reuse, or the first frame) would
+        // have restir_temporal copy each selected reservoir unchanged (RestirParams.temporal
+        // = 0 merges nothing and skips the boiling filter), so select writes where the
+        // merge would and the merge is not dispatched: on lavapipe a dispatch costs about
+        // half a millisecond whatever it does, 5-7 % of a 32 x 32 frame without temporal
+        // reuse (docs/benchmarks/ci-time.md, "A dispatch's floor").
+        let temporal_on = self.settings.temporal && self.frame > 0;
+        let selected_out = if temporal_on { self.selected } else { merged_out };
         let [candidates_kernel, select_kernel, keys_kernel, temporal_kernel, shade_kernel] = self.kernels;
         let timed = self.timed && backend.info().timestamps;
         let mut pass_times = [std::time::Duration::ZERO; 5];
@@ -394,14 +402,13 @@ impl RestirRenderer {
                     ("path_candidates", self.candidates),
                     ("sorted_pixels", self.histogram.sorted_pixels),
                     ("spans", self.histogram.spans),
-                    ("reservoirs_out", self.selected),
+                    ("reservoirs_out", selected_out),
                     ("blue_noise", self.blue_noise),
                 ],
             )?,
         )?;
         // Temporal sources, and with T > 0 their histogram (the spatial histogram's runs
         // stand in for it when unused: the merge reads them only with T > 0).
-        let temporal_on = self.settings.temporal && self.frame > 0;
         if temporal_on {
             pass_times[3] = run(
                 backend,
@@ -427,24 +434,26 @@ impl RestirRenderer {
             }
         }
         let temporal_runs = self.temporal_histogram.as_ref().unwrap_or(&self.histogram);
-        pass_times[3] += run(
-            backend,
-            temporal_kernel,
-            &with(
+        if temporal_on {
+            pass_times[3] += run(
+                backend,
                 temporal_kernel,
-                &[
-                    ("primaries", self.primaries[current]),
-                    ("previous_primaries", self.primaries[previous_index]),
-                    ("current_reservoirs", self.selected),
-                    ("previous_reservoirs", self.reservoirs[previous_index]),
-                    ("merged_reservoirs", merged_out),
-                    ("temporal_sorted_pixels", temporal_runs.sorted_pixels),
-                    ("temporal_spans", temporal_runs.spans),
-                    ("temporal_sources", self.temporal_sources),
-                    ("blue_noise", self.blue_noise),
-                ],
-            )?,
-        )?;
+                &with(
+                    temporal_kernel,
+                    &[
+                        ("primaries", self.primaries[current]),
+                        ("previous_primaries", self.primaries[previous_index]),
+                        ("current_reservoirs", self.selected),
+                        ("previous_reservoirs", self.reservoirs[previous_index]),
+                        ("merged_reservoirs", merged_out),
+                        ("temporal_sorted_pixels", temporal_runs.sorted_pixels),
+                        ("temporal_spans", temporal_runs.spans),
+                        ("temporal_sources", self.temporal_sources),
+                        ("blue_noise", self.blue_noise),
+                    ],
+                )?,
+            )?;
+        }
         if let Some(first) = first {
             if self.settings.method.uses_histogram() {
                 pass_times[1] = run(
@@ -520,12 +529,24 @@ impl RestirRenderer {
             candidates: download(backend, self.candidates)?,
             histogram_candidates: download(backend, self.histogram.candidates)?,
             base_radiance: download(backend, self.base_radiance)?,
-            selected: download(backend, self.selected)?,
+            selected: download(backend, self.selected_buffer(last))?,
             temporal_keys: download(backend, self.temporal_keys_buffer())?,
             temporal_sources: download(backend, self.temporal_sources)?,
             reservoirs: download(backend, self.reservoirs[last])?,
             image: download(backend, self.frame_out)?,
         })
+    }
+
+    /// Where `restir_select` wrote in the last frame, whose reservoirs are
+    /// `reservoirs[last]`: its own buffer, which the temporal merge read, or in a frame
+    /// without a merge where the merge would have written (see `render_frame`).
+    fn selected_buffer(&self, last: usize) -> BufferId {
+        let merged = self.settings.temporal && self.frame > 1;
+        match &self.temporal_first {
+            _ if merged => self.selected,
+            Some(first) => first.merged,
+            None => self.reservoirs[last],
+        }
     }
 
     /// Where `restir_temporal_keys` writes: the temporal histogram's input, or a buffer

@@ -83,8 +83,9 @@ fn select_reservoir(id: vec3<u32>, pixel: u32, lane: u32) -> Reservoir {
     var state = resampling_start(k, pixel);
     if k == 0u {
         // K = 0 (the temporal-first order's first pass, RestirSettings::reuse_order): the
-        // canonical candidate alone, a reservoir of M = 1 that restir_temporal merges and
-        // restir_spatial then reuses.
+        // canonical candidate alone, a reservoir of M = 1 that restir_temporal merges (from
+        // the second frame; the renderer has the first frame's written to the merge's
+        // output) and restir_spatial then reuses.
         state.canonical_weight = canonical.target_value * c.weight;
     }
     for (var slot = 0u; slot < k; slot++) {

@@ -29,6 +29,9 @@
 // otherwise; W = sum(w) / p̂_c(Y);
 // M = M_c + mean_j M_j.
 // The shift is the identity on x2 (area measure) or on the direction (environment).
+// With RestirParams.temporal = 0 every reservoir is copied unchanged and the boiling
+// filter skipped; RestirRenderer never dispatches that (a frame without a merge has
+// restir_select write the merge's output itself), but an engine driving the passes may.
 //
 // Bindings (group 0): 0-1 the scene (2-7 unused), 8 RestirParams, and
 //   9  storage, read     array<Primary>      this frame's G-buffer

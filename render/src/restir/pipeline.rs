@@ -1,7 +1,9 @@
 //! One ReSTIR frame after another on any backend: the scene uploaded once, per-frame
 //! buffers (two G-buffers and two reservoir buffers alternate for temporal reuse), and
 //! the five passes dispatched in order (seven in the temporal-first order:
-//! [`ReuseOrder::TemporalFirst`]).
+//! [`ReuseOrder::TemporalFirst`]). A frame without a temporal merge (no temporal reuse,
+//! or the first frame) skips `restir_temporal_keys` and `restir_temporal`: the selection
+//! is written where the merge would have copied it.
 
 use super::{RestirSettings, ReuseOrder};
 use crate::histogram_pass::{BlockHistogramPass, HistogramVariant, PassError};
@@ -26,7 +28,8 @@ pub struct FrameStats {
     /// temporal histogram and merge), shade; in the temporal-first order the histogram
     /// includes its keys' pass and select the spatial reuse after the merge) from
     /// timestamp queries, when [`RestirRenderer::set_timed`] is on and the backend has
-    /// them; zero otherwise (and for the histogram of restir-disc, which skips it).
+    /// them; zero otherwise (and for the histogram of restir-disc, which skips it, and for
+    /// the temporal entry of a frame without a temporal merge, which skips its passes).
     pub pass_times: [std::time::Duration; 5],
 }
 
@@ -49,7 +52,7 @@ pub struct FrameBuffers {
     /// `restir_temporal_keys`: each pixel's temporal source pixel.
     pub temporal_sources: Vec<u32>,
     /// The final reservoirs: `restir_temporal`'s (`restir_spatial`'s in the temporal-first
-    /// order).
+    /// order; `restir_select`'s in a spatial-first frame without a temporal merge).
     pub reservoirs: Vec<Reservoir>,
     /// `restir_shade`: the frame (rgb, invalid flag).
     pub image: Vec<[f32; 4]>,
@@ -97,14 +100,16 @@ pub struct RestirRenderer {
 
 /// What the temporal-first order adds: `restir_select` runs with K = 0 (each pixel's
 /// canonical candidate alone, from its own uniform), `restir_temporal` merges the history
-/// into it, `restir_reservoir_keys` gives the histogram the merged reservoirs' estimates
+/// into it (from the second frame; the first frame's selection is written to `merged`
+/// directly), `restir_reservoir_keys` gives the histogram the merged reservoirs' estimates
 /// and `restir_spatial` reuses K of them into the final reservoirs.
 struct TemporalFirst {
     keys_kernel: &'static Kernel,
     spatial_kernel: &'static Kernel,
     /// `RestirParams` with K = 0, for the canonical pass.
     canonical_params: BufferId,
-    /// The temporal merge's output, the spatial pass's input.
+    /// The temporal merge's output (the selection's in the first frame), the spatial pass's
+    /// input.
     merged: BufferId,
 }
 
@@ -345,7 +350,7 @@ impl RestirRenderer {
         // merge would and the merge is not dispatched: on lavapipe a dispatch costs about
         // half a millisecond whatever it does, 5-7 % of a 32 x 32 frame without temporal
         // reuse (docs/benchmarks/ci-time.md, "A dispatch's floor").
-        let temporal_on = self.settings.temporal && self.frame > 0;
+        let temporal_on = self.merges(self.frame);
         let selected_out = if temporal_on { self.selected } else { merged_out };
         let [candidates_kernel, select_kernel, keys_kernel, temporal_kernel, shade_kernel] = self.kernels;
         let timed = self.timed && backend.info().timestamps;
@@ -541,12 +546,17 @@ impl RestirRenderer {
     /// `reservoirs[last]`: its own buffer, which the temporal merge read, or in a frame
     /// without a merge where the merge would have written (see `render_frame`).
     fn selected_buffer(&self, last: usize) -> BufferId {
-        let merged = self.settings.temporal && self.frame > 1;
         match &self.temporal_first {
-            _ if merged => self.selected,
+            _ if self.frame > 0 && self.merges(self.frame - 1) => self.selected,
             Some(first) => first.merged,
             None => self.reservoirs[last],
         }
+    }
+
+    /// Whether frame `frame` (counted from 0) merges the history: temporal reuse on, and a
+    /// previous frame to merge.
+    fn merges(&self, frame: u32) -> bool {
+        self.settings.temporal && frame > 0
     }
 
     /// Where `restir_temporal_keys` writes: the temporal histogram's input, or a buffer

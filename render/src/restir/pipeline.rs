@@ -349,7 +349,7 @@ impl RestirRenderer {
         // = 0 merges nothing and skips the boiling filter), so select writes where the
         // merge would and the merge is not dispatched: on lavapipe a dispatch costs about
         // half a millisecond whatever it does, 5-7 % of a 32 x 32 frame without temporal
-        // reuse (docs/benchmarks/ci-time.md, "A dispatch's floor").
+        // reuse (docs/benchmarks/ci-time.md, "Where a 32 × 32 ReSTIR frame's CPU goes").
         let temporal_on = self.merges(self.frame);
         let selected_out = if temporal_on { self.selected } else { merged_out };
         let [candidates_kernel, select_kernel, keys_kernel, temporal_kernel, shade_kernel] = self.kernels;

@@ -343,7 +343,7 @@ impl RestirRenderer {
         // merge its own buffer, and the histogram waits for the merged reservoirs' keys.
         let first = self.temporal_first.as_ref();
         let select_restir = first.map_or(self.restir_params, |f| f.canonical_params);
-        let merged_out = first.map_or(self.reservoirs[current], |f| f.merged);
+        let merged_out = self.merge_output(current);
         // A frame without a temporal merge (no temporal reuse, or the first frame) would
         // have restir_temporal copy each selected reservoir unchanged (RestirParams.temporal
         // = 0 merges nothing and skips the boiling filter), so select writes where the
@@ -412,8 +412,8 @@ impl RestirRenderer {
                 ],
             )?,
         )?;
-        // Temporal sources, and with T > 0 their histogram (the spatial histogram's runs
-        // stand in for it when unused: the merge reads them only with T > 0).
+        // Temporal sources, with T > 0 their histogram (the spatial histogram's runs stand
+        // in for it when unused: the merge reads them only with T > 0), then the merge.
         if temporal_on {
             pass_times[3] = run(
                 backend,
@@ -437,9 +437,7 @@ impl RestirRenderer {
                     std::time::Duration::ZERO
                 };
             }
-        }
-        let temporal_runs = self.temporal_histogram.as_ref().unwrap_or(&self.histogram);
-        if temporal_on {
+            let temporal_runs = self.temporal_histogram.as_ref().unwrap_or(&self.histogram);
             pass_times[3] += run(
                 backend,
                 temporal_kernel,
@@ -546,11 +544,15 @@ impl RestirRenderer {
     /// `reservoirs[last]`: its own buffer, which the temporal merge read, or in a frame
     /// without a merge where the merge would have written (see `render_frame`).
     fn selected_buffer(&self, last: usize) -> BufferId {
-        match &self.temporal_first {
-            _ if self.frame > 0 && self.merges(self.frame - 1) => self.selected,
-            Some(first) => first.merged,
-            None => self.reservoirs[last],
-        }
+        let merged = self.frame.checked_sub(1).is_some_and(|frame| self.merges(frame));
+        if merged { self.selected } else { self.merge_output(last) }
+    }
+
+    /// Where the temporal merge writes in a frame whose reservoirs are
+    /// `reservoirs[current]`: those, or the temporal-first order's `merged`, which
+    /// `restir_spatial` then reuses.
+    fn merge_output(&self, current: usize) -> BufferId {
+        self.temporal_first.as_ref().map_or(self.reservoirs[current], |first| first.merged)
     }
 
     /// Whether frame `frame` (counted from 0) merges the history: temporal reuse on, and a

@@ -159,6 +159,21 @@ impl RegionStats {
         self.count += 1.0;
     }
 
+    /// The estimates of `self` and `other` together (two runs of the same setting over
+    /// different seeds).
+    fn merged(mut self, other: &RegionStats) -> Self {
+        for (mine, theirs) in self.sum.iter_mut().zip(&other.sum) {
+            *mine += theirs;
+        }
+        for (mine, theirs) in self.squares.iter_mut().zip(&other.squares) {
+            *mine += theirs;
+        }
+        self.total_sum += other.total_sum;
+        self.total_squares += other.total_squares;
+        self.count += other.count;
+        self
+    }
+
     /// The same estimates scaled by `factor` (a deliberately biased variant).
     fn scaled(&self, factor: f64) -> Self {
         RegionStats {
@@ -1252,7 +1267,11 @@ const GLASS_TEMPORAL_FRAMES: u32 = 5;
 /// default) and without, with random replay at the alpha-0.03 wall (strata shading the
 /// sample, the baselines the expectation) and without; a 3 % bias is caught on the same
 /// scene, with replay.
-/// One test per method (they share the cores), all against one reference.
+/// One test per method (they share the cores), all against one reference. Without
+/// temporal reuse restir's three runs are held to the reference, and restir-disc's three
+/// (the same settings) and strata's without chains are paired with them frame by frame
+/// ([`assert_same_mean_with_power`], [`GLASS_PARTNERS`]); strata's other two, with
+/// settings restir does not run, are held to the reference.
 fn glass_metal_and_environment_reuse_stays_unbiased(test: &str, method: Method) {
     static REFERENCE: OnceLock<RegionStats> = OnceLock::new();
     let Some(mut backend) = strata_tests::vulkan_backend(test) else {
@@ -1261,15 +1280,7 @@ fn glass_metal_and_environment_reuse_stays_unbiased(test: &str, method: Method) 
     };
     let scene = glass_metal_environment_scene();
     let reference = REFERENCE.get_or_init(|| reference(&mut backend, &scene, 2048)).clone();
-    let chains = RestirSettings::default().specular_chain;
-    // Random replay in one of the runs with chains, each method with one shading (a
-    // replayed candidate costs a traced path per weighing: two runs each took CI +5 min).
-    let replay_with = if method == Method::Strata { Shading::Sample } else { Shading::Expectation };
-    for (shading, specular_chain, glossy_replay) in [
-        (Shading::Sample, chains, replay_with == Shading::Sample),
-        (Shading::Expectation, chains, replay_with == Shading::Expectation),
-        (Shading::Expectation, 0, false),
-    ] {
+    for (shading, specular_chain, glossy_replay) in glass_runs(method) {
         let restir = RestirSettings {
             method,
             shading,
@@ -1279,24 +1290,80 @@ fn glass_metal_and_environment_reuse_stays_unbiased(test: &str, method: Method) 
             selection: blocks_of_8(),
             ..RestirSettings::default()
         };
-        let ours = restir_frames(&mut backend, &scene, restir, 1..9, 32);
-        let what = format!(
-            "{} ({shading:?}, chain {specular_chain}, replay {glossy_replay}) without temporal reuse, glass/metal/environment",
-            method.name()
-        );
-        assert_unbiased_with_power(&what, &ours, &reference, POWER_GLASS);
-        if method == Method::Strata && shading == Shading::Sample {
-            let pooled = pooled_z(&ours.scaled(1.03), &reference);
-            assert!(pooled > 4.5, "a 3 % bias gives pooled z {pooled:.2} only");
+        let describe = |settings: &RestirSettings| {
+            format!(
+                "{} ({:?}, chain {}, replay {})",
+                settings.method.name(),
+                settings.shading,
+                settings.specular_chain,
+                settings.glossy_replay
+            )
+        };
+        let partners: Vec<RestirSettings> = if method == Method::Restir {
+            GLASS_PARTNERS
+                .iter()
+                .map(|&partner| RestirSettings { method: partner, ..restir })
+                .filter(|partner| glass_runs(partner.method).contains(&(shading, specular_chain, glossy_replay)))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        // Paired with restir in restir's test (below): nothing to render here.
+        let paired_elsewhere = GLASS_PARTNERS.contains(&method)
+            && glass_runs(Method::Restir).contains(&(shading, specular_chain, glossy_replay));
+        if !paired_elsewhere {
+            // restir's first seeds with its partners in lockstep, then the rest alone: the
+            // same frames restir_frames renders over 1..9.
+            let paired = paired_differences(&mut backend, &scene, restir, &partners, PAIRED_SEEDS, 32, |render| render);
+            let ours = restir_frames(&mut backend, &scene, restir, PAIRED_SEEDS.end..9, 32).merged(&paired.base);
+            let what = format!("{} without temporal reuse, glass/metal/environment", describe(&restir));
+            assert_unbiased_with_power(&what, &ours, &reference, POWER_GLASS);
+            if method == Method::Strata && shading == Shading::Sample {
+                let pooled = pooled_z(&ours.scaled(1.03), &reference);
+                assert!(pooled > 4.5, "a 3 % bias gives pooled z {pooled:.2} only");
+            }
+            for (partner, difference) in partners.iter().zip(&paired.differences) {
+                let what =
+                    format!("{} less restir, without temporal reuse, glass/metal/environment", describe(partner));
+                assert_same_mean_with_power(&what, difference, &reference, POWER_GLASS);
+                // The paired test can fail: the partner's frames 3 % too bright are caught.
+                let mut brighter = difference.clone();
+                let (total, _) = reference.total();
+                brighter.total_sum += 0.03 * total * brighter.count;
+                assert!(pooled_z(&brighter, &RegionStats::zero()) > 4.5, "{what}: a 3 % difference goes unnoticed");
+            }
         }
         let restir = RestirSettings { temporal: true, ..restir };
         let ours = restir_frames(&mut backend, &scene, restir, TEMPORAL_RENDERS, GLASS_TEMPORAL_FRAMES);
         let what = format!(
-            "{} ({shading:?}, chain {specular_chain}, replay {glossy_replay}) with temporal reuse, frames 3-{GLASS_TEMPORAL_FRAMES}, glass/metal/environment",
-            method.name()
+            "{} with temporal reuse, frames 3-{GLASS_TEMPORAL_FRAMES}, glass/metal/environment",
+            describe(&restir)
         );
         assert_unbiased_with_power(&what, &ours, &reference, POWER_GLASS_TEMPORAL);
     }
+}
+
+/// The methods whose runs without temporal reuse in the glass/metal/environment room are
+/// paired with restir's where restir runs the same setting. Their difference from restir
+/// spreads about a tenth as much as their frames (0.09-0.13 of the variance per region,
+/// 0.10-0.11 of the image total's; 64 frames of each of restir's three settings,
+/// restir-disc and strata against restir), so 2 renders of 32 frames resolve more finely
+/// than the 8 of 32 each ran against the reference before (docs/benchmarks/ci-time.md,
+/// "Compiling less for the tests, and the glass room's pairs").
+const GLASS_PARTNERS: [Method; 2] = [Method::RestirDisc, Method::Strata];
+
+/// The (shading, smooth chain, random replay) of `method`'s runs in the
+/// glass/metal/environment room: random replay in one of the runs with chains, each
+/// method with one shading (a replayed candidate costs a traced path per weighing: two
+/// runs each took CI +5 min).
+fn glass_runs(method: Method) -> [(Shading, u32, bool); 3] {
+    let chains = RestirSettings::default().specular_chain;
+    let replay_with = if method == Method::Strata { Shading::Sample } else { Shading::Expectation };
+    [
+        (Shading::Sample, chains, replay_with == Shading::Sample),
+        (Shading::Expectation, chains, replay_with == Shading::Expectation),
+        (Shading::Expectation, 0, false),
+    ]
 }
 
 #[test]

@@ -12,11 +12,14 @@ use strata_render::rgb_image::RgbImage;
 pub const MODULE_TARGET_DIR: &str = "target/web";
 
 /// The command that builds the module, as [`build_module`] runs it in the workspace's
-/// root (CI runs the same one early, in the background). Debug build without debug info:
-/// it compiles in about a minute on two cores, and the page's host work is light (the
-/// frame's time is the GPU's). Warnings in strata-web are errors here: its wasm32-only
-/// code is outside the workspace's (native) clippy step.
-pub const BUILD_COMMAND: [&str; 13] = [
+/// root (CI runs the same one early, in the background). Debug build without debug info,
+/// and unoptimised: the workspace's debug profile optimises the dependencies (opt-level 1)
+/// and the interpreter (2) for the native tests, which the page does not run; the page's
+/// host work is light (the frame's time is the GPU's), and the module compiles in 78
+/// CPU-s instead of 141 on the 2-core VM (docs/benchmarks/ci-time.md). Warnings in
+/// strata-web are errors here: its wasm32-only code is outside the workspace's (native)
+/// clippy step.
+pub const BUILD_COMMAND: [&str; 17] = [
     "rustc",
     "--quiet",
     "--package",
@@ -27,6 +30,10 @@ pub const BUILD_COMMAND: [&str; 13] = [
     "cdylib",
     "--target-dir",
     MODULE_TARGET_DIR,
+    "--config",
+    "profile.dev.package.\"*\".opt-level=0",
+    "--config",
+    "profile.dev.package.strata-backends.opt-level=0",
     "--",
     "-D",
     "warnings",
@@ -68,4 +75,26 @@ pub fn page_files(module: Vec<u8>, settings: &LiveSettings, reference: &RgbImage
     files.push(("reference.bin".into(), reference_bytes(reference)));
     files.push(("page.json".into(), config.to_string().into_bytes()));
     files
+}
+
+#[cfg(test)]
+mod tests {
+    use super::BUILD_COMMAND;
+
+    /// CI builds the module early, in the background, with the same command, so that the
+    /// page's test finds it built: a command that drifted apart would build it twice (the
+    /// second time inside the tests, about 80 CPU-s on CI's 2 cores).
+    #[test]
+    fn ci_builds_the_module_with_the_same_command() {
+        let run = concat!(env!("CARGO_MANIFEST_DIR"), "/../.ci/run");
+        let script = std::fs::read_to_string(run).unwrap_or_else(|e| panic!("{run}: {e}"));
+        let joined = script.replace("\\\n", " ");
+        let line = joined
+            .lines()
+            .find(|line| line.contains("cargo rustc") && line.contains("strata-web"))
+            .unwrap_or_else(|| panic!("{run}: no `cargo rustc` of strata-web"));
+        let command = &line[line.find("cargo rustc").unwrap()..line.find('>').unwrap_or(line.len())];
+        let words: Vec<&str> = command.split_whitespace().skip(1).map(|word| word.trim_matches('\'')).collect();
+        assert_eq!(words, BUILD_COMMAND, "{run} builds the page's module otherwise than serve::BUILD_COMMAND");
+    }
 }

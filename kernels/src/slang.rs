@@ -15,6 +15,7 @@ use crate::glslang::{ToolError, run_tool};
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::sync::OnceLock;
 
 /// The tool's source.
 const TOOL_SOURCE: &str = include_str!("slang_hlsl.cpp");
@@ -24,14 +25,21 @@ fn slang_folder() -> Result<PathBuf, ToolError> {
     if let Some(folder) = std::env::var_os("STRATA_SLANG_DIR") {
         return Ok(PathBuf::from(folder));
     }
+    // Asked of `python3` once per process: every Slang compile asks for the tool, and a
+    // Python start per compile (about 90 ms through pyenv's shim on the project's VM) was
+    // 58 starts and some 5 CPU-s of tests/tests/corpus.rs alone.
+    static INSTALLED: OnceLock<Option<PathBuf>> = OnceLock::new();
+    INSTALLED.get_or_init(installed_slangpy_folder).clone().ok_or_else(missing)
+}
+
+/// The installed `slangpy` package's folder, asked of `python3`; `None` without Python
+/// or the package.
+fn installed_slangpy_folder() -> Option<PathBuf> {
     let finder =
         "import importlib.util as u; s = u.find_spec('slangpy'); print(s.submodule_search_locations[0] if s else '')";
-    let output = Command::new("python3").args(["-c", finder]).output().map_err(|_| missing())?;
+    let output = Command::new("python3").args(["-c", finder]).output().ok()?;
     let folder = String::from_utf8_lossy(&output.stdout).trim().to_string();
-    if folder.is_empty() {
-        return Err(missing());
-    }
-    Ok(PathBuf::from(folder))
+    (!folder.is_empty()).then(|| PathBuf::from(folder))
 }
 
 fn missing() -> ToolError {

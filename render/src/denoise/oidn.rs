@@ -242,9 +242,16 @@ impl OidnLibrary {
 }
 
 /// `oidn/lib/`[`LIBRARY_NAME`] in the installed `pyoidn` package's folder, asked of
-/// `python3` without importing the package (which needs numpy); `None` without Python
-/// or the package.
+/// `python3` without importing the package (which needs numpy), once per process (a
+/// Python start is about 90 ms through pyenv's shim); `None` without Python or the
+/// package.
 fn wheel_library() -> Option<PathBuf> {
+    static FOUND: std::sync::OnceLock<Option<PathBuf>> = std::sync::OnceLock::new();
+    FOUND.get_or_init(ask_python_for_the_wheel_library).clone()
+}
+
+/// [`wheel_library`], asked of `python3`.
+fn ask_python_for_the_wheel_library() -> Option<PathBuf> {
     let finder =
         "import importlib.util as u; s = u.find_spec('pyoidn'); print(s.submodule_search_locations[0] if s else '')";
     let output = std::process::Command::new("python3").args(["-c", finder]).output().ok()?;

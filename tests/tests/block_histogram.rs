@@ -37,11 +37,14 @@ fn assert_same(grid: BlockGrid, variant: HistogramVariant, got: &HistogramOutput
     assert_eq!(got, want, "{context}");
 }
 
-fn check_sizes(variant: HistogramVariant, sizes: &[(u32, u32)], seed: u64) {
+/// Every variant of `variants` against the reference at every block size of every size in
+/// `sizes`: one input (from `seed`) and one reference per size and block size, shared by
+/// the variants.
+fn check_sizes(variants: &[HistogramVariant], sizes: &[(u32, u32)], seed: u64) {
     let Some(mut backend) = vulkan_backend("block_histogram") else {
         return;
     };
-    if variant == HistogramVariant::Subgroup && backend.info().subgroup_sizes.is_none() {
+    if variants.contains(&HistogramVariant::Subgroup) && backend.info().subgroup_sizes.is_none() {
         panic!("the Vulkan device has no subgroups: {}", backend.info().summary());
     }
     for (index, &(width, height)) in sizes.iter().enumerate() {
@@ -52,8 +55,10 @@ fn check_sizes(variant: HistogramVariant, sizes: &[(u32, u32)], seed: u64) {
                 CandidateMix { objects: 1 + (seed % 7) as u32, key_levels: 1 + (seed % 23) as u32, awkward: 0.08 };
             let candidates = candidate_image(width, height, seed, mix);
             let want = block_histogram(grid, &candidates);
-            let got = run_poisoned(&mut backend, variant, grid, &candidates);
-            assert_same(grid, variant, &got, &want);
+            for &variant in variants {
+                let got = run_poisoned(&mut backend, variant, grid, &candidates);
+                assert_same(grid, variant, &got, &want);
+            }
         }
     }
 }
@@ -62,17 +67,17 @@ const SMALL: &[(u32, u32)] = &[(1, 1), (17, 33), (33, 17), (64, 64), (3, 100), (
 
 #[test]
 fn portable_matches_reference_on_small_images() {
-    check_sizes(HistogramVariant::Portable, SMALL, 0x5eed_0001);
+    check_sizes(&[HistogramVariant::Portable], SMALL, 0x5eed_0001);
 }
 
 #[test]
 fn subgroup_matches_reference_on_small_images() {
-    check_sizes(HistogramVariant::Subgroup, SMALL, 0x5eed_0002);
+    check_sizes(&[HistogramVariant::Subgroup], SMALL, 0x5eed_0002);
 }
 
 #[test]
 fn rank_matches_reference_on_small_images() {
-    check_sizes(HistogramVariant::Rank, SMALL, 0x5eed_0006);
+    check_sizes(&[HistogramVariant::Rank], SMALL, 0x5eed_0006);
 }
 
 /// At 1080p the three variants share each block size's input and its reference: the Rust
@@ -80,26 +85,8 @@ fn rank_matches_reference_on_small_images() {
 /// when each variant had inputs of its own (18.4 s; docs/benchmarks/ci-time.md).
 #[test]
 fn every_variant_matches_reference_at_1080p() {
-    let Some(mut backend) = vulkan_backend("block_histogram") else {
-        return;
-    };
-    assert!(
-        backend.info().subgroup_sizes.is_some(),
-        "the Vulkan device has no subgroups: {}",
-        backend.info().summary()
-    );
-    let (width, height) = (1920, 1080);
-    for (b, &block_size) in BLOCK_SIZES.iter().enumerate() {
-        let grid = BlockGrid::new(width, height, block_size).unwrap();
-        let seed = 0x5eed_0003 ^ b as u64;
-        let mix = CandidateMix { objects: 1 + (seed % 7) as u32, key_levels: 1 + (seed % 23) as u32, awkward: 0.08 };
-        let candidates = candidate_image(width, height, seed, mix);
-        let want = block_histogram(grid, &candidates);
-        for variant in [HistogramVariant::Portable, HistogramVariant::Subgroup, HistogramVariant::Rank] {
-            let got = run_poisoned(&mut backend, variant, grid, &candidates);
-            assert_same(grid, variant, &got, &want);
-        }
-    }
+    let variants = [HistogramVariant::Portable, HistogramVariant::Subgroup, HistogramVariant::Rank];
+    check_sizes(&variants, &[(1920, 1080)], 0x5eed_0003);
 }
 
 /// The portable kernel on wgpu's GL backend (naga's GLSL on llvmpipe's OpenGL), which

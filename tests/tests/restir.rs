@@ -1306,15 +1306,6 @@ fn glass_metal_and_environment_reuse_stays_unbiased(test: &str, method: Method) 
             selection: blocks_of_8(),
             ..RestirSettings::default()
         };
-        let describe = |settings: &RestirSettings| {
-            format!(
-                "{} ({:?}, chain {}, replay {})",
-                settings.method.name(),
-                settings.shading,
-                settings.specular_chain,
-                settings.glossy_replay
-            )
-        };
         let partners: Vec<RestirSettings> = if method == Method::Restir {
             GLASS_PARTNERS
                 .iter()
@@ -1332,7 +1323,7 @@ fn glass_metal_and_environment_reuse_stays_unbiased(test: &str, method: Method) 
             // same frames restir_frames renders over 1..9.
             let paired = paired_differences(&mut backend, &scene, restir, &partners, PAIRED_SEEDS, 32, |render| render);
             let ours = restir_frames(&mut backend, &scene, restir, PAIRED_SEEDS.end..9, 32).merged(&paired.base);
-            let what = format!("{} without temporal reuse, glass/metal/environment", describe(&restir));
+            let what = format!("{} without temporal reuse, glass/metal/environment", glass_run_name(&restir));
             assert_unbiased_with_power(&what, &ours, &reference, POWER_GLASS);
             if method == Method::Strata && shading == Shading::Sample {
                 let pooled = pooled_z(&ours.scaled(1.03), &reference);
@@ -1340,7 +1331,7 @@ fn glass_metal_and_environment_reuse_stays_unbiased(test: &str, method: Method) 
             }
             for (partner, difference) in partners.iter().zip(&paired.differences) {
                 let what =
-                    format!("{} less restir, without temporal reuse, glass/metal/environment", describe(partner));
+                    format!("{} less restir, without temporal reuse, glass/metal/environment", glass_run_name(partner));
                 assert_same_mean_with_power(&what, difference, &reference, POWER_GLASS_PAIRED);
                 // The paired test can fail: the partner's frames 3 % too bright are caught.
                 let (total, _) = reference.total();
@@ -1352,7 +1343,7 @@ fn glass_metal_and_environment_reuse_stays_unbiased(test: &str, method: Method) 
         let ours = restir_frames(&mut backend, &scene, restir, TEMPORAL_RENDERS, GLASS_TEMPORAL_FRAMES);
         let what = format!(
             "{} with temporal reuse, frames 3-{GLASS_TEMPORAL_FRAMES}, glass/metal/environment",
-            describe(&restir)
+            glass_run_name(&restir)
         );
         assert_unbiased_with_power(&what, &ours, &reference, POWER_GLASS_TEMPORAL);
     }
@@ -1366,6 +1357,18 @@ fn glass_metal_and_environment_reuse_stays_unbiased(test: &str, method: Method) 
 /// than the 8 of 32 each ran against the reference before (docs/benchmarks/ci-time.md,
 /// "Compiling less for the tests, and the glass room's pairs").
 const GLASS_PARTNERS: [Method; 2] = [Method::RestirDisc, Method::Strata];
+
+/// A glass-room run's method and (shading, smooth chain, random replay), as its messages
+/// name it.
+fn glass_run_name(settings: &RestirSettings) -> String {
+    format!(
+        "{} ({:?}, chain {}, replay {})",
+        settings.method.name(),
+        settings.shading,
+        settings.specular_chain,
+        settings.glossy_replay
+    )
+}
 
 /// The (shading, smooth chain, random replay) of `method`'s runs in the
 /// glass/metal/environment room: random replay in one of the runs with chains, each

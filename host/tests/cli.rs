@@ -8,7 +8,8 @@ use std::process::{Command, Output};
 
 /// A fresh, empty folder for one test.
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("strata-cli-{name}-{}", std::process::id()));
+    let dir =
+        std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-cli-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("a scratch folder");
     dir
@@ -268,6 +269,7 @@ fn a_user_mistake_is_one_line_without_a_backtrace_even_with_rust_backtrace_set()
     assert_eq!(lines.len(), 1, "more than one line:\n{stderr}");
     assert!(lines[0].starts_with("error: ") && lines[0].contains("no-such-reference.exr"), "{stderr}");
     assert!(!stderr.to_lowercase().contains("backtrace"), "{stderr}");
+    std::fs::remove_dir_all(&out).unwrap();
 }
 
 #[test]
@@ -305,6 +307,7 @@ fn a_second_run_into_the_same_folder_replaces_the_first_runs_files() {
     // The interpreter sorts with the network (ranking pays B² comparisons lane by lane).
     let histogram = record["settings"]["histogram_kernel"].as_str();
     assert!(matches!(histogram, Some("block_histogram" | "block_histogram_subgroup")), "{record}");
+    std::fs::remove_dir_all(&out).unwrap();
 }
 
 /// `docs/cli.md` is every subcommand's `--help`, so the flag reference and the command

@@ -9,7 +9,8 @@ use std::process::Command;
 
 #[test]
 fn compare_with_svgf_measures_every_frame_denoised_and_the_frames_are_smoother() {
-    let out: PathBuf = std::env::temp_dir().join(format!("strata-denoise-{}", std::process::id()));
+    let out: PathBuf =
+        std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-denoise-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     // On the interpreter (every Vulkan driver hidden), so that it runs on any machine.
     let output = Command::new(env!("CARGO_BIN_EXE_strata"))

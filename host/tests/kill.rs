@@ -10,7 +10,8 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("strata-kill-{name}-{}", std::process::id()));
+    let dir =
+        std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-kill-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("a scratch folder");
     dir
@@ -72,8 +73,10 @@ fn kill_at_several_points(name: &str, args: &[&str], warm_up: &[&str]) {
     // number of frames, seeds or samples, so the first run is the smallest that runs
     // every pass (two frames, for the temporal passes; two seeds, which compare needs).
     let first = scratch(&format!("{name}-first"));
+    let mut folders = vec![first.clone()];
     assert!(strata(warm_up, &first).status().unwrap().success(), "the first uninterrupted run failed");
     let timing = scratch(&format!("{name}-timing"));
+    folders.push(timing.clone());
     let started = Instant::now();
     assert!(strata(args, &timing).status().unwrap().success(), "the uninterrupted run failed");
     let whole = started.elapsed();
@@ -82,6 +85,7 @@ fn kill_at_several_points(name: &str, args: &[&str], warm_up: &[&str]) {
     let mut last = timing;
     for (index, fraction) in [0.15, 0.35, 0.55, 0.75, 0.9, 0.97].into_iter().enumerate() {
         let out = scratch(&format!("{name}-{index}"));
+        folders.push(out.clone());
         let mut child = strata(args, &out).spawn().unwrap();
         std::thread::sleep(whole.mul_f64(fraction));
         let _ = child.kill();
@@ -112,6 +116,7 @@ fn kill_at_several_points(name: &str, args: &[&str], warm_up: &[&str]) {
         .collect();
     assert!(leftovers.is_empty(), "leftovers after a complete run: {leftovers:?}");
     assert!(Duration::from_secs(0) < whole);
+    folders.into_iter().for_each(|folder| std::fs::remove_dir_all(folder).unwrap());
 }
 
 /// The check itself: a truncated PNG, EXR or report under a final name is caught.
@@ -126,7 +131,9 @@ fn the_check_catches_truncated_files() {
         std::fs::write(out.join(name), &bytes[..bytes.len() * 2 / 3]).unwrap();
         let caught = std::panic::catch_unwind(|| assert_complete(&out)).is_err();
         assert!(caught, "a truncated {name} passed the check");
+        std::fs::remove_dir_all(out).unwrap();
     }
+    std::fs::remove_dir_all(whole).unwrap();
 }
 
 #[test]

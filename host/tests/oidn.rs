@@ -100,7 +100,8 @@ fn oidn_removes_most_of_the_noise_of_an_image_with_a_known_answer() {
 
 #[test]
 fn a_missing_library_is_one_line_saying_what_to_install() {
-    let out: PathBuf = std::env::temp_dir().join(format!("strata-oidn-missing-{}", std::process::id()));
+    let out: PathBuf =
+        std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-oidn-missing-{}", std::process::id()));
     let output = strata()
         .args(["compare", "--width", "32", "--height", "32", "--frames", "2", "--seeds", "2", "--denoise", "oidn"])
         .arg("--out")
@@ -126,7 +127,8 @@ fn compare_with_oidn_measures_every_frame_denoised() {
     if library().is_none() {
         return;
     }
-    let out: PathBuf = std::env::temp_dir().join(format!("strata-oidn-{}", std::process::id()));
+    let out: PathBuf =
+        std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-oidn-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     let output = strata()
         .args(["compare", "--width", "32", "--height", "32", "--frames", "3", "--seeds", "3"])

@@ -67,7 +67,8 @@ fn every_committed_finding_is_now_refused_cleanly() {
 
 #[test]
 fn a_short_fixed_seed_campaign_of_every_target_finds_nothing() {
-    let crash_dir = std::env::temp_dir().join(format!("strata-fuzz-findings-{}", std::process::id()));
+    let crash_dir =
+        std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-fuzz-findings-{}", std::process::id()));
     let started = Instant::now();
     let mut failures = Vec::new();
     for target in fuzz::targets(readers()) {
@@ -117,7 +118,8 @@ fn a_campaign_is_deterministic_from_its_seed() {
         seed,
         executions: Some(2000),
         duration: None,
-        crash_dir: std::env::temp_dir().join("strata-fuzz-determinism"),
+        crash_dir: std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+            .join(format!("strata-fuzz-determinism-{}", std::process::id())),
         hang_after: Duration::from_secs(20),
         allocation_limit: 0,
         shared_scenes: None,

@@ -13,7 +13,8 @@ use strata_render::render::{GpuScene, RenderSettings};
 use strata_render::scene::default_scene;
 
 fn scratch(name: &str) -> PathBuf {
-    let folder = std::env::temp_dir().join(format!("strata-pipeline-cache-{name}-{}", std::process::id()));
+    let folder = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("strata-pipeline-cache-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&folder);
     folder
 }

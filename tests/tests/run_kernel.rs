@@ -16,7 +16,8 @@ fn square(@builtin(global_invocation_id) id: vec3<u32>) {
 "#;
 
 fn setup(name: &str) -> (PathBuf, RunRequest) {
-    let dir = std::env::temp_dir().join(format!("strata-run-{name}-{}", std::process::id()));
+    let dir =
+        std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-run-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("square.wgsl"), SQUARE).unwrap();
     let input: Vec<u8> = (0..128u32).flat_map(|i| (i * 3).to_le_bytes()).collect();
@@ -102,7 +103,8 @@ fn bad_requests_are_named() {
 
 #[test]
 fn a_shader_with_overrides_runs_everywhere_with_and_without_override() {
-    let dir = std::env::temp_dir().join(format!("strata-run-override-{}", std::process::id()));
+    let dir =
+        std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-run-override-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let (width, height) = (32u32, 16u32);
     let size: Vec<u8> = [width, height].iter().flat_map(|v| v.to_le_bytes()).collect();
@@ -147,7 +149,7 @@ fn a_shader_with_overrides_runs_everywhere_with_and_without_override() {
 #[test]
 fn a_png_texture_and_a_sampler_run_everywhere_and_the_output_comes_back_as_png() {
     use strata_check::run_images::{ImageSpec, SamplerDesc, TextureFile};
-    let dir = std::env::temp_dir().join(format!("strata-run-png-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-run-png-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let (width, height) = (37u32, 22u32);
     let picture = image::RgbaImage::from_fn(width, height, |x, y| {
@@ -198,6 +200,7 @@ fn a_png_texture_and_a_sampler_run_everywhere_and_the_output_comes_back_as_png()
     wrong.images[2] = ImageSpec::StorageTexture((0, 2), [4, 4, 1], Some(strata_kernels::TexelFormat::R32Float));
     let error = run_kernel(&wrong).unwrap_err().to_string();
     assert!(error.contains("half_size") && error.contains("r32float") && error.contains("rgba8unorm"), "{error}");
+    std::fs::remove_dir_all(dir).unwrap();
 }
 
 /// `xtask run`'s sanitizer: with `--sanitize` the interpreter's findings come back with
@@ -231,4 +234,5 @@ fn the_interpreter_sanitizes_and_stops_endless_kernels_for_xtask_run() {
     let outcome = run_kernel(&request).unwrap();
     let error = outcome.runs[0].outputs.as_ref().expect_err("stopped");
     assert!(error.contains("time limit of 100 ms") && error.contains("endless.wgsl:9 in `main`"), "{error}");
+    std::fs::remove_dir_all(folder).unwrap();
 }

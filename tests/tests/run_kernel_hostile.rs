@@ -48,7 +48,8 @@ fn main() {
 
 /// A fresh scratch folder with the shaders and an input.
 fn scratch(name: &str) -> PathBuf {
-    let folder = std::env::temp_dir().join(format!("strata-hostile-{name}-{}", std::process::id()));
+    let folder =
+        std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-hostile-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&folder);
     std::fs::create_dir_all(&folder).unwrap();
     std::fs::write(folder.join("square.wgsl"), SQUARE).unwrap();
@@ -359,7 +360,8 @@ fn child_without_slang() {
 
 #[test]
 fn a_missing_toolchain_is_unavailable_under_all() {
-    let empty = std::env::temp_dir().join(format!("strata-hostile-no-slang-dir-{}", std::process::id()));
+    let empty = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("strata-hostile-no-slang-dir-{}", std::process::id()));
     std::fs::create_dir_all(&empty).unwrap();
     let status = std::process::Command::new(std::env::current_exe().unwrap())
         .args(["--exact", "child_without_slang", "--ignored", "--nocapture"])

@@ -10,7 +10,8 @@ use strata_render::scene::{Albedo, CameraFrame, Material, Scene, SceneError, loa
 
 /// A fresh folder under the system's temporary folder.
 fn temp_folder(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("strata-formats-{name}-{}", std::process::id()));
+    let dir =
+        std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-formats-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir

@@ -27,12 +27,12 @@
 //! and the OS error once, never the temporary folder beside it.
 //!
 //! ```
-//! let out = std::env::temp_dir().join(format!("strata-doc-package-{}", std::process::id()));
+//! let scratch = tempfile::tempdir()?; // removed when dropped
+//! let out = scratch.path().join("package");
 //! let package = strata_export::export(&out)?;
 //! assert!(package.files.iter().any(|f| f == "include/strata.h"));
 //! let manifest: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("manifest.json"))?)?;
 //! assert_eq!(manifest["schema_version"], 2);
-//! # std::fs::remove_dir_all(&out)?;
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 

@@ -142,11 +142,10 @@ mod tests {
     fn the_glsl_glslang_compiles_zeroes_workgroup_arrays_in_loops() {
         let registry = crate::Registry::shared().unwrap();
         let kernel = registry.get(crate::KernelId::BlockHistogram);
-        let dir = std::env::temp_dir().join(format!("strata-glsl-zero-init-{}", std::process::id()));
+        let dir = tempfile::Builder::new().prefix("strata-glsl-zero-init-").tempdir().unwrap();
         // The source is written before glslang runs: whether it is installed does not matter.
-        let _ = crate::glslang::compile(kernel, crate::glslang::GlslangInput::Glsl, &dir);
-        let text = std::fs::read_to_string(dir.join(format!("{}.comp", kernel.name()))).unwrap();
-        let _ = std::fs::remove_dir_all(&dir);
+        let _ = crate::glslang::compile(kernel, crate::glslang::GlslangInput::Glsl, dir.path());
+        let text = std::fs::read_to_string(dir.path().join(format!("{}.comp", kernel.name()))).unwrap();
         assert!(text.contains("shared_local[_zi0] = 0u;"), "no zeroing loop");
         for zero in ["0u, ", "uvec2(0u), "] {
             assert!(!text.contains(&zero.repeat(64)), "a zeroing constructor of `{zero}`");

@@ -257,11 +257,9 @@ fn stage(path: &Path, bytes: &[u8]) -> Result<strata_files::TemporaryFile, Write
 mod tests {
     use super::*;
 
+    /// A new empty folder of a random name (the test removes it).
     fn scratch(name: &str) -> PathBuf {
-        let folder = std::env::temp_dir().join(format!("strata-atomic-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&folder);
-        std::fs::create_dir_all(&folder).unwrap();
-        folder
+        tempfile::Builder::new().prefix(&format!("strata-atomic-{name}-")).tempdir().unwrap().keep()
     }
 
     fn names(folder: &Path) -> Vec<String> {

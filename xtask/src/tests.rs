@@ -31,12 +31,9 @@ fn refused(args: &[&str], wanted: &[&str]) -> String {
     error
 }
 
-/// A fresh scratch folder of this test.
+/// A new empty folder of a random name for this test (the test removes it).
 fn scratch(name: &str) -> PathBuf {
-    let folder = std::env::temp_dir().join(format!("strata-xtask-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&folder);
-    std::fs::create_dir_all(&folder).unwrap();
-    folder
+    tempfile::Builder::new().prefix(&format!("strata-xtask-{name}-")).tempdir().unwrap().keep()
 }
 
 fn text(path: &Path) -> String {

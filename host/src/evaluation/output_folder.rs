@@ -232,12 +232,9 @@ pub fn prepare(folder: &Path, keep: Option<&Path>) -> Result<(FolderLock, Vec<St
 mod tests {
     use super::*;
 
-    /// An empty scratch folder of this test process.
+    /// A new empty folder of a random name (the test removes it).
     fn scratch(name: &str) -> PathBuf {
-        let folder = std::env::temp_dir().join(format!("strata-output-folder-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&folder);
-        std::fs::create_dir_all(&folder).unwrap();
-        folder
+        tempfile::Builder::new().prefix(&format!("strata-output-folder-{name}-")).tempdir().unwrap().keep()
     }
 
     #[test]

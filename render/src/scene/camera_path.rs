@@ -361,7 +361,6 @@ fn unit_or_zero(v: DVec3) -> [f32; 3] {
 mod tests {
     use super::*;
     use crate::scene::default_scene;
-    use std::sync::atomic::{AtomicUsize, Ordering};
 
     fn base() -> Camera {
         default_scene().camera
@@ -384,11 +383,11 @@ mod tests {
         (glam::Vec3::from(a) - glam::Vec3::from(b)).length()
     }
 
-    /// Writes `text` to a new file under the temp folder; the caller removes it.
+    /// Writes `text` to a new file of a random name under the temp folder; the caller
+    /// removes it.
     fn temp_file(name: &str, text: &str) -> PathBuf {
-        static COUNT: AtomicUsize = AtomicUsize::new(0);
-        let unique = COUNT.fetch_add(1, Ordering::Relaxed);
-        let path = std::env::temp_dir().join(format!("strata-camera-path-{}-{unique}-{name}.json", std::process::id()));
+        let file = tempfile::Builder::new().prefix(&format!("strata-camera-path-{name}-")).suffix(".json").tempfile();
+        let path = file.unwrap().into_temp_path().keep().unwrap();
         std::fs::write(&path, text).unwrap();
         path
     }
@@ -589,7 +588,8 @@ mod tests {
         assert_eq!(field("dolly:", &base), "dolly");
         assert_eq!(field("orbit:1", &Camera { up: [0.0; 3], ..base.clone() }), "camera.up");
         assert_eq!(field("dolly:1", &Camera { target: base.origin, ..base.clone() }), "camera.target");
-        let missing = std::env::temp_dir().join(format!("strata-camera-path-{}-missing.json", std::process::id()));
+        let folder = tempfile::Builder::new().prefix("strata-camera-path-").tempdir().unwrap();
+        let missing = folder.path().join("missing.json");
         assert!(matches!(parse_camera_path(missing.to_str().unwrap(), &base), Err(SceneError::Io { .. })));
     }
 

@@ -32,12 +32,9 @@ fn rows(methods: &[Method], frames: u32, seeds: u32) -> Vec<FrameError> {
     errors
 }
 
-/// A fresh empty folder for one test's files.
+/// A new empty folder of a random name for one test's files (the test removes it).
 fn folder(name: &str) -> PathBuf {
-    let path = std::env::temp_dir().join(format!("strata-plot-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&path);
-    std::fs::create_dir_all(&path).unwrap();
-    path
+    tempfile::Builder::new().prefix(&format!("strata-plot-{name}-")).tempdir().unwrap().keep()
 }
 
 /// Each `<polyline>` of an SVG: its stroke colour (lower case) and number of points.

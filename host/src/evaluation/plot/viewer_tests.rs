@@ -36,12 +36,9 @@ fn curves(method: Method, stage: Stage, low: f64) -> ViewerCurves {
     }
 }
 
-/// A fresh empty folder for one test's files.
+/// A new empty folder of a random name for one test's files (the test removes it).
 fn folder(name: &str) -> PathBuf {
-    let path = std::env::temp_dir().join(format!("strata-viewer-plot-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&path);
-    std::fs::create_dir_all(&path).unwrap();
-    path
+    tempfile::Builder::new().prefix(&format!("strata-viewer-plot-{name}-")).tempdir().unwrap().keep()
 }
 
 /// The texts of an SVG's `<text>` elements.

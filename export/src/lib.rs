@@ -27,7 +27,7 @@
 //! and the OS error once, never the temporary folder beside it.
 //!
 //! ```
-//! let scratch = tempfile::tempdir()?; // removed when dropped
+//! let scratch = strata_files::private_scratch_folder("my-package-")?; // removed when dropped
 //! let out = scratch.path().join("package");
 //! let package = strata_export::export(&out)?;
 //! assert!(package.files.iter().any(|f| f == "include/strata.h"));

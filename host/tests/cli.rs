@@ -6,7 +6,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-/// A fresh, empty folder for one test.
+/// A fresh, empty folder for one test, under cargo's `target/tmp`, not the shared `/tmp`, where
+/// another user could create the name first.
 fn scratch(name: &str) -> PathBuf {
     let dir =
         std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-cli-{name}-{}", std::process::id()));

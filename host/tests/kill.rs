@@ -9,6 +9,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+/// A fresh empty folder of this test process, under cargo's `target/tmp`, not the shared `/tmp`,
+/// where another user could create the name first; the test removes it once it passed.
 fn scratch(name: &str) -> PathBuf {
     let dir =
         std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-kill-{name}-{}", std::process::id()));

@@ -142,7 +142,7 @@ mod tests {
     fn the_glsl_glslang_compiles_zeroes_workgroup_arrays_in_loops() {
         let registry = crate::Registry::shared().unwrap();
         let kernel = registry.get(crate::KernelId::BlockHistogram);
-        let dir = tempfile::Builder::new().prefix("strata-glsl-zero-init-").tempdir().unwrap();
+        let dir = strata_files::private_scratch_folder("strata-glsl-zero-init-").unwrap();
         // The source is written before glslang runs: whether it is installed does not matter.
         let _ = crate::glslang::compile(kernel, crate::glslang::GlslangInput::Glsl, dir.path());
         let text = std::fs::read_to_string(dir.path().join(format!("{}.comp", kernel.name()))).unwrap();

@@ -259,7 +259,7 @@ mod tests {
 
     /// A new empty folder of a random name (the test removes it).
     fn scratch(name: &str) -> PathBuf {
-        tempfile::Builder::new().prefix(&format!("strata-atomic-{name}-")).tempdir().unwrap().keep()
+        strata_files::private_scratch_folder(&format!("strata-atomic-{name}-")).unwrap().keep()
     }
 
     fn names(folder: &Path) -> Vec<String> {

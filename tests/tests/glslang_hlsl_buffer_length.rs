@@ -23,6 +23,7 @@ fn reproducer_disassembly() -> Option<String> {
     let source = format!("{}/data/upstream/glslang_byte_address_get_dimensions.hlsl", env!("CARGO_MANIFEST_DIR"));
     let dir =
         std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-glslang-repro-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let spv = dir.join("repro.spv");
     let args: Vec<&std::ffi::OsStr> = ["-D", "-e", "main", "-V", "--target-env", "vulkan1.1", "-S", "comp"]

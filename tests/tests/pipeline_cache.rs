@@ -12,6 +12,8 @@ use strata_backends::{Backend, BackendError, gpu_required};
 use strata_render::render::{GpuScene, RenderSettings};
 use strata_render::scene::default_scene;
 
+/// A path for this test process's cache folder, under cargo's `target/tmp`, not the shared `/tmp`,
+/// where another user could create the name first; nothing is there yet (the cache makes it).
 fn scratch(name: &str) -> PathBuf {
     let folder = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join(format!("strata-pipeline-cache-{name}-{}", std::process::id()));

@@ -15,9 +15,12 @@ fn square(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 "#;
 
+/// A fresh folder holding the squaring kernel and its input, under cargo's `target/tmp`, not the
+/// shared `/tmp`, where another user could create the name first, and the request that runs it.
 fn setup(name: &str) -> (PathBuf, RunRequest) {
     let dir =
         std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-run-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("square.wgsl"), SQUARE).unwrap();
     let input: Vec<u8> = (0..128u32).flat_map(|i| (i * 3).to_le_bytes()).collect();
@@ -105,6 +108,7 @@ fn bad_requests_are_named() {
 fn a_shader_with_overrides_runs_everywhere_with_and_without_override() {
     let dir =
         std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-run-override-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let (width, height) = (32u32, 16u32);
     let size: Vec<u8> = [width, height].iter().flat_map(|v| v.to_le_bytes()).collect();
@@ -150,6 +154,7 @@ fn a_shader_with_overrides_runs_everywhere_with_and_without_override() {
 fn a_png_texture_and_a_sampler_run_everywhere_and_the_output_comes_back_as_png() {
     use strata_check::run_images::{ImageSpec, SamplerDesc, TextureFile};
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-run-png-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let (width, height) = (37u32, 22u32);
     let picture = image::RgbaImage::from_fn(width, height, |x, y| {

@@ -362,6 +362,7 @@ fn child_without_slang() {
 fn a_missing_toolchain_is_unavailable_under_all() {
     let empty = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join(format!("strata-hostile-no-slang-dir-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&empty);
     std::fs::create_dir_all(&empty).unwrap();
     let status = std::process::Command::new(std::env::current_exe().unwrap())
         .args(["--exact", "child_without_slang", "--ignored", "--nocapture"])

@@ -8,7 +8,8 @@ use std::path::{Path, PathBuf};
 use strata_check::fuzz::build::base64;
 use strata_render::scene::{Albedo, CameraFrame, Material, Scene, SceneError, load_scene_file, srgb_to_linear};
 
-/// A fresh folder under the system's temporary folder.
+/// A fresh empty folder of this test process, under cargo's `target/tmp`, not the shared `/tmp`,
+/// where another user could create the name first.
 fn temp_folder(name: &str) -> PathBuf {
     let dir =
         std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-formats-{name}-{}", std::process::id()));

@@ -59,6 +59,7 @@ fn ply(vertices: &[[f32; 3]], faces: &[[i32; 3]]) -> Vec<u8> {
 #[test]
 fn bad_meshes_are_named() {
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-ply-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let good = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
     assert_eq!(read_ply(&write(&dir, "good.ply", &ply(&good, &[[0, 1, 2]]))).unwrap().faces.len(), 1);
@@ -84,6 +85,7 @@ fn bad_meshes_are_named() {
 #[test]
 fn bad_scene_files_name_the_field() {
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-scene-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     write(&dir, "tri.ply", &ply(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &[[0, 1, 2]]));
     write(&dir, "flat.ply", &ply(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]], &[[0, 1, 2]]));
@@ -131,6 +133,7 @@ fn bad_environment_maps_and_textures_are_named() {
     use strata_render::scene::{Environment, Texture};
     let dir =
         std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-bad-images-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let missing = dir.join("missing.exr");
     let error = Environment::load(&missing, 1.0, None).unwrap_err().to_string();

@@ -11,6 +11,7 @@ fn every_kernel_translates_and_validates_for_every_target() {
     let required = std::env::var("STRATA_REQUIRE_VALIDATORS").is_ok_and(|v| !v.is_empty() && v != "0");
     let dir =
         std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("strata-translation-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let registry = Registry::load().unwrap_or_else(|e| panic!("{e}"));
     let mut problems = Vec::new();

@@ -33,7 +33,7 @@ fn refused(args: &[&str], wanted: &[&str]) -> String {
 
 /// A new empty folder of a random name for this test (the test removes it).
 fn scratch(name: &str) -> PathBuf {
-    tempfile::Builder::new().prefix(&format!("strata-xtask-{name}-")).tempdir().unwrap().keep()
+    strata_files::private_scratch_folder(&format!("strata-xtask-{name}-")).unwrap().keep()
 }
 
 fn text(path: &Path) -> String {

@@ -234,7 +234,7 @@ mod tests {
 
     /// A new empty folder of a random name (the test removes it).
     fn scratch(name: &str) -> PathBuf {
-        tempfile::Builder::new().prefix(&format!("strata-output-folder-{name}-")).tempdir().unwrap().keep()
+        strata_files::private_scratch_folder(&format!("strata-output-folder-{name}-")).unwrap().keep()
     }
 
     #[test]

@@ -383,11 +383,11 @@ mod tests {
         (glam::Vec3::from(a) - glam::Vec3::from(b)).length()
     }
 
-    /// Writes `text` to a new file of a random name under the temp folder; the caller
-    /// removes it.
+    /// Writes `text` to `NAME.json` in a new folder of a random name; the caller removes
+    /// the folder (the path's parent).
     fn temp_file(name: &str, text: &str) -> PathBuf {
-        let file = tempfile::Builder::new().prefix(&format!("strata-camera-path-{name}-")).suffix(".json").tempfile();
-        let path = file.unwrap().into_temp_path().keep().unwrap();
+        let folder = strata_files::private_scratch_folder("strata-camera-path-").unwrap().keep();
+        let path = folder.join(format!("{name}.json"));
         std::fs::write(&path, text).unwrap();
         path
     }
@@ -396,7 +396,7 @@ mod tests {
     fn load_error_field(name: &str, text: &str) -> (String, String) {
         let path = temp_file(name, text);
         let result = CameraPath::load(&path);
-        std::fs::remove_file(&path).unwrap();
+        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
         match result {
             Err(error @ SceneError::Json { .. }) => {
                 let message = error.to_string();
@@ -562,7 +562,7 @@ mod tests {
                               {"frame": 2.5, "origin": [1, 1, -5], "target": [0, 1, 0]}]}"#,
         );
         let parsed = parse_camera_path(path.to_str().unwrap(), &base);
-        std::fs::remove_file(&path).unwrap();
+        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
         assert_eq!(
             parsed.unwrap(),
             CameraPath::Keyframes(vec![
@@ -588,7 +588,7 @@ mod tests {
         assert_eq!(field("dolly:", &base), "dolly");
         assert_eq!(field("orbit:1", &Camera { up: [0.0; 3], ..base.clone() }), "camera.up");
         assert_eq!(field("dolly:1", &Camera { target: base.origin, ..base.clone() }), "camera.target");
-        let folder = tempfile::Builder::new().prefix("strata-camera-path-").tempdir().unwrap();
+        let folder = strata_files::private_scratch_folder("strata-camera-path-").unwrap();
         let missing = folder.path().join("missing.json");
         assert!(matches!(parse_camera_path(missing.to_str().unwrap(), &base), Err(SceneError::Io { .. })));
     }
@@ -657,7 +657,7 @@ mod tests {
                                      {"frame": 2, "origin": [0, 5, 0], "target": [0, 1, 0]}]}"#;
         let path = temp_file("along-up", text);
         let parsed = parse_camera_path(&path, &base);
-        std::fs::remove_file(&path).unwrap();
+        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
         match parsed {
             Err(error @ SceneError::Json { .. }) => {
                 let message = error.to_string();

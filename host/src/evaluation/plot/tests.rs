@@ -34,7 +34,7 @@ fn rows(methods: &[Method], frames: u32, seeds: u32) -> Vec<FrameError> {
 
 /// A new empty folder of a random name for one test's files (the test removes it).
 fn folder(name: &str) -> PathBuf {
-    tempfile::Builder::new().prefix(&format!("strata-plot-{name}-")).tempdir().unwrap().keep()
+    strata_files::private_scratch_folder(&format!("strata-plot-{name}-")).unwrap().keep()
 }
 
 /// Each `<polyline>` of an SVG: its stroke colour (lower case) and number of points.

@@ -38,7 +38,7 @@ fn curves(method: Method, stage: Stage, low: f64) -> ViewerCurves {
 
 /// A new empty folder of a random name for one test's files (the test removes it).
 fn folder(name: &str) -> PathBuf {
-    tempfile::Builder::new().prefix(&format!("strata-viewer-plot-{name}-")).tempdir().unwrap().keep()
+    strata_files::private_scratch_folder(&format!("strata-viewer-plot-{name}-")).unwrap().keep()
 }
 
 /// The texts of an SVG's `<text>` elements.

@@ -27,7 +27,9 @@ fn strata_without_vulkan(args: &[&str]) -> Output {
         .env_remove("VK_ADD_ICD_FILENAMES")
         .env("RUST_BACKTRACE", "0")
         .env("RUST_LIB_BACKTRACE", "0")
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        // A runtime folder that does not exist, in cargo's target folder, not the shared /tmp: Mesa's
+        // Vulkan layer connects to $XDG_RUNTIME_DIR/wayland-0, which anyone can create there (SECURITY.md).
+        .env("XDG_RUNTIME_DIR", concat!(env!("CARGO_TARGET_TMPDIR"), "/no-display"))
         .output()
         .expect("the strata binary runs")
 }
@@ -261,7 +263,7 @@ fn a_user_mistake_is_one_line_without_a_backtrace_even_with_rust_backtrace_set()
         .arg(&out)
         .env("RUST_BACKTRACE", "1")
         .env("RUST_LIB_BACKTRACE", "1")
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .env("XDG_RUNTIME_DIR", concat!(env!("CARGO_TARGET_TMPDIR"), "/no-display"))
         .output()
         .expect("the strata binary runs");
     let stderr = text(&output.stderr);
@@ -270,6 +272,43 @@ fn a_user_mistake_is_one_line_without_a_backtrace_even_with_rust_backtrace_set()
     assert_eq!(lines.len(), 1, "more than one line:\n{stderr}");
     assert!(lines[0].starts_with("error: ") && lines[0].contains("no-such-reference.exr"), "{stderr}");
     assert!(!stderr.to_lowercase().contains("backtrace"), "{stderr}");
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// An `XDG_RUNTIME_DIR` that other users can write (as `/tmp`) gets one warning line before
+/// anything else (Mesa's Vulkan layer connects to a display socket there; runtime_dir.rs in
+/// the binary says why); a folder of the user's own gets none.
+#[cfg(unix)]
+#[test]
+fn a_runtime_folder_others_can_write_is_warned_about_in_one_line() {
+    use std::os::unix::fs::PermissionsExt;
+    let out = scratch("shared-runtime-dir");
+    let shared = out.join("shared");
+    std::fs::create_dir(&shared).unwrap();
+    std::fs::set_permissions(&shared, std::fs::Permissions::from_mode(0o1777)).unwrap();
+    let missing = out.join("no-such-reference.exr");
+    let run = |runtime: &Path| {
+        let output = Command::new(env!("CARGO_BIN_EXE_strata"))
+            .args(["compare", "--width", "8", "--height", "8", "--reference"])
+            .arg(&missing)
+            .arg("--out")
+            .arg(&out)
+            .env("XDG_RUNTIME_DIR", runtime)
+            .output()
+            .expect("the strata binary runs");
+        assert_eq!(output.status.code(), Some(1), "{}", text(&output.stderr));
+        text(&output.stderr).lines().map(str::to_string).collect::<Vec<_>>()
+    };
+    let lines = run(&shared);
+    assert_eq!(lines.len(), 2, "{lines:#?}");
+    let warning = format!("warning: XDG_RUNTIME_DIR={}: ", shared.display());
+    assert!(lines[0].starts_with(&warning) && lines[0].contains("wayland-0"), "{lines:#?}");
+    assert!(lines[1].starts_with("error: ") && lines[1].contains("no-such-reference.exr"), "{lines:#?}");
+    let private = out.join("private");
+    std::fs::create_dir(&private).unwrap();
+    std::fs::set_permissions(&private, std::fs::Permissions::from_mode(0o700)).unwrap();
+    let lines = run(&private);
+    assert_eq!(lines.len(), 1, "{lines:#?}");
     std::fs::remove_dir_all(&out).unwrap();
 }
 

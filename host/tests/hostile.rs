@@ -33,7 +33,9 @@ fn command(args: &[&std::ffi::OsStr]) -> Command {
         .args(args)
         .env("RUST_BACKTRACE", "1")
         .env("RUST_LIB_BACKTRACE", "1")
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir());
+        // A runtime folder that does not exist, in cargo's target folder, not the shared /tmp: Mesa's
+        // Vulkan layer connects to $XDG_RUNTIME_DIR/wayland-0, which anyone can create there (SECURITY.md).
+        .env("XDG_RUNTIME_DIR", concat!(env!("CARGO_TARGET_TMPDIR"), "/no-display"));
     command
 }
 
@@ -188,7 +190,7 @@ fn in_small_tmpfs(mount: &Path, kib: u64, script: &str) -> Option<String> {
     let output = Command::new("unshare")
         .args(["-rm", "sh", "-c", &full])
         .env("RUST_BACKTRACE", "1")
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .env("XDG_RUNTIME_DIR", concat!(env!("CARGO_TARGET_TMPDIR"), "/no-display"))
         .output();
     match output {
         Ok(output) if output.status.code() != Some(97) => {
@@ -1163,7 +1165,7 @@ fn render_refuses_a_folder_it_cannot_write_before_rendering() {
     let output = Command::new("unshare")
         .args(["-rm", "sh", "-c", &script])
         .env("RUST_BACKTRACE", "1")
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .env("XDG_RUNTIME_DIR", concat!(env!("CARGO_TARGET_TMPDIR"), "/no-display"))
         .output();
     let output = match output {
         Ok(output) if output.status.code() != Some(97) => output,

@@ -25,7 +25,9 @@ fn strata(args: &[&str], out: &Path) -> Command {
         .args(args)
         .arg("--out")
         .arg(out)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        // A runtime folder that does not exist, in cargo's target folder, not the shared /tmp: Mesa's
+        // Vulkan layer connects to $XDG_RUNTIME_DIR/wayland-0, which anyone can create there (SECURITY.md).
+        .env("XDG_RUNTIME_DIR", concat!(env!("CARGO_TARGET_TMPDIR"), "/no-display"))
         .stdout(Stdio::null())
         .stderr(Stdio::null());
     command

@@ -164,7 +164,9 @@ fn run_c_sized(
             "--block-shift",
             &number(u32::from(settings.block_shift)),
         ])
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        // A runtime folder that does not exist, in cargo's target folder, not the shared /tmp: Mesa's
+        // Vulkan layer connects to $XDG_RUNTIME_DIR/wayland-0, which anyone can create there (SECURITY.md).
+        .env("XDG_RUNTIME_DIR", concat!(env!("CARGO_TARGET_TMPDIR"), "/no-display"))
         // cargo's LD_LIBRARY_PATH names target/debug, whose libstrata_vk.so only a build of
         // the workspace refreshes: the program finds the library by its rpath instead
         // (`library_folder`, the one this test binary was built with).
@@ -1113,7 +1115,7 @@ fn run_synchronization_validated(program: &Path, package: &Path, inputs: &Path) 
         .args(["package", inputs.to_str().unwrap(), out.to_str().unwrap(), "--package", package.to_str().unwrap()])
         .args(["--width", &WIDTH.to_string(), "--height", &HEIGHT.to_string(), "--frames", "4"])
         .args(["--block-size", "8", "--candidates", "4", "--block-shift", "1", "--histogram", "auto"])
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .env("XDG_RUNTIME_DIR", concat!(env!("CARGO_TARGET_TMPDIR"), "/no-display"))
         .env_remove("LD_LIBRARY_PATH")
         .env("VK_INSTANCE_LAYERS", "VK_LAYER_KHRONOS_validation")
         .env("VK_LAYER_ENABLES", "VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT")

@@ -2,6 +2,7 @@
 
 mod compare_command;
 mod histogram_command;
+mod runtime_dir;
 mod warm_up;
 
 /// `--exposure` and other scales: a finite, positive number (NaN or a negative exposure
@@ -135,7 +136,9 @@ struct RenderArgs {
 fn main() -> std::process::ExitCode {
     quiet_output_failures();
     write_limits_are_errors();
-    let result = match parse_command_line().command {
+    let command = parse_command_line().command;
+    runtime_dir::warn_if_shared();
+    let result = match command {
         Command::Histogram(args) => histogram_command::histogram(args),
         Command::Render(args) => render(args),
         Command::Metrics(args) => metrics(args),

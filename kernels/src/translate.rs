@@ -8,10 +8,10 @@
 //! * GLSL 4.50 core with `layout(binding = b)` from a binding map (GLSL has no sets),
 //!   integer `/` and `%` written as helpers with WGSL's meaning (`integer_division`).
 //!
-//! WGSL zero-initialises workgroup memory. [`WorkgroupZeroInit`] says who does it: naga's
-//! polyfill (a store loop and a barrier in the shader: correct everywhere, slow on
-//! lavapipe), the driver (`shaderZeroInitializeWorkgroupMemory`, Vulkan 1.3), or nobody,
-//! for tools that reject naga's initialisers (glslang's HLSL front end); strata's kernels
+//! WGSL zero-initialises workgroup memory. [`WorkgroupZeroInit`] says who does it: the
+//! shader (loops the invocations share, then a barrier: correct everywhere; `Zeroed`
+//! below), the driver (`shaderZeroInitializeWorkgroupMemory`, Vulkan 1.3), or nobody, for
+//! tools that reject naga's initialisers (glslang's HLSL front end); strata's kernels
 //! initialise every workgroup variable they read, so they are correct without it.
 
 use crate::error::KernelError;
@@ -20,7 +20,8 @@ use crate::registry::Kernel;
 /// Who zero-initialises workgroup memory.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum WorkgroupZeroInit {
-    /// naga writes the zeros in the shader.
+    /// The shader writes the zeros: in loops the invocations share wherever they can be
+    /// written ([`crate::workgroup_zero_loops`]), else by naga's own polyfill.
     Polyfill,
     /// The driver does (SPIR-V only; Vulkan's `shaderZeroInitializeWorkgroupMemory`).
     Native,
@@ -41,9 +42,48 @@ impl Default for TranslateOptions {
     }
 }
 
-impl TranslateOptions {
-    fn zero_init_in_source(self) -> bool {
-        self.workgroup_zero_init != WorkgroupZeroInit::Off
+/// The module a writer translates, and whether the writer itself zeroes workgroup memory.
+///
+/// With [`WorkgroupZeroInit::Polyfill`] the shader zeroes it, in loops that the
+/// workgroup's invocations share ([`crate::workgroup_zero_loops`], ending in a barrier)
+/// wherever they can be written, and the writer's own zeroing is off. naga's writers would
+/// have one invocation store each variable whole: an array as one null constant in SPIR-V,
+/// one constructor with an argument per element in GLSL. lavapipe compiled a
+/// block-histogram kernel of the kernel package's SPIR-V so zeroed in 25-30 s, against
+/// under a second in loops or zeroed by the driver, and a new machine (no shader cache)
+/// paid that for every variant it met (docs/benchmarks/ci-time.md, tenth session). Where
+/// no loops can be written (an override-sized array, a struct holding an atomic), the
+/// writer zeroes as before. [`WorkgroupZeroInit::Native`] leaves the module to the writer
+/// (SPIR-V: the driver zeroes; the text writers: zeroing in the source, as before), and
+/// [`WorkgroupZeroInit::Off`] zeroes nothing.
+struct Zeroed {
+    /// The kernel's module with the zeroing loops, and its validation info; `None` for the
+    /// kernel's own.
+    rewritten: Option<(naga::Module, naga::valid::ModuleInfo)>,
+    /// Whether the writer's own zeroing stays on.
+    writer_zeroes: bool,
+}
+
+impl Zeroed {
+    fn new(kernel: &Kernel, options: TranslateOptions, target: &'static str) -> Result<Self, KernelError> {
+        match options.workgroup_zero_init {
+            WorkgroupZeroInit::Polyfill => {
+                let rewritten =
+                    crate::workgroup_zero_loops::zero_in_loops(&kernel.module, &kernel.info, kernel.entry_point())
+                        .map_err(|e| error(kernel, target, e))?;
+                let writer_zeroes = rewritten.is_none();
+                Ok(Self { rewritten, writer_zeroes })
+            }
+            WorkgroupZeroInit::Native => Ok(Self { rewritten: None, writer_zeroes: true }),
+            WorkgroupZeroInit::Off => Ok(Self { rewritten: None, writer_zeroes: false }),
+        }
+    }
+
+    fn module<'a>(&'a self, kernel: &'a Kernel) -> (&'a naga::Module, &'a naga::valid::ModuleInfo) {
+        match &self.rewritten {
+            Some((module, info)) => (module, info),
+            None => (&kernel.module, &kernel.info),
+        }
     }
 }
 
@@ -67,37 +107,40 @@ pub fn spirv(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, 
     use naga::back::spv;
     let mut flags = spv::WriterFlags::empty();
     flags.set(spv::WriterFlags::LABEL_VARYINGS, true);
+    let zeroed = Zeroed::new(kernel, options, "SPIR-V")?;
     let spv_options = spv::Options {
         lang_version: (1, 3),
         flags,
         bounds_check_policies: image_bounds_checks(),
-        zero_initialize_workgroup_memory: match options.workgroup_zero_init {
-            WorkgroupZeroInit::Polyfill => spv::ZeroInitializeWorkgroupMemoryMode::Polyfill,
-            WorkgroupZeroInit::Native => spv::ZeroInitializeWorkgroupMemoryMode::Native,
-            WorkgroupZeroInit::Off => spv::ZeroInitializeWorkgroupMemoryMode::None,
+        zero_initialize_workgroup_memory: match (options.workgroup_zero_init, zeroed.writer_zeroes) {
+            (WorkgroupZeroInit::Native, _) => spv::ZeroInitializeWorkgroupMemoryMode::Native,
+            (WorkgroupZeroInit::Polyfill, true) => spv::ZeroInitializeWorkgroupMemoryMode::Polyfill,
+            _ => spv::ZeroInitializeWorkgroupMemoryMode::None,
         },
         ..spv::Options::default()
     };
     let pipeline =
         spv::PipelineOptions { shader_stage: naga::ShaderStage::Compute, entry_point: kernel.entry_point().into() };
-    let words = spv::write_vec(&kernel.module, &kernel.info, &spv_options, Some(&pipeline))
-        .map_err(|e| error(kernel, "SPIR-V", e))?;
+    let (module, info) = zeroed.module(kernel);
+    let words = spv::write_vec(module, info, &spv_options, Some(&pipeline)).map_err(|e| error(kernel, "SPIR-V", e))?;
     Ok(Translation { text: String::new(), words, entry_point: kernel.entry_point().into() })
 }
 
 /// HLSL (shader model 6.0) for DXC, or glslang's HLSL front end.
 pub fn hlsl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, KernelError> {
     use naga::back::hlsl;
+    let zeroed = Zeroed::new(kernel, options, "HLSL")?;
     let hlsl_options = hlsl::Options {
         shader_model: hlsl::ShaderModel::V6_0,
-        zero_initialize_workgroup_memory: options.zero_init_in_source(),
+        zero_initialize_workgroup_memory: zeroed.writer_zeroes,
         ..hlsl::Options::default()
     };
     let pipeline =
         hlsl::PipelineOptions { entry_point: Some((naga::ShaderStage::Compute, kernel.entry_point().into())) };
     let mut text = String::new();
+    let (module, info) = zeroed.module(kernel);
     let reflection = hlsl::Writer::new(&mut text, &hlsl_options, &pipeline)
-        .write(&kernel.module, &kernel.info, None)
+        .write(module, info, None)
         .map_err(|e| error(kernel, "HLSL", e))?;
     let entry_point = translated_name(kernel, "HLSL", reflection.entry_point_names)?;
     Ok(Translation { text, words: Vec::new(), entry_point })
@@ -112,6 +155,7 @@ pub fn msl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, Ke
 /// the array-sizes buffer at 30.
 pub fn msl_version(kernel: &Kernel, options: TranslateOptions, version: (u8, u8)) -> Result<Translation, KernelError> {
     use naga::back::msl;
+    let zeroed = Zeroed::new(kernel, options, "MSL")?;
     let mut resources = msl::BindingMap::default();
     for binding in &kernel.bindings {
         resources.insert(
@@ -132,15 +176,15 @@ pub fn msl_version(kernel: &Kernel, options: TranslateOptions, version: (u8, u8)
         lang_version: version,
         per_entry_point_map,
         fake_missing_bindings: false,
-        zero_initialize_workgroup_memory: options.zero_init_in_source(),
+        zero_initialize_workgroup_memory: zeroed.writer_zeroes,
         ..msl::Options::default()
     };
     let pipeline = msl::PipelineOptions {
         entry_point: Some((naga::ShaderStage::Compute, kernel.entry_point().into())),
         ..Default::default()
     };
-    let (text, info) = msl::write_string(&kernel.module, &kernel.info, &msl_options, &pipeline)
-        .map_err(|e| error(kernel, "MSL", e))?;
+    let (module, info) = zeroed.module(kernel);
+    let (text, info) = msl::write_string(module, info, &msl_options, &pipeline).map_err(|e| error(kernel, "MSL", e))?;
     let entry_point = translated_name(kernel, "MSL", info.entry_point_names)?;
     Ok(Translation { text, words: Vec::new(), entry_point })
 }
@@ -149,6 +193,7 @@ pub fn msl_version(kernel: &Kernel, options: TranslateOptions, version: (u8, u8)
 /// flattened into one set: `Kernel::flat_binding`).
 pub fn glsl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, KernelError> {
     use naga::back::glsl;
+    let zeroed = Zeroed::new(kernel, options, "GLSL")?;
     let mut binding_map = glsl::BindingMap::default();
     for binding in &kernel.bindings {
         let flat = kernel.flat_binding(binding.group, binding.binding) as u8;
@@ -158,7 +203,7 @@ pub fn glsl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, K
         version: glsl::Version::Desktop(450),
         writer_flags: glsl::WriterFlags::empty(),
         binding_map,
-        zero_initialize_workgroup_memory: options.zero_init_in_source(),
+        zero_initialize_workgroup_memory: zeroed.writer_zeroes,
     };
     let pipeline = glsl::PipelineOptions {
         shader_stage: naga::ShaderStage::Compute,
@@ -168,11 +213,12 @@ pub fn glsl(kernel: &Kernel, options: TranslateOptions) -> Result<Translation, K
     // GLSL leaves integer `%` of negative numbers and division by zero undefined; WGSL
     // does not (see `integer_division`). And naga's writer passes unsigned texture
     // levels where GLSL takes `int` (see `signed_image_levels`).
-    let defined = crate::signed_image_levels::defined_for_glsl(&kernel.module, &kernel.info)
+    let (zeroed_module, zeroed_info) = zeroed.module(kernel);
+    let defined = crate::signed_image_levels::defined_for_glsl(zeroed_module, zeroed_info)
         .map_err(|e| error(kernel, "GLSL", e))?;
     let (module, info) = match &defined {
         Some((module, info)) => (module, info),
-        None => (&kernel.module, &kernel.info),
+        None => (zeroed_module, zeroed_info),
     };
     let mut text = String::new();
     glsl::Writer::new(&mut text, module, info, &glsl_options, &pipeline, image_bounds_checks())

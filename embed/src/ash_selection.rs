@@ -33,9 +33,10 @@ pub struct AshDevice<'a> {
     /// Whether the engine enabled `shaderZeroInitializeWorkgroupMemory` on `device`
     /// (Vulkan 1.3 core, or `VK_KHR_zero_initialize_workgroup_memory`). WGSL promises
     /// zeroed workgroup memory: with the feature the driver zeroes it, without it each
-    /// pipeline carries code of its own that does (naga's polyfill), which some drivers
-    /// compile far more slowly: on lavapipe making the pass took 365 ms instead of 39 ms
-    /// (BENCHMARKS.md, "embed"). `false` is always correct. `true` for a device that lacks the
+    /// pipeline zeroes it in loops its invocations share (`strata_kernels::translate`); on
+    /// lavapipe making the pass takes the same time either way (38.9 and 39.4 ms; 365 ms
+    /// before 2026-11-30 with naga's own zeroing: BENCHMARKS.md, "embed"). `false` is
+    /// always correct. `true` for a device that lacks the
     /// feature is refused; `true` for one that has it but where the engine did not
     /// enable it cannot be detected and makes the pipelines invalid usage.
     pub shader_zero_initialize_workgroup_memory: bool,

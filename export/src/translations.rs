@@ -31,8 +31,9 @@ pub struct Translated {
     pub msl_sized_bindings: Vec<String>,
 }
 
-/// Translates `kernel`. Workgroup memory is zeroed by naga's code in the shader (every
-/// API and driver; the Rust flavours can leave it to a Vulkan 1.3 driver instead).
+/// Translates `kernel`. Workgroup memory is zeroed by the shader itself, in loops its
+/// invocations share (every API and driver; the Rust flavours can leave it to a Vulkan 1.3
+/// driver instead).
 pub fn translate(kernel: &Kernel) -> Result<Translated, ExportError> {
     let options = TranslateOptions { workgroup_zero_init: WorkgroupZeroInit::Polyfill };
     let failed = |error: strata_kernels::KernelError| ExportError::Translation(error.to_string());

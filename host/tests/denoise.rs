@@ -4,6 +4,9 @@
 
 mod support;
 
+#[path = "support/no_display.rs"]
+mod no_display;
+use no_display::NO_DISPLAY;
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -21,9 +24,7 @@ fn compare_with_svgf_measures_every_frame_denoised_and_the_frames_are_smoother()
         .env("VK_DRIVER_FILES", "/nonexistent/strata-no-driver.json")
         .env_remove("VK_ADD_DRIVER_FILES")
         .env_remove("VK_ADD_ICD_FILENAMES")
-        // A runtime folder that does not exist, in cargo's target folder, not the shared /tmp: Mesa's
-        // Vulkan layer connects to $XDG_RUNTIME_DIR/wayland-0, which anyone can create there (SECURITY.md).
-        .env("XDG_RUNTIME_DIR", concat!(env!("CARGO_TARGET_TMPDIR"), "/no-display"))
+        .env("XDG_RUNTIME_DIR", NO_DISPLAY)
         .output()
         .expect("the strata binary runs");
     support::denoised_run::assert_denoised_run(&output, &out, "SVGF", 6);

@@ -6,6 +6,9 @@
 //! When a change means to alter what strata computes, `STRATA_BLESS=1 cargo test -p
 //! strata --test golden` rewrites the files; the commit then says why the numbers moved.
 
+#[path = "support/no_display.rs"]
+mod no_display;
+use no_display::NO_DISPLAY;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -27,9 +30,7 @@ fn scratch(name: &str) -> PathBuf {
 fn strata(args: &[&str]) {
     let output = Command::new(env!("CARGO_BIN_EXE_strata"))
         .args(args)
-        // A runtime folder that does not exist, in cargo's target folder, not the shared /tmp: Mesa's
-        // Vulkan layer connects to $XDG_RUNTIME_DIR/wayland-0, which anyone can create there (SECURITY.md).
-        .env("XDG_RUNTIME_DIR", concat!(env!("CARGO_TARGET_TMPDIR"), "/no-display"))
+        .env("XDG_RUNTIME_DIR", NO_DISPLAY)
         .output()
         .expect("the strata binary runs");
     assert!(output.status.success(), "strata {}: {}", args.join(" "), String::from_utf8_lossy(&output.stderr));

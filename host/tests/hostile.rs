@@ -8,6 +8,9 @@
 //! `STRATA_HOSTILE_BINARY=PATH` runs the suite against another build of `strata` (how
 //! each test was seen failing before its fix: against the binary of 47d7e0e).
 
+#[path = "support/no_display.rs"]
+mod no_display;
+use no_display::NO_DISPLAY;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use strata_render::rgb_image::RgbImage;
@@ -29,13 +32,7 @@ fn scratch(name: &str) -> PathBuf {
 /// `strata` with `args`, a backtrace asked for, and Mesa kept quiet.
 fn command(args: &[&std::ffi::OsStr]) -> Command {
     let mut command = Command::new(binary());
-    command
-        .args(args)
-        .env("RUST_BACKTRACE", "1")
-        .env("RUST_LIB_BACKTRACE", "1")
-        // A runtime folder that does not exist, in cargo's target folder, not the shared /tmp: Mesa's
-        // Vulkan layer connects to $XDG_RUNTIME_DIR/wayland-0, which anyone can create there (SECURITY.md).
-        .env("XDG_RUNTIME_DIR", concat!(env!("CARGO_TARGET_TMPDIR"), "/no-display"));
+    command.args(args).env("RUST_BACKTRACE", "1").env("RUST_LIB_BACKTRACE", "1").env("XDG_RUNTIME_DIR", NO_DISPLAY);
     command
 }
 
@@ -190,7 +187,7 @@ fn in_small_tmpfs(mount: &Path, kib: u64, script: &str) -> Option<String> {
     let output = Command::new("unshare")
         .args(["-rm", "sh", "-c", &full])
         .env("RUST_BACKTRACE", "1")
-        .env("XDG_RUNTIME_DIR", concat!(env!("CARGO_TARGET_TMPDIR"), "/no-display"))
+        .env("XDG_RUNTIME_DIR", NO_DISPLAY)
         .output();
     match output {
         Ok(output) if output.status.code() != Some(97) => {
@@ -1165,7 +1162,7 @@ fn render_refuses_a_folder_it_cannot_write_before_rendering() {
     let output = Command::new("unshare")
         .args(["-rm", "sh", "-c", &script])
         .env("RUST_BACKTRACE", "1")
-        .env("XDG_RUNTIME_DIR", concat!(env!("CARGO_TARGET_TMPDIR"), "/no-display"))
+        .env("XDG_RUNTIME_DIR", NO_DISPLAY)
         .output();
     let output = match output {
         Ok(output) if output.status.code() != Some(97) => output,

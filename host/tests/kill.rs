@@ -5,6 +5,9 @@
 //! are hidden (`.NAME.tmp-PID-RANDOM.EXT`), and the next run into the folder takes over the
 //! dead run's lock, removes the leftovers and succeeds.
 
+#[path = "support/no_display.rs"]
+mod no_display;
+use no_display::NO_DISPLAY;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -25,9 +28,7 @@ fn strata(args: &[&str], out: &Path) -> Command {
         .args(args)
         .arg("--out")
         .arg(out)
-        // A runtime folder that does not exist, in cargo's target folder, not the shared /tmp: Mesa's
-        // Vulkan layer connects to $XDG_RUNTIME_DIR/wayland-0, which anyone can create there (SECURITY.md).
-        .env("XDG_RUNTIME_DIR", concat!(env!("CARGO_TARGET_TMPDIR"), "/no-display"))
+        .env("XDG_RUNTIME_DIR", NO_DISPLAY)
         .stdout(Stdio::null())
         .stderr(Stdio::null());
     command

@@ -14,6 +14,9 @@
 //! test says so and passes, unless `STRATA_REQUIRE_BROWSER=1` (CI sets it), where a
 //! missing browser fails.
 
+#[path = "support/no_display.rs"]
+mod no_display;
+use no_display::NO_DISPLAY;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -135,9 +138,7 @@ fn the_report_page_shows_every_image_and_table_in_chromium() {
         .args(["compare", "--width", "32", "--height", "32", "--frames", "4", "--seeds", "3", "--reference-spp", "16"])
         .arg("--out")
         .arg(&folder)
-        // A runtime folder that does not exist, in cargo's target folder, not the shared /tmp: Mesa's
-        // Vulkan layer connects to $XDG_RUNTIME_DIR/wayland-0, which anyone can create there (SECURITY.md).
-        .env("XDG_RUNTIME_DIR", concat!(env!("CARGO_TARGET_TMPDIR"), "/no-display"))
+        .env("XDG_RUNTIME_DIR", NO_DISPLAY)
         .status()
         .expect("the strata binary runs");
     assert!(status.success(), "strata compare failed");

@@ -1,6 +1,10 @@
 //! naga's zero-initialisation of arrays, rewritten as loops that glslang's and Slang's
 //! HLSL front ends accept.
 //!
+//! Workgroup arrays now reach the writer already zeroed in loops in naga's IR
+//! (`translate`, `workgroup_zero_loops`); what this rewrite still meets is `var<private>`
+//! and function arrays, and workgroup arrays where no loop could be written there.
+//!
 //! WGSL promises zeroed workgroup memory and zeroed `var`s without an initialiser, and
 //! naga's HLSL keeps both promises with a cast of zero to the array's type:
 //! - workgroup memory: `NAME = (T[4][128])0;` at the start of each entry point (written

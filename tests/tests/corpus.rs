@@ -391,6 +391,47 @@ fn workgroup_memory_starts_zeroed_everywhere() {
     assert_corruption_caught(&runs, &Tolerance::default(), case.file);
 }
 
+/// The same kernel on ash with naga's SPIR-V where the shader zeroes its workgroup memory
+/// itself, in the loops `strata_kernels::translate` writes into naga's IR (what an engine
+/// gets from the kernel package, and the embed pass on a device without the driver's
+/// zeroing). lavapipe offers the driver's zeroing, which the ash column of the test above
+/// takes, so without this test those loops would run on no device here.
+#[test]
+fn workgroup_memory_starts_zeroed_when_the_shader_zeroes_it() {
+    use strata_backends::Backend;
+    use strata_backends::ash_backend::{AshBackend, AshOptions, SpirvSource};
+    use strata_backends::backend::{download, upload};
+    let test = "workgroup_memory_starts_zeroed_when_the_shader_zeroes_it";
+    let options = AshOptions {
+        source: SpirvSource::Naga,
+        pipeline_cache: None,
+        driver_zeroes_workgroup_memory: false,
+        ..Default::default()
+    };
+    let mut backend = match AshBackend::new(options) {
+        Ok(backend) => backend,
+        Err(error) if !strata_backends::gpu_required() => {
+            eprintln!("SKIPPED {test}: {error}");
+            return;
+        }
+        Err(error) => panic!("{test}: {error}"),
+    };
+    let file = "workgroup_zeroing.wgsl";
+    let kernel = Kernel::from_wgsl(file, source(file), "main", false).unwrap_or_else(|e| panic!("{file}: {e}"));
+    let groups = 4u32;
+    let counts = upload(&mut backend, "counts", &vec![0xABAB_ABABu32; (groups * 3) as usize]).unwrap();
+    let untouched = upload(&mut backend, "untouched", &vec![0xABAB_ABABu32; groups as usize]).unwrap();
+    let binds = [strata_backends::Bind::new(0, counts), strata_backends::Bind::new(1, untouched)];
+    // Twice: a second dispatch finds the workgroup memory the first one left.
+    for run in 0..2 {
+        backend.dispatch(&kernel, &binds, [groups, 1, 1]).unwrap();
+        let got: Vec<u32> = download(&mut backend, counts).unwrap();
+        assert_eq!(got, [64, 0, 16].repeat(groups as usize), "run {run}: counts");
+        let got: Vec<u32> = download(&mut backend, untouched).unwrap();
+        assert_eq!(got, vec![0.0f32.to_bits(); groups as usize], "run {run}: the unwritten rows");
+    }
+}
+
 /// Private and function `var`s without an initialiser must start zeroed on every path:
 /// private arrays (1-D, a non-square array of arrays, of structs), a private struct with
 /// an array member, and function-local arrays of arrays in the entry point and a helper.

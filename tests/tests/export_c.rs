@@ -20,6 +20,10 @@ const WIDTH: u32 = 45;
 const HEIGHT: u32 = 29;
 const FRAMES: u32 = 4;
 const SEED: u32 = 7;
+/// The `XDG_RUNTIME_DIR` of the programs this test starts: a name that does not exist, in
+/// cargo's target folder, not the shared `/tmp` (Mesa's Vulkan layer connects to
+/// `$XDG_RUNTIME_DIR/wayland-0`; SECURITY.md, "The display socket").
+const NO_DISPLAY: &str = concat!(env!("CARGO_TARGET_TMPDIR"), "/no-display");
 
 /// The workspace's root.
 fn root() -> PathBuf {
@@ -164,9 +168,7 @@ fn run_c_sized(
             "--block-shift",
             &number(u32::from(settings.block_shift)),
         ])
-        // A runtime folder that does not exist, in cargo's target folder, not the shared /tmp: Mesa's
-        // Vulkan layer connects to $XDG_RUNTIME_DIR/wayland-0, which anyone can create there (SECURITY.md).
-        .env("XDG_RUNTIME_DIR", concat!(env!("CARGO_TARGET_TMPDIR"), "/no-display"))
+        .env("XDG_RUNTIME_DIR", NO_DISPLAY)
         // cargo's LD_LIBRARY_PATH names target/debug, whose libstrata_vk.so only a build of
         // the workspace refreshes: the program finds the library by its rpath instead
         // (`library_folder`, the one this test binary was built with).
@@ -698,6 +700,7 @@ int main(void) {
         })
         .collect();
     let mut child = Command::new(&program)
+        .env("XDG_RUNTIME_DIR", NO_DISPLAY)
         .stdin(std::process::Stdio::piped())
         .stdout(std::process::Stdio::piped())
         .spawn()
@@ -718,6 +721,7 @@ int main(void) {
     }
     // Bad settings are refused by both, naming the field in C as in Rust.
     let refused = Command::new(&program)
+        .env("XDG_RUNTIME_DIR", NO_DISPLAY)
         .stdin(std::process::Stdio::piped())
         .stdout(std::process::Stdio::piped())
         .spawn()
@@ -843,7 +847,11 @@ fn the_package_builds_with_cmake_both_ways_and_pkg_config_resolves() {
                 .arg(format!("-DSTRATA_VK_LIBRARY={}", path(&library))),
         );
         run_tool(Command::new("cmake").args(["--build", &path(&build)]));
-        let said = run_tool(Command::new(build.join("strata_consumer")).env_remove("LD_LIBRARY_PATH"));
+        let said = run_tool(
+            Command::new(build.join("strata_consumer"))
+                .env_remove("LD_LIBRARY_PATH")
+                .env("XDG_RUNTIME_DIR", NO_DISPLAY),
+        );
         assert!(said.ends_with(": ok\n") && said.contains(env!("CARGO_PKG_VERSION")), "{way}: {said}");
     }
     // find_package asking for the next major version is refused by strataConfigVersion.cmake.
@@ -885,7 +893,7 @@ fn the_package_builds_with_cmake_both_ways_and_pkg_config_resolves() {
             .arg("-o")
             .arg(&program),
     );
-    let said = run_tool(Command::new(&program).env_remove("LD_LIBRARY_PATH"));
+    let said = run_tool(Command::new(&program).env_remove("LD_LIBRARY_PATH").env("XDG_RUNTIME_DIR", NO_DISPLAY));
     assert!(said.ends_with(": ok\n"), "pkg-config: {said}");
 }
 
@@ -1115,7 +1123,7 @@ fn run_synchronization_validated(program: &Path, package: &Path, inputs: &Path) 
         .args(["package", inputs.to_str().unwrap(), out.to_str().unwrap(), "--package", package.to_str().unwrap()])
         .args(["--width", &WIDTH.to_string(), "--height", &HEIGHT.to_string(), "--frames", "4"])
         .args(["--block-size", "8", "--candidates", "4", "--block-shift", "1", "--histogram", "auto"])
-        .env("XDG_RUNTIME_DIR", concat!(env!("CARGO_TARGET_TMPDIR"), "/no-display"))
+        .env("XDG_RUNTIME_DIR", NO_DISPLAY)
         .env_remove("LD_LIBRARY_PATH")
         .env("VK_INSTANCE_LAYERS", "VK_LAYER_KHRONOS_validation")
         .env("VK_LAYER_ENABLES", "VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT")

@@ -178,9 +178,9 @@ fn creating_and_destroying_the_ash_embed_pass_hundreds_of_times_keeps_host_memor
         (0..pixels as u32).map(|p| Candidate { key: (p % 17) as f32, object_id: p % 3 }).collect();
     let candidate_buffer = engine.buffer(8 * pixels, bytemuck::cast_slice(&candidates));
     let selection_buffer = engine.buffer(size_of::<SelectedCandidates>() as u64 * pixels, &[]);
-    // The device zeroes workgroup memory where it can, as a pass then builds 9x faster on
-    // lavapipe (AshDevice::shader_zero_initialize_workgroup_memory); what is made and
-    // destroyed is the same either way.
+    // The device zeroes workgroup memory where it can, as an engine's would
+    // (AshDevice::shader_zero_initialize_workgroup_memory); what is made and destroyed is
+    // the same either way.
     let vulkan = engine.embed_device();
     let buffers = AshBuffers {
         candidates: AshBufferSlice { buffer: candidate_buffer.0, offset: 0, size: 8 * pixels },

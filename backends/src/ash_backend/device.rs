@@ -157,8 +157,8 @@ impl VulkanDevice {
                     | vk::SubgroupFeatureFlags::SHUFFLE_RELATIVE,
             ))
         .then_some(subgroup.subgroup_size);
-        // The driver zero-initialises workgroup memory where it can (Vulkan 1.3), instead
-        // of naga's in-shader polyfill, which costs a store loop and a barrier per workgroup.
+        // The driver zero-initialises workgroup memory where it can (Vulkan 1.3) and the
+        // options allow, instead of the shader's own loops and barrier per workgroup.
         let mut vulkan13 = vk::PhysicalDeviceVulkan13Features::default();
         if properties.api_version >= vk::API_VERSION_1_3 {
             let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut vulkan13);
@@ -181,7 +181,8 @@ impl VulkanDevice {
         let mut enable11 = vk::PhysicalDeviceVulkan11Features::default()
             .storage_buffer16_bit_access(vulkan11.storage_buffer16_bit_access == vk::TRUE)
             .uniform_and_storage_buffer16_bit_access(vulkan11.uniform_and_storage_buffer16_bit_access == vk::TRUE);
-        let native_zero_init = vulkan13.shader_zero_initialize_workgroup_memory == vk::TRUE;
+        let native_zero_init =
+            options.driver_zeroes_workgroup_memory && vulkan13.shader_zero_initialize_workgroup_memory == vk::TRUE;
         let mut enable13 =
             vk::PhysicalDeviceVulkan13Features::default().shader_zero_initialize_workgroup_memory(native_zero_init);
         let priorities = [1.0f32];

@@ -68,6 +68,12 @@ pub struct AshOptions {
     /// The folder the driver's `VkPipelineCache` is kept in between runs; `None`: no
     /// file. Default: [`crate::pipeline_cache_file::default_folder`].
     pub pipeline_cache: Option<std::path::PathBuf>,
+    /// Let the driver zero workgroup memory where the device offers it (Vulkan 1.3's
+    /// `shaderZeroInitializeWorkgroupMemory`), as wgpu does. `false`: every pipeline zeroes
+    /// it in the shader, in loops its invocations share
+    /// ([`strata_kernels::translate::WorkgroupZeroInit::Polyfill`]), as on a device without
+    /// the feature. Default `true`.
+    pub driver_zeroes_workgroup_memory: bool,
 }
 
 impl Default for AshOptions {
@@ -77,6 +83,7 @@ impl Default for AshOptions {
             source: SpirvSource::Naga,
             subgroups: true,
             pipeline_cache: crate::pipeline_cache_file::default_folder(),
+            driver_zeroes_workgroup_memory: true,
         }
     }
 }

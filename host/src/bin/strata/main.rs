@@ -132,12 +132,16 @@ struct RenderArgs {
 
 /// Runs the command; an error (a user's mistake, a missing file, a device that refuses)
 /// is one line on standard error and exit status 1, with no backtrace whatever
-/// `RUST_BACKTRACE` says. Panics, which are bugs, keep theirs.
+/// `RUST_BACKTRACE` says. Panics, which are bugs, keep theirs. The commands that open a
+/// Vulkan device first warn about an `XDG_RUNTIME_DIR` others could plant a display socket
+/// in (`runtime_dir.rs`).
 fn main() -> std::process::ExitCode {
     quiet_output_failures();
     write_limits_are_errors();
     let command = parse_command_line().command;
-    runtime_dir::warn_if_shared();
+    if matches!(command, Command::Histogram(_) | Command::Render(_) | Command::Compare(_)) {
+        runtime_dir::warn_if_shared();
+    }
     let result = match command {
         Command::Histogram(args) => histogram_command::histogram(args),
         Command::Render(args) => render(args),

@@ -180,10 +180,23 @@ fn paths_that_are_not_utf8_are_taken_by_every_command() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `path` as one word of a POSIX shell script: single-quoted, each `'` in it written `'\''`
+/// (a checkout's path may hold any character).
+fn sh_word(path: &Path) -> String {
+    format!("'{}'", path.display().to_string().replace('\'', r"'\''"))
+}
+
+#[test]
+fn a_path_with_quotes_and_spaces_is_one_shell_word() {
+    let path = Path::new("/no/such place/it's \"here\" $HOME");
+    let output = Command::new("sh").args(["-c", &format!("printf %s {}", sh_word(path))]).output().unwrap();
+    assert_eq!(String::from_utf8_lossy(&output.stdout), path.to_string_lossy());
+}
+
 /// Runs `script` (sh) in a new mount namespace where `mount` is a tmpfs of `kib` KiB,
 /// or `None` (with the reason) where this machine cannot make one.
 fn in_small_tmpfs(mount: &Path, kib: u64, script: &str) -> Option<String> {
-    let full = format!("mount -t tmpfs -o size={kib}k tmpfs '{}' || exit 97\n{script}", mount.display());
+    let full = format!("mount -t tmpfs -o size={kib}k tmpfs {} || exit 97\n{script}", sh_word(mount));
     let output = Command::new("unshare")
         .args(["-rm", "sh", "-c", &full])
         .env("RUST_BACKTRACE", "1")
@@ -220,10 +233,10 @@ fn a_full_disk_is_an_error_and_leaves_no_half_written_file() {
     let mount = dir.join("tiny");
     std::fs::create_dir_all(&mount).unwrap();
     let script = format!(
-        "'{}' render --backend cpu --width 64 --height 64 --spp 1 --out '{}'; echo \"exit $?\"; ls -la '{}'",
-        binary().display(),
-        mount.display(),
-        mount.display()
+        "{} render --backend cpu --width 64 --height 64 --spp 1 --out {}; echo \"exit $?\"; ls -la {}",
+        sh_word(&binary()),
+        sh_word(&mount),
+        sh_word(&mount)
     );
     let Some(report) = in_small_tmpfs(&mount, kib, &script) else { return };
     assert!(report.contains("exit 1"), "the render must fail on a full disk:\n{report}");
@@ -249,11 +262,12 @@ fn a_full_disk_is_an_error_and_leaves_no_half_written_file() {
     assert!(map_png > 4096, "the map's PNG must need more than the one spare page: {map_png} bytes");
     let kib = map_exr.div_ceil(4096) * 4 + 4;
     let script = format!(
-        "'{bin}' metrics '{image}' '{reference}' --map '{mount}/map.exr'; echo \"exit $?\"; ls -la '{mount}'",
-        bin = binary().display(),
-        image = image.display(),
-        reference = reference.display(),
-        mount = mount.display()
+        "{bin} metrics {image} {reference} --map {map}; echo \"exit $?\"; ls -la {mount}",
+        bin = sh_word(&binary()),
+        image = sh_word(&image),
+        reference = sh_word(&reference),
+        map = sh_word(&mount.join("map.exr")),
+        mount = sh_word(&mount)
     );
     let Some(report) = in_small_tmpfs(&mount, kib, &script) else { return };
     assert!(report.contains("exit 1") && report.contains("map.png: cannot write"), "{report}");
@@ -937,12 +951,8 @@ fn a_write_cut_short_by_a_size_limit_is_an_error_and_leaves_no_file() {
     // `ulimit -f` counts 512-byte blocks in dash (1024 in bash): a limit between the sizes.
     let blocks = (svg + 1024) / 512;
     let limited = dir.join("limited");
-    let script = format!(
-        "ulimit -f {blocks}; exec '{}' plot '{}' --out '{}'",
-        binary().display(),
-        file.display(),
-        limited.display()
-    );
+    let script =
+        format!("ulimit -f {blocks}; exec {} plot {} --out {}", sh_word(&binary()), sh_word(&file), sh_word(&limited));
     let output = Command::new("sh").args(["-c", &script]).env("RUST_BACKTRACE", "1").output().unwrap();
     assert_refused(&output, &["limited.png", "cannot write"]);
     let left: Vec<String> =
@@ -951,10 +961,10 @@ fn a_write_cut_short_by_a_size_limit_is_an_error_and_leaves_no_file() {
     assert!(!left.iter().any(|n| n.starts_with("limited") || n.contains(".tmp-")), "{left:?}");
     // Standard output on a full device: one line, no panic.
     let script = format!(
-        "exec '{}' plot '{}' --out '{}' > /dev/full",
-        binary().display(),
-        file.display(),
-        dir.join("again").display()
+        "exec {} plot {} --out {} > /dev/full",
+        sh_word(&binary()),
+        sh_word(&file),
+        sh_word(&dir.join("again"))
     );
     let output = Command::new("sh").args(["-c", &script]).env("RUST_BACKTRACE", "1").output().unwrap();
     assert_refused(&output, &["standard out", "cannot write"]);
@@ -1154,10 +1164,10 @@ fn render_refuses_a_folder_it_cannot_write_before_rendering() {
     std::fs::create_dir_all(&mount).unwrap();
     // Far more samples than the deadline allows: only a refusal before rendering ends in time.
     let script = format!(
-        "mount -t tmpfs -o size=64k,ro tmpfs '{mount}' || exit 97\ntimeout 60 '{bin}' render --backend cpu --width 64 \
-         --height 64 --spp 100000 --out '{mount}'; echo \"exit $?\"",
-        mount = mount.display(),
-        bin = binary().display()
+        "mount -t tmpfs -o size=64k,ro tmpfs {mount} || exit 97\ntimeout 60 {bin} render --backend cpu --width 64 \
+         --height 64 --spp 100000 --out {mount}; echo \"exit $?\"",
+        mount = sh_word(&mount),
+        bin = sh_word(&binary())
     );
     let output = Command::new("unshare")
         .args(["-rm", "sh", "-c", &script])

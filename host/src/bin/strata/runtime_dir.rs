@@ -39,10 +39,13 @@ fn why_shared(dir: &Path) -> Option<String> {
     match std::fs::metadata(dir) {
         Ok(metadata) if metadata.is_dir() => strata_files::owned_and_unshared(&metadata).err(),
         Ok(_) => None,
-        // Missing: whoever may write the nearest folder above it can create it.
+        // Missing: whoever may write the nearest folder above it can create it. Only other
+        // users' write bit counts here: a group-writable folder is the rule under a user
+        // private group (umask 002, where cargo's own target folder is 0775), and the tests
+        // give strata a missing name there.
         Err(_) => dir.ancestors().skip(1).find_map(|above| std::fs::metadata(above).ok().map(|m| (above, m))).and_then(
             |(above, metadata)| {
-                (metadata.mode() & 0o022 != 0)
+                (metadata.mode() & 0o002 != 0)
                     .then(|| format!("does not exist, and others may write {:?}, where it would be", above.as_os_str()))
             },
         ),
@@ -76,6 +79,12 @@ mod tests {
         let root = strata_files::private_scratch_folder("strata-runtime-dir-").unwrap();
         assert_eq!(shared_runtime_dir_warning(root.path()), None);
         assert_eq!(shared_runtime_dir_warning(&root.path().join("missing")), None, "a name only this user can make");
+        std::fs::set_permissions(root.path(), std::fs::Permissions::from_mode(0o770)).unwrap();
+        assert_eq!(
+            shared_runtime_dir_warning(&root.path().join("missing")),
+            None,
+            "group-writable, as under umask 002"
+        );
         std::fs::set_permissions(root.path(), std::fs::Permissions::from_mode(0o1777)).unwrap();
         let warning = shared_runtime_dir_warning(root.path()).expect("a folder anyone can write is warned about");
         assert!(warning.starts_with(&format!("warning: XDG_RUNTIME_DIR={:?}: ", root.path())), "{warning}");

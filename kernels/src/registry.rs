@@ -36,6 +36,12 @@ pub struct Kernel {
     memory: MemoryBytes,
     /// The values its `override` constants were given ([`Kernel::overrides`]).
     overrides: Vec<(String, f64)>,
+    /// The names of the `override` constants its source declares
+    /// ([`Kernel::declares_override`]).
+    declared_overrides: Vec<String>,
+    /// The names of the globals its source declares ([`Kernel::declares`]): specialising
+    /// compacts [`Kernel::module`] to what the entry point reaches.
+    declared_globals: Vec<String>,
 }
 
 /// A kernel's workgroup memory per workgroup and private and function memory per
@@ -76,6 +82,11 @@ impl MemoryBytes {
         }
     }
 }
+
+/// A kernel's pipeline as backends cache it ([`Kernel::pipeline_key`]): its id and a hash
+/// of its overrides' values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct PipelineKey(pub KernelId, pub u64);
 
 impl Kernel {
     /// Registry name.
@@ -131,7 +142,13 @@ impl Kernel {
     /// Whether the kernel's source declares a global named `name` (a binding its entry
     /// point may never reach, which naga then leaves out of [`Self::bindings`]).
     pub fn declares(&self, name: &str) -> bool {
-        self.module.global_variables.iter().any(|(_, variable)| variable.name.as_deref() == Some(name))
+        self.declared_globals.iter().any(|declared| declared == name)
+    }
+
+    /// Whether the kernel's source declares an `override` constant named `name` (its
+    /// module is specialised, so [`Self::module`] no longer does).
+    pub fn declares_override(&self, name: &str) -> bool {
+        self.declared_overrides.iter().any(|declared| declared == name)
     }
 
     /// Bytes of workgroup memory the entry point declares.
@@ -152,10 +169,27 @@ impl Kernel {
     /// ([`Kernel::from_wgsl_with_overrides`]), keyed as naga's and WebGPU's pipeline
     /// constants are (an `@id` number as text, or the name): [`Kernel::module`] is
     /// already specialised with them, and a backend that compiles [`Kernel::source`]
-    /// itself (WebGPU's) passes them as its pipeline's constants. Empty for registry
-    /// kernels.
+    /// itself (WebGPU's) passes them as its pipeline's constants. Empty for the registry's
+    /// own kernels ([`Registry::get`]); a registry kernel specialised for settings
+    /// ([`Registry::without_random_replay`]) has its values here.
     pub fn overrides(&self) -> &[(String, f64)] {
         &self.overrides
+    }
+
+    /// What a backend caches this kernel's pipeline under: its id and a hash of the values
+    /// its overrides were given (0 for none). A registry kernel specialised with other
+    /// values ([`Registry::without_random_replay`]) keeps its id, so the id alone would
+    /// hand it the general kernel's pipeline.
+    pub fn pipeline_key(&self) -> PipelineKey {
+        use std::hash::{Hash, Hasher};
+        if self.overrides.is_empty() {
+            return PipelineKey(self.id, 0);
+        }
+        let mut hasher = std::collections::hash_map::DefaultHasher::new();
+        for (name, value) in &self.overrides {
+            (name, value.to_bits()).hash(&mut hasher);
+        }
+        PipelineKey(self.id, hasher.finish())
     }
 
     /// Parses, validates and describes registry kernel `id`.
@@ -165,6 +199,16 @@ impl Kernel {
             entry: "(external kernels are made with Kernel::from_wgsl)".into(),
         })?;
         Self::from_spec(id, spec, &[])
+    }
+
+    /// Registry kernel `id` with its `override` constants given `overrides` (the others
+    /// keep their defaults); see [`Kernel::from_wgsl_with_overrides`].
+    pub fn load_with_overrides(id: KernelId, overrides: &[(String, f64)]) -> Result<Kernel, KernelError> {
+        let spec = id.spec().ok_or_else(|| KernelError::MissingEntryPoint {
+            kernel: format!("{id:?}"),
+            entry: "(external kernels are made with Kernel::from_wgsl)".into(),
+        })?;
+        Self::from_spec(id, spec, overrides)
     }
 
     /// A kernel that is not in the registry: WGSL source from `path`, entry point
@@ -235,6 +279,8 @@ impl Kernel {
                 kernel: spec.name.to_string(),
                 message: error.emit_to_string(&source.text),
             })?;
+        let declared_overrides = module.overrides.iter().filter_map(|(_, o)| o.name.clone()).collect();
+        let declared_globals = module.global_variables.iter().filter_map(|(_, v)| v.name.clone()).collect();
         let (module, info) = specialise(&spec, module, info, overrides)?;
         let entry_index = module
             .entry_points
@@ -249,7 +295,19 @@ impl Kernel {
         let bindings = describe_bindings(&spec.name, &module, &info, entry_index, registry)?;
         let memory = MemoryBytes::of(&module, &info, entry_index);
         let overrides = overrides.to_vec();
-        Ok(Kernel { id, spec, source, module, info, workgroup_size, bindings, memory, overrides })
+        Ok(Kernel {
+            id,
+            spec,
+            source,
+            module,
+            info,
+            workgroup_size,
+            bindings,
+            memory,
+            overrides,
+            declared_overrides,
+            declared_globals,
+        })
     }
 }
 
@@ -402,7 +460,13 @@ fn handle_kind(module: &naga::Module, ty: naga::Handle<naga::Type>) -> Result<Bi
 #[derive(Debug)]
 pub struct Registry {
     kernels: Vec<Kernel>,
+    /// The kernels that declare [`RANDOM_REPLAY`], specialised without it, made on first use.
+    without_replay: std::sync::OnceLock<Result<Vec<Kernel>, KernelError>>,
 }
+
+/// The `override` of the ReSTIR kernels (`restir/reservoir.wgsl`) that keeps random
+/// replay's path re-trace in the pipeline (the default, `true`).
+pub const RANDOM_REPLAY: &str = "random_replay";
 
 impl Registry {
     /// The registry of this process, loaded on first use.
@@ -414,7 +478,27 @@ impl Registry {
     /// Loads every kernel of [`KernelId::ALL`].
     pub fn load() -> Result<Registry, KernelError> {
         let kernels = KernelId::ALL.iter().map(|&id| Kernel::load(id)).collect::<Result<_, _>>()?;
-        Ok(Registry { kernels })
+        Ok(Registry { kernels, without_replay: std::sync::OnceLock::new() })
+    }
+
+    /// Kernel `id` for settings without random replay (`RestirParams.replay` off): where
+    /// it declares [`RANDOM_REPLAY`], specialised with `false`, so that a driver drops the
+    /// replayed path's re-trace as dead code (on lavapipe, which runs every branch under a
+    /// mask, about 45 % of `restir_select`'s time); the kernel itself elsewhere. Its
+    /// outputs are the general kernel's wherever no pixel replays.
+    pub fn without_random_replay(&self, id: KernelId) -> Result<&Kernel, KernelError> {
+        let specialised = self
+            .without_replay
+            .get_or_init(|| {
+                self.kernels
+                    .iter()
+                    .filter(|kernel| kernel.declares_override(RANDOM_REPLAY))
+                    .map(|kernel| Kernel::load_with_overrides(kernel.id, &[(RANDOM_REPLAY.to_string(), 0.0)]))
+                    .collect()
+            })
+            .as_ref()
+            .map_err(Clone::clone)?;
+        Ok(specialised.iter().find(|k| k.id == id).unwrap_or_else(|| self.get(id)))
     }
 
     /// The kernel `id`.
@@ -432,6 +516,32 @@ impl Registry {
 mod tests {
     use super::*;
     use crate::fragment;
+
+    #[test]
+    fn kernels_without_random_replay_are_specialised_and_cached_apart() {
+        let registry = Registry::load().unwrap_or_else(|e| panic!("{e}"));
+        for id in [KernelId::RestirSelect, KernelId::RestirSpatial, KernelId::RestirTemporal, KernelId::RestirShade] {
+            let general = registry.get(id);
+            assert!(general.declares_override(RANDOM_REPLAY), "{id:?}");
+            assert!(general.overrides().is_empty(), "{id:?}");
+            let specialised = registry.without_random_replay(id).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(specialised.overrides(), [(RANDOM_REPLAY.to_string(), 0.0)], "{id:?}");
+            assert_ne!(specialised.pipeline_key(), general.pipeline_key(), "{id:?}");
+            assert_eq!(specialised.bindings, general.bindings, "{id:?}");
+        }
+        // Specialising compacts the module to what the entry point reaches; `declares`
+        // still answers for the source, so that binding a scene buffer the kernel never
+        // reads is not an error.
+        let keys = registry.without_random_replay(KernelId::RestirReservoirKeys).unwrap_or_else(|e| panic!("{e}"));
+        assert!(keys.declares("scene_rows"));
+        assert!(keys.binding_named("scene_rows").is_none());
+        let path = registry.get(KernelId::PathTrace);
+        assert!(!path.declares_override(RANDOM_REPLAY));
+        assert!(std::ptr::eq(
+            registry.without_random_replay(KernelId::PathTrace).unwrap_or_else(|e| panic!("{e}")),
+            path
+        ));
+    }
 
     #[test]
     fn every_kernel_loads_with_bindings_from_the_ir() {

@@ -15,7 +15,7 @@ use strata_kernels::combined_samplers::combined_samplers;
 use strata_kernels::glslang::{self, GlslangInput};
 use strata_kernels::hlsl_samplers;
 use strata_kernels::translate::{self, TranslateOptions, WorkgroupZeroInit};
-use strata_kernels::{BindingInfo, BindingKind, Kernel, KernelId};
+use strata_kernels::{BindingInfo, BindingKind, Kernel, PipelineKey};
 
 /// The Vulkan objects of one compute pipeline with one descriptor set (set 0).
 #[derive(Clone, Copy, Debug)]
@@ -243,7 +243,7 @@ impl AshPipeline {
 
 pub(super) struct PipelineCache {
     source: SpirvSource,
-    pipelines: HashMap<KernelId, Arc<AshPipeline>>,
+    pipelines: HashMap<PipelineKey, Arc<AshPipeline>>,
     /// The driver's pipeline cache and the file it is kept in between runs, where a
     /// folder was given (`AshOptions::pipeline_cache`).
     driver_cache: Option<DriverCache>,
@@ -352,7 +352,7 @@ impl PipelineCache {
         vulkan: &VulkanDevice,
         kernel: &Kernel,
     ) -> Result<Arc<AshPipeline>, BackendError> {
-        if let Some(pipeline) = self.pipelines.get(&kernel.id) {
+        if let Some(pipeline) = self.pipelines.get(&kernel.pipeline_key()) {
             return Ok(Arc::clone(pipeline));
         }
         super::texture_paths::check_texture_bindings(self.source, kernel)?;
@@ -377,7 +377,7 @@ impl PipelineCache {
             driver_cache.save(vulkan);
         }
         let pipeline = Arc::new(AshPipeline { set_layouts, layout, pipeline, plan });
-        self.pipelines.insert(kernel.id, Arc::clone(&pipeline));
+        self.pipelines.insert(kernel.pipeline_key(), Arc::clone(&pipeline));
         Ok(pipeline)
     }
 

@@ -113,7 +113,7 @@ use program::Program;
 pub use sanitize::{Finding, FindingKind, MAX_FINDINGS};
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
-use strata_kernels::{Kernel, KernelId};
+use strata_kernels::{Kernel, KernelId, PipelineKey};
 
 /// How to configure the interpreter.
 #[derive(Clone, Copy, Debug)]
@@ -183,9 +183,10 @@ pub struct CpuBackend {
     textures: HashMap<u64, CpuTexture>,
     samplers: HashMap<u64, SamplerDesc>,
     next_buffer: u64,
-    programs: HashMap<KernelId, Program>,
+    /// Compiled programs, by kernel and overrides ([`Kernel::pipeline_key`]).
+    programs: HashMap<PipelineKey, Program>,
     /// Sanitizing programs ([`CpuOptions::sanitize`]), compiled apart.
-    sanitizing: HashMap<KernelId, Program>,
+    sanitizing: HashMap<PipelineKey, Program>,
     last_counts: DispatchCounts,
     counts_by_kernel: HashMap<KernelId, DispatchCounts>,
     /// The sanitizer's findings since the last [`CpuBackend::take_findings`].
@@ -249,10 +250,10 @@ impl CpuBackend {
     fn program(&mut self, kernel: &Kernel) -> Result<&Program, BackendError> {
         let sanitize = self.options.sanitize;
         let programs = if sanitize { &mut self.sanitizing } else { &mut self.programs };
-        if let std::collections::hash_map::Entry::Vacant(slot) = programs.entry(kernel.id) {
+        if let std::collections::hash_map::Entry::Vacant(slot) = programs.entry(kernel.pipeline_key()) {
             slot.insert(decode::compile(kernel, sanitize)?);
         }
-        Ok(&programs[&kernel.id])
+        Ok(&programs[&kernel.pipeline_key()])
     }
 
     /// What the sanitizer found ([`CpuOptions::sanitize`]) in the dispatches since the
@@ -454,7 +455,8 @@ impl Backend for CpuBackend {
                 }
             }
         }
-        let program = if self.options.sanitize { &self.sanitizing[&kernel.id] } else { &self.programs[&kernel.id] };
+        let key = kernel.pipeline_key();
+        let program = if self.options.sanitize { &self.sanitizing[&key] } else { &self.programs[&key] };
         let sanitizer = self.options.sanitize.then(|| {
             let per_workgroup = kernel.workgroup_size.iter().product::<u32>();
             sanitize::Sanitizer::new(per_workgroup, workgroups, bound.iter().map(Vec::len))

@@ -246,7 +246,7 @@ impl Link {
 /// The page's key of `kernel`'s pipeline for binds in which the sampled float textures
 /// `unfilterable` cannot be filtered (as the wgpu backend keys its pipelines).
 fn pipeline_key(kernel: &Kernel, unfilterable: &[(u32, u32)]) -> String {
-    format!("{:?}{unfilterable:?}", kernel.id)
+    format!("{:?}{unfilterable:?}", kernel.pipeline_key())
 }
 
 /// The WGSL Tint compiles: the kernel's source, with `enable subgroups;` first where it

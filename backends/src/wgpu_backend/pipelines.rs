@@ -11,7 +11,7 @@ use std::borrow::Cow;
 use std::collections::HashMap;
 use std::num::NonZeroU64;
 use std::sync::Arc;
-use strata_kernels::{BindingAccess, BindingKind, Kernel, KernelId};
+use strata_kernels::{BindingAccess, BindingKind, Kernel};
 
 pub(super) struct Pipeline {
     pub(super) pipeline: wgpu::ComputePipeline,
@@ -19,10 +19,10 @@ pub(super) struct Pipeline {
     pub(super) layouts: Vec<wgpu::BindGroupLayout>,
 }
 
-/// A pipeline's key: the kernel, and the sampled float textures (group, binding) bound
-/// with a format this device cannot filter (each such set its own layout:
-/// [`layout_entries_with`]).
-type PipelineKey = (KernelId, Vec<(u32, u32)>);
+/// A pipeline's key: the kernel and its overrides' values ([`Kernel::pipeline_key`]), and
+/// the sampled float textures (group, binding) bound with a format this device cannot
+/// filter (each such set its own layout: [`layout_entries_with`]).
+type PipelineKey = (strata_kernels::PipelineKey, Vec<(u32, u32)>);
 
 pub(super) struct PipelineCache {
     /// By kernel and its unfilterable textures ([`PipelineKey`]).
@@ -95,7 +95,7 @@ impl PipelineCache {
         kernel: &Kernel,
         unfilterable: Vec<(u32, u32)>,
     ) -> Result<Arc<Pipeline>, BackendError> {
-        let key = (kernel.id, unfilterable);
+        let key = (kernel.pipeline_key(), unfilterable);
         if let Some(pipeline) = self.pipelines.get(&key) {
             return Ok(Arc::clone(pipeline));
         }

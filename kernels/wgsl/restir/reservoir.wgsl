@@ -36,6 +36,18 @@
 // #import render/path.wgsl
 // #import strata/candidate.wgsl
 
+// Whether this pipeline can meet replay pixels and candidates (RestirParams.replay set:
+// RestirSettings::glossy_replay). strata's renderer makes its pipelines for settings
+// without random replay with `false` (Registry::without_random_replay), and a driver then
+// drops the path re-trace of `replayed` from every pass as dead code. Why it matters: a
+// CPU driver that runs a workgroup's invocations side by side in SIMD lanes (lavapipe,
+// Mesa 22.3) executes the body of every `if` under a mask, taken by no lane or not, and
+// the first iteration of every loop: with the re-trace in, restir_select took 4.5-4.8 ms
+// of a 32 x 32 frame without one replay pixel, 2.5 ms without it (2026-11-30,
+// docs/benchmarks/ci-time.md). The default keeps every pipeline made from the registry
+// as it was: the exported package and the cross-backend check run the general kernels.
+override random_replay: bool = true;
+
 // No pixel for a reuse slot (restir/reuse_slot.wgsl): the slot stays empty.
 const NO_PIXEL: u32 = 0xffffffffu;
 
@@ -139,6 +151,11 @@ fn integrand(p: Primary, x: PathCandidate, lane: u32) -> vec3<f32> {
         return vec3<f32>(0.0);
     }
     if replay_pixel {
+        if !random_replay {
+            // Never met: a pipeline without random replay runs with RestirParams.replay
+            // off, where no pixel replays (and gives nothing if one did).
+            return vec3<f32>(0.0);
+        }
         return replayed(p, x, lane);
     }
     return reconnection_integrand(p, x);

@@ -140,14 +140,22 @@ impl RestirRenderer {
         settings.check()?;
         let settings = settings.as_run().for_camera(false);
         let registry = Registry::shared()?;
+        // Without random replay no pixel replays, and the reuse kernels are specialised
+        // without the replayed path's re-trace (`random_replay` in restir/reservoir.wgsl):
+        // the same outputs, and on a CPU driver that runs every branch under a mask
+        // (lavapipe) select, spatial and temporal take 30-45 % less time. Not the
+        // candidates pass: specialised, it measured about 0.4 ms slower per 32 x 32 frame in
+        // three of four alternated pairs on lavapipe (docs/benchmarks/ci-time.md).
+        let kernel = |id| -> Result<&'static Kernel, PassError> {
+            if settings.glossy_replay { Ok(registry.get(id)) } else { Ok(registry.without_random_replay(id)?) }
+        };
         let kernels = [
-            KernelId::RestirCandidates,
-            KernelId::RestirSelect,
-            KernelId::RestirTemporalKeys,
-            KernelId::RestirTemporal,
-            KernelId::RestirShade,
-        ]
-        .map(|id| registry.get(id));
+            registry.get(KernelId::RestirCandidates),
+            kernel(KernelId::RestirSelect)?,
+            kernel(KernelId::RestirTemporalKeys)?,
+            kernel(KernelId::RestirTemporal)?,
+            kernel(KernelId::RestirShade)?,
+        ];
         for kernel in kernels {
             backend.check_kernel(kernel)?;
         }
@@ -173,7 +181,7 @@ impl RestirRenderer {
         let temporal_first = match settings.reuse_order {
             ReuseOrder::TemporalFirst if settings.temporal => {
                 let [keys_kernel, spatial_kernel] =
-                    [KernelId::RestirReservoirKeys, KernelId::RestirSpatial].map(|id| registry.get(id));
+                    [kernel(KernelId::RestirReservoirKeys)?, kernel(KernelId::RestirSpatial)?];
                 backend.check_kernel(keys_kernel)?;
                 backend.check_kernel(spatial_kernel)?;
                 Some(TemporalFirst {
@@ -251,7 +259,12 @@ impl RestirRenderer {
         if self.guides.is_some() {
             return Ok(());
         }
-        let kernel = Registry::shared()?.get(KernelId::RestirGuide);
+        let registry = Registry::shared()?;
+        let kernel = if self.settings.glossy_replay {
+            registry.get(KernelId::RestirGuide)
+        } else {
+            registry.without_random_replay(KernelId::RestirGuide)?
+        };
         backend.check_kernel(kernel)?;
         let (width, height) = (self.render.camera.width, self.render.camera.height);
         let bytes = u64::from(width) * u64::from(height) * size_of::<DenoiseGuide>() as u64;

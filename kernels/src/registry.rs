@@ -36,9 +36,9 @@ pub struct Kernel {
     memory: MemoryBytes,
     /// The values its `override` constants were given ([`Kernel::overrides`]).
     overrides: Vec<(String, f64)>,
-    /// The names of the `override` constants its source declares
-    /// ([`Kernel::declares_override`]).
-    declared_overrides: Vec<String>,
+    /// The names of the `override` constants its entry point reaches
+    /// ([`Kernel::uses_override`]).
+    used_overrides: Vec<String>,
     /// The names of the globals its source declares ([`Kernel::declares`]): specialising
     /// compacts [`Kernel::module`] to what the entry point reaches.
     declared_globals: Vec<String>,
@@ -145,10 +145,12 @@ impl Kernel {
         self.declared_globals.iter().any(|declared| declared == name)
     }
 
-    /// Whether the kernel's source declares an `override` constant named `name` (its
-    /// module is specialised, so [`Self::module`] no longer does).
-    pub fn declares_override(&self, name: &str) -> bool {
-        self.declared_overrides.iter().any(|declared| declared == name)
+    /// Whether the kernel's entry point reaches an `override` constant named `name` (its
+    /// module is specialised, so [`Self::module`] no longer holds any). One its source
+    /// declares but the entry point never reaches does not count: naga's specialisation
+    /// drops it, so every value would give the same module.
+    pub fn uses_override(&self, name: &str) -> bool {
+        self.used_overrides.iter().any(|used| used == name)
     }
 
     /// Bytes of workgroup memory the entry point declares.
@@ -279,7 +281,7 @@ impl Kernel {
                 kernel: spec.name.to_string(),
                 message: error.emit_to_string(&source.text),
             })?;
-        let declared_overrides = module.overrides.iter().filter_map(|(_, o)| o.name.clone()).collect();
+        let used_overrides = used_overrides(&module, &spec.entry_point);
         let declared_globals = module.global_variables.iter().filter_map(|(_, v)| v.name.clone()).collect();
         let (module, info) = specialise(&spec, module, info, overrides)?;
         let entry_index = module
@@ -305,10 +307,22 @@ impl Kernel {
             bindings,
             memory,
             overrides,
-            declared_overrides,
+            used_overrides,
             declared_globals,
         })
     }
+}
+
+/// The names of the `override` constants entry point `entry` of `module` reaches: those
+/// left after naga's compaction to that entry point (what `process_overrides` keeps).
+fn used_overrides(module: &naga::Module, entry: &str) -> Vec<String> {
+    if module.overrides.is_empty() {
+        return Vec::new();
+    }
+    let mut reached = module.clone();
+    reached.entry_points.retain(|ep| ep.name == entry && ep.stage == naga::ShaderStage::Compute);
+    naga::compact::compact(&mut reached, naga::compact::KeepUnused::No);
+    reached.overrides.iter().filter_map(|(_, o)| o.name.clone()).collect()
 }
 
 /// Replaces the module's `override` constants by `overrides` or their defaults (naga's
@@ -460,7 +474,7 @@ fn handle_kind(module: &naga::Module, ty: naga::Handle<naga::Type>) -> Result<Bi
 #[derive(Debug)]
 pub struct Registry {
     kernels: Vec<Kernel>,
-    /// The kernels that declare [`RANDOM_REPLAY`], specialised without it, made on first use.
+    /// The kernels that use [`RANDOM_REPLAY`], specialised without it, made on first use.
     without_replay: std::sync::OnceLock<Result<Vec<Kernel>, KernelError>>,
 }
 
@@ -482,7 +496,7 @@ impl Registry {
     }
 
     /// Kernel `id` for settings without random replay (`RestirParams.replay` off): where
-    /// it declares [`RANDOM_REPLAY`], specialised with `false`, so that a driver drops the
+    /// it uses [`RANDOM_REPLAY`], specialised with `false`, so that a driver drops the
     /// replayed path's re-trace as dead code (on lavapipe, which runs every branch under a
     /// mask, about 45 % of `restir_select`'s time); the kernel itself elsewhere. Its
     /// outputs are the general kernel's wherever no pixel replays.
@@ -492,7 +506,7 @@ impl Registry {
             .get_or_init(|| {
                 self.kernels
                     .iter()
-                    .filter(|kernel| kernel.declares_override(RANDOM_REPLAY))
+                    .filter(|kernel| kernel.uses_override(RANDOM_REPLAY))
                     .map(|kernel| Kernel::load_with_overrides(kernel.id, &[(RANDOM_REPLAY.to_string(), 0.0)]))
                     .collect()
             })
@@ -522,25 +536,30 @@ mod tests {
         let registry = Registry::load().unwrap_or_else(|e| panic!("{e}"));
         for id in [KernelId::RestirSelect, KernelId::RestirSpatial, KernelId::RestirTemporal, KernelId::RestirShade] {
             let general = registry.get(id);
-            assert!(general.declares_override(RANDOM_REPLAY), "{id:?}");
+            assert!(general.uses_override(RANDOM_REPLAY), "{id:?}");
             assert!(general.overrides().is_empty(), "{id:?}");
             let specialised = registry.without_random_replay(id).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(specialised.overrides(), [(RANDOM_REPLAY.to_string(), 0.0)], "{id:?}");
             assert_ne!(specialised.pipeline_key(), general.pipeline_key(), "{id:?}");
             assert_eq!(specialised.bindings, general.bindings, "{id:?}");
         }
-        // Specialising compacts the module to what the entry point reaches; `declares`
-        // still answers for the source, so that binding a scene buffer the kernel never
-        // reads is not an error.
-        let keys = registry.without_random_replay(KernelId::RestirReservoirKeys).unwrap_or_else(|e| panic!("{e}"));
+        // A kernel that declares the override (through restir/reservoir.wgsl) but never
+        // reaches it, or does not declare it, is itself: a copy would be the same module
+        // compiled twice.
+        for id in
+            [KernelId::RestirCandidates, KernelId::RestirReservoirKeys, KernelId::RestirGuide, KernelId::PathTrace]
+        {
+            let kernel = registry.get(id);
+            assert!(!kernel.uses_override(RANDOM_REPLAY), "{id:?}");
+            let same = registry.without_random_replay(id).unwrap_or_else(|e| panic!("{e}"));
+            assert!(std::ptr::eq(same, kernel), "{id:?}");
+        }
+        // Specialising compacts a module to what its entry point reaches; `declares` still
+        // answers for the source, so that binding a scene buffer the kernel never reads is
+        // not an error.
+        let keys = registry.get(KernelId::RestirReservoirKeys);
         assert!(keys.declares("scene_rows"));
         assert!(keys.binding_named("scene_rows").is_none());
-        let path = registry.get(KernelId::PathTrace);
-        assert!(!path.declares_override(RANDOM_REPLAY));
-        assert!(std::ptr::eq(
-            registry.without_random_replay(KernelId::PathTrace).unwrap_or_else(|e| panic!("{e}")),
-            path
-        ));
     }
 
     #[test]

@@ -1043,9 +1043,8 @@ fn pixel_centres_remove_the_film_jitter() {
 /// general kernels. In the default room no surface is a glossy conductor, so no pixel
 /// replays either way and the two must render the same frames bit for bit (every method,
 /// both reuse orders between them, temporal reuse with four drawn reservoirs, the kept
-/// sample's shading): seen failing with the specialised reconnection 0.1 % darker. The two
-/// kernels' pipelines are cached apart (their keys differ), or a backend would hand the
-/// specialised kernel the general one's pipeline.
+/// sample's shading): seen failing with the specialised reconnection 0.1 % darker. (That
+/// backends cache the two apart is the registry's unit test: their pipeline keys differ.)
 #[test]
 fn kernels_without_random_replay_render_the_same_frames() {
     use strata_kernels::{KernelId, RANDOM_REPLAY, Registry};

@@ -39,13 +39,14 @@
 // Whether this pipeline can meet replay pixels and candidates (RestirParams.replay set:
 // RestirSettings::glossy_replay). strata's renderer makes its pipelines for settings
 // without random replay with `false` (Registry::without_random_replay), and a driver then
-// drops the path re-trace of `replayed` from every pass as dead code. Why it matters: a
-// CPU driver that runs a workgroup's invocations side by side in SIMD lanes (lavapipe,
-// Mesa 22.3) executes the body of every `if` under a mask, taken by no lane or not, and
-// the first iteration of every loop: with the re-trace in, restir_select took 4.5-4.8 ms
-// of a 32 x 32 frame without one replay pixel, 2.5 ms without it (2026-11-30,
-// docs/benchmarks/ci-time.md). The default keeps every pipeline made from the registry
-// as it was: the exported package and the cross-backend check run the general kernels.
+// drops the path re-trace of `replayed` as dead code from the passes that weigh
+// candidates (select, spatial, temporal, shade; the others never reach `integrand`, so
+// naga's specialisation drops the override there). Why it matters: a CPU driver that runs
+// a workgroup's invocations side by side in SIMD lanes (lavapipe, Mesa 22.3) executes the
+// body of every `if` under a mask, taken by no lane or not, and the first iteration of
+// every loop: with the re-trace in, restir_select took 4.5-4.8 ms of a 32 x 32 frame
+// without one replay pixel, 2.5 ms without it (2026-11-30, docs/benchmarks/ci-time.md).
+// The default, `true`, is the general kernel every registry pipeline was before.
 override random_replay: bool = true;
 
 // No pixel for a reuse slot (restir/reuse_slot.wgsl): the slot stays empty.

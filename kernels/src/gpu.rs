@@ -175,23 +175,25 @@ pub struct GpuModule {
     pub constants: Vec<GpuConstant>,
     /// Its structs, each after the structs its fields use.
     pub structs: Vec<StructDeclaration>,
-    /// Functions that read structs (of this module or those it imports) out of a storage
-    /// array of 16-byte rows: a module of readers names that array in a `// #requires`
-    /// line and the structs' modules in `// #import` lines ([`RowReaders`]).
+    /// Functions that read structs (of this module or those it imports) out of an array of
+    /// 16-byte rows: a module of readers names the function that reads a row in a
+    /// `// #requires` line and the structs' modules in `// #import` lines ([`RowReaders`]).
     pub readers: Option<RowReaders>,
 }
 
-/// Readers of structs packed in one storage array of 16-byte rows (`array<vec4<u32>>`),
-/// generated from the structs' declarations, for kernels that bind several arrays of
-/// records as one buffer (WebGPU allows a stage 8 to 10 storage buffers). Each struct is
-/// laid out in its rows exactly as in its own array (the Rust layout; a struct read this
-/// way must be a whole number of rows, which [`RowReaders::wgsl`] checks), so the host
-/// appends each array's bytes as they are.
+/// Readers of structs packed in one array of 16-byte rows, generated from the structs'
+/// declarations, for kernels that bind several arrays of records as one buffer (WebGPU
+/// allows a stage 8 to 10 storage buffers). Each struct is laid out in its rows exactly as
+/// in its own array (the Rust layout; a struct read this way must be a whole number of
+/// rows, which [`RowReaders::wgsl`] checks), so the host appends each array's bytes as
+/// they are. The readers take each row from a function the including kernel defines
+/// (`render/scene.wgsl`'s `scene_row` reads a storage buffer or, for a small scene, a
+/// uniform one).
 #[derive(Clone, Debug)]
 pub struct RowReaders {
-    /// The name of the required array, `var<storage, read> NAME: array<vec4<u32>>`
-    /// ([`Self::declaration`]).
-    pub array: &'static str,
+    /// The name of the required function, `fn NAME(row: u32) -> vec4<u32>`
+    /// ([`Self::declaration`]): row `row` of the records' array.
+    pub row: &'static str,
     /// The generated modules that declare the structs (`gpu/render.wgsl`).
     pub imports: Vec<&'static str>,
     /// The structs read.
@@ -199,10 +201,10 @@ pub struct RowReaders {
 }
 
 impl RowReaders {
-    /// The array's declaration without `@group`/`@binding`, as its `// #requires` line
-    /// and the including kernel write it.
+    /// The row function's signature, as its `// #requires` line and the including kernel
+    /// write it.
     pub fn declaration(&self) -> String {
-        format!("var<storage, read> {}: array<vec4<u32>>", self.array)
+        format!("fn {}(row: u32) -> vec4<u32>", self.row)
     }
 
     /// The module's directive lines and one function per struct:
@@ -216,17 +218,17 @@ impl RowReaders {
         text += &format!("// #requires {}\n", self.declaration());
         for declaration in &self.structs {
             text += "\n";
-            text += &row_reader(declaration, self.array);
+            text += &row_reader(declaration, self.row);
         }
         text
     }
 }
 
-/// The WGSL reader of `declaration` from `array` (see [`RowReaders::wgsl`]). Every field
+/// The WGSL reader of `declaration` through the row function `row` (see [`RowReaders::wgsl`]). Every field
 /// is a scalar or vector of `u32`, `i32` or `f32` within one row; a declaration that has
 /// another (an array, a struct, a vector across rows) cannot be packed this way, and the
 /// panic names it (the module tests generate every reader, so that cannot reach a user).
-fn row_reader(declaration: &StructDeclaration, array: &str) -> String {
+fn row_reader(declaration: &StructDeclaration, row_function: &str) -> String {
     assert!(
         declaration.size.is_multiple_of(16),
         "struct {} is {} bytes, not a whole number of rows",
@@ -235,7 +237,7 @@ fn row_reader(declaration: &StructDeclaration, array: &str) -> String {
     );
     let rows = declaration.size / 16;
     let mut text = format!(
-        "// The {name} at `index` of the section of `{array}` that starts at row `first_row` ({rows} row{s} each).\n\
+        "// The {name} at `index` of the section of the rows that starts at row `first_row` ({rows} row{s} each).\n\
          fn read_{snake}(first_row: u32, index: u32) -> {name} {{\n    let row = first_row + index * {rows}u;\n",
         name = declaration.name,
         snake = snake_case(declaration.name),
@@ -243,7 +245,7 @@ fn row_reader(declaration: &StructDeclaration, array: &str) -> String {
     );
     for row in 0..rows {
         let at = if row == 0 { String::new() } else { format!(" + {row}u") };
-        text += &format!("    let r{row} = {array}[row{at}];\n");
+        text += &format!("    let r{row} = {row_function}(row{at});\n");
     }
     let fields: Vec<String> = declaration.fields.iter().map(|field| field_from_row(declaration.name, field)).collect();
     text += &format!("    return {}({});\n}}\n", declaration.name, fields.join(", "));
@@ -492,16 +494,16 @@ mod tests {
     #[test]
     fn a_row_reader_reads_each_field_from_its_lanes() {
         let readers = RowReaders {
-            array: "rows",
+            row: "row_at",
             imports: vec!["gpu/test.wgsl"],
             structs: vec![StructDeclaration::of::<Packed>()],
         };
         let text = readers.wgsl();
-        assert!(text.starts_with("// #import gpu/test.wgsl\n// #requires var<storage, read> rows: array<vec4<u32>>\n"));
+        assert!(text.starts_with("// #import gpu/test.wgsl\n// #requires fn row_at(row: u32) -> vec4<u32>\n"));
         assert!(text.contains(
             "fn read_packed(first_row: u32, index: u32) -> Packed {\n    let row = first_row + index * 2u;\n"
         ));
-        assert!(text.contains("let r1 = rows[row + 1u];"), "{text}");
+        assert!(text.contains("let r1 = row_at(row + 1u);"), "{text}");
         assert!(
             text.contains(
                 "return Packed(bitcast<vec3<f32>>(r0.xyz), r0.w, bitcast<vec2<f32>>(r1.xy), bitcast<i32>(r1.z), \
@@ -510,7 +512,7 @@ mod tests {
             "{text}"
         );
         let source = format!(
-            "{}@group(0) @binding(0) {};\n{text}",
+            "{}{} {{ return vec4<u32>(row); }}\n{text}",
             StructDeclaration::of::<Packed>().wgsl(),
             readers.declaration()
         );

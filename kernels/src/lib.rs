@@ -82,6 +82,6 @@ pub use binding::{BindingAccess, BindingInfo, BindingKind, ElementLayout};
 pub use block_grid::{BlockGrid, BlockRect, GridError};
 pub use catalogue::Executor;
 pub use error::KernelError;
-pub use registry::{Kernel, KernelId, PipelineKey, RANDOM_REPLAY, Registry};
+pub use registry::{Kernel, KernelId, PipelineKey, RANDOM_REPLAY, Registry, SCENE_IN_UNIFORM, Specialisation};
 pub use texture::{StorageTextureAccess, TexelFormat, TexelKind, TextureDimension};
 pub use word_kinds::{WordKind, WordKinds};

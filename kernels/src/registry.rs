@@ -173,14 +173,14 @@ impl Kernel {
     /// already specialised with them, and a backend that compiles [`Kernel::source`]
     /// itself (WebGPU's) passes them as its pipeline's constants. Empty for the registry's
     /// own kernels ([`Registry::get`]); a registry kernel specialised for settings
-    /// ([`Registry::without_random_replay`]) has its values here.
+    /// ([`Registry::specialised`]) has its values here.
     pub fn overrides(&self) -> &[(String, f64)] {
         &self.overrides
     }
 
     /// What a backend caches this kernel's pipeline under: its id and a hash of the values
     /// its overrides were given (0 for none). A registry kernel specialised with other
-    /// values ([`Registry::without_random_replay`]) keeps its id, so the id alone would
+    /// values ([`Registry::specialised`]) keeps its id, so the id alone would
     /// hand it the general kernel's pipeline.
     pub fn pipeline_key(&self) -> PipelineKey {
         use std::hash::{Hash, Hasher};
@@ -474,13 +474,71 @@ fn handle_kind(module: &naga::Module, ty: naga::Handle<naga::Type>) -> Result<Bi
 #[derive(Debug)]
 pub struct Registry {
     kernels: Vec<Kernel>,
-    /// The kernels that use [`RANDOM_REPLAY`], specialised without it, made on first use.
-    without_replay: std::sync::OnceLock<Result<Vec<Kernel>, KernelError>>,
+    /// Per [`Specialisation::index`], the kernels that reach an override it gives a value
+    /// other than the default, specialised with those values, made on first use.
+    specialised: [std::sync::OnceLock<Result<Vec<Kernel>, KernelError>>; Specialisation::COUNT],
 }
 
 /// The `override` of the ReSTIR kernels (`restir/reservoir.wgsl`) that keeps random
 /// replay's path re-trace in the pipeline (the default, `true`).
 pub const RANDOM_REPLAY: &str = "random_replay";
+
+/// The `override` of every kernel that reads the scene (`render/scene.wgsl`) that reads
+/// its rows from their uniform copy instead of the storage buffer (default `false`).
+pub const SCENE_IN_UNIFORM: &str = "scene_in_uniform";
+
+/// Values for the registry kernels' `override` constants ([`Registry::specialised`]):
+/// what a renderer knows before its first dispatch. [`Default`] is every override's own
+/// default, i.e. the kernels as written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Specialisation {
+    /// [`RANDOM_REPLAY`]: some pixel may resample by random replay (`RestirParams.replay`
+    /// on). Without it the replayed path's re-trace is dropped as dead code (on lavapipe,
+    /// which runs every branch under a mask, about 45 % of `restir_select`'s time).
+    pub random_replay: bool,
+    /// [`SCENE_IN_UNIFORM`]: the scene's rows fit its uniform copy
+    /// (`SCENE_UNIFORM_ROWS`) and are read from there (on lavapipe the path tracer takes
+    /// 29 % less time a sample).
+    pub scene_in_uniform: bool,
+}
+
+impl Default for Specialisation {
+    fn default() -> Self {
+        Self { random_replay: true, scene_in_uniform: false }
+    }
+}
+
+impl Specialisation {
+    /// How many distinct specialisations there are.
+    const COUNT: usize = 4;
+
+    /// Every specialisation.
+    pub const ALL: [Specialisation; Self::COUNT] = [
+        Specialisation { random_replay: true, scene_in_uniform: false },
+        Specialisation { random_replay: false, scene_in_uniform: false },
+        Specialisation { random_replay: true, scene_in_uniform: true },
+        Specialisation { random_replay: false, scene_in_uniform: true },
+    ];
+
+    /// Its slot among the [`Self::COUNT`].
+    fn index(self) -> usize {
+        usize::from(self.random_replay) | usize::from(self.scene_in_uniform) << 1
+    }
+
+    /// The overrides `kernel` reaches whose value here is not their default, as
+    /// [`Kernel::load_with_overrides`] takes them (none: the kernel as it is).
+    fn overrides_for(self, kernel: &Kernel) -> Vec<(String, f64)> {
+        let defaults = Self::default();
+        [
+            (RANDOM_REPLAY, self.random_replay, defaults.random_replay),
+            (SCENE_IN_UNIFORM, self.scene_in_uniform, defaults.scene_in_uniform),
+        ]
+        .into_iter()
+        .filter(|&(name, value, default)| value != default && kernel.uses_override(name))
+        .map(|(name, value, _)| (name.to_string(), f64::from(u8::from(value))))
+        .collect()
+    }
+}
 
 impl Registry {
     /// The registry of this process, loaded on first use.
@@ -492,27 +550,27 @@ impl Registry {
     /// Loads every kernel of [`KernelId::ALL`].
     pub fn load() -> Result<Registry, KernelError> {
         let kernels = KernelId::ALL.iter().map(|&id| Kernel::load(id)).collect::<Result<_, _>>()?;
-        Ok(Registry { kernels, without_replay: std::sync::OnceLock::new() })
+        Ok(Registry { kernels, specialised: Default::default() })
     }
 
-    /// Kernel `id` for settings without random replay (`RestirParams.replay` off): where
-    /// it uses [`RANDOM_REPLAY`], specialised with `false`, so that a driver drops the
-    /// replayed path's re-trace as dead code (on lavapipe, which runs every branch under a
-    /// mask, about 45 % of `restir_select`'s time); the kernel itself elsewhere. Its
-    /// outputs are the general kernel's wherever no pixel replays.
-    pub fn without_random_replay(&self, id: KernelId) -> Result<&Kernel, KernelError> {
-        let specialised = self
-            .without_replay
+    /// Kernel `id` with its `override` constants given the values of `specialisation`:
+    /// specialised where it reaches one whose value there is not its default (so that a
+    /// driver drops the other side of each such branch as dead code), the kernel itself
+    /// elsewhere. Its outputs are the general kernel's wherever the specialisation holds
+    /// (no pixel replays; the scene fits its uniform copy).
+    pub fn specialised(&self, id: KernelId, specialisation: Specialisation) -> Result<&Kernel, KernelError> {
+        let kernels = self.specialised[specialisation.index()]
             .get_or_init(|| {
                 self.kernels
                     .iter()
-                    .filter(|kernel| kernel.uses_override(RANDOM_REPLAY))
-                    .map(|kernel| Kernel::load_with_overrides(kernel.id, &[(RANDOM_REPLAY.to_string(), 0.0)]))
+                    .map(|kernel| (kernel, specialisation.overrides_for(kernel)))
+                    .filter(|(_, overrides)| !overrides.is_empty())
+                    .map(|(kernel, overrides)| Kernel::load_with_overrides(kernel.id, &overrides))
                     .collect()
             })
             .as_ref()
             .map_err(Clone::clone)?;
-        Ok(specialised.iter().find(|k| k.id == id).unwrap_or_else(|| self.get(id)))
+        Ok(kernels.iter().find(|k| k.id == id).unwrap_or_else(|| self.get(id)))
     }
 
     /// The kernel `id`.
@@ -532,27 +590,58 @@ mod tests {
     use crate::fragment;
 
     #[test]
-    fn kernels_without_random_replay_are_specialised_and_cached_apart() {
+    fn specialised_kernels_are_specialised_and_cached_apart() {
         let registry = Registry::load().unwrap_or_else(|e| panic!("{e}"));
+        let without_replay = Specialisation { random_replay: false, ..Specialisation::default() };
         for id in [KernelId::RestirSelect, KernelId::RestirSpatial, KernelId::RestirTemporal, KernelId::RestirShade] {
             let general = registry.get(id);
             assert!(general.uses_override(RANDOM_REPLAY), "{id:?}");
             assert!(general.overrides().is_empty(), "{id:?}");
-            let specialised = registry.without_random_replay(id).unwrap_or_else(|e| panic!("{e}"));
+            let specialised = registry.specialised(id, without_replay).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(specialised.overrides(), [(RANDOM_REPLAY.to_string(), 0.0)], "{id:?}");
             assert_ne!(specialised.pipeline_key(), general.pipeline_key(), "{id:?}");
             assert_eq!(specialised.bindings, general.bindings, "{id:?}");
         }
         // A kernel that declares the override (through restir/reservoir.wgsl) but never
         // reaches it, or does not declare it, is itself: a copy would be the same module
-        // compiled twice.
+        // compiled twice. So is every kernel under the defaults.
         for id in
             [KernelId::RestirCandidates, KernelId::RestirReservoirKeys, KernelId::RestirGuide, KernelId::PathTrace]
         {
             let kernel = registry.get(id);
             assert!(!kernel.uses_override(RANDOM_REPLAY), "{id:?}");
-            let same = registry.without_random_replay(id).unwrap_or_else(|e| panic!("{e}"));
+            let same = registry.specialised(id, without_replay).unwrap_or_else(|e| panic!("{e}"));
             assert!(std::ptr::eq(same, kernel), "{id:?}");
+        }
+        let slots: std::collections::HashSet<usize> = Specialisation::ALL.iter().map(|s| s.index()).collect();
+        assert_eq!(slots.len(), Specialisation::COUNT, "two specialisations share a slot");
+        for kernel in registry.kernels() {
+            let same = registry.specialised(kernel.id, Specialisation::default()).unwrap_or_else(|e| panic!("{e}"));
+            assert!(std::ptr::eq(same, kernel), "{:?}", kernel.id);
+        }
+        // The scene's uniform copy: every kernel that reads the scene reaches the override;
+        // together with no replay, the kernels that reach both get both values. (naga keeps
+        // the branch the constant decides, so both bindings stay in the reflection and are
+        // bound; the driver drops the dead read when it builds the pipeline.)
+        let in_uniform = Specialisation { scene_in_uniform: true, ..Specialisation::default() };
+        let both = Specialisation { random_replay: false, scene_in_uniform: true };
+        for id in [KernelId::PathTrace, KernelId::RestirCandidates, KernelId::RestirSelect, KernelId::RestirShade] {
+            let general = registry.get(id);
+            assert!(general.uses_override(SCENE_IN_UNIFORM), "{id:?}");
+            assert!(
+                general.binding_named("scene_rows").is_some() && general.binding_named("scene_rows_uniform").is_some()
+            );
+            let specialised = registry.specialised(id, in_uniform).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(specialised.overrides(), [(SCENE_IN_UNIFORM.to_string(), 1.0)], "{id:?}");
+            assert_eq!(specialised.bindings, general.bindings, "{id:?}");
+            let both_kernel = registry.specialised(id, both).unwrap_or_else(|e| panic!("{e}"));
+            let mut expected = vec![(SCENE_IN_UNIFORM.to_string(), 1.0)];
+            if general.uses_override(RANDOM_REPLAY) {
+                expected.insert(0, (RANDOM_REPLAY.to_string(), 0.0));
+            }
+            assert_eq!(both_kernel.overrides(), expected, "{id:?}");
+            let distinct = both_kernel.pipeline_key() != specialised.pipeline_key();
+            assert_eq!(distinct, general.uses_override(RANDOM_REPLAY), "{id:?}");
         }
         // Specialising compacts a module to what its entry point reaches; `declares` still
         // answers for the source, so that binding a scene buffer the kernel never reads is

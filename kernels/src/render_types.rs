@@ -43,6 +43,11 @@ gpu_constants! {
 
     /// `TriangleInfo.light` of a triangle that does not emit.
     pub const NO_LIGHT: u32 = u32::MAX;
+
+    /// Rows of the scene's uniform copy (`scene_rows_uniform`, 16 KiB: the smallest
+    /// uniform binding every device allows): a scene of at most this many rows is read
+    /// from there by kernels specialised with `scene_in_uniform` (`render/scene.wgsl`).
+    pub const SCENE_UNIFORM_ROWS: u32 = 1024;
 }
 
 gpu_struct! {
@@ -194,18 +199,18 @@ gpu_struct! {
     }
 }
 
-/// The WGSL module `gpu/scene_rows.wgsl`: readers of the scene's records from the one
-/// storage buffer the path-tracing kernels bind for the whole scene, `scene_rows`
-/// (`render/scene.wgsl`). One buffer instead of seven keeps every ReSTIR pass within the
-/// 10 storage buffers per stage a browser's WebGPU allows (the temporal pass binds 9 of
-/// its own). The host appends the arrays in 16-byte rows and gives where each starts in
-/// `RenderParams.*_row`.
+/// The WGSL module `gpu/scene_rows.wgsl`: readers of the scene's records from the rows
+/// the path-tracing kernels bind for the whole scene, through `render/scene.wgsl`'s
+/// `scene_row` (the storage buffer `scene_rows`, or its uniform copy for a small scene).
+/// One buffer instead of seven keeps every ReSTIR pass within the 10 storage buffers per
+/// stage a browser's WebGPU allows (the temporal pass binds 9 of its own). The host
+/// appends the arrays in 16-byte rows and gives where each starts in `RenderParams.*_row`.
 pub fn scene_rows_module() -> GpuModule {
     GpuModule {
         path: "gpu/scene_rows.wgsl",
         source: "kernels/src/render_types.rs",
         readers: Some(RowReaders {
-            array: "scene_rows",
+            row: "scene_row",
             imports: vec!["gpu/trace.wgsl", "gpu/render.wgsl"],
             structs: vec![
                 StructDeclaration::of::<GpuBvhNode>(),

@@ -22,11 +22,17 @@ use strata_kernels::Registry;
 /// expressions per field (a row load, a swizzle, a bitcast) where an array read was one,
 /// with no heavy function called from one more place; the main command on a fresh Mesa cache took 77 s
 /// after against 79-80 s before (docs/benchmarks/first-run.md).
+///
+/// Raised again on 2026-11-30 (candidates 20.5k → 22.7k, the three reuse passes 14.4k →
+/// 15.7k, the path tracer 4.9k → 5.4k) when every row of the scene came through
+/// `scene_row` (`render/scene.wgsl`), which reads the storage buffer or its uniform copy
+/// as the `scene_in_uniform` override says: both reads stay in the general module that
+/// this test counts, and a specialised pipeline keeps one (the driver drops the other).
 const BUDGETS: &[(&str, usize)] = &[
-    ("restir_candidates", 22_000),
-    ("restir_select", 15_500),
-    ("restir_spatial", 15_500),
-    ("restir_temporal", 15_500),
+    ("restir_candidates", 24_000),
+    ("restir_select", 16_500),
+    ("restir_spatial", 16_500),
+    ("restir_temporal", 16_500),
 ];
 
 /// The budget of every other kernel: the block histograms (9k) are the largest.

@@ -1038,42 +1038,48 @@ fn pixel_centres_remove_the_film_jitter() {
     assert_ne!(emission(3, false), emission(4, false));
 }
 
-/// Settings without random replay run kernels specialised without the replayed path's
-/// re-trace (`random_replay = false`, `Registry::without_random_replay`); with it, the
-/// general kernels. In the default room no surface is a glossy conductor, so no pixel
-/// replays either way and the two must render the same frames bit for bit (every method,
-/// both reuse orders between them, temporal reuse with four drawn reservoirs, the kept
-/// sample's shading): seen failing with the specialised reconnection 0.1 % darker. (That
-/// backends cache the two apart is the registry's unit test: their pipeline keys differ.)
+/// The renderers run kernels specialised for what they know before the first frame
+/// (`Registry::specialised`): without the replayed path's re-trace when random replay is
+/// off (`random_replay = false`), and reading the scene's rows from their uniform copy
+/// when the scene fits it (`scene_in_uniform = true`); the general kernels otherwise. In
+/// the default room no surface is a glossy conductor, so no pixel replays either way, and
+/// the same room with unused materials enough to overflow the uniform copy renders the
+/// same image from the storage buffer: all four combinations must render the same frames
+/// bit for bit (every method, both reuse orders between them, temporal reuse with four
+/// drawn reservoirs, the kept sample's shading), and the path tracer the same image.
+/// Seen failing with the specialised reconnection 0.1 % darker, and with the uniform copy
+/// written from its second row. (That backends cache the variants apart is the
+/// registry's unit test: their pipeline keys differ.)
 #[test]
-fn kernels_without_random_replay_render_the_same_frames() {
-    use strata_kernels::{KernelId, RANDOM_REPLAY, Registry};
-    let Some(mut backend) = strata_tests::vulkan_backend("kernels_without_random_replay_render_the_same_frames") else {
+fn specialised_kernels_render_the_same_frames() {
+    use strata_kernels::render_types::SCENE_UNIFORM_ROWS;
+    use strata_render::scene::Material;
+    let Some(mut backend) = strata_tests::vulkan_backend("specialised_kernels_render_the_same_frames") else {
         assert!(!gpu_required());
         return;
     };
-    let registry = Registry::shared().unwrap();
-    let specialised = registry.without_random_replay(KernelId::RestirSelect).unwrap();
-    assert_eq!(specialised.overrides(), &[(RANDOM_REPLAY.to_string(), 0.0)]);
-    assert_ne!(specialised.pipeline_key(), registry.get(KernelId::RestirSelect).pipeline_key());
-    // A kernel without the override is itself.
-    assert!(std::ptr::eq(
-        registry.without_random_replay(KernelId::PathTrace).unwrap(),
-        registry.get(KernelId::PathTrace)
-    ));
     let scene = default_scene();
-    let gpu_scene = GpuScene::build(&scene).unwrap();
+    let small = GpuScene::build(&scene).unwrap();
+    let mut padded_scene = scene.clone();
+    let unused = Material::Diffuse { albedo: strata_render::scene::Albedo::Constant([0.5; 3]), two_sided: false };
+    padded_scene.materials.extend(std::iter::repeat_n(unused, SCENE_UNIFORM_ROWS as usize / 4));
+    let padded = GpuScene::build(&padded_scene).unwrap();
+    assert!(small.fits_uniform_copy() && !padded.fits_uniform_copy());
     let render = RenderSettings {
         camera: Camera { width: 16, height: 16, ..settings(&scene, 5).camera },
         ..settings(&scene, 5)
     };
+    let traced = |gpu_scene: &GpuScene, backend: &mut dyn Backend| {
+        strata_render::render::render(backend, gpu_scene, &render, 4, |_| {}).unwrap().pixels
+    };
+    assert!(traced(&small, &mut backend) == traced(&padded, &mut backend), "the path tracer's uniform copy differs");
     let runs = [
         (Method::Strata, ReuseOrder::TemporalFirst),
         (Method::Restir, ReuseOrder::SpatialFirst),
         (Method::RestirDisc, ReuseOrder::TemporalFirst),
     ];
     for (method, reuse_order) in runs {
-        let frames = |glossy_replay: bool, backend: &mut dyn Backend| {
+        let frames = |glossy_replay: bool, gpu_scene: &GpuScene, backend: &mut dyn Backend| {
             let restir = RestirSettings {
                 method,
                 reuse_order,
@@ -1083,15 +1089,25 @@ fn kernels_without_random_replay_render_the_same_frames() {
                 selection: blocks_of_8(),
                 ..RestirSettings::default()
             };
-            let mut renderer = RestirRenderer::new(backend, &gpu_scene, &render, restir, scene.extent()).unwrap();
+            let mut renderer = RestirRenderer::new(backend, gpu_scene, &render, restir, scene.extent()).unwrap();
             let images: Vec<_> = (0..3).map(|_| renderer.render_frame(backend, None).unwrap().0.pixels).collect();
             renderer.destroy(backend).unwrap();
             images
         };
-        let general = frames(true, &mut backend);
-        let without = frames(false, &mut backend);
+        let general = frames(true, &padded, &mut backend);
         assert!(general[2].iter().any(|p| p[0] > 0.0), "a black frame");
-        assert!(general == without, "{} {:?}: the specialised kernels render other frames", method.name(), reuse_order);
+        for (glossy_replay, gpu_scene, what) in [
+            (false, &padded, "without replay"),
+            (true, &small, "from the uniform copy"),
+            (false, &small, "without replay, from the uniform copy"),
+        ] {
+            let specialised = frames(glossy_replay, gpu_scene, &mut backend);
+            assert!(
+                general == specialised,
+                "{} {reuse_order:?}: the kernels {what} render other frames",
+                method.name()
+            );
+        }
     }
 }
 

@@ -2,7 +2,7 @@
 // (the reference mode: N dispatches = N samples per pixel). The film position is uniform
 // in the pixel (box filter, CONVENTIONS.md "Output").
 //
-// Bindings (group 0): 0-1 the scene (2-7 unused) (render/scene.wgsl), and
+// Bindings (group 0): 0-2 the scene (3-7 unused) (render/scene.wgsl), and
 //   8 storage, rw        array<vec4<f32>>  per pixel: rgb = sum of samples, a = number of
 //                                          samples dropped as invalid (non-finite radiance
 //                                          or a traversal stack overflow)

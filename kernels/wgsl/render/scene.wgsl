@@ -13,13 +13,15 @@
 // Bindings (group 0), shared by every kernel that includes this fragment:
 //   0 uniform            RenderParams              image, camera, environment, flags, rows
 //   1 storage, read      array<vec4<u32>>          the scene's rows:
-//                          BvhNode (2 rows)          obvhs Bvh2 nodes (root at 0)
+//                          BvhNode (3 rows)          obvhs Bvh2 nodes (root at 0)
 //                          Triangle (3 rows)         triangles in BVH leaf order
 //                          TriangleInfo (3 rows)     object id, material, light, UVs
 //                          Material (4 rows)         materials
 //                          EmissiveTriangle (2 rows) area lights with their selection CDF
 //                          vec4<f32> (1 row)         texels: textures, then the environment
 //                          f32 (4 per row)           environment CDFs (marginal, conditionals)
+//   2 uniform            array<vec4<u32>, SCENE_UNIFORM_ROWS>  the first rows again: the
+//                          whole scene when it fits, read with scene_in_uniform (below)
 
 // #import gpu/render.wgsl
 // #import gpu/scene_rows.wgsl
@@ -58,6 +60,26 @@ const INFINITY: f32 = 0x1.fffffep+127f;
 
 @group(0) @binding(0) var<uniform> params: RenderParams;
 @group(0) @binding(1) var<storage, read> scene_rows: array<vec4<u32>>;
+@group(0) @binding(2) var<uniform> scene_rows_uniform: array<vec4<u32>, SCENE_UNIFORM_ROWS>;
+
+// Whether the scene's rows are read from their uniform copy (the host specialises a
+// kernel with true when the scene has at most SCENE_UNIFORM_ROWS rows: the default room
+// has 307). Why: lavapipe reads a storage buffer one lane at a time, with a branch per
+// lane and per component, and a uniform buffer with a branch-free gather; the
+// path tracer at 128 x 128 takes 21 ms a sample against 29, the ReSTIR frame 13 % less
+// (benches/benches/memory_reads.rs; docs/benchmarks/ci-time.md, twelfth section). On a
+// GPU either is fine. Specialised (a pipeline constant), not a uniform flag: lavapipe
+// runs both sides of a branch, and the constant lets the driver drop the other read.
+override scene_in_uniform: bool = false;
+
+// Row `row` of the scene's rows (gpu/scene_rows.wgsl's readers read every record
+// through it).
+fn scene_row(row: u32) -> vec4<u32> {
+    if scene_in_uniform {
+        return scene_rows_uniform[row];
+    }
+    return scene_rows[row];
+}
 
 fn bvh_node(index: u32) -> BvhNode {
     return read_bvh_node(params.nodes_row, index);
@@ -80,11 +102,11 @@ fn scene_light(index: u32) -> EmissiveTriangle {
 }
 
 fn scene_texel(index: u32) -> vec4<f32> {
-    return bitcast<vec4<f32>>(scene_rows[params.texels_row + index]);
+    return bitcast<vec4<f32>>(scene_row(params.texels_row + index));
 }
 
 fn scene_environment_cdf(index: u32) -> f32 {
-    return bitcast<f32>(scene_rows[params.environment_cdf_row + index / 4u][index % 4u]);
+    return bitcast<f32>(scene_row(params.environment_cdf_row + index / 4u)[index % 4u]);
 }
 
 var<workgroup> trace_stack: array<u32, 2560>;

@@ -29,7 +29,7 @@
 // whole path estimate goes to `base_radiance` and its histogram candidate is
 // OBJECT_ID_NONE. With specular_chain = 0 every smooth primary hit path-traces alone.
 //
-// Bindings (group 0): 0-1 the scene (2-7 unused), 8 RestirParams (restir/reservoir.wgsl), and
+// Bindings (group 0): 0-2 the scene (3-7 unused), 8 RestirParams (restir/reservoir.wgsl), and
 //   9  storage, rw       array<Primary>        G-buffer, one per pixel
 //   10 storage, rw       array<PathCandidate>  one per pixel
 //   11 storage, rw       array<Candidate>      the histogram pass's input (key, object id)

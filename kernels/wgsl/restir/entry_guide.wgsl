@@ -7,7 +7,7 @@
 // previous frame's camera (RestirParams.previous_*) to this one's, both without the
 // sub-pixel jitter. Pixels whose camera ray hit nothing get depth 0.
 //
-// Bindings (group 0): 0-1 the scene (2-7 unused), 8 RestirParams, and
+// Bindings (group 0): 0-2 the scene (3-7 unused), 8 RestirParams, and
 //   9  storage, read     array<Primary>        this frame's G-buffer
 //   10 storage, rw       array<DenoiseGuide>   the denoiser's guide
 //

@@ -10,7 +10,7 @@
 // keys' order matters: every selection draws each member of a run with the expected
 // count K/n whatever the order (entry_spatial.wgsl), so the pass stays unbiased.
 //
-// Bindings (group 0): 0-1 the scene (2-7 unused), 8 RestirParams, and
+// Bindings (group 0): 0-2 the scene (3-7 unused), 8 RestirParams, and
 //   9  storage, read     array<Primary>    this frame's G-buffer
 //   10 storage, read     array<Reservoir>  the merged reservoirs (restir_temporal)
 //   11 storage, rw       array<Candidate>  the block histogram's input

@@ -31,7 +31,7 @@
 // estimate f(Y)/p̂(Y) sum(w), are unbiased (derivation: docs/restir.md, "Why the
 // selection stays unbiased").
 //
-// Bindings (group 0): 0-1 the scene (2-7 unused), 8 RestirParams, and
+// Bindings (group 0): 0-2 the scene (3-7 unused), 8 RestirParams, and
 //   9  storage, read     array<Primary>        G-buffer
 //   10 storage, read     array<PathCandidate>  every pixel's candidate
 //   11 storage, read     array<u32>            the histogram's sorted_pixels

@@ -8,7 +8,7 @@
 // found along an unoccluded ray: it needs no shadow ray. RestirParams.shaded_parts can
 // leave out either part, to measure the other's variance (a diagnostic).
 //
-// Bindings (group 0): 0-1 the scene (2-7 unused), 8 RestirParams, and
+// Bindings (group 0): 0-2 the scene (3-7 unused), 8 RestirParams, and
 //   9  storage, read     array<Primary>     G-buffer
 //   10 storage, read     array<Reservoir>   final reservoirs
 //   11 storage, read     array<vec4<f32>>   base radiance (rgb; a = 1 for an invalid sample)

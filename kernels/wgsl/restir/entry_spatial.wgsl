@@ -30,7 +30,7 @@
 // proportion to w, W = sum(w) / p̂_i(Y), M = M_c + the sum of the merged M_j (Bitterli et
 // al. 2020, Alg. 4; the next merge caps it at RestirParams.temporal_cap).
 //
-// Bindings (group 0): 0-1 the scene (2-7 unused), 8 RestirParams, and
+// Bindings (group 0): 0-2 the scene (3-7 unused), 8 RestirParams, and
 //   9  storage, read     array<Primary>        this frame's G-buffer
 //   10 storage, read     array<Reservoir>      the merged reservoirs (restir_temporal)
 //   11 storage, read     array<u32>            the histogram's sorted_pixels (of the merged reservoirs' keys)

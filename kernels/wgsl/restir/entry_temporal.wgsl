@@ -33,7 +33,7 @@
 // filter skipped; RestirRenderer never dispatches that (a frame without a merge has
 // restir_select write the merge's output itself), but an engine driving the passes may.
 //
-// Bindings (group 0): 0-1 the scene (2-7 unused), 8 RestirParams, and
+// Bindings (group 0): 0-2 the scene (3-7 unused), 8 RestirParams, and
 //   9  storage, read     array<Primary>      this frame's G-buffer
 //   10 storage, read     array<Primary>      the previous frame's G-buffer
 //   11 storage, read     array<Reservoir>    this frame's reservoirs (restir_select)

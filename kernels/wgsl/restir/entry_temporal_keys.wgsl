@@ -24,7 +24,7 @@
 // which source a pixel takes depends on the G-buffers alone, and the temporal merge
 // weighs whatever source it is given by pairwise MIS with targets evaluated at both ends.
 //
-// Bindings (group 0): 0-1 the scene (2-7 unused), 8 RestirParams, and
+// Bindings (group 0): 0-2 the scene (3-7 unused), 8 RestirParams, and
 //   9  storage, read     array<Primary>    this frame's G-buffer
 //   10 storage, read     array<Primary>    the previous frame's G-buffer
 //   11 storage, read     array<Reservoir>  the previous frame's final reservoirs

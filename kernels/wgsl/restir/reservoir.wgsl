@@ -29,7 +29,7 @@
 // share nothing (p̂ = 0 both ways), like pixels of different path segments, so each kind
 // of pixel resamples its own integral with the same GRIS weights.
 //
-// Bindings used with this fragment (group 0): 0-1 the scene (render/scene.wgsl) and
+// Bindings used with this fragment (group 0): 0-2 the scene (render/scene.wgsl) and
 //   8 uniform            RestirParams      the method and its settings
 
 // #import gpu/restir.wgsl

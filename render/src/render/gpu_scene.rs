@@ -260,6 +260,13 @@ impl GpuScene {
         self.section_rows().iter().sum::<u64>() * 16
     }
 
+    /// Whether its rows fit their uniform copy (`SCENE_UNIFORM_ROWS`, `render/scene.wgsl`),
+    /// from which the kernels then read them (on lavapipe much faster than from the
+    /// storage buffer).
+    pub fn fits_uniform_copy(&self) -> bool {
+        self.rows_size() <= u64::from(strata_kernels::render_types::SCENE_UNIFORM_ROWS) * 16
+    }
+
     /// The row at which each of [`Self::sections`] starts, or the total row count when it
     /// does not fit a `u32`.
     fn first_rows(&self) -> Result<[u32; 7], u64> {

@@ -9,8 +9,9 @@ use strata_backends::backend::{download, upload};
 use strata_backends::{Backend, BackendError, Bind, BufferId};
 use strata_kernels::render_types::{
     FLAG_HIT_LIGHTS, FLAG_PIXEL_CENTRES, FLAG_RUSSIAN_ROULETTE, FLAG_SAMPLE_LIGHTS, FLAG_STRATIFIED_FILM, RenderParams,
+    SCENE_UNIFORM_ROWS,
 };
-use strata_kernels::{Kernel, KernelId, Registry};
+use strata_kernels::{Kernel, KernelId, Registry, Specialisation};
 
 /// How light is found (all three estimate the same image).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -137,9 +138,13 @@ impl RenderSettings {
     }
 }
 
-/// The scene's device buffer ([`GpuScene::rows`]), bound at 1 of every path-tracing kernel.
+/// The scene's device buffers ([`GpuScene::rows`]), bound at 1 of every path-tracing
+/// kernel, and their uniform copy at 2 (`render/scene.wgsl`): the rows when they fit
+/// ([`GpuScene::fits_uniform_copy`]), zeros otherwise.
 pub struct SceneBuffers {
     rows: BufferId,
+    uniform_rows: BufferId,
+    in_uniform: bool,
 }
 
 impl SceneBuffers {
@@ -163,18 +168,31 @@ impl SceneBuffers {
                 limit as f64 / 1048576.0
             )));
         }
-        Ok(SceneBuffers { rows: upload(backend, "scene rows", &scene.rows())? })
+        let rows = scene.rows();
+        let in_uniform = scene.fits_uniform_copy();
+        let uniform_rows = backend.create_buffer("scene rows (uniform copy)", u64::from(SCENE_UNIFORM_ROWS) * 16)?;
+        if in_uniform {
+            backend.write_buffer(uniform_rows, 0, bytemuck::cast_slice(&rows))?;
+        }
+        Ok(SceneBuffers { rows: upload(backend, "scene rows", &rows)?, uniform_rows, in_uniform })
     }
 
-    /// The scene's buffer and the parameters `params` under their WGSL names
+    /// Whether the kernels are to read the rows from their uniform copy: what
+    /// [`Specialisation::scene_in_uniform`] must say for every kernel bound to them.
+    pub fn in_uniform(&self) -> bool {
+        self.in_uniform
+    }
+
+    /// The scene's buffers and the parameters `params` under their WGSL names
     /// (`render/scene.wgsl`), for [`Bind::named`].
     pub fn named(&self, params: BufferId) -> Vec<(&'static str, BufferId)> {
-        vec![("params", params), ("scene_rows", self.rows)]
+        vec![("params", params), ("scene_rows", self.rows), ("scene_rows_uniform", self.uniform_rows)]
     }
 
-    /// Frees the buffer.
+    /// Frees the buffers.
     pub fn destroy(self, backend: &mut dyn Backend) -> Result<(), BackendError> {
-        backend.destroy_buffer(self.rows)
+        backend.destroy_buffer(self.rows)?;
+        backend.destroy_buffer(self.uniform_rows)
     }
 }
 
@@ -191,7 +209,9 @@ pub struct PathTracer {
 impl PathTracer {
     /// Uploads `scene` and clears the running sum.
     pub fn new(backend: &mut dyn Backend, scene: &GpuScene, settings: &RenderSettings) -> Result<Self, PassError> {
-        let kernel = Registry::shared()?.get(KernelId::PathTrace);
+        let specialisation =
+            Specialisation { scene_in_uniform: scene.fits_uniform_copy(), ..Specialisation::default() };
+        let kernel = Registry::shared()?.specialised(KernelId::PathTrace, specialisation)?;
         backend.check_kernel(kernel)?;
         let params = settings.params(&scene.params)?;
         let pixels = params.width as u64 * params.height as u64;

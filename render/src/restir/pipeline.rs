@@ -17,7 +17,7 @@ use strata_kernels::denoise_types::DenoiseGuide;
 use strata_kernels::render_types::{FLAG_HIT_LIGHTS, FLAG_SAMPLE_LIGHTS, RenderParams};
 use strata_kernels::restir_types::{PathCandidate, Primary, Reservoir, RestirParams};
 use strata_kernels::types::Candidate;
-use strata_kernels::{BlockGrid, Kernel, KernelId, Registry};
+use strata_kernels::{BlockGrid, Kernel, KernelId, Registry, Specialisation};
 
 /// What one frame did besides its image.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -61,6 +61,8 @@ pub struct FrameBuffers {
 /// The ReSTIR renderer of one scene, image size and settings.
 pub struct RestirRenderer {
     kernels: [&'static Kernel; 5],
+    /// What its kernels are specialised for ([`specialisation_for`]).
+    specialisation: Specialisation,
     settings: RestirSettings,
     render: RenderSettings,
     params: RenderParams,
@@ -124,11 +126,11 @@ pub struct DenoiserInputs {
     pub previous_guides: BufferId,
 }
 
-/// ReSTIR kernel `id` for settings with or without random replay (`glossy_replay`):
-/// without, the registry's copy specialised without the replayed path's re-trace
-/// ([`Registry::without_random_replay`]; the kernel itself where it never reaches it).
-fn kernel_for(registry: &'static Registry, glossy_replay: bool, id: KernelId) -> Result<&'static Kernel, PassError> {
-    if glossy_replay { Ok(registry.get(id)) } else { Ok(registry.without_random_replay(id)?) }
+/// What the renderer's kernels are specialised for ([`Registry::specialised`]): random
+/// replay only with `glossy_replay`, the scene's rows from their uniform copy where they
+/// fit it.
+fn specialisation_for(glossy_replay: bool, scene: &GpuScene) -> Specialisation {
+    Specialisation { random_replay: glossy_replay, scene_in_uniform: scene.fits_uniform_copy() }
 }
 
 impl RestirRenderer {
@@ -151,8 +153,11 @@ impl RestirRenderer {
         // (select, spatial, temporal, shade) are specialised without the replayed path's
         // re-trace (`random_replay` in restir/reservoir.wgsl; the other passes never reach
         // it and are their general selves): the same outputs, and on a CPU driver that runs
-        // every branch under a mask (lavapipe) those passes take 30-45 % less time.
-        let kernel = |id| kernel_for(registry, settings.glossy_replay, id);
+        // every branch under a mask (lavapipe) those passes take 30-45 % less time. A scene
+        // that fits the rows' uniform copy is read from there (`scene_in_uniform` in
+        // render/scene.wgsl): the same outputs, the frame 13 % faster on lavapipe.
+        let specialisation = specialisation_for(settings.glossy_replay, scene);
+        let kernel = |id| -> Result<&'static Kernel, PassError> { Ok(registry.specialised(id, specialisation)?) };
         let kernels = [
             kernel(KernelId::RestirCandidates)?,
             kernel(KernelId::RestirSelect)?,
@@ -208,6 +213,7 @@ impl RestirRenderer {
         let reservoir_size = pixels * size_of::<Reservoir>() as u64;
         let renderer = RestirRenderer {
             kernels,
+            specialisation,
             settings,
             render: render.clone(),
             params,
@@ -263,7 +269,7 @@ impl RestirRenderer {
         if self.guides.is_some() {
             return Ok(());
         }
-        let kernel = kernel_for(Registry::shared()?, self.settings.glossy_replay, KernelId::RestirGuide)?;
+        let kernel = Registry::shared()?.specialised(KernelId::RestirGuide, self.specialisation)?;
         backend.check_kernel(kernel)?;
         let (width, height) = (self.render.camera.width, self.render.camera.height);
         let bytes = u64::from(width) * u64::from(height) * size_of::<DenoiseGuide>() as u64;

@@ -13,16 +13,18 @@ use super::replay::{Recording, recorded, recorded_outputs, replayed_outputs};
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};
 use std::sync::Arc;
 use strata_backends::Backend;
+use strata_kernels::render_types::SCENE_UNIFORM_ROWS;
 use strata_kernels::{KernelId, Registry};
 use strata_render::histogram_pass::PassError;
 use strata_render::render::{GpuScene, RenderSettings, render};
-use strata_render::scene::{Material, Scene, default_scene};
+use strata_render::scene::{Albedo, Material, Scene, default_scene};
 
 /// Checks [`KernelId::PathTrace`].
 pub struct PathTraceCheck;
 
-/// The default room with its tall box turned to glass, its short box to rough metal and
-/// a small environment map shining in (family 1), or the plain default scene (family 0).
+/// The default room with its tall box turned to glass, its short box to rough metal, a
+/// small environment map shining in and rows enough to be read from the storage buffer
+/// (family 1), or the plain default scene, read from its rows' uniform copy (family 0).
 pub(super) fn scene(case: &Case) -> Scene {
     let mut scene = default_scene();
     if case.family == 1 {
@@ -42,6 +44,13 @@ pub(super) fn scene(case: &Case) -> Scene {
             }
         }
         scene.environment = Some(crate::fuzz::build::generated_environment(1.0));
+        // Unused materials enough that the scene's rows overflow their uniform copy: the
+        // renderers then run the kernels that read the storage buffer (`scene_in_uniform`
+        // false, render/scene.wgsl) for this family and the uniform copy for family 0, so
+        // both reads are checked on every backend.
+        let unused = Material::Diffuse { albedo: Albedo::Constant([0.5; 3]), two_sided: false };
+        scene.materials.extend(std::iter::repeat_n(unused, SCENE_UNIFORM_ROWS as usize / 4));
+        debug_assert!(!strata_render::render::GpuScene::build(&scene).is_ok_and(|s| s.fits_uniform_copy()));
     }
     scene
 }

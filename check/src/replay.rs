@@ -18,15 +18,14 @@ use std::time::Duration;
 use strata_backends::{
     Backend, BackendError, Bind, BufferId, DeviceInfo, SamplerDesc, SamplerId, TextureDesc, TextureId,
 };
-use strata_kernels::{Kernel, KernelId, PipelineKey, Registry, Specialisation, WordKind};
+use strata_kernels::{Kernel, KernelId, Registry, Specialisation, WordKind};
 
 /// One dispatch as the interpreter ran it.
 #[derive(Clone, Debug)]
 pub struct RecordedDispatch {
-    /// The kernel's variant ([`Kernel::pipeline_key`]): the renderers run registry kernels
-    /// specialised for their settings and scene ([`Registry::specialised`]), and a replay
-    /// runs the same one.
-    pub kernel: PipelineKey,
+    /// The kernel's specialisation: the renderers run registry kernels specialised for
+    /// their settings and scene ([`Registry::specialised`]), and a replay runs the same one.
+    pub specialisation: Specialisation,
     /// Workgroups dispatched.
     pub workgroups: [u32; 3],
     /// Per bound buffer: (binding, contents before, contents after).
@@ -122,8 +121,8 @@ impl Backend for RecordingBackend<'_> {
         for ((bind, &buffer), before) in binds.iter().zip(&buffers).zip(before) {
             recorded.push((bind.binding, before, self.inner.read_buffer(buffer)?));
         }
-        self.recording
-            .insert(kernel.id, RecordedDispatch { kernel: kernel.pipeline_key(), workgroups, binds: recorded });
+        let specialisation = Specialisation::of(kernel);
+        self.recording.insert(kernel.id, RecordedDispatch { specialisation, workgroups, binds: recorded });
         Ok(())
     }
 
@@ -180,15 +179,11 @@ pub fn replayed_outputs(
         operation: "registry".into(),
         message: e.to_string(),
     })?;
-    let kernel = Specialisation::ALL
-        .into_iter()
-        .filter_map(|specialisation| registry.specialised(kernel_id, specialisation).ok())
-        .find(|kernel| kernel.pipeline_key() == dispatch.kernel)
-        .ok_or_else(|| BackendError::Validation {
-            backend: "replay".into(),
-            operation: "registry".into(),
-            message: format!("no registry variant of `{kernel_id:?}` has the recorded key {:?}", dispatch.kernel),
-        })?;
+    let kernel = registry.specialised(kernel_id, dispatch.specialisation).map_err(|e| BackendError::Validation {
+        backend: "replay".into(),
+        operation: "registry".into(),
+        message: e.to_string(),
+    })?;
     let after = replay(backend, kernel, dispatch)?;
     Ok(outputs(kernel_id, dispatch, &after, float))
 }

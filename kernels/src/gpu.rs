@@ -193,7 +193,7 @@ pub struct GpuModule {
 pub struct RowReaders {
     /// The name of the required function, `fn NAME(row: u32) -> vec4<u32>`
     /// ([`Self::declaration`]): row `row` of the records' array.
-    pub row: &'static str,
+    pub row_function: &'static str,
     /// The generated modules that declare the structs (`gpu/render.wgsl`).
     pub imports: Vec<&'static str>,
     /// The structs read.
@@ -204,7 +204,7 @@ impl RowReaders {
     /// The row function's signature, as its `// #requires` line and the including kernel
     /// write it.
     pub fn declaration(&self) -> String {
-        format!("fn {}(row: u32) -> vec4<u32>", self.row)
+        format!("fn {}(row: u32) -> vec4<u32>", self.row_function)
     }
 
     /// The module's directive lines and one function per struct:
@@ -218,7 +218,7 @@ impl RowReaders {
         text += &format!("// #requires {}\n", self.declaration());
         for declaration in &self.structs {
             text += "\n";
-            text += &row_reader(declaration, self.row);
+            text += &row_reader(declaration, self.row_function);
         }
         text
     }
@@ -494,7 +494,7 @@ mod tests {
     #[test]
     fn a_row_reader_reads_each_field_from_its_lanes() {
         let readers = RowReaders {
-            row: "row_at",
+            row_function: "row_at",
             imports: vec!["gpu/test.wgsl"],
             structs: vec![StructDeclaration::of::<Packed>()],
         };

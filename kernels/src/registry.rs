@@ -476,7 +476,7 @@ pub struct Registry {
     kernels: Vec<Kernel>,
     /// Per [`Specialisation::index`], the kernels that reach an override it gives a value
     /// other than the default, specialised with those values, made on first use.
-    specialised: [std::sync::OnceLock<Result<Vec<Kernel>, KernelError>>; Specialisation::COUNT],
+    variants: [std::sync::OnceLock<Result<Vec<Kernel>, KernelError>>; Specialisation::COUNT],
 }
 
 /// The `override` of the ReSTIR kernels (`restir/reservoir.wgsl`) that keeps random
@@ -498,7 +498,7 @@ pub struct Specialisation {
     pub random_replay: bool,
     /// [`SCENE_IN_UNIFORM`]: the scene's rows fit its uniform copy
     /// (`SCENE_UNIFORM_ROWS`) and are read from there (on lavapipe the path tracer takes
-    /// 29 % less time a sample).
+    /// 27 % less time a sample).
     pub scene_in_uniform: bool,
 }
 
@@ -519,6 +519,21 @@ impl Specialisation {
         Specialisation { random_replay: true, scene_in_uniform: true },
         Specialisation { random_replay: false, scene_in_uniform: true },
     ];
+
+    /// The specialisation `kernel` was made with: its overrides' values, the defaults for
+    /// those it was not given (a registry kernel from [`Registry::specialised`] or
+    /// [`Registry::get`]; any other override is ignored).
+    pub fn of(kernel: &Kernel) -> Specialisation {
+        let mut specialisation = Specialisation::default();
+        for (name, value) in kernel.overrides() {
+            match name.as_str() {
+                RANDOM_REPLAY => specialisation.random_replay = *value != 0.0,
+                SCENE_IN_UNIFORM => specialisation.scene_in_uniform = *value != 0.0,
+                _ => {}
+            }
+        }
+        specialisation
+    }
 
     /// Its slot among the [`Self::COUNT`].
     fn index(self) -> usize {
@@ -550,7 +565,7 @@ impl Registry {
     /// Loads every kernel of [`KernelId::ALL`].
     pub fn load() -> Result<Registry, KernelError> {
         let kernels = KernelId::ALL.iter().map(|&id| Kernel::load(id)).collect::<Result<_, _>>()?;
-        Ok(Registry { kernels, specialised: Default::default() })
+        Ok(Registry { kernels, variants: Default::default() })
     }
 
     /// Kernel `id` with its `override` constants given the values of `specialisation`:
@@ -559,7 +574,7 @@ impl Registry {
     /// elsewhere. Its outputs are the general kernel's wherever the specialisation holds
     /// (no pixel replays; the scene fits its uniform copy).
     pub fn specialised(&self, id: KernelId, specialisation: Specialisation) -> Result<&Kernel, KernelError> {
-        let kernels = self.specialised[specialisation.index()]
+        let kernels = self.variants[specialisation.index()]
             .get_or_init(|| {
                 self.kernels
                     .iter()
@@ -612,6 +627,16 @@ mod tests {
             assert!(!kernel.uses_override(RANDOM_REPLAY), "{id:?}");
             let same = registry.specialised(id, without_replay).unwrap_or_else(|e| panic!("{e}"));
             assert!(std::ptr::eq(same, kernel), "{id:?}");
+        }
+        for specialisation in Specialisation::ALL {
+            for id in [KernelId::PathTrace, KernelId::RestirSelect] {
+                let kernel = registry.specialised(id, specialisation).unwrap_or_else(|e| panic!("{e}"));
+                let expected = Specialisation {
+                    random_replay: specialisation.random_replay || !kernel.uses_override(RANDOM_REPLAY),
+                    ..specialisation
+                };
+                assert_eq!(Specialisation::of(kernel), expected, "{id:?}");
+            }
         }
         let slots: std::collections::HashSet<usize> = Specialisation::ALL.iter().map(|s| s.index()).collect();
         assert_eq!(slots.len(), Specialisation::COUNT, "two specialisations share a slot");

@@ -210,7 +210,7 @@ pub fn scene_rows_module() -> GpuModule {
         path: "gpu/scene_rows.wgsl",
         source: "kernels/src/render_types.rs",
         readers: Some(RowReaders {
-            row: "scene_row",
+            row_function: "scene_row",
             imports: vec!["gpu/trace.wgsl", "gpu/render.wgsl"],
             structs: vec![
                 StructDeclaration::of::<GpuBvhNode>(),

@@ -8,7 +8,9 @@
 // its rows as in an array of its own, each array from the row RenderParams names
 // (`nodes_row`, `triangles_row`, ...; the host's GpuScene::rows). One buffer, not seven,
 // because a browser's WebGPU allows a stage 10 storage buffers, and the ReSTIR passes
-// bind up to 9 of their own. The accessors below are all that reads it.
+// bind up to 9 of their own. A scene of at most SCENE_UNIFORM_ROWS rows is also bound as
+// a uniform copy, which kernels specialised with scene_in_uniform read instead. The
+// accessors below, through scene_row, are all that reads either.
 //
 // Bindings (group 0), shared by every kernel that includes this fragment:
 //   0 uniform            RenderParams              image, camera, environment, flags, rows
@@ -20,8 +22,8 @@
 //                          EmissiveTriangle (2 rows) area lights with their selection CDF
 //                          vec4<f32> (1 row)         texels: textures, then the environment
 //                          f32 (4 per row)           environment CDFs (marginal, conditionals)
-//   2 uniform            array<vec4<u32>, SCENE_UNIFORM_ROWS>  the first rows again: the
-//                          whole scene when it fits, read with scene_in_uniform (below)
+//   2 uniform            array<vec4<u32>, SCENE_UNIFORM_ROWS>  the same rows when the
+//                          scene fits, zeros otherwise; read with scene_in_uniform (below)
 
 // #import gpu/render.wgsl
 // #import gpu/scene_rows.wgsl
@@ -66,7 +68,7 @@ const INFINITY: f32 = 0x1.fffffep+127f;
 // kernel with true when the scene has at most SCENE_UNIFORM_ROWS rows: the default room
 // has 307). Why: lavapipe reads a storage buffer one lane at a time, with a branch per
 // lane and per component, and a uniform buffer with a branch-free gather; the
-// path tracer at 128 x 128 takes 21 ms a sample against 29, the ReSTIR frame 13 % less
+// path tracer at 128 x 128 takes 21.7 ms a sample against 29.6, a ReSTIR frame 10-20 % less
 // (benches/benches/memory_reads.rs; docs/benchmarks/ci-time.md, twelfth section). On a
 // GPU either is fine. Specialised (a pipeline constant), not a uniform flag: lavapipe
 // runs both sides of a branch, and the constant lets the driver drop the other read.

@@ -38,7 +38,7 @@
 
 // Whether this pipeline can meet replay pixels and candidates (RestirParams.replay set:
 // RestirSettings::glossy_replay). strata's renderer makes its pipelines for settings
-// without random replay with `false` (Registry::without_random_replay), and a driver then
+// without random replay with `false` (Registry::specialised), and a driver then
 // drops the path re-trace of `replayed` as dead code from the passes that weigh
 // candidates (select, spatial, temporal, shade; the others never reach `integrand`, so
 // naga's specialisation drops the override there). Why it matters: a CPU driver that runs

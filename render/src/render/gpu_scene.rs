@@ -280,7 +280,8 @@ impl GpuScene {
         Ok(first)
     }
 
-    /// The scene's one storage buffer (`scene_rows` of `render/scene.wgsl`): every array of
+    /// The scene's rows (`scene_rows` of `render/scene.wgsl`, and its uniform copy
+    /// `scene_rows_uniform` when they fit): every array of
     /// [`Self::sections`] in 16-byte rows from the row `params` gives it, each record laid
     /// out as in its own array (the CDF's last row padded with zeros).
     pub fn rows(&self) -> Vec<[u32; 4]> {

@@ -138,13 +138,13 @@ impl RenderSettings {
     }
 }
 
-/// The scene's device buffers ([`GpuScene::rows`]), bound at 1 of every path-tracing
-/// kernel, and their uniform copy at 2 (`render/scene.wgsl`): the rows when they fit
-/// ([`GpuScene::fits_uniform_copy`]), zeros otherwise.
+/// The scene's storage buffer ([`GpuScene::rows`]), bound at 1 of every path-tracing
+/// kernel, and its uniform copy at 2 (`render/scene.wgsl`): the rows when they fit
+/// ([`GpuScene::fits_uniform_copy`], which also decides the kernels' `scene_in_uniform`),
+/// zeros otherwise.
 pub struct SceneBuffers {
     rows: BufferId,
     uniform_rows: BufferId,
-    in_uniform: bool,
 }
 
 impl SceneBuffers {
@@ -169,18 +169,24 @@ impl SceneBuffers {
             )));
         }
         let rows = scene.rows();
-        let in_uniform = scene.fits_uniform_copy();
-        let uniform_rows = backend.create_buffer("scene rows (uniform copy)", u64::from(SCENE_UNIFORM_ROWS) * 16)?;
-        if in_uniform {
-            backend.write_buffer(uniform_rows, 0, bytemuck::cast_slice(&rows))?;
+        let storage = upload(backend, "scene rows", &rows)?;
+        // Whatever fails from here frees what was made.
+        let uniform_rows = match backend.create_buffer("scene rows (uniform copy)", u64::from(SCENE_UNIFORM_ROWS) * 16)
+        {
+            Ok(buffer) => buffer,
+            Err(error) => {
+                backend.destroy_buffer(storage)?;
+                return Err(error.into());
+            }
+        };
+        let buffers = SceneBuffers { rows: storage, uniform_rows };
+        if scene.fits_uniform_copy()
+            && let Err(error) = backend.write_buffer(uniform_rows, 0, bytemuck::cast_slice(&rows))
+        {
+            buffers.destroy(backend)?;
+            return Err(error.into());
         }
-        Ok(SceneBuffers { rows: upload(backend, "scene rows", &rows)?, uniform_rows, in_uniform })
-    }
-
-    /// Whether the kernels are to read the rows from their uniform copy: what
-    /// [`Specialisation::scene_in_uniform`] must say for every kernel bound to them.
-    pub fn in_uniform(&self) -> bool {
-        self.in_uniform
+        Ok(buffers)
     }
 
     /// The scene's buffers and the parameters `params` under their WGSL names

@@ -155,7 +155,7 @@ impl RestirRenderer {
         // it and are their general selves): the same outputs, and on a CPU driver that runs
         // every branch under a mask (lavapipe) those passes take 30-45 % less time. A scene
         // that fits the rows' uniform copy is read from there (`scene_in_uniform` in
-        // render/scene.wgsl): the same outputs, the frame 13 % faster on lavapipe.
+        // render/scene.wgsl): the same outputs, a frame 10-20 % faster on lavapipe.
         let specialisation = specialisation_for(settings.glossy_replay, scene);
         let kernel = |id| -> Result<&'static Kernel, PassError> { Ok(registry.specialised(id, specialisation)?) };
         let kernels = [

@@ -196,11 +196,7 @@ impl Kernel {
 
     /// Parses, validates and describes registry kernel `id`.
     pub fn load(id: KernelId) -> Result<Kernel, KernelError> {
-        let spec = id.spec().ok_or_else(|| KernelError::MissingEntryPoint {
-            kernel: format!("{id:?}"),
-            entry: "(external kernels are made with Kernel::from_wgsl)".into(),
-        })?;
-        Self::from_spec(id, spec, &[])
+        Self::load_with_overrides(id, &[])
     }
 
     /// Registry kernel `id` with its `override` constants given `overrides` (the others
@@ -474,10 +470,16 @@ fn handle_kind(module: &naga::Module, ty: naga::Handle<naga::Type>) -> Result<Bi
 #[derive(Debug)]
 pub struct Registry {
     kernels: Vec<Kernel>,
-    /// Per [`Specialisation::index`], the kernels that reach an override it gives a value
-    /// other than the default, specialised with those values, made on first use.
-    variants: [std::sync::OnceLock<Result<Vec<Kernel>, KernelError>>; Specialisation::COUNT],
+    /// Per [`Specialisation::index`] and per kernel (in `kernels`' order), the kernel
+    /// specialised with the values it reaches that are not their defaults (`None`: it
+    /// reaches none, and is itself), made on first use: a renderer that asks for one
+    /// kernel does not load the others.
+    variants: [Vec<VariantSlot>; Specialisation::COUNT],
 }
+
+/// One kernel's specialisation, made on first use ([`Registry::specialised`]): `None`
+/// where the kernel is itself.
+type VariantSlot = std::sync::OnceLock<Result<Option<Kernel>, KernelError>>;
 
 /// The `override` of the ReSTIR kernels (`restir/reservoir.wgsl`) that keeps random
 /// replay's path re-trace in the pipeline (the default, `true`).
@@ -564,8 +566,9 @@ impl Registry {
 
     /// Loads every kernel of [`KernelId::ALL`].
     pub fn load() -> Result<Registry, KernelError> {
-        let kernels = KernelId::ALL.iter().map(|&id| Kernel::load(id)).collect::<Result<_, _>>()?;
-        Ok(Registry { kernels, variants: Default::default() })
+        let kernels: Vec<Kernel> = KernelId::ALL.iter().map(|&id| Kernel::load(id)).collect::<Result<_, _>>()?;
+        let variants = std::array::from_fn(|_| kernels.iter().map(|_| std::sync::OnceLock::new()).collect());
+        Ok(Registry { kernels, variants })
     }
 
     /// Kernel `id` with its `override` constants given the values of `specialisation`:
@@ -574,18 +577,16 @@ impl Registry {
     /// elsewhere. Its outputs are the general kernel's wherever the specialisation holds
     /// (no pixel replays; the scene fits its uniform copy).
     pub fn specialised(&self, id: KernelId, specialisation: Specialisation) -> Result<&Kernel, KernelError> {
-        let kernels = self.variants[specialisation.index()]
+        let index = self.kernels.iter().position(|k| k.id == id).expect("the registry loads every KernelId");
+        let general = &self.kernels[index];
+        let variant = self.variants[specialisation.index()][index]
             .get_or_init(|| {
-                self.kernels
-                    .iter()
-                    .map(|kernel| (kernel, specialisation.overrides_for(kernel)))
-                    .filter(|(_, overrides)| !overrides.is_empty())
-                    .map(|(kernel, overrides)| Kernel::load_with_overrides(kernel.id, &overrides))
-                    .collect()
+                let overrides = specialisation.overrides_for(general);
+                if overrides.is_empty() { Ok(None) } else { Kernel::load_with_overrides(id, &overrides).map(Some) }
             })
             .as_ref()
             .map_err(Clone::clone)?;
-        Ok(kernels.iter().find(|k| k.id == id).unwrap_or_else(|| self.get(id)))
+        Ok(variant.as_ref().unwrap_or(general))
     }
 
     /// The kernel `id`.

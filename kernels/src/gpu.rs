@@ -224,10 +224,11 @@ impl RowReaders {
     }
 }
 
-/// The WGSL reader of `declaration` through the row function `row` (see [`RowReaders::wgsl`]). Every field
-/// is a scalar or vector of `u32`, `i32` or `f32` within one row; a declaration that has
-/// another (an array, a struct, a vector across rows) cannot be packed this way, and the
-/// panic names it (the module tests generate every reader, so that cannot reach a user).
+/// The WGSL reader of `declaration` through the row function `row_function` (see
+/// [`RowReaders::wgsl`]). Every field is a scalar or vector of `u32`, `i32` or `f32` within
+/// one row; a declaration that has another (an array, a struct, a vector across rows)
+/// cannot be packed this way, and the panic names it (the module tests generate every
+/// reader, so that cannot reach a user).
 fn row_reader(declaration: &StructDeclaration, row_function: &str) -> String {
     assert!(
         declaration.size.is_multiple_of(16),

@@ -416,3 +416,117 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         assert_eq!(&got[i * 2..(i + 1) * 2], &want, "invocation {i}");
     }
 }
+
+/// Element loads of a fixed-size array in a buffer (a uniform buffer's rows, as
+/// `render/scene.wgsl` reads a small scene): one instruction too, clamping an index past
+/// the end to the last element as the pointer it replaces did (`PtrIndex`), after a
+/// header.
+#[test]
+fn element_loads_of_a_fixed_size_array_clamp_to_its_last_element() {
+    let source = r#"
+struct Rows { first: vec4<u32>, rows: array<vec4<u32>, 40> }
+@group(0) @binding(0) var<storage, read> table: Rows;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    let row = table.rows[(i * 7u) % 64u];
+    output[i] = row.x ^ (row.w << 3u) ^ table.first.y;
+}
+"#;
+    let kernel = Kernel::from_wgsl("fixed_element_loads.wgsl", source.into(), "main", false).unwrap();
+    let words: Vec<u32> = (0..164u32).map(|k| k.wrapping_mul(2_654_435_761) >> (k % 7)).collect();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &words, 128, 2);
+    for (i, &have) in got.iter().enumerate() {
+        let row = 4 + 4 * ((i * 7) % 64).min(39);
+        let want = words[row] ^ (words[row + 3] << 3) ^ words[1];
+        assert_eq!(have, want, "invocation {i}");
+    }
+}
+
+/// The passes that keep the generated row readers (`gpu/scene_rows.wgsl`) and their
+/// callers from copying what they read (issue 59): a struct or call result returned by
+/// an inlined callee is computed in the call's result registers; consecutive components
+/// (`row.yzw`) are the vector's own registers, also when it is a variable read in place
+/// that is stored afterwards; a branch on a constant compiles only the side it takes.
+/// Each output puts one of them at its edge: values computed before their `return` and
+/// returned in one branch, results passed on through two calls, a swap of a struct's
+/// fields into the result.
+#[test]
+fn returned_records_and_consecutive_components_keep_wgsl_semantics() {
+    let source = r#"
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+
+struct Pair { a: u32, b: u32 }
+struct Halves { lo: vec2<u32>, hi: vec2<u32> }
+
+const FOLDED: bool = false;
+
+fn make(x: u32) -> Pair { return Pair(x + 1u, x * 2u); }
+fn forward(x: u32) -> Pair { return make(x); }
+fn swapped(p: Pair) -> Pair { return Pair(p.b, p.a); }
+fn pick(c: bool, x: u32) -> Pair {
+    let first = Pair(x, 1u);
+    let second = Pair(2u, x);
+    if c { return first; }
+    return second;
+}
+fn branchy(c: bool, x: u32) -> Pair {
+    if c { return Pair(x, 3u); } else { return make(x + 5u); }
+}
+fn halves(row: vec4<u32>) -> Halves { return Halves(row.xy, row.zw); }
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    let x = input[i];
+    let c = (x & 1u) != 0u;
+    let o = i * 8u;
+    let f = forward(x);
+    output[o] = f.a * 1000u + f.b;
+    let s = swapped(swapped(swapped(forward(x))));
+    output[o + 1u] = s.a * 1000u + s.b;
+    let p = pick(c, x);
+    output[o + 2u] = p.a * 1000u + p.b;
+    let q = branchy(c, x);
+    output[o + 3u] = q.a * 1000u + q.b;
+    var row = vec4<u32>(x, x + 1u, x + 2u, x + 3u);
+    let tail = row.yzw;
+    row.y = 0u;
+    output[o + 4u] = tail.x * 10000u + tail.y * 100u + tail.z + row.y;
+    let h = halves(vec4<u32>(x, x ^ 5u, x * 3u, 7u));
+    output[o + 5u] = h.lo.y * 1000u + h.hi.x + h.hi.y + h.lo.x;
+    var k = 0u;
+    if FOLDED { k = x; } else { k = x + 9u; }
+    output[o + 6u] = k;
+    if !FOLDED { output[o + 7u] = 1u; } else { output[o + 7u] = 2u; }
+}
+"#;
+    let kernel = Kernel::from_wgsl("returns.wgsl", source.into(), "main", false).unwrap();
+    let inputs: Vec<u32> = (0..128u32).map(|i| i.wrapping_mul(2_654_435_761) >> (i % 9)).collect();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &inputs, inputs.len() * 8, 2);
+    for (i, &x) in inputs.iter().enumerate() {
+        let c = x & 1 != 0;
+        let pair = |a: u32, b: u32| a.wrapping_mul(1000).wrapping_add(b);
+        let (ma, mb) = (x.wrapping_add(1), x.wrapping_mul(2));
+        let picked = if c { pair(x, 1) } else { pair(2, x) };
+        let branched = if c { pair(x, 3) } else { pair(x.wrapping_add(6), x.wrapping_add(5).wrapping_mul(2)) };
+        let tail = x.wrapping_add(1).wrapping_mul(10000).wrapping_add(x.wrapping_add(2).wrapping_mul(100));
+        let halves = (x ^ 5).wrapping_mul(1000).wrapping_add(x.wrapping_mul(3)).wrapping_add(7).wrapping_add(x);
+        let want = [
+            pair(ma, mb),
+            pair(mb, ma),
+            picked,
+            branched,
+            tail.wrapping_add(x.wrapping_add(3)),
+            halves,
+            x.wrapping_add(9),
+            1,
+        ];
+        assert_eq!(&got[i * 8..(i + 1) * 8], &want, "invocation {i} (input {x})");
+    }
+}

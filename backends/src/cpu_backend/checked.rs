@@ -107,8 +107,7 @@ fn check(
             }
             Insn::LoadElement(load) => {
                 let bytes = buffer_words(BUFFER | load.buffer) * 4;
-                let available = bytes.saturating_sub(load.address as usize);
-                let length = (available / load.stride.max(1) as usize) as u64;
+                let length = load.elements(bytes);
                 let index = regs[load.index as usize];
                 index_check(local, u64::from(index), length, &|| format!(" (elements in {})", binding(load.buffer)));
                 let first = load.first_word(bytes, index);

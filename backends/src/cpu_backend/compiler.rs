@@ -32,8 +32,14 @@ use naga::{Expression, Handle, Module, TypeInner};
 
 /// Callees with at most this many IR expressions are inlined.
 pub(super) const INLINE_EXPRESSIONS: usize = 400;
-/// Inlining stops this many calls deep.
-pub(super) const INLINE_DEPTH: u32 = 8;
+/// Inlining stops this many calls deep. Why 16, not 8: since the scene is read through
+/// generated readers and `scene_row` (render/scene.wgsl), some of the path tracer's reads
+/// lie deeper than 8 calls, and a call left as a call costs far more than its body here
+/// (while any invocation is inside one, the scheduler compares whole stacks): at 8 the
+/// frame took 283 ms, at 16 187 ms (issue 59, docs/benchmarks/interpreter.md).
+/// WGSL has no recursion, and each callee is small ([`INLINE_EXPRESSIONS`]), so the
+/// depth bounds the code's growth.
+pub(super) const INLINE_DEPTH: u32 = 16;
 /// Marks an expression without a register yet.
 pub(super) const NONE: Reg = Reg::MAX;
 
@@ -447,6 +453,9 @@ impl Compiler<'_> {
                     None => self.expression(&mut scope, handle)?,
                 },
             }
+        }
+        if let (true, Some((dst, words))) = (scope.inlined, result) {
+            super::retarget::return_in_place(&mut scope, dst, words);
         }
         for (index, (_, local)) in function.local_variables.iter().enumerate() {
             let variable = scope.locals[index];

@@ -220,8 +220,14 @@ pub(super) mod tests {
     /// The entry point's instructions of a kernel whose body is `body` after `let x =
     /// data[id.x];` (`data`: a read-write `array<u32>`, `id`: the global invocation id).
     pub(in super::super) fn compiled(body: &str) -> Vec<Insn> {
+        compiled_with("", body)
+    }
+
+    /// As [`compiled`], with module-scope `declarations` (structs, functions, constants,
+    /// other bindings) before the kernel.
+    pub(in super::super) fn compiled_with(declarations: &str, body: &str) -> Vec<Insn> {
         let source = format!(
-            "@group(0) @binding(0) var<storage, read_write> data: array<u32>;\n\
+            "{declarations}\n@group(0) @binding(0) var<storage, read_write> data: array<u32>;\n\
              @compute @workgroup_size(8) fn main(@builtin(global_invocation_id) id: vec3<u32>) {{\n\
              let x = data[id.x];\n{body}\n}}"
         );

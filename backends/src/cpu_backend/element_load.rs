@@ -1,6 +1,6 @@
-//! Loads of a runtime-sized buffer array's element, `nodes[i]`, as one instruction
-//! ([`ElementLoad`]) instead of a pointer computed into registers (`PtrIndexRt`) and a
-//! load through it.
+//! Loads of a buffer array's element, `nodes[i]`, as one instruction ([`ElementLoad`])
+//! instead of a pointer computed into registers (`PtrIndexRt` for a runtime-sized array,
+//! `PtrIndex` for a fixed-size one such as a uniform buffer's) and a load through it.
 //!
 //! Why: a BVH walk loads a node or a triangle per step, and the interpreter ran both
 //! instructions member by member; the path tracer spent about a tenth of its time on
@@ -13,7 +13,8 @@
 //! load (tracked by [`Compiler::last_value`], which every statement that may place a
 //! jump target clears), so the index register holds the same value at the load; and
 //! the fused instruction clamps the index and reads out-of-bounds words as 0 exactly as
-//! the two did ([`super::insn::element_offset`], `execute.rs`).
+//! the two did (a fixed-size array's index to its last element, as `PtrIndex` does;
+//! [`super::insn::element_offset`], `execute.rs`).
 //!
 //! Where: the instruction itself ([`ElementLoad`]) is defined with the others in
 //! [`super::insn`], which the executor reads; this file is the compiler's pass that
@@ -26,7 +27,7 @@ use naga::{Expression, Handle};
 
 impl Compiler<'_> {
     /// The fused load of `pointer` (`len` words into `dst`), if `pointer` is an element
-    /// of a runtime-sized array in a buffer known when compiling, computed by the last
+    /// of an array in a buffer known when compiling, computed by the last
     /// instruction, with no other use: that instruction is then replaced by the load.
     pub(super) fn fuse_element_load(
         &mut self,
@@ -42,11 +43,15 @@ impl Compiler<'_> {
         }
         let Expression::Access { base, .. } = scope.function.expressions[pointer] else { return false };
         let Some(Place::Buffer(buffer, address)) = scope.places[base.index()] else { return false };
-        let Some(&Insn::PtrIndexRt { dst: computed, index, stride, .. }) = self.insns.last() else { return false };
+        let (computed, index, stride, count) = match self.insns.last() {
+            Some(&Insn::PtrIndexRt { dst, index, stride, .. }) => (dst, index, stride, None),
+            Some(&Insn::PtrIndex { dst, index, stride, count, .. }) => (dst, index, stride, Some(count)),
+            _ => return false,
+        };
         if computed != scope.regs[pointer.index()] {
             return false;
         }
-        let load = ElementLoad { dst, buffer, address, index, stride, len, runs: runs.clone() };
+        let load = ElementLoad { dst, buffer, address, index, stride, count, len, runs: runs.clone() };
         *self.insns.last_mut().expect("checked above") = Insn::LoadElement(Box::new(load));
         self.took_over = Some(last);
         true
@@ -55,7 +60,7 @@ impl Compiler<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::decode::tests::compiled;
+    use super::super::decode::tests::{compiled, compiled_with};
     use super::super::insn::Insn;
 
     /// The element loads and pointer computations of `body`.
@@ -74,6 +79,18 @@ mod tests {
         assert_eq!(kinds("let p = &data[x % 7u]; *p = *p + 1u;"), (1, 1));
         // Another instruction between the pointer and the load: kept.
         assert_eq!(kinds("let p = &data[x % 7u]; let y = x * 3u; data[id.x] = *p + y;"), (1, 2));
+    }
+
+    #[test]
+    fn a_fixed_size_array_in_a_buffer_loads_its_element_in_one_instruction() {
+        let insns = compiled_with(
+            "struct Rows { rows: array<vec4<u32>, 8> }\n@group(0) @binding(1) var<uniform> table: Rows;",
+            "let r = table.rows[x % 9u]; data[id.x] = r.y + r.w;",
+        );
+        let count = |f: fn(&Insn) -> bool| insns.iter().filter(|i| f(i)).count();
+        // `data[id.x]` and the row: element loads; no pointer computed.
+        assert_eq!(count(|i| matches!(i, Insn::LoadElement(_))), 2);
+        assert_eq!(count(|i| matches!(i, Insn::PtrIndex { .. } | Insn::Load { .. } | Insn::LoadRuns { .. })), 0);
     }
 
     #[test]

@@ -79,8 +79,19 @@ impl Compiler<'_> {
                             }
                             word += gap + covered[word + gap..].iter().take_while(|&&c| c).count();
                         }
+                        // Members that lie next to each other in their sources too (the
+                        // fields of a record read from one row, `Node(r0.xyz, r0.w)`) are
+                        // copied as one range.
+                        let mut runs: Vec<(Reg, Reg, u32)> = Vec::with_capacity(parts.len());
                         for ((src, part), at) in parts.into_iter().zip(offsets) {
-                            self.copy(dst + at, src, part.min(len.saturating_sub(at)));
+                            let words = part.min(len.saturating_sub(at));
+                            match runs.last_mut() {
+                                Some((to, from, n)) if *to + *n == dst + at && *from + *n == src => *n += words,
+                                _ => runs.push((dst + at, src, words)),
+                            }
+                        }
+                        for (to, from, words) in runs {
+                            self.copy(to, from, words);
                         }
                     }
                     Err(what) => {
@@ -106,6 +117,12 @@ impl Compiler<'_> {
                 for (i, c) in pattern.iter().take(size as usize).enumerate() {
                     self.copy(dst + 2 * i as u32, src + 2 * *c as u32, 2);
                 }
+            }
+            // Consecutive components (`v.yzw`): the vector's own registers, as for one
+            // component (`access_index`).
+            Expression::Swizzle { size, vector, pattern } if let Some(first) = consecutive(size, &pattern) => {
+                let (src, _) = operand!(vector);
+                scope.regs[index] = src + first;
             }
             Expression::Swizzle { size, vector, pattern } => {
                 let (src, _) = operand!(vector);
@@ -559,5 +576,26 @@ impl Compiler<'_> {
                 }
             },
         }
+    }
+}
+
+/// The first component of a swizzle whose components are consecutive (`.xyz`, `.zw`),
+/// which reads the vector's registers from there on; `None` for any other pattern.
+pub(super) fn consecutive(size: naga::VectorSize, pattern: &[naga::SwizzleComponent; 4]) -> Option<u32> {
+    let first = pattern[0] as u32;
+    (0..size as u32).all(|i| pattern[i as usize] as u32 == first + i).then_some(first)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::decode::tests::compiled;
+    use super::super::insn::Insn;
+
+    #[test]
+    fn consecutive_components_are_the_vectors_own_registers() {
+        let body =
+            "let v = vec4<u32>(x, x + 1u, x * 3u, 7u); let t = v.yzw; let u = v.wx; data[id.x] = t.x + t.z + u.y;";
+        // `.yzw` reads v's registers; `.wx` is a swizzle.
+        assert_eq!(compiled(body).iter().filter(|i| matches!(i, Insn::Swizzle { .. })).count(), 1);
     }
 }

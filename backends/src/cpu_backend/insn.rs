@@ -274,6 +274,9 @@ pub(super) struct ElementLoad {
     pub index: Reg,
     /// Bytes from one element to the next.
     pub stride: u32,
+    /// The array's element count if it has a fixed size (a uniform buffer's
+    /// `array<T, N>`), `None` for a runtime-sized array (its count is the buffer's).
+    pub count: Option<u32>,
     /// Words of the value.
     pub len: u32,
     /// The runs of words its uses read ([`super::load_fields`]), or `None`: all.
@@ -282,12 +285,28 @@ pub(super) struct ElementLoad {
 
 impl ElementLoad {
     /// The buffer word where the element of `index` starts, for a buffer of `bytes`
-    /// bytes: the element clamped as `PtrIndexRt` clamps it ([`element_offset`]).
+    /// bytes: the element clamped as `PtrIndexRt` clamps it ([`element_offset`]), or for
+    /// a fixed-size array as `PtrIndex` does (to its last element; words past the
+    /// buffer's end then read as 0, as through the pointer).
     #[inline(always)]
     pub(super) fn first_word(&self, bytes: usize, index: u32) -> usize {
         let address = self.address as usize;
-        let available = bytes.saturating_sub(address);
-        (address + element_offset(available, self.stride as usize, index as usize)) / 4
+        match self.count {
+            Some(count) => (address + index.min(count.saturating_sub(1)) as usize * self.stride as usize) / 4,
+            None => {
+                let available = bytes.saturating_sub(address);
+                (address + element_offset(available, self.stride as usize, index as usize)) / 4
+            }
+        }
+    }
+
+    /// The array's element count, in a buffer of `bytes` bytes (for the sanitizer's
+    /// index check).
+    pub(super) fn elements(&self, bytes: usize) -> u64 {
+        match self.count {
+            Some(count) => u64::from(count),
+            None => (bytes.saturating_sub(self.address as usize) / self.stride.max(1) as usize) as u64,
+        }
     }
 }
 

@@ -11,7 +11,8 @@
 //! Sound because the value and the variable hold the same words from the load until
 //! the variable is next written, and every use of the value comes before that:
 //! - the uses counted are those of the load and of the expressions that share its
-//!   registers (a field or component taken with a constant index, a bitcast); their
+//!   registers (a field or component taken with a constant index, consecutive
+//!   components, a bitcast); their
 //!   number must equal naga's reference counts, so a use this analysis does not see
 //!   (an expression kind it does not list, the continuing block of a loop reading a
 //!   body's value) keeps the copy;
@@ -44,6 +45,11 @@ pub(super) fn in_place_loads(function: &Function, info: &FunctionInfo) -> Vec<bo
         let load = match *expression {
             Expression::Load { pointer } if variable_of(function, pointer, Indices::Constant).is_some() => Some(handle),
             Expression::AccessIndex { base, .. } => shares[base.index()],
+            Expression::Swizzle { size, vector, pattern }
+                if super::expression::consecutive(size, &pattern).is_some() =>
+            {
+                shares[vector.index()]
+            }
             Expression::As { expr, convert: None, .. } => shares[expr.index()],
             _ => None,
         };

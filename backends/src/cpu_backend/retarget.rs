@@ -1,7 +1,9 @@
 //! Store forwarding: a value computed by the instruction just before its only use, a
 //! store into a local variable or an inlined callee's `return`, is computed straight
 //! into the variable's (or the call result's) registers instead of its own and then
-//! copied.
+//! copied. And a value of several instructions (a struct composed, a call's result)
+//! that an inlined callee returns right after computing it is given the call result's
+//! registers from the start ([`return_in_place`]).
 //!
 //! Why: naga IR loads a variable into a new expression and stores an expression into a
 //! variable, so `top1 = top0;` or `i = i + 1u;` compiled word for word ends with a copy.
@@ -15,9 +17,71 @@
 //! operand may equal the new destination but must not partly overlap it (checked per
 //! instruction kind, [`retargetable`]).
 
-use super::compiler::{Compiler, LastValue, Scope};
+use super::compiler::{Compiler, LastValue, NONE, Scope};
 use super::insn::{Insn, Reg};
-use naga::{Expression, Handle};
+use naga::{Block, Expression, Handle, Statement};
+
+/// Gives the call result's registers (`dst`, `words` words) to every value of an inlined
+/// callee's `scope` that a `return` right after it returns and nothing else uses: a
+/// struct composed (`return Node(r0.xyz, ...)`) or a call's result (`return
+/// read_node(...)`), which store forwarding cannot move (several instructions compute
+/// them). Why: the generated row readers (gpu/scene_rows.wgsl) and their callers
+/// (render/scene.wgsl's `bvh_node`) return such values; each return copied the whole
+/// record, twice per BVH node the path tracer visits (issue 59).
+///
+/// Sound because the value is computed by the statement just before its `return` (the
+/// `Emit` holding it, or the `Call`) and used by nothing else (naga reference count 1),
+/// so the result registers, which nothing else in the callee writes, hold it from its
+/// computation to the return; several such returns (in different branches) each write
+/// them just before returning. Its operands are never the result registers: only values
+/// returned are given them, and a returned value is used by nothing else.
+pub(super) fn return_in_place(scope: &mut Scope, dst: Reg, words: u32) {
+    fn visit(scope: &mut Scope, block: &Block, dst: Reg, words: u32) {
+        let mut before: Option<&Statement> = None;
+        for statement in block.iter() {
+            match statement {
+                Statement::Return { value: Some(value) } => {
+                    let computed_just_before = match before {
+                        Some(Statement::Emit(range)) => range.clone().any(|h| h == *value),
+                        Some(Statement::Call { result: Some(result), .. }) => result == value,
+                        _ => false,
+                    };
+                    let index = value.index();
+                    if computed_just_before
+                        && matches!(
+                            scope.function.expressions[*value],
+                            Expression::Compose { .. } | Expression::CallResult(_)
+                        )
+                        && scope.info[*value].ref_count == 1
+                        && scope.lens[index] == words
+                        && scope.regs[index] == NONE
+                        && !scope.pre_emitted[index]
+                    {
+                        scope.regs[index] = dst;
+                    }
+                }
+                Statement::Block(inner) => visit(scope, inner, dst, words),
+                Statement::If { accept, reject, .. } => {
+                    visit(scope, accept, dst, words);
+                    visit(scope, reject, dst, words);
+                }
+                Statement::Switch { cases, .. } => {
+                    for case in cases {
+                        visit(scope, &case.body, dst, words);
+                    }
+                }
+                Statement::Loop { body, continuing, .. } => {
+                    visit(scope, body, dst, words);
+                    visit(scope, continuing, dst, words);
+                }
+                _ => {}
+            }
+            before = Some(statement);
+        }
+    }
+    let function = scope.function;
+    visit(scope, &function.body, dst, words);
+}
 
 impl Compiler<'_> {
     /// Makes the instruction that computed `value` (`len` words) write `dst` instead, if
@@ -92,7 +156,7 @@ fn retargetable(insn: &mut Insn, src: Reg, dst: Reg, len: u32) -> bool {
 
 #[cfg(test)]
 mod tests {
-    use super::super::decode::tests::compiled;
+    use super::super::decode::tests::{compiled, compiled_with};
     use super::*;
 
     fn copies(body: &str) -> usize {
@@ -109,6 +173,41 @@ mod tests {
         // The load of `a` for `a * 3u` reads in place (`load_alias`); the two stores
         // copy nothing.
         assert_eq!(copies("var a = 0u; a = x + 1u; a = a * 3u; data[id.x] = a;"), baseline());
+    }
+
+    /// The words `insns` copy.
+    fn copied_words(insns: &[Insn]) -> u32 {
+        insns
+            .iter()
+            .map(|i| match i {
+                Insn::Copy1 { .. } => 1,
+                Insn::Copy2 { .. } => 2,
+                Insn::Copy3 { .. } => 3,
+                Insn::Copy4 { .. } => 4,
+                Insn::Copy { len, .. } => *len,
+                _ => 0,
+            })
+            .sum()
+    }
+
+    #[test]
+    fn records_returned_through_two_calls_are_composed_in_place() {
+        let declarations = "struct P { a: u32, b: u32 }\n\
+             fn make(x: u32) -> P { return P(x + 1u, x * 2u); }\n\
+             fn forward(x: u32) -> P { return make(x); }";
+        // The struct's two words written once, straight into `p`'s registers by its
+        // composition; no copy of the whole at `make`'s and `forward`'s returns.
+        let insns = compiled_with(declarations, "let p = forward(x); data[id.x] = p.a + p.b;");
+        assert_eq!(copied_words(&insns), 2);
+        // A value computed before another and returned in one branch keeps its own
+        // registers (the other would overwrite it in the result's).
+        let declarations = "struct P { a: u32, b: u32 }\n\
+             fn pick(c: bool, x: u32) -> P { let first = P(x, 1u); let second = P(2u, x); \
+             if c { return first; } return second; }";
+        let insns = compiled_with(declarations, "let p = pick(x > 3u, x); data[id.x] = p.a + p.b;");
+        // (Both are composed, then copied at their returns: `second` too, as an `if`
+        // stands between its computation and its return.)
+        assert_eq!(copied_words(&insns), 2 + 2 + 2 + 2);
     }
 
     #[test]

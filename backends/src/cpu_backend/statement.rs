@@ -52,6 +52,16 @@ impl Compiler<'_> {
                 }
             }
             Statement::Block(block) => self.block(scope, block)?,
+            // A branch on a constant (a pipeline constant once specialised, such as
+            // render/scene.wgsl's `scene_in_uniform` on every row read): only the side it
+            // takes is compiled, as a driver's compiler keeps only that side. Otherwise the
+            // interpreter tested the constant on every execution (issue 59: the path
+            // tracer's frame, docs/benchmarks/interpreter.md).
+            Statement::If { condition, accept, reject } if scope.constant[condition.index()] => {
+                let reg = self.reg(scope, *condition) as usize;
+                let taken = if self.template[reg] != 0 { accept } else { reject };
+                self.block(scope, taken)?;
+            }
             Statement::If { condition, accept, reject }
                 if !self.sanitize && self.if_as_select(scope, *condition, accept, reject)? => {}
             Statement::If { condition, accept, reject } => {
@@ -330,5 +340,29 @@ impl Compiler<'_> {
         self.line = line;
         self.source = scope.source;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::decode::tests::compiled_with;
+    use super::super::insn::Insn;
+
+    /// Branch instructions (a jump on a condition, or the select of an if-conversion) of
+    /// a kernel with `declarations` whose body branches on `condition`.
+    fn branches(declarations: &str, condition: &str) -> usize {
+        let body = format!("if {condition} {{ data[id.x] = x + 1u; }} else {{ data[id.x] = x * 3u; }}");
+        compiled_with(declarations, &body)
+            .iter()
+            .filter(|i| matches!(i, Insn::JumpUnless { .. } | Insn::Select { .. }))
+            .count()
+    }
+
+    #[test]
+    fn a_branch_on_a_constant_compiles_only_the_side_it_takes() {
+        assert_eq!(branches("const F: bool = false;", "F"), 0);
+        assert_eq!(branches("const F: bool = true;", "!F"), 0);
+        // The same branch on a value: a branch.
+        assert_eq!(branches("", "x > 3u"), 1);
     }
 }

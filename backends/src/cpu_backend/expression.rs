@@ -118,20 +118,20 @@ impl Compiler<'_> {
                     self.copy(dst + 2 * i as u32, src + 2 * *c as u32, 2);
                 }
             }
-            // Consecutive components (`v.yzw`): the vector's own registers, as for one
-            // component (`access_index`).
-            Expression::Swizzle { size, vector, pattern } if let Some(first) = consecutive(size, &pattern) => {
-                let (src, _) = operand!(vector);
-                scope.regs[index] = src + first;
-            }
             Expression::Swizzle { size, vector, pattern } => {
                 let (src, _) = operand!(vector);
-                let dst = self.reg(scope, handle);
-                let mut p = [0u8; 4];
-                for (i, c) in pattern.iter().enumerate() {
-                    p[i] = *c as u8;
+                if let Some(first) = consecutive(size, &pattern) {
+                    // Consecutive components (`v.yzw`): the vector's own registers, as for
+                    // one component (`access_index`).
+                    scope.regs[index] = src + first;
+                } else {
+                    let dst = self.reg(scope, handle);
+                    let mut p = [0u8; 4];
+                    for (i, c) in pattern.iter().enumerate() {
+                        p[i] = *c as u8;
+                    }
+                    self.push(Insn::Swizzle { dst, src, pattern: p, n: size as u8 });
                 }
-                self.push(Insn::Swizzle { dst, src, pattern: p, n: size as u8 });
             }
             Expression::Access { base, index: index_handle } => {
                 let (base_reg, _) = operand!(base);

@@ -453,7 +453,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
 /// that is stored afterwards; a branch on a constant compiles only the side it takes.
 /// Each output puts one of them at its edge: values computed before their `return` and
 /// returned in one branch, results passed on through two calls, a swap of a struct's
-/// fields into the result.
+/// fields into the result, returns inside a loop and a switch.
 #[test]
 fn returned_records_and_consecutive_components_keep_wgsl_semantics() {
     let source = r#"
@@ -478,13 +478,26 @@ fn branchy(c: bool, x: u32) -> Pair {
     if c { return Pair(x, 3u); } else { return make(x + 5u); }
 }
 fn halves(row: vec4<u32>) -> Halves { return Halves(row.xy, row.zw); }
+fn first_set_bit(x: u32) -> Pair {
+    for (var i = 0u; i < 8u; i++) {
+        if ((x >> i) & 1u) == 1u { return Pair(i, x >> i); }
+    }
+    return Pair(99u, x);
+}
+fn by_case(x: u32) -> Pair {
+    switch x & 3u {
+        case 0u: { return Pair(1u, x); }
+        case 1u: { return make(x); }
+        default: { return Pair(x, 2u); }
+    }
+}
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
     let x = input[i];
     let c = (x & 1u) != 0u;
-    let o = i * 8u;
+    let o = i * 10u;
     let f = forward(x);
     output[o] = f.a * 1000u + f.b;
     let s = swapped(swapped(swapped(forward(x))));
@@ -503,12 +516,16 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if FOLDED { k = x; } else { k = x + 9u; }
     output[o + 6u] = k;
     if !FOLDED { output[o + 7u] = 1u; } else { output[o + 7u] = 2u; }
+    let b = first_set_bit(x);
+    output[o + 8u] = b.a * 1000u + b.b;
+    let w = by_case(x);
+    output[o + 9u] = w.a * 1000u + w.b;
 }
 "#;
     let kernel = Kernel::from_wgsl("returns.wgsl", source.into(), "main", false).unwrap();
     let inputs: Vec<u32> = (0..128u32).map(|i| i.wrapping_mul(2_654_435_761) >> (i % 9)).collect();
     let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
-    let got = run_words(&mut cpu, &kernel, &inputs, inputs.len() * 8, 2);
+    let got = run_words(&mut cpu, &kernel, &inputs, inputs.len() * 10, 2);
     for (i, &x) in inputs.iter().enumerate() {
         let c = x & 1 != 0;
         let pair = |a: u32, b: u32| a.wrapping_mul(1000).wrapping_add(b);
@@ -526,7 +543,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             halves,
             x.wrapping_add(9),
             1,
+            (0..8).find(|b| (x >> b) & 1 == 1).map_or(pair(99, x), |b| pair(b, x >> b)),
+            match x & 3 {
+                0 => pair(1, x),
+                1 => pair(ma, mb),
+                _ => pair(x, 2),
+            },
         ];
-        assert_eq!(&got[i * 8..(i + 1) * 8], &want, "invocation {i} (input {x})");
+        assert_eq!(&got[i * 10..(i + 1) * 10], &want, "invocation {i} (input {x})");
     }
 }

@@ -40,6 +40,12 @@ pub(super) const INLINE_EXPRESSIONS: usize = 400;
 /// WGSL has no recursion, and each callee is small ([`INLINE_EXPRESSIONS`]), so the
 /// depth bounds the code's growth.
 pub(super) const INLINE_DEPTH: u32 = 16;
+/// IR expressions one code may take in by inlining; past them calls stay calls. Why: a
+/// call tree that branches at every level grows twice per level when inlined, and 16
+/// levels could make a small kernel millions of instructions long (a compile error at
+/// [`super::budget::SPACE_CAP`], or minutes); the largest kernel in the repository inlines
+/// about 60 000 (docs/kernels.md).
+pub(super) const INLINE_BUDGET: usize = 250_000;
 /// Marks an expression without a register yet.
 pub(super) const NONE: Reg = Reg::MAX;
 
@@ -140,6 +146,8 @@ pub(super) struct Compiler<'a> {
     /// variables' words): an upper bound of the template's length, held under
     /// [`super::budget::SPACE_CAP`] before any of it is allocated.
     committed: u64,
+    /// IR expressions inlined into the code so far (held under [`INLINE_BUDGET`]).
+    pub(super) inlined: usize,
     names: &'a mut Vec<String>,
     /// Per module function already compiled: its arguments' registers.
     pub(super) arguments: &'a [Vec<(u32, Reg, u32)>],
@@ -501,6 +509,7 @@ pub(super) fn compile_code(
         sanitize,
         kernel,
         committed: 0,
+        inlined: 0,
         names,
         arguments,
         insns: Vec::new(),

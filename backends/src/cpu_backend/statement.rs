@@ -4,7 +4,7 @@
 //! table of (value, target)), barriers, atomics, subgroup operations and calls (small
 //! callees inlined into the caller's frame).
 
-use super::compiler::{Compiler, INLINE_DEPTH, INLINE_EXPRESSIONS, LastValue, Scope};
+use super::compiler::{Compiler, INLINE_BUDGET, INLINE_DEPTH, INLINE_EXPRESSIONS, LastValue, Scope};
 use super::error::unsupported;
 use super::insn::{CallInsn, CollectiveFun, CollectiveInsn, GatherInsn, Insn, Reg};
 use super::layout::{Place, is_half, is_wide, shape};
@@ -298,7 +298,8 @@ impl Compiler<'_> {
         Ok(())
     }
 
-    /// A call: inlined if the callee is small and the nesting shallow, else a `Call`.
+    /// A call: inlined if the callee is small, the nesting shallow and the code's inlining
+    /// budget not spent, else a `Call`.
     fn call(
         &mut self,
         scope: &mut Scope,
@@ -311,7 +312,9 @@ impl Compiler<'_> {
         let callee = &module.functions[function];
         let line = self.line;
         let result = result.map(|r| (self.reg(scope, r), scope.lens[r.index()]));
-        if callee.expressions.len() <= INLINE_EXPRESSIONS && scope.depth < INLINE_DEPTH {
+        let size = callee.expressions.len();
+        if size <= INLINE_EXPRESSIONS && scope.depth < INLINE_DEPTH && self.inlined + size <= INLINE_BUDGET {
+            self.inlined += size;
             let values: Vec<(Reg, Option<Place>)> =
                 arguments.iter().map(|a| (self.reg(scope, *a), scope.places[a.index()])).collect();
             let mut unused = Vec::new();
@@ -356,6 +359,23 @@ mod tests {
             .iter()
             .filter(|i| matches!(i, Insn::JumpUnless { .. } | Insn::Select { .. }))
             .count()
+    }
+
+    #[test]
+    fn a_call_tree_that_doubles_at_every_level_stops_inlining_at_the_budget() {
+        // f(k) calls f(k-1) twice, 14 levels within the inlining depth: 2^14 copies of f0
+        // (about 40 IR expressions) if every call were inlined, 650 000 expressions.
+        let mut declarations = String::from("fn f0(x: u32) -> u32 { var y = x;");
+        for i in 0..10 {
+            declarations += &format!(" y = y * {}u + (y >> 3u);", i + 3);
+        }
+        declarations += " return y; }\n";
+        for k in 1..=14 {
+            declarations += &format!("fn f{k}(x: u32) -> u32 {{ return f{p}(x) ^ f{p}(x + 1u); }}\n", p = k - 1);
+        }
+        let insns = compiled_with(&declarations, "data[id.x] = f14(x);");
+        let calls = insns.iter().filter(|i| matches!(i, Insn::Call(_))).count();
+        assert!(calls > 0, "the whole tree was inlined: {} instructions", insns.len());
     }
 
     #[test]

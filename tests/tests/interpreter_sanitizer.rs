@@ -64,6 +64,17 @@ fn out_of_range_indices_are_reported_with_index_and_length() {
     assert!(findings.iter().all(|f| f.kind.undefined()));
 }
 
+/// The same for an element of a fixed-size array in a buffer, which the interpreter loads
+/// in one instruction: the length is the array's, not the buffer's.
+#[test]
+fn out_of_range_rows_of_a_fixed_size_array_are_reported() {
+    let findings = findings_of("out_of_range_fixed.wgsl", 16, [1, 1, 1]);
+    assert_found("out_of_range_fixed.wgsl", &findings, FindingKind::OutOfRangeIndex);
+    // Three rows read by 16 invocations: 13 of them past the end (the buffer holds four).
+    assert_eq!(findings[0].count, 13, "{findings:#?}");
+    assert!(findings[0].detail.starts_with("index 3, length 3"), "{findings:#?}");
+}
+
 #[test]
 fn reads_of_workgroup_memory_nobody_wrote_are_noted() {
     let findings = findings_of("unwritten_workgroup.wgsl", 128, [2, 1, 1]);

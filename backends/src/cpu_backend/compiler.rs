@@ -462,7 +462,9 @@ impl Compiler<'_> {
                 },
             }
         }
-        if let (true, Some((dst, words))) = (scope.inlined, result) {
+        if scope.inlined
+            && let Some((dst, words)) = result
+        {
             super::retarget::return_in_place(&mut scope, dst, words);
         }
         for (index, (_, local)) in function.local_variables.iter().enumerate() {

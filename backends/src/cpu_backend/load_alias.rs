@@ -12,10 +12,9 @@
 //! the variable is next written, and every use of the value comes before that:
 //! - the uses counted are those of the load and of the expressions that share its
 //!   registers (a field or component taken with a constant index, consecutive
-//!   components, a bitcast); their
-//!   number must equal naga's reference counts, so a use this analysis does not see
-//!   (an expression kind it does not list, the continuing block of a loop reading a
-//!   body's value) keeps the copy;
+//!   components, a bitcast); their number must equal naga's reference counts, so a use
+//!   this analysis does not see (an expression kind it does not list, the continuing
+//!   block of a loop reading a body's value) keeps the copy;
 //! - they all lie in the rest of the block that emits the load, and no statement from
 //!   the load up to and including the one holding the last use may write the variable
 //!   (a store or call through a pointer into it, or a statement this file does not

@@ -320,25 +320,34 @@ fn run_batch(
                 ),
             ));
         }
-        // Everyone waits at the same instruction: a barrier needs nothing more; a
-        // subgroup gather is computed for all invocations now.
+        // Everyone waits at the same instruction.
         let Stop::Sync(code, pc) = first else { unreachable!() };
-        let file = &mut memory.files[code as usize];
-        match &program.codes[code as usize].insns[pc as usize] {
-            Insn::Gather(gather) => self::gather(invocations, file, gather),
-            Insn::Collective(collective) => self::collective(invocations, file, collective),
-            Insn::Barrier { workgroup, storage } => {
-                if let Some(local) = memory.sanitizing.as_mut() {
-                    local.barrier(*workgroup, *storage);
-                }
-            }
-            _ => {}
-        }
+        complete_sync(program, invocations, memory, code, pc);
         for invocation in invocations.iter_mut() {
             invocation.frame.as_mut().expect("waiting invocations have frames").pc += 1;
         }
     }
     Ok(counts)
+}
+
+/// Completes the barrier or subgroup operation at instruction `pc` of code `code`, where
+/// every invocation of the batch stands: a barrier needs nothing more (but the sanitizer's
+/// note of it); a subgroup gather or collective is computed for all invocations now. The
+/// caller moves them past it. (Run by the dispatch once every invocation has stopped
+/// there, and by [`interp::run_until_sync`] at once when the whole batch reached it as one
+/// group.)
+pub(super) fn complete_sync(program: &Program, invocations: &[Invocation], memory: &mut Batch, code: u32, pc: u32) {
+    let file = &mut memory.files[code as usize];
+    match &program.codes[code as usize].insns[pc as usize] {
+        Insn::Gather(gather) => self::gather(invocations, file, gather),
+        Insn::Collective(collective) => self::collective(invocations, file, collective),
+        Insn::Barrier { workgroup, storage } => {
+            if let Some(local) = memory.sanitizing.as_mut() {
+                local.barrier(*workgroup, *storage);
+            }
+        }
+        _ => {}
+    }
 }
 
 /// Computes a subgroup gather for every invocation of the workgroup (never a batch of

@@ -289,6 +289,19 @@ pub(super) fn run_until_sync(
                     }
                 }
             }
+            // The whole batch reached the barrier or subgroup operation together (none has
+            // finished, none is elsewhere): completed here and now, as the dispatch would
+            // complete it once every invocation had stopped there, without stopping them
+            // (a subgroup kernel's batch is one workgroup, so its shuffles mostly end here).
+            GroupEnd::Sync(pc) if members.len() == width => {
+                super::dispatch::complete_sync(program, invocations, memory, code_index, pc);
+                for &i in members.iter() {
+                    invocations[i].frame.as_mut().expect("running").pc = pc + 1;
+                    if placed {
+                        places.add(pc + 1, i);
+                    }
+                }
+            }
             GroupEnd::Sync(pc) => {
                 for &i in members.iter() {
                     invocations[i].frame.as_mut().expect("running").pc = pc;

@@ -1,7 +1,8 @@
 //! The group loop, a workgroup (or a batch of them, [`super::batch`]) at a time: runs
 //! the bytecode of every invocation of the batch until each ends or reaches a barrier or
-//! subgroup operation, where it stops (that instruction still next) so that
-//! [`super::dispatch`] can synchronise them.
+//! subgroup operation. Where the whole batch reaches one as a single group, it is completed
+//! there and the batch goes on; otherwise each invocation stops at it (that instruction
+//! still next) so that [`super::dispatch`] can synchronise them.
 //!
 //! Invocations at the same place (the same instruction of the same call stack) run as
 //! one *group*: each instruction is decoded and dispatched once and executed for every
@@ -172,7 +173,9 @@ fn meeting_point(leader: &Invocation, other: &Invocation) -> Option<u32> {
 }
 
 /// Runs every invocation of a batch until it returns from the entry point or stops
-/// at a barrier or subgroup operation; `stops[i]` says where invocation `i` stopped.
+/// at a barrier or subgroup operation (one the whole batch reaches as a single group is
+/// completed at once, [`super::dispatch::complete_sync`], and not stopped at); `stops[i]`
+/// says where invocation `i` stopped.
 /// Counts what the groups executed into `counts`. Fails when the dispatch runs past
 /// `limit`.
 #[allow(clippy::too_many_arguments)]

@@ -21,6 +21,7 @@ use std::time::Duration;
 use strata_backends::Backend;
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions, DispatchCounts, WARP_WIDTH};
 use strata_backends::wgpu_backend::{WgpuBackend, WgpuOptions};
+use strata_benches::PassTimes;
 use strata_kernels::selection::SelectionSettings;
 use strata_kernels::{BlockGrid, Executor, KernelId};
 use strata_render::histogram_pass::{BlockHistogramPass, HistogramVariant};
@@ -107,44 +108,6 @@ fn restir_frames(c: &mut Criterion, backend: &mut dyn Backend) {
         renderer.destroy(backend).expect("destroy");
     }
     group.finish();
-}
-
-/// Device time per ReSTIR pass summed over a benchmark's frames (warm-up included), for
-/// the per-pass times and shares printed beside criterion's frame times.
-#[derive(Default)]
-struct PassTimes {
-    frames: u32,
-    passes: [Duration; 5],
-}
-
-impl PassTimes {
-    /// Adds one frame's pass times and returns the frame's total.
-    fn add(&mut self, times: [Duration; 5]) -> Duration {
-        self.frames += 1;
-        for (total, t) in self.passes.iter_mut().zip(times) {
-            *total += t;
-        }
-        times.iter().sum()
-    }
-
-    /// One line to stderr: each pass's mean time and share of the frame. Nothing when a
-    /// filter left the benchmark out (no frames ran).
-    fn print(&self, name: &str) {
-        let total: Duration = self.passes.iter().sum();
-        if self.frames == 0 || total.is_zero() {
-            return;
-        }
-        let names = ["candidates", "histogram", "select", "temporal", "shade"];
-        let parts: Vec<String> = names
-            .iter()
-            .zip(self.passes)
-            .map(|(pass, t)| {
-                let ms = 1e3 * t.as_secs_f64() / f64::from(self.frames);
-                format!("{pass} {ms:.3} ms ({:.1} %)", 100.0 * t.as_secs_f64() / total.as_secs_f64())
-            })
-            .collect();
-        eprintln!("{name}: {} frames, mean per frame: {}", self.frames, parts.join(", "));
-    }
 }
 
 /// The histogram's share of a strata frame in SIMT issue slots (see the module doc).

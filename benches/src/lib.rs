@@ -1,6 +1,9 @@
 //! strata's criterion benchmarks live in `benches/benches/`; results and the exact
 //! commands are in `BENCHMARKS.md`. This library holds what they share.
 
+pub mod pass_times;
+
+pub use pass_times::PassTimes;
 use strata_kernels::types::Candidate;
 use strata_render::synthetic::{CandidateMix, candidate_image};
 

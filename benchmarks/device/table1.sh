@@ -7,14 +7,15 @@
 # device machine (which has a GPU driver, not necessarily a Rust toolchain):
 #
 #   cargo bench -p strata-benches --bench table1 --no-run   # prints the executable's path
-#   (the device tool: carry that path, run `benchmarks/device/table1.sh PATH`)
+#   (the device tool: carry that path as the repository gives it, target/release/deps/
+#   table1-HASH, and run `benchmarks/device/table1.sh target/release/deps/table1-HASH`)
 #
 # Writes, under $OUT (the device tool's folder; target/table1 elsewhere): machine.txt
 # (the GPU and driver), table1.txt (criterion's output and the per-pass lines); prints
 # the `table1:` line at the end. On a CPU device set STRATA_TABLE1_SIZE=160x90 to try it.
 set -euo pipefail
 bench=${1:?usage: benchmarks/device/table1.sh BENCH_EXECUTABLE (from cargo bench -p strata-benches --bench table1 --no-run)}
-[ -x "$bench" ] || { echo "error: $bench: not an executable file" >&2; exit 1; }
+[ -f "$bench" ] && [ -x "$bench" ] || { echo "error: $bench: not an executable file" >&2; exit 1; }
 out=${OUT:-target/table1}
 mkdir -p "$out"
 {
@@ -27,4 +28,5 @@ mkdir -p "$out"
 runtime=$(mktemp -d)
 trap 'rm -rf "$runtime"' EXIT
 XDG_RUNTIME_DIR=$runtime "$bench" --bench 2>&1 | tee "$out/table1.txt"
-grep "^table1:" "$out/table1.txt" || { echo "error: no table1 line (no timestamps on this device?)" >&2; exit 1; }
+grep "^table1:" "$out/table1.txt" \
+  || { echo "error: no table1 line; see $out/table1.txt (no GPU adapter, or no timestamp queries?)" >&2; exit 1; }

@@ -14,8 +14,6 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::time::Duration;
-use strata_backends::Backend;
-use strata_backends::wgpu_backend::{WgpuBackend, WgpuOptions};
 use strata_benches::benchmark_candidates;
 use strata_kernels::BlockGrid;
 use strata_kernels::reference::block_histogram::{block_histogram, sort_block};
@@ -43,14 +41,7 @@ fn block_sort(c: &mut Criterion) {
     });
     group.bench_function("native_reference", |b| b.iter(|| black_box(block_histogram(grid, &candidates))));
 
-    let mut backend = match WgpuBackend::new(WgpuOptions::default()) {
-        Ok(backend) => backend,
-        Err(error) => {
-            eprintln!("wgpu benchmarks skipped: {error}");
-            return;
-        }
-    };
-    eprintln!("device: {}", backend.info().summary());
+    let Some(mut backend) = strata_benches::open_wgpu("wgpu benchmarks") else { return };
     for (name, variant) in [
         ("wgpu_portable", HistogramVariant::Portable),
         ("wgpu_subgroup", HistogramVariant::Subgroup),

@@ -11,22 +11,14 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::Duration;
 use strata_backends::Backend;
-use strata_backends::wgpu_backend::{WgpuBackend, WgpuOptions};
 use strata_render::denoise::{SvgfDenoiser, SvgfSettings};
 use strata_render::render::{GpuScene, RenderSettings};
 use strata_render::restir::{RestirRenderer, RestirSettings};
 use strata_render::scene::default_scene;
 
 fn svgf(c: &mut Criterion) {
-    let mut backend = match WgpuBackend::new(WgpuOptions::default()) {
-        Ok(backend) => backend,
-        Err(error) => {
-            eprintln!("denoise skipped: {error}");
-            return;
-        }
-    };
+    let Some(mut backend) = strata_benches::open_wgpu("denoise") else { return };
     let backend: &mut dyn Backend = &mut backend;
-    eprintln!("wgpu: {}", backend.info().summary());
     let scene = default_scene();
     let gpu_scene = GpuScene::build(&scene).expect("default scene");
     let render = RenderSettings::for_scene(&scene, 256, 256, 1);

@@ -15,7 +15,6 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::Duration;
 use strata_backends::texture::TextureDesc;
-use strata_backends::wgpu_backend::{WgpuBackend, WgpuOptions};
 use strata_backends::{Backend, Bind};
 use strata_kernels::Kernel;
 use strata_kernels::texture::{TexelFormat, TextureDimension};
@@ -42,14 +41,7 @@ const ENTRY_POINTS: [(&str, &[u32]); 8] = [
 ];
 
 fn memory_reads(c: &mut Criterion) {
-    let mut backend = match WgpuBackend::new(WgpuOptions::default()) {
-        Ok(backend) => backend,
-        Err(error) => {
-            eprintln!("memory_reads skipped: {error}");
-            return;
-        }
-    };
-    eprintln!("{}", backend.info().summary());
+    let Some(mut backend) = strata_benches::open_wgpu("memory_reads") else { return };
     // Words that spread the chain over the whole table.
     let words: Vec<u32> = (0..ENTRIES * 4).map(|i| i.wrapping_mul(2_654_435_761) >> 8).collect();
     let bytes: &[u8] = bytemuck::cast_slice(&words);

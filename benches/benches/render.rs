@@ -20,7 +20,6 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::Duration;
 use strata_backends::Backend;
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions, DispatchCounts, WARP_WIDTH};
-use strata_backends::wgpu_backend::{WgpuBackend, WgpuOptions};
 use strata_benches::PassTimes;
 use strata_kernels::selection::SelectionSettings;
 use strata_kernels::{BlockGrid, Executor, KernelId};
@@ -197,14 +196,7 @@ fn histogram_share_simt(c: &mut Criterion) {
 
 fn render(c: &mut Criterion) {
     histogram_share_simt(c);
-    let mut wgpu = match WgpuBackend::new(WgpuOptions::default()) {
-        Ok(backend) => backend,
-        Err(error) => {
-            eprintln!("render benchmarks skipped: {error}");
-            return;
-        }
-    };
-    eprintln!("wgpu: {}", wgpu.info().summary());
+    let Some(mut wgpu) = strata_benches::open_wgpu("render benchmarks") else { return };
     path_trace(c, "wgpu", &mut wgpu, 512);
     path_trace(c, "wgpu", &mut wgpu, 128);
     let mut interpreter = CpuBackend::new(CpuOptions::default()).expect("interpreter");

@@ -18,7 +18,6 @@ use obvhs::ray::{Ray as ObvhsRay, RayHit};
 use std::hint::black_box;
 use std::time::Duration;
 use strata_backends::backend::upload;
-use strata_backends::wgpu_backend::{WgpuBackend, WgpuOptions};
 use strata_backends::{Backend, Bind};
 use strata_kernels::trace_types::{Hit, TraceParams};
 use strata_kernels::{KernelId, Registry};
@@ -110,13 +109,7 @@ fn trace(c: &mut Criterion) {
         })
     });
 
-    let mut backend = match WgpuBackend::new(WgpuOptions::default()) {
-        Ok(backend) => backend,
-        Err(error) => {
-            eprintln!("wgpu skipped: {error}");
-            return;
-        }
-    };
+    let Some(mut backend) = strata_benches::open_wgpu("wgpu") else { return };
     let scene = SceneBvh::build(&soup).expect("scene");
     let kernel = Registry::shared().expect("registry").get(KernelId::BvhClosestHit);
     let groups = (rays.len() as u32).div_ceil(64);

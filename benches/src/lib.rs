@@ -4,6 +4,8 @@
 pub mod pass_times;
 
 pub use pass_times::PassTimes;
+use strata_backends::Backend;
+use strata_backends::wgpu_backend::{WgpuBackend, WgpuOptions};
 use strata_kernels::types::Candidate;
 use strata_render::synthetic::{CandidateMix, candidate_image};
 
@@ -22,4 +24,19 @@ pub fn engine_candidates(width: u32, height: u32) -> Vec<Candidate> {
             object_id: if p % 101 == 0 { u32::MAX } else { (p % width) / 214 },
         })
         .collect()
+}
+
+/// The wgpu device a bench runs on (the default options), its summary printed first; or,
+/// where none opens here, `None` after a line saying that `what` is skipped and why.
+pub fn open_wgpu(what: &str) -> Option<WgpuBackend> {
+    match WgpuBackend::new(WgpuOptions::default()) {
+        Ok(backend) => {
+            eprintln!("device: {}", backend.info().summary());
+            Some(backend)
+        }
+        Err(error) => {
+            eprintln!("{what} skipped: {error}");
+            None
+        }
+    }
 }

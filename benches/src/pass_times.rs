@@ -25,11 +25,6 @@ impl PassTimes {
         times.iter().sum()
     }
 
-    /// The frames added so far.
-    pub fn frames(&self) -> u32 {
-        self.frames
-    }
-
     /// Each pass's mean time per frame, in [`PASS_NAMES`]' order (zero before any frame).
     pub fn means(&self) -> [Duration; 5] {
         self.passes.map(|t| if self.frames == 0 { Duration::ZERO } else { t / self.frames })

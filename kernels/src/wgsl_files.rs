@@ -45,6 +45,8 @@ pub static WGSL_FILES: &[Fragment] = &[
     fragment!("strata/entry_histogram_subgroup.wgsl"),
     fragment!("strata/histogram.wgsl"),
     fragment!("strata/histogram_rank.wgsl"),
+    fragment!("strata/histogram_slot_pairs.wgsl"),
+    fragment!("strata/histogram_slots.wgsl"),
     fragment!("strata/masking.wgsl"),
     fragment!("strata/resampling.wgsl"),
     fragment!("strata/selection.wgsl"),

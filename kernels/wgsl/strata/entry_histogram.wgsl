@@ -3,6 +3,7 @@
 // strata/histogram.wgsl.
 
 // #import strata/histogram.wgsl
+// #import strata/histogram_slots.wgsl
 
 // Never called: with zero lane bits every exchange stays in registers or workgroup memory.
 fn lane_exchange(value: vec4<u32>, mask: u32) -> vec4<u32> {

@@ -7,6 +7,7 @@
 // sorts exactly like the portable one.
 
 // #import strata/histogram.wgsl
+// #import strata/histogram_slots.wgsl
 
 var<workgroup> lane_mismatch: atomic<u32>;
 var<workgroup> lane_bits_chosen: u32;

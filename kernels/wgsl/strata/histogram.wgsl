@@ -43,6 +43,8 @@
 // #import strata/candidate.wgsl
 // #import strata/masking.wgsl
 // #requires fn lane_exchange(value: vec4<u32>, mask: u32) -> vec4<u32>
+// #requires fn slot_cluster_key(slot: u32) -> vec2<u32>
+// #requires fn set_slot_cluster_key(slot: u32, value: vec2<u32>)
 
 const ELEMS: u32 = 16u;
 const ELEM_BITS: u32 = 4u;
@@ -57,8 +59,9 @@ const SENTINEL_KEY: u32 = 0xffffffffu;
 @group(0) @binding(3) var<storage, read_write> spans: array<ClusterSpan>;
 @group(0) @binding(4) var<storage, read_write> block_stats: array<BlockStats>;
 
-// The block's elements between relayouts: (cluster, key) and local pixel index.
-var<workgroup> shared_cluster_key: array<vec2<u32>, HISTOGRAM_SLOTS_PER_WORKGROUP>;
+// The block's elements between relayouts: (cluster, key) through slot_cluster_key and
+// set_slot_cluster_key (the entry's choice of storage: strata/histogram_slots.wgsl or
+// strata/histogram_slot_pairs.wgsl), and local pixel index.
 var<workgroup> shared_local: array<u32, HISTOGRAM_SLOTS_PER_WORKGROUP>;
 // Per segment (block of this workgroup): clusters, invalid, empty.
 var<workgroup> shared_stats: array<atomic<u32>, 192>;
@@ -196,7 +199,7 @@ fn step_lanes(el: Elements, t: u32, lane_bit: u32, log_k: u32, log_n: u32) -> El
 }
 
 fn place(slot: u32, cluster: u32, key: u32, local: u32) {
-    shared_cluster_key[slot] = vec2<u32>(cluster, key);
+    set_slot_cluster_key(slot, vec2<u32>(cluster, key));
     shared_local[slot] = local;
 }
 
@@ -219,10 +222,10 @@ fn store_registers(el: Elements, t: u32, lo: u32) {
 // Quad of elements first..first+3 from their slots in layout `lo`.
 fn load_quad(first: u32, t: u32, lo: u32) -> Quad {
     let slots = vec4<u32>(slot_of(t, 0u, lo)) | ((vec4<u32>(first) + vec4<u32>(0u, 1u, 2u, 3u)) << vec4<u32>(lo));
-    let a = shared_cluster_key[slots.x];
-    let b = shared_cluster_key[slots.y];
-    let c = shared_cluster_key[slots.z];
-    let d = shared_cluster_key[slots.w];
+    let a = slot_cluster_key(slots.x);
+    let b = slot_cluster_key(slots.y);
+    let c = slot_cluster_key(slots.z);
+    let d = slot_cluster_key(slots.w);
     return Quad(
         vec4<u32>(a.x, b.x, c.x, d.x),
         vec4<u32>(a.y, b.y, c.y, d.y),
@@ -249,7 +252,7 @@ fn search_cluster(begin: u32, end: u32, cluster: u32, inclusive: bool) -> u32 {
     var hi = end;
     while lo < hi {
         let mid = (lo + hi) / 2u;
-        let c = shared_cluster_key[mid].x;
+        let c = slot_cluster_key(mid).x;
         if c < cluster || (inclusive && c == cluster) {
             lo = mid + 1u;
         } else {
@@ -266,7 +269,7 @@ fn search_invalid(begin: u32, end: u32) -> u32 {
     var hi = end;
     while lo < hi {
         let mid = (lo + hi) / 2u;
-        if shared_cluster_key[mid].y < INVALID_KEY {
+        if slot_cluster_key(mid).y < INVALID_KEY {
             lo = mid + 1u;
         } else {
             hi = mid;
@@ -454,11 +457,11 @@ fn finish_elements(rect: BlockRect, begin: u32, segment: u32, first: u32, el: El
     // Neighbours just outside: the previous and next sorted elements of the block.
     var previous = vec2(~cluster.q0.x, 0u);
     if first > 0u {
-        previous = shared_cluster_key[base - 1u];
+        previous = slot_cluster_key(base - 1u);
     }
     var next_cluster = ~cluster.q3.w;
     if first + 16u < count {
-        next_cluster = shared_cluster_key[base + 16u].x;
+        next_cluster = slot_cluster_key(base + 16u).x;
     }
 
     // Run starts and ends.

@@ -3,67 +3,100 @@
 // and finishing code it shares), found by counting instead of exchanging. Each element's
 // sorted position is the number of elements of its block that precede it in the order
 // (cluster, canonical key, pixel index); every invocation counts, for its 16 elements,
-// over the block's slots read once from workgroup memory. That is n comparisons per
-// element (n = B², 256 at B = 16) against the network's ~log²(n)/2 exchanges, but it
-// needs three barriers instead of one pair per round trip, and every lane of a SIMD
-// row reads the same slot: on a CPU device (lavapipe), where a round trip through
-// workgroup memory costs one scalar access per lane and element, that is cheaper.
+// over the block's slots read once from workgroup memory, two slots a read
+// (strata/histogram_slot_pairs.wgsl). That is n comparisons per element (n = B², 256 at
+// B = 16) against the network's ~log²(n)/2 exchanges, but it needs three barriers instead
+// of one pair per round trip, and every lane of a SIMD row reads the same slots: on a CPU
+// device (lavapipe), where a round trip through workgroup memory costs one scalar access
+// per lane and element, that is cheaper.
+//
+// The counting loop runs over the whole block in every lane (the same trip count in a
+// SIMD row) with one comparison, "below" in (cluster, key): a slot before the
+// invocation's own 16 precedes an element it ties with, so its key is lowered by one
+// first (keys are moved to 1 ..= 0x7f800002 for the count, so nothing wraps); ties
+// among the invocation's own 16 are then counted by position. Measured on lavapipe at 1M
+// candidates (docs/benchmarks/block_sort.md): 48 ms with three loops split at each
+// invocation's own slots and one slot a read, 41 ms with this loop, 36 ms reading pairs.
 
 // #import strata/histogram.wgsl
+// #import strata/histogram_slot_pairs.wgsl
 
-// Count of (cluster, key) pairs `other` at or below / below each of q's four, as 0 or 1.
-fn at_or_below(other: vec2<u32>, q: Quad) -> vec4<u32> {
-    let c = vec4<u32>(other.x);
-    return select(vec4(0u), vec4(1u), (c < q.cluster) | ((c == q.cluster) & (vec4<u32>(other.y) <= q.key)));
+// A canonical key moved into 1 ..= 0x7f800002 with its order kept: finite keys
+// (0 ..= 0x7f7fffff, strata/candidate.wgsl) plus one, INVALID_KEY and SENTINEL_KEY just
+// above them. So a key lowered by one stays a key, and "at or below" is "below" the key
+// one higher.
+fn counting_keys(key: vec4<u32>) -> vec4<u32> {
+    return select(key - vec4(0x807ffffdu), key + vec4(1u), key < vec4(0x80000000u));
 }
 
+fn with_counting_keys(q: Quad) -> Quad {
+    return Quad(q.cluster, counting_keys(q.key), q.local);
+}
+
+// Whether (cluster, key) `other` lies below each of q's four, as 0 or 1.
 fn below(other: vec2<u32>, q: Quad) -> vec4<u32> {
     let c = vec4<u32>(other.x);
     return select(vec4(0u), vec4(1u), (c < q.cluster) | ((c == q.cluster) & (vec4<u32>(other.y) < q.key)));
 }
 
-// Whether `other` (with block position `local`) precedes each of q's four.
-fn before(other: vec2<u32>, local: u32, q: Quad) -> vec4<u32> {
-    let o = Quad(vec4<u32>(other.x), vec4<u32>(other.y), vec4<u32>(local));
-    return select(vec4(0u), vec4(1u), precedes(o, q));
+// Whether `other` (at block position `position`) ties with each of q's four in
+// (cluster, key) and comes first by position, as 0 or 1.
+fn tie_before(other: vec2<u32>, position: u32, q: Quad) -> vec4<u32> {
+    let same = (vec4<u32>(other.x) == q.cluster) & (vec4<u32>(other.y) == q.key);
+    return select(vec4(0u), vec4(1u), same & (vec4<u32>(position) < q.local));
+}
+
+// This invocation's 16 slots (natural layout, from `base`) as 8 pairs.
+fn store_pairs(el: Elements, base: u32) {
+    let pair = base >> 1u;
+    set_slot_pair(pair, vec4(el.q0.cluster.x, el.q0.key.x, el.q0.cluster.y, el.q0.key.y));
+    set_slot_pair(pair + 1u, vec4(el.q0.cluster.z, el.q0.key.z, el.q0.cluster.w, el.q0.key.w));
+    set_slot_pair(pair + 2u, vec4(el.q1.cluster.x, el.q1.key.x, el.q1.cluster.y, el.q1.key.y));
+    set_slot_pair(pair + 3u, vec4(el.q1.cluster.z, el.q1.key.z, el.q1.cluster.w, el.q1.key.w));
+    set_slot_pair(pair + 4u, vec4(el.q2.cluster.x, el.q2.key.x, el.q2.cluster.y, el.q2.key.y));
+    set_slot_pair(pair + 5u, vec4(el.q2.cluster.z, el.q2.key.z, el.q2.cluster.w, el.q2.key.w));
+    set_slot_pair(pair + 6u, vec4(el.q3.cluster.x, el.q3.key.x, el.q3.cluster.y, el.q3.key.y));
+    set_slot_pair(pair + 7u, vec4(el.q3.cluster.z, el.q3.key.z, el.q3.cluster.w, el.q3.key.w));
 }
 
 // The whole pass for one workgroup. Must be called in uniform control flow.
 fn run_block_histogram_ranked(t: u32, workgroup_id: vec3<u32>) {
     let setup = setup_block_histogram(t, workgroup_id);
     let el = load_block_elements(setup);
-    // The unsorted blocks in the natural layout: slot begin + p holds block position p.
-    store_registers(el, t, 0u);
+    let counted = Elements(with_counting_keys(el.q0), with_counting_keys(el.q1), with_counting_keys(el.q2), with_counting_keys(el.q3));
+    // The unsorted blocks in the natural layout, keys as counting_keys: slot begin + p
+    // holds block position p (blocks and an invocation's slots start at even slots).
+    store_pairs(counted, setup.base);
     workgroupBarrier();
 
-    // Positions below this invocation's own come first in a tie of (cluster, key), those
-    // above come after; its own 16 are compared with the position too.
     let begin = setup.base - setup.first;
     let end = begin + (1u << setup.log_n);
     var r0 = vec4(0u);
     var r1 = vec4(0u);
     var r2 = vec4(0u);
     var r3 = vec4(0u);
-    for (var j = begin; j < setup.base; j++) {
-        let other = shared_cluster_key[j];
-        r0 += at_or_below(other, el.q0);
-        r1 += at_or_below(other, el.q1);
-        r2 += at_or_below(other, el.q2);
-        r3 += at_or_below(other, el.q3);
+    for (var j = begin; j < end; j += 4u) {
+        let pair = slot_pair(j >> 1u);
+        let next = slot_pair((j >> 1u) + 1u);
+        // Before this invocation's slots: precedes the elements it ties with.
+        let lower = select(0u, 1u, j < setup.base);
+        let a = vec2(pair.x, pair.y - lower);
+        let b = vec2(pair.z, pair.w - lower);
+        let c = vec2(next.x, next.y - lower);
+        let d = vec2(next.z, next.w - lower);
+        r0 += below(a, counted.q0) + below(b, counted.q0) + below(c, counted.q0) + below(d, counted.q0);
+        r1 += below(a, counted.q1) + below(b, counted.q1) + below(c, counted.q1) + below(d, counted.q1);
+        r2 += below(a, counted.q2) + below(b, counted.q2) + below(c, counted.q2) + below(d, counted.q2);
+        r3 += below(a, counted.q3) + below(b, counted.q3) + below(c, counted.q3) + below(d, counted.q3);
     }
-    for (var j = setup.base; j < setup.base + ELEMS; j++) {
-        let other = shared_cluster_key[j];
-        r0 += before(other, j - begin, el.q0);
-        r1 += before(other, j - begin, el.q1);
-        r2 += before(other, j - begin, el.q2);
-        r3 += before(other, j - begin, el.q3);
-    }
-    for (var j = setup.base + ELEMS; j < end; j++) {
-        let other = shared_cluster_key[j];
-        r0 += below(other, el.q0);
-        r1 += below(other, el.q1);
-        r2 += below(other, el.q2);
-        r3 += below(other, el.q3);
+    for (var j = setup.base; j < setup.base + ELEMS; j += 2u) {
+        let pair = slot_pair(j >> 1u);
+        let a = pair.xy;
+        let b = pair.zw;
+        r0 += tie_before(a, j - begin, counted.q0) + tie_before(b, j + 1u - begin, counted.q0);
+        r1 += tie_before(a, j - begin, counted.q1) + tie_before(b, j + 1u - begin, counted.q1);
+        r2 += tie_before(a, j - begin, counted.q2) + tie_before(b, j + 1u - begin, counted.q2);
+        r3 += tie_before(a, j - begin, counted.q3) + tie_before(b, j + 1u - begin, counted.q3);
     }
 
     // Every element to its sorted slot, then this invocation's sorted slots back.

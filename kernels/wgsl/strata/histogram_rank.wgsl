@@ -15,8 +15,9 @@
 // invocation's own 16 precedes an element it ties with, so its key is lowered by one
 // first (keys are moved to 1 ..= 0x7f800002 for the count, so nothing wraps); ties
 // among the invocation's own 16 are then counted by position. Measured on lavapipe at 1M
-// candidates (docs/benchmarks/block_sort.md): 48 ms with three loops split at each
-// invocation's own slots and one slot a read, 41 ms with this loop, 36 ms reading pairs.
+// candidates, B = 16 (docs/benchmarks/block_sort.md): 48 ms with three loops split at each
+// invocation's own slots (so a SIMD row ran its widest split) and one slot a read, 41 ms
+// with this loop, 36 ms reading pairs, 33 ms with two pairs an iteration (four: 36 ms).
 
 // #import strata/histogram.wgsl
 // #import strata/histogram_slot_pairs.wgsl

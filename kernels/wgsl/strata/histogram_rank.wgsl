@@ -11,33 +11,45 @@
 // per lane and element, that is cheaper.
 //
 // The counting loop runs over the whole block in every lane (the same trip count in a
-// SIMD row) with one comparison, "below" in (cluster, key): a slot before the
-// invocation's own 16 precedes an element it ties with, so its key is lowered by one
-// first (keys are moved to 1 ..= 0x7f800002 for the count, so nothing wraps); ties
-// among the invocation's own 16 are then counted by position. Measured on lavapipe at 1M
-// candidates, B = 16 (docs/benchmarks/block_sort.md): 48 ms with three loops split at each
-// invocation's own slots (so a SIMD row ran its widest split) and one slot a read, 41 ms
-// with this loop, 36 ms reading pairs, 33 ms with two pairs an iteration (four: 36 ms).
+// SIMD row) with one test, "below" in (cluster, key): a slot before the invocation's own
+// 16 precedes an element it ties with, so its key is lowered by one first (keys are moved
+// to 1 ..= 0x7f800002 for the count, so nothing wraps); ties among the invocation's own
+// 16 are then counted by position. An element is counted as the two halves of the 63-bit
+// number cluster * 2^31 + key, each offset so that a signed comparison orders it, and
+// "below" is two signed comparisons and an add (the three unsigned comparisons of a
+// lexicographic order cost two to three instructions each on x86). Measured on lavapipe
+// at 1M candidates, B = 16 (docs/benchmarks/block_sort.md): 48 ms with three loops split
+// at each invocation's own slots (a SIMD row ran its widest split) and one slot a read,
+// 41 ms with this loop, 36 ms reading pairs, 33 ms with two pairs an iteration (four:
+// 36 ms), 32 ms with the halves compared unsigned, 28 ms signed.
 
 // #import strata/histogram.wgsl
 // #import strata/histogram_slot_pairs.wgsl
 
 // A canonical key moved into 1 ..= 0x7f800002 with its order kept: finite keys
 // (0 ..= 0x7f7fffff, strata/candidate.wgsl) plus one, INVALID_KEY and SENTINEL_KEY just
-// above them. So a key lowered by one stays a key, and "at or below" is "below" the key
-// one higher.
+// above them. So a key lowered by one stays a key (and does not borrow from the cluster's
+// bit above it in counting_form), and "at or below" is "below" the key one higher.
 fn counting_keys(key: vec4<u32>) -> vec4<u32> {
     return select(key - vec4(0x807ffffdu), key + vec4(1u), key < vec4(0x80000000u));
 }
 
-fn with_counting_keys(q: Quad) -> Quad {
-    return Quad(q.cluster, counting_keys(q.key), q.local);
+// An element in the counting loop's form, in the quad's cluster and key fields: the high
+// and low halves of the 63-bit number cluster * 2^31 + counting key (whose order is
+// (cluster, key)'s), the high half (below 2^31) less 2^30 and the low half with its top
+// bit flipped, so that both order as signed integers and the high half plus one cannot
+// overflow.
+fn counting_form(q: Quad) -> Quad {
+    let high = (q.cluster >> vec4(1u)) + vec4(0xc0000000u);
+    let low = ((q.cluster << vec4(31u)) | counting_keys(q.key)) ^ vec4(0x80000000u);
+    return Quad(high, low, q.local);
 }
 
-// Whether (cluster, key) `other` lies below each of q's four, as 0 or 1.
+// Whether `other` (a slot in counting form) lies below each of q's four, as 0 or 1: its
+// high half below q's plus the borrow of the low halves.
 fn below(other: vec2<u32>, q: Quad) -> vec4<u32> {
-    let c = vec4<u32>(other.x);
-    return select(vec4(0u), vec4(1u), (c < q.cluster) | ((c == q.cluster) & (vec4<u32>(other.y) < q.key)));
+    let borrow = select(vec4(0i), vec4(1i), vec4<i32>(bitcast<i32>(other.y)) < bitcast<vec4<i32>>(q.key));
+    return select(vec4(0u), vec4(1u), vec4<i32>(bitcast<i32>(other.x)) < bitcast<vec4<i32>>(q.cluster) + borrow);
 }
 
 // Whether `other` (at block position `position`) ties with each of q's four in
@@ -64,9 +76,9 @@ fn store_pairs(el: Elements, base: u32) {
 fn run_block_histogram_ranked(t: u32, workgroup_id: vec3<u32>) {
     let setup = setup_block_histogram(t, workgroup_id);
     let el = load_block_elements(setup);
-    let counted = Elements(with_counting_keys(el.q0), with_counting_keys(el.q1), with_counting_keys(el.q2), with_counting_keys(el.q3));
-    // The unsorted blocks in the natural layout, keys as counting_keys: slot begin + p
-    // holds block position p (blocks and an invocation's slots start at even slots).
+    let counted = Elements(counting_form(el.q0), counting_form(el.q1), counting_form(el.q2), counting_form(el.q3));
+    // The unsorted blocks in the natural layout, in counting form: slot begin + p holds
+    // block position p (blocks and an invocation's slots start at even slots).
     store_pairs(counted, setup.base);
     workgroupBarrier();
 

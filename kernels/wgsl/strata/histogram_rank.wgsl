@@ -3,9 +3,9 @@
 // and finishing code it shares), found by counting instead of exchanging. Each element's
 // sorted position is the number of elements of its block that precede it in the order
 // (cluster, canonical key, pixel index); every invocation counts, for its 16 elements,
-// over the block's slots read once from workgroup memory, two slots a read
+// over the block's slots read from workgroup memory, two slots a read
 // (strata/histogram_slot_pairs.wgsl). That is n comparisons per element (n = B², 256 at
-// B = 16) against the network's ~log²(n)/2 exchanges, but it needs three barriers instead
+// B = 16) against the network's ~log²(n)/2 exchanges, but it needs four barriers instead
 // of one pair per round trip, and every lane of a SIMD row reads the same slots: on a CPU
 // device (lavapipe), where a round trip through workgroup memory costs one scalar access
 // per lane and element, that is cheaper.
@@ -28,8 +28,9 @@
 
 // A canonical key moved into 1 ..= 0x7f800002 with its order kept: finite keys
 // (0 ..= 0x7f7fffff, strata/candidate.wgsl) plus one, INVALID_KEY and SENTINEL_KEY just
-// above them. So a key lowered by one stays a key (and does not borrow from the cluster's
-// bit above it in counting_form), and "at or below" is "below" the key one higher.
+// above them. So a key lowered by one stays within 31 bits (it does not borrow from the
+// cluster's bit above it in counting_form), and a slot "at or below" an element is a slot
+// whose key, lowered by one, is below the element's.
 fn counting_keys(key: vec4<u32>) -> vec4<u32> {
     return select(key - vec4(0x807ffffdu), key + vec4(1u), key < vec4(0x80000000u));
 }
@@ -112,19 +113,51 @@ fn run_block_histogram_ranked(t: u32, workgroup_id: vec3<u32>) {
         r3 += tie_before(a, j - begin, counted.q3) + tie_before(b, j + 1u - begin, counted.q3);
     }
 
-    // Every element to its sorted slot, then this invocation's sorted slots back.
+    // Every element's block position to its sorted slot (shared_local, which the loops
+    // above do not read); then each invocation pulls its own sorted slots' elements from
+    // the pairs, still in counting form, and writes them back as whole pairs once every
+    // pull is done. So no two invocations ever write the two halves of one vec4
+    // (strata/histogram_slot_pairs.wgsl says why that matters).
+    scatter_positions(el.q0.local, begin + r0);
+    scatter_positions(el.q1.local, begin + r1);
+    scatter_positions(el.q2.local, begin + r2);
+    scatter_positions(el.q3.local, begin + r3);
     workgroupBarrier();
-    scatter_quad(el.q0, begin + r0);
-    scatter_quad(el.q1, begin + r1);
-    scatter_quad(el.q2, begin + r2);
-    scatter_quad(el.q3, begin + r3);
+    let sorted = Elements(
+        pull_quad(setup.base, begin),
+        pull_quad(setup.base + 4u, begin),
+        pull_quad(setup.base + 8u, begin),
+        pull_quad(setup.base + 12u, begin),
+    );
     workgroupBarrier();
-    finish_block_histogram(setup, load_registers(t, 0u));
+    store_pairs(sorted, setup.base);
+    workgroupBarrier();
+    finish_block_histogram(setup, sorted);
 }
 
-fn scatter_quad(q: Quad, slots: vec4<u32>) {
-    place(slots.x, q.cluster.x, q.key.x, q.local.x);
-    place(slots.y, q.cluster.y, q.key.y, q.local.y);
-    place(slots.z, q.cluster.z, q.key.z, q.local.z);
-    place(slots.w, q.cluster.w, q.key.w, q.local.w);
+fn scatter_positions(local: vec4<u32>, slots: vec4<u32>) {
+    shared_local[slots.x] = local.x;
+    shared_local[slots.y] = local.y;
+    shared_local[slots.z] = local.z;
+    shared_local[slots.w] = local.w;
+}
+
+// (cluster, canonical key) of a slot in counting form: counting_form undone.
+fn from_counting_form(slot: vec2<u32>) -> vec2<u32> {
+    let low = slot.y ^ 0x80000000u;
+    let cluster = ((slot.x - 0xc0000000u) << 1u) | (low >> 31u);
+    let key = low & 0x7fffffffu;
+    return vec2(cluster, select(key + 0x807ffffdu, key - 1u, key <= 0x7f800000u));
+}
+
+// The elements that sorted slots first..first+3 of the block starting at slot `begin`
+// hold: their block positions from shared_local, their (cluster, key) from the slots
+// they came from, which still hold the natural layout in counting form.
+fn pull_quad(first: u32, begin: u32) -> Quad {
+    let local = vec4(shared_local[first], shared_local[first + 1u], shared_local[first + 2u], shared_local[first + 3u]);
+    let a = from_counting_form(slot_cluster_key(begin + local.x));
+    let b = from_counting_form(slot_cluster_key(begin + local.y));
+    let c = from_counting_form(slot_cluster_key(begin + local.z));
+    let d = from_counting_form(slot_cluster_key(begin + local.w));
+    return Quad(vec4(a.x, b.x, c.x, d.x), vec4(a.y, b.y, c.y, d.y), local);
 }

@@ -3,7 +3,7 @@
 // (strata/histogram_rank.wgsl), whose counting loop reads every slot of its block in every
 // lane. On a CPU driver such a read is one memory access per lane whatever its width
 // (lavapipe cannot see that every lane reads the same slot), so reading two slots at a
-// time halves the loop's accesses: the ranking at 1M candidates took 36 ms against 43 ms
+// time halves the loop's accesses: the ranking at 1M candidates took 36 ms against 41 ms
 // with one slot a read (docs/benchmarks/block_sort.md). The same 8 KiB as
 // strata/histogram_slots.wgsl, whose two functions this file declares too.
 
@@ -12,14 +12,18 @@
 var<workgroup> shared_slot_pairs: array<vec4<u32>, HISTOGRAM_SLOTS_PER_WORKGROUP / 2u>;
 
 // Component indices into the vec4 rather than a branch or a select on the slot's half:
-// each is a single scalar access, as with strata/histogram_slots.wgsl's vec2, and the other
-// half of the vec4 (another slot, which another invocation may be writing) is not touched.
+// each is a single scalar access, as with strata/histogram_slots.wgsl's vec2.
 fn slot_cluster_key(slot: u32) -> vec2<u32> {
     let pair = slot >> 1u;
     let half = (slot & 1u) << 1u;
     return vec2(shared_slot_pairs[pair][half], shared_slot_pairs[pair][half + 1u]);
 }
 
+// One slot's two components. Translators may turn a store to one component of a vector
+// in workgroup memory into a read-modify-write of the whole vector (Tint's HLSL for FXC
+// does), so two invocations must never write the two halves of one pair at once: the
+// ranking writes whole pairs only (set_slot_pair) and never calls this; it is here for
+// strata/histogram.wgsl's network code, which the ranking's module contains unused.
 fn set_slot_cluster_key(slot: u32, value: vec2<u32>) {
     let pair = slot >> 1u;
     let half = (slot & 1u) << 1u;

@@ -10,7 +10,6 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::{Duration, Instant};
 use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
-use strata_backends::wgpu_backend::{WgpuBackend, WgpuOptions};
 use strata_kernels::BlockGrid;
 use strata_render::histogram_pass::{BlockHistogramPass, HistogramVariant};
 use strata_render::synthetic::{CandidateMix, candidate_image};
@@ -35,15 +34,11 @@ fn interpreter(c: &mut Criterion) {
     );
     group.bench_function("histogram_128x128/cpu", |b| b.iter(|| pass.dispatch_timed(&mut cpu).expect("dispatch")));
 
-    match WgpuBackend::new(WgpuOptions::default()) {
-        Ok(mut wgpu) => {
-            let pass = BlockHistogramPass::new(&mut wgpu, HistogramVariant::Subgroup, grid).expect("pass");
-            pass.upload_candidates(&mut wgpu, &candidates).expect("upload");
-            group.bench_function("histogram_128x128/wgpu", |b| {
-                b.iter(|| pass.dispatch_timed(&mut wgpu).expect("dispatch"))
-            });
-        }
-        Err(error) => eprintln!("wgpu skipped: {error}"),
+    if let Some(mut wgpu) = strata_benches::open_wgpu("wgpu") {
+        let pass = BlockHistogramPass::new(&mut wgpu, HistogramVariant::Subgroup, grid).expect("pass");
+        pass.upload_candidates(&mut wgpu, &candidates).expect("upload");
+        group
+            .bench_function("histogram_128x128/wgpu", |b| b.iter(|| pass.dispatch_timed(&mut wgpu).expect("dispatch")));
     }
     group.finish();
 }

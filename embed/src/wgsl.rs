@@ -19,7 +19,8 @@ pub enum ModuleId {
     /// The same with subgroup shuffles (needs subgroup operations; same output).
     HistogramSubgroup,
     /// The same output by ranking: each candidate's position counted over its block
-    /// (portable; faster than the network up to 16 × 16 blocks where measured).
+    /// (portable; faster than the network on a CPU driver at every block size where
+    /// measured).
     HistogramRank,
     /// `strata_select`.
     Select,
@@ -52,7 +53,7 @@ impl ModuleId {
 /// The histogram module to run for `block_size` on `executor` with or without subgroup
 /// shuffles: the choice strata's own renderer makes there ([`KernelId::fastest_histogram`];
 /// every choice gives the same output). On a GPU the sorting network, on a CPU driver such
-/// as lavapipe ranking up to B = 16 (BENCHMARKS.md, block_sort).
+/// as lavapipe ranking (BENCHMARKS.md, block_sort).
 /// [`Executor::of_device`] tells them apart from the adapter's device type.
 pub fn histogram_module(block_size: u32, subgroups: bool, executor: Executor) -> ModuleId {
     match KernelId::fastest_histogram(block_size, subgroups, executor) {

@@ -303,10 +303,7 @@ pub fn histogram_choice() -> HistogramChoice {
         ],
         rules: vec![
             ChoiceRule {
-                when: vec![
-                    condition("device_type", "equals", "VK_PHYSICAL_DEVICE_TYPE_CPU".into()),
-                    condition("B", "at_most", 16.into()),
-                ],
+                when: vec![condition("device_type", "equals", "VK_PHYSICAL_DEVICE_TYPE_CPU".into())],
                 kernel: "block_histogram_rank",
             },
             ChoiceRule {

@@ -27,7 +27,7 @@ pub enum HistogramVariant {
     Rank,
     /// The fastest measured ([`KernelId::fastest_histogram`]): on a GPU and on the
     /// interpreter the network (with subgroups if the device has them), on a CPU driver
-    /// such as lavapipe ranking up to B = 16 and the network at B = 32.
+    /// such as lavapipe ranking at every block size.
     Auto,
 }
 

@@ -281,7 +281,7 @@ function needLimit(device, limit, needed, why) {
 // The histogram kernel `choice` names, or for "auto" the package's rule without a device
 // type (WebGPU does not tell a CPU adapter apart): the kernel that needs subgroups where
 // the device has them, else the rule's last (unconditional) kernel. On a CPU adapter,
-// `block_histogram_rank` is faster up to B = 16: pass it. All give the same output.
+// `block_histogram_rank` is faster at every block size: pass it. All give the same output.
 function histogramKernel(device, choice) {
   const subgroups = device.features.has('subgroups');
   if (choice === undefined || choice === 'auto') {

@@ -44,7 +44,7 @@ pub(crate) struct HistogramArgs {
 #[derive(Clone, Copy, clap::ValueEnum)]
 pub(crate) enum VariantArg {
     /// The best for this device and block size (the network on a GPU and on the
-    /// interpreter, ranking up to B = 16 on a CPU driver such as lavapipe).
+    /// interpreter, ranking on a CPU driver such as lavapipe).
     Auto,
     /// The bitonic network through workgroup memory.
     Portable,

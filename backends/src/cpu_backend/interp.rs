@@ -248,7 +248,10 @@ pub(super) fn run_until_sync(
         // its workgroup's place in the batch times the workgroup's size, plus its local
         // index (dispatch.rs).
         let group = group_of(members, mask, width);
-        let end = {
+        let whole_batch = members.len() == width;
+        let mut steps = 0;
+        let mut start = pc;
+        let end = loop {
             let mut file = std::mem::take(&mut memory.files[code_index as usize]);
             let mut group_memory = GroupMemory {
                 buffers,
@@ -267,15 +270,26 @@ pub(super) fn run_until_sync(
                     _ => None,
                 },
             };
-            let mut steps = 0;
             let end =
-                run_group(program, code_index, pc, meet, group, &mut file, &mut group_memory, &mut steps, targets);
+                run_group(program, code_index, start, meet, group, &mut file, &mut group_memory, &mut steps, targets);
             memory.fuel = group_memory.fuel;
             memory.files[code_index as usize] = file;
-            counts.add_group(steps, members.iter().map(|&i| invocations[i].simt_index));
-            end?
+            match end {
+                // The whole batch reached a barrier or subgroup operation together (none
+                // has finished, none is elsewhere): completed here and now, as the
+                // dispatch would complete it once every invocation had stopped there, and
+                // the same group runs on past it without a round through the scheduler (a
+                // subgroup kernel's batch is one workgroup, so its shuffles mostly end
+                // here). The invocations' places are written once the group ends otherwise.
+                Ok(GroupEnd::Sync(at)) if whole_batch => {
+                    super::dispatch::complete_sync(program, invocations, memory, code_index, at);
+                    start = at + 1;
+                }
+                other => break other,
+            }
         };
-        match end {
+        counts.add_group(steps, members.iter().map(|&i| invocations[i].simt_index));
+        match end? {
             GroupEnd::Meet(pc) => {
                 for &i in members.iter() {
                     invocations[i].frame.as_mut().expect("running").pc = pc;
@@ -289,19 +303,6 @@ pub(super) fn run_until_sync(
                     invocations[i].frame.as_mut().expect("running").pc = pc;
                     if placed {
                         places.add(pc, i);
-                    }
-                }
-            }
-            // The whole batch reached the barrier or subgroup operation together (none has
-            // finished, none is elsewhere): completed here and now, as the dispatch would
-            // complete it once every invocation had stopped there, without stopping them
-            // (a subgroup kernel's batch is one workgroup, so its shuffles mostly end here).
-            GroupEnd::Sync(pc) if members.len() == width => {
-                super::dispatch::complete_sync(program, invocations, memory, code_index, pc);
-                for &i in members.iter() {
-                    invocations[i].frame.as_mut().expect("running").pc = pc + 1;
-                    if placed {
-                        places.add(pc + 1, i);
                     }
                 }
             }

@@ -38,7 +38,8 @@
 //!   strata-embed and the export package follow.
 //!
 //! Where the paper lives in WGSL (`kernels/wgsl/strata/`): §4.1 `histogram.wgsl` (with
-//! its records in `candidate.wgsl`), §4.2 `selection.wgsl` (and its last step,
+//! its records in `candidate.wgsl`, its sorting in `histogram_network.wgsl` or
+//! `histogram_rank.wgsl`), §4.2 `selection.wgsl` (and its last step,
 //! `resampling.wgsl`), §4.3 `masking.wgsl`.
 
 pub mod binding;

@@ -44,6 +44,7 @@ pub static WGSL_FILES: &[Fragment] = &[
     fragment!("strata/entry_histogram_rank.wgsl"),
     fragment!("strata/entry_histogram_subgroup.wgsl"),
     fragment!("strata/histogram.wgsl"),
+    fragment!("strata/histogram_network.wgsl"),
     fragment!("strata/histogram_rank.wgsl"),
     fragment!("strata/histogram_slot_pairs.wgsl"),
     fragment!("strata/histogram_slots.wgsl"),

@@ -1,8 +1,8 @@
 // Entry point of the block histogram without subgroup operations (any adapter, the
 // GL backend and the CPU interpreter included): paper §4.1. Bindings and dispatch:
-// strata/histogram.wgsl.
+// strata/histogram.wgsl; the sorting: strata/histogram_network.wgsl.
 
-// #import strata/histogram.wgsl
+// #import strata/histogram_network.wgsl
 // #import strata/histogram_slots.wgsl
 
 // Never called: with zero lane bits every exchange stays in registers or workgroup memory.

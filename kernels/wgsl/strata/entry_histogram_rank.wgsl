@@ -5,11 +5,6 @@
 // #import strata/histogram.wgsl
 // #import strata/histogram_rank.wgsl
 
-// Never called: the ranking exchanges nothing between lanes.
-fn lane_exchange(value: vec4<u32>, mask: u32) -> vec4<u32> {
-    return value;
-}
-
 @compute @workgroup_size(64)
 fn block_histogram_rank(
     @builtin(local_invocation_index) local_index: u32,

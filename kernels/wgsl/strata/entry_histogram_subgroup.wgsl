@@ -1,12 +1,13 @@
 // Entry point of the block histogram (paper §4.1; bindings and dispatch:
-// strata/histogram.wgsl) that exchanges elements between subgroup lanes
+// strata/histogram.wgsl; the sorting: strata/histogram_network.wgsl) that exchanges
+// elements between subgroup lanes
 // with subgroupShuffleXor instead of workgroup memory (needs the SUBGROUP feature).
 // The lanes are used only if every lane's id is its local index modulo the subgroup
 // size (true of 1-D workgroups on the drivers we know; checked here, not assumed) and
 // the size is a power of two no larger than the workgroup; otherwise this entry point
 // sorts exactly like the portable one.
 
-// #import strata/histogram.wgsl
+// #import strata/histogram_network.wgsl
 // #import strata/histogram_slots.wgsl
 
 var<workgroup> lane_mismatch: atomic<u32>;

@@ -1,6 +1,7 @@
 // The block histogram by ranking (paper §4.1): the same order and the same outputs as
-// the bitonic network of strata/histogram.wgsl (whose bindings, dispatch, element layout
-// and finishing code it shares), found by counting instead of exchanging. Each element's
+// the bitonic network (strata/histogram_network.wgsl), found by counting instead of
+// exchanging; the bindings, dispatch, element layout and finishing code are
+// strata/histogram.wgsl's, shared with the network. Each element's
 // sorted position is the number of elements of its block that precede it in the order
 // (cluster, canonical key, pixel index); every invocation counts, for its 16 elements,
 // over the block's slots read from workgroup memory, two slots a read

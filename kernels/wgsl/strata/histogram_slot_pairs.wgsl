@@ -5,7 +5,11 @@
 // (lavapipe cannot see that every lane reads the same slot), so reading two slots at a
 // time halves the loop's accesses: the ranking at 1M candidates took 36 ms against 41 ms
 // with one slot a read (docs/benchmarks/block_sort.md). The same 8 KiB as
-// strata/histogram_slots.wgsl, whose two functions this file declares too.
+// strata/histogram_slots.wgsl, whose reader slot_cluster_key this file declares too (for
+// strata/histogram.wgsl's finishing code). It has no writer of one slot: translators may
+// turn a store to one component of a vector in workgroup memory into a read-modify-write
+// of the whole vector (Tint's HLSL for FXC does), so two invocations writing the two
+// halves of one pair at once could lose one; the ranking writes whole pairs only.
 
 // #import gpu/strata.wgsl
 
@@ -17,18 +21,6 @@ fn slot_cluster_key(slot: u32) -> vec2<u32> {
     let pair = slot >> 1u;
     let half = (slot & 1u) << 1u;
     return vec2(shared_slot_pairs[pair][half], shared_slot_pairs[pair][half + 1u]);
-}
-
-// One slot's two components. Translators may turn a store to one component of a vector
-// in workgroup memory into a read-modify-write of the whole vector (Tint's HLSL for FXC
-// does), so two invocations must never write the two halves of one pair at once: the
-// ranking writes whole pairs only (set_slot_pair) and never calls this; it is here for
-// strata/histogram.wgsl's network code, which the ranking's module contains unused.
-fn set_slot_cluster_key(slot: u32, value: vec2<u32>) {
-    let pair = slot >> 1u;
-    let half = (slot & 1u) << 1u;
-    shared_slot_pairs[pair][half] = value.x;
-    shared_slot_pairs[pair][half + 1u] = value.y;
 }
 
 // Slots 2 * pair and 2 * pair + 1: (cluster, key, cluster, key).

@@ -1,9 +1,9 @@
 // The block histogram's (cluster, key) of each slot in workgroup memory, one vec2 a slot:
-// the storage of the sorting network (strata/entry_histogram.wgsl,
-// strata/entry_histogram_subgroup.wgsl), whose round trips read and write single slots in
-// every layout. strata/histogram_slot_pairs.wgsl declares the same two functions over two
-// slots a vec4, for the ranking (strata/histogram_rank.wgsl). strata/histogram.wgsl
-// reaches the slots through these two functions only.
+// the storage of the sorting network (strata/histogram_network.wgsl, run by
+// strata/entry_histogram.wgsl and strata/entry_histogram_subgroup.wgsl), whose round trips
+// read and write single slots in every layout. strata/histogram_slot_pairs.wgsl declares
+// the reader over two slots a vec4, for the ranking (strata/histogram_rank.wgsl).
+// strata/histogram.wgsl and the network reach the slots through these two functions only.
 
 // #import gpu/strata.wgsl
 

@@ -16,8 +16,14 @@
 //!   catalogue names its entry file only.
 //! * `#requires DECLARATION`: a binding the file reads whose binding number belongs to the
 //!   kernel that includes it, declared there (`block_reuse.wgsl` reads the histogram's
-//!   output under the numbers each ReSTIR pass gives it). The declaration is written as
-//!   the including kernel declares it, without `@group`/`@binding`.
+//!   output under the numbers each ReSTIR pass gives it), or a function the including
+//!   kernel declares (`strata/histogram.wgsl` reads the slots through
+//!   `slot_cluster_key`, which each histogram entry takes from the storage it uses). The
+//!   declaration is written as the including kernel declares it, without
+//!   `@group`/`@binding`, a function by its signature. A file that imports another names
+//!   only the requirements the other does not already name: the test gives every
+//!   `#requires` line of a file's imports its own stand-in, so a name required twice
+//!   would be declared twice.
 //!
 //! The test `every_file_parses_with_what_it_names` makes the names true: each file,
 //! with only the files it imports and the bindings it requires, must parse with naga,

@@ -680,6 +680,39 @@ fn main(@builtin(local_invocation_index) i: u32) {
     assert_eq!(all.instructions, 32 * all.warp_issues);
 }
 
+/// A whole workgroup that reaches a barrier together runs on past it without stopping
+/// (`interp::run_until_sync`): the instructions before each barrier still count. Each turn
+/// of a loop with a barrier costs every invocation the same instructions, so the count
+/// grows by the same amount with every turn.
+#[test]
+fn instructions_before_each_barrier_count() {
+    let source = r#"
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+@compute @workgroup_size(64)
+fn main(@builtin(local_invocation_index) i: u32) {
+    var x = i;
+    for (var n = 0u; n < input[0]; n++) {
+        x = x * 1664525u + 1013904223u;
+        workgroupBarrier();
+    }
+    output[i] = x;
+}
+"#;
+    let kernel = Kernel::from_wgsl("barrier_loop.wgsl", source.into(), "main", false).unwrap();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let mut instructions = |turns: u32| {
+        run_words(&mut cpu, &kernel, &[turns], 64, 1);
+        let counts = cpu.take_counts_by_kernel();
+        assert_eq!(counts.len(), 1, "one kernel dispatched");
+        counts[&kernel.id].instructions
+    };
+    let [one, two, three] = [1, 2, 3].map(&mut instructions);
+    let turn = two.checked_sub(one).expect("a second turn cannot cost fewer instructions");
+    assert!(turn > 0 && turn % 64 == 0, "a turn costs {turn} instructions: {one}, {two}, {three}");
+    assert_eq!(three - two, turn, "{one}, {two}, {three}");
+}
+
 #[test]
 fn bad_subgroup_sizes_are_refused() {
     assert!(CpuBackend::new(CpuOptions { subgroup_size: Some(12), ..CpuOptions::default() }).is_err());

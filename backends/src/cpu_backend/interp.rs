@@ -464,8 +464,8 @@ fn return_from_function(
 /// Runs the group `group` (all at instruction `pc` of code `code_index`, whose register
 /// file is `file`) together until it reaches `meet`, a branch splits it (each member's
 /// next instruction into `targets`), it calls or returns, or it stops at a barrier or
-/// subgroup operation. `steps`: how many instructions the group executed (each for
-/// every member).
+/// subgroup operation. Adds the instructions the group executed (each for every member)
+/// to `steps`.
 #[allow(clippy::too_many_arguments)]
 fn run_group(
     program: &Program,
@@ -648,6 +648,6 @@ fn run_group(
             _ => execute(insn, file, group, memory),
         }
     };
-    *steps = count;
+    *steps += count;
     Ok(end)
 }

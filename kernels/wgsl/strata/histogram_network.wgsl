@@ -26,7 +26,6 @@ fn pick(a: Quad, b: Quad, take_b: vec4<bool>) -> Quad {
     return Quad(select(a.cluster, b.cluster, take_b), select(a.key, b.key, take_b), select(a.local, b.local, take_b));
 }
 
-
 // Sort direction of the pairs whose lower elements are `lower` (element indices) in
 // merge stage 2^log_k. The last stage sorts every block ascending; earlier stages
 // alternate to build bitonic sequences.

@@ -28,6 +28,7 @@ use super::counts::DispatchCounts;
 use super::error::{invalid, unsupported};
 use super::execute::{GroupMemory, execute};
 use super::insn::{BinOp, CallInsn, Insn, UnOp};
+use super::invocations::{Batch, Invocation};
 use super::lanes::{LaneRegs, Members, N as LANES};
 use super::limit::{FUEL, Limit};
 use super::memory::{FUNCTION, Frame};
@@ -45,47 +46,6 @@ pub(super) enum Stop {
     Done,
     /// At a barrier or subgroup gather: (code, instruction index).
     Sync(u32, u32),
-}
-
-/// One invocation: where it is (its running frame, its callers' frames) and who it is.
-/// Its registers are its column of each code's file, its private memory its slice of
-/// [`Batch::private`].
-pub(super) struct Invocation {
-    /// The running frame (`None` once the entry point returned).
-    pub frame: Option<Frame>,
-    /// Callers of the running frame, outermost first.
-    pub callers: Vec<Frame>,
-    /// Subgroup lane, subgroup index and size, local index (for gathers).
-    pub lane: u32,
-    /// Index of the invocation's subgroup.
-    pub subgroup_id: u32,
-    /// Invocations per subgroup.
-    pub subgroup_size: u32,
-    /// `local_invocation_index`.
-    pub local_index: u32,
-    /// Its index in the SIMT count ([`DispatchCounts`]): its local index, after a warp
-    /// boundary per earlier workgroup of its batch ([`super::batch`]).
-    pub simt_index: u32,
-}
-
-/// The memory of a batch's invocations ([`super::batch`]), kept by a worker thread from
-/// one batch to the next (register files of tens of kilobytes per invocation cost more in page faults
-/// than the kernels' work when allocated anew).
-pub(super) struct Batch {
-    /// Per code, its lane-minor register file (empty until the code first runs).
-    pub files: Vec<Vec<u32>>,
-    /// Every invocation's private memory, `private_words` each, in the batch's order
-    /// (workgroup after workgroup, each in local-index order).
-    pub private: Vec<u32>,
-    /// Words of private memory per invocation.
-    pub private_words: usize,
-    /// The workgroup memory of the batch's workgroups, the program's `workgroup_words`
-    /// each, in order.
-    pub shared: Vec<u32>,
-    /// Fuel left before the time limit is looked at ([`super::limit`]).
-    pub fuel: u32,
-    /// The worker's sanitizer state, when the dispatch sanitizes.
-    pub sanitizing: Option<super::sanitize::Local>,
 }
 
 /// The scheduler's working lists, kept from one synchronisation point to the next.
@@ -174,7 +134,7 @@ fn meeting_point(leader: &Invocation, other: &Invocation) -> Option<u32> {
 
 /// Runs every invocation of a batch until it returns from the entry point or stops
 /// at a barrier or subgroup operation (one the whole batch reaches as a single group is
-/// completed at once, [`super::dispatch::complete_sync`], and not stopped at); `stops[i]`
+/// completed at once, [`super::sync_point::complete_sync`], and not stopped at); `stops[i]`
 /// says where invocation `i` stopped.
 /// Counts what the groups executed into `counts`. Fails when the dispatch runs past
 /// `limit`.
@@ -282,7 +242,7 @@ pub(super) fn run_until_sync(
                 // subgroup kernel's batch is one workgroup, so its shuffles mostly end
                 // here). The invocations' places are written once the group ends otherwise.
                 Ok(GroupEnd::Sync(at)) if whole_batch => {
-                    super::dispatch::complete_sync(program, invocations, memory, code_index, at);
+                    super::sync_point::complete_sync(program, invocations, memory, code_index, at);
                     start = at + 1;
                 }
                 other => break other,

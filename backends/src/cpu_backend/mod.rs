@@ -18,9 +18,10 @@
 //! the invocations of a workgroup run together from barrier to barrier (`dispatch`; the
 //! workgroups of a kernel without barriers or subgroup operations several at a time as
 //! one batch, `batch`), each
-//! a resumable stack of frames, so every invocation reaches a barrier before any passes
-//! it; those at the same place run as one group, each instruction decoded once for the
-//! whole group (`interp`), as a loop over the members' words: registers are
+//! a resumable stack of frames (`invocations`), so every invocation reaches a barrier
+//! before any passes it, and the barrier or subgroup operation is then completed for all
+//! (`sync_point`); those at the same place run as one group, each instruction decoded
+//! once for the whole group (`interp`), as a loop over the members' words: registers are
 //! lane-minor, one file per code for the whole workgroup with register `r` of invocation
 //! `l` at `r * width + l` (`lanes`). Each dispatch is counted (`counts`): instructions, and
 //! the issue slots a 32-wide SIMT GPU would spend on the same groups, by kernel. A
@@ -84,6 +85,7 @@ mod image;
 mod image_lower;
 mod insn;
 mod interp;
+mod invocations;
 mod jump_cleanup;
 mod lanes;
 mod layout;
@@ -98,6 +100,7 @@ mod program;
 mod retarget;
 mod sanitize;
 mod statement;
+mod sync_point;
 mod wide;
 
 use crate::backend::{Backend, Bind, BufferId, Resource};

@@ -465,7 +465,7 @@ impl Compiler<'_> {
         if scope.inlined
             && let Some((dst, words)) = result
         {
-            super::retarget::return_in_place(&mut scope, dst, words);
+            scope.return_in_place(dst, words);
         }
         for (index, (_, local)) in function.local_variables.iter().enumerate() {
             let variable = scope.locals[index];

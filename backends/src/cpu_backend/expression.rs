@@ -10,8 +10,8 @@ use super::constant::{compose_offsets, literal};
 use super::insn::{BinOp, Insn, Reg, UnOp, per_lane};
 use super::lanes::LaneRegs;
 use super::layout::{
-    Place, Words, array_length, byte_addressed, component_step, component_words, element_step, is_half, is_wide,
-    member_step, scalar_shape, shape,
+    Place, Words, array_length, byte_addressed, component_step, component_words, consecutive, element_step, is_half,
+    is_wide, member_step, scalar_shape, shape,
 };
 use super::math_call::{put, slice};
 use super::matrix::column_words;
@@ -577,13 +577,6 @@ impl Compiler<'_> {
             },
         }
     }
-}
-
-/// The first component of a swizzle whose components are consecutive (`.xyz`, `.zw`),
-/// which reads the vector's registers from there on; `None` for any other pattern.
-pub(super) fn consecutive(size: naga::VectorSize, pattern: &[naga::SwizzleComponent; 4]) -> Option<u32> {
-    let first = pattern[0] as u32;
-    (0..size as u32).all(|i| pattern[i as usize] as u32 == first + i).then_some(first)
 }
 
 #[cfg(test)]

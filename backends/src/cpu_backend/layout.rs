@@ -314,3 +314,12 @@ pub(super) fn component_words(scalar: naga::Scalar) -> u32 {
 
 /// A value: its words, inline up to a vec4.
 pub(super) type Words = SmallVec<[u32; 4]>;
+
+/// The first component of a swizzle whose components are consecutive (`.xyz`, `.zw`),
+/// which reads the vector's registers from there on; `None` for any other pattern. (The
+/// expression compiler gives such a swizzle the vector's registers, and the analysis of
+/// loads read in place, [`super::load_alias`], follows the registers through it.)
+pub(super) fn consecutive(size: naga::VectorSize, pattern: &[naga::SwizzleComponent; 4]) -> Option<u32> {
+    let first = pattern[0] as u32;
+    (0..size as u32).all(|i| pattern[i as usize] as u32 == first.saturating_add(i)).then_some(first)
+}

@@ -44,9 +44,7 @@ pub(super) fn in_place_loads(function: &Function, info: &FunctionInfo) -> Vec<bo
         let load = match *expression {
             Expression::Load { pointer } if variable_of(function, pointer, Indices::Constant).is_some() => Some(handle),
             Expression::AccessIndex { base, .. } => shares[base.index()],
-            Expression::Swizzle { size, vector, pattern }
-                if super::expression::consecutive(size, &pattern).is_some() =>
-            {
+            Expression::Swizzle { size, vector, pattern } if super::layout::consecutive(size, &pattern).is_some() => {
                 shares[vector.index()]
             }
             Expression::As { expr, convert: None, .. } => shares[expr.index()],

@@ -3,7 +3,7 @@
 //! into the variable's (or the call result's) registers instead of its own and then
 //! copied. And a value of several instructions (a struct composed, a call's result)
 //! that an inlined callee returns right after computing it is given the call result's
-//! registers from the start ([`return_in_place`]).
+//! registers from the start ([`Scope::return_in_place`]).
 //!
 //! Why: naga IR loads a variable into a new expression and stores an expression into a
 //! variable, so `top1 = top0;` or `i = i + 1u;` compiled word for word ends with a copy.
@@ -21,66 +21,69 @@ use super::compiler::{Compiler, LastValue, NONE, Scope};
 use super::insn::{Insn, Reg};
 use naga::{Block, Expression, Handle, Statement};
 
-/// Gives the call result's registers (`dst`, `words` words) to every value of an inlined
-/// callee's `scope` that a `return` right after it returns and nothing else uses: a
-/// struct composed (`return Node(r0.xyz, ...)`) or a call's result (`return
-/// read_node(...)`), which store forwarding cannot move (several instructions compute
-/// them). Why: the generated row readers (gpu/scene_rows.wgsl) and their callers
-/// (render/scene.wgsl's `bvh_node`) return such values; each return copied the whole
-/// record, twice per BVH node the path tracer visits (issue 59).
-///
-/// Sound because the value is computed by the statement just before its `return` (the
-/// `Emit` holding it, or the `Call`) and used by nothing else (naga reference count 1),
-/// so the result registers, which nothing else in the callee writes, hold it from its
-/// computation to the return; several such returns (in different branches) each write
-/// them just before returning. Its operands are never the result registers: only values
-/// returned are given them, and a returned value is used by nothing else.
-pub(super) fn return_in_place(scope: &mut Scope, dst: Reg, words: u32) {
-    fn visit(scope: &mut Scope, block: &Block, dst: Reg, words: u32) {
-        let mut before: Option<&Statement> = None;
-        for statement in block.iter() {
-            match statement {
-                Statement::Return { value: Some(value) } => {
-                    let computed_just_before = match before {
-                        Some(Statement::Emit(range)) => range.clone().any(|h| h == *value),
-                        Some(Statement::Call { result: Some(result), .. }) => result == value,
-                        _ => false,
-                    };
-                    let index = value.index();
-                    if computed_just_before
-                        && matches!(
-                            scope.function.expressions[*value],
-                            Expression::Compose { .. } | Expression::CallResult(_)
-                        )
-                        && scope.info[*value].ref_count == 1
-                        && scope.lens[index] == words
-                        && scope.regs[index] == NONE
-                        && !scope.pre_emitted[index]
-                    {
-                        scope.regs[index] = dst;
+impl Scope<'_> {
+    /// Gives the call result's registers (`dst`, `words` words) to every value of this
+    /// scope (an inlined callee's) that a `return` right after it returns and nothing else
+    /// uses: a
+    /// struct composed (`return Node(r0.xyz, ...)`) or a call's result (`return
+    /// read_node(...)`), which store forwarding cannot move (several instructions compute
+    /// them). Why: the generated row readers (gpu/scene_rows.wgsl) and their callers
+    /// (render/scene.wgsl's `bvh_node`) return such values; each return copied the whole
+    /// record, twice per BVH node the path tracer visits (issue 59).
+    ///
+    /// Sound because the value is computed by the statement just before its `return` (the
+    /// `Emit` holding it, or the `Call`) and used by nothing else (naga reference count 1),
+    /// so the result registers, which nothing else in the callee writes, hold it from its
+    /// computation to the return; several such returns (in different branches) each write
+    /// them just before returning. Its operands are never the result registers: only values
+    /// returned are given them, and a returned value is used by nothing else.
+    pub(super) fn return_in_place(&mut self, dst: Reg, words: u32) {
+        fn visit(scope: &mut Scope, block: &Block, dst: Reg, words: u32) {
+            let mut before: Option<&Statement> = None;
+            for statement in block.iter() {
+                match statement {
+                    Statement::Return { value: Some(value) } => {
+                        let computed_just_before = match before {
+                            Some(Statement::Emit(range)) => range.clone().any(|h| h == *value),
+                            Some(Statement::Call { result: Some(result), .. }) => result == value,
+                            _ => false,
+                        };
+                        let index = value.index();
+                        if computed_just_before
+                            && matches!(
+                                scope.function.expressions[*value],
+                                Expression::Compose { .. } | Expression::CallResult(_)
+                            )
+                            && scope.info[*value].ref_count == 1
+                            && scope.lens[index] == words
+                            && scope.regs[index] == NONE
+                            && !scope.pre_emitted[index]
+                        {
+                            scope.regs[index] = dst;
+                        }
                     }
-                }
-                Statement::Block(inner) => visit(scope, inner, dst, words),
-                Statement::If { accept, reject, .. } => {
-                    visit(scope, accept, dst, words);
-                    visit(scope, reject, dst, words);
-                }
-                Statement::Switch { cases, .. } => {
-                    for case in cases {
-                        visit(scope, &case.body, dst, words);
+                    Statement::Block(inner) => visit(scope, inner, dst, words),
+                    Statement::If { accept, reject, .. } => {
+                        visit(scope, accept, dst, words);
+                        visit(scope, reject, dst, words);
                     }
+                    Statement::Switch { cases, .. } => {
+                        for case in cases {
+                            visit(scope, &case.body, dst, words);
+                        }
+                    }
+                    Statement::Loop { body, continuing, .. } => {
+                        visit(scope, body, dst, words);
+                        visit(scope, continuing, dst, words);
+                    }
+                    _ => {}
                 }
-                Statement::Loop { body, continuing, .. } => {
-                    visit(scope, body, dst, words);
-                    visit(scope, continuing, dst, words);
-                }
-                _ => {}
+                before = Some(statement);
             }
-            before = Some(statement);
         }
+        let function = self.function;
+        visit(self, &function.body, dst, words);
     }
-    let function = scope.function;
-    visit(scope, &function.body, dst, words);
 }
 
 impl Compiler<'_> {

@@ -1,9 +1,9 @@
 //! Where values live: the words a naga type takes in registers, the byte and word steps
 //! of fields, elements and components in each address space, how f16 values move
 //! between buffers and registers, and what a pointer points at when that is known at
-//! compile time. Shared by the compiler ([`super::compiler`], [`super::expression`]), the
-//! instructions ([`super::insn`]) and memory access ([`super::memory`]), and dependent on
-//! none of them.
+//! compile time. Shared by the compiler ([`super::compiler`], [`super::expression`]), its
+//! analyses ([`super::load_alias`], [`super::load_fields`]), the instructions
+//! ([`super::insn`]) and memory access ([`super::memory`]), and dependent on none of them.
 //!
 //! Sizes and offsets here come from the kernel's types: no arithmetic may wrap or panic
 //! (the lint below). A size that does not fit in `u32` words is an error; offsets inside

@@ -22,14 +22,14 @@ pub(super) struct Invocation {
     pub subgroup_size: u32,
     /// `local_invocation_index`.
     pub local_index: u32,
-    /// Its index in the SIMT count ([`super::counts::DispatchCounts`]): its local index, after a warp
-    /// boundary per earlier workgroup of its batch ([`super::batch`]).
+    /// Its index in the SIMT count ([`super::counts::DispatchCounts`]): its local index,
+    /// after a warp boundary per earlier workgroup of its batch ([`super::batch`]).
     pub simt_index: u32,
 }
 
 /// The memory of a batch's invocations ([`super::batch`]), kept by a worker thread from
-/// one batch to the next (register files of tens of kilobytes per invocation cost more in page faults
-/// than the kernels' work when allocated anew).
+/// one batch to the next (register files of tens of kilobytes per invocation cost more in
+/// page faults than the kernels' work when allocated anew).
 pub(super) struct Batch {
     /// Per code, its lane-minor register file (empty until the code first runs).
     pub files: Vec<Vec<u32>>,

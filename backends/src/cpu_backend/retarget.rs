@@ -24,8 +24,7 @@ use naga::{Block, Expression, Handle, Statement};
 impl Scope<'_> {
     /// Gives the call result's registers (`dst`, `words` words) to every value of this
     /// scope (an inlined callee's) that a `return` right after it returns and nothing else
-    /// uses: a
-    /// struct composed (`return Node(r0.xyz, ...)`) or a call's result (`return
+    /// uses: a struct composed (`return Node(r0.xyz, ...)`) or a call's result (`return
     /// read_node(...)`), which store forwarding cannot move (several instructions compute
     /// them). Why: the generated row readers (gpu/scene_rows.wgsl) and their callers
     /// (render/scene.wgsl's `bvh_node`) return such values; each return copied the whole

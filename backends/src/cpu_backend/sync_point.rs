@@ -1,7 +1,7 @@
 //! What a barrier or subgroup operation does once every invocation of the batch stands
 //! at it: a barrier nothing more (but the sanitizer's note of it); a subgroup gather
-//! (broadcast, shuffle) or collective (ballot, reduction, scan) computed for all
-//! invocations at once, lane by lane in WGSL's scalar semantics.
+//! (broadcast, shuffle) computed for all invocations at once, and a collective (ballot,
+//! reduction, scan) too, combined lane by lane in WGSL's scalar semantics.
 //!
 //! Why a file of its own: both the dispatch ([`super::dispatch`], once every invocation
 //! has stopped there) and the group loop ([`super::interp`], when the whole batch reached
@@ -16,8 +16,8 @@ use smallvec::SmallVec;
 /// every invocation of the batch stands: a barrier needs nothing more (but the sanitizer's
 /// note of it); a subgroup gather or collective is computed for all invocations now. The
 /// caller moves them past it. (Run by the dispatch once every invocation has stopped
-/// there, and by [`super::interp::run_until_sync`] at once when the whole batch reached it as one
-/// group.)
+/// there, and by [`super::interp::run_until_sync`] at once when the whole batch reached it
+/// as one group.)
 pub(super) fn complete_sync(program: &Program, invocations: &[Invocation], memory: &mut Batch, code: u32, pc: u32) {
     let file = &mut memory.files[code as usize];
     match &program.codes[code as usize].insns[pc as usize] {

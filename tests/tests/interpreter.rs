@@ -4,7 +4,7 @@
 
 use strata_backends::ash_backend::{AshBackend, AshOptions, SpirvSource};
 use strata_backends::backend::{download, upload};
-use strata_backends::cpu_backend::{CpuBackend, CpuOptions};
+use strata_backends::cpu_backend::{CpuBackend, CpuOptions, DispatchCounts};
 use strata_backends::{Backend, BackendError, Bind};
 use strata_kernels::reference::block_histogram::block_histogram;
 use strata_kernels::types::BLOCK_SIZES;
@@ -641,30 +641,44 @@ fn main(@builtin(local_invocation_index) i: u32) {
     assert!(message.contains("WGSL line 8 in `sync_step`"), "{message}");
 }
 
+/// A 64-wide kernel whose invocations each step a generator `bound` times (a WGSL
+/// expression of `input` and the local index `i`), running `in_loop` after each step.
+fn stepping_kernel(name: &str, bound: &str, in_loop: &str) -> Kernel {
+    let source = format!(
+        r#"
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+@compute @workgroup_size(64)
+fn main(@builtin(local_invocation_index) i: u32) {{
+    var x = i;
+    for (var n = 0u; n < {bound}; n++) {{
+        x = x * 1664525u + 1013904223u;
+        {in_loop}
+    }}
+    output[i] = x;
+}}
+"#
+    );
+    Kernel::from_wgsl(name, source, "main", false).unwrap()
+}
+
+/// What one workgroup of `kernel` executed on `inputs`.
+fn counts_of(cpu: &mut CpuBackend, kernel: &Kernel, inputs: &[u32]) -> DispatchCounts {
+    run_words(cpu, kernel, inputs, 64, 1);
+    let counts = cpu.take_counts_by_kernel();
+    assert_eq!(counts.len(), 1, "one kernel dispatched");
+    counts[&kernel.id]
+}
+
 /// The SIMT issue model (`DispatchCounts::warp_issues`): a warp with one busy lane costs
 /// as many issues as a full one, while the instruction count follows the busy lanes.
 #[test]
 fn warp_issues_charge_divergent_warps_as_full_ones() {
-    let source = r#"
-@group(0) @binding(0) var<storage, read> input: array<u32>;
-@group(0) @binding(1) var<storage, read_write> output: array<u32>;
-@compute @workgroup_size(64)
-fn main(@builtin(local_invocation_index) i: u32) {
-    var x = i;
-    for (var n = 0u; n < input[i]; n++) {
-        x = x * 1664525u + 1013904223u;
-    }
-    output[i] = x;
-}
-"#;
-    let kernel = Kernel::from_wgsl("warp_issues.wgsl", source.into(), "main", false).unwrap();
+    let kernel = stepping_kernel("warp_issues.wgsl", "input[i]", "");
     let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
     let mut counts_with = |busy: &[u32]| {
         let inputs: Vec<u32> = (0..64).map(|i| if busy.contains(&i) { 200 } else { 0 }).collect();
-        run_words(&mut cpu, &kernel, &inputs, 64, 1);
-        let counts = cpu.take_counts_by_kernel();
-        assert_eq!(counts.len(), 1, "one kernel dispatched");
-        counts[&kernel.id]
+        counts_of(&mut cpu, &kernel, &inputs)
     };
     let all = counts_with(&(0..64).collect::<Vec<_>>());
     let one_per_warp = counts_with(&[5, 40]);
@@ -686,28 +700,9 @@ fn main(@builtin(local_invocation_index) i: u32) {
 /// grows by the same amount with every turn.
 #[test]
 fn instructions_before_each_barrier_count() {
-    let source = r#"
-@group(0) @binding(0) var<storage, read> input: array<u32>;
-@group(0) @binding(1) var<storage, read_write> output: array<u32>;
-@compute @workgroup_size(64)
-fn main(@builtin(local_invocation_index) i: u32) {
-    var x = i;
-    for (var n = 0u; n < input[0]; n++) {
-        x = x * 1664525u + 1013904223u;
-        workgroupBarrier();
-    }
-    output[i] = x;
-}
-"#;
-    let kernel = Kernel::from_wgsl("barrier_loop.wgsl", source.into(), "main", false).unwrap();
+    let kernel = stepping_kernel("barrier_loop.wgsl", "input[0]", "workgroupBarrier();");
     let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
-    let mut instructions = |turns: u32| {
-        run_words(&mut cpu, &kernel, &[turns], 64, 1);
-        let counts = cpu.take_counts_by_kernel();
-        assert_eq!(counts.len(), 1, "one kernel dispatched");
-        counts[&kernel.id].instructions
-    };
-    let [one, two, three] = [1, 2, 3].map(&mut instructions);
+    let [one, two, three] = [1, 2, 3].map(|turns| counts_of(&mut cpu, &kernel, &[turns]).instructions);
     let turn = two.checked_sub(one).expect("a second turn cannot cost fewer instructions");
     assert!(turn > 0 && turn % 64 == 0, "a turn costs {turn} instructions: {one}, {two}, {three}");
     assert_eq!(three - two, turn, "{one}, {two}, {three}");

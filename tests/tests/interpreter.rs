@@ -787,6 +787,95 @@ fn float_math_and_matrices_agree_with_lavapipe_within_ulps() {
     assert_close_to_lavapipe("float math", got, want);
 }
 
+const GEOMETRY: &str = r#"
+@group(0) @binding(0) var<storage, read> input: array<f32>;
+@group(0) @binding(1) var<storage, read_write> output: array<f32>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let k = 4u * id.x;
+    let a = vec4<f32>(input[k], input[k + 1u], input[k + 2u], input[k + 3u]);
+    let b = a.wzyx * vec4<f32>(1.5, -0.75, 3.0, 0.125);
+    var v = a.xyz;
+    if (id.x % 3u == 1u) {
+        // A partial group, the result written over its operand's variable.
+        v = normalize(v);
+    }
+    let o = id.x * 16u;
+    let n2 = normalize(a.xy);
+    let n4 = normalize(a);
+    let c = cross(a.xyz, b.xyz);
+    output[o] = v.x;
+    output[o + 1u] = v.y;
+    output[o + 2u] = v.z;
+    output[o + 3u] = n2.x;
+    output[o + 4u] = n2.y;
+    output[o + 5u] = n4.x;
+    output[o + 6u] = n4.w;
+    output[o + 7u] = length(a.x);
+    output[o + 8u] = length(a.xy);
+    output[o + 9u] = length(a.xyz);
+    output[o + 10u] = length(a);
+    output[o + 11u] = distance(a.xyz, b.xyz);
+    output[o + 12u] = distance(a, b);
+    output[o + 13u] = c.x;
+    output[o + 14u] = c.y;
+    output[o + 15u] = c.z;
+}
+"#;
+
+/// `normalize`, `length`, `distance` and `cross` on the interpreter give the bits of
+/// their formulas (the sum of squares from 0 in component order, one square root, a
+/// division per component; the cross product's three differences), also in a partial
+/// group whose result replaces its operand. The interpreter runs them as closures with
+/// the function fixed (`math_call.rs`, `geometric`), which must compute what the general
+/// form does; lavapipe is compared within ulps by the tests above.
+#[test]
+fn geometric_functions_give_the_bits_of_their_formulas() {
+    let kernel = Kernel::from_wgsl("geometry.wgsl", GEOMETRY.into(), "main", false).unwrap();
+    let inputs = uniform_floats(4242, 4 * 192);
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &inputs, 192 * 16, 3);
+    let f = f32::from_bits;
+    let length = |v: &[f32]| v.iter().fold(0.0f32, |sum, &x| sum + x * x).sqrt();
+    let normalize = |v: &[f32]| -> Vec<f32> { v.iter().map(|&x| x / length(v)).collect() };
+    for p in 0..192 {
+        let a: Vec<f32> = (0..4).map(|i| f(inputs[4 * p + i])).collect();
+        let b = [a[3] * 1.5, a[2] * -0.75, a[1] * 3.0, a[0] * 0.125];
+        let v = if p % 3 == 1 { normalize(&a[..3]) } else { a[..3].to_vec() };
+        let (n2, n4) = (normalize(&a[..2]), normalize(&a));
+        let d3: Vec<f32> = (0..3).map(|i| a[i] - b[i]).collect();
+        let d4: Vec<f32> = (0..4).map(|i| a[i] - b[i]).collect();
+        let cross = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+        let want = [
+            v[0],
+            v[1],
+            v[2],
+            n2[0],
+            n2[1],
+            n4[0],
+            n4[3],
+            length(&a[..1]),
+            length(&a[..2]),
+            length(&a[..3]),
+            length(&a),
+            length(&d3),
+            length(&d4),
+            cross[0],
+            cross[1],
+            cross[2],
+        ];
+        for (k, want) in want.iter().enumerate() {
+            assert_eq!(
+                got[16 * p + k],
+                want.to_bits(),
+                "invocation {p}, output {k}: {} against {want}",
+                f(got[16 * p + k])
+            );
+        }
+    }
+}
+
 const MORE_MATH: &str = r#"
 @group(0) @binding(0) var<storage, read> input: array<f32>;
 @group(0) @binding(1) var<storage, read_write> output: array<f32>;

@@ -446,6 +446,53 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
+/// Element loads as a group executes them (`load_element` in the interpreter's
+/// `execute.rs`): a group whose members all read one element (each word read once, its
+/// rows filled), a batch whose workgroups each read one element (chunks that agree, a
+/// group that does not), members at elements of their own with indices past the end
+/// clamped, and each of these in a branch that a third of the invocations take (a
+/// partial group, whose other lanes must keep the words they hold in the same variable).
+#[test]
+fn element_loads_of_uniform_chunked_and_divergent_groups() {
+    let source = r#"
+struct Quad { a: u32, b: u32, c: u32, d: u32 }
+@group(0) @binding(0) var<storage, read> quads: array<Quad>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(workgroup_id) group: vec3<u32>) {
+    let i = id.x;
+    let last = arrayLength(&quads) - 1u;
+    var same = quads[last - 2u];
+    var per_group = quads[group.x * 2u];
+    var own = quads[i * 3u];
+    if (i % 3u == 1u) {
+        same = quads[last];
+        per_group = quads[group.x * 5u + 1u];
+        own = quads[i * 7u + 1u];
+    }
+    output[i * 3u] = same.a ^ (same.d << 1u);
+    output[i * 3u + 1u] = per_group.b + per_group.c;
+    output[i * 3u + 2u] = own.a ^ (own.d << 2u);
+}
+"#;
+    let kernel = Kernel::from_wgsl("group_element_loads.wgsl", source.into(), "main", false).unwrap();
+    const QUADS: usize = 300;
+    let words: Vec<u32> = (0..4 * QUADS as u32).map(|k| k.wrapping_mul(2_654_435_761) >> (k % 7)).collect();
+    let quad = |k: usize| -> [u32; 4] { words[4 * k.min(QUADS - 1)..][..4].try_into().unwrap() };
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    const GROUPS: usize = 12;
+    let got = run_words(&mut cpu, &kernel, &words, GROUPS * 64 * 3, GROUPS as u32);
+    for i in 0..GROUPS * 64 {
+        let (group, branch) = (i / 64, i % 3 == 1);
+        let same = quad(if branch { QUADS - 1 } else { QUADS - 3 });
+        let per_group = quad(if branch { group * 5 + 1 } else { group * 2 });
+        let own = quad(if branch { i * 7 + 1 } else { i * 3 });
+        let want = [same[0] ^ (same[3] << 1), per_group[1].wrapping_add(per_group[2]), own[0] ^ (own[3] << 2)];
+        assert_eq!(&got[i * 3..(i + 1) * 3], &want, "invocation {i}");
+    }
+}
+
 /// The passes that keep the generated row readers (`gpu/scene_rows.wgsl`) and their
 /// callers from copying what they read (issue 59): a struct or call result returned by
 /// an inlined callee is computed in the call's result registers; consecutive components

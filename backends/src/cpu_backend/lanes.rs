@@ -443,7 +443,14 @@ impl Members<'_> {
                     }
                 }
             }
-            Members::Masked(lanes, mask, _) => Members::Some(lanes, mask.len()).fill(regs, dst, len, value),
+            Members::Masked(_, mask, chunks) => {
+                let width = mask.len();
+                for r in dst..dst + len {
+                    each_chunk(mask, chunks, |c, mask| {
+                        keep_members(&mut regs[r * width + c..][..N], &[value; N], mask)
+                    });
+                }
+            }
         }
     }
 }

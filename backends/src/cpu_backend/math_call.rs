@@ -157,6 +157,67 @@ fn component_rows(
     })
 }
 
+/// `normalize`, `length`, `distance` and `cross` of float vectors with the function
+/// fixed, so that each member's words are read straight from its registers and no match
+/// on the function runs per member (the general form copied every operand out and
+/// matched per member: `normalize` alone cost the path tracer's large groups about 50
+/// cycles a member). The same operations in the same order as [`math`], so the same bits.
+fn geometric(
+    fun: naga::MathFunction,
+    kind: ScalarKind,
+    comps: usize,
+    dst: Reg,
+    (a, a_len): (Reg, u32),
+    b: Option<(Reg, u32)>,
+) -> Option<Compute> {
+    use naga::MathFunction as M;
+    if kind != ScalarKind::Float || a_len as usize != comps || !(1..=4).contains(&comps) {
+        return None;
+    }
+    let (dst, a) = (dst as usize, a as usize);
+    let f = f32::from_bits;
+    // Every operand word read before the first result word is written (the result may
+    // share registers with an operand).
+    let read = move |regs: &LaneRegs, at: usize| -> [f32; 4] {
+        std::array::from_fn(|i| if i < comps { f(regs[at + i]) } else { 0.0 })
+    };
+    let squares = move |x: &[f32; 4]| x[..comps].iter().fold(0.0f32, |sum, &v| sum + v * v);
+    match (fun, b) {
+        (M::Normalize, None) => Some(per_lane(move |regs: &mut LaneRegs| {
+            let x = read(regs, a);
+            let length = squares(&x).sqrt();
+            for (i, v) in x[..comps].iter().enumerate() {
+                regs[dst + i] = (v / length).to_bits();
+            }
+        })),
+        (M::Length, None) => Some(per_lane(move |regs: &mut LaneRegs| {
+            regs[dst] = squares(&read(regs, a)).sqrt().to_bits();
+        })),
+        (M::Distance, Some((b, b_len))) if b_len as usize == comps => {
+            let b = b as usize;
+            Some(per_lane(move |regs: &mut LaneRegs| {
+                let (x, y) = (read(regs, a), read(regs, b));
+                let sum = (0..comps).fold(0.0f32, |sum, i| {
+                    let d = x[i] - y[i];
+                    sum + d * d
+                });
+                regs[dst] = sum.sqrt().to_bits();
+            }))
+        }
+        (M::Cross, Some((b, 3))) if comps == 3 => {
+            let b = b as usize;
+            Some(per_lane(move |regs: &mut LaneRegs| {
+                let (x, y) = (read(regs, a), read(regs, b));
+                let value = [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]];
+                for (i, v) in value.iter().enumerate() {
+                    regs[dst + i] = v.to_bits();
+                }
+            }))
+        }
+        _ => None,
+    }
+}
+
 /// The common component-wise functions of [`arith::math`] with the function and kind
 /// fixed, so that the compiler specialises each (the path tracer spends a fifth of its
 /// interpreted time in math builtins, and matching on the function per component was
@@ -332,6 +393,8 @@ impl Compiler<'_> {
                         let rows = (at(Some(a)).expect("a first argument"), at(b), at(c));
                         let (rows_dst, n) = (dst as usize, comps.min(len as usize));
                         if let Some(compute) = specialised(fun, kind, rows_dst, n, rows.0, rows.1, rows.2) {
+                            Ok(compute)
+                        } else if let Some(compute) = geometric(fun, kind, comps, dst, a, b) {
                             Ok(compute)
                         } else if let (M::Dot, ScalarKind::Float, Some(b)) = (fun, kind, b) {
                             let (a, b, dst) = (a.0 as usize, b.0 as usize, dst as usize);

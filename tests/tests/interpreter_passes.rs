@@ -447,11 +447,18 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 /// Element loads as a group executes them (`load_element` in the interpreter's
-/// `execute.rs`): a group whose members all read one element (each word read once, its
-/// rows filled), a batch whose workgroups each read one element (chunks that agree, a
-/// group that does not), members at elements of their own with indices past the end
-/// clamped, and each of these in a branch that a third of the invocations take (a
-/// partial group, whose other lanes must keep the words they hold in the same variable).
+/// `execute.rs`), in a batch of several workgroups (512 invocations, `batch.rs`): a group
+/// whose members all read one element (each word read once, its rows filled), workgroups
+/// that each read one element (chunks of 64 members that agree in a group that does not),
+/// members at elements of their own with indices past the end clamped, each of these also
+/// in a branch that a third of the invocations take (a masked group, whose other lanes
+/// must keep the words they hold in the same variable), in one that every other workgroup
+/// takes (a masked group whose chunks agree) and in one that one invocation per workgroup
+/// takes (a few members, lane by lane); two fields of an element (the other words not
+/// loaded); indices past the end, clamped to the last whole element (the buffer ends
+/// three words into one more); and a load at an address known when compiling
+/// (`LoadBuffer`, read once). The buffer stores in the branches keep them branches (an `if` of loads into
+/// variables alone becomes selects).
 #[test]
 fn element_loads_of_uniform_chunked_and_divergent_groups() {
     let source = r#"
@@ -462,6 +469,7 @@ struct Quad { a: u32, b: u32, c: u32, d: u32 }
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(workgroup_id) group: vec3<u32>) {
     let i = id.x;
+    // The last element: the same for every invocation, not known when compiling.
     let last = arrayLength(&quads) - 1u;
     var same = quads[last - 2u];
     var per_group = quads[group.x * 2u];
@@ -470,26 +478,60 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(workgroup_id) gro
         same = quads[last];
         per_group = quads[group.x * 5u + 1u];
         own = quads[i * 7u + 1u];
+        output[i * 4u] = 1u;
     }
-    output[i * 3u] = same.a ^ (same.d << 1u);
-    output[i * 3u + 1u] = per_group.b + per_group.c;
-    output[i * 3u + 2u] = own.a ^ (own.d << 2u);
+    if (group.x % 2u == 0u) {
+        per_group = quads[group.x * 3u + 2u];
+        output[i * 4u + 1u] = 1u;
+    }
+    if (i % 64u == 5u) {
+        same = quads[last - 1u];
+        per_group = quads[group.x + 7u];
+        own = quads[i + 2u];
+        output[i * 4u + 2u] = 1u;
+    }
+    let part = quads[i * 2u + 1u].b ^ quads[i / 64u].d;
+    output[i * 4u] = same.a ^ (same.d << 1u);
+    output[i * 4u + 1u] = per_group.b + per_group.c;
+    output[i * 4u + 2u] = own.a ^ (own.d << 2u);
+    output[i * 4u + 3u] = part + quads[3u].c;
 }
 "#;
     let kernel = Kernel::from_wgsl("group_element_loads.wgsl", source.into(), "main", false).unwrap();
-    const QUADS: usize = 300;
-    let words: Vec<u32> = (0..4 * QUADS as u32).map(|k| k.wrapping_mul(2_654_435_761) >> (k % 7)).collect();
-    let quad = |k: usize| -> [u32; 4] { words[4 * k.min(QUADS - 1)..][..4].try_into().unwrap() };
+    // 300 whole quads and three words of a 301st, which is no element of the array.
+    let words: Vec<u32> = (0..4 * 301 - 1).map(|k: u32| k.wrapping_mul(2_654_435_761) >> (k % 7)).collect();
+    let quad = |k: usize| -> [u32; 4] { words[4 * k.min(299)..][..4].try_into().unwrap() };
     let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
     const GROUPS: usize = 12;
-    let got = run_words(&mut cpu, &kernel, &words, GROUPS * 64 * 3, GROUPS as u32);
+    let got = run_words(&mut cpu, &kernel, &words, GROUPS * 64 * 4, GROUPS as u32);
     for i in 0..GROUPS * 64 {
-        let (group, branch) = (i / 64, i % 3 == 1);
-        let same = quad(if branch { QUADS - 1 } else { QUADS - 3 });
-        let per_group = quad(if branch { group * 5 + 1 } else { group * 2 });
-        let own = quad(if branch { i * 7 + 1 } else { i * 3 });
-        let want = [same[0] ^ (same[3] << 1), per_group[1].wrapping_add(per_group[2]), own[0] ^ (own[3] << 2)];
-        assert_eq!(&got[i * 3..(i + 1) * 3], &want, "invocation {i}");
+        let (group, third, even, one) = (i / 64, i % 3 == 1, (i / 64) % 2 == 0, i % 64 == 5);
+        let same = quad(if one {
+            298
+        } else if third {
+            299
+        } else {
+            297
+        });
+        let per_group = quad(if one {
+            group + 7
+        } else if even {
+            group * 3 + 2
+        } else if third {
+            group * 5 + 1
+        } else {
+            group * 2
+        });
+        let own = quad(if one {
+            i + 2
+        } else if third {
+            i * 7 + 1
+        } else {
+            i * 3
+        });
+        let part = (quad(i * 2 + 1)[1] ^ quad(i / 64)[3]).wrapping_add(quad(3)[2]);
+        let want = [same[0] ^ (same[3] << 1), per_group[1].wrapping_add(per_group[2]), own[0] ^ (own[3] << 2), part];
+        assert_eq!(&got[i * 4..(i + 1) * 4], &want, "invocation {i}");
     }
 }
 

@@ -24,14 +24,18 @@
 use super::insn::Insn;
 use super::program::Program;
 
-/// How many invocations a batch holds at most: eight of the common 64-wide workgroups,
-/// where the path tracer's frame was fastest (128, 256 and 1 024 were slower:
-/// BENCHMARKS.md, "Batches of workgroups").
-pub(super) const BATCH_INVOCATIONS: u32 = 512;
+/// How many invocations a batch holds at most: sixteen of the common 64-wide workgroups,
+/// where the path tracer's 128² frame is now fastest (512 was 4-5 % slower, 2 048 the
+/// same within the noise, 4 096 and 256 about 10 % slower: docs/benchmarks/interpreter.md,
+/// "The path tracer's loads by rows"; in 2026-11-28's code 512 had been the fastest).
+pub(super) const BATCH_INVOCATIONS: u32 = 1024;
 
-/// How many workgroups of `program` run as one batch: 1 where the kernel could observe it
-/// (a barrier or a subgroup operation), else as many as fit in [`BATCH_INVOCATIONS`].
-pub(super) fn workgroups_per_batch(program: &Program) -> u32 {
+/// How many workgroups of `program` run as one batch in a dispatch of `total` workgroups
+/// on `threads` threads: 1 where the kernel could observe it (a barrier or a subgroup
+/// operation), else as many as fit in [`BATCH_INVOCATIONS`] but no more than leave each
+/// thread a batch (a dispatch of 16 workgroups of 64 runs as two batches of 8 on two
+/// threads, not one of 16 on one).
+pub(super) fn workgroups_per_batch(program: &Program, total: u64, threads: usize) -> u64 {
     let [x, y, z] = program.workgroup_size;
     let invocations = (x * y * z).max(1);
     let synchronises = program
@@ -39,7 +43,11 @@ pub(super) fn workgroups_per_batch(program: &Program) -> u32 {
         .iter()
         .flat_map(|code| &code.insns)
         .any(|insn| matches!(insn, Insn::Barrier { .. } | Insn::Gather(_) | Insn::Collective(_)));
-    if synchronises { 1 } else { (BATCH_INVOCATIONS / invocations).max(1) }
+    if synchronises {
+        return 1;
+    }
+    let per_thread = total.div_ceil(threads.max(1) as u64);
+    u64::from((BATCH_INVOCATIONS / invocations).max(1)).min(per_thread).max(1)
 }
 
 #[cfg(test)]
@@ -49,8 +57,9 @@ mod tests {
     use strata_kernels::Kernel;
 
     /// Workgroups per batch of a 64-wide kernel whose body is `body` (with a read-write
-    /// `data` array and a workgroup array `slots`).
-    fn per_batch(body: &str) -> u32 {
+    /// `data` array and a workgroup array `slots`), in a dispatch of `total` workgroups on
+    /// `threads` threads.
+    fn per_batch_of(body: &str, total: u64, threads: usize) -> u64 {
         let subgroup = body.contains("subgroup");
         let source = format!(
             "@group(0) @binding(0) var<storage, read_write> data: array<u32>;\n\
@@ -58,13 +67,18 @@ mod tests {
              @compute @workgroup_size(64) fn main(@builtin(local_invocation_index) i: u32) {{\n{body}\n}}"
         );
         let kernel = Kernel::from_wgsl("batch.wgsl", source, "main", subgroup).expect("valid WGSL");
-        workgroups_per_batch(&compile_program(&kernel).expect("compiles"))
+        workgroups_per_batch(&compile_program(&kernel).expect("compiles"), total, threads)
+    }
+
+    /// Workgroups per batch of a large dispatch on two threads.
+    fn per_batch(body: &str) -> u64 {
+        per_batch_of(body, 1 << 20, 2)
     }
 
     #[test]
     fn only_kernels_that_never_wait_run_in_batches() {
         // Workgroup memory alone: each workgroup of the batch gets its own.
-        assert_eq!(per_batch("slots[i] = i; data[i] = slots[i];"), 8);
+        assert_eq!(per_batch("slots[i] = i; data[i] = slots[i];"), 16);
         // A barrier (including workgroupUniformLoad's): one workgroup at a time.
         assert_eq!(per_batch("slots[i] = i; workgroupBarrier(); data[i] = slots[63u - i];"), 1);
         assert_eq!(per_batch("data[i] = workgroupUniformLoad(&slots[0]);"), 1);
@@ -72,5 +86,16 @@ mod tests {
         // A subgroup operation: the subgroups are the workgroup's.
         assert_eq!(per_batch("data[i] = subgroupAdd(i);"), 1);
         assert_eq!(per_batch("data[i] = subgroupShuffle(i, 0u);"), 1);
+    }
+
+    #[test]
+    fn every_thread_gets_a_batch_before_batches_grow() {
+        let body = "data[i] = i;";
+        assert_eq!(per_batch_of(body, 16, 2), 8);
+        assert_eq!(per_batch_of(body, 17, 2), 9);
+        assert_eq!(per_batch_of(body, 256, 2), 16);
+        assert_eq!(per_batch_of(body, 256, 64), 4);
+        assert_eq!(per_batch_of(body, 1, 2), 1);
+        assert_eq!(per_batch_of(body, 3, 0), 3);
     }
 }

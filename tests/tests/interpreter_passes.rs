@@ -312,6 +312,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     assert_eq!(got, [101]);
 }
 
+/// The 4-word records and the two bindings of the load tests below.
+const QUADS: &str = "
+struct Quad { a: u32, b: u32, c: u32, d: u32 }
+@group(0) @binding(0) var<storage, read> quads: array<Quad>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+";
+
 /// Structs loaded through a pointer load only the fields their uses read (the
 /// interpreter's `load_fields`): fields read directly, through a callee, in divergent
 /// branches; from a buffer (an index past the end clamps to the last element), from
@@ -319,11 +326,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
 /// store of the whole value). Checked word for word against Rust.
 #[test]
 fn struct_loads_read_the_fields_their_uses_need() {
-    let source = r#"
-struct Quad { a: u32, b: u32, c: u32, d: u32 }
-@group(0) @binding(0) var<storage, read> quads: array<Quad>;
-@group(0) @binding(1) var<storage, read_write> output: array<u32>;
-var<workgroup> shared_quads: array<Quad, 64>;
+    let source = QUADS.to_string()
+        + r#"var<workgroup> shared_quads: array<Quad, 64>;
 var<private> own: array<Quad, 2>;
 
 fn cross(q: Quad) -> u32 {
@@ -457,15 +461,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
 /// takes (a few members, lane by lane); two fields of an element (the other words not
 /// loaded); indices past the end, clamped to the last whole element (the buffer ends
 /// three words into one more); and a load at an address known when compiling
-/// (`LoadBuffer`, read once). The buffer stores in the branches keep them branches (an `if` of loads into
-/// variables alone becomes selects).
+/// (`LoadBuffer`, read once). The buffer stores in the branches keep them branches (an
+/// `if` of loads into variables alone becomes selects).
 #[test]
 fn element_loads_of_uniform_chunked_and_divergent_groups() {
-    let source = r#"
-struct Quad { a: u32, b: u32, c: u32, d: u32 }
-@group(0) @binding(0) var<storage, read> quads: array<Quad>;
-@group(0) @binding(1) var<storage, read_write> output: array<u32>;
-
+    let source = QUADS.to_string()
+        + r#"
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(workgroup_id) group: vec3<u32>) {
     let i = id.x;

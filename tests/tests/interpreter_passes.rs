@@ -361,7 +361,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_
     output[o + 5u] = whole.a + whole.b + whole.c + whole.d;
 }
 "#;
-    let kernel = Kernel::from_wgsl("struct_loads.wgsl", source.into(), "main", false).unwrap();
+    let kernel = Kernel::from_wgsl("struct_loads.wgsl", source, "main", false).unwrap();
     let words: Vec<u32> = (0..256u32).map(|k| k.wrapping_mul(2_654_435_761) >> (k % 7)).collect();
     let quad = |k: usize| -> [u32; 4] { words[4 * k.min(63)..][..4].try_into().unwrap() };
     let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
@@ -498,7 +498,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(workgroup_id) gro
     output[i * 4u + 3u] = part + quads[3u].c;
 }
 "#;
-    let kernel = Kernel::from_wgsl("group_element_loads.wgsl", source.into(), "main", false).unwrap();
+    let kernel = Kernel::from_wgsl("group_element_loads.wgsl", source, "main", false).unwrap();
     // 300 whole quads and three words of a 301st, which is no element of the array.
     let words: Vec<u32> = (0..4 * 301 - 1).map(|k: u32| k.wrapping_mul(2_654_435_761) >> (k % 7)).collect();
     let quad = |k: usize| -> [u32; 4] { words[4 * k.min(299)..][..4].try_into().unwrap() };

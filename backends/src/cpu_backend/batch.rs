@@ -30,12 +30,22 @@ use super::program::Program;
 /// "The path tracer's loads by rows"; in 2026-11-28's code 512 had been the fastest).
 pub(super) const BATCH_INVOCATIONS: u32 = 1024;
 
-/// How many workgroups of `program` run as one batch in a dispatch of `total` workgroups
-/// on `threads` threads: 1 where the kernel could observe it (a barrier or a subgroup
-/// operation), else as many as fit in [`BATCH_INVOCATIONS`] but no more than leave each
-/// thread a batch (a dispatch of 16 workgroups of 64 runs as two batches of 8 on two
-/// threads, not one of 16 on one).
-pub(super) fn workgroups_per_batch(program: &Program, total: u64, threads: usize) -> u64 {
+/// How many invocations a batch of a smaller dispatch holds at most (one of fewer than
+/// [`WIDE_BATCHES`] × [`BATCH_INVOCATIONS`] invocations): 512 as before, so that a 32²
+/// frame's 16 workgroups still make two batches for two cores rather than one.
+const SMALL_DISPATCH_BATCH: u32 = 512;
+
+/// How many full batches a dispatch must fill before its batches are
+/// [`BATCH_INVOCATIONS`] wide.
+const WIDE_BATCHES: u64 = 4;
+
+/// How many workgroups of `program` run as one batch in a dispatch of `total`
+/// workgroups: 1 where the kernel could observe it (a barrier or a subgroup operation),
+/// else as many as fit in [`BATCH_INVOCATIONS`], or in [`SMALL_DISPATCH_BATCH`] where the
+/// dispatch is small. Why a rule on the dispatch and not on the machine's cores: what a
+/// batch holds, and so what a test's dispatch exercises, is then the same on every
+/// machine.
+pub(super) fn workgroups_per_batch(program: &Program, total: u64) -> u64 {
     let [x, y, z] = program.workgroup_size;
     let invocations = (x * y * z).max(1);
     let synchronises = program
@@ -46,8 +56,9 @@ pub(super) fn workgroups_per_batch(program: &Program, total: u64, threads: usize
     if synchronises {
         return 1;
     }
-    let per_thread = total.div_ceil(threads.max(1) as u64);
-    u64::from((BATCH_INVOCATIONS / invocations).max(1)).min(per_thread).max(1)
+    let wide = total.saturating_mul(u64::from(invocations)) >= WIDE_BATCHES * u64::from(BATCH_INVOCATIONS);
+    let most = if wide { BATCH_INVOCATIONS } else { SMALL_DISPATCH_BATCH };
+    u64::from((most / invocations).max(1))
 }
 
 #[cfg(test)]
@@ -57,9 +68,8 @@ mod tests {
     use strata_kernels::Kernel;
 
     /// Workgroups per batch of a 64-wide kernel whose body is `body` (with a read-write
-    /// `data` array and a workgroup array `slots`), in a dispatch of `total` workgroups on
-    /// `threads` threads.
-    fn per_batch_of(body: &str, total: u64, threads: usize) -> u64 {
+    /// `data` array and a workgroup array `slots`), in a dispatch of `total` workgroups.
+    fn per_batch_of(body: &str, total: u64) -> u64 {
         let subgroup = body.contains("subgroup");
         let source = format!(
             "@group(0) @binding(0) var<storage, read_write> data: array<u32>;\n\
@@ -67,12 +77,12 @@ mod tests {
              @compute @workgroup_size(64) fn main(@builtin(local_invocation_index) i: u32) {{\n{body}\n}}"
         );
         let kernel = Kernel::from_wgsl("batch.wgsl", source, "main", subgroup).expect("valid WGSL");
-        workgroups_per_batch(&compile_program(&kernel).expect("compiles"), total, threads)
+        workgroups_per_batch(&compile_program(&kernel).expect("compiles"), total)
     }
 
-    /// Workgroups per batch of a large dispatch on two threads.
+    /// Workgroups per batch of a large dispatch.
     fn per_batch(body: &str) -> u64 {
-        per_batch_of(body, 1 << 20, 2)
+        per_batch_of(body, 1 << 20)
     }
 
     #[test]
@@ -89,13 +99,14 @@ mod tests {
     }
 
     #[test]
-    fn every_thread_gets_a_batch_before_batches_grow() {
+    fn small_dispatches_keep_batches_of_512() {
         let body = "data[i] = i;";
-        assert_eq!(per_batch_of(body, 16, 2), 8);
-        assert_eq!(per_batch_of(body, 17, 2), 9);
-        assert_eq!(per_batch_of(body, 256, 2), 16);
-        assert_eq!(per_batch_of(body, 256, 64), 4);
-        assert_eq!(per_batch_of(body, 1, 2), 1);
-        assert_eq!(per_batch_of(body, 3, 0), 3);
+        // A 32² frame's 16 workgroups of 64, up to 63: two or more batches of 8.
+        assert_eq!(per_batch_of(body, 16), 8);
+        assert_eq!(per_batch_of(body, 63), 8);
+        // From four batches of 1 024 invocations on (a 64² frame), batches of 16.
+        assert_eq!(per_batch_of(body, 64), 16);
+        assert_eq!(per_batch_of(body, u64::MAX), 16);
+        assert_eq!(per_batch_of(body, 0), 8);
     }
 }

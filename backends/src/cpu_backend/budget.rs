@@ -205,7 +205,7 @@ mod tests {
             let per_invocation = bytes_of(program.private_init.len() as u64 + registers);
             let workgroup = bytes_of(u64::from(program.workgroup_words));
             let invocations = u64::from(kernel.invocations());
-            let wanted = super::super::batch::workgroups_per_batch(&program, u64::MAX, 2);
+            let wanted = super::super::batch::workgroups_per_batch(&program, u64::MAX);
             let plan = plan_batches(kernel.name(), per_invocation, invocations, workgroup, wanted, 2).unwrap();
             assert_eq!(plan, BatchPlan { workgroups: wanted, threads: 2 }, "{}", kernel.name());
             if per_invocation.max(workgroup) > largest.0 {

@@ -50,14 +50,13 @@ pub(super) fn run(
     // invocation holds its private memory and a column of every code's registers.
     // Planned before the buffers are taken, so that a refusal leaves them as they were.
     let registers: u64 = program.codes.iter().map(|code| code.template.len() as u64).sum();
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let plan = super::budget::plan_batches(
         &program.kernel,
         super::budget::bytes_of(program.private_init.len() as u64 + registers),
         u64::from(program.workgroup_size.iter().product::<u32>()),
         super::budget::bytes_of(u64::from(program.workgroup_words)),
-        super::batch::workgroups_per_batch(program, total, threads),
-        threads,
+        super::batch::workgroups_per_batch(program, total),
+        std::thread::available_parallelism().map_or(1, |n| n.get()),
     )?;
     let per_batch = plan.workgroups;
     let batches = total.div_ceil(per_batch);

@@ -4,7 +4,7 @@
 //! smallest such instruction next and stops it at the next one.
 //!
 //! Why: found by scanning every invocation's next instruction, each group cost the
-//! scheduler three passes over the batch; a divergent kernel's groups have a tenth of a
+//! scheduler three passes over the batch; a divergent kernel's groups had a tenth of a
 //! 512-wide batch or fewer, so those passes were a seventh of the path tracer's time.
 //! Here a group costs its members and a few words.
 

@@ -444,11 +444,9 @@ impl Members<'_> {
                 }
             }
             Members::Masked(_, mask, chunks) => {
-                let width = mask.len();
+                let (width, words) = (mask.len(), [value; N]);
                 for r in dst..dst + len {
-                    each_chunk(mask, chunks, |c, mask| {
-                        keep_members(&mut regs[r * width + c..][..N], &[value; N], mask)
-                    });
+                    each_chunk(mask, chunks, |c, mask| keep_members(&mut regs[r * width + c..][..N], &words, mask));
                 }
             }
         }

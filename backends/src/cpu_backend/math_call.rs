@@ -47,17 +47,13 @@ fn math(
             let b = b?;
             one(out, (0..comps).fold(0u32, |acc, i| acc.wrapping_add(a[i].wrapping_mul(b[i]))))
         }
-        M::Length => one(out, (0..comps).fold(0.0f32, |acc, i| acc + f(a[i]) * f(a[i])).sqrt().to_bits()),
+        M::Length => one(out, sum_of_squares(a[..comps].iter().map(|&x| f(x))).sqrt().to_bits()),
         M::Distance => {
             let b = b?;
-            let sum = (0..comps).fold(0.0f32, |acc, i| {
-                let d = f(a[i]) - f(b[i]);
-                acc + d * d
-            });
-            one(out, sum.sqrt().to_bits())
+            one(out, sum_of_squares((0..comps).map(|i| f(a[i]) - f(b[i]))).sqrt().to_bits())
         }
         M::Normalize => {
-            let length = (0..comps).fold(0.0f32, |acc, i| acc + f(a[i]) * f(a[i])).sqrt();
+            let length = sum_of_squares(a[..comps].iter().map(|&x| f(x))).sqrt();
             for (o, &x) in out.iter_mut().zip(a) {
                 *o = (f(x) / length).to_bits();
             }
@@ -65,10 +61,10 @@ fn math(
         }
         M::Cross => {
             let b = b?;
-            let (x, y) = (|i: usize| f(a[i]), |i: usize| f(b[i]));
-            out[0] = (x(1) * y(2) - x(2) * y(1)).to_bits();
-            out[1] = (x(2) * y(0) - x(0) * y(2)).to_bits();
-            out[2] = (x(0) * y(1) - x(1) * y(0)).to_bits();
+            let value = cross(std::array::from_fn(|i| f(a[i])), std::array::from_fn(|i| f(b[i])));
+            for (o, v) in out.iter_mut().zip(value) {
+                *o = v.to_bits();
+            }
             Some(3)
         }
         M::Reflect => {
@@ -157,11 +153,25 @@ fn component_rows(
     })
 }
 
+/// The sum of the squares of `x`, from 0 in order: `length`, `normalize` and `distance`
+/// take it, in [`math`] and in [`geometric`] alike (so with the same bits).
+#[inline(always)]
+fn sum_of_squares(x: impl Iterator<Item = f32>) -> f32 {
+    x.fold(0.0f32, |sum, v| sum + v * v)
+}
+
+/// `cross(x, y)`, in [`math`] and in [`geometric`].
+#[inline(always)]
+fn cross(x: [f32; 3], y: [f32; 3]) -> [f32; 3] {
+    [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]]
+}
+
 /// `normalize`, `length`, `distance` and `cross` of float vectors with the function
 /// fixed, so that each member's words are read straight from its registers and no match
 /// on the function runs per member (the general form copied every operand out and
 /// matched per member: `normalize` alone cost the path tracer's large groups about 50
-/// cycles a member). The same operations in the same order as [`math`], so the same bits.
+/// cycles a member). Their formulas are [`math`]'s ([`sum_of_squares`], [`cross`]), so
+/// the same bits.
 fn geometric(
     fun: naga::MathFunction,
     kind: ScalarKind,
@@ -181,7 +191,7 @@ fn geometric(
     let read = move |regs: &LaneRegs, at: usize| -> [f32; 4] {
         std::array::from_fn(|i| if i < comps { f(regs[at + i]) } else { 0.0 })
     };
-    let squares = move |x: &[f32; 4]| x[..comps].iter().fold(0.0f32, |sum, &v| sum + v * v);
+    let squares = move |x: &[f32; 4]| sum_of_squares(x[..comps].iter().copied());
     match (fun, b) {
         (M::Normalize, None) => Some(per_lane(move |regs: &mut LaneRegs| {
             let x = read(regs, a);
@@ -197,18 +207,14 @@ fn geometric(
             let b = b as usize;
             Some(per_lane(move |regs: &mut LaneRegs| {
                 let (x, y) = (read(regs, a), read(regs, b));
-                let sum = (0..comps).fold(0.0f32, |sum, i| {
-                    let d = x[i] - y[i];
-                    sum + d * d
-                });
-                regs[dst] = sum.sqrt().to_bits();
+                regs[dst] = sum_of_squares((0..comps).map(|i| x[i] - y[i])).sqrt().to_bits();
             }))
         }
         (M::Cross, Some((b, 3))) if comps == 3 => {
             let b = b as usize;
             Some(per_lane(move |regs: &mut LaneRegs| {
                 let (x, y) = (read(regs, a), read(regs, b));
-                let value = [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]];
+                let value = cross([x[0], x[1], x[2]], [y[0], y[1], y[2]]);
                 for (i, v) in value.iter().enumerate() {
                     regs[dst + i] = v.to_bits();
                 }

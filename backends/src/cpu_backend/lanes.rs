@@ -7,6 +7,7 @@
 //! instruction). [`LaneRegs`] is one invocation's view of such a file, for the
 //! instructions run member by member (memory through pointers, atomics, rare math).
 
+use multiversion::multiversion;
 use smallvec::SmallVec;
 use std::ops::{Index, IndexMut};
 
@@ -215,7 +216,7 @@ impl Members<'_> {
     /// `regs[dst + r row] = f(regs[a + r row], regs[b + r row])` for the members and
     /// `r < rows`, in that order (rows are register indices; each is `width` words). The
     /// rows of a vector are contiguous, so a whole group's vector operation is one loop.
-    #[inline(never)]
+    #[inline(always)]
     pub(super) fn binary(
         self,
         regs: &mut [u32],
@@ -223,159 +224,25 @@ impl Members<'_> {
         rows: usize,
         f: impl Fn(u32, u32) -> u32,
     ) {
-        match self {
-            Members::All(width) => chunks!(rows * width, |start, n| {
-                let (d, x, y) = (dst * width + start, a * width + start, b * width + start);
-                // Rows of distinct registers are `n` or more words apart: chunks of them
-                // never overlap in part (checked, not assumed: see the last branch).
-                let apart = |p: usize, q: usize| p.abs_diff(q) >= n;
-                if apart(d, x) && apart(d, y) && apart(x, y) {
-                    let [out, xs, ys] = regs.get_disjoint_mut([d..d + n, x..x + n, y..y + n]).expect("rows apart");
-                    for i in 0..n {
-                        out[i] = f(xs[i], ys[i]);
-                    }
-                } else if apart(d, x) && x == y {
-                    let [out, xs] = regs.get_disjoint_mut([d..d + n, x..x + n]).expect("rows apart");
-                    for i in 0..n {
-                        out[i] = f(xs[i], xs[i]);
-                    }
-                } else if [(d, x), (d, y), (x, y)].iter().all(|&(p, q)| p == q || apart(p, q)) {
-                    // The destination is an operand (not compiled today): through copies.
-                    let (xs, ys) = (row::<N>(regs, x, n), row::<N>(regs, y, n));
-                    for (i, o) in regs[d..d + n].iter_mut().enumerate() {
-                        *o = f(xs[i], ys[i]);
-                    }
-                } else {
-                    // Overlapping in part (never compiled): word by word in order, as one
-                    // invocation at a time would.
-                    for i in 0..n {
-                        regs[d + i] = f(regs[x + i], regs[y + i]);
-                    }
-                }
-            }),
-            Members::Some(lanes, width) => {
-                for r in 0..rows {
-                    for &l in lanes {
-                        regs[(dst + r) * width + l] = f(regs[(a + r) * width + l], regs[(b + r) * width + l]);
-                    }
-                }
-            }
-            Members::Masked(_, mask, chunks) => {
-                let width = mask.len();
-                for r in 0..rows {
-                    each_chunk(mask, chunks, |c, mask| {
-                        let (xs, ys) = (&regs[(a + r) * width + c..][..N], &regs[(b + r) * width + c..][..N]);
-                        let words: [u32; N] = std::array::from_fn(|i| f(xs[i], ys[i]));
-                        keep_members(&mut regs[(dst + r) * width + c..][..N], &words, mask);
-                    });
-                }
-            }
-        }
+        binary_rows(self, regs, (dst, a, b), rows, f)
     }
 
     /// `regs[dst + r row] = f(regs[src + r row])` for the members and `r < rows`.
-    #[inline(never)]
+    #[inline(always)]
     pub(super) fn unary(self, regs: &mut [u32], dst: usize, src: usize, rows: usize, f: impl Fn(u32) -> u32) {
-        match self {
-            Members::All(width) => chunks!(rows * width, |start, n| {
-                let (d, x) = (dst * width + start, src * width + start);
-                if d.abs_diff(x) >= n {
-                    let [out, xs] = regs.get_disjoint_mut([d..d + n, x..x + n]).expect("rows apart");
-                    for i in 0..n {
-                        out[i] = f(xs[i]);
-                    }
-                } else if d == x {
-                    for o in &mut regs[d..d + n] {
-                        *o = f(*o);
-                    }
-                } else {
-                    // Overlapping in part (never compiled): word by word in order.
-                    for i in 0..n {
-                        regs[d + i] = f(regs[x + i]);
-                    }
-                }
-            }),
-            Members::Some(lanes, width) => {
-                for r in 0..rows {
-                    for &l in lanes {
-                        regs[(dst + r) * width + l] = f(regs[(src + r) * width + l]);
-                    }
-                }
-            }
-            Members::Masked(_, mask, chunks) => {
-                let width = mask.len();
-                for r in 0..rows {
-                    each_chunk(mask, chunks, |c, mask| {
-                        let xs = &regs[(src + r) * width + c..][..N];
-                        let words: [u32; N] = std::array::from_fn(|i| f(xs[i]));
-                        keep_members(&mut regs[(dst + r) * width + c..][..N], &words, mask);
-                    });
-                }
-            }
-        }
+        unary_rows(self, regs, dst, src, rows, f)
     }
 
     /// `regs[dst + r row] = regs[cond + r row] != 0 ? regs[accept + r row] : regs[reject
     /// + r row]` for the members and `r < rows`.
-    #[inline(never)]
+    #[inline(always)]
     pub(super) fn select(
         self,
         regs: &mut [u32],
         (dst, cond, accept, reject): (usize, usize, usize, usize),
         rows: usize,
     ) {
-        match self {
-            Members::All(width) => chunks!(rows * width, |start, n| {
-                let (d, c, x, y) =
-                    (dst * width + start, cond * width + start, accept * width + start, reject * width + start);
-                if let Ok([out, cs, xs, ys]) = regs.get_disjoint_mut([d..d + n, c..c + n, x..x + n, y..y + n]) {
-                    // With masks, not a choice of address: the compiler vectorises this.
-                    for i in 0..n {
-                        let mask = 0u32.wrapping_sub(u32::from(cs[i] != 0));
-                        out[i] = (xs[i] & mask) | (ys[i] & !mask);
-                    }
-                } else if [(d, c), (d, x), (d, y), (c, x), (c, y), (x, y)]
-                    .iter()
-                    .all(|&(p, q)| p == q || p.abs_diff(q) >= n)
-                {
-                    // Rows repeated (`select(x, x, c)`, ...): through copies.
-                    let (cs, xs, ys) = (row::<N>(regs, c, n), row::<N>(regs, x, n), row::<N>(regs, y, n));
-                    for (i, o) in regs[d..d + n].iter_mut().enumerate() {
-                        *o = if cs[i] != 0 { xs[i] } else { ys[i] };
-                    }
-                } else {
-                    // Overlapping in part (never compiled): word by word in order.
-                    for i in 0..n {
-                        regs[d + i] = if regs[c + i] != 0 { regs[x + i] } else { regs[y + i] };
-                    }
-                }
-            }),
-            Members::Some(lanes, width) => {
-                for r in 0..rows {
-                    for &l in lanes {
-                        let from = if regs[(cond + r) * width + l] != 0 { accept } else { reject };
-                        regs[(dst + r) * width + l] = regs[(from + r) * width + l];
-                    }
-                }
-            }
-            Members::Masked(_, mask, chunks) => {
-                let width = mask.len();
-                for r in 0..rows {
-                    each_chunk(mask, chunks, |c, mask| {
-                        let (cs, xs, ys) = (
-                            &regs[(cond + r) * width + c..][..N],
-                            &regs[(accept + r) * width + c..][..N],
-                            &regs[(reject + r) * width + c..][..N],
-                        );
-                        let words: [u32; N] = std::array::from_fn(|i| {
-                            let m = 0u32.wrapping_sub(u32::from(cs[i] != 0));
-                            (xs[i] & m) | (ys[i] & !m)
-                        });
-                        keep_members(&mut regs[(dst + r) * width + c..][..N], &words, mask);
-                    });
-                }
-            }
-        }
+        select_rows(self, regs, (dst, cond, accept, reject), rows)
     }
 
     /// `regs[dst row] = f(regs[a row], regs[b row], regs[c row])` for the members, an
@@ -399,55 +266,238 @@ impl Members<'_> {
     }
 
     /// Copies `len` rows from `src` to `dst` (the ranges may overlap).
-    #[inline(never)]
+    #[inline(always)]
     pub(super) fn copy(self, regs: &mut [u32], dst: usize, src: usize, len: usize) {
-        match self {
-            // The rows of a value are contiguous: one copy of `len * width` words.
-            Members::All(width) => regs.copy_within(src * width..(src + len) * width, dst * width),
-            Members::Some(lanes, width) => {
-                for i in 0..len {
-                    let r = if dst <= src { i } else { len - 1 - i };
-                    for &l in lanes {
-                        regs[(dst + r) * width + l] = regs[(src + r) * width + l];
-                    }
-                }
-            }
-            Members::Masked(_, mask, chunks) => {
-                let width = mask.len();
-                for i in 0..len {
-                    let r = if dst <= src { i } else { len - 1 - i };
-                    each_chunk(mask, chunks, |c, mask| {
-                        let words: [u32; N] = std::array::from_fn(|k| regs[(src + r) * width + c + k]);
-                        keep_members(&mut regs[(dst + r) * width + c..][..N], &words, mask);
-                    });
-                }
-            }
-        }
+        copy_rows(self, regs, dst, src, len)
     }
 
     /// Sets `len` rows from `dst` to `value`.
-    #[inline(never)]
+    #[inline(always)]
     pub(super) fn fill(self, regs: &mut [u32], dst: usize, len: usize, value: u32) {
-        match self {
-            Members::All(width) => {
-                for r in dst..dst + len {
-                    chunks!(width, |start, n| {
-                        regs[r * width + start..][..n].fill(value);
+        fill_rows(self, regs, dst, len, value)
+    }
+}
+
+/// [`Members::binary`]. This and the four row loops below are each compiled twice, for
+/// the base x86-64 instruction set and for AVX2 with the bit instructions that come with
+/// it (`multiversion`); each call runs the second where the machine has them (one cached
+/// feature check a call, against a loop over hundreds of lanes). Why: the loops then
+/// take eight lanes a step instead of four, and the path tracer's frame on the
+/// interpreter took 8-10 % less time (the histogram 6-8 %), most of what building the
+/// whole workspace for AVX2 gave (11 %); BENCHMARKS.md, "interpreter". Both versions
+/// compute the same bits: integer and IEEE f32 operations have one result, and Rust
+/// never fuses a multiply and an add.
+#[multiversion(targets("x86_64+avx2+bmi1+bmi2+lzcnt+popcnt"))]
+fn binary_rows(
+    members: Members<'_>,
+    regs: &mut [u32],
+    (dst, a, b): (usize, usize, usize),
+    rows: usize,
+    f: impl Fn(u32, u32) -> u32,
+) {
+    match members {
+        Members::All(width) => chunks!(rows * width, |start, n| {
+            let (d, x, y) = (dst * width + start, a * width + start, b * width + start);
+            // Rows of distinct registers are `n` or more words apart: chunks of them
+            // never overlap in part (checked, not assumed: see the last branch).
+            let apart = |p: usize, q: usize| p.abs_diff(q) >= n;
+            if apart(d, x) && apart(d, y) && apart(x, y) {
+                let [out, xs, ys] = regs.get_disjoint_mut([d..d + n, x..x + n, y..y + n]).expect("rows apart");
+                for i in 0..n {
+                    out[i] = f(xs[i], ys[i]);
+                }
+            } else if apart(d, x) && x == y {
+                let [out, xs] = regs.get_disjoint_mut([d..d + n, x..x + n]).expect("rows apart");
+                for i in 0..n {
+                    out[i] = f(xs[i], xs[i]);
+                }
+            } else if [(d, x), (d, y), (x, y)].iter().all(|&(p, q)| p == q || apart(p, q)) {
+                // The destination is an operand (not compiled today): through copies.
+                let (xs, ys) = (row::<N>(regs, x, n), row::<N>(regs, y, n));
+                for (i, o) in regs[d..d + n].iter_mut().enumerate() {
+                    *o = f(xs[i], ys[i]);
+                }
+            } else {
+                // Overlapping in part (never compiled): word by word in order, as one
+                // invocation at a time would.
+                for i in 0..n {
+                    regs[d + i] = f(regs[x + i], regs[y + i]);
+                }
+            }
+        }),
+        Members::Some(lanes, width) => {
+            for r in 0..rows {
+                for &l in lanes {
+                    regs[(dst + r) * width + l] = f(regs[(a + r) * width + l], regs[(b + r) * width + l]);
+                }
+            }
+        }
+        Members::Masked(_, mask, chunks) => {
+            let width = mask.len();
+            for r in 0..rows {
+                each_chunk(mask, chunks, |c, mask| {
+                    let (xs, ys) = (&regs[(a + r) * width + c..][..N], &regs[(b + r) * width + c..][..N]);
+                    let words: [u32; N] = std::array::from_fn(|i| f(xs[i], ys[i]));
+                    keep_members(&mut regs[(dst + r) * width + c..][..N], &words, mask);
+                });
+            }
+        }
+    }
+}
+
+/// [`Members::unary`], compiled twice as [`binary_rows`].
+#[multiversion(targets("x86_64+avx2+bmi1+bmi2+lzcnt+popcnt"))]
+fn unary_rows(members: Members<'_>, regs: &mut [u32], dst: usize, src: usize, rows: usize, f: impl Fn(u32) -> u32) {
+    match members {
+        Members::All(width) => chunks!(rows * width, |start, n| {
+            let (d, x) = (dst * width + start, src * width + start);
+            if d.abs_diff(x) >= n {
+                let [out, xs] = regs.get_disjoint_mut([d..d + n, x..x + n]).expect("rows apart");
+                for i in 0..n {
+                    out[i] = f(xs[i]);
+                }
+            } else if d == x {
+                for o in &mut regs[d..d + n] {
+                    *o = f(*o);
+                }
+            } else {
+                // Overlapping in part (never compiled): word by word in order.
+                for i in 0..n {
+                    regs[d + i] = f(regs[x + i]);
+                }
+            }
+        }),
+        Members::Some(lanes, width) => {
+            for r in 0..rows {
+                for &l in lanes {
+                    regs[(dst + r) * width + l] = f(regs[(src + r) * width + l]);
+                }
+            }
+        }
+        Members::Masked(_, mask, chunks) => {
+            let width = mask.len();
+            for r in 0..rows {
+                each_chunk(mask, chunks, |c, mask| {
+                    let xs = &regs[(src + r) * width + c..][..N];
+                    let words: [u32; N] = std::array::from_fn(|i| f(xs[i]));
+                    keep_members(&mut regs[(dst + r) * width + c..][..N], &words, mask);
+                });
+            }
+        }
+    }
+}
+
+/// [`Members::select`], compiled twice as [`binary_rows`].
+#[multiversion(targets("x86_64+avx2+bmi1+bmi2+lzcnt+popcnt"))]
+fn select_rows(
+    members: Members<'_>,
+    regs: &mut [u32],
+    (dst, cond, accept, reject): (usize, usize, usize, usize),
+    rows: usize,
+) {
+    match members {
+        Members::All(width) => chunks!(rows * width, |start, n| {
+            let (d, c, x, y) =
+                (dst * width + start, cond * width + start, accept * width + start, reject * width + start);
+            if let Ok([out, cs, xs, ys]) = regs.get_disjoint_mut([d..d + n, c..c + n, x..x + n, y..y + n]) {
+                // With masks, not a choice of address: the compiler vectorises this.
+                for i in 0..n {
+                    let mask = 0u32.wrapping_sub(u32::from(cs[i] != 0));
+                    out[i] = (xs[i] & mask) | (ys[i] & !mask);
+                }
+            } else if [(d, c), (d, x), (d, y), (c, x), (c, y), (x, y)]
+                .iter()
+                .all(|&(p, q)| p == q || p.abs_diff(q) >= n)
+            {
+                // Rows repeated (`select(x, x, c)`, ...): through copies.
+                let (cs, xs, ys) = (row::<N>(regs, c, n), row::<N>(regs, x, n), row::<N>(regs, y, n));
+                for (i, o) in regs[d..d + n].iter_mut().enumerate() {
+                    *o = if cs[i] != 0 { xs[i] } else { ys[i] };
+                }
+            } else {
+                // Overlapping in part (never compiled): word by word in order.
+                for i in 0..n {
+                    regs[d + i] = if regs[c + i] != 0 { regs[x + i] } else { regs[y + i] };
+                }
+            }
+        }),
+        Members::Some(lanes, width) => {
+            for r in 0..rows {
+                for &l in lanes {
+                    let from = if regs[(cond + r) * width + l] != 0 { accept } else { reject };
+                    regs[(dst + r) * width + l] = regs[(from + r) * width + l];
+                }
+            }
+        }
+        Members::Masked(_, mask, chunks) => {
+            let width = mask.len();
+            for r in 0..rows {
+                each_chunk(mask, chunks, |c, mask| {
+                    let (cs, xs, ys) = (
+                        &regs[(cond + r) * width + c..][..N],
+                        &regs[(accept + r) * width + c..][..N],
+                        &regs[(reject + r) * width + c..][..N],
+                    );
+                    let words: [u32; N] = std::array::from_fn(|i| {
+                        let m = 0u32.wrapping_sub(u32::from(cs[i] != 0));
+                        (xs[i] & m) | (ys[i] & !m)
                     });
+                    keep_members(&mut regs[(dst + r) * width + c..][..N], &words, mask);
+                });
+            }
+        }
+    }
+}
+
+/// [`Members::copy`], compiled twice as [`binary_rows`].
+#[multiversion(targets("x86_64+avx2+bmi1+bmi2+lzcnt+popcnt"))]
+fn copy_rows(members: Members<'_>, regs: &mut [u32], dst: usize, src: usize, len: usize) {
+    match members {
+        // The rows of a value are contiguous: one copy of `len * width` words.
+        Members::All(width) => regs.copy_within(src * width..(src + len) * width, dst * width),
+        Members::Some(lanes, width) => {
+            for i in 0..len {
+                let r = if dst <= src { i } else { len - 1 - i };
+                for &l in lanes {
+                    regs[(dst + r) * width + l] = regs[(src + r) * width + l];
                 }
             }
-            Members::Some(lanes, width) => {
-                for r in dst..dst + len {
-                    for &l in lanes {
-                        regs[r * width + l] = value;
-                    }
+        }
+        Members::Masked(_, mask, chunks) => {
+            let width = mask.len();
+            for i in 0..len {
+                let r = if dst <= src { i } else { len - 1 - i };
+                each_chunk(mask, chunks, |c, mask| {
+                    let words: [u32; N] = std::array::from_fn(|k| regs[(src + r) * width + c + k]);
+                    keep_members(&mut regs[(dst + r) * width + c..][..N], &words, mask);
+                });
+            }
+        }
+    }
+}
+
+/// [`Members::fill`], compiled twice as [`binary_rows`].
+#[multiversion(targets("x86_64+avx2+bmi1+bmi2+lzcnt+popcnt"))]
+fn fill_rows(members: Members<'_>, regs: &mut [u32], dst: usize, len: usize, value: u32) {
+    match members {
+        Members::All(width) => {
+            for r in dst..dst + len {
+                chunks!(width, |start, n| {
+                    regs[r * width + start..][..n].fill(value);
+                });
+            }
+        }
+        Members::Some(lanes, width) => {
+            for r in dst..dst + len {
+                for &l in lanes {
+                    regs[r * width + l] = value;
                 }
             }
-            Members::Masked(_, mask, chunks) => {
-                let (width, words) = (mask.len(), [value; N]);
-                for r in dst..dst + len {
-                    each_chunk(mask, chunks, |c, mask| keep_members(&mut regs[r * width + c..][..N], &words, mask));
-                }
+        }
+        Members::Masked(_, mask, chunks) => {
+            let (width, words) = (mask.len(), [value; N]);
+            for r in dst..dst + len {
+                each_chunk(mask, chunks, |c, mask| keep_members(&mut regs[r * width + c..][..N], &words, mask));
             }
         }
     }

@@ -643,3 +643,60 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         assert_eq!(&got[i * 10..(i + 1) * 10], &want, "invocation {i} (input {x})");
     }
 }
+
+#[test]
+fn records_composed_from_whole_call_results_keep_wgsl_semantics() {
+    // `node` is a row reader as gpu/scene_rows.wgsl writes them: its rows are read
+    // straight into the record's words. In `either` the rows also feed a second
+    // composition, in another order, so they must keep their own registers: placed in the
+    // record, the second composition's first copy would overwrite `r0.x` before reading it.
+    let source = r#"
+@group(0) @binding(0) var<storage, read> input: array<u32>;
+@group(0) @binding(1) var<storage, read_write> output: array<u32>;
+
+struct Node { lo: vec3<f32>, a: u32, hi: vec3<u32>, b: u32, c: vec2<u32>, d: u32, e: u32 }
+
+fn row(i: u32) -> vec4<u32> { return vec4<u32>(input[i], input[i + 1u], input[i + 2u], input[i + 3u]); }
+fn node(i: u32) -> Node {
+    let r0 = row(i);
+    let r1 = row(i + 4u);
+    let r2 = row(i + 8u);
+    return Node(bitcast<vec3<f32>>(r0.xyz), r0.w, r1.xyz, r1.w, r2.xy, r2.z, r2.w);
+}
+fn either(c: bool, i: u32) -> Node {
+    let r0 = row(i);
+    let r1 = row(i + 4u);
+    let r2 = row(i + 8u);
+    if c { return Node(bitcast<vec3<f32>>(r0.xyz), r0.w, r1.xyz, r1.w, r2.xy, r2.z, r2.w); }
+    return Node(bitcast<vec3<f32>>(r1.yzw), r0.x, r0.yzw, r2.x, r1.xx, r2.y, r2.w);
+}
+fn words(n: Node) -> array<u32, 12> {
+    return array<u32, 12>(bitcast<u32>(n.lo.x), bitcast<u32>(n.lo.y), bitcast<u32>(n.lo.z), n.a,
+        n.hi.x, n.hi.y, n.hi.z, n.b, n.c.x, n.c.y, n.d, n.e);
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    let first = words(node(i * 12u));
+    let second = words(either((input[i * 12u] & 1u) != 0u, i * 12u));
+    for (var k = 0u; k < 12u; k++) {
+        output[i * 24u + k] = first[k];
+        output[i * 24u + 12u + k] = second[k];
+    }
+}
+"#;
+    let kernel = Kernel::from_wgsl("rows.wgsl", source.into(), "main", false).unwrap();
+    let inputs: Vec<u32> = (0..128 * 12u32).map(|i| i.wrapping_mul(2_654_435_761) ^ (i >> 3)).collect();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    let got = run_words(&mut cpu, &kernel, &inputs, 128 * 24, 2);
+    for (i, w) in inputs.chunks(12).enumerate() {
+        let second: Vec<u32> = if w[0] & 1 != 0 {
+            w.to_vec()
+        } else {
+            vec![w[5], w[6], w[7], w[0], w[1], w[2], w[3], w[8], w[4], w[4], w[9], w[11]]
+        };
+        assert_eq!(&got[i * 24..i * 24 + 12], w, "invocation {i}: node");
+        assert_eq!(&got[i * 24 + 12..(i + 1) * 24], &second[..], "invocation {i}: either");
+    }
+}

@@ -466,6 +466,7 @@ impl Compiler<'_> {
             && let Some((dst, words)) = result
         {
             scope.return_in_place(dst, words);
+            self.components_in_place(&mut scope);
         }
         for (index, (_, local)) in function.local_variables.iter().enumerate() {
             let variable = scope.locals[index];

@@ -18,8 +18,10 @@
 //! instruction kind, [`retargetable`]).
 
 use super::compiler::{Compiler, LastValue, NONE, Scope};
+use super::constant::compose_offsets;
 use super::insn::{Insn, Reg};
-use naga::{Block, Expression, Handle, Statement};
+use super::layout::consecutive;
+use naga::{Block, Expression, Handle, Statement, TypeInner};
 
 impl Scope<'_> {
     /// Gives the call result's registers (`dst`, `words` words) to every value of this
@@ -86,6 +88,101 @@ impl Scope<'_> {
 }
 
 impl Compiler<'_> {
+    /// Gives each call result that a composition already placed by
+    /// [`Scope::return_in_place`] takes whole, word for word, the words of the composition
+    /// where it lands: the row readers' `return Node(bitcast<vec3<f32>>(r0.xyz), r0.w,
+    /// ...)` then reads its rows (`let r0 = scene_row(row);`) straight into the call result's
+    /// registers, and the composition copies nothing. Why: those copies were about half the
+    /// words the path tracer copied, 12 words per BVH node visited (issue 59).
+    ///
+    /// A call result `r` is placed at word `at` of the composition when its components
+    /// that come from `r`, through bitcasts of the same size, consecutive swizzles and
+    /// components of 32-bit vectors, take `r`'s words in order to words `at..at + len` of
+    /// the composition, and nothing else uses `r` or anything on those paths (naga
+    /// reference counts).
+    ///
+    /// Sound because the composition's registers are the call result's, which nothing
+    /// else in this callee writes until a `return` ([`Scope::return_in_place`]); `r`'s
+    /// words are read only by the composition's components; and each word of `r` is the
+    /// word the composition puts there, so its copies of `r` go onto themselves (which
+    /// [`Compiler::copy`] drops), and its other components' copies write words outside
+    /// `r`'s.
+    pub(super) fn components_in_place(&self, scope: &mut Scope) {
+        let function = scope.function;
+        for (handle, expression) in function.expressions.iter() {
+            let Expression::Compose { components, .. } = expression else { continue };
+            let dst = scope.regs[handle.index()];
+            let len = scope.lens[handle.index()];
+            if dst == NONE {
+                continue;
+            }
+            let lens: Vec<u32> = components.iter().map(|c| scope.lens[c.index()]).collect();
+            let Ok(offsets) = compose_offsets(self.module, self.ty(scope, handle), &lens) else { continue };
+            // Per call result: where its first word lands, the words placed, and how many
+            // of its uses the components account for.
+            let mut placed: Vec<(Handle<Expression>, i64, u32, u32)> = Vec::new();
+            let mut rejected: Vec<Handle<Expression>> = Vec::new();
+            for (&component, (&at, &words)) in components.iter().zip(offsets.iter().zip(&lens)) {
+                let Some((root, first)) = self.word_source(scope, component) else { continue };
+                let origin = i64::from(at) - i64::from(first);
+                match placed.iter_mut().find(|p| p.0 == root) {
+                    // The next words of `root`, at the next words of the composition.
+                    Some(p) if p.1 == origin && p.2 == first => {
+                        p.2 += words;
+                        p.3 += 1;
+                    }
+                    Some(_) => rejected.push(root),
+                    None if first == 0 => placed.push((root, origin, words, 1)),
+                    None => rejected.push(root),
+                }
+            }
+            for (root, origin, words, uses) in placed {
+                let index = root.index();
+                if !rejected.contains(&root)
+                    && words == scope.lens[index]
+                    && uses as usize == scope.info[root].ref_count
+                    && origin >= 0
+                    && origin + i64::from(words) <= i64::from(len)
+                    && scope.regs[index] == NONE
+                    && !scope.pre_emitted[index]
+                    && !scope.constant[index]
+                {
+                    scope.regs[index] = dst + origin as Reg;
+                }
+            }
+        }
+    }
+
+    /// The call result whose words `value` is, and the first of them, where `value` is a
+    /// call result, or takes some of one's words unchanged through expressions used once
+    /// (bitcasts of the same size, consecutive swizzles and components of 32-bit vectors,
+    /// which the compiler compiles into the source's own registers); `None` otherwise.
+    fn word_source(&self, scope: &Scope, value: Handle<Expression>) -> Option<(Handle<Expression>, u32)> {
+        let single = |of: Handle<Expression>| scope.info[of].ref_count == 1;
+        let is_word_vector = |of: Handle<Expression>| matches!(self.ty(scope, of), TypeInner::Vector { scalar, .. } if scalar.width == 4);
+        let mut at = value;
+        let mut first = 0;
+        loop {
+            match scope.function.expressions[at] {
+                Expression::CallResult(_) => return Some((at, first)),
+                Expression::As { expr, convert: None, .. }
+                    if single(at) && scope.lens[expr.index()] == scope.lens[at.index()] =>
+                {
+                    at = expr;
+                }
+                Expression::Swizzle { size, vector, pattern } if single(at) && is_word_vector(vector) => {
+                    first += consecutive(size, &pattern)?;
+                    at = vector;
+                }
+                Expression::AccessIndex { base, index } if single(at) && is_word_vector(base) => {
+                    first += index;
+                    at = base;
+                }
+                _ => return None,
+            }
+        }
+    }
+
     /// Makes the instruction that computed `value` (`len` words) write `dst` instead, if
     /// `value` of `scope` was the last expression compiled, by one instruction, and has
     /// no other use. True if it did (the caller then emits no copy).
@@ -210,6 +307,35 @@ mod tests {
         // (Both are composed, then copied at their returns: `second` too, as an `if`
         // stands between its computation and its return.)
         assert_eq!(copied_words(&insns), 2 + 2 + 2 + 2);
+    }
+
+    /// A record of three rows and its reader, as `gpu/scene_rows.wgsl` writes them
+    /// (`row` stands for `scene_row`), with the reader's `return` given as `ret`.
+    fn row_reader(ret: &str) -> String {
+        format!(
+            "@group(0) @binding(1) var<storage, read> rows: array<vec4<u32>>;\n\
+             struct Node {{ lo: vec3<f32>, a: u32, hi: vec3<f32>, b: u32, c: u32, d: u32, e: u32, f: u32 }}\n\
+             fn row(i: u32) -> vec4<u32> {{ return rows[i]; }}\n\
+             fn read_node(i: u32) -> Node {{ let r0 = row(i); let r1 = row(i + 1u); let r2 = row(i + 2u); {ret} }}"
+        )
+    }
+
+    #[test]
+    fn rows_read_by_calls_are_composed_in_place() {
+        let body = "let n = read_node(x); data[id.x] = n.a + n.b + n.f + bitcast<u32>(n.hi.y);";
+        // Each row is read straight into its words of the record: nothing is copied.
+        let reader = row_reader(
+            "return Node(bitcast<vec3<f32>>(r0.xyz), r0.w, bitcast<vec3<f32>>(r1.xyz), r1.w, r2.x, r2.y, r2.z, r2.w);",
+        );
+        assert_eq!(copied_words(&compiled_with(&reader, body)), 0);
+        // A row whose words land out of order (r0.yzw first), one that something else
+        // also reads (r1.x), and one with a word computed (r2.x + extra) keep their own
+        // registers and are copied: 4 words each.
+        let reader = row_reader(
+            "let extra = r1.x; return Node(bitcast<vec3<f32>>(r0.yzw), r0.x, bitcast<vec3<f32>>(r1.xyz), r1.w, \
+             r2.x + extra, r2.y, r2.z, r2.w);",
+        );
+        assert_eq!(copied_words(&compiled_with(&reader, body)), 4 + 4 + 4);
     }
 
     #[test]

@@ -76,6 +76,7 @@ const U32_MAX_F32: f32 = 4_294_967_040.0;
 /// range of floats that the integer type represents (so `u32(4294967296.0)` is
 /// 4294967040, not u32::MAX); NaN → 0 (implementation-defined in WGSL: D3D and
 /// WebAssembly also give 0, lavapipe's x86 conversion gives i32::MIN).
+#[inline]
 pub(super) fn convert(value: u32, from: ScalarKind, to: ScalarKind) -> Option<u32> {
     use ScalarKind as K;
     Some(match (from, to) {

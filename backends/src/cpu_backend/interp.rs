@@ -574,10 +574,24 @@ fn run_group(
                 }
             }
             Insn::Convert { from, to, dst, src, n } => {
-                let (from, to) = (*from, *to);
-                group.unary(file, *dst as usize, *src as usize, *n as usize, |x| {
-                    super::arith::convert(x, from, to).expect("checked when compiled")
-                });
+                let (dst, src, n) = (*dst as usize, *src as usize, *n as usize);
+                // The conversions between floats and integers with the kinds fixed, so
+                // that each is compiled into its row loop (they were a call a lane).
+                macro_rules! each {
+                    ($from:expr, $to:expr) => {
+                        group.unary(file, dst, src, n, |x| {
+                            super::arith::convert(x, $from, $to).expect("checked when compiled")
+                        })
+                    };
+                }
+                use naga::ScalarKind as K;
+                match (*from, *to) {
+                    (K::Float, K::Sint) => each!(K::Float, K::Sint),
+                    (K::Float, K::Uint) => each!(K::Float, K::Uint),
+                    (K::Sint, K::Float) => each!(K::Sint, K::Float),
+                    (K::Uint, K::Float) => each!(K::Uint, K::Float),
+                    (from, to) => each!(from, to),
+                }
             }
             Insn::Extract { dst, base, index, count, stride, len } => {
                 let (dst, base, index, len) = (*dst as usize, *base as usize, *index as usize, *len as usize);

@@ -8,7 +8,8 @@
 //! fields and bitcasts aliasing their source's registers, compile-time values in a
 //! register template. Passes make the code shorter and less divergent: an `if` that
 //! only stores into locals becomes selects (`if_conversion`), a value stored right
-//! after it is computed goes straight into the variable (`retarget`), a local's load
+//! after it is computed goes straight into the variable, and a call result that a
+//! returned record takes whole into the record's registers (`retarget`), a local's load
 //! reads the variable's registers where nothing writes it before the value's last use
 //! (`load_alias`), an array element's pointer and its load become one instruction
 //! (`element_load`), and jumps to jumps or to the next instruction are tidied away
@@ -23,7 +24,8 @@
 //! (`sync_point`); those at the same place run as one group, each instruction decoded
 //! once for the whole group (`interp`), as a loop over the members' words: registers are
 //! lane-minor, one file per code for the whole workgroup with register `r` of invocation
-//! `l` at `r * width + l` (`lanes`). Each dispatch is counted (`counts`): instructions, and
+//! `l` at `r * width + l` (`lanes`; its row loops compiled for AVX2 too, chosen at run
+//! time). Each dispatch is counted (`counts`): instructions, and
 //! the issue slots a 32-wide SIMT GPU would spend on the same groups, by kernel. A
 //! barrier or subgroup operation reached in non-uniform control flow is an error
 //! naming the line and function. Subgroup operations run with a configurable subgroup

@@ -3,7 +3,9 @@
 //! into the variable's (or the call result's) registers instead of its own and then
 //! copied. And a value of several instructions (a struct composed, a call's result)
 //! that an inlined callee returns right after computing it is given the call result's
-//! registers from the start ([`Scope::return_in_place`]).
+//! registers from the start ([`Scope::return_in_place`]); a call result that such a
+//! record takes whole, word for word, is given its words of the record's registers in
+//! turn ([`Compiler::components_in_place`]).
 //!
 //! Why: naga IR loads a variable into a new expression and stores an expression into a
 //! variable, so `top1 = top0;` or `i = i + 1u;` compiled word for word ends with a copy.

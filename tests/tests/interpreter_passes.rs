@@ -650,6 +650,8 @@ fn records_composed_from_whole_call_results_keep_wgsl_semantics() {
     // straight into the record's words. In `either` the rows also feed a second
     // composition, in another order, so they must keep their own registers: placed in the
     // record, the second composition's first copy would overwrite `r0.x` before reading it.
+    // In `pick` each return takes a row of its own whole: placed, both rows would share
+    // the result's words, and `s` would overwrite `r` (a reviewer's case).
     let source = r#"
 @group(0) @binding(0) var<storage, read> input: array<u32>;
 @group(0) @binding(1) var<storage, read_write> output: array<u32>;
@@ -670,6 +672,13 @@ fn either(c: bool, i: u32) -> Node {
     if c { return Node(bitcast<vec3<f32>>(r0.xyz), r0.w, r1.xyz, r1.w, r2.xy, r2.z, r2.w); }
     return Node(bitcast<vec3<f32>>(r1.yzw), r0.x, r0.yzw, r2.x, r1.xx, r2.y, r2.w);
 }
+struct Two { v: vec4<u32>, k: u32 }
+fn pick(c: bool, i: u32) -> Two {
+    let r = row(i);
+    let s = row(i + 4u);
+    if c { return Two(s, 1u); }
+    return Two(r, 2u);
+}
 fn words(n: Node) -> array<u32, 12> {
     return array<u32, 12>(bitcast<u32>(n.lo.x), bitcast<u32>(n.lo.y), bitcast<u32>(n.lo.z), n.a,
         n.hi.x, n.hi.y, n.hi.z, n.b, n.c.x, n.c.y, n.d, n.e);
@@ -681,22 +690,30 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let first = words(node(i * 12u));
     let second = words(either((input[i * 12u] & 1u) != 0u, i * 12u));
     for (var k = 0u; k < 12u; k++) {
-        output[i * 24u + k] = first[k];
-        output[i * 24u + 12u + k] = second[k];
+        output[i * 29u + k] = first[k];
+        output[i * 29u + 12u + k] = second[k];
     }
+    let t = pick((input[i * 12u] & 2u) != 0u, i * 12u);
+    output[i * 29u + 24u] = t.v.x;
+    output[i * 29u + 25u] = t.v.y;
+    output[i * 29u + 26u] = t.v.z;
+    output[i * 29u + 27u] = t.v.w;
+    output[i * 29u + 28u] = t.k;
 }
 "#;
     let kernel = Kernel::from_wgsl("rows.wgsl", source.into(), "main", false).unwrap();
     let inputs: Vec<u32> = (0..128 * 12u32).map(|i| i.wrapping_mul(2_654_435_761) ^ (i >> 3)).collect();
     let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
-    let got = run_words(&mut cpu, &kernel, &inputs, 128 * 24, 2);
+    let got = run_words(&mut cpu, &kernel, &inputs, 128 * 29, 2);
     for (i, w) in inputs.chunks(12).enumerate() {
         let second: Vec<u32> = if w[0] & 1 != 0 {
             w.to_vec()
         } else {
             vec![w[5], w[6], w[7], w[0], w[1], w[2], w[3], w[8], w[4], w[4], w[9], w[11]]
         };
-        assert_eq!(&got[i * 24..i * 24 + 12], w, "invocation {i}: node");
-        assert_eq!(&got[i * 24 + 12..(i + 1) * 24], &second[..], "invocation {i}: either");
+        let picked = if w[0] & 2 != 0 { [w[4], w[5], w[6], w[7], 1] } else { [w[0], w[1], w[2], w[3], 2] };
+        assert_eq!(&got[i * 29..i * 29 + 12], w, "invocation {i}: node");
+        assert_eq!(&got[i * 29 + 12..i * 29 + 24], &second[..], "invocation {i}: either");
+        assert_eq!(&got[i * 29 + 24..(i + 1) * 29], &picked, "invocation {i}: pick");
     }
 }

@@ -283,7 +283,7 @@ impl Members<'_> {
 /// it (`multiversion`); each call runs the second where the machine has them (one cached
 /// feature check a call, against a loop over hundreds of lanes). Why: the loops then
 /// take eight lanes a step instead of four, and the path tracer's frame on the
-/// interpreter took 8-10 % less time (the histogram 6-8 %), most of what building the
+/// interpreter took 8-10 % less time (the histogram 5-8 %), most of what building the
 /// whole workspace for AVX2 gave (11 %); BENCHMARKS.md, "interpreter". Both versions
 /// compute the same bits: integer and IEEE f32 operations have one result, and Rust
 /// never fuses a multiply and an add.

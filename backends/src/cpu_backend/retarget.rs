@@ -89,6 +89,21 @@ impl Scope<'_> {
     }
 }
 
+/// How many `return`s with a value `block` holds, nested blocks included.
+fn valued_returns(block: &Block) -> usize {
+    block
+        .iter()
+        .map(|statement| match statement {
+            Statement::Return { value: Some(_) } => 1,
+            Statement::Block(inner) => valued_returns(inner),
+            Statement::If { accept, reject, .. } => valued_returns(accept) + valued_returns(reject),
+            Statement::Switch { cases, .. } => cases.iter().map(|case| valued_returns(&case.body)).sum(),
+            Statement::Loop { body, continuing, .. } => valued_returns(body) + valued_returns(continuing),
+            _ => 0,
+        })
+        .sum()
+}
+
 impl Compiler<'_> {
     /// Gives each call result that a composition already placed by
     /// [`Scope::return_in_place`] takes whole, word for word, the words of the composition
@@ -103,14 +118,22 @@ impl Compiler<'_> {
     /// the composition, and nothing else uses `r` or anything on those paths (naga
     /// reference counts).
     ///
-    /// Sound because the composition's registers are the call result's, which nothing
-    /// else in this callee writes until a `return` ([`Scope::return_in_place`]); `r`'s
+    /// Only in a callee with a single `return` of a value. Sound because the
+    /// composition's registers are the call result's, which nothing else in this callee
+    /// writes ([`Scope::return_in_place`]; with one `return`, one record); `r`'s
     /// words are read only by the composition's components; and each word of `r` is the
     /// word the composition puts there, so its copies of `r` go onto themselves (which
     /// [`Compiler::copy`] drops), and its other components' copies write words outside
     /// `r`'s.
     pub(super) fn components_in_place(&self, scope: &mut Scope) {
         let function = scope.function;
+        // With two returns, two records share the result's registers, and a call result
+        // placed for one would be overwritten by one placed for the other while both are
+        // alive (`let r = row(i); let s = row(i + 4u); if c { return Two(s, 1u); }
+        // return Two(r, 2u);`). The row readers have one.
+        if valued_returns(&function.body) != 1 {
+            return;
+        }
         for (handle, expression) in function.expressions.iter() {
             let Expression::Compose { components, .. } = expression else { continue };
             let dst = scope.regs[handle.index()];

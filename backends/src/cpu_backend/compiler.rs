@@ -465,8 +465,9 @@ impl Compiler<'_> {
         if scope.inlined
             && let Some((dst, words)) = result
         {
-            scope.return_in_place(dst, words);
-            self.components_in_place(&mut scope);
+            for record in scope.return_in_place(dst, words) {
+                self.components_in_place(&mut scope, record);
+            }
         }
         for (index, (_, local)) in function.local_variables.iter().enumerate() {
             let variable = scope.locals[index];

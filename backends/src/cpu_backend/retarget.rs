@@ -40,8 +40,10 @@ impl Scope<'_> {
     /// computation to the return; several such returns (in different branches) each write
     /// them just before returning. Its operands are never the result registers: only values
     /// returned are given them, and a returned value is used by nothing else.
-    pub(super) fn return_in_place(&mut self, dst: Reg, words: u32) {
-        fn visit(scope: &mut Scope, block: &Block, dst: Reg, words: u32) {
+    ///
+    /// Returns the values given the registers.
+    pub(super) fn return_in_place(&mut self, dst: Reg, words: u32) -> Vec<Handle<Expression>> {
+        fn visit(scope: &mut Scope, block: &Block, dst: Reg, words: u32, placed: &mut Vec<Handle<Expression>>) {
             let mut before: Option<&Statement> = None;
             for statement in block.iter() {
                 match statement {
@@ -63,21 +65,22 @@ impl Scope<'_> {
                             && !scope.pre_emitted[index]
                         {
                             scope.regs[index] = dst;
+                            placed.push(*value);
                         }
                     }
-                    Statement::Block(inner) => visit(scope, inner, dst, words),
+                    Statement::Block(inner) => visit(scope, inner, dst, words, placed),
                     Statement::If { accept, reject, .. } => {
-                        visit(scope, accept, dst, words);
-                        visit(scope, reject, dst, words);
+                        visit(scope, accept, dst, words, placed);
+                        visit(scope, reject, dst, words, placed);
                     }
                     Statement::Switch { cases, .. } => {
                         for case in cases {
-                            visit(scope, &case.body, dst, words);
+                            visit(scope, &case.body, dst, words, placed);
                         }
                     }
                     Statement::Loop { body, continuing, .. } => {
-                        visit(scope, body, dst, words);
-                        visit(scope, continuing, dst, words);
+                        visit(scope, body, dst, words, placed);
+                        visit(scope, continuing, dst, words, placed);
                     }
                     _ => {}
                 }
@@ -85,7 +88,9 @@ impl Scope<'_> {
             }
         }
         let function = self.function;
-        visit(self, &function.body, dst, words);
+        let mut placed = Vec::new();
+        visit(self, &function.body, dst, words, &mut placed);
+        placed
     }
 }
 
@@ -105,8 +110,8 @@ fn valued_returns(block: &Block) -> usize {
 }
 
 impl Compiler<'_> {
-    /// Gives each call result that a composition already placed by
-    /// [`Scope::return_in_place`] takes whole, word for word, the words of the composition
+    /// Gives each call result that `record`, a composition already placed by
+    /// [`Scope::return_in_place`], takes whole, word for word, the words of the composition
     /// where it lands: the row readers' `return Node(bitcast<vec3<f32>>(r0.xyz), r0.w,
     /// ...)` then reads its rows (`let r0 = scene_row(row);`) straight into the call result's
     /// registers, and the composition copies nothing. Why: those copies were about half the
@@ -125,7 +130,7 @@ impl Compiler<'_> {
     /// word the composition puts there, so its copies of `r` go onto themselves (which
     /// [`Compiler::copy`] drops), and its other components' copies write words outside
     /// `r`'s.
-    pub(super) fn components_in_place(&self, scope: &mut Scope) {
+    pub(super) fn components_in_place(&self, scope: &mut Scope, record: Handle<Expression>) {
         let function = scope.function;
         // With two returns, two records share the result's registers, and a call result
         // placed for one would be overwritten by one placed for the other while both are
@@ -134,46 +139,47 @@ impl Compiler<'_> {
         if valued_returns(&function.body) != 1 {
             return;
         }
-        for (handle, expression) in function.expressions.iter() {
-            let Expression::Compose { components, .. } = expression else { continue };
-            let dst = scope.regs[handle.index()];
-            let len = scope.lens[handle.index()];
-            if dst == NONE {
-                continue;
-            }
-            let lens: Vec<u32> = components.iter().map(|c| scope.lens[c.index()]).collect();
-            let Ok(offsets) = compose_offsets(self.module, self.ty(scope, handle), &lens) else { continue };
-            // Per call result: where its first word lands, the words placed, and how many
-            // of its uses the components account for.
-            let mut placed: Vec<(Handle<Expression>, i64, u32, u32)> = Vec::new();
-            let mut rejected: Vec<Handle<Expression>> = Vec::new();
-            for (&component, (&at, &words)) in components.iter().zip(offsets.iter().zip(&lens)) {
-                let Some((root, first)) = self.word_source(scope, component) else { continue };
-                let origin = i64::from(at) - i64::from(first);
-                match placed.iter_mut().find(|p| p.0 == root) {
-                    // The next words of `root`, at the next words of the composition.
-                    Some(p) if p.1 == origin && p.2 == first => {
-                        p.2 += words;
-                        p.3 += 1;
-                    }
-                    Some(_) => rejected.push(root),
-                    None if first == 0 => placed.push((root, origin, words, 1)),
-                    None => rejected.push(root),
+        let Expression::Compose { ref components, .. } = function.expressions[record] else { return };
+        let (dst, len) = (scope.regs[record.index()], scope.lens[record.index()]);
+        let lens: Vec<u32> = components.iter().map(|c| scope.lens[c.index()]).collect();
+        let Ok(offsets) = compose_offsets(self.module, self.ty(scope, record), &lens) else { return };
+        /// A call result met among the components so far.
+        struct Run {
+            root: Handle<Expression>,
+            /// The composition's word that its first word lands on.
+            origin: i64,
+            /// Its words taken so far, in order.
+            words: u32,
+            /// The components taken from it (its uses that the composition accounts for).
+            uses: usize,
+        }
+        let mut runs: Vec<Run> = Vec::new();
+        let mut rejected: Vec<Handle<Expression>> = Vec::new();
+        for (&component, (&at, &words)) in components.iter().zip(offsets.iter().zip(&lens)) {
+            let Some((root, first)) = self.word_source(scope, component) else { continue };
+            let origin = i64::from(at) - i64::from(first);
+            match runs.iter_mut().find(|run| run.root == root) {
+                // The next words of `root`, at the next words of the composition.
+                Some(run) if run.origin == origin && run.words == first => {
+                    run.words += words;
+                    run.uses += 1;
                 }
+                None if first == 0 => runs.push(Run { root, origin, words, uses: 1 }),
+                _ => rejected.push(root),
             }
-            for (root, origin, words, uses) in placed {
-                let index = root.index();
-                if !rejected.contains(&root)
-                    && words == scope.lens[index]
-                    && uses as usize == scope.info[root].ref_count
-                    && origin >= 0
-                    && origin + i64::from(words) <= i64::from(len)
-                    && scope.regs[index] == NONE
-                    && !scope.pre_emitted[index]
-                    && !scope.constant[index]
-                {
-                    scope.regs[index] = dst + origin as Reg;
-                }
+        }
+        for Run { root, origin, words, uses } in runs {
+            let index = root.index();
+            if !rejected.contains(&root)
+                && words == scope.lens[index]
+                && uses == scope.info[root].ref_count
+                && origin >= 0
+                && origin + i64::from(words) <= i64::from(len)
+                && scope.regs[index] == NONE
+                && !scope.pre_emitted[index]
+                && !scope.constant[index]
+            {
+                scope.regs[index] = dst + origin as Reg;
             }
         }
     }

@@ -46,6 +46,14 @@ impl DispatchCounts {
             warps += u64::from(warp != last_warp);
             last_warp = warp;
         }
+        self.add_counted_group(steps, width, warps);
+    }
+
+    /// Adds `steps` instructions executed together by a group of `width` members in
+    /// `warps` warps, counted by the caller (from the group's set of lanes, where each
+    /// invocation's SIMT index is its lane).
+    #[inline(always)]
+    pub(super) fn add_counted_group(&mut self, steps: u64, width: u64, warps: u64) {
         self.instructions += steps * width;
         self.warp_issues += steps * warps;
     }

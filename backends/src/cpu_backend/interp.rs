@@ -32,7 +32,7 @@ use super::invocations::{Batch, Invocation};
 use super::lanes::{LaneRegs, Members, N as LANES};
 use super::limit::{FUEL, Limit};
 use super::memory::{FUNCTION, Frame};
-use super::places::Places;
+use super::places::{Places, members_of};
 use super::program::Program;
 use super::sanitize::{Sanitizer, Sanitizing};
 use crate::error::BackendError;
@@ -52,9 +52,15 @@ pub(super) enum Stop {
 #[derive(Default)]
 pub(super) struct Scratch {
     members: Vec<usize>,
-    /// Per lane, all ones for a member of the running group (see [`Members::Masked`]).
+    /// The running group as a set: bit `l % 64` of word `l / 64` for member `l`.
+    lanes: Vec<u64>,
+    /// Per lane, all ones for a member of the running group (see [`Members::Masked`]);
+    /// only the chunks of 64 lanes with a member are written.
     mask: Vec<u32>,
+    /// Each member's next instruction after a [`GroupEnd::Split`].
     targets: Vec<u32>,
+    /// The members that jump at a [`GroupEnd::Branch`], as a set like `lanes`.
+    taken: Vec<u64>,
     caller_codes: Vec<u32>,
     places: Places,
 }
@@ -87,7 +93,10 @@ enum GroupEnd {
     /// It reached the place where other invocations wait (or a uniform jump did): every
     /// member continues at this instruction.
     Meet(u32),
-    /// A branch sent the members different ways: each continues at its entry of
+    /// A conditional jump sent some members to `target` (those of the set `taken`) and
+    /// the others on to `fall`.
+    Branch { target: u32, fall: u32 },
+    /// A switch sent the members different ways: each continues at its entry of
     /// `targets`.
     Split,
     /// Every member calls (the instruction after the call is the return address).
@@ -152,7 +161,12 @@ pub(super) fn run_until_sync(
     stops.clear();
     stops.extend(invocations.iter().map(|inv| if inv.frame.is_some() { None } else { Some(Stop::Done) }));
     let width = invocations.len();
-    let Scratch { members, mask, targets, caller_codes, places } = scratch;
+    let Scratch { members, lanes, mask, targets, taken, caller_codes, places } = scratch;
+    const { assert!(super::counts::WARP_WIDTH == 32, "a warp is half a word of the set") };
+    // Whether each invocation's SIMT index is its lane (workgroups a whole number of
+    // warps wide, as both benches' are): a group's warps are then the 32-bit halves of
+    // its set with a member.
+    let warps_are_halves = invocations.iter().enumerate().all(|(lane, inv)| inv.simt_index as usize == lane);
     // While no invocation is inside a call (the common case: small functions are
     // inlined), where an invocation is is its next instruction alone: the group to run is
     // then found from `places`, the invocations by instruction, instead of by comparing
@@ -161,6 +175,8 @@ pub(super) fn run_until_sync(
     let mut in_calls = invocations.iter().filter(|inv| !inv.callers.is_empty()).count();
     let entry_instructions = program.codes[program.entry as usize].insns.len();
     // Whether `places` holds every runnable invocation (it is not kept during calls).
+    // While it does, `places` alone says where they are: their frames' instructions are
+    // left as they were and written when the frames are needed again (a call).
     let mut placed = false;
     loop {
         // The group furthest behind, and the instruction where it meets the next one.
@@ -175,9 +191,17 @@ pub(super) fn run_until_sync(
                 places.rebuild(entry_instructions, width, running);
                 placed = true;
             }
-            let Some((_, next)) = places.take_first(members) else { return Ok(()) };
+            let Some((at, next)) = places.take_first(lanes) else { return Ok(()) };
             meet = next;
-            members[0]
+            // A whole batch is not listed (`Members::All` needs no list): the ends that
+            // go member by member list it first.
+            if lanes.iter().map(|bits| bits.count_ones() as usize).sum::<usize>() < width {
+                members_of(lanes, members);
+            }
+            // The first member (an invocation stopped inside a call may be lane 0, and
+            // the group's callers are its leader's).
+            let first = lanes.iter().position(|&bits| bits != 0).expect("a group has members");
+            (first * 64 + lanes[first].trailing_zeros() as usize, program.entry, at)
         } else {
             placed = false;
             let mut leader = None;
@@ -187,28 +211,33 @@ pub(super) fn run_until_sync(
                 }
             }
             let Some(leader) = leader else { return Ok(()) };
+            lanes.clear();
+            lanes.resize(width.div_ceil(64), 0);
             for (i, stop) in stops.iter().enumerate() {
                 if stop.is_some() {
                     continue;
                 }
                 if position(&invocations[i], &invocations[leader]).is_eq() {
                     members.push(i);
+                    lanes[i / 64] |= 1 << (i % 64);
                 } else if let Some(pc) = meeting_point(&invocations[leader], &invocations[i]) {
                     meet = meet.min(pc);
                 }
             }
-            leader
+            let frame = invocations[leader].frame.as_ref().expect("running invocations have frames");
+            (leader, frame.code, frame.pc)
         };
-        let frame = invocations[leader].frame.as_ref().expect("running invocations have frames");
-        let (code_index, pc) = (frame.code, frame.pc);
+        let (leader, code_index, pc) = leader;
+        // How many members the group has (`members` is empty for a whole batch).
+        let size = if members.is_empty() { width } else { members.len() };
         // Members at the same place have the same callers.
         caller_codes.clear();
         caller_codes.extend(invocations[leader].callers.iter().map(|f| f.code));
         // An invocation's position in the batch is its lane in the register files:
         // its workgroup's place in the batch times the workgroup's size, plus its local
         // index (dispatch.rs).
-        let group = group_of(members, mask, width);
-        let whole_batch = members.len() == width;
+        let group = group_of(members, size, lanes, mask, width);
+        let whole_batch = size == width;
         let mut steps = 0;
         let mut start = pc;
         let end = loop {
@@ -230,8 +259,16 @@ pub(super) fn run_until_sync(
                     _ => None,
                 },
             };
-            let end =
-                run_group(program, code_index, start, meet, group, &mut file, &mut group_memory, &mut steps, targets);
+            let end = run_group(
+                program,
+                code_index,
+                (start, meet),
+                group,
+                &mut file,
+                &mut group_memory,
+                &mut steps,
+                (targets, taken),
+            );
             memory.fuel = group_memory.fuel;
             memory.files[code_index as usize] = file;
             match end {
@@ -248,21 +285,42 @@ pub(super) fn run_until_sync(
                 other => break other,
             }
         };
-        counts.add_group(steps, members.iter().map(|&i| invocations[i].simt_index));
-        match end? {
+        if warps_are_halves {
+            let warps = lanes.iter().map(|&bits| u64::from(bits as u32 != 0) + u64::from(bits >> 32 != 0)).sum();
+            counts.add_counted_group(steps, size as u64, warps);
+        } else {
+            counts.add_group(
+                steps,
+                (0..width).filter(|&i| lanes[i / 64] >> (i % 64) & 1 != 0).map(|i| invocations[i].simt_index),
+            );
+        }
+        let end = end?;
+        if members.is_empty() && !matches!(end, GroupEnd::Meet(_) | GroupEnd::Branch { .. }) {
+            members.extend(0..width);
+        }
+        match end {
+            GroupEnd::Meet(pc) if placed => places.add_set(pc, lanes, None),
             GroupEnd::Meet(pc) => {
                 for &i in members.iter() {
                     invocations[i].frame.as_mut().expect("running").pc = pc;
-                    if placed {
-                        places.add(pc, i);
-                    }
+                }
+            }
+            GroupEnd::Branch { target, fall } if placed => {
+                places.add_set(target, taken, None);
+                places.add_set(fall, lanes, Some(taken));
+            }
+            GroupEnd::Branch { target, fall } => {
+                for &i in members.iter() {
+                    let jumps = taken[i / 64] >> (i % 64) & 1 != 0;
+                    invocations[i].frame.as_mut().expect("running").pc = if jumps { target } else { fall };
                 }
             }
             GroupEnd::Split => {
                 for (&i, &pc) in members.iter().zip(targets.iter()) {
-                    invocations[i].frame.as_mut().expect("running").pc = pc;
                     if placed {
                         places.add(pc, i);
+                    } else {
+                        invocations[i].frame.as_mut().expect("running").pc = pc;
                     }
                 }
             }
@@ -282,6 +340,12 @@ pub(super) fn run_until_sync(
                 }
                 let group = if members.len() == width { Members::All(width) } else { Members::Some(members, width) };
                 enter_function(program, &mut memory.files, code_index, call, group, caller_codes.len() as u32 + 1)?;
+                if placed {
+                    // The frames take over from `places` (`in_calls` is no longer 0):
+                    // every runnable invocation's instruction written back.
+                    places.drain(|i, pc| invocations[i].frame.as_mut().expect("running").pc = pc);
+                    placed = false;
+                }
                 for &i in members.iter() {
                     in_calls += usize::from(invocations[i].callers.is_empty());
                     let invocation = &mut invocations[i];
@@ -321,22 +385,31 @@ pub(super) fn open_file(file: &mut Vec<u32>, template: &[u32], width: usize, ker
     Ok(())
 }
 
-/// The group of invocations `members` (in increasing order) of a batch `width` wide:
-/// all of them; in a batch a multiple of 64 wide, members filling a quarter or more of
-/// the chunks of 64 lanes they touch (by mask, those chunks computed whole: cheaper than
-/// member by member from there on, and a batch's divergent groups touch few chunks); or
-/// a few.
-fn group_of<'a>(members: &'a [usize], mask: &'a mut Vec<u32>, width: usize) -> Members<'a> {
-    if members.len() == width {
+/// The group of invocations `members` (`size` of them, in increasing order; not listed
+/// when they are the whole batch; `lanes` the same as a set, a word per 64 lanes) of a
+/// batch `width` wide: all of them; in a batch a multiple of
+/// 64 wide, members filling a quarter or more of the chunks of 64 lanes they touch (by
+/// mask, those chunks computed whole: cheaper than member by member from there on, and
+/// a batch's divergent groups touch few chunks); or a few.
+fn group_of<'a>(members: &'a [usize], size: usize, lanes: &[u64], mask: &'a mut Vec<u32>, width: usize) -> Members<'a> {
+    const { assert!(LANES == 64, "a chunk of lanes is a word of the set") };
+    if size == width {
         return Members::All(width);
     }
     if width.is_multiple_of(LANES) && width <= 64 * LANES {
-        let chunks = members.iter().fold(0u64, |chunks, &l| chunks | 1 << (l / LANES));
+        let chunks = lanes.iter().enumerate().fold(0u64, |chunks, (c, &bits)| chunks | u64::from(bits != 0) << c);
         if members.len() * 4 >= chunks.count_ones() as usize * LANES {
-            mask.clear();
+            // Only the chunks with a member are read (`Members::Masked`): only they are
+            // written, from their words of the set.
             mask.resize(width, 0);
-            for &l in members {
-                mask[l] = u32::MAX;
+            let mut touched = chunks;
+            while touched != 0 {
+                let c = touched.trailing_zeros() as usize;
+                touched &= touched - 1;
+                let bits = lanes[c];
+                for (i, word) in mask[c * LANES..][..LANES].iter_mut().enumerate() {
+                    *word = 0u32.wrapping_sub((bits >> i) as u32 & 1);
+                }
             }
             return Members::Masked(members, &mask[..], chunks);
         }
@@ -422,21 +495,21 @@ fn return_from_function(
 }
 
 /// Runs the group `group` (all at instruction `pc` of code `code_index`, whose register
-/// file is `file`) together until it reaches `meet`, a branch splits it (each member's
-/// next instruction into `targets`), it calls or returns, or it stops at a barrier or
-/// subgroup operation. Adds the instructions the group executed (each for every member)
-/// to `steps`.
+/// file is `file`) together until it reaches `meet`, a branch splits it (a conditional
+/// jump: the members that jump into `taken`; a switch: each member's next instruction
+/// into `targets`), it calls or returns, or it stops at a barrier or subgroup
+/// operation. Adds the instructions the group executed (each for every member) to
+/// `steps`.
 #[allow(clippy::too_many_arguments)]
 fn run_group(
     program: &Program,
     code_index: u32,
-    pc: u32,
-    meet: u32,
+    (pc, meet): (u32, u32),
     group: Members,
     file: &mut [u32],
     memory: &mut GroupMemory,
     steps: &mut u64,
-    targets: &mut Vec<u32>,
+    (targets, taken): (&mut Vec<u32>, &mut Vec<u64>),
 ) -> Result<GroupEnd, BackendError> {
     let insns = &program.codes[code_index as usize].insns[..];
     let width = memory.width;
@@ -472,16 +545,12 @@ fn run_group(
                 pc = *target as usize;
             }
             Insn::JumpUnless { cond, target } => {
-                let row = *cond as usize * width;
-                let mut taken = 0;
-                group.for_each(|l| taken += usize::from(file[row + l] == 0));
-                if taken == group.len() {
+                let jumping = group.zeros(&file[*cond as usize * width..][..width], taken);
+                if jumping == group.len() {
                     burn!(pc - 1);
                     pc = *target as usize;
-                } else if taken > 0 {
-                    targets.clear();
-                    group.for_each(|l| targets.push(if file[row + l] == 0 { *target } else { pc as u32 }));
-                    break GroupEnd::Split;
+                } else if jumping > 0 {
+                    break GroupEnd::Branch { target: *target, fall: pc as u32 };
                 }
             }
             Insn::Switch { selector, cases, default } => {

@@ -157,6 +157,23 @@ fn each_chunk(mask: &[u32], mut chunks: u64, mut f: impl FnMut(usize, &[u32; N])
     }
 }
 
+/// Bit `i` set where `words[i]` is 0 and `mask[i]` all ones (`mask`: all ones or 0 per
+/// lane). Eight lanes a byte, each lane's test without a branch (`w | !m == 0`), a shape
+/// the compiler turns into vector compares and mask moves; a test per lane with `&&`
+/// was a branch per lane and most of the time of a divergent jump.
+#[inline(always)]
+fn zero_bits(words: &[u32; N], mask: &[u32; N]) -> u64 {
+    let mut bits = 0u64;
+    for (k, (words, mask)) in words.chunks_exact(8).zip(mask.chunks_exact(8)).enumerate() {
+        let mut byte = 0u8;
+        for i in 0..8 {
+            byte |= u8::from(words[i] | !mask[i] == 0) << i;
+        }
+        bits |= u64::from(byte) << (8 * k);
+    }
+    bits
+}
+
 /// Words `at..at + n` of `regs` (`n <= M`) copied into an array.
 #[inline(always)]
 fn row<const M: usize>(regs: &[u32], at: usize, n: usize) -> [u32; M] {
@@ -175,7 +192,8 @@ pub(super) enum Members<'a> {
     Some(&'a [usize], usize),
     /// These lanes of a file whose width is a multiple of [`N`], many of them: the row
     /// operations compute whole chunks of [`N`] lanes and keep the members' words
-    /// (`mask`: per lane, all ones for a member, else 0), loops the compiler vectorises
+    /// (`mask`: per lane of a chunk with a member, all ones for a member, else 0; the
+    /// other chunks' words are never read and may be stale), loops the compiler vectorises
     /// where a member at a time could not be (a divergent kernel's groups have tens of
     /// members); chunks without a member (bit `c` of the `u64` clear) are skipped.
     Masked(&'a [usize], &'a [u32], u64),
@@ -211,6 +229,38 @@ impl Members<'_> {
                 }
             }
         }
+    }
+
+    /// Sets bit `l % 64` of word `l / 64` of `taken` for each member `l` whose word of
+    /// `row` (a register's row, `width` words) is 0, and clears every other bit; returns
+    /// how many members that is. What a conditional jump asks (which members jump), as a
+    /// set the scheduler merges a word at a time ([`super::places`]).
+    #[inline(always)]
+    pub(super) fn zeros(self, row: &[u32], taken: &mut Vec<u64>) -> usize {
+        const { assert!(N == 64, "a chunk is a word of the set") };
+        let width = self.width();
+        taken.clear();
+        taken.resize(width.div_ceil(N), 0);
+        match self {
+            Members::All(_) => {
+                for (slot, words) in taken.iter_mut().zip(row[..width].chunks(N)) {
+                    *slot = match words.try_into() {
+                        Ok(words) => zero_bits(words, &[u32::MAX; N]),
+                        // The last chunk of a batch whose width is not a multiple of 64.
+                        Err(_) => words.iter().enumerate().fold(0, |bits, (i, &w)| bits | u64::from(w == 0) << i),
+                    };
+                }
+            }
+            Members::Masked(_, mask, chunks) => each_chunk(mask, chunks, |c, mask| {
+                taken[c / N] = zero_bits(row[c..c + N].try_into().expect("a chunk of N lanes"), mask)
+            }),
+            Members::Some(lanes, _) => {
+                for &l in lanes {
+                    taken[l / N] |= u64::from(row[l] == 0) << (l % N);
+                }
+            }
+        }
+        taken.iter().map(|bits| bits.count_ones() as usize).sum()
     }
 
     /// `regs[dst + r row] = f(regs[a + r row], regs[b + r row])` for the members and
@@ -500,5 +550,40 @@ fn fill_rows(members: Members<'_>, regs: &mut [u32], dst: usize, len: usize, val
                 each_chunk(mask, chunks, |c, mask| keep_members(&mut regs[r * width + c..][..N], &words, mask));
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Members, N};
+
+    /// Which members of `members` `zeros` says have a zero word in `row`, and how many.
+    fn zeros_of(members: Members, row: &[u32]) -> (Vec<usize>, usize) {
+        let mut taken = Vec::new();
+        let count = members.zeros(row, &mut taken);
+        let lanes = (0..row.len()).filter(|&l| taken[l / N] >> (l % N) & 1 != 0).collect();
+        (lanes, count)
+    }
+
+    #[test]
+    fn zeros_are_the_members_whose_word_is_zero() {
+        // Every third lane's word is 0.
+        let row: Vec<u32> = (0..192).map(|l| if l % 3 == 0 { 0 } else { l + 1 }).collect();
+        let expected = |members: &[usize]| members.iter().copied().filter(|l| l % 3 == 0).collect::<Vec<_>>();
+        // A whole batch, and one whose last chunk is short (130 lanes).
+        let all: Vec<usize> = (0..192).collect();
+        assert_eq!(zeros_of(Members::All(192), &row), (expected(&all), 64));
+        assert_eq!(zeros_of(Members::All(130), &row[..130]), (expected(&all[..130]), 44));
+        // Some members, listed and masked: lanes 3, 6, 7, 66, 129 and 191 (chunks 0, 1, 2).
+        let some = [3, 6, 7, 66, 129, 191];
+        assert_eq!(zeros_of(Members::Some(&some, 192), &row), (vec![3, 6, 66, 129], 4));
+        let mut mask = vec![0; 192];
+        for &l in &some {
+            mask[l] = u32::MAX;
+        }
+        assert_eq!(zeros_of(Members::Masked(&some, &mask, 0b111), &row), (vec![3, 6, 66, 129], 4));
+        // A chunk left out of the mask's chunks is not looked at, whatever its words.
+        mask[0] = u32::MAX;
+        assert_eq!(zeros_of(Members::Masked(&some[3..], &mask, 0b110), &row), (vec![66, 129], 2));
     }
 }

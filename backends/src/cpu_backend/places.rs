@@ -57,21 +57,50 @@ impl Places {
         self.occupied[pc / BITS] |= 1 << (pc % BITS);
     }
 
-    /// Takes the invocations at the smallest instruction with any: appends them to
-    /// `members` in increasing order and returns that instruction and the next one with
-    /// invocations (`u32::MAX` if none); `None` when no invocation is left.
-    pub(super) fn take_first(&mut self, members: &mut Vec<usize>) -> Option<(u32, u32)> {
+    /// Puts the invocations of the set `lanes` (a bit per invocation, as the sets here)
+    /// at instruction `pc`, except those of `except` where given: a group's members
+    /// moved on together, a word at a time rather than a member at a time.
+    pub(super) fn add_set(&mut self, pc: u32, lanes: &[u64], except: Option<&[u64]>) {
+        let pc = pc as usize;
+        let set = &mut self.sets[pc * self.words..][..self.words];
+        let mut any = 0;
+        for (w, (slot, &bits)) in set.iter_mut().zip(lanes).enumerate() {
+            let bits = bits & !except.map_or(0, |except| except[w]);
+            *slot |= bits;
+            any |= bits;
+        }
+        if any != 0 {
+            self.occupied[pc / BITS] |= 1 << (pc % BITS);
+        }
+    }
+
+    /// Takes the invocations at the smallest instruction with any: puts their set in
+    /// `lanes` (a bit per invocation, [`members_of`] lists them) and returns that
+    /// instruction and the next one with invocations (`u32::MAX` if none); `None` when no
+    /// invocation is left.
+    pub(super) fn take_first(&mut self, lanes: &mut Vec<u64>) -> Option<(u32, u32)> {
         let pc = self.next_occupied(0)?;
         self.occupied[pc / BITS] &= !(1 << (pc % BITS));
-        for (w, word) in self.sets[pc * self.words..][..self.words].iter_mut().enumerate() {
-            let mut bits = std::mem::take(word);
-            while bits != 0 {
-                members.push(w * BITS + bits.trailing_zeros() as usize);
-                bits &= bits - 1;
-            }
-        }
+        lanes.clear();
+        lanes.extend(self.sets[pc * self.words..][..self.words].iter_mut().map(std::mem::take));
         let next = self.next_occupied(pc + 1).map_or(u32::MAX, |next| next as u32);
         Some((pc as u32, next))
+    }
+
+    /// Empties every set, calling `f(lane, instruction)` for each invocation in one: where
+    /// the scheduler writes the invocations' places back into their frames before it
+    /// leaves them to the frames (a call).
+    pub(super) fn drain(&mut self, mut f: impl FnMut(usize, u32)) {
+        while let Some(pc) = self.next_occupied(0) {
+            self.occupied[pc / BITS] &= !(1 << (pc % BITS));
+            for (w, word) in self.sets[pc * self.words..][..self.words].iter_mut().enumerate() {
+                let mut bits = std::mem::take(word);
+                while bits != 0 {
+                    f(w * BITS + bits.trailing_zeros() as usize, pc as u32);
+                    bits &= bits - 1;
+                }
+            }
+        }
     }
 
     /// The smallest instruction from `from` on with invocations.
@@ -88,9 +117,25 @@ impl Places {
     }
 }
 
+/// Appends the invocations of the set `lanes` (a bit per invocation) to `members`, in
+/// increasing order.
+pub(super) fn members_of(lanes: &[u64], members: &mut Vec<usize>) {
+    let start = members.len();
+    members.resize(start + lanes.iter().map(|bits| bits.count_ones() as usize).sum::<usize>(), 0);
+    // Written through a slice, not pushed: a push stores the list's length every time.
+    let mut slots = members[start..].iter_mut();
+    for (w, &word) in lanes.iter().enumerate() {
+        let mut bits = word;
+        while bits != 0 {
+            *slots.next().expect("a slot per bit") = w * BITS + bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use super::Places;
+    use super::{Places, members_of};
 
     #[test]
     fn groups_come_out_furthest_behind_first_with_their_meeting_point() {
@@ -98,27 +143,54 @@ mod tests {
         // 130 lanes (three words per set): lanes 1, 64 and 129 at 7, lane 3 at 2, the
         // rest stopped.
         places.rebuild(100, 130, [(1, 7), (64, 7), (129, 7), (3, 2)]);
-        let mut members = Vec::new();
-        assert_eq!(places.take_first(&mut members), Some((2, 7)));
+        let (mut members, mut lanes) = (Vec::new(), Vec::new());
+        // What the scheduler takes: the set, listed.
+        let mut take = |places: &mut Places, members: &mut Vec<usize>| {
+            let first = places.take_first(&mut lanes);
+            members_of(&lanes, members);
+            first
+        };
+        assert_eq!(take(&mut places, &mut members), Some((2, 7)));
         assert_eq!(members, [3]);
         // Lane 3 runs on to 99, the last instruction index + 0 (a code's end).
         places.add(99, 3);
         members.clear();
-        assert_eq!(places.take_first(&mut members), Some((7, 99)));
+        assert_eq!(take(&mut places, &mut members), Some((7, 99)));
         assert_eq!(members, [1, 64, 129]);
         members.clear();
-        assert_eq!(places.take_first(&mut members), Some((99, u32::MAX)));
+        assert_eq!(take(&mut places, &mut members), Some((99, u32::MAX)));
         assert_eq!(members, [3]);
         // Lane 4 comes back to 2 (a loop): alone there (the set was emptied).
         places.add(2, 4);
         members.clear();
-        assert_eq!(places.take_first(&mut members), Some((2, u32::MAX)));
+        assert_eq!(take(&mut places, &mut members), Some((2, u32::MAX)));
         assert_eq!(members, [4]);
         members.clear();
-        assert_eq!(places.take_first(&mut members), None);
+        assert_eq!(take(&mut places, &mut members), None);
         // Sets left behind are emptied by the next rebuild.
         places.add(5, 0);
         places.rebuild(100, 130, []);
-        assert_eq!(places.take_first(&mut members), None);
+        assert_eq!(take(&mut places, &mut members), None);
+    }
+
+    #[test]
+    fn sets_move_a_word_at_a_time_and_drain_back_to_lanes() {
+        let mut places = Places::default();
+        places.rebuild(10, 130, [(0, 4), (65, 4), (129, 4), (2, 6)]);
+        let (mut members, mut lanes) = (Vec::new(), Vec::new());
+        assert_eq!(places.take_first(&mut lanes), Some((4, 6)));
+        members_of(&lanes, &mut members);
+        assert_eq!(members, [0, 65, 129]);
+        assert_eq!(lanes, [1, 1 << 1, 1 << 1]);
+        // A branch: lane 65 jumps to 9, the others fall through to 5; an empty set
+        // leaves its instruction unoccupied.
+        let taken = [0, 1 << 1, 0];
+        places.add_set(9, &taken, None);
+        places.add_set(5, &lanes, Some(&taken));
+        places.add_set(7, &[0, 0, 0], None);
+        let mut drained = Vec::new();
+        places.drain(|lane, pc| drained.push((lane, pc)));
+        assert_eq!(drained, [(0, 5), (129, 5), (2, 6), (65, 9)]);
+        assert_eq!(places.take_first(&mut lanes), None);
     }
 }

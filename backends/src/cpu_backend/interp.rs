@@ -193,11 +193,8 @@ pub(super) fn run_until_sync(
             }
             let Some((at, next)) = places.take_first(lanes) else { return Ok(()) };
             meet = next;
-            // A whole batch is not listed (`Members::All` needs no list): the ends that
-            // go member by member list it first.
-            if lanes.iter().map(|bits| bits.count_ones() as usize).sum::<usize>() < width {
-                members_of(lanes, members);
-            }
+            // Listed only where needed: by `group_of` for a group of a few, and by the
+            // ends that go member by member.
             // The first member (an invocation stopped inside a call may be lane 0, and
             // the group's callers are its leader's).
             let first = lanes.iter().position(|&bits| bits != 0).expect("a group has members");
@@ -228,8 +225,8 @@ pub(super) fn run_until_sync(
             (leader, frame.code, frame.pc)
         };
         let (leader, code_index, pc) = leader;
-        // How many members the group has (`members` is empty for a whole batch).
-        let size = if members.is_empty() { width } else { members.len() };
+        // How many members the group has (`members` is empty until they are listed).
+        let size = lanes.iter().map(|bits| bits.count_ones() as usize).sum::<usize>();
         // Members at the same place have the same callers.
         caller_codes.clear();
         caller_codes.extend(invocations[leader].callers.iter().map(|f| f.code));
@@ -296,7 +293,7 @@ pub(super) fn run_until_sync(
         }
         let end = end?;
         if members.is_empty() && !matches!(end, GroupEnd::Meet(_) | GroupEnd::Branch { .. }) {
-            members.extend(0..width);
+            members_of(lanes, members);
         }
         match end {
             GroupEnd::Meet(pc) if placed => places.add_set(pc, lanes, None),
@@ -385,20 +382,25 @@ pub(super) fn open_file(file: &mut Vec<u32>, template: &[u32], width: usize, ker
     Ok(())
 }
 
-/// The group of invocations `members` (`size` of them, in increasing order; not listed
-/// when they are the whole batch; `lanes` the same as a set, a word per 64 lanes) of a
-/// batch `width` wide: all of them; in a batch a multiple of
-/// 64 wide, members filling a quarter or more of the chunks of 64 lanes they touch (by
-/// mask, those chunks computed whole: cheaper than member by member from there on, and
-/// a batch's divergent groups touch few chunks); or a few.
-fn group_of<'a>(members: &'a [usize], size: usize, lanes: &[u64], mask: &'a mut Vec<u32>, width: usize) -> Members<'a> {
+/// The group of invocations of the set `lanes` (a word per 64 lanes; `size` of them) of
+/// a batch `width` wide: all of them; in a batch a multiple of 64 wide, members filling a
+/// quarter or more of the chunks of 64 lanes they touch (by mask, those chunks computed
+/// whole: cheaper than member by member from there on, and a batch's divergent groups
+/// touch few chunks); or a few, listed in `members` (where they are not listed yet).
+fn group_of<'a>(
+    members: &'a mut Vec<usize>,
+    size: usize,
+    lanes: &'a [u64],
+    mask: &'a mut Vec<u32>,
+    width: usize,
+) -> Members<'a> {
     const { assert!(LANES == 64, "a chunk of lanes is a word of the set") };
     if size == width {
         return Members::All(width);
     }
     if width.is_multiple_of(LANES) && width <= 64 * LANES {
         let chunks = lanes.iter().enumerate().fold(0u64, |chunks, (c, &bits)| chunks | u64::from(bits != 0) << c);
-        if members.len() * 4 >= chunks.count_ones() as usize * LANES {
+        if size * 4 >= chunks.count_ones() as usize * LANES {
             // Only the chunks with a member are read (`Members::Masked`): only they are
             // written, from their words of the set.
             mask.resize(width, 0);
@@ -411,8 +413,11 @@ fn group_of<'a>(members: &'a [usize], size: usize, lanes: &[u64], mask: &'a mut 
                     *word = 0u32.wrapping_sub((bits >> i) as u32 & 1);
                 }
             }
-            return Members::Masked(members, &mask[..], chunks);
+            return Members::Masked(lanes, &mask[..], chunks);
         }
+    }
+    if members.is_empty() {
+        members_of(lanes, members);
     }
     Members::Some(members, width)
 }

@@ -183,20 +183,23 @@ fn row<const M: usize>(regs: &[u32], at: usize, n: usize) -> [u32; M] {
 }
 
 /// The invocations of a running group: every lane of the file (`All`, the common case,
-/// rows are contiguous) or some, by lane, in increasing order.
+/// rows are contiguous) or some, listed by lane in increasing order or as a set.
 #[derive(Clone, Copy)]
 pub(super) enum Members<'a> {
     /// Every lane `0..width`.
     All(usize),
     /// These lanes of a file `width` lanes wide.
     Some(&'a [usize], usize),
-    /// These lanes of a file whose width is a multiple of [`N`], many of them: the row
-    /// operations compute whole chunks of [`N`] lanes and keep the members' words
-    /// (`mask`: per lane of a chunk with a member, all ones for a member, else 0; the
-    /// other chunks' words are never read and may be stale), loops the compiler vectorises
-    /// where a member at a time could not be (a divergent kernel's groups have tens of
-    /// members); chunks without a member (bit `c` of the `u64` clear) are skipped.
-    Masked(&'a [usize], &'a [u32], u64),
+    /// The lanes of a set (bit `l % 64` of word `l / 64` for lane `l`) of a file whose
+    /// width is a multiple of [`N`], many of them: the row operations compute whole
+    /// chunks of [`N`] lanes and keep the members' words (`mask`: per lane of a chunk
+    /// with a member, all ones for a member, else 0; the other chunks' words are never
+    /// read and may be stale), loops the compiler vectorises where a member at a time
+    /// could not be (a divergent kernel's groups have tens of members); chunks without a
+    /// member (bit `c` of the `u64` clear) are skipped. A set rather than a list: most
+    /// such groups run only row operations before they split again, and listing hundreds
+    /// of members for each was a twentieth of the path tracer's time.
+    Masked(&'a [u64], &'a [u32], u64),
 }
 
 impl Members<'_> {
@@ -205,7 +208,8 @@ impl Members<'_> {
     pub(super) fn len(self) -> usize {
         match self {
             Members::All(width) => width,
-            Members::Some(lanes, _) | Members::Masked(lanes, ..) => lanes.len(),
+            Members::Some(lanes, _) => lanes.len(),
+            Members::Masked(set, ..) => set.iter().map(|bits| bits.count_ones() as usize).sum(),
         }
     }
 
@@ -223,9 +227,20 @@ impl Members<'_> {
     pub(super) fn for_each(self, mut f: impl FnMut(usize)) {
         match self {
             Members::All(width) => (0..width).for_each(f),
-            Members::Some(lanes, _) | Members::Masked(lanes, ..) => {
+            Members::Some(lanes, _) => {
                 for &l in lanes {
                     f(l)
+                }
+            }
+            Members::Masked(set, _, mut chunks) => {
+                while chunks != 0 {
+                    let c = chunks.trailing_zeros() as usize;
+                    chunks &= chunks - 1;
+                    let mut bits = set[c];
+                    while bits != 0 {
+                        f(c * N + bits.trailing_zeros() as usize);
+                        bits &= bits - 1;
+                    }
                 }
             }
         }
@@ -578,12 +593,19 @@ mod tests {
         let some = [3, 6, 7, 66, 129, 191];
         assert_eq!(zeros_of(Members::Some(&some, 192), &row), (vec![3, 6, 66, 129], 4));
         let mut mask = vec![0; 192];
+        let mut set = [0u64; 3];
         for &l in &some {
             mask[l] = u32::MAX;
+            set[l / N] |= 1 << (l % N);
         }
-        assert_eq!(zeros_of(Members::Masked(&some, &mask, 0b111), &row), (vec![3, 6, 66, 129], 4));
+        let masked = Members::Masked(&set, &mask, 0b111);
+        assert_eq!(zeros_of(masked, &row), (vec![3, 6, 66, 129], 4));
+        let mut listed = Vec::new();
+        masked.for_each(|l| listed.push(l));
+        assert_eq!((listed, masked.len()), (some.to_vec(), 6));
         // A chunk left out of the mask's chunks is not looked at, whatever its words.
         mask[0] = u32::MAX;
-        assert_eq!(zeros_of(Members::Masked(&some[3..], &mask, 0b110), &row), (vec![66, 129], 2));
+        set[0] = 0;
+        assert_eq!(zeros_of(Members::Masked(&set, &mask, 0b110), &row), (vec![66, 129], 2));
     }
 }

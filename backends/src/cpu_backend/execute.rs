@@ -300,11 +300,12 @@ fn load_element(load: &ElementLoad, memory: &[AtomicU32], file: &mut [u32], memb
     let (dst, index, bytes) = (load.dst as usize, load.index as usize, memory.len() * 4);
     let word = |first: usize, i: usize| memory.get(first + i).map_or(0, |w| w.load(Ordering::Relaxed));
     let registers = || runs.iter().flat_map(|&(start, words)| start as usize..(start + words) as usize);
+    // Whether every member reads the same element (then one read fills the rows), found
+    // out no further than the first member that does not.
     let mut leader = None;
-    let mut same = true;
-    members.for_each(|lane| {
+    let same = members.all(|lane| {
         let first = load.first_word(bytes, file[index * width + lane]);
-        same &= *leader.get_or_insert(first) == first;
+        *leader.get_or_insert(first) == first
     });
     if let (true, Some(first)) = (same, leader) {
         for i in registers() {

@@ -278,6 +278,30 @@ impl Members<'_> {
         taken.iter().map(|bits| bits.count_ones() as usize).sum()
     }
 
+    /// Whether `f` holds for every member, asked in increasing order of lanes and no
+    /// further than the first member for which it does not.
+    #[inline(always)]
+    pub(super) fn all(self, mut f: impl FnMut(usize) -> bool) -> bool {
+        match self {
+            Members::All(width) => (0..width).all(f),
+            Members::Some(lanes, _) => lanes.iter().all(|&l| f(l)),
+            Members::Masked(set, _, mut chunks) => {
+                while chunks != 0 {
+                    let c = chunks.trailing_zeros() as usize;
+                    chunks &= chunks - 1;
+                    let mut bits = set[c];
+                    while bits != 0 {
+                        if !f(c * N + bits.trailing_zeros() as usize) {
+                            return false;
+                        }
+                        bits &= bits - 1;
+                    }
+                }
+                true
+            }
+        }
+    }
+
     /// `regs[dst + r row] = f(regs[a + r row], regs[b + r row])` for the members and
     /// `r < rows`, in that order (rows are register indices; each is `width` words). The
     /// rows of a vector are contiguous, so a whole group's vector operation is one loop.
@@ -603,6 +627,16 @@ mod tests {
         let mut listed = Vec::new();
         masked.for_each(|l| listed.push(l));
         assert_eq!((listed, masked.len()), (some.to_vec(), 6));
+        // `all` stops at the first member that fails.
+        for members in [masked, Members::Some(&some, 192)] {
+            let mut asked = Vec::new();
+            assert!(!members.all(|l| {
+                asked.push(l);
+                l < 66
+            }));
+            assert_eq!(asked, [3, 6, 7, 66]);
+            assert!(members.all(|l| l < 192));
+        }
         // A chunk left out of the mask's chunks is not looked at, whatever its words.
         mask[0] = u32::MAX;
         set[0] = 0;

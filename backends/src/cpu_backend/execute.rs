@@ -1,8 +1,9 @@
 //! The instructions that the group loop of [`super::interp`] runs member by member
 //! (memory through pointers, atomics, textures): decoded once for the group, then
-//! executed for each member in turn; never control flow. Two loads go a register at a
-//! time instead: a buffer's words at an address known when compiling (the same for
-//! every member) and a buffer array's element (`load_element`). And [`GroupMemory`],
+//! executed for each member in turn; never control flow. Some go a register at a time
+//! instead: a buffer's words at an address known when compiling (the same for every
+//! member), a buffer array's element (`load_element`), and loads and stores through
+//! pointers into the workgroup memory of a batch of one workgroup. And [`GroupMemory`],
 //! what they reach besides the running code's registers.
 //!
 //! Why [`GroupMemory`] is defined here and not in the group loop that fills it: this
@@ -87,6 +88,9 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
             }
         };
     }
+    // Whether the batch is one workgroup (or has no workgroup memory): every member's
+    // workgroup memory is then the same words.
+    let one_workgroup = workgroup_words == 0 || per_workgroup == width;
     match insn {
         Insn::Image(image) => each_lane!(|regs, lane, private| {
             super::image::execute(image, regs, buffers);
@@ -112,9 +116,28 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
                 Insn::LoadRuns { runs, .. } => runs,
                 _ => &whole,
             };
-            let dst = *dst as usize;
+            let (dst, pointer) = (*dst as usize, *pointer as usize);
+            // Every member's pointer into the one workgroup's memory of the batch (a kernel
+            // with barriers: the histogram's exchanges): a register's row at a time, without
+            // each member's registers, region and memory looked up apart. Not where the
+            // value's registers overlap the pointer's, which the rows would overwrite.
+            if one_workgroup
+                && (dst + *len as usize <= pointer || pointer + 2 <= dst)
+                && members.all(|lane| file[pointer * width + lane] & TAG_MASK == WORKGROUP)
+            {
+                let workgroup = &shared[..workgroup_words];
+                for &(start, words) in runs {
+                    for i in start as usize..(start + words) as usize {
+                        members.for_each(|lane| {
+                            let offset = file[(pointer + 1) * width + lane] as usize;
+                            file[(dst + i) * width + lane] = workgroup.get(offset + i).copied().unwrap_or(0);
+                        });
+                    }
+                }
+                return;
+            }
             each_lane!(|regs, lane, private| {
-                let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1] as usize);
+                let (tag, offset) = (regs[pointer], regs[pointer + 1] as usize);
                 // The common regions inline; the others (and the general rules) in `Memory`.
                 match tag & TAG_MASK {
                     BUFFER => load_runs(&buffers[(tag & !TAG_MASK) as usize], offset / 4, runs, regs, dst),
@@ -134,6 +157,22 @@ pub(super) fn execute(insn: &Insn, file: &mut [u32], members: Members, group: &m
         Insn::LoadElement(load) => load_element(load, &buffers[load.buffer as usize], file, members, width),
         Insn::Store { pointer, src, len } => {
             let (src, len) = (*src as usize, *len as usize);
+            // As the loads above: into the one workgroup's memory, member after member
+            // (the order the per-member path writes in) without each one's registers,
+            // region and memory looked up apart.
+            let p = *pointer as usize;
+            if one_workgroup && members.all(|lane| file[p * width + lane] & TAG_MASK == WORKGROUP) {
+                let workgroup = &mut shared[..workgroup_words];
+                members.for_each(|lane| {
+                    let offset = file[(p + 1) * width + lane] as usize;
+                    for i in 0..len {
+                        if let Some(word) = workgroup.get_mut(offset + i) {
+                            *word = file[(src + i) * width + lane];
+                        }
+                    }
+                });
+                return;
+            }
             each_lane!(|regs, lane, private| {
                 let (tag, offset) = (regs[*pointer as usize], regs[*pointer as usize + 1] as usize);
                 match tag & TAG_MASK {

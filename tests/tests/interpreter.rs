@@ -1673,3 +1673,50 @@ fn a_buffer_bound_at_two_read_only_bindings_is_read_through_both_and_kept() {
         assert_eq!(download::<[f32; 4]>(&mut backend, buffers[1]).unwrap(), colour, "the shared buffer is kept");
     }
 }
+
+/// A kernel whose every invocation calls `long`, a function too large to be inlined
+/// (over the compiler's `INLINE_EXPRESSIONS`), where a third of them return early and the
+/// others run on. `long` adds 1 through a pointer before it branches: an invocation that
+/// ran its start twice would count one too many.
+fn early_returns_kernel() -> String {
+    let mut source = String::from(
+        "@group(0) @binding(0) var<storage, read> input: array<u32>;\n\
+         @group(0) @binding(1) var<storage, read_write> output: array<u32>;\n\
+         fn long(p: ptr<function, u32>, x: u32) -> u32 {\n\
+             *p += 1u;\n\
+             if x % 3u == 0u { return x; }\n\
+             var y = x;\n",
+    );
+    for k in 0..200 {
+        source += &format!("    y = (y ^ {k}u) * 3u + (y >> 7u);\n");
+    }
+    source += "    *p += 10u;\n\
+                   return y;\n\
+               }\n\
+               @compute @workgroup_size(64)\n\
+               fn main(@builtin(global_invocation_id) id: vec3<u32>) {\n\
+                   var acc = 0u;\n\
+                   let result = long(&acc, input[id.x]);\n\
+                   output[2u * id.x] = result;\n\
+                   output[2u * id.x + 1u] = acc;\n\
+               }\n";
+    source
+}
+
+#[test]
+fn invocations_left_in_a_call_when_others_return_early_go_on_where_they_were() {
+    let kernel = Kernel::from_wgsl("early_returns.wgsl", early_returns_kernel(), "main", false).unwrap();
+    let inputs: Vec<u32> = (0..256u32).map(|i| i.wrapping_mul(2_654_435_761).rotate_left(11) ^ i).collect();
+    let expected: Vec<u32> = inputs
+        .iter()
+        .flat_map(|&x| {
+            if x % 3 == 0 {
+                return [x, 1];
+            }
+            let y = (0..200u32).fold(x, |y, k| (y ^ k).wrapping_mul(3).wrapping_add(y >> 7));
+            [y, 11]
+        })
+        .collect();
+    let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+    assert_eq!(run_words(&mut cpu, &kernel, &inputs, 256 * 2, 4), expected);
+}

@@ -167,30 +167,36 @@ pub(super) fn run_until_sync(
     // warps wide, as both benches' are): a group's warps are then the 32-bit halves of
     // its set with a member.
     let warps_are_halves = invocations.iter().enumerate().all(|(lane, inv)| inv.simt_index as usize == lane);
-    // While no invocation is inside a call (the common case: small functions are
-    // inlined), where an invocation is is its next instruction alone: the group to run is
-    // then found from `places`, the invocations by instruction, instead of by comparing
-    // stacks.
-    // Runnable invocations inside a call (stopped ones no longer count).
-    let mut in_calls = invocations.iter().filter(|inv| !inv.callers.is_empty()).count();
-    let entry_instructions = program.codes[program.entry as usize].insns.len();
-    // Whether `places` holds every runnable invocation (it is not kept during calls).
-    // While it does, `places` alone says where they are: their frames' instructions are
-    // left as they were and written when the frames are needed again (a call).
+    // While every runnable invocation has the same callers (the common case: no call, as
+    // small functions are inlined; or all in the same call, as the histogram's network
+    // functions), where an invocation is is its next instruction in one code alone: the
+    // group to run is then found from `places`, the invocations by instruction, instead
+    // of by comparing stacks.
+    let instructions = program.codes.iter().map(|code| code.insns.len()).max().unwrap_or(0);
+    // Whether `places` holds every runnable invocation, all in code `placed_code` under
+    // the same callers. While it does, `places` alone says where they are: their running
+    // frames' instructions are left as they were and written when the frames are needed
+    // again (a call or return of some of them only).
     let mut placed = false;
+    let mut placed_code = program.entry;
+    // Whether the stacks may have become the same again since they were last compared
+    // (at the start, after a return or a stop).
+    let mut compare = true;
     loop {
         // The group furthest behind, and the instruction where it meets the next one.
         members.clear();
         let mut meet = u32::MAX;
-        let leader = if in_calls == 0 {
-            if !placed {
-                // Every runnable invocation is in the entry point's frame.
+        if !placed && compare {
+            compare = false;
+            if let Some(code) = same_stack(invocations, stops) {
                 let running = invocations.iter().zip(stops.iter()).enumerate().filter_map(|(lane, (inv, stop))| {
                     inv.frame.as_ref().filter(|_| stop.is_none()).map(|frame| (lane, frame.pc))
                 });
-                places.rebuild(entry_instructions, width, running);
-                placed = true;
+                places.rebuild(instructions, width, running);
+                (placed, placed_code) = (true, code);
             }
+        }
+        let leader = if placed {
             let Some((at, next)) = places.take_first(lanes) else { return Ok(()) };
             meet = next;
             // Listed only where needed: by `group_of` for a group of a few, and by the
@@ -198,9 +204,8 @@ pub(super) fn run_until_sync(
             // The first member (an invocation stopped inside a call may be lane 0, and
             // the group's callers are its leader's).
             let first = lanes.iter().position(|&bits| bits != 0).expect("a group has members");
-            (first * 64 + lanes[first].trailing_zeros() as usize, program.entry, at)
+            (first * 64 + lanes[first].trailing_zeros() as usize, placed_code, at)
         } else {
-            placed = false;
             let mut leader = None;
             for (i, stop) in stops.iter().enumerate() {
                 if stop.is_none() && leader.is_none_or(|l: usize| position(&invocations[i], &invocations[l]).is_lt()) {
@@ -325,8 +330,9 @@ pub(super) fn run_until_sync(
                 for &i in members.iter() {
                     invocations[i].frame.as_mut().expect("running").pc = pc;
                     stops[i] = Some(Stop::Sync(code_index, pc));
-                    in_calls -= usize::from(!invocations[i].callers.is_empty());
                 }
+                // The invocations still running may now share their callers.
+                compare = !placed;
             }
             GroupEnd::Call(return_pc) => {
                 let Insn::Call(call) = &program.codes[code_index as usize].insns[return_pc as usize - 1] else {
@@ -337,14 +343,18 @@ pub(super) fn run_until_sync(
                 }
                 let group = if members.len() == width { Members::All(width) } else { Members::Some(members, width) };
                 enter_function(program, &mut memory.files, code_index, call, group, caller_codes.len() as u32 + 1)?;
-                if placed {
-                    // The frames take over from `places` (`in_calls` is no longer 0):
-                    // every runnable invocation's instruction written back.
+                if placed && places.is_empty() {
+                    // Every runnable invocation calls: they still share their callers, and
+                    // all start the callee at its first instruction.
+                    places.rebuild(instructions, width, members.iter().map(|&i| (i, 0)));
+                    placed_code = call.code;
+                } else if placed {
+                    // Only some call: the frames take over from `places`, every runnable
+                    // invocation's instruction written back.
                     places.drain(|i, pc| invocations[i].frame.as_mut().expect("running").pc = pc);
                     placed = false;
                 }
                 for &i in members.iter() {
-                    in_calls += usize::from(invocations[i].callers.is_empty());
                     let invocation = &mut invocations[i];
                     let frame = invocation.frame.as_mut().expect("running");
                     frame.pc = return_pc;
@@ -353,15 +363,37 @@ pub(super) fn run_until_sync(
                 }
             }
             GroupEnd::Return { src, len } => {
+                if placed {
+                    // The invocations left in the code (if any) no longer share the
+                    // returning ones' callers: their instructions written back; the stacks
+                    // are compared again below.
+                    places.drain(|i, pc| invocations[i].frame.as_mut().expect("running").pc = pc);
+                    placed = false;
+                }
                 for &i in members.iter() {
                     if return_from_function(&mut invocations[i], &mut memory.files, i, width, src, len) {
                         stops[i] = Some(Stop::Done);
                     }
-                    in_calls -= usize::from(stops[i].is_none() && invocations[i].callers.is_empty());
                 }
+                compare = true;
             }
         }
     }
+}
+
+/// The code every runnable invocation (`stops[i]` empty) runs, where they all run the
+/// same code under the same callers (the same codes and return addresses); `None` where
+/// they do not or none is runnable.
+fn same_stack(invocations: &[Invocation], stops: &[Option<Stop>]) -> Option<u32> {
+    let mut running = invocations.iter().zip(stops).filter(|(_, stop)| stop.is_none()).map(|(inv, _)| inv);
+    let first = running.next()?;
+    let code = first.frame.as_ref()?.code;
+    let same = |inv: &Invocation| {
+        inv.frame.as_ref().is_some_and(|frame| frame.code == code)
+            && inv.callers.len() == first.callers.len()
+            && inv.callers.iter().zip(&first.callers).all(|(a, b)| a.code == b.code && a.pc == b.pc)
+    };
+    running.all(same).then_some(code)
 }
 
 /// Allocates a code's register file for `width` lanes, every register at its template

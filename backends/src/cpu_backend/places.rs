@@ -1,6 +1,6 @@
-//! Where the invocations of a batch stand while none is inside a call: per instruction
-//! of the entry point, the set of invocations whose next instruction it is, and which
-//! instructions have any. The scheduler of [`super::interp`] runs the set of the
+//! Where the invocations of a batch stand while they all run one code under the same
+//! callers: per instruction of that code, the set of invocations whose next instruction
+//! it is, and which instructions have any. The scheduler of [`super::interp`] runs the set of the
 //! smallest such instruction next and stops it at the next one.
 //!
 //! Why: found by scanning every invocation's next instruction, each group cost the
@@ -101,6 +101,11 @@ impl Places {
                 }
             }
         }
+    }
+
+    /// Whether no instruction has an invocation.
+    pub(super) fn is_empty(&self) -> bool {
+        self.next_occupied(0).is_none()
     }
 
     /// The smallest instruction from `from` on with invocations.

@@ -32,7 +32,7 @@ use super::invocations::{Batch, Invocation};
 use super::lanes::{LaneRegs, Members, N as LANES};
 use super::limit::{FUEL, Limit};
 use super::memory::{FUNCTION, Frame};
-use super::places::{Places, members_of};
+use super::places::{Places, lanes_in, members_of};
 use super::program::Program;
 use super::sanitize::{Sanitizer, Sanitizing};
 use crate::error::BackendError;
@@ -279,7 +279,7 @@ pub(super) fn run_until_sync(
                 // dispatch would complete it once every invocation had stopped there, and
                 // the same group runs on past it without a round through the scheduler (a
                 // subgroup kernel's batch is one workgroup, so its shuffles mostly end
-                // here). The invocations' places are written once the group ends otherwise.
+                // here). Where the invocations are is recorded once the group ends otherwise.
                 Ok(GroupEnd::Sync(at)) if whole_batch => {
                     super::sync_point::complete_sync(program, invocations, memory, code_index, at);
                     start = at + 1;
@@ -291,10 +291,7 @@ pub(super) fn run_until_sync(
             let warps = lanes.iter().map(|&bits| u64::from(bits as u32 != 0) + u64::from(bits >> 32 != 0)).sum();
             counts.add_counted_group(steps, size as u64, warps);
         } else {
-            counts.add_group(
-                steps,
-                (0..width).filter(|&i| lanes[i / 64] >> (i % 64) & 1 != 0).map(|i| invocations[i].simt_index),
-            );
+            counts.add_group(steps, lanes_in(lanes).map(|i| invocations[i].simt_index));
         }
         let end = end?;
         if members.is_empty() && !matches!(end, GroupEnd::Meet(_) | GroupEnd::Branch { .. }) {
@@ -363,10 +360,11 @@ pub(super) fn run_until_sync(
                 }
             }
             GroupEnd::Return { src, len } => {
-                if placed {
-                    // The invocations left in the code (if any) no longer share the
-                    // returning ones' callers: their instructions written back; the stacks
-                    // are compared again below.
+                // From the entry point the members are done, and the invocations left
+                // still share their (empty) callers: the sets stay. From a call, those
+                // left in the code no longer share the returning ones' callers: their
+                // instructions written back, and the stacks compared again.
+                if placed && !caller_codes.is_empty() {
                     places.drain(|i, pc| invocations[i].frame.as_mut().expect("running").pc = pc);
                     placed = false;
                 }
@@ -375,7 +373,7 @@ pub(super) fn run_until_sync(
                         stops[i] = Some(Stop::Done);
                     }
                 }
-                compare = true;
+                compare = !placed;
             }
         }
     }

@@ -38,7 +38,8 @@ impl Places {
             self.sets = vec![0; slots * words];
             self.occupied = vec![0; slots.div_ceil(BITS)];
         } else {
-            // Only sets left behind by an earlier use (a call or an error) are not empty.
+            // Only sets left behind by an earlier use (a dispatch that failed) are not
+            // empty.
             while let Some(pc) = self.next_occupied(0) {
                 self.sets[pc * words..][..words].fill(0);
                 self.occupied[pc / BITS] &= !(1 << (pc % BITS));
@@ -122,6 +123,14 @@ impl Places {
     }
 }
 
+/// The invocations of the set `lanes` (a bit per invocation), in increasing order.
+pub(super) fn lanes_in(lanes: &[u64]) -> impl Iterator<Item = usize> + '_ {
+    lanes.iter().enumerate().flat_map(|(w, &word)| {
+        std::iter::successors((word != 0).then_some(word), |&bits| Some(bits & (bits - 1)).filter(|&b| b != 0))
+            .map(move |bits| w * BITS + bits.trailing_zeros() as usize)
+    })
+}
+
 /// Appends the invocations of the set `lanes` (a bit per invocation) to `members`, in
 /// increasing order.
 pub(super) fn members_of(lanes: &[u64], members: &mut Vec<usize>) {
@@ -140,7 +149,7 @@ pub(super) fn members_of(lanes: &[u64], members: &mut Vec<usize>) {
 
 #[cfg(test)]
 mod tests {
-    use super::{Places, members_of};
+    use super::{Places, lanes_in, members_of};
 
     #[test]
     fn groups_come_out_furthest_behind_first_with_their_meeting_point() {
@@ -186,6 +195,7 @@ mod tests {
         assert_eq!(places.take_first(&mut lanes), Some((4, 6)));
         members_of(&lanes, &mut members);
         assert_eq!(members, [0, 65, 129]);
+        assert_eq!(lanes_in(&lanes).collect::<Vec<_>>(), members);
         assert_eq!(lanes, [1, 1 << 1, 1 << 1]);
         // A branch: lane 65 jumps to 9, the others fall through to 5; an empty set
         // leaves its instruction unoccupied.

@@ -279,7 +279,10 @@ impl Members<'_> {
     }
 
     /// Whether `f` holds for every member, asked in increasing order of lanes and no
-    /// further than the first member for which it does not.
+    /// further than the first member for which it does not. Its walk over a masked
+    /// group's set repeats `for_each`'s on purpose: `for_each` written as `all` with a
+    /// test that always holds made the path tracer's frame 3-6 % slower (measured
+    /// alternated, 2026-12-01).
     #[inline(always)]
     pub(super) fn all(self, mut f: impl FnMut(usize) -> bool) -> bool {
         match self {

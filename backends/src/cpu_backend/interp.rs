@@ -199,10 +199,8 @@ pub(super) fn run_until_sync(
         let leader = if placed {
             let Some((at, next)) = places.take_first(lanes) else { return Ok(()) };
             meet = next;
-            // Listed only where needed: by `group_of` for a group of a few, and by the
-            // ends that go member by member.
-            // The first member (an invocation stopped inside a call may be lane 0, and
-            // the group's callers are its leader's).
+            // The leader is the first member (an invocation stopped inside a call may be
+            // lane 0, and the group's callers are its leader's).
             let first = lanes.iter().position(|&bits| bits != 0).expect("a group has members");
             (first * 64 + lanes[first].trailing_zeros() as usize, placed_code, at)
         } else {
@@ -230,7 +228,9 @@ pub(super) fn run_until_sync(
             (leader, frame.code, frame.pc)
         };
         let (leader, code_index, pc) = leader;
-        // How many members the group has (`members` is empty until they are listed).
+        // How many members the group has. `members` is empty until they are listed, which
+        // is only where needed: by `group_of` for a group of a few, and by the ends that
+        // go member by member.
         let size = lanes.iter().map(|bits| bits.count_ones() as usize).sum::<usize>();
         // Members at the same place have the same callers.
         caller_codes.clear();
@@ -348,7 +348,7 @@ pub(super) fn run_until_sync(
                 } else if placed {
                     // Only some call: the frames take over from `places`, every runnable
                     // invocation's instruction written back.
-                    places.drain(|i, pc| invocations[i].frame.as_mut().expect("running").pc = pc);
+                    hand_back(places, invocations);
                     placed = false;
                 }
                 for &i in members.iter() {
@@ -365,7 +365,7 @@ pub(super) fn run_until_sync(
                 // left in the code no longer share the returning ones' callers: their
                 // instructions written back, and the stacks compared again.
                 if placed && !caller_codes.is_empty() {
-                    places.drain(|i, pc| invocations[i].frame.as_mut().expect("running").pc = pc);
+                    hand_back(places, invocations);
                     placed = false;
                 }
                 for &i in members.iter() {
@@ -377,6 +377,12 @@ pub(super) fn run_until_sync(
             }
         }
     }
+}
+
+/// Writes the place of every invocation in `places` into its running frame and empties
+/// `places`: the frames are where the scheduler finds the invocations from then on.
+fn hand_back(places: &mut Places, invocations: &mut [Invocation]) {
+    places.drain(|i, pc| invocations[i].frame.as_mut().expect("running").pc = pc);
 }
 
 /// The code every runnable invocation (`stops[i]` empty) runs, where they all run the

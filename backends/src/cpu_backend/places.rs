@@ -90,17 +90,13 @@ impl Places {
 
     /// Empties every set, calling `f(lane, instruction)` for each invocation in one: where
     /// the scheduler writes the invocations' places back into their frames before it
-    /// leaves them to the frames (a call).
+    /// leaves them to the frames (a call by some of them, a return from a call).
     pub(super) fn drain(&mut self, mut f: impl FnMut(usize, u32)) {
         while let Some(pc) = self.next_occupied(0) {
             self.occupied[pc / BITS] &= !(1 << (pc % BITS));
-            for (w, word) in self.sets[pc * self.words..][..self.words].iter_mut().enumerate() {
-                let mut bits = std::mem::take(word);
-                while bits != 0 {
-                    f(w * BITS + bits.trailing_zeros() as usize, pc as u32);
-                    bits &= bits - 1;
-                }
-            }
+            let set = &mut self.sets[pc * self.words..][..self.words];
+            lanes_in(set).for_each(|lane| f(lane, pc as u32));
+            set.fill(0);
         }
     }
 

@@ -8,9 +8,11 @@
 //! [`INLINE_DEPTH`] levels deep) are inlined: the callee's expressions and local
 //! variables get registers of the caller's frame, its arguments are the caller's
 //! registers, its returns jump to the end of its body. Every expression gets its own
-//! register range (naga evaluates each expression once where it is emitted, and an
-//! expression's uses are dominated by its emission), so a field of a struct value, a
-//! component of a vector or a bitcast is the source's register range itself, not a copy.
+//! register range while it is alive (naga evaluates each expression once where it is
+//! emitted, and an expression's uses are dominated by its emission), so a field of a
+//! struct value, a component of a vector or a bitcast is the source's register range
+//! itself, not a copy; after its last read ([`super::liveness`]) the range serves later
+//! values.
 //!
 //! Why the lowering itself is elsewhere: each construct adds its methods to [`Compiler`]
 //! in a file of its own, above this one: expressions in [`super::expression`] (math
@@ -25,6 +27,7 @@ use super::constant::{compose, literal};
 use super::error::unsupported;
 use super::insn::{Insn, Reg, Runs};
 use super::layout::{Place, words_of};
+use super::liveness::{DeadAfter, Slot};
 use super::memory;
 use super::program::Code;
 use crate::error::BackendError;
@@ -122,7 +125,16 @@ pub(super) struct Scope<'a> {
     pub depth: u32,
     /// Per enclosing breakable construct: (break jumps, continue jumps).
     pub(super) loops: Vec<(Vec<usize>, Vec<usize>)>,
+    /// Per expression: the index of the run-time range [`Compiler::reg`] allocated for it
+    /// in [`Compiler::runtime`] ([`NOT_OWNED`] if none: a constant, an alias of another
+    /// value's registers, a caller's register).
+    pub(super) owned: Vec<u32>,
+    /// Where each of its values dies ([`super::liveness`]).
+    dead_after: DeadAfter,
 }
+
+/// Marks an expression that owns no run-time range ([`Scope::owned`]).
+const NOT_OWNED: u32 = u32::MAX;
 
 /// Compiles one code: instructions, registers and the module context they need.
 pub(super) struct Compiler<'a> {
@@ -159,11 +171,16 @@ pub(super) struct Compiler<'a> {
     pub template: Vec<u32>,
     /// Local-variable pointer registers being built.
     pub local_pointers: Vec<(Reg, u32)>,
-    /// Register ranges of inlined callees whose bodies are compiled, free for later
-    /// values (see [`Compiler::release`]).
-    free: Vec<(Reg, u32)>,
-    /// Ranges allocated for values computed at run time, in allocation order.
-    runtime: Vec<(Reg, u32)>,
+    /// Register ranges free for later values: dead values' ([`Compiler::free_dead`]) and
+    /// those of inlined callees whose bodies are compiled ([`Compiler::release`]).
+    pub(super) free: Vec<(Reg, u32)>,
+    /// Ranges allocated for values computed at run time, in allocation order, each with
+    /// whether it was freed already (after its value's last read, [`Compiler::free_dead`]).
+    pub(super) runtime: Vec<(Reg, u32, bool)>,
+    /// Whether a value's range is freed after its last read. Off while if-conversion
+    /// compiles branches that may be undone or whose values its selects read afterwards
+    /// ([`super::if_conversion`]).
+    pub(super) free_early: bool,
     /// Ranges holding values that are not computed where they are used: compile-time
     /// values in the template, pointers set when a frame starts. Never reused.
     permanent: std::collections::HashSet<Reg>,
@@ -186,10 +203,14 @@ pub(super) struct Compiler<'a> {
 }
 
 impl Compiler<'_> {
-    /// Allocates `len` registers for a value computed at run time: from the ranges of
-    /// inlined callees already compiled (first fit) if one is large enough, else new.
+    /// Allocates `len` registers for a value computed at run time: from the free ranges
+    /// (dead values', inlined callees' already compiled) if one is large enough, else
+    /// new. The free range freed last of `len` words exactly, else the last one larger:
+    /// the registers written most recently are the likeliest still in the cache.
     pub(super) fn alloc(&mut self, len: u32) -> Reg {
-        let at = match self.free.iter().position(|&(_, free)| free >= len && len > 0) {
+        let exact = self.free.iter().rposition(|&(_, free)| free == len && len > 0);
+        let fits = || self.free.iter().rposition(|&(_, free)| free > len && len > 0);
+        let at = match exact.or_else(fits) {
             Some(i) => {
                 let (at, free) = self.free[i];
                 if free == len {
@@ -202,7 +223,7 @@ impl Compiler<'_> {
             }
             None => self.alloc_new(len),
         };
-        self.runtime.push((at, len));
+        self.runtime.push((at, len, false));
         at
     }
 
@@ -266,10 +287,36 @@ impl Compiler<'_> {
     /// expression whose uses end with its block, before the callee can run again (naga
     /// scopes expressions to the block that emits them).
     pub(super) fn release(&mut self, mark: usize) {
-        for (at, len) in self.runtime.drain(mark..) {
-            if !self.permanent.contains(&at) {
+        for (at, len, freed) in self.runtime.drain(mark..) {
+            if !freed && !self.permanent.contains(&at) {
                 self.free.push((at, len));
             }
+        }
+    }
+
+    /// Frees the ranges of the values of `scope` that die after `slot`
+    /// ([`super::liveness`]).
+    pub(super) fn free_dead(&mut self, scope: &mut Scope, slot: Slot) {
+        if !self.free_early {
+            return;
+        }
+        for index in 0..scope.dead_after.at(slot).len() {
+            let handle = scope.dead_after.at(slot)[index];
+            self.free_value(scope, handle);
+        }
+    }
+
+    /// Frees the run-time range `handle` of `scope` owns, if it has one not freed yet.
+    fn free_value(&mut self, scope: &mut Scope, handle: Handle<Expression>) {
+        let owned = std::mem::replace(&mut scope.owned[handle.index()], NOT_OWNED);
+        if owned == NOT_OWNED {
+            return;
+        }
+        scope.regs[handle.index()] = NONE;
+        let (at, len, freed) = &mut self.runtime[owned as usize];
+        if !*freed && !self.permanent.contains(at) {
+            *freed = true;
+            self.free.push((*at, *len));
         }
     }
 
@@ -327,7 +374,12 @@ impl Compiler<'_> {
     pub(super) fn reg(&mut self, scope: &mut Scope, handle: Handle<Expression>) -> Reg {
         let index = handle.index();
         if scope.regs[index] == NONE {
-            scope.regs[index] = self.alloc(scope.lens[index]);
+            if scope.dead_after.own_registers(handle) {
+                scope.regs[index] = self.alloc_new(scope.lens[index]);
+            } else {
+                scope.regs[index] = self.alloc(scope.lens[index]);
+                scope.owned[index] = (self.runtime.len() - 1) as u32;
+            }
         }
         scope.regs[index]
     }
@@ -395,6 +447,8 @@ impl Compiler<'_> {
             inlined: arguments.is_some(),
             depth,
             loops: Vec::new(),
+            owned: vec![NOT_OWNED; count],
+            dead_after: DeadAfter::default(),
         };
         for words in local_words {
             let reg = self.alloc(words);
@@ -462,6 +516,7 @@ impl Compiler<'_> {
                 },
             }
         }
+        scope.dead_after = super::liveness::dead_after(function, &scope.pre_emitted);
         if scope.inlined
             && let Some((dst, words)) = result
         {
@@ -523,6 +578,7 @@ pub(super) fn compile_code(
         local_pointers: Vec::new(),
         free: Vec::new(),
         runtime: Vec::new(),
+        free_early: true,
         permanent: Default::default(),
         reused: Default::default(),
         constants: Default::default(),

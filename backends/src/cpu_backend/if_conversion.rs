@@ -26,6 +26,7 @@ use super::compiler::{Compiler, Scope};
 use super::error::unsupported;
 use super::insn::{Insn, Reg};
 use super::layout::Place;
+use super::liveness::slots;
 use crate::error::BackendError;
 use naga::{Expression, Handle, Statement};
 
@@ -67,9 +68,15 @@ impl Compiler<'_> {
         let cond = self.reg(scope, condition);
         let start = self.here() as usize;
         let (regs, places, constant) = (scope.regs.clone(), scope.places.clone(), scope.constant.clone());
+        let owned = scope.owned.clone();
+        let (free, runtime) = (self.free.clone(), self.runtime.len());
         let local_pointers = self.local_pointers.len();
-        let accept_stores = self.speculate(scope, accept)?;
-        let reject_stores = self.speculate(scope, reject)?;
+        // No register is freed inside the branches: the selects read their values after
+        // both, and an undone compilation must leave the registers as they were.
+        let free_early = std::mem::replace(&mut self.free_early, false);
+        let stores = self.speculate(scope, accept).and_then(|a| Ok((a, self.speculate(scope, reject)?)));
+        self.free_early = free_early;
+        let (accept_stores, reject_stores) = stores?;
         let selects = match (accept_stores, reject_stores) {
             (Some(a), Some(r)) if self.insns[start..].iter().all(speculable) => {
                 merge(&a, &r).filter(|selects| reads_before_writes(selects, cond))
@@ -83,7 +90,9 @@ impl Compiler<'_> {
         let Some(selects) = selects else {
             // Undo: the `if` is compiled as a branch, its expressions anew.
             self.truncate(start);
-            (scope.regs, scope.places, scope.constant) = (regs, places, constant);
+            (scope.regs, scope.places, scope.constant, scope.owned) = (regs, places, constant, owned);
+            self.free = free;
+            self.runtime.truncate(runtime);
             self.local_pointers.truncate(local_pointers);
             return Ok(false);
         };
@@ -100,6 +109,10 @@ impl Compiler<'_> {
                     sc: 0,
                 });
             }
+        }
+        // Now that the selects have read them, the values that die in the branches.
+        for slot in slots(accept).into_iter().chain(slots(reject)) {
+            self.free_dead(scope, slot);
         }
         Ok(true)
     }

@@ -92,6 +92,7 @@ mod jump_cleanup;
 mod lanes;
 mod layout;
 mod limit;
+mod liveness;
 mod load_alias;
 mod load_fields;
 mod math_call;

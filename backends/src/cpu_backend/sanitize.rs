@@ -40,7 +40,7 @@
 //! - function-space (`var` in a function) and private variables read before written:
 //!   WGSL and every naga backend zero-initialise them, so no path differs; and the
 //!   compiler's register passes (a load reading its variable's registers in place,
-//!   values computed straight into variables, registers reused by inlined callees) make
+//!   values computed straight into variables, registers reused once a value is dead) make
 //!   per-register tracking unreliable.
 //! - races through half-words (`f16` in buffers: two invocations writing the two halves
 //!   of one word touch different WGSL memory locations, which a shadow per word cannot

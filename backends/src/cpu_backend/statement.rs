@@ -8,14 +8,17 @@ use super::compiler::{Compiler, INLINE_BUDGET, INLINE_DEPTH, INLINE_EXPRESSIONS,
 use super::error::unsupported;
 use super::insn::{CallInsn, CollectiveFun, CollectiveInsn, GatherInsn, Insn, Reg};
 use super::layout::{Place, is_half, is_wide, shape};
+use super::liveness::Slot;
 use crate::error::BackendError;
 use naga::{Expression, Handle, Statement, TypeInner};
 
 impl Compiler<'_> {
-    /// Lowers every statement of `block` in order.
+    /// Lowers every statement of `block` in order, freeing the registers of the values
+    /// that die after each ([`super::liveness`]).
     pub(super) fn block(&mut self, scope: &mut Scope, block: &naga::Block) -> Result<(), BackendError> {
         for (statement, span) in block.span_iter() {
             self.statement(scope, statement, *span)?;
+            self.free_dead(scope, Slot::Statement(statement));
         }
         Ok(())
     }
@@ -49,6 +52,7 @@ impl Compiler<'_> {
                         };
                         self.last_value = Some(LastValue::new(scope, handle, first));
                     }
+                    self.free_dead(scope, Slot::Expression(handle));
                 }
             }
             Statement::Block(block) => self.block(scope, block)?,
@@ -59,8 +63,12 @@ impl Compiler<'_> {
             // tracer's frame, docs/benchmarks/interpreter.md).
             Statement::If { condition, accept, reject } if scope.constant[condition.index()] => {
                 let reg = self.reg(scope, *condition) as usize;
-                let taken = if self.template[reg] != 0 { accept } else { reject };
+                let (taken, skipped) = if self.template[reg] != 0 { (accept, reject) } else { (reject, accept) };
                 self.block(scope, taken)?;
+                // The values whose last read was on the side not taken are dead here too.
+                for slot in super::liveness::slots(skipped) {
+                    self.free_dead(scope, slot);
+                }
             }
             Statement::If { condition, accept, reject }
                 if !self.sanitize && self.if_as_select(scope, *condition, accept, reject)? => {}

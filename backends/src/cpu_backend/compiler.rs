@@ -126,8 +126,9 @@ pub(super) struct Scope<'a> {
     /// Per enclosing breakable construct: (break jumps, continue jumps).
     pub(super) loops: Vec<(Vec<usize>, Vec<usize>)>,
     /// Per expression: the index of the run-time range [`Compiler::reg`] allocated for it
-    /// in [`Compiler::runtime`] ([`NOT_OWNED`] if none: a constant, an alias of another
-    /// value's registers, a caller's register).
+    /// in [`Compiler::runtime`] ([`NOT_OWNED`] if there is none to free: a constant, an
+    /// alias of another value's registers, a caller's register, a value with registers
+    /// never shared ([`DeadAfter::own_registers`]), or one freed already).
     pub(super) owned: Vec<u32>,
     /// Where each of its values dies ([`super::liveness`]).
     dead_after: DeadAfter,
@@ -205,8 +206,9 @@ pub(super) struct Compiler<'a> {
 impl Compiler<'_> {
     /// Allocates `len` registers for a value computed at run time: from the free ranges
     /// (dead values', inlined callees' already compiled) if one is large enough, else
-    /// new. The free range freed last of `len` words exactly, else the last one larger:
-    /// the registers written most recently are the likeliest still in the cache.
+    /// new. A free range of `len` words exactly, else a larger one, each searched from the
+    /// end of the free list, where the ranges freed most recently mostly are: their
+    /// registers are the likeliest still in the cache.
     pub(super) fn alloc(&mut self, len: u32) -> Reg {
         let exact = self.free.iter().rposition(|&(_, free)| free == len && len > 0);
         let fits = || self.free.iter().rposition(|&(_, free)| free > len && len > 0);
@@ -227,7 +229,8 @@ impl Compiler<'_> {
         at
     }
 
-    /// Allocates `len` new registers (never used before, never reused).
+    /// Allocates `len` new registers at the template's end (reused later only where
+    /// [`Compiler::alloc`] records them as a run-time range).
     fn alloc_new(&mut self, len: u32) -> Reg {
         let at = self.template.len() as Reg;
         self.template.resize(self.template.len() + len as usize, 0);

@@ -16,7 +16,9 @@
 //! - **Aliases.** A component, a field, a consecutive swizzle or a bitcast is compiled
 //!   into its source's own registers ([`super::expression`]), and an element pointer's
 //!   index is read again by the load that fuses it ([`super::element_load`]): a use of
-//!   `Access`, `AccessIndex`, `Swizzle` or `As` is a use of its operands too.
+//!   `Access`, `AccessIndex`, `Swizzle` or a bitcast (`As` without conversion) is a use of
+//!   its operands too (for an `Access` into a value rather than a pointer, longer than
+//!   needed, which is safe).
 //! - **Loops.** A value defined before a loop and used in it is read again on the next
 //!   iteration: it lives to the loop's end.
 //! - **`continue`.** A loop's continuing block and `break_if` may read a value of its body
@@ -50,8 +52,11 @@ pub(super) enum Slot<'a> {
 /// The values that die after each point of one function.
 #[derive(Default)]
 pub(super) struct DeadAfter {
+    /// By the emitted expression.
     expressions: HashMap<Handle<Expression>, Vec<Handle<Expression>>>,
-    /// By the statement's address: a function's statements do not move while it is compiled.
+    /// By the statement's address: a function's statements do not move while it is
+    /// compiled (a pass that compiled a copy of a block would find nothing here, and so
+    /// free nothing, which is safe).
     statements: HashMap<*const Statement, Vec<Handle<Expression>>>,
     /// Values of a loop body read in its continuing block or `break_if`.
     own: HashSet<Handle<Expression>>,
@@ -77,7 +82,7 @@ impl DeadAfter {
 
 /// Where each value of `function` dies, never for the expressions `keep` marks (those
 /// evaluated when the scope opens); nothing dies in a function with a statement the walk
-/// does not know.
+/// does not know or an expression emitted twice.
 pub(super) fn dead_after(function: &Function, keep: &[bool]) -> DeadAfter {
     let count = function.expressions.len();
     let mut walk = Walk {
@@ -85,7 +90,7 @@ pub(super) fn dead_after(function: &Function, keep: &[bool]) -> DeadAfter {
         next: 0,
         defined: vec![UNSEEN; count],
         last: vec![UNSEEN; count],
-        slots: Vec::new(),
+        keys: Vec::new(),
         loops: Vec::new(),
         known: true,
         own: HashSet::new(),
@@ -108,7 +113,7 @@ pub(super) fn dead_after(function: &Function, keep: &[bool]) -> DeadAfter {
         }
         // A value never read dies where it is computed.
         let point = if walk.last[index] == UNSEEN { walk.defined[index] } else { walk.last[index] };
-        match walk.slots[point as usize] {
+        match walk.keys[point as usize] {
             Key::Expression(at) => dead.expressions.entry(at).or_default().push(handle),
             Key::Statement(at) => dead.statements.entry(at).or_default().push(handle),
         }
@@ -157,6 +162,7 @@ struct OpenLoop {
 
 /// The walk's state.
 struct Walk<'a> {
+    /// The function walked.
     function: &'a Function,
     /// The next point's number.
     next: u32,
@@ -165,7 +171,7 @@ struct Walk<'a> {
     /// Per expression: the last point that reads it.
     last: Vec<u32>,
     /// Per point: what it is.
-    slots: Vec<Key>,
+    keys: Vec<Key>,
     /// The loops around the walk, outermost first.
     loops: Vec<OpenLoop>,
     /// No statement of a kind the walk does not know so far, no expression emitted twice.
@@ -177,17 +183,20 @@ struct Walk<'a> {
 impl Walk<'_> {
     /// Numbers a new point.
     fn point(&mut self, key: Key) -> u32 {
-        self.slots.push(key);
+        self.keys.push(key);
         self.next += 1;
         self.next - 1
     }
 
+    /// Walks the statements of `block` in order.
     fn block(&mut self, block: &naga::Block) {
         for statement in block.iter() {
             self.statement(statement);
         }
     }
 
+    /// Walks `statement`: what nests in it, then its own point (an `Emit` has a point per
+    /// expression instead). [`slots`] lists the same points and must change with it.
     fn statement(&mut self, statement: &Statement) {
         use Statement as S;
         let mut reads: Vec<Handle<Expression>> = Vec::new();
@@ -308,14 +317,15 @@ impl Walk<'_> {
     fn read(&mut self, value: Handle<Expression>, at: u32) {
         let index = value.index();
         let defined = self.defined[index];
-        // The outermost loop that the value must outlive: one it was defined before, or,
-        // in its continuing block, one whose body defined it.
+        // A body's value read in the loop's continuing block or `break_if` gets registers
+        // of its own (a `continue` may have skipped computing it).
         let skippable = |open: &OpenLoop| {
             open.continuing.is_some_and(|continuing| at >= continuing && defined >= open.start && defined < continuing)
         };
         if self.loops.iter().any(skippable) {
             self.own.insert(value);
         }
+        // A value defined before a loop lives to the end of the outermost such loop.
         let outlived = self.loops.iter_mut().find(|open| defined == UNSEEN || defined < open.start);
         match outlived {
             Some(open) => open.to_end.push(value),
@@ -507,11 +517,19 @@ mod tests {
             let z = x * 11u; data[id.x] = a + z;";
         let f = |x: u32| if x > 7 { x * 3 + 1 } else { x * 6 + ((x * 3) >> 1) } + x * 11;
         assert_eq!(run(body), expected(f));
+        // `k`, stored by one branch, read last by an expression of the other: freed there,
+        // `* 3u` would take its registers before the select reads them.
+        let body = "var a = 0u; let k = x * 3u;
+            if x > 7u { a = k; } else { a = (k + 1u) * 3u; }
+            let z = x * 11u; data[id.x] = a + z;";
+        let f = |x: u32| if x > 7 { x * 3 } else { (x * 3 + 1) * 3 } + x * 11;
+        assert_eq!(run(body), expected(f));
     }
 
     #[test]
-    fn values_read_across_a_switch_a_call_and_a_loops_continuing_block_keep_their_words() {
-        // `k` from before the loop read in `break if`; `a` and `b` of the body read by a
+    fn a_switch_an_inlined_call_and_a_continuing_block_together_compute_as_written() {
+        // A smoke test of the constructs together (the rules' own tests are above): `k`
+        // from before the loop read in `break if`; `a` and `b` of the body read by a
         // switch's cases, an inlined callee and the continuing block; an element load
         // whose index has no other read.
         let declarations = "fn mix_in(v: u32, k: u32) -> u32 { let t = v * 2654435761u; return (t >> (k & 7u)) ^ k; }";

@@ -87,7 +87,6 @@ pub(super) fn dead_after(function: &Function, keep: &[bool]) -> DeadAfter {
     let count = function.expressions.len();
     let mut walk = Walk {
         function,
-        next: 0,
         defined: vec![UNSEEN; count],
         last: vec![UNSEEN; count],
         keys: Vec::new(),
@@ -164,8 +163,6 @@ struct OpenLoop {
 struct Walk<'a> {
     /// The function walked.
     function: &'a Function,
-    /// The next point's number.
-    next: u32,
     /// Per expression: the point that computes it.
     defined: Vec<u32>,
     /// Per expression: the last point that reads it.
@@ -181,11 +178,15 @@ struct Walk<'a> {
 }
 
 impl Walk<'_> {
+    /// The next point's number.
+    fn next(&self) -> u32 {
+        self.keys.len() as u32
+    }
+
     /// Numbers a new point.
     fn point(&mut self, key: Key) -> u32 {
         self.keys.push(key);
-        self.next += 1;
-        self.next - 1
+        self.next() - 1
     }
 
     /// Walks the statements of `block` in order.
@@ -225,9 +226,9 @@ impl Walk<'_> {
                 reads.push(*selector);
             }
             S::Loop { body, continuing, break_if } => {
-                self.loops.push(OpenLoop { start: self.next, continuing: None, to_end: Vec::new() });
+                self.loops.push(OpenLoop { start: self.next(), continuing: None, to_end: Vec::new() });
                 self.block(body);
-                let continuing_start = self.next;
+                let continuing_start = self.next();
                 self.loops.last_mut().expect("pushed above").continuing = Some(continuing_start);
                 self.block(continuing);
                 if let Some(condition) = break_if {
@@ -237,7 +238,7 @@ impl Walk<'_> {
                 }
                 let open = self.loops.pop().expect("pushed above");
                 let end = match break_if {
-                    Some(_) => self.next - 1,
+                    Some(_) => self.next() - 1,
                     None => self.point(Key::Statement(statement)),
                 };
                 for value in open.to_end {

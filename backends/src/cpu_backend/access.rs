@@ -104,3 +104,57 @@ impl Compiler<'_> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::decode::tests::{INVOCATIONS, entry_code, kernel_with, run_kernel};
+    use super::super::{CpuBackend, CpuOptions, memory};
+    use crate::backend::{Backend, Bind, download, upload};
+    use strata_kernels::Kernel;
+
+    /// `data` after `kernel` ran on `data[i] = i`, with `table` (binding 1) bound too.
+    fn run_kernel_with_table(kernel: &Kernel) -> Vec<u32> {
+        let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+        let data = upload(&mut cpu, "data", &(0..INVOCATIONS).collect::<Vec<_>>()).unwrap();
+        let table = upload(&mut cpu, "table", &[10u32, 20, 30, 40]).unwrap();
+        cpu.dispatch(kernel, &[Bind::new(0, data), Bind::new(1, table)], [INVOCATIONS / 8, 1, 1]).unwrap();
+        download::<u32>(&mut cpu, data).unwrap()
+    }
+
+    /// Whether `template` holds a pointer's words `(tag, address)`.
+    fn holds_pointer(template: &[u32], tag: u32, address: u32) -> bool {
+        template.windows(2).any(|w| w == [tag, address])
+    }
+
+    #[test]
+    fn a_pointer_with_a_known_target_gets_a_register_only_where_one_is_read() {
+        // Loads and stores at places known when compiling, also through an inlined
+        // callee's pointer arguments, read no pointer register: none is set when the
+        // frame starts, and `table`'s pointer is not in the template.
+        let declarations = "struct Pair { a: u32, b: array<u32, 4> }
+            @group(0) @binding(1) var<storage, read> table: array<u32, 4>;
+            fn bump(p: ptr<function, u32>, by: u32) { *p = *p * 3u + by; }";
+        let body = "var pair: Pair; var v = array<u32, 4>(x, 1u, 2u, 3u);
+            pair.a = x + 1u; pair.b[2] = v[0] * 5u; bump(&pair.b[2], 7u); bump(&v[3], x);
+            data[id.x] = pair.a + pair.b[2] + v[3] + table[2];";
+        let kernel = kernel_with(declarations, body);
+        let code = entry_code(&kernel);
+        assert_eq!(code.local_pointers.len(), 0, "local pointers set when the frame starts");
+        assert!(!code.template.contains(&(memory::BUFFER | 1)), "a pointer into `table` in the template");
+        assert!(holds_pointer(&code.template, memory::BUFFER, 0), "`data`, indexed at run time, reads its pointer");
+        let expected: Vec<u32> = (0..INVOCATIONS).map(|x| (x + 1) + (x * 5 * 3 + 7) + (3 * 3 + x) + 30).collect();
+        assert_eq!(run_kernel_with_table(&kernel), expected);
+
+        // An index known only at run time reads the variable's pointer: one register,
+        // set when the frame starts.
+        let body = "var v = array<u32, 4>(x, 1u, 2u, 3u); v[x & 3u] = 9u; data[id.x] = v[0] + v[3];";
+        let kernel = kernel_with("", body);
+        assert_eq!(entry_code(&kernel).local_pointers.len(), 1);
+        let f = |x: u32| {
+            let mut v = [x, 1, 2, 3];
+            v[(x & 3) as usize] = 9;
+            v[0] + v[3]
+        };
+        assert_eq!(run_kernel(&kernel), (0..INVOCATIONS).map(f).collect::<Vec<_>>());
+    }
+}

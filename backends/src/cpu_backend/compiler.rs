@@ -373,10 +373,14 @@ impl Compiler<'_> {
         scope.info[handle].ty.inner_with(&self.module.types)
     }
 
-    /// The register of expression `handle` (allocated, zero, if it has none yet).
+    /// The register of expression `handle` (allocated, zero, if it has none yet; for a
+    /// pointer whose target is known when compiling, [`Compiler::place_reg`]).
     pub(super) fn reg(&mut self, scope: &mut Scope, handle: Handle<Expression>) -> Reg {
         let index = handle.index();
         if scope.regs[index] == NONE {
+            if let Some(place) = scope.places[index] {
+                return self.place_reg(scope, handle, place);
+            }
             if scope.dead_after.own_registers(handle) {
                 scope.regs[index] = self.alloc_new(scope.lens[index]);
             } else {
@@ -385,6 +389,26 @@ impl Compiler<'_> {
             }
         }
         scope.regs[index]
+    }
+
+    /// The register of `handle`, a pointer to `place`, made the first time an instruction
+    /// reads it. Why not when the pointer is made: most pointers with a known target are
+    /// only loaded from and stored through, which [`super::access`] compiles to the place
+    /// itself, and every register made costs each invocation its writing when a frame
+    /// starts (the template's copy, or [`Code::local_pointers`]'s fill). Made here: a
+    /// local variable's pointer is set when the frame starts (its frame is known only
+    /// then); any other pointer's words are in the template, shared by equal pointers.
+    fn place_reg(&mut self, scope: &mut Scope, handle: Handle<Expression>, place: Place) -> Reg {
+        match place {
+            Place::Local(variable) => {
+                let reg = self.reg_permanent(scope, handle);
+                self.local_pointers.push((reg, variable));
+                reg
+            }
+            Place::Workgroup(address) => self.constant(scope, handle, &[memory::WORKGROUP, address]),
+            Place::Private(address) => self.constant(scope, handle, &[memory::PRIVATE, address]),
+            Place::Buffer(buffer, address) => self.constant(scope, handle, &[memory::BUFFER | buffer, address]),
+        }
     }
 
     /// Opens the scope of `function`: registers for its expressions and variables,
@@ -493,7 +517,6 @@ impl Compiler<'_> {
                 },
                 Expression::GlobalVariable(g) => {
                     let (tag, offset) = self.globals[g.index()];
-                    self.constant(&mut scope, handle, &[tag, offset]);
                     scope.constant[index] = true;
                     scope.places[index] = match tag & memory::TAG_MASK {
                         memory::WORKGROUP => Some(Place::Workgroup(offset)),
@@ -503,12 +526,15 @@ impl Compiler<'_> {
                         }
                         _ => None,
                     };
+                    // A pointer with a place gets its register where one is read
+                    // (`place_reg`); a texture or sampler, or a buffer not bound, now.
+                    if scope.places[index].is_none() {
+                        self.constant(&mut scope, handle, &[tag, offset]);
+                    }
                 }
+                // Its register is made where one is read (`place_reg`).
                 Expression::LocalVariable(l) => {
-                    let variable = scope.locals[l.index()];
-                    let reg = self.reg_permanent(&mut scope, handle);
-                    self.local_pointers.push((reg, variable));
-                    scope.places[index] = Some(Place::Local(variable));
+                    scope.places[index] = Some(Place::Local(scope.locals[l.index()]));
                 }
                 _ => match const_value(self, &scope, handle) {
                     Some(value) => {
@@ -619,7 +645,7 @@ pub(super) fn const_value(compiler: &Compiler, scope: &Scope, handle: Handle<Exp
     let module = compiler.module;
     let value_of = |h: Handle<Expression>| -> Option<&[u32]> {
         let i = h.index();
-        if !scope.constant[i] {
+        if !scope.constant[i] || scope.regs[i] == NONE {
             return None;
         }
         let reg = scope.regs[i] as usize;

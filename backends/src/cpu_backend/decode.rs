@@ -226,13 +226,36 @@ pub(super) mod tests {
     /// As [`compiled`], with module-scope `declarations` (structs, functions, constants,
     /// other bindings) before the kernel.
     pub(in super::super) fn compiled_with(declarations: &str, body: &str) -> Vec<Insn> {
+        entry_code(&kernel_with(declarations, body)).insns
+    }
+
+    /// A kernel whose body is `body` after `let x = data[id.x];`, with module-scope
+    /// `declarations` (structs, functions, constants, other bindings) before it.
+    pub(in super::super) fn kernel_with(declarations: &str, body: &str) -> Kernel {
         let source = format!(
             "{declarations}\n@group(0) @binding(0) var<storage, read_write> data: array<u32>;\n\
              @compute @workgroup_size(8) fn main(@builtin(global_invocation_id) id: vec3<u32>) {{\n\
              let x = data[id.x];\n{body}\n}}"
         );
-        let kernel = Kernel::from_wgsl("compiled.wgsl", source, "main", false).expect("valid WGSL");
-        let program = compile_program(&kernel).expect("compiles");
-        program.codes.into_iter().nth(program.entry as usize).expect("entry code").insns
+        Kernel::from_wgsl("compiled.wgsl", source, "main", false).expect("valid WGSL")
+    }
+
+    /// The entry point's code of `kernel`.
+    pub(in super::super) fn entry_code(kernel: &Kernel) -> Code {
+        let program = compile_program(kernel).expect("compiles");
+        program.codes.into_iter().nth(program.entry as usize).expect("entry code")
+    }
+
+    /// Invocations [`run_kernel`] runs (8 workgroups of 8).
+    pub(in super::super) const INVOCATIONS: u32 = 64;
+
+    /// `data` after `kernel` (of [`kernel_with`]) ran on `data[i] = i`.
+    pub(in super::super) fn run_kernel(kernel: &Kernel) -> Vec<u32> {
+        use super::super::{CpuBackend, CpuOptions};
+        use crate::backend::{Backend, Bind, download, upload};
+        let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
+        let data = upload(&mut cpu, "data", &(0..INVOCATIONS).collect::<Vec<_>>()).unwrap();
+        cpu.dispatch(kernel, &[Bind::new(0, data)], [INVOCATIONS / 8, 1, 1]).unwrap();
+        download::<u32>(&mut cpu, data).unwrap()
     }
 }

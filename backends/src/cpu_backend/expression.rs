@@ -224,7 +224,6 @@ impl Compiler<'_> {
             }
             Expression::AccessIndex { base, index: i } => self.access_index(scope, handle, base, i),
             Expression::Load { pointer } => {
-                self.reg(scope, pointer);
                 match scope.places[pointer.index()] {
                     // Read in place (`load_alias`): the variable's own registers.
                     Some(Place::Local(variable)) if scope.in_place_loads[index] && scope.regs[index] == NONE => {
@@ -516,7 +515,6 @@ impl Compiler<'_> {
     fn access_index(&mut self, scope: &mut Scope, handle: Handle<Expression>, base: Handle<Expression>, index: u32) {
         let module = self.module;
         let line = self.line;
-        let base_reg = self.reg(scope, base);
         let step = match self.ty(scope, base) {
             TypeInner::Pointer { base: pointee, space } => {
                 // Pointers into buffers count bytes, others register words.
@@ -554,23 +552,16 @@ impl Compiler<'_> {
                 self.fail(what, line);
             }
             // A component or field of a value: the value's registers.
-            Ok((false, step)) => scope.regs[i] = base_reg + step,
+            Ok((false, step)) => scope.regs[i] = self.reg(scope, base) + step,
             Ok((true, step)) => match scope.places[base.index()] {
+                // A pointer known now: its register is made where one is read
+                // (`Compiler::place_reg`), in the template or set when the frame starts.
                 Some(place) => {
-                    let place = place.offset(step);
-                    scope.places[i] = Some(place);
-                    let dst = self.reg_permanent(scope, handle);
-                    match place {
-                        // Pointer values known now: in the template, or set when the frame starts.
-                        Place::Local(variable) => self.local_pointers.push((dst, variable)),
-                        _ => {
-                            self.template[dst as usize] = self.template[base_reg as usize];
-                            self.template[dst as usize + 1] = self.template[base_reg as usize + 1] + step;
-                            scope.constant[i] = true;
-                        }
-                    }
+                    scope.places[i] = Some(place.offset(step));
+                    scope.constant[i] = !matches!(place, Place::Local(_));
                 }
                 None => {
+                    let base_reg = self.reg(scope, base);
                     let dst = self.reg(scope, handle);
                     self.push(Insn::PtrAdd { dst, base: base_reg, add: step });
                 }

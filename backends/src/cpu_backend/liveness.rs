@@ -420,27 +420,12 @@ fn operands(expression: &Expression) -> Vec<Handle<Expression>> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::decode::compile_program;
-    use super::super::{CpuBackend, CpuOptions};
-    use crate::backend::{Backend, Bind, download, upload};
+    use super::super::decode::tests::{INVOCATIONS, entry_code, kernel_with, run_kernel};
     use strata_kernels::Kernel;
-
-    /// Invocations of each kernel run here (8 workgroups of 8).
-    const INVOCATIONS: u32 = 64;
 
     /// A kernel whose body is `body` after `let x = data[id.x];`.
     fn kernel(body: &str) -> Kernel {
         kernel_with("", body)
-    }
-
-    /// As [`kernel`], with module-scope `declarations` before the kernel.
-    fn kernel_with(declarations: &str, body: &str) -> Kernel {
-        let source = format!(
-            "{declarations}\n@group(0) @binding(0) var<storage, read_write> data: array<u32>;\n\
-             @compute @workgroup_size(8) fn main(@builtin(global_invocation_id) id: vec3<u32>) {{\n\
-             let x = data[id.x];\n{body}\n}}"
-        );
-        Kernel::from_wgsl("liveness.wgsl", source, "main", false).expect("valid WGSL")
     }
 
     /// `data` after the kernel ran on `data[i] = i`.
@@ -448,18 +433,9 @@ mod tests {
         run_kernel(&kernel(body))
     }
 
-    /// `data` after `kernel` ran on `data[i] = i`.
-    fn run_kernel(kernel: &Kernel) -> Vec<u32> {
-        let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
-        let data = upload(&mut cpu, "data", &(0..INVOCATIONS).collect::<Vec<_>>()).unwrap();
-        cpu.dispatch(kernel, &[Bind::new(0, data)], [INVOCATIONS / 8, 1, 1]).unwrap();
-        download::<u32>(&mut cpu, data).unwrap()
-    }
-
     /// The entry code's register words.
     fn registers(body: &str) -> usize {
-        let program = compile_program(&kernel(body)).expect("compiles");
-        program.codes[program.entry as usize].template.len()
+        entry_code(&kernel(body)).template.len()
     }
 
     /// `f` of each invocation's `x`.

@@ -323,8 +323,15 @@ impl Compiler<'_> {
         let size = callee.expressions.len();
         if size <= INLINE_EXPRESSIONS && scope.depth < INLINE_DEPTH && self.inlined + size <= INLINE_BUDGET {
             self.inlined += size;
-            let values: Vec<(Reg, Option<Place>)> =
-                arguments.iter().map(|a| (self.reg(scope, *a), scope.places[a.index()])).collect();
+            // A pointer argument with a known target passes its place, and its register
+            // only if it has one: the callee makes it where one is read (`place_reg`).
+            let values: Vec<(Reg, Option<Place>)> = arguments
+                .iter()
+                .map(|a| match scope.places[a.index()] {
+                    Some(place) => (scope.regs[a.index()], Some(place)),
+                    None => (self.reg(scope, *a), None),
+                })
+                .collect();
             let mut unused = Vec::new();
             let mark = self.mark();
             let mut inner = self.open(callee, &info[function], Some(&values), result, scope.depth + 1, &mut unused)?;

@@ -6,7 +6,9 @@
 //! `decode` from the functions `compiler` and the lowering files compile): instructions
 //! whose operands are word offsets in the frame's register file, small callees inlined,
 //! fields and bitcasts aliasing their source's registers, compile-time values in a
-//! register template. Passes make the code shorter and less divergent: an `if` that
+//! register template, and a pointer whose target is known when compiling given a
+//! register only where an instruction reads it (a load or store through it is compiled
+//! to the target itself). Passes make the code shorter and less divergent: an `if` that
 //! only stores into locals becomes selects (`if_conversion`), a value stored right
 //! after it is computed goes straight into the variable, and a call result that a
 //! returned record takes whole into the record's registers (`retarget`), a local's load

@@ -19,8 +19,9 @@ pub(super) struct Code {
     pub sources: Vec<u32>,
     /// Initial register file: compile-time values filled in, zeros elsewhere.
     pub template: Vec<u32>,
-    /// Registers of pointers to local variables: (register, variable's register), set
-    /// to (function tag | frame depth, variable's register) when a frame starts.
+    /// Registers of pointers to local variables that an instruction reads (loads and
+    /// stores at a known variable need none): (register, variable's register), set to
+    /// (function tag | frame depth, variable's register) when a frame starts.
     pub local_pointers: Vec<(Reg, u32)>,
     /// The function's own local variables (register, words): set from the template
     /// when a frame starts. Every other register is either a compile-time value (in

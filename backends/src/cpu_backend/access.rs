@@ -157,4 +157,41 @@ mod tests {
         };
         assert_eq!(run_kernel(&kernel), (0..INVOCATIONS).map(f).collect::<Vec<_>>());
     }
+
+    #[test]
+    fn a_pointer_register_made_where_it_is_read_points_at_its_target() {
+        // Each way a pointer with a known target is read as a value: a workgroup and a
+        // private array indexed at run time, a local indexed at run time by the caller
+        // before an inlined callee indexes it too (the caller's register passed on), a
+        // local first indexed at run time inside an inlined callee (the callee makes the
+        // register), and that local indexed at run time again inside a branch.
+        let declarations = "var<workgroup> w: array<u32, 8>;
+            var<private> q: array<u32, 4>;
+            fn put(p: ptr<function, array<u32, 4>>, i: u32, value: u32) { (*p)[i] = value; }";
+        let body = "w[x & 7u] = x * 2u;
+            workgroupBarrier();
+            q[x & 3u] = x + 100u;
+            var v = array<u32, 4>(0u, 0u, 0u, 0u);
+            v[(x + 1u) & 3u] = 5u;
+            put(&v, x & 3u, 7u);
+            var u = array<u32, 4>(1u, 2u, 3u, 4u);
+            put(&u, (x + 2u) & 3u, 40u);
+            if (x & 1u) == 1u { u[x & 3u] = 50u; }
+            data[id.x] = w[(x + 1u) & 7u] + q[x & 3u] + v[(x + 1u) & 3u] * 1000u + v[x & 3u] * 100u
+                + u[0] + u[1] + u[2] + u[3];";
+        let kernel = kernel_with(declarations, body);
+        // One register for each of `v` and `u`, however many pointers to them are read.
+        assert_eq!(entry_code(&kernel).local_pointers.len(), 2);
+        let f = |x: u32| {
+            // The workgroup's neighbour (8 invocations a workgroup, `x & 7` the local index).
+            let w = ((x & !7) + ((x + 1) & 7)) * 2;
+            let mut u = [1, 2, 3, 4];
+            u[((x + 2) & 3) as usize] = 40;
+            if x & 1 == 1 {
+                u[(x & 3) as usize] = 50;
+            }
+            w + (x + 100) + 5 * 1000 + 7 * 100 + u.iter().sum::<u32>()
+        };
+        assert_eq!(run_kernel(&kernel), (0..INVOCATIONS).map(f).collect::<Vec<_>>());
+    }
 }

@@ -246,7 +246,9 @@ impl Compiler<'_> {
         if scope.regs[index] == NONE {
             scope.regs[index] = self.alloc_new(scope.lens[index]);
         } else if self.reused.contains(&scope.regs[index]) {
-            // Not reached: these expressions get their register where they are compiled.
+            // Not reached: these expressions get their register where they are compiled,
+            // or a pointer with a known target where one is first read (`place_reg`),
+            // from `reg_permanent` or `constant`, never from the reused ranges.
             self.fail("internal: a compile-time value in a reused register".into(), self.line);
         }
         self.permanent.insert(scope.regs[index]);
@@ -397,10 +399,19 @@ impl Compiler<'_> {
     /// itself, and every register made costs each invocation its writing when a frame
     /// starts (the template's copy, or [`Code::local_pointers`]'s fill). Made here: a
     /// local variable's pointer is set when the frame starts (its frame is known only
-    /// then); any other pointer's words are in the template, shared by equal pointers.
+    /// then); any other pointer's words are in the template; either is shared by every
+    /// pointer to the same target.
     fn place_reg(&mut self, scope: &mut Scope, handle: Handle<Expression>, place: Place) -> Reg {
         match place {
             Place::Local(variable) => {
+                // Every pointer to one variable has the same words in a frame (an inlined
+                // callee's pointer argument too), so one register serves them all. Found in
+                // `local_pointers` itself, so that a speculation undone (`if_conversion`),
+                // which cuts that list back, forgets it as well.
+                if let Some(&(reg, _)) = self.local_pointers.iter().find(|&&(_, v)| v == variable) {
+                    scope.regs[handle.index()] = reg;
+                    return reg;
+                }
                 let reg = self.reg_permanent(scope, handle);
                 self.local_pointers.push((reg, variable));
                 reg

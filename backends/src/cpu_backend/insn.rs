@@ -5,8 +5,8 @@
 //! A frame's register file holds, in this order, the value of every expression that
 //! needs storage, the function's local variables (and those of every callee inlined into
 //! it), all as 32-bit words. Values that are known when the kernel is compiled
-//! (literals, constants, pointers to globals) are filled into each code's register
-//! template once and never recomputed.
+//! (literals, constants, pointers to globals that an instruction reads as values) are
+//! filled into each code's register template once and never recomputed.
 //!
 //! Why every instruction type sits here, the boxed operands of the rarer ones too
 //! ([`ElementLoad`], [`ImageInsn`], ...): this file is the contract between the compiler

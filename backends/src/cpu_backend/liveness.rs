@@ -26,7 +26,8 @@
 //!   registers of its own, never shared ([`DeadAfter::own_registers`]), so that it keeps
 //!   its previous iteration's words as before.
 //! - **Never freed.** Values evaluated when the scope opens (constants, arguments,
-//!   variables' pointers) and variables' initialisers; and every value of a function
+//!   variables' pointers, whose registers are made there or, for a pointer with a known
+//!   target, where an instruction first reads it) and variables' initialisers; and every value of a function
 //!   with a statement this walk does not know, or with an expression emitted twice (naga
 //!   IR allows it in two blocks, WGSL does not produce it), whose two emissions would
 //!   share one death.

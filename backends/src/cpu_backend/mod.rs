@@ -7,8 +7,9 @@
 //! whose operands are word offsets in the frame's register file, small callees inlined,
 //! fields and bitcasts aliasing their source's registers, compile-time values in a
 //! register template, and a pointer whose target is known when compiling given a
-//! register only where an instruction reads it (a load or store through it is compiled
-//! to the target itself). Passes make the code shorter and less divergent: an `if` that
+//! register only where an instruction reads it (most loads and stores through it are
+//! compiled to the target itself; not those of a value holding `f16` in a buffer, nor
+//! atomics). Passes make the code shorter and less divergent: an `if` that
 //! only stores into locals becomes selects (`if_conversion`), a value stored right
 //! after it is computed goes straight into the variable, and a call result that a
 //! returned record takes whole into the record's registers (`retarget`), a local's load

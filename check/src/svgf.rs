@@ -3,7 +3,7 @@
 //! few slanted planes (objects with their own normals, depths and textured albedo), a
 //! share of sky pixels in some families, motion vectors that land between pixels, off the
 //! image, or are NaN, histories of every length, and moments whose variance is not lost
-//! to cancellation (E[l²] at least 1.1 E[l]², so that a fused multiply-add in one backend
+//! to cancellation (`E[l²]` at least 1.1 `E[l]²`, so that a fused multiply-add in one backend
 //! cannot turn a 0 into many ULPs). Every output is f32, within the registry's bound.
 
 use super::{Case, CheckConfig, Compare, KernelCheck, Output};

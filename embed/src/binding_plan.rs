@@ -44,8 +44,8 @@ pub(crate) struct OwnBuffers<B> {
 
 impl<B> OwnBuffers<B> {
     /// Makes each of the pass's own buffers with `make(buffer, bytes)`, sized by its
-    /// [`SizeRule`] for `pixels` pixels and `blocks` blocks (the unused payloads buffer
-    /// takes 4 bytes).
+    /// [`SizeRule`](crate::SizeRule) for `pixels` pixels and `blocks` blocks (the unused
+    /// payloads buffer takes 4 bytes).
     pub fn make<E>(pixels: u64, blocks: u64, mut make: impl FnMut(PassBuffer, u64) -> Result<B, E>) -> Result<Self, E> {
         let mut own = |buffer: PassBuffer| make(buffer, buffer.size_rule().bytes(pixels, blocks));
         Ok(OwnBuffers {

@@ -63,7 +63,7 @@ pub(super) enum BinOp {
 
 impl BinOp {
     /// The operator `op` on components of kind `kind`; `None` where WGSL has none
-    /// (mirrors [`super::arith::binary`] case by case).
+    /// (mirrors `arith::binary`, the tests' reference, compiled for tests only, case by case).
     pub(super) fn resolve(op: naga::BinaryOperator, kind: ScalarKind) -> Option<Self> {
         use BinOp as O;
         use ScalarKind as K;

@@ -107,19 +107,8 @@ impl Compiler<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::decode::tests::{INVOCATIONS, entry_code, kernel_with, run_kernel};
-    use super::super::{CpuBackend, CpuOptions, memory};
-    use crate::backend::{Backend, Bind, download, upload};
-    use strata_kernels::Kernel;
-
-    /// `data` after `kernel` ran on `data[i] = i`, with `table` (binding 1) bound too.
-    fn run_kernel_with_table(kernel: &Kernel) -> Vec<u32> {
-        let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
-        let data = upload(&mut cpu, "data", &(0..INVOCATIONS).collect::<Vec<_>>()).unwrap();
-        let table = upload(&mut cpu, "table", &[10u32, 20, 30, 40]).unwrap();
-        cpu.dispatch(kernel, &[Bind::new(0, data), Bind::new(1, table)], [INVOCATIONS / 8, 1, 1]).unwrap();
-        download::<u32>(&mut cpu, data).unwrap()
-    }
+    use super::super::decode::tests::{INVOCATIONS, entry_code, kernel_with, run_kernel, run_kernel_bound};
+    use super::super::memory;
 
     /// Whether `template` holds a pointer's words `(tag, address)`.
     fn holds_pointer(template: &[u32], tag: u32, address: u32) -> bool {
@@ -143,7 +132,7 @@ mod tests {
         assert!(!code.template.contains(&(memory::BUFFER | 1)), "a pointer into `table` in the template");
         assert!(holds_pointer(&code.template, memory::BUFFER, 0), "`data`, indexed at run time, reads its pointer");
         let expected: Vec<u32> = (0..INVOCATIONS).map(|x| (x + 1) + (x * 5 * 3 + 7) + (3 * 3 + x) + 30).collect();
-        assert_eq!(run_kernel_with_table(&kernel), expected);
+        assert_eq!(run_kernel_bound(&kernel, &[(1, &[10, 20, 30, 40])]), expected);
 
         // An index known only at run time reads the variable's pointer: one register,
         // set when the frame starts.

@@ -251,11 +251,20 @@ pub(super) mod tests {
 
     /// `data` after `kernel` (of [`kernel_with`]) ran on `data[i] = i`.
     pub(in super::super) fn run_kernel(kernel: &Kernel) -> Vec<u32> {
+        run_kernel_bound(kernel, &[])
+    }
+
+    /// As [`run_kernel`], with the buffers `more` bound too, each (binding, words).
+    pub(in super::super) fn run_kernel_bound(kernel: &Kernel, more: &[(u32, &[u32])]) -> Vec<u32> {
         use super::super::{CpuBackend, CpuOptions};
         use crate::backend::{Backend, Bind, download, upload};
         let mut cpu = CpuBackend::new(CpuOptions::default()).unwrap();
         let data = upload(&mut cpu, "data", &(0..INVOCATIONS).collect::<Vec<_>>()).unwrap();
-        cpu.dispatch(kernel, &[Bind::new(0, data)], [INVOCATIONS / 8, 1, 1]).unwrap();
+        let mut binds = vec![Bind::new(0, data)];
+        for &(binding, words) in more {
+            binds.push(Bind::new(binding, upload(&mut cpu, "more", words).unwrap()));
+        }
+        cpu.dispatch(kernel, &binds, [INVOCATIONS / 8, 1, 1]).unwrap();
         download::<u32>(&mut cpu, data).unwrap()
     }
 }

@@ -27,10 +27,10 @@
 //!   its previous iteration's words as before.
 //! - **Never freed.** Values evaluated when the scope opens (constants, arguments,
 //!   variables' pointers, whose registers are made there or, for a pointer with a known
-//!   target, where an instruction first reads it) and variables' initialisers; and every value of a function
-//!   with a statement this walk does not know, or with an expression emitted twice (naga
-//!   IR allows it in two blocks, WGSL does not produce it), whose two emissions would
-//!   share one death.
+//!   target, where an instruction first reads it) and variables' initialisers; and every
+//!   value of a function with a statement this walk does not know, or with an
+//!   expression emitted twice (naga IR allows it in two blocks, WGSL does not produce
+//!   it), whose two emissions would share one death.
 //!
 //! Sound because naga's functions are structured: every jump but a loop's back edge goes
 //! forward in this order, and a value is emitted before its uses on every path (naga

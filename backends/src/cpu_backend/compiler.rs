@@ -134,6 +134,14 @@ pub(super) struct Scope<'a> {
     dead_after: DeadAfter,
 }
 
+impl Scope<'_> {
+    /// Whether `value` needs registers no other value ever takes
+    /// ([`DeadAfter::own_registers`]).
+    pub(super) fn dead_after_own_registers(&self, value: Handle<Expression>) -> bool {
+        self.dead_after.own_registers(value)
+    }
+}
+
 /// Marks an expression that owns no run-time range ([`Scope::owned`]).
 const NOT_OWNED: u32 = u32::MAX;
 

@@ -77,6 +77,7 @@ mod batch;
 mod budget;
 mod checked;
 mod compiler;
+mod compose_in_place;
 mod constant;
 mod counts;
 mod decode;

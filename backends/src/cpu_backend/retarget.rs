@@ -325,10 +325,11 @@ mod tests {
         let declarations = "struct P { a: u32, b: u32 }\n\
              fn make(x: u32) -> P { return P(x + 1u, x * 2u); }\n\
              fn forward(x: u32) -> P { return make(x); }";
-        // The struct's two words written once, straight into `p`'s registers by its
-        // composition; no copy of the whole at `make`'s and `forward`'s returns.
+        // The struct's two words computed straight into `p`'s registers (its members
+        // into the composition's words, `compose_in_place`, and the composition into
+        // the result's): no copy at all, at the composition or at either return.
         let insns = compiled_with(declarations, "let p = forward(x); data[id.x] = p.a + p.b;");
-        assert_eq!(copied_words(&insns), 2);
+        assert_eq!(copied_words(&insns), 0);
         // A value computed before another and returned in one branch keeps its own
         // registers (the other would overwrite it in the result's).
         let declarations = "struct P { a: u32, b: u32 }\n\
@@ -361,12 +362,13 @@ mod tests {
         assert_eq!(copied_words(&compiled_with(&reader, body)), 0);
         // A row whose words land out of order (r0.yzw first), one that something else
         // also reads (r1.x), and one with a word computed (r2.x + extra) keep their own
-        // registers and are copied: 4 words each.
+        // registers and are copied: 4 words each, less the computed word, which is
+        // computed in its place (`compose_in_place`).
         let reader = row_reader(
             "let extra = r1.x; return Node(bitcast<vec3<f32>>(r0.yzw), r0.x, bitcast<vec3<f32>>(r1.xyz), r1.w, \
              r2.x + extra, r2.y, r2.z, r2.w);",
         );
-        assert_eq!(copied_words(&compiled_with(&reader, body)), 4 + 4 + 4);
+        assert_eq!(copied_words(&compiled_with(&reader, body)), 4 + 4 + 3);
     }
 
     #[test]

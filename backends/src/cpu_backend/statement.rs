@@ -16,7 +16,25 @@ impl Compiler<'_> {
     /// Lowers every statement of `block` in order, freeing the registers of the values
     /// that die after each ([`super::liveness`]).
     pub(super) fn block(&mut self, scope: &mut Scope, block: &naga::Block) -> Result<(), BackendError> {
-        for (statement, span) in block.span_iter() {
+        let statements: Vec<(&Statement, &naga::Span)> = block.span_iter().collect();
+        for (at, &(statement, span)) in statements.iter().enumerate() {
+            // At the first of consecutive `Emit` statements: the compositions among their
+            // expressions given registers before any of them is compiled, their components
+            // placed in them (`compose_in_place`). Consecutive because naga's front end
+            // splits one line's expressions around every constant it evaluates.
+            let starts_emits = matches!(statement, Statement::Emit(_))
+                && (at == 0 || !matches!(statements[at - 1].0, Statement::Emit(_)));
+            if starts_emits {
+                let emitted: Vec<Handle<Expression>> = statements[at..]
+                    .iter()
+                    .map_while(|&(next, _)| match next {
+                        Statement::Emit(range) => Some(range.clone()),
+                        _ => None,
+                    })
+                    .flatten()
+                    .collect();
+                self.place_compositions(scope, &emitted);
+            }
             self.statement(scope, statement, *span)?;
             self.free_dead(scope, Slot::Statement(statement));
         }

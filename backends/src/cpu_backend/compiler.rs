@@ -127,7 +127,8 @@ pub(super) struct Scope<'a> {
     pub(super) loops: Vec<(Vec<usize>, Vec<usize>)>,
     /// Per expression: the index of the run-time range [`Compiler::reg`] allocated for it
     /// in [`Compiler::runtime`] ([`NOT_OWNED`] if there is none to free: a constant, an
-    /// alias of another value's registers, a caller's register, a value with registers
+    /// alias of another value's registers, a caller's register, a component computed in
+    /// its composition's registers ([`super::compose_in_place`]), a value with registers
     /// never shared ([`DeadAfter::own_registers`]), or one freed already).
     pub(super) owned: Vec<u32>,
     /// Where each of its values dies ([`super::liveness`]).

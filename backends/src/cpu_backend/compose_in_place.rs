@@ -20,17 +20,22 @@
 //! components in it, so nested compositions (`Quad(vec4(a.xz, b.xz), ..)`) copy
 //! nothing either.
 //!
-//! Sound because the composition's registers are taken from the free ranges before the
-//! run's first expression is compiled, so no value computed or alive in between can
-//! hold them; each placed component writes only its own words of them (its operands are
+//! Sound because the composition's registers are taken before the run's first expression
+//! is compiled (from the free ranges, or they are an inlined callee's result registers or
+//! the composition's slot in an enclosing one), so no value computed or alive in between
+//! can hold them; each placed component writes only its own words of them (its operands are
 //! other values, never the composition or its components, which nothing but the
 //! composition reads); and the composition then finds each component where it would
 //! have copied it and emits no copy ([`Compiler::copy`] drops a copy onto itself). A
 //! composition given the registers of an inlined callee's result
 //! ([`Scope::return_in_place`]) places its components there: nothing else in the callee
 //! reads or writes those registers, and within a run of `Emit` statements no other
-//! statement runs between a component and the composition. A speculated branch undone
-//! by if-conversion restores the registers and the ranges taken, these included.
+//! statement runs between a component and the composition.
+//!
+//! Placement runs where [`Compiler::block`] compiles a block. The branches that
+//! if-conversion speculates ([`super::if_conversion`]) are compiled statement by
+//! statement and keep their copies; a speculation undone is compiled again as a block,
+//! with placement.
 
 use super::compiler::{Compiler, NONE, Scope};
 use super::constant::compose_offsets;
@@ -39,9 +44,10 @@ use std::collections::HashSet;
 
 impl Compiler<'_> {
     /// Before the expressions `handles` of a run of consecutive `Emit` statements of
-    /// `scope` are compiled:
-    /// gives every composition among them registers, and its components their words of
-    /// them, as the module comment describes. Nothing is compiled here.
+    /// `scope` are compiled: gives each composition among them with a component to place
+    /// registers (unless it was evaluated when the scope opened, or needs registers never
+    /// shared), and those components their words of them, as the module comment
+    /// describes. Nothing is compiled here.
     pub(super) fn place_compositions(&mut self, scope: &mut Scope, handles: &[Handle<Expression>]) {
         let emitted: HashSet<Handle<Expression>> = handles.iter().copied().collect();
         let emitted_here = |h: Handle<Expression>| emitted.contains(&h);
@@ -177,9 +183,10 @@ mod tests {
     }
 
     #[test]
-    fn compositions_in_branches_if_conversion_takes_or_undoes() {
-        // Straight-line branches (if-conversion speculates both and selects) and a branch
-        // with a loop (speculation undone, compiled as branches): the same values.
+    fn compositions_in_converted_and_compiled_branches() {
+        // Straight-line branches (if-conversion speculates both and selects; nothing is
+        // placed in them) and a branch with a loop (not speculated: compiled as branches,
+        // each block with placement): the values.
         let selected = "var r = vec2<u32>();\n\
                         if x > 20u { r = vec2<u32>(x * 2u, x + 1u); } else { r = vec2<u32>(x ^ 3u, 7u); }\n\
                         data[id.x] = r.x * 1000u + r.y;";

@@ -39,7 +39,10 @@ impl Scope<'_> {
     /// so the result registers, which nothing else in the callee writes, hold it from its
     /// computation to the return; several such returns (in different branches) each write
     /// them just before returning. Its operands are never the result registers: only values
-    /// returned are given them, and a returned value is used by nothing else.
+    /// returned are given them, and a returned value is used by nothing else; the parts
+    /// that also lie in them (a call result placed by [`Compiler::components_in_place`],
+    /// a component computed in place by `compose_in_place`) are used by the record alone
+    /// and computed just before it.
     ///
     /// Returns the values given the registers.
     pub(super) fn return_in_place(&mut self, dst: Reg, words: u32) -> Vec<Handle<Expression>> {

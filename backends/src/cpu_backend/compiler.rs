@@ -132,15 +132,7 @@ pub(super) struct Scope<'a> {
     /// never shared ([`DeadAfter::own_registers`]), or one freed already).
     pub(super) owned: Vec<u32>,
     /// Where each of its values dies ([`super::liveness`]).
-    dead_after: DeadAfter,
-}
-
-impl Scope<'_> {
-    /// Whether `value` needs registers no other value ever takes
-    /// ([`DeadAfter::own_registers`]).
-    pub(super) fn dead_after_own_registers(&self, value: Handle<Expression>) -> bool {
-        self.dead_after.own_registers(value)
-    }
+    pub(super) dead_after: DeadAfter,
 }
 
 /// Marks an expression that owns no run-time range ([`Scope::owned`]).

@@ -50,9 +50,8 @@ impl Compiler<'_> {
     /// describes. Nothing is compiled here.
     pub(super) fn place_compositions(&mut self, scope: &mut Scope, handles: &[Handle<Expression>]) {
         let emitted: HashSet<Handle<Expression>> = handles.iter().copied().collect();
-        let emitted_here = |h: Handle<Expression>| emitted.contains(&h);
         // Compositions given registers here (a nested one by its parent).
-        let mut placed: Vec<Handle<Expression>> = Vec::new();
+        let mut placed: HashSet<Handle<Expression>> = HashSet::new();
         // Outermost first: a composition comes after its components in the arena.
         for &record in handles.iter().rev() {
             let Expression::Compose { ref components, .. } = scope.function.expressions[record] else { continue };
@@ -61,35 +60,35 @@ impl Compiler<'_> {
                 continue;
             }
             let in_result = scope.inlined && scope.result.is_some_and(|(reg, _)| reg == scope.regs[index]);
-            let free_to_place = scope.regs[index] == NONE && !scope.dead_after_own_registers(record);
+            let free_to_place = scope.regs[index] == NONE && !scope.dead_after.own_registers(record);
             if !(free_to_place || in_result || placed.contains(&record)) {
                 continue;
             }
-            let slots: Vec<Handle<Expression>> = components
+            let lens: Vec<u32> = components.iter().map(|c| scope.lens[c.index()]).collect();
+            let Ok(offsets) = compose_offsets(self.module, self.ty(scope, record), &lens) else { continue };
+            let slots: Vec<(Handle<Expression>, u32)> = components
                 .iter()
                 .copied()
-                .filter(|&c| {
+                .zip(offsets)
+                .filter(|&(c, at)| {
                     let i = c.index();
-                    emitted_here(c)
-                        && c.index() < index
+                    emitted.contains(&c)
+                        && i < index
+                        && at + scope.lens[i] <= scope.lens[index]
                         && scope.info[c].ref_count == 1
                         && scope.regs[i] == NONE
                         && !scope.pre_emitted[i]
-                        && !scope.dead_after_own_registers(c)
+                        && !scope.dead_after.own_registers(c)
                         && computed_in_own_registers(&scope.function.expressions[c])
                 })
                 .collect();
             if slots.is_empty() {
                 continue;
             }
-            let lens: Vec<u32> = components.iter().map(|c| scope.lens[c.index()]).collect();
-            let Ok(offsets) = compose_offsets(self.module, self.ty(scope, record), &lens) else { continue };
             let base = self.reg(scope, record);
-            for (&component, &at) in components.iter().zip(&offsets) {
-                if slots.contains(&component) && at + scope.lens[component.index()] <= scope.lens[index] {
-                    scope.regs[component.index()] = base + at;
-                    placed.push(component);
-                }
+            for (component, at) in slots {
+                scope.regs[component.index()] = base + at;
+                placed.insert(component);
             }
         }
     }

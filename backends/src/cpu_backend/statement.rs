@@ -16,18 +16,17 @@ impl Compiler<'_> {
     /// Lowers every statement of `block` in order, freeing the registers of the values
     /// that die after each ([`super::liveness`]).
     pub(super) fn block(&mut self, scope: &mut Scope, block: &naga::Block) -> Result<(), BackendError> {
-        let statements: Vec<(&Statement, &naga::Span)> = block.span_iter().collect();
-        for (at, &(statement, span)) in statements.iter().enumerate() {
+        let mut after_emit = false;
+        for (at, (statement, span)) in block.span_iter().enumerate() {
             // At the first of consecutive `Emit` statements: the compositions among their
             // expressions given registers before any of them is compiled, their components
             // placed in them (`compose_in_place`). Consecutive because naga's front end
             // splits one line's expressions around every constant it evaluates.
-            let starts_emits = matches!(statement, Statement::Emit(_))
-                && (at == 0 || !matches!(statements[at - 1].0, Statement::Emit(_)));
-            if starts_emits {
-                let emitted: Vec<Handle<Expression>> = statements[at..]
+            let emit = matches!(statement, Statement::Emit(_));
+            if emit && !after_emit {
+                let emitted: Vec<Handle<Expression>> = block[at..]
                     .iter()
-                    .map_while(|&(next, _)| match next {
+                    .map_while(|next| match next {
                         Statement::Emit(range) => Some(range.clone()),
                         _ => None,
                     })
@@ -35,6 +34,7 @@ impl Compiler<'_> {
                     .collect();
                 self.place_compositions(scope, &emitted);
             }
+            after_emit = emit;
             self.statement(scope, statement, *span)?;
             self.free_dead(scope, Slot::Statement(statement));
         }

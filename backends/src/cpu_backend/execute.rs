@@ -341,9 +341,10 @@ fn load_element(load: &ElementLoad, memory: &[AtomicU32], file: &mut [u32], memb
     let registers = || runs.iter().flat_map(|&(start, words)| start as usize..(start + words) as usize);
     // Whether every member reads the same element (then one read fills the rows), found
     // out no further than the first member that does not.
+    let clamp = load.clamp(bytes);
     let mut leader = None;
     let same = members.all(|lane| {
-        let first = load.first_word(bytes, file[index * width + lane]);
+        let first = clamp.first_word(file[index * width + lane]);
         *leader.get_or_insert(first) == first
     });
     if let (true, Some(first)) = (same, leader) {
@@ -368,7 +369,7 @@ fn load_element(load: &ElementLoad, memory: &[AtomicU32], file: &mut [u32], memb
     let (mut lanes, mut firsts, mut n) = ([0usize; CHUNK], [0usize; CHUNK], 0);
     members.for_each(|lane| {
         lanes[n] = lane;
-        firsts[n] = load.first_word(bytes, file[index * width + lane]);
+        firsts[n] = clamp.first_word(file[index * width + lane]);
         n += 1;
         if n == CHUNK {
             write_rows(file, &lanes, &firsts);

@@ -419,8 +419,22 @@ fn binary_rows(
         }),
         Members::Some(lanes, width) => {
             for r in 0..rows {
-                for &l in lanes {
-                    regs[(dst + r) * width + l] = f(regs[(a + r) * width + l], regs[(b + r) * width + l]);
+                let (d, x, y) = ((dst + r) * width, (a + r) * width, (b + r) * width);
+                // Whole rows as slices of `width` words: one bound for the three reads
+                // and the write of a member, which the compiler tests once.
+                if let Ok([out, xs, ys]) = regs.get_disjoint_mut([d..d + width, x..x + width, y..y + width]) {
+                    for &l in lanes {
+                        out[l] = f(xs[l], ys[l]);
+                    }
+                } else if x == y && d != x {
+                    let [out, xs] = regs.get_disjoint_mut([d..d + width, x..x + width]).expect("rows apart");
+                    for &l in lanes {
+                        out[l] = f(xs[l], xs[l]);
+                    }
+                } else {
+                    for &l in lanes {
+                        regs[d + l] = f(regs[x + l], regs[y + l]);
+                    }
                 }
             }
         }
@@ -461,8 +475,15 @@ fn unary_rows(members: Members<'_>, regs: &mut [u32], dst: usize, src: usize, ro
         }),
         Members::Some(lanes, width) => {
             for r in 0..rows {
-                for &l in lanes {
-                    regs[(dst + r) * width + l] = f(regs[(src + r) * width + l]);
+                let (d, x) = ((dst + r) * width, (src + r) * width);
+                if let Ok([out, xs]) = regs.get_disjoint_mut([d..d + width, x..x + width]) {
+                    for &l in lanes {
+                        out[l] = f(xs[l]);
+                    }
+                } else {
+                    for &l in lanes {
+                        regs[d + l] = f(regs[x + l]);
+                    }
                 }
             }
         }
@@ -515,9 +536,17 @@ fn select_rows(
         }),
         Members::Some(lanes, width) => {
             for r in 0..rows {
-                for &l in lanes {
-                    let from = if regs[(cond + r) * width + l] != 0 { accept } else { reject };
-                    regs[(dst + r) * width + l] = regs[(from + r) * width + l];
+                let (d, c, x, y) = ((dst + r) * width, (cond + r) * width, (accept + r) * width, (reject + r) * width);
+                if let Ok([out, cs, xs, ys]) =
+                    regs.get_disjoint_mut([d..d + width, c..c + width, x..x + width, y..y + width])
+                {
+                    for &l in lanes {
+                        out[l] = if cs[l] != 0 { xs[l] } else { ys[l] };
+                    }
+                } else {
+                    for &l in lanes {
+                        regs[d + l] = if regs[c + l] != 0 { regs[x + l] } else { regs[y + l] };
+                    }
                 }
             }
         }
@@ -550,8 +579,15 @@ fn copy_rows(members: Members<'_>, regs: &mut [u32], dst: usize, src: usize, len
         Members::Some(lanes, width) => {
             for i in 0..len {
                 let r = if dst <= src { i } else { len - 1 - i };
-                for &l in lanes {
-                    regs[(dst + r) * width + l] = regs[(src + r) * width + l];
+                let (d, x) = ((dst + r) * width, (src + r) * width);
+                if let Ok([out, xs]) = regs.get_disjoint_mut([d..d + width, x..x + width]) {
+                    for &l in lanes {
+                        out[l] = xs[l];
+                    }
+                } else {
+                    for &l in lanes {
+                        regs[d + l] = regs[x + l];
+                    }
                 }
             }
         }
@@ -560,7 +596,9 @@ fn copy_rows(members: Members<'_>, regs: &mut [u32], dst: usize, src: usize, len
             for i in 0..len {
                 let r = if dst <= src { i } else { len - 1 - i };
                 each_chunk(mask, chunks, |c, mask| {
-                    let words: [u32; N] = std::array::from_fn(|k| regs[(src + r) * width + c + k]);
+                    // The chunk's words copied out whole (one bound, a vector copy), not
+                    // word by word.
+                    let words: [u32; N] = regs[(src + r) * width + c..][..N].try_into().expect("a chunk of N lanes");
                     keep_members(&mut regs[(dst + r) * width + c..][..N], &words, mask);
                 });
             }
@@ -644,5 +682,81 @@ mod tests {
         mask[0] = u32::MAX;
         set[0] = 0;
         assert_eq!(zeros_of(Members::Masked(&set, &mask, 0b110), &row), (vec![66, 129], 2));
+    }
+
+    /// The row operations of listed and masked members against one member and one
+    /// register at a time, rows in order (what an invocation alone computes), for rows
+    /// apart and for every way the rows of one instruction can coincide or overlap.
+    #[test]
+    fn some_members_rows_match_one_member_at_a_time() {
+        const WIDTH: usize = 128;
+        let start: Vec<u32> = (0..WIDTH as u32 * 12).map(|i| i.wrapping_mul(2_654_435_761) >> 7).collect();
+        let some = [1, 2, 40, 64, 100, 127];
+        let (mut mask, mut set) = (vec![0; WIDTH], [0u64; 2]);
+        for &l in &some {
+            mask[l] = u32::MAX;
+            set[l / N] |= 1 << (l % N);
+        }
+        let groups = [Members::Some(&some, WIDTH), Members::Masked(&set, &mask, 0b11)];
+        let at = |reg: usize, lane: usize| reg * WIDTH + lane;
+        let f = |x: u32, y: u32| x.wrapping_mul(3) ^ y.rotate_left(5);
+        // (dst, a, b, rows): apart, the destination an operand, both operands one row, all
+        // three one row, and overlapping in part.
+        let cases = [(0, 4, 8, 2), (4, 4, 8, 2), (8, 4, 8, 2), (0, 4, 4, 2), (4, 4, 4, 2), (5, 4, 8, 2), (3, 4, 8, 2)];
+        for group in groups {
+            let kind = if matches!(group, Members::Some(..)) { "listed" } else { "masked" };
+            for (dst, a, b, rows) in cases {
+                let mut expected = start.clone();
+                for r in 0..rows {
+                    for &l in &some {
+                        expected[at(dst + r, l)] = f(expected[at(a + r, l)], expected[at(b + r, l)]);
+                    }
+                }
+                let mut regs = start.clone();
+                group.binary(&mut regs, (dst, a, b), rows, f);
+                assert!(regs == expected, "{kind} binary {dst} <- {a}, {b} ({rows} rows)");
+
+                let mut expected = start.clone();
+                for r in 0..rows {
+                    for &l in &some {
+                        expected[at(dst + r, l)] = f(expected[at(a + r, l)], 7);
+                    }
+                }
+                let mut regs = start.clone();
+                group.unary(&mut regs, dst, a, rows, |x| f(x, 7));
+                assert!(regs == expected, "{kind} unary {dst} <- {a} ({rows} rows)");
+
+                // The condition in rows `b..`: zero for every other member, so that both
+                // `a`'s and `a + 2`'s rows are chosen.
+                let mut chosen = start.clone();
+                for r in 0..rows {
+                    for (k, &l) in some.iter().enumerate() {
+                        chosen[at(b + r, l)] = if (k + r) % 2 == 0 { 0 } else { chosen[at(b + r, l)] | 1 };
+                    }
+                }
+                let mut expected = chosen.clone();
+                for r in 0..rows {
+                    for &l in &some {
+                        let from = if expected[at(b + r, l)] != 0 { a } else { a + 2 };
+                        expected[at(dst + r, l)] = expected[at(from + r, l)];
+                    }
+                }
+                let mut regs = chosen.clone();
+                group.select(&mut regs, (dst, b, a, a + 2), rows);
+                assert!(regs == expected, "{kind} select {dst} <- {b} ? {a} : {} ({rows} rows)", a + 2);
+
+                // A copy of overlapping rows reads each word before it is overwritten.
+                let mut expected = start.clone();
+                for &l in &some {
+                    let column: Vec<u32> = (0..rows).map(|r| start[at(a + r, l)]).collect();
+                    for (r, &word) in column.iter().enumerate() {
+                        expected[at(dst + r, l)] = word;
+                    }
+                }
+                let mut regs = start.clone();
+                group.copy(&mut regs, dst, a, rows);
+                assert!(regs == expected, "{kind} copy {dst} <- {a} ({rows} rows)");
+            }
+        }
     }
 }

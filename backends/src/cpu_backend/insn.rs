@@ -343,9 +343,10 @@ pub(super) struct ElementClamp {
 }
 
 impl ElementClamp {
-    /// The buffer word where the element of `index` starts: `ElementLoad::first_word`'s.
-    /// No overflow: `last * stride` is at most the buffer's size for a runtime-sized
-    /// array and below 2^64 for a fixed one (a `u32` count times a `u32` stride).
+    /// The buffer word where the element of `index` starts, as
+    /// [`ElementLoad::first_word`] gives it. No overflow: `address + last * stride` is at
+    /// most the buffer's size for a runtime-sized array, and at most (2^32 - 1)^2 for a
+    /// fixed one (a `u32` address, count and stride).
     #[inline(always)]
     pub(super) fn first_word(self, index: u32) -> usize {
         (self.address + (index as usize).min(self.last) * self.stride) / 4

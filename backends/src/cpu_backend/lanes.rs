@@ -420,14 +420,16 @@ fn binary_rows(
         Members::Some(lanes, width) => {
             for r in 0..rows {
                 let (d, x, y) = ((dst + r) * width, (a + r) * width, (b + r) * width);
-                // Whole rows as slices of `width` words: one bound for the three reads
-                // and the write of a member, which the compiler tests once.
+                // Whole rows as slices of `width` words: the three reads and the write of
+                // a member share one bound, which the compiler tests once per member.
+                // Rows start at multiples of `width`, so two rows are the same row or
+                // apart: `Err` means rows that coincide (the destination an operand).
                 if let Ok([out, xs, ys]) = regs.get_disjoint_mut([d..d + width, x..x + width, y..y + width]) {
                     for &l in lanes {
                         out[l] = f(xs[l], ys[l]);
                     }
                 } else if x == y && d != x {
-                    let [out, xs] = regs.get_disjoint_mut([d..d + width, x..x + width]).expect("rows apart");
+                    let [out, xs] = regs.get_disjoint_mut([d..d + width, x..x + width]).expect("rows in the file");
                     for &l in lanes {
                         out[l] = f(xs[l], xs[l]);
                     }
@@ -481,6 +483,7 @@ fn unary_rows(members: Members<'_>, regs: &mut [u32], dst: usize, src: usize, ro
                         out[l] = f(xs[l]);
                     }
                 } else {
+                    // The same row (rows are the same or apart): word by word, as before.
                     for &l in lanes {
                         regs[d + l] = f(regs[x + l]);
                     }
@@ -544,6 +547,8 @@ fn select_rows(
                         out[l] = if cs[l] != 0 { xs[l] } else { ys[l] };
                     }
                 } else {
+                    // Rows that coincide (`select(x, x, c)`, the destination an operand):
+                    // word by word, as before.
                     for &l in lanes {
                         regs[d + l] = if regs[c + l] != 0 { regs[x + l] } else { regs[y + l] };
                     }
@@ -585,6 +590,7 @@ fn copy_rows(members: Members<'_>, regs: &mut [u32], dst: usize, src: usize, len
                         out[l] = xs[l];
                     }
                 } else {
+                    // The same row: word by word, as before.
                     for &l in lanes {
                         regs[d + l] = regs[x + l];
                     }

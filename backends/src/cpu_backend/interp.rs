@@ -419,10 +419,13 @@ pub(super) fn open_file(file: &mut Vec<u32>, template: &[u32], width: usize, ker
 }
 
 /// The group of invocations of the set `lanes` (a word per 64 lanes; `size` of them) of
-/// a batch `width` wide: all of them; in a batch a multiple of 64 wide, members filling a
-/// quarter or more of the chunks of 64 lanes they touch (by mask, those chunks computed
+/// a batch `width` wide: all of them; in a batch a multiple of 64 wide, members filling
+/// half or more of the chunks of 64 lanes they touch (by mask, those chunks computed
 /// whole: cheaper than member by member from there on, and a batch's divergent groups
-/// touch few chunks); or a few, listed in `members` (where they are not listed yet).
+/// touch few chunks); or fewer, listed in `members` (where they are not listed yet). Half
+/// since a listed member's words share one bound (`lanes.rs`): the path tracer 2 % faster
+/// than with a quarter, the histogram the same; an eighth 6 % slower, and only chunks
+/// every lane of which is a member 8 % slower (docs/benchmarks/interpreter.md).
 fn group_of<'a>(
     members: &'a mut Vec<usize>,
     size: usize,
@@ -436,7 +439,7 @@ fn group_of<'a>(
     }
     if width.is_multiple_of(LANES) && width <= 64 * LANES {
         let chunks = lanes.iter().enumerate().fold(0u64, |chunks, (c, &bits)| chunks | u64::from(bits != 0) << c);
-        if size * 4 >= chunks.count_ones() as usize * LANES {
+        if size * 2 >= chunks.count_ones() as usize * LANES {
             // Only the chunks with a member are read (`Members::Masked`): only they are
             // written, from their words of the set.
             mask.resize(width, 0);
